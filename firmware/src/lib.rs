@@ -1,0 +1,3 @@
+//! Firmware for the MorphoSys model: the assembler, the ray tracer's
+//! TinyRISC and context sources, and the scene compiler. Knows nothing of
+//! host-side rendering.

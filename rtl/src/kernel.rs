@@ -1,0 +1,125 @@
+//! The simulation kernel: two-phase clocking of register-transfer modules.
+//!
+//! Every module holds registered state `q`. Each cycle the kernel calls
+//! [`Clocked::eval`] on the top module, which computes every next state `d`
+//! from the current states and inputs only, and then [`Clocked::commit`],
+//! the clock edge, which makes `d` the new `q` everywhere at once. Nothing a
+//! module can see changes during `eval`, so the order in which a parent
+//! evaluates its children never matters.
+//!
+//! Tracing samples a cycle between the two phases: registers show the state
+//! during the cycle, combinational signals the values computed from it, and
+//! a register's new value appears in the next cycle, as in any RTL waveform.
+
+use std::fmt;
+use std::io;
+
+use crate::trace::{TraceConfig, Traced, Tracer};
+
+/// A fault inside the model: the simulation stops with this message.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Fault {
+    /// The block that detected it (`rc`, `array`, `tinyrisc`, `dma`...).
+    pub block: String,
+    pub message: String,
+}
+
+impl Fault {
+    pub fn new(block: impl Into<String>, message: impl Into<String>) -> Fault {
+        Fault {
+            block: block.into(),
+            message: message.into(),
+        }
+    }
+}
+
+impl fmt::Display for Fault {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.block, self.message)
+    }
+}
+
+impl std::error::Error for Fault {}
+
+/// A module with registered state.
+pub trait Clocked {
+    /// Compute the next state from the current state and the inputs. Must not
+    /// change any state another module (or a waveform) can observe.
+    fn eval(&mut self) -> Result<(), Fault>;
+    /// The clock edge: next state becomes current state.
+    fn commit(&mut self);
+}
+
+/// Why [`Sim::step`] stopped.
+#[derive(Debug)]
+pub enum StepError {
+    Fault { cycle: u64, fault: Fault },
+    Trace(io::Error),
+}
+
+impl fmt::Display for StepError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            StepError::Fault { cycle, fault } => write!(f, "cycle {cycle}: {fault}"),
+            StepError::Trace(e) => write!(f, "writing waveform: {e}"),
+        }
+    }
+}
+
+impl std::error::Error for StepError {}
+
+/// The kernel: a top module, a cycle counter and an optional tracer.
+pub struct Sim<T> {
+    pub top: T,
+    cycle: u64,
+    tracer: Option<Tracer>,
+}
+
+impl<T: Clocked + Traced> Sim<T> {
+    pub fn new(top: T) -> Sim<T> {
+        Sim {
+            top,
+            cycle: 0,
+            tracer: None,
+        }
+    }
+
+    /// Cycles completed so far.
+    pub fn cycle(&self) -> u64 {
+        self.cycle
+    }
+
+    /// Start writing a waveform of the top module, named `top_name`.
+    pub fn trace(&mut self, cfg: TraceConfig, top_name: &str) -> io::Result<()> {
+        self.tracer = Some(Tracer::create(cfg, top_name, &self.top)?);
+        Ok(())
+    }
+
+    /// One clock cycle.
+    #[inline]
+    pub fn step(&mut self) -> Result<(), StepError> {
+        if let Err(fault) = self.top.eval() {
+            if let Some(t) = &mut self.tracer {
+                t.note(&format!("stopped by a fault at cycle {}: {fault}", self.cycle));
+            }
+            return Err(StepError::Fault {
+                cycle: self.cycle,
+                fault,
+            });
+        }
+        if let Some(t) = &mut self.tracer {
+            t.sample(self.cycle, &self.top).map_err(StepError::Trace)?;
+        }
+        self.top.commit();
+        self.cycle += 1;
+        Ok(())
+    }
+
+    /// Close the waveform, if any; returns the files written.
+    pub fn finish_trace(&mut self) -> io::Result<Vec<std::path::PathBuf>> {
+        match self.tracer.take() {
+            Some(t) => t.finish(),
+            None => Ok(Vec::new()),
+        }
+    }
+}

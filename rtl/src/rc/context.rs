@@ -1,0 +1,532 @@
+//! The RC context word: 32 bits broadcast to the RCs each cycle.
+//!
+//! Layout (bit 31 on the left), documented with the operation set in
+//! `docs/isa.md`:
+//!
+//! ```text
+//!  31    26 25 24 23 22   19 18  16 15  12 11 10           0
+//! +--------+-----+--+-------+------+------+--+--------------+
+//! |   op   |guard|we|  rd   | asrc |  ra  |bs|      f       |
+//! +--------+-----+--+-------+------+------+--+--------------+
+//! ```
+//!
+//! * `op`    operation (see [`Op`]).
+//! * `guard` 0 always, 1 only where the flag F is set, 2 only where F is clear.
+//! * `we`    write the result to register `rd` (the output register is always
+//!           written by an operation that has a result).
+//! * `rd`    destination register; for `CMP` the condition ([`Cond`]).
+//! * `asrc`  source of operand A ([`ASrc`]); `ra` is the register or, for the
+//!           interconnect sources, the direction / lane index.
+//! * `bs`    0: operand B is register `f[3:0]`, `f[8:4]` is the multiplier
+//!           shift and `f[9]` selects truncation instead of rounding;
+//!           1: operand B is the 11-bit signed immediate `f`.
+//!
+//! A context word is decoded once ([`Context::decode`]) into a [`Context`];
+//! the array executes the decoded form, so 64 RCs never decode 64 times.
+
+use std::fmt;
+
+/// Operations of the RC datapath. The numeric value is the `op` field.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(u8)]
+pub enum Op {
+    Nop = 0x00,
+    // ALU
+    Add = 0x01,
+    Adc = 0x02,
+    Sub = 0x03,
+    Sbc = 0x04,
+    Rsb = 0x05,
+    Adds = 0x06,
+    Subs = 0x07,
+    And = 0x08,
+    Or = 0x09,
+    Xor = 0x0A,
+    Not = 0x0B,
+    Mov = 0x0C,
+    Movb = 0x0D,
+    Min = 0x0E,
+    Max = 0x0F,
+    Abs = 0x10,
+    Absd = 0x11,
+    Neg = 0x12,
+    Cmp = 0x13,
+    Sel = 0x14,
+    Clz = 0x15,
+    // Shifter
+    Sll = 0x18,
+    Srl = 0x19,
+    Sra = 0x1A,
+    Asl = 0x1B,
+    // Multiplier
+    Mul = 0x20,
+    Mac = 0x21,
+    Msu = 0x22,
+    Acc = 0x23,
+    Acch = 0x24,
+    Accl = 0x25,
+    Ldacc = 0x26,
+    // RAM
+    Ld = 0x28,
+    St = 0x29,
+    // Power
+    Sleep = 0x30,
+    Wake = 0x31,
+}
+
+/// Every operation, in opcode order; the disassembler and docs tests walk it.
+pub const ALL_OPS: &[Op] = &[
+    Op::Nop,
+    Op::Add,
+    Op::Adc,
+    Op::Sub,
+    Op::Sbc,
+    Op::Rsb,
+    Op::Adds,
+    Op::Subs,
+    Op::And,
+    Op::Or,
+    Op::Xor,
+    Op::Not,
+    Op::Mov,
+    Op::Movb,
+    Op::Min,
+    Op::Max,
+    Op::Abs,
+    Op::Absd,
+    Op::Neg,
+    Op::Cmp,
+    Op::Sel,
+    Op::Clz,
+    Op::Sll,
+    Op::Srl,
+    Op::Sra,
+    Op::Asl,
+    Op::Mul,
+    Op::Mac,
+    Op::Msu,
+    Op::Acc,
+    Op::Acch,
+    Op::Accl,
+    Op::Ldacc,
+    Op::Ld,
+    Op::St,
+    Op::Sleep,
+    Op::Wake,
+];
+
+impl Op {
+    pub fn from_bits(v: u8) -> Option<Op> {
+        ALL_OPS.iter().copied().find(|o| *o as u8 == v)
+    }
+
+    pub fn mnemonic(self) -> &'static str {
+        use Op::*;
+        match self {
+            Nop => "nop",
+            Add => "add",
+            Adc => "adc",
+            Sub => "sub",
+            Sbc => "sbc",
+            Rsb => "rsb",
+            Adds => "adds",
+            Subs => "subs",
+            And => "and",
+            Or => "or",
+            Xor => "xor",
+            Not => "not",
+            Mov => "mov",
+            Movb => "movb",
+            Min => "min",
+            Max => "max",
+            Abs => "abs",
+            Absd => "absd",
+            Neg => "neg",
+            Cmp => "cmp",
+            Sel => "sel",
+            Clz => "clz",
+            Sll => "sll",
+            Srl => "srl",
+            Sra => "sra",
+            Asl => "asl",
+            Mul => "mul",
+            Mac => "mac",
+            Msu => "msu",
+            Acc => "acc",
+            Acch => "acch",
+            Accl => "accl",
+            Ldacc => "ldacc",
+            Ld => "ld",
+            St => "st",
+            Sleep => "sleep",
+            Wake => "wake",
+        }
+    }
+
+    /// Does the operation produce a 16-bit result (written to `out`, and to
+    /// `rd` when `we` is set)?
+    pub fn has_result(self) -> bool {
+        !matches!(
+            self,
+            Op::Nop | Op::Cmp | Op::St | Op::Sleep | Op::Wake | Op::Ldacc
+        )
+    }
+
+    /// Operations that use the multiplier's shift field.
+    pub fn uses_shift(self) -> bool {
+        matches!(self, Op::Mul | Op::Mac | Op::Msu | Op::Acc | Op::Ldacc)
+    }
+}
+
+/// Guard: which RCs execute the context.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Guard {
+    Always = 0,
+    IfF = 1,
+    IfNotF = 2,
+}
+
+/// Source of operand A.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ASrc {
+    /// Register `ra` of the RC's own register file.
+    Reg = 0,
+    /// The RC's own output register.
+    Out = 1,
+    /// Output register of a neighbour; `ra[1:0]`: 0 north, 1 south, 2 west, 3 east.
+    Nbr = 2,
+    /// Horizontal short lane: the RC in the same row and quadrant at quadrant
+    /// column `ra[1:0]`.
+    QRow = 3,
+    /// Vertical short lane: same column and quadrant, quadrant row `ra[1:0]`.
+    QCol = 4,
+    /// Horizontal express lane: the RC of the same row at column `ra[2:0]`.
+    XRow = 5,
+    /// Vertical express lane: the RC of the same column at row `ra[2:0]`.
+    XCol = 6,
+    /// Frame-buffer broadcast datum of set `ra[0]`.
+    Fb = 7,
+}
+
+impl ASrc {
+    fn from_bits(v: u32) -> ASrc {
+        match v & 7 {
+            0 => ASrc::Reg,
+            1 => ASrc::Out,
+            2 => ASrc::Nbr,
+            3 => ASrc::QRow,
+            4 => ASrc::QCol,
+            5 => ASrc::XRow,
+            6 => ASrc::XCol,
+            _ => ASrc::Fb,
+        }
+    }
+}
+
+/// Source of operand B.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum BSrc {
+    Reg(u8),
+    Imm(i16),
+}
+
+/// Conditions of `CMP` (in the `rd` field). Signed unless marked `u`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Cond {
+    Eq = 0,
+    Ne = 1,
+    Lt = 2,
+    Ge = 3,
+    Le = 4,
+    Gt = 5,
+    Ltu = 6,
+    Geu = 7,
+    Leu = 8,
+    Gtu = 9,
+    /// Carry/borrow flag set.
+    Cs = 10,
+    /// Overflow flag set.
+    Vs = 11,
+    True = 12,
+    False = 13,
+    /// `A & B != 0`.
+    Bit = 14,
+    /// `A & B == 0`.
+    Nbit = 15,
+}
+
+pub const ALL_CONDS: [Cond; 16] = [
+    Cond::Eq,
+    Cond::Ne,
+    Cond::Lt,
+    Cond::Ge,
+    Cond::Le,
+    Cond::Gt,
+    Cond::Ltu,
+    Cond::Geu,
+    Cond::Leu,
+    Cond::Gtu,
+    Cond::Cs,
+    Cond::Vs,
+    Cond::True,
+    Cond::False,
+    Cond::Bit,
+    Cond::Nbit,
+];
+
+impl Cond {
+    pub fn from_bits(v: u8) -> Cond {
+        ALL_CONDS[(v & 15) as usize]
+    }
+    pub fn mnemonic(self) -> &'static str {
+        use Cond::*;
+        match self {
+            Eq => "eq",
+            Ne => "ne",
+            Lt => "lt",
+            Ge => "ge",
+            Le => "le",
+            Gt => "gt",
+            Ltu => "ltu",
+            Geu => "geu",
+            Leu => "leu",
+            Gtu => "gtu",
+            Cs => "cs",
+            Vs => "vs",
+            True => "true",
+            False => "false",
+            Bit => "bit",
+            Nbit => "nbit",
+        }
+    }
+}
+
+/// A decoded context word.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Context {
+    pub op: Op,
+    pub guard: Guard,
+    pub we: bool,
+    pub rd: u8,
+    pub asrc: ASrc,
+    pub ra: u8,
+    pub b: BSrc,
+    /// Multiplier shift amount, 0..=31 (register form only; 0 with an immediate).
+    pub shift: u8,
+    /// Multiplier result truncated (floor) instead of rounded to nearest.
+    pub trunc: bool,
+}
+
+/// Why a context word does not decode.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum DecodeError {
+    IllegalOp(u8),
+    IllegalGuard,
+    /// Spare bits of the register form are not zero.
+    ReservedBits,
+}
+
+impl fmt::Display for DecodeError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DecodeError::IllegalOp(o) => write!(f, "illegal RC opcode 0x{o:02x}"),
+            DecodeError::IllegalGuard => write!(f, "illegal guard field 3"),
+            DecodeError::ReservedBits => write!(f, "reserved context bits 10 set"),
+        }
+    }
+}
+
+impl std::error::Error for DecodeError {}
+
+impl Context {
+    pub const NOP: Context = Context {
+        op: Op::Nop,
+        guard: Guard::Always,
+        we: false,
+        rd: 0,
+        asrc: ASrc::Reg,
+        ra: 0,
+        b: BSrc::Reg(0),
+        shift: 0,
+        trunc: false,
+    };
+
+    /// A context with operand A from register `ra`, B from register `rb`,
+    /// result to `rd`.
+    pub fn rrr(op: Op, rd: u8, ra: u8, rb: u8) -> Context {
+        Context {
+            op,
+            we: op.has_result(),
+            rd,
+            ra,
+            b: BSrc::Reg(rb),
+            ..Context::NOP
+        }
+    }
+
+    /// Operand A from register `ra`, B the immediate `imm` (-1024..=1023).
+    pub fn rri(op: Op, rd: u8, ra: u8, imm: i16) -> Context {
+        Context {
+            op,
+            we: op.has_result(),
+            rd,
+            ra,
+            b: BSrc::Imm(imm),
+            ..Context::NOP
+        }
+    }
+
+    pub fn decode(w: u32) -> Result<Context, DecodeError> {
+        let opb = (w >> 26) as u8;
+        let op = Op::from_bits(opb).ok_or(DecodeError::IllegalOp(opb))?;
+        let guard = match (w >> 24) & 3 {
+            0 => Guard::Always,
+            1 => Guard::IfF,
+            2 => Guard::IfNotF,
+            _ => return Err(DecodeError::IllegalGuard),
+        };
+        let f = w & 0x7FF;
+        let (b, shift, trunc) = if w & (1 << 11) != 0 {
+            // sign-extend 11 bits
+            (BSrc::Imm(((f << 5) as i16) >> 5), 0, false)
+        } else {
+            if f & (1 << 10) != 0 {
+                return Err(DecodeError::ReservedBits);
+            }
+            (
+                BSrc::Reg((f & 15) as u8),
+                ((f >> 4) & 31) as u8,
+                f & (1 << 9) != 0,
+            )
+        };
+        Ok(Context {
+            op,
+            guard,
+            we: w & (1 << 23) != 0,
+            rd: ((w >> 19) & 15) as u8,
+            asrc: ASrc::from_bits(w >> 16),
+            ra: ((w >> 12) & 15) as u8,
+            b,
+            shift,
+            trunc,
+        })
+    }
+
+    /// Encode; panics only on a field out of range, which is a bug in the caller
+    /// (the assembler range-checks user input before building a `Context`).
+    pub fn encode(&self) -> u32 {
+        assert!(self.rd < 16 && self.ra < 16 && self.shift < 32);
+        let f = match self.b {
+            BSrc::Reg(rb) => {
+                assert!(rb < 16);
+                rb as u32
+                    | (self.shift as u32) << 4
+                    | (self.trunc as u32) << 9
+            }
+            BSrc::Imm(i) => {
+                assert!((-1024..=1023).contains(&i), "immediate {i} out of range");
+                (1 << 11) | (i as u32 & 0x7FF)
+            }
+        };
+        (self.op as u32) << 26
+            | (self.guard as u32) << 24
+            | (self.we as u32) << 23
+            | (self.rd as u32) << 19
+            | (self.asrc as u32) << 16
+            | (self.ra as u32) << 12
+            | f
+    }
+
+    /// Condition of a `CMP`.
+    pub fn cond(&self) -> Cond {
+        Cond::from_bits(self.rd)
+    }
+}
+
+impl fmt::Display for Context {
+    /// The disassembly; the assembler of the firmware crate reads it back.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.guard {
+            Guard::Always => {}
+            Guard::IfF => write!(f, "(f) ")?,
+            Guard::IfNotF => write!(f, "(!f) ")?,
+        }
+        write!(f, "{}", self.op.mnemonic())?;
+        if self.op == Op::Cmp {
+            write!(f, ".{}", self.cond().mnemonic())?;
+        }
+        if self.op.uses_shift() && self.trunc {
+            write!(f, ".t")?;
+        }
+        let a = match self.asrc {
+            ASrc::Reg => format!("r{}", self.ra),
+            ASrc::Out => "out".to_string(),
+            ASrc::Nbr => ["n", "s", "w", "e"][(self.ra & 3) as usize].to_string(),
+            ASrc::QRow => format!("qrow{}", self.ra & 3),
+            ASrc::QCol => format!("qcol{}", self.ra & 3),
+            ASrc::XRow => format!("xrow{}", self.ra & 7),
+            ASrc::XCol => format!("xcol{}", self.ra & 7),
+            ASrc::Fb => format!("fb{}", self.ra & 1),
+        };
+        let b = match self.b {
+            BSrc::Reg(r) => format!("r{r}"),
+            BSrc::Imm(i) => format!("#{i}"),
+        };
+        let d = if self.we {
+            format!("r{}", self.rd)
+        } else {
+            "out".to_string()
+        };
+        let sh = if self.op.uses_shift() && self.shift != 0 {
+            format!(", >>{}", self.shift)
+        } else {
+            String::new()
+        };
+        use Op::*;
+        match self.op {
+            Nop | Sleep | Wake => Ok(()),
+            Cmp => write!(f, " {a}, {b}"),
+            St => write!(f, " {a}, [{b}]"),
+            Ld => write!(f, " {d}, [{a} + {b}]"),
+            Not | Mov | Abs | Neg | Clz => write!(f, " {d}, {a}"),
+            Movb => write!(f, " {d}, {b}"),
+            Acc | Acch | Accl => write!(f, " {d}{sh}"),
+            Ldacc => write!(f, " {a}{sh}"),
+            _ => write!(f, " {d}, {a}, {b}{sh}"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_op_round_trips_through_its_encoding() {
+        for &op in ALL_OPS {
+            for (asrc, ra) in [(ASrc::Reg, 3), (ASrc::Nbr, 2), (ASrc::Fb, 1)] {
+                for b in [BSrc::Reg(7), BSrc::Imm(-1024), BSrc::Imm(1023)] {
+                    let c = Context {
+                        op,
+                        guard: Guard::IfNotF,
+                        we: true,
+                        rd: 9,
+                        asrc,
+                        ra,
+                        b,
+                        shift: if matches!(b, BSrc::Reg(_)) { 12 } else { 0 },
+                        trunc: matches!(b, BSrc::Reg(_)),
+                    };
+                    assert_eq!(Context::decode(c.encode()), Ok(c), "{op:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn illegal_words_are_refused() {
+        assert_eq!(Context::decode(0x3F << 26), Err(DecodeError::IllegalOp(0x3F)));
+        assert_eq!(Context::decode(3 << 24), Err(DecodeError::IllegalGuard));
+        assert_eq!(Context::decode(1 << 10), Err(DecodeError::ReservedBits));
+    }
+}

@@ -1,0 +1,470 @@
+//! The Reconfigurable Cell, held lane-wise for `N` RCs at once.
+//!
+//! `RcArray<64>` is the datapath of the whole 8x8 array; `RcArray<1>` is a
+//! single RC for testbenches. Each cycle one decoded [`Context`] drives every
+//! lane: the operation is matched once, and the lanes are a loop inside it.
+//!
+//! Units, one file each: [`alu`], [`shifter`], [`multiplier`] (with the
+//! accumulator), [`register_file`], [`ram`], [`flags`], plus the output
+//! register `out` that the interconnect and the frame-buffer write path read.
+
+pub mod alu;
+pub mod context;
+pub mod flags;
+pub mod lanes;
+pub mod multiplier;
+pub mod ram;
+pub mod register_file;
+pub mod shifter;
+
+use std::fmt;
+
+use crate::kernel::{Clocked, Fault};
+use crate::trace::{Display, Filter, Probe, Traced};
+use context::{ASrc, BSrc, Context, Guard, Op};
+use flags::Flags;
+use lanes::{full, select, Mask};
+use ram::Ram;
+use register_file::RegisterFile;
+
+/// How lanes are named in waveforms.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LaneNames {
+    /// One RC, scope `rc`.
+    Single,
+    /// Row-major 8-wide grid: `rc_r{row}_c{col}`.
+    Grid,
+}
+
+/// Which pending updates the clock edge applies.
+#[derive(Clone, Copy, Default)]
+struct Pending {
+    result: bool,
+    cv: bool,
+    f: bool,
+    acc: bool,
+    store: bool,
+}
+
+pub struct RcArray<const N: usize> {
+    // ---- registered state (q) ----
+    pub regs: RegisterFile<N>,
+    pub ram: Ram<N>,
+    pub acc: [i32; N],
+    pub out: [i16; N],
+    pub flags: Flags,
+    // ---- inputs for this cycle ----
+    ctx: Context,
+    ctx_word: u32,
+    /// Operand A for the interconnect and frame-buffer sources, driven by
+    /// the array around the RCs.
+    pub ext: [i16; N],
+    // ---- next state (d), computed by eval ----
+    en: Mask,
+    res: [i16; N],
+    acc_d: [i32; N],
+    addr: [u16; N],
+    d_c: Mask,
+    d_v: Mask,
+    d_f: Mask,
+    pend: Pending,
+    names: LaneNames,
+    /// Executing-RC count summed over cycles (for the active-RC fraction).
+    pub active_lane_cycles: u64,
+}
+
+fn op_text(v: u64) -> Option<String> {
+    Op::from_bits(v as u8).map(|o| o.mnemonic().to_string())
+}
+
+fn ctx_text(v: u64) -> Option<String> {
+    Context::decode(v as u32).ok().map(|c| c.to_string())
+}
+
+/// Translate filter: opcode field to mnemonic.
+pub static OP_FILTER: Filter = Filter {
+    name: "rc_op",
+    text: op_text,
+};
+/// Translate filter: context word to its disassembly.
+pub static CTX_FILTER: Filter = Filter {
+    name: "rc_ctx",
+    text: ctx_text,
+};
+
+impl<const N: usize> RcArray<N> {
+    pub const FULL: Mask = full(N);
+
+    pub fn new(names: LaneNames) -> Self {
+        assert!(N >= 1 && N <= 64, "1 to 64 lanes");
+        RcArray {
+            regs: RegisterFile::default(),
+            ram: Ram::default(),
+            acc: [0; N],
+            out: [0; N],
+            flags: Flags::default(),
+            ctx: Context::NOP,
+            ctx_word: Context::NOP.encode(),
+            ext: [0; N],
+            en: 0,
+            res: [0; N],
+            acc_d: [0; N],
+            addr: [0; N],
+            d_c: 0,
+            d_v: 0,
+            d_f: 0,
+            pend: Pending::default(),
+            names,
+            active_lane_cycles: 0,
+        }
+    }
+
+    /// Drive this cycle's context (decoded once by the caller).
+    #[inline]
+    pub fn set_context(&mut self, word: u32, ctx: Context) {
+        self.ctx_word = word;
+        self.ctx = ctx;
+    }
+
+    pub fn context(&self) -> &Context {
+        &self.ctx
+    }
+
+    /// Lanes that execute the current context: awake and passing the guard
+    /// (`WAKE` also reaches sleeping lanes).
+    #[inline(always)]
+    pub fn enabled(&self) -> Mask {
+        let g = match self.ctx.guard {
+            Guard::Always => Self::FULL,
+            Guard::IfF => self.flags.f,
+            Guard::IfNotF => !self.flags.f & Self::FULL,
+        };
+        if self.ctx.op == Op::Wake {
+            g
+        } else {
+            g & !self.flags.sleep & Self::FULL
+        }
+    }
+
+    /// Lanes that executed in the cycle just evaluated.
+    pub fn executed(&self) -> Mask {
+        self.en
+    }
+
+    /// Operand A of lane `i` (for waveforms and testbenches).
+    pub fn operand_a(&self, i: usize) -> i16 {
+        match self.ctx.asrc {
+            ASrc::Reg => self.regs.read(self.ctx.ra)[i],
+            ASrc::Out => self.out[i],
+            _ => self.ext[i],
+        }
+    }
+
+    /// Operand B of lane `i`.
+    pub fn operand_b(&self, i: usize) -> i16 {
+        match self.ctx.b {
+            BSrc::Reg(r) => self.regs.read(r)[i],
+            BSrc::Imm(v) => v,
+        }
+    }
+
+    fn lane_fault(&self, lane: usize, msg: String) -> Fault {
+        let who = match self.names {
+            LaneNames::Single => "rc".to_string(),
+            LaneNames::Grid => format!("rc_r{}_c{}", lane / 8, lane % 8),
+        };
+        Fault::new(who, format!("{msg} (context `{}`)", self.ctx))
+    }
+}
+
+/// Apply a unary or binary lane function to every lane.
+macro_rules! map {
+    ($res:expr, |$i:ident| $e:expr) => {
+        for $i in 0..N {
+            $res[$i] = $e;
+        }
+    };
+}
+
+/// Run a flag-producing ALU function over every lane.
+#[inline(always)]
+fn cv<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> alu::Flagged) -> (Mask, Mask) {
+    let (mut mc, mut mv) = (0u64, 0u64);
+    for i in 0..N {
+        let r = f(i);
+        res[i] = r.value;
+        mc |= (r.c as u64) << i;
+        mv |= (r.v as u64) << i;
+    }
+    (mc, mv)
+}
+
+/// Run a saturating function over every lane; returns the saturation mask.
+#[inline(always)]
+fn sat<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> (i16, bool)) -> Mask {
+    let mut mv = 0u64;
+    for i in 0..N {
+        let (r, v) = f(i);
+        res[i] = r;
+        mv |= (v as u64) << i;
+    }
+    mv
+}
+
+impl<const N: usize> Clocked for RcArray<N> {
+    fn eval(&mut self) -> Result<(), Fault> {
+        let c = self.ctx;
+        let en = self.enabled();
+        self.en = en;
+        self.pend = Pending {
+            result: c.op.has_result(),
+            ..Pending::default()
+        };
+        if en == 0 {
+            self.pend = Pending::default();
+            return Ok(());
+        }
+        self.active_lane_cycles += en.count_ones() as u64;
+        let imm;
+        let a: &[i16; N] = match c.asrc {
+            ASrc::Reg => &self.regs.r[c.ra as usize],
+            ASrc::Out => &self.out,
+            _ => &self.ext,
+        };
+        let b: &[i16; N] = match c.b {
+            BSrc::Reg(r) => &self.regs.r[r as usize],
+            BSrc::Imm(v) => {
+                imm = [v; N];
+                &imm
+            }
+        };
+        let res = &mut self.res;
+        let (sh, trunc) = (c.shift as u32, c.trunc);
+        let cin = self.flags.c;
+        match c.op {
+            Op::Nop | Op::Sleep | Op::Wake => {}
+            Op::Add => {
+                (self.d_c, self.d_v) = cv(res, |i| alu::add(a[i], b[i], false));
+                self.pend.cv = true;
+            }
+            Op::Adc => {
+                (self.d_c, self.d_v) = cv(res, |i| alu::add(a[i], b[i], cin >> i & 1 != 0));
+                self.pend.cv = true;
+            }
+            Op::Sub => {
+                (self.d_c, self.d_v) = cv(res, |i| alu::sub(a[i], b[i], false));
+                self.pend.cv = true;
+            }
+            Op::Sbc => {
+                (self.d_c, self.d_v) = cv(res, |i| alu::sub(a[i], b[i], cin >> i & 1 != 0));
+                self.pend.cv = true;
+            }
+            Op::Rsb => {
+                (self.d_c, self.d_v) = cv(res, |i| alu::sub(b[i], a[i], false));
+                self.pend.cv = true;
+            }
+            Op::Neg => {
+                (self.d_c, self.d_v) = cv(res, |i| alu::sub(0, a[i], false));
+                self.pend.cv = true;
+            }
+            Op::Adds => {
+                self.d_v = sat(res, |i| alu::adds(a[i], b[i]));
+                (self.d_c, self.pend.cv) = (0, true);
+            }
+            Op::Subs => {
+                self.d_v = sat(res, |i| alu::subs(a[i], b[i]));
+                (self.d_c, self.pend.cv) = (0, true);
+            }
+            Op::Abs => {
+                self.d_v = sat(res, |i| alu::abs(a[i]));
+                (self.d_c, self.pend.cv) = (0, true);
+            }
+            Op::Absd => {
+                self.d_v = sat(res, |i| alu::absd(a[i], b[i]));
+                (self.d_c, self.pend.cv) = (0, true);
+            }
+            Op::Asl => {
+                self.d_v = sat(res, |i| shifter::asl(a[i], shifter::amount(b[i])));
+                (self.d_c, self.pend.cv) = (0, true);
+            }
+            Op::And => map!(res, |i| a[i] & b[i]),
+            Op::Or => map!(res, |i| a[i] | b[i]),
+            Op::Xor => map!(res, |i| a[i] ^ b[i]),
+            Op::Not => map!(res, |i| !a[i]),
+            Op::Mov => *res = *a,
+            Op::Movb => *res = *b,
+            Op::Min => map!(res, |i| alu::min(a[i], b[i])),
+            Op::Max => map!(res, |i| alu::max(a[i], b[i])),
+            Op::Clz => map!(res, |i| alu::clz(a[i])),
+            Op::Sel => {
+                let f = self.flags.f;
+                map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
+            }
+            Op::Cmp => {
+                let (cf, vf, cond) = (self.flags.c, self.flags.v, c.cond());
+                self.d_f = lanes::pack::<N>(|i| {
+                    alu::cond(cond, a[i], b[i], cf >> i & 1 != 0, vf >> i & 1 != 0)
+                });
+                self.pend.f = true;
+            }
+            Op::Sll => map!(res, |i| shifter::sll(a[i], shifter::amount(b[i]))),
+            Op::Srl => map!(res, |i| shifter::srl(a[i], shifter::amount(b[i]))),
+            Op::Sra => map!(res, |i| shifter::sra(a[i], shifter::amount(b[i]))),
+            Op::Mul | Op::Mac | Op::Msu => {
+                let acc = &self.acc;
+                let acc_d = &mut self.acc_d;
+                let mut mv = 0u64;
+                for i in 0..N {
+                    let p = multiplier::product(a[i], b[i]);
+                    let (nacc, s1) = match c.op {
+                        Op::Mul => (p, false),
+                        Op::Mac => multiplier::accumulate(acc[i], p, false),
+                        _ => multiplier::accumulate(acc[i], p, true),
+                    };
+                    let (r, s2) = multiplier::scale(nacc, sh, trunc);
+                    acc_d[i] = nacc;
+                    res[i] = r;
+                    mv |= ((s1 | s2) as u64) << i;
+                }
+                (self.d_v, self.d_c) = (mv, 0);
+                self.pend.cv = true;
+                self.pend.acc = true;
+            }
+            Op::Acc => {
+                let acc = &self.acc;
+                self.d_v = sat(res, |i| multiplier::scale(acc[i], sh, trunc));
+                (self.d_c, self.pend.cv) = (0, true);
+            }
+            Op::Acch => map!(res, |i| (self.acc[i] >> 16) as i16),
+            Op::Accl => map!(res, |i| self.acc[i] as i16),
+            Op::Ldacc => {
+                let acc_d = &mut self.acc_d;
+                for i in 0..N {
+                    acc_d[i] = ((a[i] as i64) << sh).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                }
+                self.pend.acc = true;
+            }
+            Op::Ld | Op::St => {
+                let store = c.op == Op::St;
+                for i in 0..N {
+                    let addr = if store {
+                        b[i] as i32
+                    } else {
+                        a[i] as i32 + b[i] as i32
+                    };
+                    if en >> i & 1 != 0 && !Ram::<N>::valid(addr) {
+                        let msg = format!("RAM address {addr} outside 0..=511");
+                        return Err(self.lane_fault(i, msg));
+                    }
+                    let addr = addr.clamp(0, 511) as u16;
+                    self.addr[i] = addr;
+                    if !store {
+                        res[i] = self.ram.read(i, addr as usize);
+                    }
+                }
+                self.pend.store = store;
+            }
+        }
+        Ok(())
+    }
+
+    fn commit(&mut self) {
+        let en = self.en;
+        if en == 0 {
+            return;
+        }
+        let c = self.ctx;
+        let p = self.pend;
+        if p.result {
+            select(&mut self.out, en, &self.res);
+            if c.we {
+                self.regs.write(c.rd, en, &self.res);
+            }
+        }
+        if p.cv {
+            self.flags.c = Flags::merge(self.flags.c, en, self.d_c);
+            self.flags.v = Flags::merge(self.flags.v, en, self.d_v);
+        }
+        if p.f {
+            self.flags.f = Flags::merge(self.flags.f, en, self.d_f);
+        }
+        if p.acc {
+            select(&mut self.acc, en, &self.acc_d);
+        }
+        if p.store {
+            let a: [i16; N] = std::array::from_fn(|i| self.operand_a(i));
+            for (i, v) in a.iter().enumerate() {
+                if en >> i & 1 != 0 {
+                    self.ram.write(i, self.addr[i] as usize, *v);
+                }
+            }
+        }
+        match c.op {
+            Op::Sleep => self.flags.sleep |= en,
+            Op::Wake => self.flags.sleep &= !en,
+            _ => {}
+        }
+    }
+}
+
+const REG_NAMES: [&str; 16] = [
+    "r0", "r1", "r2", "r3", "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "r12", "r13",
+    "r14", "r15",
+];
+
+impl<const N: usize> Traced for RcArray<N> {
+    fn trace(&self, p: &mut dyn Probe) {
+        let c = &self.ctx;
+        p.signal("ctx", 32, Display::Translate(&CTX_FILTER), self.ctx_word as u64);
+        p.signal("op", 6, Display::Translate(&OP_FILTER), c.op as u64);
+        let en = self.enabled();
+        for i in 0..N {
+            let open = match self.names {
+                LaneNames::Single => p.scope(format_args!("rc")),
+                LaneNames::Grid => p.scope(format_args!("rc_r{}_c{}", i / 8, i % 8)),
+            };
+            if !open {
+                continue;
+            }
+            let bit = |m: Mask| (m >> i & 1) as u64;
+            p.signal("out", 16, Display::Signed, self.out[i] as u16 as u64);
+            if p.scope(format_args!("alu")) {
+                p.signal("a", 16, Display::Signed, self.operand_a(i) as u16 as u64);
+                p.signal("b", 16, Display::Signed, self.operand_b(i) as u16 as u64);
+                p.signal("result", 16, Display::Signed, self.res[i] as u16 as u64);
+                p.signal("en", 1, Display::Bin, bit(en));
+                p.end();
+            }
+            if p.scope(format_args!("mul")) {
+                p.signal("acc", 32, Display::Signed, self.acc[i] as u32 as u64);
+                p.end();
+            }
+            if p.scope(format_args!("flags")) {
+                p.signal("f", 1, Display::Bin, bit(self.flags.f));
+                p.signal("c", 1, Display::Bin, bit(self.flags.c));
+                p.signal("v", 1, Display::Bin, bit(self.flags.v));
+                p.signal("sleep", 1, Display::Bin, bit(self.flags.sleep));
+                p.end();
+            }
+            if p.scope(format_args!("regfile")) {
+                for (k, name) in REG_NAMES.iter().enumerate() {
+                    p.signal(name, 16, Display::Signed, self.regs.r[k][i] as u16 as u64);
+                }
+                p.end();
+            }
+            if p.scope(format_args!("ram")) {
+                let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
+                p.signal("addr", 9, Display::Hex, if mem { self.addr[i] as u64 } else { 0 });
+                p.signal("we", 1, Display::Bin, (mem && c.op == Op::St) as u64);
+                p.end();
+            }
+            p.end();
+        }
+    }
+}
+
+impl<const N: usize> fmt::Debug for RcArray<N> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "RcArray<{N}> {{ ctx: {}, flags: {:?} }}", self.ctx, self.flags)
+    }
+}

@@ -1,0 +1,51 @@
+//! The RC's 16x16 multiplier with a 32-bit accumulator.
+//!
+//! * `MUL`: `acc = a * b` (the full 32-bit product; `(-32768)^2` fits).
+//! * `MAC` / `MSU`: `acc = acc ± a * b`, saturating at the 32-bit bounds.
+//! * Every multiplier operation also yields a 16-bit result
+//!   `sat16(acc >> sh)`, rounded to nearest (ties towards +inf: `+2^(sh-1)`
+//!   before the arithmetic shift) or truncated towards -inf, so with `sh = n`
+//!   two Qm.n operands give a Qm.n result in 16 bits.
+//!
+//! `V` is set when the accumulator or the 16-bit result saturated.
+
+/// The full product of two 16-bit values.
+#[inline(always)]
+pub fn product(a: i16, b: i16) -> i32 {
+    a as i32 * b as i32
+}
+
+/// `acc + p` (or `acc - p` when `sub`), saturating at the 32-bit bounds.
+#[inline(always)]
+pub fn accumulate(acc: i32, p: i32, sub: bool) -> (i32, bool) {
+    let wide = if sub {
+        acc as i64 - p as i64
+    } else {
+        acc as i64 + p as i64
+    };
+    if wide > i32::MAX as i64 {
+        (i32::MAX, true)
+    } else if wide < i32::MIN as i64 {
+        (i32::MIN, true)
+    } else {
+        (wide as i32, false)
+    }
+}
+
+/// Scale the accumulator to 16 bits: shift right by `sh` (0..=31), rounding
+/// to nearest unless `trunc`, then saturate.
+#[inline(always)]
+pub fn scale(acc: i32, sh: u32, trunc: bool) -> (i16, bool) {
+    let mut w = acc as i64;
+    if !trunc && sh > 0 {
+        w += 1i64 << (sh - 1);
+    }
+    w >>= sh;
+    if w > i16::MAX as i64 {
+        (i16::MAX, true)
+    } else if w < i16::MIN as i64 {
+        (i16::MIN, true)
+    } else {
+        (w as i16, false)
+    }
+}

@@ -1,0 +1,511 @@
+//! Waveform tracing: VCD through the `vcd` crate, plus a GTKWave save file
+//! and translate-filter files beside it.
+//!
+//! Modules describe their signals through one function, [`Traced::trace`],
+//! which both declares them (once, when a tracer is attached) and reports
+//! their values (each traced cycle). The tracer walks the same calls in the
+//! same order in both phases, so names and values cannot drift apart.
+//!
+//! * Only cycles inside the window (`first`, `count`) are sampled; outside
+//!   it, and with no tracer attached, the simulator pays nothing.
+//! * A scope filter (`--trace-scope`) keeps only the signals whose path
+//!   matches one of its patterns; a module skips a whole scope that nothing
+//!   under it can match.
+//! * A value is written only when it changed; the file is buffered.
+//! * Names are GTKWave- and Surfer-safe: letters, digits and `_`, scopes for
+//!   hierarchy, never `name[3]` indices (`rc_r3_c4`, `r12`).
+//!
+//! Time: one clock period of `clock_hz` (300 MHz by default) per cycle, in
+//! picoseconds; the rising edge of cycle `c` is at `c * 1e12 / clock_hz` ps
+//! (rounded down). A `clk` and a `cycle` signal sit at the top.
+
+use std::collections::BTreeSet;
+use std::fmt;
+use std::fs::File;
+use std::io::{self, BufWriter, Write};
+use std::path::{Path, PathBuf};
+
+use vcd::{IdCode, TimescaleUnit};
+
+/// How GTKWave should show a signal.
+#[derive(Clone, Copy)]
+pub enum Display {
+    Hex,
+    /// Signed decimal.
+    Signed,
+    Bin,
+    /// Through a translate filter: `text(value)` gives the mnemonic.
+    Translate(&'static Filter),
+}
+
+/// A translate filter: a name (the file is `<stem>.<name>.txt`) and the
+/// function that turns a value into text (`None`: leave it as hex).
+pub struct Filter {
+    pub name: &'static str,
+    pub text: fn(u64) -> Option<String>,
+}
+
+/// The visitor every traced module reports to.
+pub trait Probe {
+    /// Enter a scope. Returns `false` when nothing under it is traced; the
+    /// caller then skips its contents and does not call [`Probe::end`].
+    fn scope(&mut self, name: fmt::Arguments<'_>) -> bool;
+    fn end(&mut self);
+    /// A signal of `width` bits (1..=64) with its current value (only the
+    /// low `width` bits are used).
+    fn signal(&mut self, name: &str, width: u32, display: Display, value: u64);
+}
+
+/// A module that has signals.
+pub trait Traced {
+    fn trace(&self, p: &mut dyn Probe);
+}
+
+/// What to trace.
+#[derive(Clone, Debug)]
+pub struct TraceConfig {
+    pub path: PathBuf,
+    /// First cycle traced.
+    pub first: u64,
+    /// Number of cycles traced (`None`: to the end).
+    pub count: Option<u64>,
+    /// Comma-separated scope patterns (`*` and `?` globs per component);
+    /// empty: everything.
+    pub scope: String,
+    pub clock_hz: u64,
+}
+
+impl TraceConfig {
+    pub fn new(path: impl Into<PathBuf>) -> TraceConfig {
+        TraceConfig {
+            path: path.into(),
+            first: 0,
+            count: None,
+            scope: String::new(),
+            clock_hz: 300_000_000,
+        }
+    }
+}
+
+#[derive(Clone, Copy)]
+struct SigInfo {
+    id: IdCode,
+    width: u32,
+    display: Display,
+}
+
+struct Decl {
+    path: Vec<String>,
+    info: SigInfo,
+}
+
+enum Phase {
+    Declare,
+    Sample,
+}
+
+/// The VCD writer. Attach it to a [`crate::kernel::Sim`].
+pub struct Tracer {
+    cfg: TraceConfig,
+    top: String,
+    w: vcd::Writer<BufWriter<File>>,
+    phase: Phase,
+    patterns: Vec<Vec<String>>,
+    // declaration state
+    stack: Vec<String>,
+    decls: Vec<Decl>,
+    // per-call tables, indexed by call order
+    scope_on: Vec<bool>,
+    slot: Vec<Option<u32>>,
+    // sampling state
+    scope_i: usize,
+    slot_i: usize,
+    last: Vec<Option<u64>>,
+    seen: Vec<BTreeSet<u64>>,
+    clk: IdCode,
+    cycle_id: IdCode,
+    sampled: u64,
+    last_cycle: Option<u64>,
+    note: Option<String>,
+}
+
+fn glob(p: &str, s: &str) -> bool {
+    let (p, s) = (p.as_bytes(), s.as_bytes());
+    let (mut pi, mut si, mut star, mut mark) = (0, 0, None, 0);
+    while si < s.len() {
+        if pi < p.len() && (p[pi] == b'?' || p[pi] == s[si]) {
+            pi += 1;
+            si += 1;
+        } else if pi < p.len() && p[pi] == b'*' {
+            star = Some(pi);
+            mark = si;
+            pi += 1;
+        } else if let Some(st) = star {
+            pi = st + 1;
+            mark += 1;
+            si = mark;
+        } else {
+            return false;
+        }
+    }
+    while pi < p.len() && p[pi] == b'*' {
+        pi += 1;
+    }
+    pi == p.len()
+}
+
+/// Check a scope pattern list for the command line: components of letters,
+/// digits, `_`, `*`, `?`, separated by dots.
+pub fn check_scope_patterns(s: &str) -> Result<(), String> {
+    for pat in s.split(',').map(str::trim).filter(|p| !p.is_empty()) {
+        for comp in pat.split('.') {
+            if comp.is_empty()
+                || !comp
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '_' | '*' | '?'))
+            {
+                return Err(format!(
+                    "bad scope pattern `{pat}`: use dot-separated names with `*` and `?` globs, e.g. `rc.alu` or `array.rc_r*_c0`"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+impl Tracer {
+    /// Create the VCD file and declare the signals of `top` (named `top_name`).
+    pub fn create(cfg: TraceConfig, top_name: &str, top: &dyn Traced) -> io::Result<Tracer> {
+        check_scope_patterns(&cfg.scope)
+            .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, e))?;
+        if let Some(dir) = cfg.path.parent() {
+            if !dir.as_os_str().is_empty() {
+                std::fs::create_dir_all(dir)?;
+            }
+        }
+        let file = File::create(&cfg.path)?;
+        let mut w = vcd::Writer::new(BufWriter::with_capacity(1 << 16, file));
+        w.version(concat!("morphosys ", env!("CARGO_PKG_VERSION")))?;
+        w.timescale(1, TimescaleUnit::PS)?;
+        w.add_module(top_name)?;
+        let clk = w.add_wire(1, "clk")?;
+        let cycle_id = w.add_wire(64, "cycle")?;
+        let patterns = cfg
+            .scope
+            .split(',')
+            .map(str::trim)
+            .filter(|p| !p.is_empty())
+            .map(|p| {
+                let mut c: Vec<String> = p.split('.').map(String::from).collect();
+                if c.len() > 1 && c[0] == top_name {
+                    c.remove(0);
+                }
+                c
+            })
+            .collect();
+        let mut t = Tracer {
+            cfg,
+            top: top_name.to_string(),
+            w,
+            phase: Phase::Declare,
+            patterns,
+            stack: Vec::new(),
+            decls: Vec::new(),
+            scope_on: Vec::new(),
+            slot: Vec::new(),
+            scope_i: 0,
+            slot_i: 0,
+            last: Vec::new(),
+            seen: Vec::new(),
+            clk,
+            cycle_id,
+            sampled: 0,
+            last_cycle: None,
+            note: None,
+        };
+        top.trace(&mut t);
+        t.w.upscope()?;
+        t.w.enddefinitions()?;
+        t.last = vec![None; t.decls.len()];
+        t.seen = vec![BTreeSet::new(); t.decls.len()];
+        t.phase = Phase::Sample;
+        Ok(t)
+    }
+
+    /// Number of signals that passed the scope filter.
+    pub fn signal_count(&self) -> usize {
+        self.decls.len()
+    }
+
+    /// Is `cycle` inside the trace window?
+    #[inline]
+    pub fn in_window(&self, cycle: u64) -> bool {
+        cycle >= self.cfg.first && self.cfg.count.is_none_or(|n| cycle - self.cfg.first < n)
+    }
+
+    fn time(&self, cycle: u64) -> u64 {
+        ((cycle as u128 * 1_000_000_000_000u128) / self.cfg.clock_hz as u128) as u64
+    }
+
+    /// Record the values of `top` during `cycle`.
+    pub fn sample(&mut self, cycle: u64, top: &dyn Traced) -> io::Result<()> {
+        if !self.in_window(cycle) {
+            return Ok(());
+        }
+        let t = self.time(cycle);
+        let half = (self.time(cycle + 1) - t) / 2;
+        self.w.timestamp(t)?;
+        self.w.change_scalar(self.clk, vcd::Value::V1)?;
+        let wr = self.w.writer();
+        writeln!(wr, "b{:b} {}", cycle, self.cycle_id)?;
+        self.scope_i = 0;
+        self.slot_i = 0;
+        top.trace(self);
+        self.w.timestamp(t + half)?;
+        self.w.change_scalar(self.clk, vcd::Value::V0)?;
+        self.sampled += 1;
+        self.last_cycle = Some(cycle);
+        Ok(())
+    }
+
+    /// Leave a note in the waveform (for example why the run stopped).
+    pub fn note(&mut self, text: &str) {
+        self.note = Some(text.to_string());
+    }
+
+    /// Close the VCD and write `<stem>.gtkw` and the filter files beside it.
+    /// Returns the paths written.
+    pub fn finish(mut self) -> io::Result<Vec<PathBuf>> {
+        let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
+        let t = self.time(end);
+        self.w.timestamp(t)?;
+        if let Some(n) = &self.note {
+            self.w.comment(n)?;
+        }
+        self.w.flush()?;
+        let mut written = vec![self.cfg.path.clone()];
+        written.extend(self.write_gtkw()?);
+        Ok(written)
+    }
+
+    fn write_gtkw(&self) -> io::Result<Vec<PathBuf>> {
+        let vcd_abs = std::path::absolute(&self.cfg.path)?;
+        let stem = vcd_abs.with_extension("");
+        let gtkw = vcd_abs.with_extension("gtkw");
+        let mut out = Vec::new();
+        // Filter files: one per filter, with every value seen in the trace
+        // (plus the filter's whole table when it is small).
+        let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
+        for (i, d) in self.decls.iter().enumerate() {
+            if let Display::Translate(f) = d.info.display {
+                let path = PathBuf::from(format!("{}.{}.txt", stem.display(), f.name));
+                let idx = match filters.iter().position(|(n, _)| *n == f.name) {
+                    Some(k) => k,
+                    None => {
+                        filters.push((f.name, path.clone()));
+                        filters.len() - 1
+                    }
+                };
+                let _ = (i, idx);
+            }
+        }
+        for (name, path) in &filters {
+            let mut vals: BTreeSet<(u32, u64)> = BTreeSet::new();
+            let mut filter: Option<&Filter> = None;
+            for (i, d) in self.decls.iter().enumerate() {
+                if let Display::Translate(f) = d.info.display {
+                    if f.name == *name {
+                        filter = Some(f);
+                        for v in &self.seen[i] {
+                            vals.insert((d.info.width, *v));
+                        }
+                        if d.info.width <= 8 {
+                            for v in 0..(1u64 << d.info.width) {
+                                vals.insert((d.info.width, v));
+                            }
+                        }
+                    }
+                }
+            }
+            let f = filter.expect("filter has a declaration");
+            let mut s = String::new();
+            s.push_str(&format!(
+                "# GTKWave translate filter `{name}` written by morphosys\n"
+            ));
+            for (w, v) in vals {
+                if let Some(text) = (f.text)(v) {
+                    let digits = w.div_ceil(4) as usize;
+                    s.push_str(&format!("{v:0digits$X} {text}\n"));
+                }
+            }
+            std::fs::write(path, s)?;
+            out.push(path.clone());
+        }
+
+        let mut s = String::new();
+        s.push_str("[*]\n[*] GTKWave save file written by morphosys\n[*]\n");
+        s.push_str(&format!("[dumpfile] \"{}\"\n", vcd_abs.display()));
+        s.push_str(&format!("[savefile] \"{}\"\n", gtkw.display()));
+        s.push_str("[timestart] 0\n[size] 1400 900\n[pos] -1 -1\n");
+        s.push_str("[sst_width] 260\n[signals_width] 320\n[sst_expanded] 1\n[sst_vpaned_height] 240\n");
+        s.push_str(&format!("[treeopen] {}.\n", self.top));
+        s.push_str(&format!("@28\n{}.clk\n@24\n{}.cycle[63:0]\n", self.top, self.top));
+        // Group consecutive signals by their scope.
+        let groups: Vec<(String, Vec<usize>)> = {
+            let mut g: Vec<(String, Vec<usize>)> = Vec::new();
+            for (i, d) in self.decls.iter().enumerate() {
+                let scope = d.path[..d.path.len() - 1].join(".");
+                match g.last_mut() {
+                    Some((s, v)) if *s == scope => v.push(i),
+                    _ => g.push((scope, vec![i])),
+                }
+            }
+            g
+        };
+        let closed = groups.len() > 8;
+        for (scope, sigs) in &groups {
+            let label = if scope.is_empty() { self.top.clone() } else { scope.clone() };
+            let begin = 0x800200 | if closed { 0x400000 } else { 0 };
+            s.push_str(&format!("@{begin:x}\n-{label}\n"));
+            for &i in sigs {
+                let d = &self.decls[i];
+                let name = format!("{}.{}", self.top, d.path.join("."));
+                let name = if d.info.width > 1 {
+                    format!("{name}[{}:0]", d.info.width - 1)
+                } else {
+                    name
+                };
+                match d.info.display {
+                    Display::Hex => s.push_str(&format!("@22\n{name}\n")),
+                    Display::Signed => s.push_str(&format!("@424\n{name}\n")),
+                    Display::Bin => s.push_str(&format!("@28\n{name}\n")),
+                    Display::Translate(f) => {
+                        let k = filters.iter().position(|(n, _)| *n == f.name).unwrap();
+                        s.push_str(&format!(
+                            "^{} {}\n@2022\n{name}\n",
+                            k + 1,
+                            filters[k].1.display()
+                        ));
+                    }
+                }
+            }
+            s.push_str(&format!("@{:x}\n-{label}\n", 0x1000200));
+        }
+        std::fs::write(&gtkw, s)?;
+        out.insert(0, gtkw);
+        Ok(out)
+    }
+
+    /// Paths of the files [`Tracer::finish`] writes, before it writes them.
+    pub fn vcd_path(&self) -> &Path {
+        &self.cfg.path
+    }
+
+    pub fn cycles_sampled(&self) -> u64 {
+        self.sampled
+    }
+
+    fn matches_prefix(&self, path: &[String], complete: bool) -> bool {
+        if self.patterns.is_empty() {
+            return true;
+        }
+        self.patterns.iter().any(|pat| {
+            let n = pat.len().min(path.len());
+            let prefix_ok = (0..n).all(|i| glob(&pat[i], &path[i]));
+            // A signal matches when the pattern covers a prefix of its path;
+            // a scope may contain matches when the two agree so far.
+            prefix_ok && (!complete || pat.len() <= path.len())
+        })
+    }
+}
+
+impl Probe for Tracer {
+    fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
+        match self.phase {
+            Phase::Declare => {
+                self.stack.push(name.to_string());
+                let on = self.matches_prefix(&self.stack, false);
+                self.scope_on.push(on);
+                if on {
+                    // Errors surface when the file is flushed at finish().
+                    let _ = self.w.add_module(self.stack.last().unwrap());
+                } else {
+                    self.stack.pop();
+                }
+                on
+            }
+            Phase::Sample => {
+                let on = self.scope_on[self.scope_i];
+                self.scope_i += 1;
+                on
+            }
+        }
+    }
+
+    fn end(&mut self) {
+        if let Phase::Declare = self.phase {
+            self.stack.pop();
+            let _ = self.w.upscope();
+        }
+    }
+
+    fn signal(&mut self, name: &str, width: u32, display: Display, value: u64) {
+        match self.phase {
+            Phase::Declare => {
+                let mut path = self.stack.clone();
+                path.push(name.to_string());
+                if self.matches_prefix(&path, true) {
+                    let id = self.w.add_wire(width, name).expect("write VCD header");
+                    self.slot.push(Some(self.decls.len() as u32));
+                    self.decls.push(Decl {
+                        path,
+                        info: SigInfo { id, width, display },
+                    });
+                } else {
+                    self.slot.push(None);
+                }
+            }
+            Phase::Sample => {
+                let s = self.slot[self.slot_i];
+                self.slot_i += 1;
+                if let Some(i) = s {
+                    let i = i as usize;
+                    let info = self.decls[i].info;
+                    let v = if width >= 64 {
+                        value
+                    } else {
+                        value & ((1u64 << width) - 1)
+                    };
+                    if self.last[i] != Some(v) {
+                        self.last[i] = Some(v);
+                        if let Display::Translate(_) = info.display {
+                            self.seen[i].insert(v);
+                        }
+                        let wr = self.w.writer();
+                        let _ = if info.width == 1 {
+                            writeln!(wr, "{}{}", v, info.id)
+                        } else {
+                            writeln!(wr, "b{:b} {}", v, info.id)
+                        };
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::glob;
+
+    #[test]
+    fn glob_matches_like_a_shell() {
+        assert!(glob("rc_r*_c0", "rc_r3_c0"));
+        assert!(!glob("rc_r*_c0", "rc_r3_c1"));
+        assert!(glob("r?", "r3"));
+        assert!(!glob("r?", "r13"));
+        assert!(glob("*", "anything"));
+        assert!(glob("alu", "alu"));
+        assert!(!glob("alu", "alux"));
+    }
+}

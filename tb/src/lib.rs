@@ -1,0 +1,5 @@
+//! Testbenches, the float reference renderer, metrics, charts, and the
+//! pieces of the `morphosys` command.
+
+pub mod cli;
+pub mod testbench;
