@@ -347,9 +347,14 @@ impl Tracer {
         s.push_str(&format!("[dumpfile] \"{}\"\n", vcd_abs.display()));
         s.push_str(&format!("[savefile] \"{}\"\n", gtkw.display()));
         s.push_str("[timestart] 0\n[size] 1400 900\n[pos] -1 -1\n");
-        s.push_str("[sst_width] 260\n[signals_width] 320\n[sst_expanded] 1\n[sst_vpaned_height] 240\n");
+        s.push_str(
+            "[sst_width] 260\n[signals_width] 320\n[sst_expanded] 1\n[sst_vpaned_height] 240\n",
+        );
         s.push_str(&format!("[treeopen] {}.\n", self.top));
-        s.push_str(&format!("@28\n{}.clk\n@24\n{}.cycle[63:0]\n", self.top, self.top));
+        s.push_str(&format!(
+            "@28\n{}.clk\n@24\n{}.cycle[63:0]\n",
+            self.top, self.top
+        ));
         // Group consecutive signals by their scope.
         let groups: Vec<(String, Vec<usize>)> = {
             let mut g: Vec<(String, Vec<usize>)> = Vec::new();
@@ -364,7 +369,11 @@ impl Tracer {
         };
         let closed = groups.len() > 8;
         for (scope, sigs) in &groups {
-            let label = if scope.is_empty() { self.top.clone() } else { scope.clone() };
+            let label = if scope.is_empty() {
+                self.top.clone()
+            } else {
+                scope.clone()
+            };
             let begin = 0x800200 | if closed { 0x400000 } else { 0 };
             s.push_str(&format!("@{begin:x}\n-{label}\n"));
             for &i in sigs {

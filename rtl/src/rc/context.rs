@@ -419,9 +419,7 @@ impl Context {
         let f = match self.b {
             BSrc::Reg(rb) => {
                 assert!(rb < 16);
-                rb as u32
-                    | (self.shift as u32) << 4
-                    | (self.trunc as u32) << 9
+                rb as u32 | (self.shift as u32) << 4 | (self.trunc as u32) << 9
             }
             BSrc::Imm(i) => {
                 assert!((-1024..=1023).contains(&i), "immediate {i} out of range");
@@ -491,7 +489,8 @@ impl fmt::Display for Context {
             Not | Mov | Abs | Neg | Clz => write!(f, " {d}, {a}"),
             Movb => write!(f, " {d}, {b}"),
             Acc | Acch | Accl => write!(f, " {d}{sh}"),
-            Ldacc => write!(f, " {a}{sh}"),
+            Ldacc if self.shift != 0 => write!(f, " {a}, <<{}", self.shift),
+            Ldacc => write!(f, " {a}"),
             _ => write!(f, " {d}, {a}, {b}{sh}"),
         }
     }
@@ -525,7 +524,10 @@ mod tests {
 
     #[test]
     fn illegal_words_are_refused() {
-        assert_eq!(Context::decode(0x3F << 26), Err(DecodeError::IllegalOp(0x3F)));
+        assert_eq!(
+            Context::decode(0x3F << 26),
+            Err(DecodeError::IllegalOp(0x3F))
+        );
         assert_eq!(Context::decode(3 << 24), Err(DecodeError::IllegalGuard));
         assert_eq!(Context::decode(1 << 10), Err(DecodeError::ReservedBits));
     }

@@ -59,6 +59,9 @@ pub struct RcArray<const N: usize> {
     /// Operand A for the interconnect and frame-buffer sources, driven by
     /// the array around the RCs.
     pub ext: [i16; N],
+    /// Lanes allowed to execute this cycle (all by default). Row and column
+    /// broadcast modes run one context per row/column by restricting this.
+    pub lane_enable: Mask,
     // ---- next state (d), computed by eval ----
     en: Mask,
     res: [i16; N],
@@ -106,6 +109,7 @@ impl<const N: usize> RcArray<N> {
             ctx: Context::NOP,
             ctx_word: Context::NOP.encode(),
             ext: [0; N],
+            lane_enable: full(N),
             en: 0,
             res: [0; N],
             acc_d: [0; N],
@@ -139,6 +143,7 @@ impl<const N: usize> RcArray<N> {
             Guard::IfF => self.flags.f,
             Guard::IfNotF => !self.flags.f & Self::FULL,
         };
+        let g = g & self.lane_enable;
         if self.ctx.op == Op::Wake {
             g
         } else {
@@ -408,14 +413,19 @@ impl<const N: usize> Clocked for RcArray<N> {
 }
 
 const REG_NAMES: [&str; 16] = [
-    "r0", "r1", "r2", "r3", "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "r12", "r13",
-    "r14", "r15",
+    "r0", "r1", "r2", "r3", "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "r12", "r13", "r14",
+    "r15",
 ];
 
 impl<const N: usize> Traced for RcArray<N> {
     fn trace(&self, p: &mut dyn Probe) {
         let c = &self.ctx;
-        p.signal("ctx", 32, Display::Translate(&CTX_FILTER), self.ctx_word as u64);
+        p.signal(
+            "ctx",
+            32,
+            Display::Translate(&CTX_FILTER),
+            self.ctx_word as u64,
+        );
         p.signal("op", 6, Display::Translate(&OP_FILTER), c.op as u64);
         let en = self.enabled();
         for i in 0..N {
@@ -454,7 +464,12 @@ impl<const N: usize> Traced for RcArray<N> {
             }
             if p.scope(format_args!("ram")) {
                 let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
-                p.signal("addr", 9, Display::Hex, if mem { self.addr[i] as u64 } else { 0 });
+                p.signal(
+                    "addr",
+                    9,
+                    Display::Hex,
+                    if mem { self.addr[i] as u64 } else { 0 },
+                );
                 p.signal("we", 1, Display::Bin, (mem && c.op == Op::St) as u64);
                 p.end();
             }
@@ -465,6 +480,10 @@ impl<const N: usize> Traced for RcArray<N> {
 
 impl<const N: usize> fmt::Debug for RcArray<N> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "RcArray<{N}> {{ ctx: {}, flags: {:?} }}", self.ctx, self.flags)
+        write!(
+            f,
+            "RcArray<{N}> {{ ctx: {}, flags: {:?} }}",
+            self.ctx, self.flags
+        )
     }
 }

@@ -1,1 +1,6 @@
-pub fn command(_vcd: Option<std::path::PathBuf>, _w: crate::cli::TraceWindow) -> anyhow::Result<()> { Ok(()) }
+pub fn command(
+    _vcd: Option<std::path::PathBuf>,
+    _w: crate::cli::TraceWindow,
+) -> anyhow::Result<()> {
+    Ok(())
+}
