@@ -107,6 +107,7 @@ enum Phase {
 /// The VCD writer. Attach it to a [`crate::kernel::Sim`].
 pub struct Tracer {
     cfg: TraceConfig,
+    tmp_path: tempfile::TempPath,
     top: String,
     w: vcd::Writer<BufWriter<File>>,
     phase: Phase,
@@ -127,6 +128,20 @@ pub struct Tracer {
     sampled: u64,
     last_cycle: Option<u64>,
     note: Option<String>,
+    /// First I/O error met while declaring (the Probe calls cannot return it).
+    err: Option<io::Error>,
+}
+
+/// Write a small text file through a temporary file and a rename.
+fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    tmp.write_all(text.as_bytes())?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
 }
 
 fn glob(p: &str, s: &str) -> bool {
@@ -183,7 +198,18 @@ impl Tracer {
                 std::fs::create_dir_all(dir)?;
             }
         }
-        let file = File::create(&cfg.path)?;
+        // Written to a temporary file beside the target and renamed into
+        // place by finish(), so an interrupted run never leaves a truncated
+        // waveform under the requested name.
+        let dir = match cfg.path.parent() {
+            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+            _ => PathBuf::from("."),
+        };
+        let tmp = tempfile::Builder::new()
+            .prefix(".morphosys-")
+            .suffix(".vcd.partial")
+            .tempfile_in(&dir)?;
+        let (file, tmp_path) = tmp.into_parts();
         let mut w = vcd::Writer::new(BufWriter::with_capacity(1 << 16, file));
         w.version(concat!("morphosys ", env!("CARGO_PKG_VERSION")))?;
         w.timescale(1, TimescaleUnit::PS)?;
@@ -205,6 +231,7 @@ impl Tracer {
             .collect();
         let mut t = Tracer {
             cfg,
+            tmp_path,
             top: top_name.to_string(),
             w,
             phase: Phase::Declare,
@@ -222,8 +249,12 @@ impl Tracer {
             sampled: 0,
             last_cycle: None,
             note: None,
+            err: None,
         };
         top.trace(&mut t);
+        if let Some(e) = t.err.take() {
+            return Err(e);
+        }
         t.w.upscope()?;
         t.w.enddefinitions()?;
         t.last = vec![None; t.decls.len()];
@@ -261,6 +292,9 @@ impl Tracer {
         self.scope_i = 0;
         self.slot_i = 0;
         top.trace(self);
+        if let Some(e) = self.err.take() {
+            return Err(e);
+        }
         self.w.timestamp(t + half)?;
         self.w.change_scalar(self.clk, vcd::Value::V0)?;
         self.sampled += 1;
@@ -283,8 +317,12 @@ impl Tracer {
             self.w.comment(n)?;
         }
         self.w.flush()?;
-        let mut written = vec![self.cfg.path.clone()];
-        written.extend(self.write_gtkw()?);
+        self.w.writer().get_ref().sync_data()?;
+        let gtkw = self.write_gtkw()?;
+        let Tracer { tmp_path, cfg, .. } = self;
+        tmp_path.persist(&cfg.path).map_err(|e| e.error)?;
+        let mut written = vec![cfg.path.clone()];
+        written.extend(gtkw);
         Ok(written)
     }
 
@@ -296,17 +334,12 @@ impl Tracer {
         // Filter files: one per filter, with every value seen in the trace
         // (plus the filter's whole table when it is small).
         let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
-        for (i, d) in self.decls.iter().enumerate() {
+        for d in &self.decls {
             if let Display::Translate(f) = d.info.display {
-                let path = PathBuf::from(format!("{}.{}.txt", stem.display(), f.name));
-                let idx = match filters.iter().position(|(n, _)| *n == f.name) {
-                    Some(k) => k,
-                    None => {
-                        filters.push((f.name, path.clone()));
-                        filters.len() - 1
-                    }
-                };
-                let _ = (i, idx);
+                if !filters.iter().any(|(n, _)| *n == f.name) {
+                    let path = PathBuf::from(format!("{}.{}.txt", stem.display(), f.name));
+                    filters.push((f.name, path));
+                }
             }
         }
         for (name, path) in &filters {
@@ -338,7 +371,7 @@ impl Tracer {
                     s.push_str(&format!("{v:0digits$X} {text}\n"));
                 }
             }
-            std::fs::write(path, s)?;
+            write_atomic(path, &s)?;
             out.push(path.clone());
         }
 
@@ -400,7 +433,7 @@ impl Tracer {
             }
             s.push_str(&format!("@{:x}\n-{label}\n", 0x1000200));
         }
-        std::fs::write(&gtkw, s)?;
+        write_atomic(&gtkw, &s)?;
         out.insert(0, gtkw);
         Ok(out)
     }
@@ -436,8 +469,9 @@ impl Probe for Tracer {
                 let on = self.matches_prefix(&self.stack, false);
                 self.scope_on.push(on);
                 if on {
-                    // Errors surface when the file is flushed at finish().
-                    let _ = self.w.add_module(self.stack.last().unwrap());
+                    if let Err(e) = self.w.add_module(self.stack.last().unwrap()) {
+                        self.err.get_or_insert(e);
+                    }
                 } else {
                     self.stack.pop();
                 }
@@ -454,7 +488,9 @@ impl Probe for Tracer {
     fn end(&mut self) {
         if let Phase::Declare = self.phase {
             self.stack.pop();
-            let _ = self.w.upscope();
+            if let Err(e) = self.w.upscope() {
+                self.err.get_or_insert(e);
+            }
         }
     }
 
@@ -464,7 +500,13 @@ impl Probe for Tracer {
                 let mut path = self.stack.clone();
                 path.push(name.to_string());
                 if self.matches_prefix(&path, true) {
-                    let id = self.w.add_wire(width, name).expect("write VCD header");
+                    let id = match self.w.add_wire(width, name) {
+                        Ok(id) => id,
+                        Err(e) => {
+                            self.err.get_or_insert(e);
+                            vcd::IdCode::FIRST
+                        }
+                    };
                     self.slot.push(Some(self.decls.len() as u32));
                     self.decls.push(Decl {
                         path,
@@ -491,11 +533,14 @@ impl Probe for Tracer {
                             self.seen[i].insert(v);
                         }
                         let wr = self.w.writer();
-                        let _ = if info.width == 1 {
+                        let r = if info.width == 1 {
                             writeln!(wr, "{}{}", v, info.id)
                         } else {
                             writeln!(wr, "b{:b} {}", v, info.id)
                         };
+                        if let Err(e) = r {
+                            self.err.get_or_insert(e);
+                        }
                     }
                 }
             }

@@ -1,1 +1,5 @@
+//! Testbenches: each drives a block of the chip, checks it against an
+//! independent reference model and writes a waveform.
+
 pub mod rc;
+pub mod rc_ref;
