@@ -380,6 +380,12 @@ impl Tracer {
         s.push_str(&format!("[dumpfile] \"{}\"\n", vcd_abs.display()));
         s.push_str(&format!("[savefile] \"{}\"\n", gtkw.display()));
         s.push_str("[timestart] 0\n[size] 1400 900\n[pos] -1 -1\n");
+        // Zoom: at zoom 0 GTKWave draws about 200 pixels per time unit and
+        // each step of -1 halves that (measured with GTKWave 3.3.118); aim
+        // for about 25 pixels per clock period. No markers set.
+        let period = (self.time(self.cfg.first + 1) - self.time(self.cfg.first)).max(1) as f64;
+        let zoom = -(period * 8.0).log2();
+        s.push_str(&format!("*{zoom:.6} -1{}\n", " -1".repeat(26)));
         s.push_str(
             "[sst_width] 260\n[signals_width] 320\n[sst_expanded] 1\n[sst_vpaned_height] 240\n",
         );

@@ -23,7 +23,11 @@ fn parse(path: &Path) -> Wave {
     let mut p = vcd::Parser::new(f);
     let header = p.parse_header().expect("VCD header parses");
     let mut vars = HashMap::new();
-    fn walk(items: &[vcd::ScopeItem], prefix: &str, vars: &mut HashMap<String, (vcd::IdCode, u32)>) {
+    fn walk(
+        items: &[vcd::ScopeItem],
+        prefix: &str,
+        vars: &mut HashMap<String, (vcd::IdCode, u32)>,
+    ) {
         for it in items {
             match it {
                 vcd::ScopeItem::Scope(s) => {
@@ -49,7 +53,10 @@ fn parse(path: &Path) -> Wave {
     let mut edges = Vec::new();
     let mut cycles = Vec::new();
     let mut pending_edge = false;
-    let to_u64 = |v: &vcd::Vector| v.iter().fold(0u64, |acc, b| acc << 1 | (b == vcd::Value::V1) as u64);
+    let to_u64 = |v: &vcd::Vector| {
+        v.iter()
+            .fold(0u64, |acc, b| acc << 1 | (b == vcd::Value::V1) as u64)
+    };
     for cmd in p {
         match cmd.expect("VCD body parses") {
             vcd::Command::Timestamp(_) => {
@@ -75,7 +82,11 @@ fn parse(path: &Path) -> Wave {
         cycles.push(cur[&cyc]);
         edges.push(cur.clone());
     }
-    Wave { vars, edges, cycles }
+    Wave {
+        vars,
+        edges,
+        cycles,
+    }
 }
 
 impl Wave {
@@ -99,7 +110,16 @@ fn testbench_passes_and_its_waveform_matches_the_reference() {
     for r in 0..16 {
         assert!(w.vars.contains_key(&format!("tb.rc.regfile.r{r}")));
     }
-    for name in ["tb.rc.out", "tb.rc.alu.a", "tb.rc.alu.b", "tb.rc.mul.acc", "tb.rc.flags.f", "tb.rc.ram.addr", "tb.op", "tb.ctx"] {
+    for name in [
+        "tb.rc.out",
+        "tb.rc.alu.a",
+        "tb.rc.alu.b",
+        "tb.rc.mul.acc",
+        "tb.rc.flags.f",
+        "tb.rc.ram.addr",
+        "tb.op",
+        "tb.ctx",
+    ] {
         assert!(w.vars.contains_key(name), "missing {name}");
     }
     let stims = stimulus();
@@ -112,21 +132,42 @@ fn testbench_passes_and_its_waveform_matches_the_reference() {
         assert_eq!(w.at(k, "tb.rc.out"), r.out, "out during cycle {k}");
         assert_eq!(w.at(k, "tb.rc.regfile.r3"), r.r[3], "r3 during cycle {k}");
         assert_eq!(w.at(k, "tb.rc.mul.acc"), r.acc, "acc during cycle {k}");
-        assert_eq!(w.at(k, "tb.rc.flags.f"), r.f as i64 * -1, "F during cycle {k}"); // 1-bit sign-extends
-        assert_eq!(w.at(k, "tb.ctx") as u32, s.ctx.encode(), "context word of cycle {k}");
+        assert_eq!(
+            w.at(k, "tb.rc.flags.f"),
+            r.f as i64 * -1,
+            "F during cycle {k}"
+        ); // 1-bit sign-extends
+        assert_eq!(
+            w.at(k, "tb.ctx") as u32,
+            s.ctx.encode(),
+            "context word of cycle {k}"
+        );
         r.step(&s.ctx, s.ext as i64);
     }
 
     // GTKWave's own converter accepts the file.
-    match std::process::Command::new("vcd2fst").arg(&vcd_path).arg(dir.path().join("rc.fst")).output() {
-        Ok(out) => assert!(out.status.success(), "vcd2fst rejected the VCD: {}", String::from_utf8_lossy(&out.stderr)),
-        Err(_) if std::env::var_os("CI").is_none() => eprintln!("vcd2fst not installed (apt-get install gtkwave); skipped that check"),
+    match std::process::Command::new("vcd2fst")
+        .arg(&vcd_path)
+        .arg(dir.path().join("rc.fst"))
+        .output()
+    {
+        Ok(out) => assert!(
+            out.status.success(),
+            "vcd2fst rejected the VCD: {}",
+            String::from_utf8_lossy(&out.stderr)
+        ),
+        Err(_) if std::env::var_os("CI").is_none() => {
+            eprintln!("vcd2fst not installed (apt-get install gtkwave); skipped that check")
+        }
         Err(e) => panic!("vcd2fst must be installed in CI: {e}"),
     }
 
     // The save file opens this VCD and names only signals it has.
     let gtkw = std::fs::read_to_string(dir.path().join("rc.gtkw")).unwrap();
-    assert!(gtkw.contains(&format!("[dumpfile] \"{}\"", std::path::absolute(&vcd_path).unwrap().display())));
+    assert!(gtkw.contains(&format!(
+        "[dumpfile] \"{}\"",
+        std::path::absolute(&vcd_path).unwrap().display()
+    )));
     let mut groups = 0;
     for line in gtkw.lines() {
         if line.starts_with("-") {
@@ -136,7 +177,10 @@ fn testbench_passes_and_its_waveform_matches_the_reference() {
             continue;
         }
         let name = line.split('[').next().unwrap();
-        assert!(w.vars.contains_key(name), "save file names {name}, not in the VCD");
+        assert!(
+            w.vars.contains_key(name),
+            "save file names {name}, not in the VCD"
+        );
     }
     assert!(groups >= 2 * 6, "signals grouped by module");
     // Translate filters: opcodes as mnemonics, context words as disassembly.
@@ -145,7 +189,11 @@ fn testbench_passes_and_its_waveform_matches_the_reference() {
     assert!(ops.lines().any(|l| l == "20 mul"));
     let ctx = std::fs::read_to_string(dir.path().join("rc.rc_ctx.txt")).unwrap();
     let first = stims[0].ctx;
-    assert!(ctx.lines().any(|l| l == format!("{:08X} {}", first.encode(), first)), "{first}");
+    assert!(
+        ctx.lines()
+            .any(|l| l == format!("{:08X} {}", first.encode(), first)),
+        "{first}"
+    );
     assert!(gtkw.contains("rc.rc_op.txt") && gtkw.contains("@2022"));
 }
 
@@ -165,9 +213,18 @@ fn window_and_scope_filter_limit_the_trace() {
     assert_eq!(
         names,
         [
-            "tb.clk", "tb.cycle", "tb.rc.flags.c", "tb.rc.flags.f", "tb.rc.flags.sleep", "tb.rc.flags.v",
-            "tb.rc.regfile.r10", "tb.rc.regfile.r11", "tb.rc.regfile.r12", "tb.rc.regfile.r13",
-            "tb.rc.regfile.r14", "tb.rc.regfile.r15",
+            "tb.clk",
+            "tb.cycle",
+            "tb.rc.flags.c",
+            "tb.rc.flags.f",
+            "tb.rc.flags.sleep",
+            "tb.rc.flags.v",
+            "tb.rc.regfile.r10",
+            "tb.rc.regfile.r11",
+            "tb.rc.regfile.r12",
+            "tb.rc.regfile.r13",
+            "tb.rc.regfile.r14",
+            "tb.rc.regfile.r15",
         ]
     );
     assert_eq!(w.cycles, (100..150).collect::<Vec<u64>>());

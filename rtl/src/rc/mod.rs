@@ -194,26 +194,27 @@ macro_rules! map {
 /// Run a flag-producing ALU function over every lane.
 #[inline(always)]
 fn cv<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> alu::Flagged) -> (Mask, Mask) {
-    let (mut mc, mut mv) = (0u64, 0u64);
+    let mut c = [false; N];
+    let mut v = [false; N];
     for i in 0..N {
         let r = f(i);
         res[i] = r.value;
-        mc |= (r.c as u64) << i;
-        mv |= (r.v as u64) << i;
+        c[i] = r.c;
+        v[i] = r.v;
     }
-    (mc, mv)
+    (lanes::pack_bools(&c), lanes::pack_bools(&v))
 }
 
 /// Run a saturating function over every lane; returns the saturation mask.
 #[inline(always)]
 fn sat<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> (i16, bool)) -> Mask {
-    let mut mv = 0u64;
+    let mut v = [false; N];
     for i in 0..N {
-        let (r, v) = f(i);
+        let (r, s) = f(i);
         res[i] = r;
-        mv |= (v as u64) << i;
+        v[i] = s;
     }
-    mv
+    lanes::pack_bools(&v)
 }
 
 impl<const N: usize> Clocked for RcArray<N> {
@@ -318,20 +319,32 @@ impl<const N: usize> Clocked for RcArray<N> {
             Op::Mul | Op::Mac | Op::Msu => {
                 let acc = &self.acc;
                 let acc_d = &mut self.acc_d;
-                let mut mv = 0u64;
-                for i in 0..N {
-                    let p = multiplier::product(a[i], b[i]);
-                    let (nacc, s1) = match c.op {
-                        Op::Mul => (p, false),
-                        Op::Mac => multiplier::accumulate(acc[i], p, false),
-                        _ => multiplier::accumulate(acc[i], p, true),
-                    };
-                    let (r, s2) = multiplier::scale(nacc, sh, trunc);
-                    acc_d[i] = nacc;
-                    res[i] = r;
-                    mv |= ((s1 | s2) as u64) << i;
+                let mut s = [false; N];
+                match c.op {
+                    Op::Mul => {
+                        for i in 0..N {
+                            acc_d[i] = multiplier::product(a[i], b[i]);
+                        }
+                    }
+                    Op::Mac => {
+                        for i in 0..N {
+                            let p = multiplier::product(a[i], b[i]);
+                            (acc_d[i], s[i]) = multiplier::accumulate(acc[i], p, false);
+                        }
+                    }
+                    _ => {
+                        for i in 0..N {
+                            let p = multiplier::product(a[i], b[i]);
+                            (acc_d[i], s[i]) = multiplier::accumulate(acc[i], p, true);
+                        }
+                    }
                 }
-                (self.d_v, self.d_c) = (mv, 0);
+                for i in 0..N {
+                    let (r, s2) = multiplier::scale(acc_d[i], sh, trunc);
+                    res[i] = r;
+                    s[i] |= s2;
+                }
+                (self.d_v, self.d_c) = (lanes::pack_bools(&s), 0);
                 self.pend.cv = true;
                 self.pend.acc = true;
             }

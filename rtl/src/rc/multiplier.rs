@@ -18,34 +18,31 @@ pub fn product(a: i16, b: i16) -> i32 {
 /// `acc + p` (or `acc - p` when `sub`), saturating at the 32-bit bounds.
 #[inline(always)]
 pub fn accumulate(acc: i32, p: i32, sub: bool) -> (i32, bool) {
-    let wide = if sub {
-        acc as i64 - p as i64
+    let (r, o) = if sub {
+        acc.overflowing_sub(p)
     } else {
-        acc as i64 + p as i64
+        acc.overflowing_add(p)
     };
-    if wide > i32::MAX as i64 {
-        (i32::MAX, true)
-    } else if wide < i32::MIN as i64 {
-        (i32::MIN, true)
+    if o {
+        // Overflow: the exact result has the sign opposite to the wrapped one.
+        (if r < 0 { i32::MAX } else { i32::MIN }, true)
     } else {
-        (wide as i32, false)
+        (r, false)
     }
 }
 
 /// Scale the accumulator to 16 bits: shift right by `sh` (0..=31), rounding
 /// to nearest unless `trunc`, then saturate.
+///
+/// Rounding adds `2^(sh-1)` before the shift; in 32 bits without overflow
+/// that is `floor(acc / 2^sh)` plus bit `sh-1` of `acc`.
 #[inline(always)]
 pub fn scale(acc: i32, sh: u32, trunc: bool) -> (i16, bool) {
-    let mut w = acc as i64;
+    let sh = sh & 31;
+    let mut w = acc >> sh;
     if !trunc && sh > 0 {
-        w += 1i64 << (sh - 1);
+        w += (acc >> (sh - 1)) & 1;
     }
-    w >>= sh;
-    if w > i16::MAX as i64 {
-        (i16::MAX, true)
-    } else if w < i16::MIN as i64 {
-        (i16::MIN, true)
-    } else {
-        (w as i16, false)
-    }
+    let r = w.clamp(i16::MIN as i32, i16::MAX as i32);
+    (r as i16, r != w)
 }

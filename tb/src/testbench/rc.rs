@@ -359,7 +359,11 @@ pub fn command(vcd: Option<PathBuf>, window: crate::cli::TraceWindow) -> anyhow:
     for f in &r.files {
         println!("  wrote {}", f.display());
     }
-    if let Some(v) = r.files.iter().find(|f| f.extension().is_some_and(|e| e == "gtkw")) {
+    if let Some(v) = r
+        .files
+        .iter()
+        .find(|f| f.extension().is_some_and(|e| e == "gtkw"))
+    {
         println!("  view:  gtkwave {}", v.display());
     }
     if !r.mismatches.is_empty() {
