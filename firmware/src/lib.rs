@@ -1,3 +1,7 @@
 //! Firmware for the MorphoSys model: the assembler, the ray tracer's
 //! TinyRISC and context sources, and the scene compiler. Knows nothing of
 //! host-side rendering.
+
+pub mod scene;
+pub mod bsp;
+pub mod scene_image;

@@ -3,3 +3,6 @@
 
 pub mod cli;
 pub mod testbench;
+pub mod reference;
+pub mod cmd_scene;
+pub mod metrics;

@@ -28,6 +28,72 @@ enum Command {
         #[command(subcommand)]
         bench: Bench,
     },
+    /// Render a scene with the float reference renderer (the golden model):
+    /// Whitted ray tracing in f64, written as PNG.
+    Reference {
+        /// Scene file (.nff or .toml); default scenes/default.toml.
+        scene: Option<PathBuf>,
+        /// Image size WIDTHxHEIGHT (default: the scene's resolution).
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
+        size: Option<(u32, u32)>,
+        /// Maximum ray depth; the eye ray is depth 1 (default 5).
+        #[arg(long, value_name = "N")]
+        depth: Option<u32>,
+        /// Write the image here (default: <scene>-reference.png).
+        #[arg(long, value_name = "PNG")]
+        out: Option<PathBuf>,
+        /// Write ray counts and timing as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
+        /// Write the per-pixel hit map (which object each eye ray hit) here.
+        #[arg(long, value_name = "PATH")]
+        hits: Option<PathBuf>,
+        /// Count rays as the SPD prescribes: 512x512, rays through pixel
+        /// corners (513x513 eye rays), depth 5.
+        #[arg(long)]
+        spd_stats: bool,
+    },
+    /// Compile a scene into the chip's fixed-point memory image (BSP in the
+    /// paper's Fig. 5 layout) and report format, errors and footprint.
+    Compile {
+        /// Scene file (.nff or .toml); default scenes/default.toml.
+        scene: Option<PathBuf>,
+        /// Write the report as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
+        /// Write the memory image (16-bit little-endian words) here.
+        #[arg(long, value_name = "PATH")]
+        out: Option<PathBuf>,
+        /// Split by the surface area heuristic instead of the paper's
+        /// spatial median.
+        #[arg(long)]
+        sah: bool,
+        /// Maximum BSP depth.
+        #[arg(long, value_name = "N", default_value_t = 15)]
+        max_depth: u32,
+        /// Maximum objects per BSP leaf.
+        #[arg(long, value_name = "N", default_value_t = 5)]
+        max_leaf: usize,
+        /// Node layout: bit-vectors (Fig. 5) or index-lists (default: the
+        /// smaller).
+        #[arg(long, value_name = "LAYOUT", value_parser = ["bit-vectors", "index-lists"])]
+        layout: Option<String>,
+    },
+    /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
+    /// than a threshold, and (with --hits) per-pixel hit agreement.
+    Compare {
+        a: PathBuf,
+        b: PathBuf,
+        /// A pixel is "off" when a channel differs by more than this.
+        #[arg(long, value_name = "N", default_value_t = 8)]
+        threshold: u8,
+        /// Hit maps of A and B (from `reference --hits`).
+        #[arg(long, num_args = 2, value_names = ["HITS_A", "HITS_B"])]
+        hits: Option<Vec<PathBuf>>,
+        /// Write the figures as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -49,6 +115,56 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         Command::Tb { bench } => match bench {
             Bench::Rc { vcd, window } => tb::testbench::rc::command(vcd, window),
         },
+        Command::Reference {
+            scene,
+            size,
+            depth,
+            out,
+            json,
+            hits,
+            spd_stats,
+        } => tb::cmd_scene::reference(tb::cmd_scene::ReferenceArgs {
+            scene,
+            size,
+            depth,
+            out,
+            json,
+            hits,
+            spd_stats,
+        }),
+        Command::Compile {
+            scene,
+            json,
+            out,
+            sah,
+            max_depth,
+            max_leaf,
+            layout,
+        } => {
+            let layout = layout.map(|l| match l.as_str() {
+                "index-lists" => firmware::scene_image::Layout::IndexLists,
+                _ => firmware::scene_image::Layout::BitVectors,
+            });
+            tb::cmd_scene::compile_cmd(tb::cmd_scene::CompileArgs {
+                scene,
+                json,
+                out,
+                sah,
+                max_depth,
+                max_leaf,
+                layout,
+            })
+        }
+        Command::Compare {
+            a,
+            b,
+            threshold,
+            hits,
+            json,
+        } => {
+            let hits = hits.map(|h| (h[0].clone(), h[1].clone()));
+            tb::cmd_scene::compare(&a, &b, threshold, hits, json)
+        }
     }
 }
 

@@ -1,0 +1,381 @@
+//! The native scene format: TOML, for hand-written scenes. It adds to NFF
+//! axis-aligned boxes, rectangles, cylinders and cones with optional end
+//! caps, and named materials. See `docs/scenes.md` for the whole format;
+//! in short:
+//!
+//! ```toml
+//! background = [0.1, 0.2, 0.4]
+//! [camera]
+//! from = [0, -8, 3]
+//! at = [0, 0, 0]
+//! up = [0, 0, 1]
+//! angle = 40          # degrees, edge to edge
+//! resolution = [256, 256]
+//! [[light]]
+//! position = [5, -5, 8]
+//! color = [0.7, 0.7, 0.7]   # optional
+//! [material.red]
+//! color = [1, 0.2, 0.2]
+//! kd = 0.7
+//! ks = 0.3
+//! shine = 30
+//! [[object]]
+//! type = "sphere"
+//! material = "red"
+//! center = [0, 0, 1]
+//! radius = 1
+//! ```
+
+use std::collections::BTreeMap;
+
+use serde::Deserialize;
+use toml::Spanned;
+
+use super::{Camera, Light, Material, Object, Scene, SceneError, Shape, Vec3};
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct File {
+    #[serde(default)]
+    background: Option<Vec3>,
+    camera: CameraDef,
+    #[serde(default)]
+    light: Vec<LightDef>,
+    #[serde(default)]
+    material: BTreeMap<String, MaterialDef>,
+    #[serde(default)]
+    object: Vec<Spanned<ObjectDef>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CameraDef {
+    from: Vec3,
+    at: Vec3,
+    up: Vec3,
+    angle: f64,
+    #[serde(default = "default_hither")]
+    hither: f64,
+    #[serde(default = "default_resolution")]
+    resolution: [u32; 2],
+}
+
+fn default_hither() -> f64 {
+    1e-3
+}
+fn default_resolution() -> [u32; 2] {
+    [256, 256]
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct LightDef {
+    position: Vec3,
+    #[serde(default)]
+    color: Option<Vec3>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MaterialDef {
+    color: Vec3,
+    #[serde(default = "one")]
+    kd: f64,
+    #[serde(default)]
+    ks: f64,
+    #[serde(default)]
+    shine: f64,
+    #[serde(default)]
+    t: f64,
+    #[serde(default = "one")]
+    ior: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// One `[[object]]` table. Flat, so that serde's errors point at the
+/// offending key; which keys each type needs is checked in [`shape_of`].
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObjectDef {
+    #[serde(rename = "type")]
+    kind: String,
+    material: String,
+    center: Option<Vec3>,
+    radius: Option<f64>,
+    base: Option<Vec3>,
+    apex: Option<Vec3>,
+    base_radius: Option<f64>,
+    apex_radius: Option<f64>,
+    caps: Option<bool>,
+    inside: Option<bool>,
+    min: Option<Vec3>,
+    max: Option<Vec3>,
+    corner: Option<Vec3>,
+    edge1: Option<Vec3>,
+    edge2: Option<Vec3>,
+    vertices: Option<Vec<Vec3>>,
+}
+
+const TYPES: &str = "sphere, cylinder, cone, box, rectangle, triangle, polygon";
+
+/// The shape an object table describes, or what is wrong with it.
+fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
+    let keys: &[(&str, bool)] = &[
+        ("center", o.center.is_some()),
+        ("radius", o.radius.is_some()),
+        ("base", o.base.is_some()),
+        ("apex", o.apex.is_some()),
+        ("base_radius", o.base_radius.is_some()),
+        ("apex_radius", o.apex_radius.is_some()),
+        ("caps", o.caps.is_some()),
+        ("inside", o.inside.is_some()),
+        ("min", o.min.is_some()),
+        ("max", o.max.is_some()),
+        ("corner", o.corner.is_some()),
+        ("edge1", o.edge1.is_some()),
+        ("edge2", o.edge2.is_some()),
+        ("vertices", o.vertices.is_some()),
+    ];
+    let (required, optional): (&[&str], &[&str]) = match o.kind.as_str() {
+        "sphere" => (&["center", "radius"], &["inside"]),
+        "cylinder" => (&["base", "apex", "radius"], &["caps", "inside"]),
+        "cone" => (
+            &["base", "apex", "base_radius", "apex_radius"],
+            &["caps", "inside"],
+        ),
+        "box" => (&["min", "max"], &[]),
+        "rectangle" => (&["corner", "edge1", "edge2"], &[]),
+        "triangle" | "polygon" => (&["vertices"], &[]),
+        k => {
+            return Err(format!(
+                "unknown object type '{k}': expected one of {TYPES}"
+            ))
+        }
+    };
+    for (k, present) in keys {
+        if *present && !required.contains(k) && !optional.contains(k) {
+            return Err(format!(
+                "a {} takes no '{k}' (it takes {})",
+                o.kind,
+                required.join(", ")
+            ));
+        }
+        if !*present && required.contains(k) {
+            return Err(format!(
+                "a {} needs '{k}' (it takes {})",
+                o.kind,
+                required.join(", ")
+            ));
+        }
+    }
+    let (caps, inside) = (o.caps.unwrap_or(false), o.inside.unwrap_or(false));
+    let u = |v: Option<Vec3>| v.unwrap_or_default();
+    let f = |v: Option<f64>| v.unwrap_or_default();
+    Ok(match o.kind.as_str() {
+        "sphere" => Shape::Sphere {
+            center: u(o.center),
+            radius: f(o.radius),
+            inside,
+        },
+        "cylinder" => Shape::Cone {
+            base: u(o.base),
+            base_radius: f(o.radius),
+            apex: u(o.apex),
+            apex_radius: f(o.radius),
+            inside,
+            caps,
+        },
+        "cone" => Shape::Cone {
+            base: u(o.base),
+            base_radius: f(o.base_radius),
+            apex: u(o.apex),
+            apex_radius: f(o.apex_radius),
+            inside,
+            caps,
+        },
+        "box" => Shape::Box {
+            min: u(o.min),
+            max: u(o.max),
+        },
+        "rectangle" => Shape::Rectangle {
+            corner: u(o.corner),
+            edge1: u(o.edge1),
+            edge2: u(o.edge2),
+        },
+        kind => {
+            let v = o.vertices.clone().unwrap_or_default();
+            match (kind, v.len()) {
+                ("triangle", 3) | ("polygon", 3) => Shape::Triangle {
+                    v: [v[0], v[1], v[2]],
+                    normals: None,
+                },
+                ("triangle", n) => return Err(format!("a triangle needs 3 vertices, found {n}")),
+                (_, n) if n < 3 => {
+                    return Err(format!("a polygon needs at least 3 vertices, found {n}"))
+                }
+                _ => Shape::Polygon { v, normals: None },
+            }
+        }
+    })
+}
+
+/// Line and column (1-based) of a byte offset.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let offset = offset.min(text.len());
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rfind('\n').map_or(offset, |i| offset - i - 1) + 1;
+    (line, col)
+}
+
+/// Parse native TOML text; `file` names it in messages. The result is
+/// validated.
+pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
+    let def: File = toml::from_str(text).map_err(|e| {
+        let (line, col) = e.span().map_or((0, 0), |s| line_col(text, s.start));
+        SceneError {
+            file: file.into(),
+            line,
+            col,
+            message: e.message().trim().replace('\n', " "),
+        }
+    })?;
+    let mut scene = Scene {
+        source: file.to_string(),
+        ..Scene::default()
+    };
+    let c = def.camera;
+    scene.camera = Camera {
+        from: c.from,
+        at: c.at,
+        up: c.up,
+        angle: c.angle,
+        hither: c.hither,
+        resolution: (c.resolution[0], c.resolution[1]),
+    };
+    scene.background = def.background.unwrap_or(Vec3::ZERO);
+    scene.lights = def
+        .light
+        .into_iter()
+        .map(|l| Light {
+            position: l.position,
+            color: l.color,
+        })
+        .collect();
+    let mut names = BTreeMap::new();
+    for (name, m) in def.material {
+        names.insert(name, scene.materials.len());
+        scene.materials.push(Material {
+            color: m.color,
+            kd: m.kd,
+            ks: m.ks,
+            shine: m.shine,
+            t: m.t,
+            ior: m.ior,
+        });
+    }
+    for o in def.object {
+        let (line, col) = line_col(text, o.span().start);
+        let err = |message: String| SceneError {
+            file: file.into(),
+            line,
+            col,
+            message,
+        };
+        let o = o.into_inner();
+        let shape = shape_of(&o).map_err(err)?;
+        let material = o.material;
+        let Some(&m) = names.get(&material) else {
+            let known: Vec<&str> = names.keys().map(|s| s.as_str()).collect();
+            return Err(err(format!(
+                "unknown material '{material}': expected one of [{}]",
+                known.join(", ")
+            )));
+        };
+        if let Some(msg) = shape.degeneracy() {
+            return Err(err(msg));
+        }
+        scene.objects.push(Object {
+            shape,
+            material: m,
+            line,
+        });
+    }
+    scene.validate()?;
+    Ok(scene)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const HEAD: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nup = [0, 1, 0]\nangle = 45\n\
+                        [[light]]\nposition = [1, 2, 3]\n[material.m]\ncolor = [1, 1, 1]\n";
+
+    #[test]
+    fn reads_every_object_type() {
+        let text = format!(
+            "{HEAD}[[object]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [0, 0, 0]\nradius = 1\n\
+             [[object]]\ntype = \"cylinder\"\nmaterial = \"m\"\nbase = [0, 0, 0]\napex = [0, 1, 0]\nradius = 0.5\ncaps = true\n\
+             [[object]]\ntype = \"cone\"\nmaterial = \"m\"\nbase = [0, 0, 0]\nbase_radius = 1\napex = [0, 1, 0]\napex_radius = 0.5\n\
+             [[object]]\ntype = \"box\"\nmaterial = \"m\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n\
+             [[object]]\ntype = \"rectangle\"\nmaterial = \"m\"\ncorner = [0, 0, 0]\nedge1 = [1, 0, 0]\nedge2 = [0, 1, 0]\n\
+             [[object]]\ntype = \"triangle\"\nmaterial = \"m\"\nvertices = [[0, 0, 0], [1, 0, 0], [0, 1, 0]]\n\
+             [[object]]\ntype = \"polygon\"\nmaterial = \"m\"\nvertices = [[0, 0, 0], [2, 0, 0], [1, 1, 0], [2, 2, 0], [0, 2, 0]]\n"
+        );
+        let s = parse(&text, "t.toml").unwrap();
+        let types: Vec<_> = s
+            .objects
+            .iter()
+            .map(|o| o.shape.prim_type().name())
+            .collect();
+        assert_eq!(
+            types,
+            [
+                "sphere",
+                "cylinder",
+                "cone",
+                "box",
+                "rectangle",
+                "triangle",
+                "polygon"
+            ]
+        );
+        assert_eq!(s.objects[0].line, 10);
+        assert_eq!(s.camera.resolution, (256, 256));
+    }
+
+    #[test]
+    fn errors_name_line() {
+        let e = parse(&format!("{HEAD}[[object]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [0, 0]\nradius = 1\n"), "b.toml")
+            .unwrap_err();
+        assert_eq!(e.line, 13, "{e}");
+        let e = parse(
+            &format!("{HEAD}[[object]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [0, 0, 0]\n"),
+            "b.toml",
+        )
+        .unwrap_err();
+        assert_eq!(e.line, 10, "{e}");
+        assert!(e.message.contains("needs 'radius'"), "{e}");
+        let e = parse(&format!("{HEAD}[[object]]\ntype = \"sphere\"\nmaterial = \"x\"\ncenter = [0, 0, 0]\nradius = 1\n"), "b.toml")
+            .unwrap_err();
+        assert_eq!(e.line, 10, "{e}");
+        assert!(e.message.contains("unknown material 'x'"), "{e}");
+        let e = parse(&format!("{HEAD}[[object]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [0, 0, 0]\nradius = 0\n"), "b.toml")
+            .unwrap_err();
+        assert_eq!(e.line, 10, "{e}");
+        assert!(e.message.contains("radius"), "{e}");
+        let e = parse(
+            &format!("{HEAD}[[object]]\ntype = \"blob\"\nmaterial = \"m\"\n"),
+            "b.toml",
+        )
+        .unwrap_err();
+        assert!(e.line >= 10, "{e}");
+        let e = parse(&format!("{HEAD}[[object]]\ntype = \"box\"\nmaterial = \"m\"\nmin = [0, 0, 0]\nmax = [1, 1, 1]\ncolour = 3\n"), "b.toml")
+            .unwrap_err();
+        assert!(e.message.contains("colour"), "{e}");
+    }
+}

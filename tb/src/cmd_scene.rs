@@ -1,0 +1,328 @@
+//! The scene subcommands: `morphosys reference`, `morphosys compile` and
+//! `morphosys compare`.
+
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{bail, Context, Result};
+use firmware::bsp::{BspParams, SplitRule};
+use firmware::scene::Scene;
+use firmware::scene_image::{compile, CompileOptions, Layout};
+use serde_json::json;
+
+use crate::metrics;
+use crate::reference::{render, Image, Options};
+
+/// The default scene: `scenes/default.toml` under the current directory,
+/// else beside this crate in the source tree.
+pub fn default_scene() -> PathBuf {
+    let local = PathBuf::from("scenes/default.toml");
+    if local.is_file() {
+        return local;
+    }
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/default.toml")
+}
+
+/// Load a scene (or the default one), errors as `file:line:col: ...`.
+pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
+    let path = path.map_or_else(default_scene, Path::to_path_buf);
+    Ok(Scene::load(&path)?)
+}
+
+/// Write a file atomically: into a temporary file beside it, renamed into
+/// place, so a failed run never leaves half a file.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    tmp.write_all(bytes)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    // A temporary file is created private (0600); the output is an
+    // ordinary file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    tmp.persist(path)
+        .map_err(|e| e.error)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(())
+}
+
+/// Encode 8-bit RGB as PNG.
+pub fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>> {
+    use image::ImageEncoder;
+    let mut out = Vec::new();
+    image::codecs::png::PngEncoder::new(&mut out)
+        .write_image(rgb, width, height, image::ExtendedColorType::Rgb8)
+        .context("cannot encode PNG")?;
+    Ok(out)
+}
+
+/// Read a PNG (any colour type) as 8-bit RGB.
+pub fn read_png(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+    let img = image::ImageReader::open(path)
+        .with_context(|| format!("cannot open {}", path.display()))?
+        .with_guessed_format()
+        .with_context(|| format!("cannot read {}", path.display()))?
+        .decode()
+        .with_context(|| format!("{}: not a readable image", path.display()))?
+        .to_rgb8();
+    Ok((img.width(), img.height(), img.into_raw()))
+}
+
+/// Hit map file: `MSHITS1\n<w> <h>\n` then one little-endian u32 per
+/// pixel (object index, 0xFFFFFFFF for none).
+pub fn hits_bytes(img: &Image) -> Vec<u8> {
+    let mut out = format!("MSHITS1\n{} {}\n", img.width, img.height).into_bytes();
+    for h in &img.hits {
+        out.extend_from_slice(&h.to_le_bytes());
+    }
+    out
+}
+
+pub fn read_hits(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
+    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bad = || {
+        anyhow::anyhow!(
+            "{}: not a hit map (expected 'MSHITS1', size, u32 per pixel)",
+            path.display()
+        )
+    };
+    let mut lines = bytes.splitn(3, |&b| b == b'\n');
+    if lines.next() != Some(b"MSHITS1") {
+        return Err(bad());
+    }
+    let size = std::str::from_utf8(lines.next().ok_or_else(bad)?).map_err(|_| bad())?;
+    let (w, h) = size.split_once(' ').ok_or_else(bad)?;
+    let (w, h): (u32, u32) = (w.parse().map_err(|_| bad())?, h.parse().map_err(|_| bad())?);
+    let data = lines.next().ok_or_else(bad)?;
+    if data.len() != w as usize * h as usize * 4 {
+        return Err(bad());
+    }
+    Ok((
+        w,
+        h,
+        data.chunks_exact(4)
+            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect(),
+    ))
+}
+
+/// Parse `WxH`.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 256x256, found '{s}'"))?;
+    let p = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .ok()
+            .filter(|&n| (1..=16384).contains(&n))
+    };
+    match (p(w), p(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => Err(format!(
+            "expected WIDTHxHEIGHT with each between 1 and 16384, found '{s}'"
+        )),
+    }
+}
+
+/// Arguments of `morphosys reference`.
+pub struct ReferenceArgs {
+    pub scene: Option<PathBuf>,
+    pub size: Option<(u32, u32)>,
+    pub depth: Option<u32>,
+    pub out: Option<PathBuf>,
+    pub json: Option<PathBuf>,
+    pub hits: Option<PathBuf>,
+    pub spd_stats: bool,
+}
+
+/// `morphosys reference`: render a scene with the float reference.
+pub fn reference(a: ReferenceArgs) -> Result<()> {
+    let scene = load_scene(a.scene.as_deref())?;
+    let (width, height, max_depth, corners) = if a.spd_stats {
+        if a.size.is_some_and(|s| s != (512, 512)) || a.depth.is_some_and(|d| d != 5) {
+            bail!("--spd-stats renders as the SPD prescribes (512x512, depth 5): drop --size and --depth");
+        }
+        (512, 512, 5, true)
+    } else {
+        let (w, h) = a.size.unwrap_or(scene.camera.resolution);
+        (w, h, a.depth.unwrap_or(5), false)
+    };
+    if max_depth == 0 {
+        bail!("--depth must be at least 1 (the eye ray)");
+    }
+    let out = a.out.clone().or_else(|| {
+        (!a.spd_stats).then(|| {
+            let stem = Path::new(&scene.source)
+                .file_stem()
+                .map_or("scene".into(), |s| s.to_string_lossy().to_string());
+            PathBuf::from(format!("{stem}-reference.png"))
+        })
+    });
+    let t0 = Instant::now();
+    let img = render(
+        &scene,
+        &Options {
+            width,
+            height,
+            max_depth,
+            corners,
+            progress: true,
+        },
+    );
+    let secs = t0.elapsed().as_secs_f64();
+    let s = img.stats;
+    println!(
+        "{}: {width}x{height}, depth {max_depth}{}, {:.2} s: {} eye rays ({} hit), {} reflection, {} refraction, {} shadow",
+        scene.source,
+        if corners { ", rays through pixel corners" } else { "" },
+        secs,
+        s.eye_rays,
+        s.eye_hit_rays,
+        s.reflect_rays,
+        s.refract_rays,
+        s.shadow_rays
+    );
+    if let Some(out) = &out {
+        write_atomic(out, &png_bytes(img.width, img.height, &img.to_rgb8())?)?;
+        println!("wrote {}", out.display());
+    }
+    if let Some(path) = &a.hits {
+        write_atomic(path, &hits_bytes(&img))?;
+        println!("wrote {}", path.display());
+    }
+    if let Some(path) = &a.json {
+        let v = json!({
+            "scene": scene.source,
+            "width": width,
+            "height": height,
+            "depth": max_depth,
+            "corners": corners,
+            "seconds": secs,
+            "eye_rays": s.eye_rays,
+            "eye_hit_rays": s.eye_hit_rays,
+            "reflect_rays": s.reflect_rays,
+            "refract_rays": s.refract_rays,
+            "shadow_rays": s.shadow_rays,
+            "image": out.as_ref().map(|p| p.display().to_string()),
+        });
+        write_atomic(path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+    }
+    Ok(())
+}
+
+/// Arguments of `morphosys compile`.
+pub struct CompileArgs {
+    pub scene: Option<PathBuf>,
+    pub json: Option<PathBuf>,
+    pub out: Option<PathBuf>,
+    pub sah: bool,
+    pub max_depth: u32,
+    pub max_leaf: usize,
+    pub layout: Option<Layout>,
+}
+
+/// `morphosys compile`: the fixed-point scene image and its report.
+pub fn compile_cmd(a: CompileArgs) -> Result<()> {
+    let scene = load_scene(a.scene.as_deref())?;
+    let opt = CompileOptions {
+        bsp: BspParams {
+            max_depth: a.max_depth,
+            max_leaf: a.max_leaf,
+            rule: if a.sah {
+                SplitRule::Sah
+            } else {
+                SplitRule::Median
+            },
+            snap: 0.0,
+        },
+        layout: a.layout,
+        ..CompileOptions::default()
+    };
+    let img = compile(&scene, &opt)?;
+    print!("{}", img.report.text());
+    if let Some(path) = &a.out {
+        write_atomic(path, &img.to_le_bytes())?;
+        println!(
+            "wrote {} ({} words, little-endian)",
+            path.display(),
+            img.words.len()
+        );
+    }
+    if let Some(path) = &a.json {
+        write_atomic(
+            path,
+            (serde_json::to_string_pretty(&img.report)? + "\n").as_bytes(),
+        )?;
+    }
+    Ok(())
+}
+
+/// `morphosys compare`: PSNR, share of pixels off, and hit agreement.
+pub fn compare(
+    a: &Path,
+    b: &Path,
+    threshold: u8,
+    hits: Option<(PathBuf, PathBuf)>,
+    json_out: Option<PathBuf>,
+) -> Result<()> {
+    let (wa, ha, pa) = read_png(a)?;
+    let (wb, hb, pb) = read_png(b)?;
+    if (wa, ha) != (wb, hb) {
+        bail!(
+            "{} is {wa}x{ha} but {} is {wb}x{hb}",
+            a.display(),
+            b.display()
+        );
+    }
+    let psnr = metrics::psnr(&pa, &pb);
+    let off = metrics::share_off(&pa, &pb, threshold);
+    println!(
+        "PSNR {} dB; {:.3}% of pixels off by more than {threshold}/255",
+        if psnr.is_infinite() {
+            "inf (identical)".to_string()
+        } else {
+            format!("{psnr:.2}")
+        },
+        off * 100.0
+    );
+    let mut agreement = None;
+    if let Some((x, y)) = hits {
+        let (w1, h1, m1) = read_hits(&x)?;
+        let (w2, h2, m2) = read_hits(&y)?;
+        if (w1, h1) != (w2, h2) || (w1, h1) != (wa, ha) {
+            bail!(
+                "hit maps {} ({w1}x{h1}) and {} ({w2}x{h2}) must match the images ({wa}x{ha})",
+                x.display(),
+                y.display()
+            );
+        }
+        let h = metrics::hit_agreement(&m1, &m2);
+        println!("hit agreement {:.3}%", h * 100.0);
+        agreement = Some(h);
+    }
+    if let Some(path) = json_out {
+        let v = json!({
+            "a": a.display().to_string(),
+            "b": b.display().to_string(),
+            "width": wa,
+            "height": ha,
+            "psnr_db": if psnr.is_infinite() { None } else { Some(psnr) },
+            "threshold": threshold,
+            "share_off": off,
+            "hit_agreement": agreement,
+        });
+        write_atomic(&path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+    }
+    Ok(())
+}

@@ -1,0 +1,338 @@
+//! The float reference renderer: the golden model every chip image is
+//! measured against.
+//!
+//! Whitted ray tracing in `f64` with the SPD's rules
+//! (`shared/scenes/README.md`): one-sided primitives (two-sided when
+//! transmitting), no shadow ray where the shading normal faces away from
+//! the light, Phong highlights, a reflection ray from every surface with
+//! Ks > 0 or T > 0, a refraction ray (Snell's law) from every transmitting
+//! surface unless the ray is totally internally reflected, and a maximum
+//! ray depth (the eye ray has depth 1).
+//!
+//! Shading, per NFF: colour = sum over unshadowed lights of
+//! `light * (Kd * colour * N.L + Ks * (R.V)^Shine)` + `Ks * reflected` +
+//! `T * refracted`; no ambient term; a light with no colour has intensity
+//! `1/sqrt(number of lights)`; a ray that hits nothing gets the background.
+//! Shadow rays are stopped by any visible surface (transmitting ones too).
+//!
+//! Every pixel is computed on its own from the scene alone, rows in
+//! parallel with rayon, so an image is bit-identical whatever the number of
+//! threads; the ray counts are integers summed per row.
+
+pub mod bvh;
+pub mod shapes;
+
+use firmware::scene::{Scene, Vec3};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+
+use self::bvh::Bvh;
+use self::shapes::Ray;
+
+/// How to render.
+#[derive(Clone, Debug)]
+pub struct Options {
+    pub width: u32,
+    pub height: u32,
+    /// Maximum ray depth; the eye ray has depth 1.
+    pub max_depth: u32,
+    /// Shoot rays through pixel corners ((w+1) x (h+1) eye rays, as the SPD
+    /// prescribes); a pixel is then the mean of its four corners. Otherwise
+    /// one ray through each pixel centre.
+    pub corners: bool,
+    /// Show a progress bar (only drawn on a terminal).
+    pub progress: bool,
+}
+
+/// The rays a render cast, counted as the SPD counts them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize)]
+pub struct RayStats {
+    pub eye_rays: u64,
+    pub eye_hit_rays: u64,
+    pub reflect_rays: u64,
+    pub refract_rays: u64,
+    pub shadow_rays: u64,
+}
+
+impl std::ops::AddAssign for RayStats {
+    fn add_assign(&mut self, o: RayStats) {
+        self.eye_rays += o.eye_rays;
+        self.eye_hit_rays += o.eye_hit_rays;
+        self.reflect_rays += o.reflect_rays;
+        self.refract_rays += o.refract_rays;
+        self.shadow_rays += o.shadow_rays;
+    }
+}
+
+/// Value of [`Image::hits`] for a pixel whose eye ray hit nothing.
+pub const NO_HIT: u32 = u32::MAX;
+
+/// A rendered image.
+#[derive(Clone, Debug)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    /// Linear RGB, row-major from the top-left, not clamped.
+    pub rgb: Vec<Vec3>,
+    /// Per pixel, the index (into `Scene::objects`) of the object the eye
+    /// ray hit, or [`NO_HIT`]. With corner rays: the pixel's top-left corner.
+    pub hits: Vec<u32>,
+    pub stats: RayStats,
+}
+
+impl Image {
+    /// 8-bit RGB: each channel clamped to [0, 1], times 255, rounded.
+    pub fn to_rgb8(&self) -> Vec<u8> {
+        self.rgb
+            .iter()
+            .flat_map(|c| [to8(c.x), to8(c.y), to8(c.z)])
+            .collect()
+    }
+}
+
+fn to8(x: f64) -> u8 {
+    (x.clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+/// The camera's ray generator.
+struct View {
+    from: Vec3,
+    w: Vec3,
+    u: Vec3,
+    v: Vec3,
+    half: f64,
+}
+
+impl View {
+    fn new(scene: &Scene) -> View {
+        let c = &scene.camera;
+        let w = (c.at - c.from).normalized();
+        let u = w.cross(c.up).normalized(); // right
+        let v = u.cross(w); // up
+        View {
+            from: c.from,
+            w,
+            u,
+            v,
+            half: (c.angle.to_radians() / 2.0).tan(),
+        }
+    }
+
+    /// Ray through screen position (sx, sy) in [-1, 1] (right, up), the
+    /// angle spanning the smaller image dimension, square pixels.
+    fn ray(&self, sx: f64, sy: f64) -> Ray {
+        let d = self.w + self.u * (sx * self.half) + self.v * (sy * self.half);
+        Ray {
+            o: self.from,
+            d: d.normalized(),
+        }
+    }
+}
+
+/// A scene ready to trace.
+pub struct Tracer<'s> {
+    scene: &'s Scene,
+    bvh: Bvh,
+    light_colors: Vec<Vec3>,
+    /// Offset of a spawned ray's origin off the surface, in scene units.
+    eps: f64,
+}
+
+impl<'s> Tracer<'s> {
+    pub fn new(scene: &'s Scene) -> Tracer<'s> {
+        let n = scene.lights.len().max(1) as f64;
+        let light_colors = scene
+            .lights
+            .iter()
+            .map(|l| l.color.unwrap_or(Vec3::ONE * (1.0 / n.sqrt())))
+            .collect();
+        let b = scene.bounds();
+        let extent = if b.is_empty() {
+            1.0
+        } else {
+            b.min.max_abs().max(b.max.max_abs()).max(1e-300)
+        };
+        Tracer {
+            scene,
+            bvh: Bvh::build(scene),
+            light_colors,
+            eps: extent * 1e-9,
+        }
+    }
+
+    /// Nearest visible hit of a ray: (object index, hit).
+    pub fn closest(&self, r: &Ray) -> Option<(usize, shapes::SurfaceHit)> {
+        self.bvh.closest(self.scene, r, 0.0, f64::INFINITY)
+    }
+
+    /// Colour seen along `r` at `depth` (1 = eye ray), counting rays in
+    /// `stats`; returns the colour and the object hit.
+    pub fn trace(
+        &self,
+        r: &Ray,
+        depth: u32,
+        max_depth: u32,
+        stats: &mut RayStats,
+    ) -> (Vec3, Option<usize>) {
+        let Some((id, h)) = self.closest(r) else {
+            return (self.scene.background, None);
+        };
+        let obj = &self.scene.objects[id];
+        let m = &self.scene.materials[obj.material];
+        let p = r.at(h.t);
+        // Normals on the side the ray came from.
+        let (n, ns) = if h.front { (h.n, h.ns) } else { (-h.n, -h.ns) };
+        let view = -r.d;
+        let mut color = Vec3::ZERO;
+        for (light, lc) in self.scene.lights.iter().zip(&self.light_colors) {
+            let to_light = light.position - p;
+            let dist = to_light.length();
+            let l = to_light / dist;
+            let nl = ns.dot(l);
+            if nl <= 0.0 {
+                continue; // the SPD's rule: no shadow ray
+            }
+            stats.shadow_rays += 1;
+            let o = self.offset(p, n, l);
+            let shadow = Ray { o, d: l };
+            if self
+                .bvh
+                .occluded(self.scene, &shadow, 0.0, (light.position - o).length())
+            {
+                continue;
+            }
+            let mut c = m.color * (m.kd * nl);
+            if m.ks > 0.0 {
+                let refl = ns * (2.0 * nl) - l;
+                let rv = refl.dot(view);
+                if rv > 0.0 {
+                    c = c + Vec3::ONE * (m.ks * rv.powf(m.shine));
+                }
+            }
+            color = color + c.mul_elem(*lc);
+        }
+        if depth < max_depth && (m.ks > 0.0 || m.t > 0.0) {
+            stats.reflect_rays += 1;
+            let d = r.d - ns * (2.0 * r.d.dot(ns));
+            let d = if d.dot(n) > 0.0 {
+                d
+            } else {
+                r.d - n * (2.0 * r.d.dot(n))
+            };
+            let refl = Ray {
+                o: self.offset(p, n, d),
+                d: d.normalized(),
+            };
+            let (c, _) = self.trace(&refl, depth + 1, max_depth, stats);
+            color = color + c * m.ks;
+        }
+        if depth < max_depth && m.t > 0.0 {
+            // Entering through the visible side: from 1 into ior.
+            let eta = if h.front { 1.0 / m.ior } else { m.ior };
+            let cos_i = -r.d.dot(ns);
+            let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
+            if k >= 0.0 {
+                stats.refract_rays += 1;
+                let d = (r.d * eta + ns * (eta * cos_i - k.sqrt())).normalized();
+                let refr = Ray {
+                    o: self.offset(p, n, d),
+                    d,
+                };
+                let (c, _) = self.trace(&refr, depth + 1, max_depth, stats);
+                color = color + c * m.t;
+            }
+        }
+        (color, Some(id))
+    }
+
+    /// Origin of a ray leaving `p` in direction `d`: nudged off the surface
+    /// to the side `d` goes.
+    fn offset(&self, p: Vec3, n: Vec3, d: Vec3) -> Vec3 {
+        if d.dot(n) >= 0.0 {
+            p + n * self.eps
+        } else {
+            p - n * self.eps
+        }
+    }
+}
+
+/// Render a scene.
+pub fn render(scene: &Scene, opt: &Options) -> Image {
+    let tracer = Tracer::new(scene);
+    let view = View::new(scene);
+    let (w, h) = (opt.width.max(1), opt.height.max(1));
+    let (sw, sh) = if opt.corners { (w + 1, h + 1) } else { (w, h) };
+    // Screen coordinates: the samples span [-1, 1] along the smaller image
+    // dimension (NFF: the angle is from the first to the last sample row).
+    let span = |i: u32, n: u32| {
+        if n <= 1 {
+            0.0
+        } else {
+            2.0 * i as f64 / (n - 1) as f64 - 1.0
+        }
+    };
+    let (ax, ay) = if w >= h {
+        (w as f64 / h as f64, 1.0)
+    } else {
+        (1.0, h as f64 / w as f64)
+    };
+    let bar = if opt.progress && (sw as u64 * sh as u64) >= 1 << 16 {
+        let b = ProgressBar::new(sh as u64);
+        b.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, {eta} left")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b.set_message("tracing");
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let rows: Vec<(Vec<Vec3>, Vec<u32>, RayStats)> = (0..sh)
+        .into_par_iter()
+        .map(|j| {
+            let mut stats = RayStats::default();
+            let mut colors = Vec::with_capacity(sw as usize);
+            let mut ids = Vec::with_capacity(sw as usize);
+            for i in 0..sw {
+                let ray = view.ray(span(i, sw) * ax, -span(j, sh) * ay);
+                stats.eye_rays += 1;
+                let (c, id) = tracer.trace(&ray, 1, opt.max_depth, &mut stats);
+                if id.is_some() {
+                    stats.eye_hit_rays += 1;
+                }
+                colors.push(c);
+                ids.push(id.map_or(NO_HIT, |i| i as u32));
+            }
+            bar.inc(1);
+            (colors, ids, stats)
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut stats = RayStats::default();
+    for (_, _, s) in &rows {
+        stats += *s;
+    }
+    let mut rgb = Vec::with_capacity((w * h) as usize);
+    let mut hits = Vec::with_capacity((w * h) as usize);
+    if opt.corners {
+        for j in 0..h as usize {
+            for i in 0..w as usize {
+                let (a, b) = (&rows[j].0, &rows[j + 1].0);
+                rgb.push((a[i] + a[i + 1] + b[i] + b[i + 1]) * 0.25);
+                hits.push(rows[j].1[i]);
+            }
+        }
+    } else {
+        for (c, id, _) in rows {
+            rgb.extend(c);
+            hits.extend(id);
+        }
+    }
+    Image {
+        width: w,
+        height: h,
+        rgb,
+        hits,
+        stats,
+    }
+}

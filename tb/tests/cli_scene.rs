@@ -1,0 +1,156 @@
+//! `morphosys reference`, `compile` and `compare` from the command line.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn shared(name: &str) -> String {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../../shared/scenes")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+#[test]
+fn reference_default_scene_png_and_json() {
+    let dir = tempfile::tempdir().unwrap();
+    // No scene argument: scenes/default.toml (found beside the sources).
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "reference",
+            "--size",
+            "40x30",
+            "--depth",
+            "2",
+            "--out",
+            "a.png",
+            "--json",
+            "a.json",
+            "--hits",
+            "a.hits",
+        ],
+    );
+    assert!(ok, "{out}{err}");
+    assert!(out.contains("default.toml: 40x30, depth 2"), "{out}");
+    let img = image::open(dir.path().join("a.png")).unwrap();
+    assert_eq!((img.width(), img.height()), (40, 30));
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("a.json")).unwrap()).unwrap();
+    assert_eq!(j["eye_rays"], 1200);
+    // Only temporary files renamed into place: nothing else left behind.
+    let mut names: Vec<String> = std::fs::read_dir(dir.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["a.hits", "a.json", "a.png"]);
+    // The same image compares as identical, hit maps agree.
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &["compare", "a.png", "a.png", "--hits", "a.hits", "a.hits"],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("PSNR inf") && out.contains("hit agreement 100.000%"),
+        "{out}"
+    );
+}
+
+#[test]
+fn spd_stats_json_keys() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "reference",
+            &shared("tetra-1.nff"),
+            "--spd-stats",
+            "--json",
+            "s.json",
+        ],
+    );
+    assert!(ok, "{out}{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("s.json")).unwrap()).unwrap();
+    for k in [
+        "eye_hit_rays",
+        "reflect_rays",
+        "refract_rays",
+        "shadow_rays",
+    ] {
+        assert!(j[k].is_u64(), "{k} missing: {j}");
+    }
+    assert_eq!(j["eye_rays"], 513 * 513);
+    assert_eq!(j["reflect_rays"], 0);
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &[
+            "reference",
+            &shared("tetra-1.nff"),
+            "--spd-stats",
+            "--depth",
+            "3",
+        ],
+    );
+    assert!(!ok && err.contains("--spd-stats"), "{err}");
+}
+
+#[test]
+fn compile_reports_and_bad_scenes_fail_with_file_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "compile",
+            &shared("jacks-1.nff"),
+            "--json",
+            "r.json",
+            "--out",
+            "img.bin",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert!(out.contains("format: Q"), "{out}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let words = j["total_words"].as_u64().unwrap();
+    assert_eq!(
+        std::fs::metadata(dir.path().join("img.bin")).unwrap().len(),
+        2 * words
+    );
+    std::fs::write(
+        dir.path().join("bad.nff"),
+        "v\nfrom 0 0 1\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 4 4\ns 0 0 0 -0\n",
+    )
+    .unwrap();
+    for cmd in ["compile", "reference"] {
+        let (ok, out, err) = morphosys(dir.path(), &[cmd, "bad.nff", "--out", "x"]);
+        assert!(!ok, "{out}");
+        assert_eq!(
+            err.trim(),
+            "morphosys: error: bad.nff:8:1: sphere has radius 0",
+            "{cmd}"
+        );
+    }
+    assert!(!dir.path().join("x").exists());
+    // An output in a missing directory: an error, no file.
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &["reference", "--size", "8x8", "--out", "nodir/a.png"],
+    );
+    assert!(!ok && err.contains("nodir/a.png"), "{err}");
+}
