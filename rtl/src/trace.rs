@@ -132,6 +132,18 @@ pub struct Tracer {
     err: Option<io::Error>,
 }
 
+/// Temporary files are created 0600; outputs are ordinary files (0644).
+fn readable(f: &File) -> io::Result<()> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        f.set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
+    #[cfg(not(unix))]
+    let _ = f;
+    Ok(())
+}
+
 /// Write a small text file through a temporary file and a rename.
 fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
     let dir = match path.parent() {
@@ -139,6 +151,7 @@ fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
         _ => Path::new("."),
     };
     let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
+    readable(tmp.as_file())?;
     tmp.write_all(text.as_bytes())?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
@@ -210,6 +223,7 @@ impl Tracer {
             .suffix(".vcd.partial")
             .tempfile_in(&dir)?;
         let (file, tmp_path) = tmp.into_parts();
+        readable(&file)?;
         let mut w = vcd::Writer::new(BufWriter::with_capacity(1 << 16, file));
         w.version(concat!("morphosys ", env!("CARGO_PKG_VERSION")))?;
         w.timescale(1, TimescaleUnit::PS)?;
