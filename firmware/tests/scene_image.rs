@@ -217,7 +217,7 @@ fn refuses_what_it_cannot_represent() {
 
 #[test]
 fn spd_scenes_compile() {
-    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/scenes");
+    let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd");
     let balls = Scene::load(&dir.join("balls-4.nff")).unwrap();
     let img = compile(&balls, &CompileOptions::default()).unwrap();
     let r = &img.report;

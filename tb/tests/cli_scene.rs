@@ -18,7 +18,7 @@ fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
 
 fn shared(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/scenes")
+        .join("../scenes/spd")
         .join(name)
         .display()
         .to_string()

@@ -7,7 +7,7 @@ use firmware::scene::{PrimType, Scene, Shape};
 
 fn spd(name: &str) -> Scene {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/scenes")
+        .join("../scenes/spd")
         .join(name);
     Scene::load(&p).unwrap_or_else(|e| panic!("{e}"))
 }
@@ -21,7 +21,7 @@ fn count(s: &Scene, t: PrimType) -> usize {
 
 #[test]
 fn spd_scenes_import_with_published_counts() {
-    // shared/scenes/README.md: jacks-1 6 spheres, 3 cylinders, 1 light.
+    // scenes/spd/README.md: jacks-1 6 spheres, 3 cylinders, 1 light.
     let j = spd("jacks-1.nff");
     assert_eq!(
         (

@@ -126,8 +126,8 @@ fn bvh_agrees_with_brute_force() {
     let dir = std::path::PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     for path in [
         dir.join("../scenes/default.toml"),
-        dir.join("../../shared/scenes/jacks-1.nff"),
-        dir.join("../../shared/scenes/tetra-6.nff"),
+        dir.join("../scenes/spd/jacks-1.nff"),
+        dir.join("../scenes/spd/tetra-6.nff"),
     ] {
         let s = Scene::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let tracer = Tracer::new(&s);

@@ -1,4 +1,4 @@
-//! The SPD's published ray statistics (shared/scenes/README.md): a correct
+//! The SPD's published ray statistics (scenes/spd/README.md): a correct
 //! classical ray tracer lands within about 10% of them. 512x512 image, rays
 //! through pixel corners (513x513 eye rays), maximum depth 5.
 
@@ -9,7 +9,7 @@ use tb::reference::{render, Options, RayStats};
 
 fn spd_scene(name: &str) -> Scene {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/scenes")
+        .join("../scenes/spd")
         .join(name);
     Scene::load(&p).unwrap_or_else(|e| panic!("{e}"))
 }

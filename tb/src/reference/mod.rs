@@ -2,7 +2,7 @@
 //! measured against.
 //!
 //! Whitted ray tracing in `f64` with the SPD's rules
-//! (`shared/scenes/README.md`): one-sided primitives (two-sided when
+//! (`scenes/spd/README.md`): one-sided primitives (two-sided when
 //! transmitting), no shadow ray where the shading normal faces away from
 //! the light, Phong highlights, a reflection ray from every surface with
 //! Ks > 0 or T > 0, a refraction ray (Snell's law) from every transmitting
