@@ -2,6 +2,7 @@
 //! TinyRISC and context sources, and the scene compiler. Knows nothing of
 //! host-side rendering.
 
+pub mod asm;
 pub mod scene;
 pub mod bsp;
 pub mod scene_image;

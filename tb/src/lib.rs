@@ -2,6 +2,8 @@
 //! pieces of the `morphosys` command.
 
 pub mod cli;
+pub mod cmd_asm;
+pub mod cmd_run;
 pub mod testbench;
 pub mod reference;
 pub mod cmd_scene;

@@ -22,6 +22,27 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// Assemble TinyRISC code and RC contexts; with -o write the image,
+    /// without print the listing.
+    Asm {
+        file: PathBuf,
+        /// Write the assembled image here.
+        #[arg(short, long, value_name = "OUT")]
+        out: Option<PathBuf>,
+    },
+    /// Run a program (assembly source or image) on the chip to its halt and
+    /// print the cycles used.
+    Run {
+        file: PathBuf,
+        /// Stop with an error after this many cycles.
+        #[arg(long, value_name = "N", default_value_t = 100_000_000)]
+        max_cycles: u64,
+        /// Write the waveform here (GTKWave save file and filters beside it).
+        #[arg(long, value_name = "PATH")]
+        vcd: Option<PathBuf>,
+        #[command(flatten)]
+        window: tb::cli::TraceWindow,
+    },
     /// Run a testbench: drive a block of the chip, check it against a
     /// reference model, write its waveform.
     Tb {
@@ -112,6 +133,13 @@ enum Bench {
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
+        Command::Asm { file, out } => tb::cmd_asm::command(file, out),
+        Command::Run {
+            file,
+            max_cycles,
+            vcd,
+            window,
+        } => tb::cmd_run::command(file, max_cycles, vcd, window),
         Command::Tb { bench } => match bench {
             Bench::Rc { vcd, window } => tb::testbench::rc::command(vcd, window),
         },

@@ -1,0 +1,274 @@
+//! RC context syntax: the disassembly of [`rtl::rc::context::Context`].
+//!
+//! ```text
+//! [(f) | (!f)] op[.cond][.t] operands
+//!   A := rN | out | n | s | w | e | qrowK | qcolK | xrowK | xcolK | fbK
+//!   B := rN | #EXPR            (immediate -1024..=1023)
+//!   D := rN | out              (out: result only to the output register)
+//!   add D, A, B [, >>SH]       (and every two-operand op; >>SH only for
+//!                               mul/mac/msu; .t = truncate instead of round)
+//!   not|mov|abs|neg|clz D, A     movb D, B     cmp.COND A, B
+//!   ld D, [A + B]     st A, [B]     acc|acch|accl D [, >>SH]
+//!   ldacc A [, <<SH]  nop  sleep  wake
+//! ```
+
+use rtl::rc::context::{ASrc, BSrc, Context, Guard, Op, ALL_CONDS, ALL_OPS};
+
+use super::lexer::{Tok, Token};
+use super::tinyrisc::register;
+use super::{split_operands, Asm, AsmError, LineCtx};
+
+fn asrc(name: &str) -> Option<(ASrc, u8)> {
+    if let Some(r) = register(name) {
+        return Some((ASrc::Reg, r));
+    }
+    let idx = |p: &str, max: u8| -> Option<u8> {
+        let n = name.strip_prefix(p)?;
+        if n.len() != 1 {
+            return None;
+        }
+        let v: u8 = n.parse().ok()?;
+        (v <= max).then_some(v)
+    };
+    Some(match name {
+        "out" => (ASrc::Out, 0),
+        "n" => (ASrc::Nbr, 0),
+        "s" => (ASrc::Nbr, 1),
+        "w" => (ASrc::Nbr, 2),
+        "e" => (ASrc::Nbr, 3),
+        _ => {
+            if let Some(k) = idx("qrow", 3) {
+                (ASrc::QRow, k)
+            } else if let Some(k) = idx("qcol", 3) {
+                (ASrc::QCol, k)
+            } else if let Some(k) = idx("xrow", 7) {
+                (ASrc::XRow, k)
+            } else if let Some(k) = idx("xcol", 7) {
+                (ASrc::XCol, k)
+            } else if let Some(k) = idx("fb", 1) {
+                (ASrc::Fb, k)
+            } else {
+                return None;
+            }
+        }
+    })
+}
+
+fn one_ident(toks: &[Token], (a, b): (usize, usize)) -> Option<&str> {
+    if b == a + 1 {
+        if let Tok::Ident(n) = &toks[a].tok {
+            return Some(n);
+        }
+    }
+    None
+}
+
+/// Assemble one context line; returns the word.
+pub(crate) fn context(asm: &Asm, lc: &LineCtx, mut i: usize) -> Result<u32, AsmError> {
+    let t = lc.toks;
+    let (guard, h) = guard_prefix(t, i);
+    i = h;
+    let head = i;
+    let Some(Tok::Ident(m)) = t.get(head).map(|x| &x.tok) else {
+        return Err(lc.err_at(Some(head), "expected a context"));
+    };
+    let mut parts = m.split('.');
+    let base = parts.next().unwrap_or("");
+    let Some(op) = ALL_OPS.iter().copied().find(|o| o.mnemonic() == base) else {
+        return Err(lc.err_at(
+            Some(head),
+            format!(
+                "unknown RC operation `{base}` (in .ctx: RC contexts; TinyRISC code goes in .text)"
+            ),
+        ));
+    };
+    let mut cond = None;
+    let mut trunc = false;
+    for s in parts {
+        if op == Op::Cmp && cond.is_none() {
+            match ALL_CONDS.iter().copied().find(|c| c.mnemonic() == s) {
+                Some(c) => cond = Some(c),
+                None => return Err(lc.err_at(Some(head), format!("unknown condition `.{s}`"))),
+            }
+        } else if s == "t" && op.uses_shift() && !trunc {
+            trunc = true;
+        } else {
+            return Err(lc.err_at(Some(head), format!("unexpected suffix `.{s}` on `{base}`")));
+        }
+    }
+    if op == Op::Cmp && cond.is_none() {
+        return Err(lc.err_at(Some(head), "`cmp` needs a condition: cmp.eq, cmp.lt, ..."));
+    }
+    let ops = split_operands(t, head + 1);
+    let mut ops = ops;
+    // optional trailing `>>SH`
+    let mut shift = 0u8;
+    let mut shift_at = None;
+    if let Some(&(a, b)) = ops.last() {
+        if matches!(
+            t.get(a).map(|x| &x.tok),
+            Some(Tok::P(">>")) | Some(Tok::P("<<"))
+        ) {
+            if !op.uses_shift() {
+                return Err(lc.err_at(Some(a), format!("`{base}` takes no shift")));
+            }
+            let left = matches!(t[a].tok, Tok::P("<<"));
+            if left != (op == Op::Ldacc) {
+                let want = if op == Op::Ldacc { "<<" } else { ">>" };
+                return Err(lc.err_at(Some(a), format!("`{base}` shifts with `{want}SH`")));
+            }
+            let v = asm.value(lc, a + 1, b)?.unwrap_or(0);
+            if !(0..=31).contains(&v) {
+                return Err(lc.err_at(Some(a + 1), format!("shift {v} out of range 0..=31")));
+            }
+            shift = v as u8;
+            shift_at = Some(a);
+            ops.pop();
+        }
+    }
+    let want = |n: usize, syn: &str| -> Result<(), AsmError> {
+        if ops.len() != n {
+            Err(lc.err_at(Some(head), format!("`{base}` takes {syn}")))
+        } else {
+            Ok(())
+        }
+    };
+    let a_of = |k: (usize, usize)| -> Result<(ASrc, u8), AsmError> {
+        one_ident(t, k).and_then(asrc).ok_or_else(|| {
+            lc.err_at(
+                Some(k.0).filter(|&x| x < k.1),
+                "expected operand A: rN, out, n, s, w, e, qrowK, qcolK, xrowK, xcolK or fbK",
+            )
+        })
+    };
+    let b_of = |k: (usize, usize)| -> Result<BSrc, AsmError> {
+        if let Some(r) = one_ident(t, k).and_then(register) {
+            return Ok(BSrc::Reg(r));
+        }
+        if matches!(t.get(k.0).map(|x| &x.tok), Some(Tok::P("#"))) && k.1 > k.0 + 1 {
+            let v = asm.value(lc, k.0 + 1, k.1)?.unwrap_or(0);
+            if !(-1024..=1023).contains(&v) {
+                return Err(lc.err_at(
+                    Some(k.0 + 1),
+                    format!("immediate {v} out of range -1024..=1023"),
+                ));
+            }
+            return Ok(BSrc::Imm(v as i16));
+        }
+        Err(lc.err_at(
+            Some(k.0).filter(|&x| x < k.1),
+            "expected operand B: rN or #EXPR",
+        ))
+    };
+    let d_of = |k: (usize, usize)| -> Result<(bool, u8), AsmError> {
+        match one_ident(t, k) {
+            Some("out") => Ok((false, 0)),
+            Some(n) if register(n).is_some() => Ok((true, register(n).unwrap_or(0))),
+            _ => Err(lc.err_at(
+                Some(k.0).filter(|&x| x < k.1),
+                "expected destination: rN or out",
+            )),
+        }
+    };
+    // [X] or [X + Y]: inner token range(s)
+    let bracket = |k: (usize, usize)| -> Option<(usize, usize)> {
+        if k.1 >= k.0 + 2
+            && matches!(t[k.0].tok, Tok::P("["))
+            && matches!(t[k.1 - 1].tok, Tok::P("]"))
+        {
+            Some((k.0 + 1, k.1 - 1))
+        } else {
+            None
+        }
+    };
+    let mut c = Context {
+        op,
+        guard,
+        ..Context::NOP
+    };
+    use Op::*;
+    match op {
+        Nop | Sleep | Wake => want(0, "no operands")?,
+        Cmp => {
+            want(2, "`A, B`")?;
+            (c.asrc, c.ra) = a_of(ops[0])?;
+            c.b = b_of(ops[1])?;
+            c.rd = cond.map_or(0, |x| x as u8);
+        }
+        St => {
+            want(2, "`A, [B]`")?;
+            (c.asrc, c.ra) = a_of(ops[0])?;
+            let inner =
+                bracket(ops[1]).ok_or_else(|| lc.err_at(Some(ops[1].0), "expected `[B]`"))?;
+            c.b = b_of(inner)?;
+        }
+        Ld => {
+            want(2, "`D, [A + B]`")?;
+            (c.we, c.rd) = d_of(ops[0])?;
+            let inner =
+                bracket(ops[1]).ok_or_else(|| lc.err_at(Some(ops[1].0), "expected `[A + B]`"))?;
+            let plus = (inner.0..inner.1).find(|&x| matches!(t[x].tok, Tok::P("+")));
+            let Some(p) = plus else {
+                return Err(lc.err_at(Some(inner.0), "expected `[A + B]`"));
+            };
+            (c.asrc, c.ra) = a_of((inner.0, p))?;
+            c.b = b_of((p + 1, inner.1))?;
+        }
+        Not | Mov | Abs | Neg | Clz => {
+            want(2, "`D, A`")?;
+            (c.we, c.rd) = d_of(ops[0])?;
+            (c.asrc, c.ra) = a_of(ops[1])?;
+        }
+        Movb => {
+            want(2, "`D, B`")?;
+            (c.we, c.rd) = d_of(ops[0])?;
+            c.b = b_of(ops[1])?;
+        }
+        Acc | Acch | Accl => {
+            want(1, "`D`")?;
+            (c.we, c.rd) = d_of(ops[0])?;
+        }
+        Ldacc => {
+            want(1, "`A`")?;
+            (c.asrc, c.ra) = a_of(ops[0])?;
+        }
+        _ => {
+            want(3, "`D, A, B`")?;
+            (c.we, c.rd) = d_of(ops[0])?;
+            (c.asrc, c.ra) = a_of(ops[1])?;
+            c.b = b_of(ops[2])?;
+        }
+    }
+    if !op.has_result() {
+        c.we = false;
+    }
+    if shift != 0 || trunc {
+        if matches!(c.b, BSrc::Imm(_)) {
+            return Err(lc.err_at(
+                shift_at.or(Some(head)),
+                "a shift or `.t` needs operand B in a register (the immediate form has no shift field)",
+            ));
+        }
+        if !matches!(op, Mul | Mac | Msu | Acc | Ldacc) && shift != 0 {
+            return Err(lc.err_at(shift_at, format!("`{base}` takes no shift")));
+        }
+    }
+    c.shift = shift;
+    c.trunc = trunc;
+    c.guard = guard;
+    Ok(c.encode())
+}
+
+/// The guard prefix `(f)` / `(!f)`: returns the guard and the index of the
+/// mnemonic.
+pub(crate) fn guard_prefix(t: &[Token], i: usize) -> (Guard, usize) {
+    let is = |k: usize, p: &str| matches!(t.get(k).map(|x| &x.tok), Some(Tok::P(q)) if *q == p);
+    let id = |k: usize, s: &str| matches!(t.get(k).map(|x| &x.tok), Some(Tok::Ident(n)) if n == s);
+    if is(i, "(") && id(i + 1, "f") && is(i + 2, ")") {
+        (Guard::IfF, i + 3)
+    } else if is(i, "(") && is(i + 1, "!") && id(i + 2, "f") && is(i + 3, ")") {
+        (Guard::IfNotF, i + 4)
+    } else {
+        (Guard::Always, i)
+    }
+}

@@ -1,0 +1,386 @@
+//! The MorphoSys chip: TinyRISC, the context broadcast unit, the 8x8 RC
+//! array with its interconnect, the frame buffer, the context memory, the
+//! DMA controller and main memory, wired together.
+//!
+//! ```text
+//!               +-----------+   commands    +-------------------+
+//!   main mem <->| TinyRISC  |-------------->| broadcast unit    |--contexts--+
+//!      ^        +-----------+  (Machine)    +-------------------+            v
+//!      |             | status, rcrisc            |  fb0/fb1 streams  +--------------+
+//!      v             +------------------------------------------- ---| 8x8 RC array |
+//!   +-----+   ldfb/stfb   +--------------+     broadcast            +--------------+
+//!   | DMA |-------------->| frame buffer |------------------------------^     | wfb
+//!   +-----+   ldctxt      +--------------+<------------------------------------+
+//!      +----------------->| context memory (decoded) |
+//! ```
+//!
+//! One [`Chip::eval`] + [`Chip::commit`] is one 300 MHz cycle. Every cycle
+//! parameter is in [`Timing`]; [`Stats`] counts cycles, array busy cycles,
+//! active RCs, stalls.
+
+use crate::array::Array;
+use crate::broadcast::Broadcast;
+use crate::context_memory::ContextMemory;
+use crate::dma::{Dma, DmaTiming};
+use crate::fb::{self, FrameBuffer};
+use crate::kernel::{Clocked, Fault, Sim, StepError};
+use crate::memory::MainMemory;
+use crate::rc::context::Context;
+use crate::tinyrisc::{decode, Command, Machine, RiscTiming, TinyRisc};
+use crate::trace::{Display, Probe, Traced};
+
+/// Every cycle parameter of the chip.
+///
+/// Fixed by the architecture (not parameters): the array executes one
+/// context (or one row/column group) per cycle; a run's first context
+/// executes in the cycle after the issuing instruction; the FB supplies one
+/// datum per set per cycle; `wfb` moves one row of 8 outputs per cycle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Timing {
+    pub risc: RiscTiming,
+    pub dma: DmaTiming,
+    /// Clock for reporting (frames/s, waveform time): 300 MHz.
+    pub clock_hz: u64,
+}
+
+impl Default for Timing {
+    fn default() -> Self {
+        Timing {
+            risc: RiscTiming::default(),
+            dma: DmaTiming::default(),
+            clock_hz: 300_000_000,
+        }
+    }
+}
+
+/// Run statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    pub cycles: u64,
+    /// Cycles in which the array executed a context.
+    pub array_busy_cycles: u64,
+    /// Sum over cycles of the RCs that executed.
+    pub active_rc_cycles: u64,
+    pub risc_instructions: u64,
+    pub risc_busy_cycles: u64,
+    /// TinyRISC cycles lost waiting for the array.
+    pub array_stall_cycles: u64,
+    /// TinyRISC cycles lost waiting for the DMA channel.
+    pub dma_stall_cycles: u64,
+    pub dma_busy_cycles: u64,
+    pub dma_words: u64,
+    pub dma_transfers: u64,
+}
+
+impl Stats {
+    /// Fraction of the RCs that executed, over the array's busy cycles.
+    pub fn active_rc_fraction(&self) -> f64 {
+        if self.array_busy_cycles == 0 {
+            0.0
+        } else {
+            self.active_rc_cycles as f64 / (64.0 * self.array_busy_cycles as f64)
+        }
+    }
+}
+
+pub struct Chip {
+    pub risc: TinyRisc,
+    pub bcast: Broadcast,
+    pub array: Array,
+    pub ctx_mem: ContextMemory,
+    pub fb: FrameBuffer,
+    pub mem: MainMemory,
+    pub dma: Dma,
+    pub timing: Timing,
+    cycles: u64,
+    array_busy: u64,
+    active_rc: u64,
+}
+
+/// TinyRISC's view of the chip.
+struct View<'a> {
+    array: &'a Array,
+    bcast: &'a Broadcast,
+    fb: &'a FrameBuffer,
+    mem: &'a MainMemory,
+    dma: &'a Dma,
+    cycles: u64,
+}
+
+fn dma_conflict(dma: &Dma, bank: usize, what: &str) -> Fault {
+    let (req, pc) = dma.current().expect("owned bank implies a transfer");
+    Fault::new(
+        "fb",
+        format!(
+            "DMA conflict: {what} FB bank {bank} while `{}` (issued at pc 0x{pc:08x}) transfers it",
+            req.kind.name()
+        ),
+    )
+}
+
+impl Machine for View<'_> {
+    #[inline]
+    fn fetch(&self, pc: u32) -> Result<u32, Fault> {
+        self.mem
+            .check(pc, 4)
+            .map_err(|f| Fault::new("tinyrisc", format!("instruction fetch: {}", f.message)))?;
+        Ok(self.mem.read(pc, 4))
+    }
+    fn load(&self, addr: u32, size: u32) -> Result<u32, Fault> {
+        self.mem.check(addr, size)?;
+        Ok(self.mem.read(addr, size))
+    }
+    fn check_store(&self, addr: u32, size: u32) -> Result<(), Fault> {
+        self.mem.check(addr, size)
+    }
+    fn fb_read(&self, addr: u16) -> Result<i16, Fault> {
+        if self.dma.owned_fb_banks() >> fb::bank(addr) & 1 != 0 {
+            return Err(dma_conflict(self.dma, fb::bank(addr), "TinyRISC reads"));
+        }
+        Ok(self.fb.read(addr))
+    }
+    fn check_fb_write(&self, addr: u16, words: u32) -> Result<(), Fault> {
+        let last = (addr as u32 + words.max(1) - 1).min(0xFFFF) as u16;
+        for b in fb::bank(addr)..=fb::bank(last) {
+            if self.dma.owned_fb_banks() >> b & 1 != 0 {
+                return Err(dma_conflict(self.dma, b, "a write to"));
+            }
+        }
+        Ok(())
+    }
+    fn rc_out(&self, lane: usize) -> i16 {
+        self.array.rc.out[lane]
+    }
+    fn rc_flags(&self) -> (u64, u64) {
+        (self.array.rc.flags.f, self.array.rc.flags.sleep)
+    }
+    fn array_can_issue(&self) -> bool {
+        self.bcast.can_issue()
+    }
+    fn array_idle(&self) -> bool {
+        self.bcast.idle()
+    }
+    fn dma_idle(&self) -> bool {
+        self.dma.idle()
+    }
+    fn mem_size(&self) -> usize {
+        self.mem.size()
+    }
+    fn cycle(&self) -> u64 {
+        self.cycles
+    }
+}
+
+impl Chip {
+    pub fn new(timing: Timing, mem_bytes: usize) -> Chip {
+        Chip {
+            risc: TinyRisc::new(0, timing.risc),
+            bcast: Broadcast::default(),
+            array: Array::new(),
+            ctx_mem: ContextMemory::default(),
+            fb: FrameBuffer::default(),
+            mem: MainMemory::new(mem_bytes),
+            dma: Dma::new(timing.dma),
+            timing,
+            cycles: 0,
+            array_busy: 0,
+            active_rc: 0,
+        }
+    }
+
+    /// Load bytes into main memory (the program loader).
+    pub fn load(&mut self, addr: u32, bytes: &[u8]) -> Result<(), Fault> {
+        self.mem.load(addr, bytes)
+    }
+
+    /// Set TinyRISC's start address.
+    pub fn set_entry(&mut self, pc: u32) {
+        self.risc.pc = pc;
+    }
+
+    pub fn halted(&self) -> bool {
+        self.risc.halted()
+    }
+
+    pub fn stats(&self) -> Stats {
+        Stats {
+            cycles: self.cycles,
+            array_busy_cycles: self.array_busy,
+            active_rc_cycles: self.active_rc,
+            risc_instructions: self.risc.issued,
+            risc_busy_cycles: self.risc.busy_cycles,
+            array_stall_cycles: self.risc.stall_array,
+            dma_stall_cycles: self.risc.stall_dma,
+            dma_busy_cycles: self.dma.busy_cycles,
+            dma_words: self.dma.words_moved,
+            dma_transfers: self.dma.transfers,
+        }
+    }
+
+    /// Add where TinyRISC is to a fault's message.
+    fn locate(&self, mut f: Fault) -> Fault {
+        let pc = self.risc.pc;
+        let text = if self.mem.check(pc, 4).is_ok() {
+            decode::disassemble(self.mem.read(pc, 4))
+        } else {
+            "?".to_string()
+        };
+        f.message = format!("{} [pc 0x{pc:08x}: `{text}`]", f.message);
+        f
+    }
+}
+
+impl Clocked for Chip {
+    #[inline]
+    fn eval(&mut self) -> Result<(), Fault> {
+        let view = View {
+            array: &self.array,
+            bcast: &self.bcast,
+            fb: &self.fb,
+            mem: &self.mem,
+            dma: &self.dma,
+            cycles: self.cycles,
+        };
+        if let Err(f) = self.risc.eval(&view) {
+            return Err(self.locate(f));
+        }
+        if let Err(f) = self.bcast.eval(
+            &self.ctx_mem,
+            &self.fb,
+            self.dma.owned_fb_banks(),
+            self.dma.owned_ctx_banks(),
+            &mut self.array,
+        ) {
+            return Err(self.locate(f));
+        }
+        if let Err(f) = self.array.eval() {
+            return Err(self.locate(f));
+        }
+        Ok(())
+    }
+
+    #[inline]
+    fn commit(&mut self) {
+        self.array.commit();
+        if self.array.is_active() {
+            self.array_busy += 1;
+            self.active_rc += self.array.active_now as u64;
+        }
+        self.bcast.commit();
+        self.dma
+            .tick(&mut self.mem, &mut self.fb, &mut self.ctx_mem);
+        match self.risc.cmd {
+            Command::None => {}
+            Command::Store { addr, size, value } => self.mem.write(addr, size, value),
+            Command::FbWrite { addr, value } => self.fb.write(addr, value),
+            Command::Wfb { addr } => {
+                for (i, v) in self.array.rc.out.iter().enumerate() {
+                    self.fb.write(addr + i as u16, *v);
+                }
+            }
+            Command::Dma(req) => self.dma.start(req, self.risc.pc),
+            Command::Run(run) => self.bcast.issue(run),
+        }
+        self.risc.commit();
+        self.cycles += 1;
+    }
+}
+
+impl Traced for Chip {
+    fn trace(&self, p: &mut dyn Probe) {
+        if p.scope(format_args!("tinyrisc")) {
+            self.risc.trace(p);
+            p.end();
+        }
+        if p.scope(format_args!("broadcast")) {
+            let (busy, ctx, k, ptr) = match self.bcast.current() {
+                Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
+                None => (0, 0, 0, [0, 0]),
+            };
+            p.signal("busy", 1, Display::Bin, busy);
+            p.signal("queued", 1, Display::Bin, !self.bcast.can_issue() as u64);
+            p.signal("run_ctx", 13, Display::Hex, ctx);
+            p.signal("step", 14, Display::Hex, k);
+            p.signal("fb0_ptr", 16, Display::Hex, ptr[0] as u64);
+            p.signal("fb1_ptr", 16, Display::Hex, ptr[1] as u64);
+            p.end();
+        }
+        if p.scope(format_args!("dma")) {
+            let (kind, mem, local) = match self.dma.current() {
+                Some((r, _)) => (r.kind as u64, r.mem as u64, r.local as u64),
+                None => (0, 0, 0),
+            };
+            p.signal("kind", 2, Display::Hex, kind);
+            p.signal("mem", 32, Display::Hex, mem);
+            p.signal("local", 16, Display::Hex, local);
+            p.signal("remaining", 16, Display::Hex, self.dma.remaining() as u64);
+            p.signal(
+                "fb_banks",
+                4,
+                Display::Bin,
+                self.dma.owned_fb_banks() as u64,
+            );
+            p.signal(
+                "ctx_banks",
+                2,
+                Display::Bin,
+                self.dma.owned_ctx_banks() as u64,
+            );
+            p.end();
+        }
+        if p.scope(format_args!("array")) {
+            self.array.trace(p);
+            p.end();
+        }
+    }
+}
+
+/// How a run ended.
+#[derive(Debug)]
+pub enum RunError {
+    Step(StepError),
+    /// The program did not halt within the cycle budget.
+    MaxCycles {
+        cycles: u64,
+        pc: u32,
+        text: String,
+    },
+}
+
+impl std::fmt::Display for RunError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RunError::Step(e) => write!(f, "{e}"),
+            RunError::MaxCycles { cycles, pc, text } => write!(
+                f,
+                "cycle {cycles}: sim: no halt within --max-cycles {cycles} [pc 0x{pc:08x}: `{text}`]"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for RunError {}
+
+/// Run to `halt`; returns the cycles used (the halt's cycle included).
+pub fn run_to_halt(sim: &mut Sim<Chip>, max_cycles: u64) -> Result<u64, RunError> {
+    while !sim.top.halted() {
+        if sim.cycle() >= max_cycles {
+            let pc = sim.top.risc.pc;
+            let text = if sim.top.mem.check(pc, 4).is_ok() {
+                decode::disassemble(sim.top.mem.read(pc, 4))
+            } else {
+                "?".into()
+            };
+            return Err(RunError::MaxCycles {
+                cycles: sim.cycle(),
+                pc,
+                text,
+            });
+        }
+        sim.step().map_err(RunError::Step)?;
+    }
+    Ok(sim.cycle())
+}
+
+// Keep the decoded-context type in the public surface of the chip module.
+pub type DecodedContext = Context;

@@ -1,0 +1,182 @@
+//! TinyRISC: the 32-bit control processor of MorphoSys, 16 registers.
+//!
+//! * [`decode`]: encoding, decoding, disassembly, the waveform filter.
+//! * [`execute`]: the semantics and the [`Machine`] interface through which
+//!   TinyRISC sees the array, the FB, the DMA and main memory.
+//! * [`register_file`]: 16 x 32-bit, `r0` = 0, `r15` = link.
+//!
+//! Timing: an instruction issues in one cycle and then keeps TinyRISC busy
+//! for its cost minus one cycles ([`RiscTiming`]); its effects land at the
+//! clock edge of its issue cycle. An instruction that needs the array idle,
+//! a free broadcast slot or a free DMA channel **stalls** (changes nothing
+//! and is retried) until it gets it; stall cycles are counted by reason.
+
+pub mod decode;
+pub mod execute;
+pub mod register_file;
+
+pub use decode::{Instr, Opcode, INSTR_FILTER};
+pub use execute::{Command, Machine};
+pub use register_file::RegisterFile;
+
+use crate::trace::{Display, Probe, Traced};
+
+/// Cycle cost of each instruction class (see `docs/isa.md`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct RiscTiming {
+    pub alu: u32,
+    pub mul: u32,
+    pub load: u32,
+    pub store: u32,
+    pub branch_taken: u32,
+    pub branch_not_taken: u32,
+    /// `j`, `jal`, `jr`, `jalr`.
+    pub jump: u32,
+    pub fb_load: u32,
+    pub fb_store: u32,
+    /// `ldctxt`, `ldfb`, `stfb` (the transfer then runs on its own).
+    pub dma_issue: u32,
+    /// `dwait` once the channel is free.
+    pub dwait: u32,
+    /// `cbcast`, `sbcb`, `dbcb`, `cbcr`, `cbcc` (the run then streams on its own).
+    pub broadcast_issue: u32,
+    /// `wfb`: 64 words, one row of 8 per cycle.
+    pub wfb: u32,
+    pub rcrisc: u32,
+    /// `rcany`, `rcall`, `rcst`, `rcfl`, `rcfh`, `rcsl`, `rcsh`.
+    pub status: u32,
+    pub halt: u32,
+}
+
+impl Default for RiscTiming {
+    fn default() -> Self {
+        RiscTiming {
+            alu: 1,
+            mul: 2,
+            load: 2,
+            store: 1,
+            branch_taken: 2,
+            branch_not_taken: 1,
+            jump: 2,
+            fb_load: 2,
+            fb_store: 1,
+            dma_issue: 1,
+            dwait: 1,
+            broadcast_issue: 1,
+            wfb: 8,
+            rcrisc: 2,
+            status: 2,
+            halt: 1,
+        }
+    }
+}
+
+/// What TinyRISC did in the cycle just evaluated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum State {
+    /// An instruction issued.
+    #[default]
+    Issue = 0,
+    /// A multi-cycle instruction is still busy.
+    Busy = 1,
+    /// Waiting for the array (idle or a free broadcast slot).
+    StallArray = 2,
+    /// Waiting for the DMA channel.
+    StallDma = 3,
+    Halted = 4,
+}
+
+#[derive(Default)]
+pub struct TinyRisc {
+    pub pc: u32,
+    pub regs: RegisterFile,
+    pub timing: RiscTiming,
+    busy: u32,
+    halted: bool,
+    icache: Option<(u32, u32, Instr)>,
+    // ---- next state ----
+    d_pc: u32,
+    d_reg: Option<(u8, u32)>,
+    d_busy: u32,
+    d_halt: bool,
+    /// The write of the instruction issued this cycle (applied by the chip).
+    pub cmd: Command,
+    /// What happened this cycle.
+    pub state: State,
+    /// Instruction word of the last issue (waveforms).
+    pub ir: u32,
+    // ---- statistics ----
+    pub issued: u64,
+    pub stall_array: u64,
+    pub stall_dma: u64,
+    pub busy_cycles: u64,
+}
+
+impl TinyRisc {
+    pub fn new(entry: u32, timing: RiscTiming) -> TinyRisc {
+        TinyRisc {
+            pc: entry,
+            timing,
+            ..TinyRisc::default()
+        }
+    }
+
+    pub fn halted(&self) -> bool {
+        self.halted
+    }
+
+    /// Clock edge.
+    #[inline]
+    pub fn commit(&mut self) {
+        match self.state {
+            State::Issue => self.issued += 1,
+            State::Busy => self.busy_cycles += 1,
+            State::StallArray => self.stall_array += 1,
+            State::StallDma => self.stall_dma += 1,
+            State::Halted => return,
+        }
+        self.pc = self.d_pc;
+        if let Some((k, v)) = self.d_reg {
+            self.regs.write(k, v);
+        }
+        self.busy = self.d_busy;
+        self.halted = self.d_halt;
+    }
+}
+
+const REG_NAMES: [&str; 16] = [
+    "r0", "r1", "r2", "r3", "r4", "r5", "r6", "r7", "r8", "r9", "r10", "r11", "r12", "r13", "r14",
+    "r15",
+];
+
+fn state_text(v: u64) -> Option<String> {
+    Some(
+        ["issue", "busy", "stall_array", "stall_dma", "halted"]
+            .get(v as usize)?
+            .to_string(),
+    )
+}
+
+pub static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
+    name: "tinyrisc_state",
+    text: state_text,
+};
+
+impl Traced for TinyRisc {
+    fn trace(&self, p: &mut dyn Probe) {
+        p.signal("pc", 32, Display::Hex, self.pc as u64);
+        p.signal("ir", 32, Display::Translate(&INSTR_FILTER), self.ir as u64);
+        p.signal(
+            "state",
+            3,
+            Display::Translate(&STATE_FILTER),
+            self.state as u64,
+        );
+        if p.scope(format_args!("regs")) {
+            for (k, n) in REG_NAMES.iter().enumerate() {
+                p.signal(n, 32, Display::Hex, self.regs.read(k as u8) as u64);
+            }
+            p.end();
+        }
+    }
+}

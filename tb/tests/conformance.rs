@@ -1,0 +1,139 @@
+//! The chip's conformance suite: the programs under `firmware/conformance/`
+//! run on the model and check their own results (halt with r1 = 1; on a
+//! failure r1 = 0xBAD and r2 = the number of the failed check).
+
+use std::path::PathBuf;
+
+use rtl::Timing;
+use tb::cmd_run::{load_program, run_image, Outcome};
+
+fn dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance")
+}
+
+pub fn run(name: &str) -> Outcome {
+    let path = dir().join(name);
+    let img = load_program(&path).unwrap_or_else(|e| panic!("{e:#}"));
+    let out = run_image(&img, Timing::default(), 2_000_000, None).unwrap();
+    if let Err(e) = &out.result {
+        panic!("{name}: {e}");
+    }
+    let (r1, r2) = (out.reg(1), out.reg(2));
+    assert_eq!(
+        r1,
+        1,
+        "{name}: failed check {r2} (r1 = {r1:#x}); stats {:?}",
+        out.stats()
+    );
+    out
+}
+
+macro_rules! conformance {
+    ($($test:ident => $file:expr,)*) => {
+        $(
+            #[test]
+            fn $test() {
+                run($file);
+            }
+        )*
+        const LISTED: &[&str] = &[$($file,)*];
+    };
+}
+
+conformance! {
+    ldctxt => "ldctxt.s",
+    ldfb_and_dwait => "ldfb.s",
+    stfb => "stfb.s",
+    cbcast => "cbcast.s",
+    sbcb => "sbcb.s",
+    dbcb => "dbcb.s",
+    cbcr_row_mode => "cbcr.s",
+    cbcc_column_mode => "cbcc.s",
+    wfb => "wfb.s",
+    rcrisc => "rcrisc.s",
+    status_rcany_rcall_masks => "status.s",
+    lfb_sfb => "lfb_sfb.s",
+    guarded_if_then_else => "ifelse.s",
+    tinyrisc_scalar => "tinyrisc.s",
+    transpose_8x8 => "transpose.s",
+}
+
+const REPORTED: &[&str] = &["double_buffer.s", "dct.s"];
+
+#[test]
+fn double_buffering_overlaps_transfer_and_computation() {
+    let out = run("double_buffer.s");
+    let (t_seq, t_ovl, t_dma, t_comp) = (out.reg(3), out.reg(4), out.reg(5), out.reg(6));
+    eprintln!("double buffering: T_dma {t_dma}, T_comp {t_comp}, 4 blocks sequential {t_seq}, overlapped {t_ovl} cycles");
+    // Independent of the program's own checks: three of the four transfers
+    // are hidden behind computation, less at most 16 cycles of loop
+    // overhead per block.
+    assert!(t_ovl < t_seq);
+    assert!(
+        t_ovl + 3 * t_dma <= t_seq + 4 * 16,
+        "only {} cycles saved",
+        t_seq - t_ovl
+    );
+    assert!(t_ovl < t_dma + 4 * (t_comp + 16));
+    assert!(out.stats().dma_busy_cycles > 0);
+}
+
+#[test]
+fn dct_8x8_matches_a_float_dct() {
+    let out = run("dct.s");
+    eprintln!(
+        "8x8 2D DCT: {} cycles (issue to status; 34 array cycles), load {} cycles, total with wfb and stfb {} cycles",
+        out.reg(3),
+        out.reg(4),
+        out.reg(5)
+    );
+    // Independent reference: the f64 DCT of the same block.
+    let img = load_program(&dir().join("dct.s")).unwrap();
+    let result = img.symbol("result").unwrap() as u32;
+    let x = |r: usize, c: usize| (((r * 37 + c * 23 + (r * c) % 5 * 11) % 256) as f64) - 128.0;
+    let a = |k: usize| if k == 0 { (1.0f64 / 8.0).sqrt() } else { 0.5 };
+    let pi = std::f64::consts::PI;
+    for l in 0..8 {
+        for k in 0..8 {
+            let mut z = 0.0;
+            for r in 0..8 {
+                for c in 0..8 {
+                    z += a(l)
+                        * a(k)
+                        * ((2 * r + 1) as f64 * l as f64 * pi / 16.0).cos()
+                        * ((2 * c + 1) as f64 * k as f64 * pi / 16.0).cos()
+                        * x(r, c);
+                }
+            }
+            let addr = result + 2 * (l * 8 + k) as u32;
+            let got = out.sim.top.mem.read(addr, 2) as u16 as i16 as f64;
+            assert!((got - z).abs() <= 2.5, "Z[{l}][{k}] = {got}, float {z:.2}");
+        }
+    }
+}
+
+#[test]
+fn every_program_in_the_directory_is_in_the_suite() {
+    let mut found: Vec<String> = std::fs::read_dir(dir())
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".s"))
+        .collect();
+    found.sort();
+    let mut listed: Vec<String> = LISTED
+        .iter()
+        .chain(REPORTED)
+        .map(|s| s.to_string())
+        .collect();
+    listed.sort();
+    assert_eq!(found, listed);
+}
+
+#[test]
+fn guarded_if_then_else_runs_the_then_and_else_parts_on_their_lanes_only() {
+    let out = run("ifelse.s");
+    let s = out.stats();
+    // the 4 guarded contexts: 20 + 44 + 44 lanes... checked by the active count
+    assert!(s.active_rc_fraction() < 1.0);
+}
