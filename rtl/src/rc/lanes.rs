@@ -30,7 +30,11 @@ pub fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, s
 /// One bool per lane from a mask.
 #[inline(always)]
 pub fn unpack<const N: usize>(mask: Mask) -> [bool; N] {
-    std::array::from_fn(|i| mask >> i & 1 != 0)
+    let mut m = [false; N];
+    for (i, b) in m.iter_mut().enumerate() {
+        *b = mask >> i & 1 != 0;
+    }
+    m
 }
 
 /// Pack one bool per lane into a mask. Eight lanes at a time: the eight
@@ -56,7 +60,10 @@ pub fn pack_bools<const N: usize>(b: &[bool; N]) -> Mask {
 /// Pack one bool per lane, computed by `f`.
 #[inline(always)]
 pub fn pack<const N: usize>(f: impl Fn(usize) -> bool) -> Mask {
-    let b: [bool; N] = std::array::from_fn(f);
+    let mut b = [false; N];
+    for (i, x) in b.iter_mut().enumerate() {
+        *x = f(i);
+    }
     pack_bools(&b)
 }
 

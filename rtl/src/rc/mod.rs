@@ -326,18 +326,14 @@ impl<const N: usize> Clocked for RcArray<N> {
                             acc_d[i] = multiplier::product(a[i], b[i]);
                         }
                     }
-                    Op::Mac => {
+                    Op::Mac | Op::Msu => {
+                        let sub = c.op == Op::Msu;
                         for i in 0..N {
                             let p = multiplier::product(a[i], b[i]);
-                            (acc_d[i], s[i]) = multiplier::accumulate(acc[i], p, false);
+                            (acc_d[i], s[i]) = multiplier::accumulate(acc[i], p, sub);
                         }
                     }
-                    _ => {
-                        for i in 0..N {
-                            let p = multiplier::product(a[i], b[i]);
-                            (acc_d[i], s[i]) = multiplier::accumulate(acc[i], p, true);
-                        }
-                    }
+                    _ => unreachable!(),
                 }
                 for i in 0..N {
                     let (r, s2) = multiplier::scale(acc_d[i], sh, trunc);

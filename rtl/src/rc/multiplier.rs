@@ -18,17 +18,11 @@ pub fn product(a: i16, b: i16) -> i32 {
 /// `acc + p` (or `acc - p` when `sub`), saturating at the 32-bit bounds.
 #[inline(always)]
 pub fn accumulate(acc: i32, p: i32, sub: bool) -> (i32, bool) {
-    let (r, o) = if sub {
-        acc.overflowing_sub(p)
-    } else {
-        acc.overflowing_add(p)
-    };
-    if o {
-        // Overflow: the exact result has the sign opposite to the wrapped one.
-        (if r < 0 { i32::MAX } else { i32::MIN }, true)
-    } else {
-        (r, false)
-    }
+    // In 64 bits the exact sum cannot overflow; clamp it (vectorises).
+    let p = if sub { -(p as i64) } else { p as i64 };
+    let w = acc as i64 + p;
+    let r = w.clamp(i32::MIN as i64, i32::MAX as i64);
+    (r as i32, r != w)
 }
 
 /// Scale the accumulator to 16 bits: shift right by `sh` (0..=31), rounding
