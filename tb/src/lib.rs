@@ -2,6 +2,8 @@
 //! pieces of the `morphosys` command.
 
 pub mod cli;
+pub mod cmd_fuzz;
+pub mod fuzz;
 pub mod cmd_asm;
 pub mod cmd_run;
 pub mod testbench;

@@ -43,6 +43,22 @@ enum Command {
         #[command(flatten)]
         window: tb::cli::TraceWindow,
     },
+    /// Fuzz the scene parsers, the assembler and the program loader with
+    /// mutated and random inputs; any panic or unlocated error is a finding.
+    Fuzz {
+        /// Targets (default: all).
+        #[arg(value_enum)]
+        targets: Vec<tb::fuzz::Target>,
+        /// Inputs per target.
+        #[arg(long, value_name = "N", default_value_t = 100_000)]
+        count: u64,
+        /// Random seed (runs are reproducible).
+        #[arg(long, value_name = "S", default_value_t = 1)]
+        seed: u64,
+        /// Save the inputs of findings under DIR/<target>/.
+        #[arg(long, value_name = "DIR")]
+        save: Option<PathBuf>,
+    },
     /// Run a testbench: drive a block of the chip, check it against a
     /// reference model, write its waveform.
     Tb {
@@ -140,6 +156,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             vcd,
             window,
         } => tb::cmd_run::command(file, max_cycles, vcd, window),
+        Command::Fuzz {
+            targets,
+            count,
+            seed,
+            save,
+        } => tb::cmd_fuzz::command(targets, count, seed, save),
         Command::Tb { bench } => match bench {
             Bench::Rc { vcd, window } => tb::testbench::rc::command(vcd, window),
         },

@@ -1,0 +1,51 @@
+//! `morphosys fuzz`: run the input fuzzers (see [`crate::fuzz`]).
+
+use std::path::PathBuf;
+
+use anyhow::bail;
+
+use crate::fuzz::{self, Target};
+
+pub fn command(targets: Vec<Target>, count: u64, seed: u64, save: Option<PathBuf>) -> anyhow::Result<()> {
+    let targets = if targets.is_empty() { fuzz::ALL.to_vec() } else { targets };
+    let mut total_findings = 0;
+    for t in targets {
+        let bar = indicatif::ProgressBar::new(count);
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{prefix:>6} [{bar:40}] {pos}/{len} inputs ({per_sec}, eta {eta})")
+                .unwrap()
+                .progress_chars("=> "),
+        );
+        bar.set_prefix(t.name());
+        let rep = fuzz::run(t, count, seed, |k| {
+            if k % 256 == 0 {
+                bar.set_position(k);
+            }
+        });
+        bar.finish_and_clear();
+        println!(
+            "{:>6}: {} inputs, {} accepted, {} rejected with a located error, {} findings; slowest input {:.3} s",
+            t.name(),
+            rep.inputs,
+            rep.accepted,
+            rep.rejected,
+            rep.findings.len(),
+            rep.slowest_s
+        );
+        for (i, f) in rep.findings.iter().enumerate().take(10) {
+            println!("        finding {i}: {}", f.what);
+            if let Some(dir) = &save {
+                let d = dir.join(t.name());
+                std::fs::create_dir_all(&d)?;
+                let p = d.join(format!("finding-{seed}-{i}"));
+                std::fs::write(&p, &f.input)?;
+                println!("          input saved to {}", p.display());
+            }
+        }
+        total_findings += rep.findings.len();
+    }
+    if total_findings > 0 {
+        bail!("{total_findings} findings");
+    }
+    Ok(())
+}

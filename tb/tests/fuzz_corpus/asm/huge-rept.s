@@ -1,0 +1,4 @@
+.text
+.rept 100000000
+  nop
+.endr

@@ -1,0 +1,3 @@
+.equ A, B
+.equ B, A
+  addi r1, r0, A
