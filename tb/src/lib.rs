@@ -1,6 +1,7 @@
 //! Testbenches, the float reference renderer, metrics, charts, and the
 //! pieces of the `morphosys` command.
 
+pub mod charts;
 pub mod cli;
 pub mod cmd_fuzz;
 pub mod fuzz;

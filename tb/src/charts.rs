@@ -1,0 +1,243 @@
+//! Charts as SVG and PNG (plotters), with a bundled font (DejaVu Sans, in
+//! `tb/assets/`) so PNG text renders without system font libraries.
+//! Every file is written through a temporary file and a rename.
+
+use std::path::{Path, PathBuf};
+use std::sync::Once;
+
+use anyhow::{anyhow, Context as _};
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+
+static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+static REGISTER: Once = Once::new();
+
+fn font() {
+    REGISTER.call_once(|| {
+        // The bundled font is valid; registration only fails on a bad file.
+        let _ = register_font("sans-serif", FontStyle::Normal, FONT);
+    });
+}
+
+/// A named series of (x, y) points.
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// A labelled point drawn on top of a chart (e.g. a published figure).
+#[derive(Clone, Debug)]
+pub struct Mark {
+    pub label: String,
+    pub x: f64,
+    pub y: f64,
+}
+
+/// What to draw.
+#[derive(Clone, Debug)]
+pub struct Chart {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub marks: Vec<Mark>,
+    /// Join the points of each series with lines (else scatter).
+    pub lines: bool,
+    /// Logarithmic x axis (base 2 ticks look best for 4..64 ways).
+    pub log_x: bool,
+    /// Draw the Pareto front (max x, max y) of all points.
+    pub pareto: bool,
+}
+
+const COLORS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+];
+
+/// Points not dominated in both coordinates (larger is better in both),
+/// sorted by x.
+pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+    let mut f: Vec<(f64, f64)> = points
+        .iter()
+        .copied()
+        .filter(|&(x, y)| {
+            !points
+                .iter()
+                .any(|&(a, b)| a >= x && b >= y && (a > x || b > y))
+        })
+        .collect();
+    f.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.total_cmp(&b.1)));
+    f.dedup();
+    f
+}
+
+fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for x in v.filter(|x| x.is_finite()) {
+        lo = lo.min(x);
+        hi = hi.max(x);
+    }
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    if log {
+        (lo / 1.3, hi * 1.3)
+    } else {
+        let pad = ((hi - lo) * 0.08).max(1e-9).max(hi.abs() * 0.02);
+        (if lo >= 0.0 { (lo - pad).max(0.0) } else { lo - pad }, hi + pad)
+    }
+}
+
+fn draw<DB: DrawingBackend>(root: DrawingArea<DB, plotters::coord::Shift>, c: &Chart) -> anyhow::Result<()>
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(|e| anyhow!("{e:?}"))?;
+    let all: Vec<(f64, f64)> = c
+        .series
+        .iter()
+        .flat_map(|s| s.points.iter().copied())
+        .chain(c.marks.iter().map(|m| (m.x, m.y)))
+        .collect();
+    let (x0, x1) = range(all.iter().map(|p| p.0), c.log_x);
+    let (y0, y1) = range(all.iter().map(|p| p.1), false);
+    let mut b = ChartBuilder::on(&root);
+    b.caption(&c.title, ("sans-serif", 22))
+        .margin(14)
+        .x_label_area_size(42)
+        .y_label_area_size(62);
+    macro_rules! body {
+        ($chart:expr) => {{
+            let mut chart = $chart;
+            chart
+                .configure_mesh()
+                .x_desc(&c.x_label)
+                .y_desc(&c.y_label)
+                .label_style(("sans-serif", 14))
+                .axis_desc_style(("sans-serif", 16))
+                .draw()
+                .map_err(|e| anyhow!("{e:?}"))?;
+            for (k, s) in c.series.iter().enumerate() {
+                let col = COLORS[k % COLORS.len()];
+                if c.lines {
+                    chart
+                        .draw_series(LineSeries::new(s.points.iter().copied(), col.stroke_width(2)))
+                        .map_err(|e| anyhow!("{e:?}"))?
+                        .label(s.name.clone())
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2)));
+                    chart
+                        .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, col.filled())))
+                        .map_err(|e| anyhow!("{e:?}"))?;
+                } else {
+                    chart
+                        .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, col.filled())))
+                        .map_err(|e| anyhow!("{e:?}"))?
+                        .label(s.name.clone())
+                        .legend(move |(x, y)| Circle::new((x + 9, y), 4, col.filled()));
+                }
+            }
+            if c.pareto {
+                let front = pareto_front(&c.series.iter().flat_map(|s| s.points.iter().copied()).collect::<Vec<_>>());
+                chart
+                    .draw_series(LineSeries::new(front.into_iter(), BLACK.stroke_width(1)))
+                    .map_err(|e| anyhow!("{e:?}"))?
+                    .label("Pareto front")
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1)));
+            }
+            for m in &c.marks {
+                chart
+                    .draw_series(std::iter::once(TriangleMarker::new((m.x, m.y), 8, RED.filled())))
+                    .map_err(|e| anyhow!("{e:?}"))?;
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        m.label.clone(),
+                        (m.x, m.y),
+                        ("sans-serif", 14).into_font().color(&RED),
+                    )))
+                    .map_err(|e| anyhow!("{e:?}"))?;
+            }
+            chart
+                .configure_series_labels()
+                .background_style(WHITE.mix(0.85))
+                .border_style(BLACK.mix(0.4))
+                .label_font(("sans-serif", 14))
+                .position(SeriesLabelPosition::UpperLeft)
+                .draw()
+                .map_err(|e| anyhow!("{e:?}"))?;
+        }};
+    }
+    if c.log_x {
+        body!(b
+            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+            .map_err(|e| anyhow!("{e:?}"))?);
+    } else {
+        body!(b.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| anyhow!("{e:?}"))?);
+    }
+    root.present().map_err(|e| anyhow!("{e:?}"))?;
+    Ok(())
+}
+
+/// Write `<stem>.svg` and `<stem>.png`; returns both paths.
+pub fn write(stem: &Path, c: &Chart) -> anyhow::Result<[PathBuf; 2]> {
+    font();
+    let (w, h) = (900u32, 560u32);
+    let mut svg = String::new();
+    draw(SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area(), c)?;
+    let svg_path = stem.with_extension("svg");
+    crate::cmd_scene::write_atomic(&svg_path, svg.as_bytes())?;
+    let mut buf = vec![0u8; (w * h * 3) as usize];
+    draw(BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area(), c)?;
+    let img = image::RgbImage::from_raw(w, h, buf).context("chart buffer size")?;
+    let mut png = Vec::new();
+    img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
+    let png_path = stem.with_extension("png");
+    crate::cmd_scene::write_atomic(&png_path, &png)?;
+    Ok([svg_path, png_path])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn writes_svg_and_png_with_text() {
+        let dir = tempfile::tempdir().unwrap();
+        let c = Chart {
+            title: "Frame rate against parallel rays".into(),
+            x_label: "ways".into(),
+            y_label: "frames/s at 300 MHz".into(),
+            series: vec![Series {
+                name: "default scene".into(),
+                points: vec![(4.0, 1.0), (8.0, 2.0), (16.0, 3.5), (32.0, 6.0), (64.0, 9.0)],
+            }],
+            marks: vec![Mark { label: "paper: 13.3".into(), x: 64.0, y: 13.3 }],
+            lines: true,
+            log_x: true,
+            pareto: false,
+        };
+        let [svg, png] = write(&dir.path().join("fig8"), &c).unwrap();
+        let s = std::fs::read_to_string(svg).unwrap();
+        assert!(s.contains("Frame rate against parallel rays") && s.contains("paper: 13.3"));
+        let img = image::open(png).unwrap().to_rgb8();
+        assert_eq!(img.dimensions(), (900, 560));
+        // The title is drawn with the bundled font: dark pixels in its band.
+        let dark = (300..600)
+            .flat_map(|x| (8..34).map(move |y| (x, y)))
+            .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&v| v < 100))
+            .count();
+        assert!(dark > 200, "title text not rendered ({dark} dark pixels)");
+    }
+
+    #[test]
+    fn pareto_front_by_hand() {
+        let p = [(1.0, 5.0), (2.0, 4.0), (2.0, 3.0), (3.0, 1.0), (0.5, 0.5), (3.0, 0.5)];
+        assert_eq!(pareto_front(&p), vec![(1.0, 5.0), (2.0, 4.0), (3.0, 1.0)]);
+    }
+}
