@@ -27,6 +27,41 @@ pub fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, s
     }
 }
 
+/// Eight lanes of 0 / -1 for each byte of a mask.
+static EXPAND8: [[i16; 8]; 256] = {
+    let mut t = [[0i16; 8]; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut k = 0;
+        while k < 8 {
+            t[b][k] = if b >> k & 1 != 0 { -1 } else { 0 };
+            k += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// `select` for 16-bit lanes: the mask is expanded to 0 / -1 lanes by table
+/// and blended with bit operations, which vectorises.
+#[inline(always)]
+pub fn select16<const N: usize>(dst: &mut [i16; N], mask: Mask, src: &[i16; N]) {
+    if mask == full(N) {
+        *dst = *src;
+    } else if mask != 0 {
+        if N % 8 != 0 {
+            return select(dst, mask, src);
+        }
+        let mut m = [0i16; N];
+        for c in 0..N / 8 {
+            m[c * 8..c * 8 + 8].copy_from_slice(&EXPAND8[(mask >> (c * 8)) as usize & 255]);
+        }
+        for i in 0..N {
+            dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
+        }
+    }
+}
+
 /// One bool per lane from a mask.
 #[inline(always)]
 pub fn unpack<const N: usize>(mask: Mask) -> [bool; N] {
@@ -83,6 +118,12 @@ mod tests {
                 assert_eq!(b[i], x >> i & 1 == 1);
             }
             assert_eq!(pack_bools(&b), x);
+            let mut d = [7i16; 64];
+            let src: [i16; 64] = std::array::from_fn(|i| i as i16 - 20);
+            select16(&mut d, x, &src);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
             let b5: [bool; 5] = std::array::from_fn(|i| b[i]);
             assert_eq!(pack_bools(&b5), x & 31);
             let b12: [bool; 12] = std::array::from_fn(|i| b[i]);

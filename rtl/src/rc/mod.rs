@@ -372,9 +372,12 @@ impl<const N: usize> Clocked for RcArray<N> {
                     }
                     let addr = addr.clamp(0, 511) as u16;
                     self.addr[i] = addr;
-                    if !store {
-                        res[i] = self.ram.read(i, addr as usize);
-                    }
+                    // A store has no result: `res` carries its data to the edge.
+                    res[i] = if store {
+                        a[i]
+                    } else {
+                        self.ram.read(i, addr as usize)
+                    };
                 }
                 self.pend.store = store;
             }
@@ -390,7 +393,7 @@ impl<const N: usize> Clocked for RcArray<N> {
         let c = self.ctx;
         let p = self.pend;
         if p.result {
-            select(&mut self.out, en, &self.res);
+            lanes::select16(&mut self.out, en, &self.res);
             if c.we {
                 self.regs.write(c.rd, en, &self.res);
             }
@@ -406,10 +409,9 @@ impl<const N: usize> Clocked for RcArray<N> {
             select(&mut self.acc, en, &self.acc_d);
         }
         if p.store {
-            let a: [i16; N] = std::array::from_fn(|i| self.operand_a(i));
-            for (i, v) in a.iter().enumerate() {
+            for i in 0..N {
                 if en >> i & 1 != 0 {
-                    self.ram.write(i, self.addr[i] as usize, *v);
+                    self.ram.write(i, self.addr[i] as usize, self.res[i]);
                 }
             }
         }

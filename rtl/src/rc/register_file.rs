@@ -5,7 +5,7 @@
 //! during the cycle; the write lands at the clock edge
 //! ([`RegisterFile::write`] is only called from the array's commit).
 
-use super::lanes::{select, Mask};
+use super::lanes::{select16, Mask};
 
 pub const REGS: usize = 16;
 
@@ -29,7 +29,7 @@ impl<const N: usize> RegisterFile<N> {
     /// Write port, at the clock edge: register `k` of the lanes in `mask`.
     #[inline(always)]
     pub fn write(&mut self, k: u8, mask: Mask, data: &[i16; N]) {
-        select(&mut self.r[k as usize & 15], mask, data);
+        select16(&mut self.r[k as usize & 15], mask, data);
     }
 
     /// Set a register of one lane directly (testbench and loader access, not
