@@ -7,6 +7,7 @@ use std::sync::Once;
 
 use anyhow::{anyhow, Context as _};
 use plotters::prelude::*;
+use plotters::style::text_anchor::{HPos, Pos, VPos};
 use plotters::style::{register_font, FontStyle};
 
 static FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
@@ -48,6 +49,8 @@ pub struct Chart {
     pub log_x: bool,
     /// Draw the Pareto front (max x, max y) of all points.
     pub pareto: bool,
+    /// Logarithmic y axis.
+    pub log_y: bool,
 }
 
 const COLORS: [RGBColor; 8] = [
@@ -78,6 +81,24 @@ pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     f
 }
 
+/// Axis tick text: integers without a fraction, large numbers with SI
+/// suffixes.
+fn tick(v: f64) -> String {
+    let a = v.abs();
+    if a >= 1e6 {
+        let t = format!("{:.2}", v / 1e6);
+        format!("{}M", t.trim_end_matches('0').trim_end_matches('.'))
+    } else if a >= 1e4 {
+        format!("{:.0}k", v / 1e3)
+    } else if (v - v.round()).abs() < 1e-9 {
+        format!("{v:.0}")
+    } else if a >= 10.0 {
+        format!("{v:.1}")
+    } else {
+        format!("{v:.2}")
+    }
+}
+
 fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for x in v.filter(|x| x.is_finite()) {
@@ -91,11 +112,21 @@ fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
         (lo / 1.3, hi * 1.3)
     } else {
         let pad = ((hi - lo) * 0.08).max(1e-9).max(hi.abs() * 0.02);
-        (if lo >= 0.0 { (lo - pad).max(0.0) } else { lo - pad }, hi + pad)
+        (
+            if lo >= 0.0 {
+                (lo - pad).max(0.0)
+            } else {
+                lo - pad
+            },
+            hi + pad,
+        )
     }
 }
 
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, plotters::coord::Shift>, c: &Chart) -> anyhow::Result<()>
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, plotters::coord::Shift>,
+    c: &Chart,
+) -> anyhow::Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -107,7 +138,7 @@ where
         .chain(c.marks.iter().map(|m| (m.x, m.y)))
         .collect();
     let (x0, x1) = range(all.iter().map(|p| p.0), c.log_x);
-    let (y0, y1) = range(all.iter().map(|p| p.1), false);
+    let (y0, y1) = range(all.iter().map(|p| p.1), c.log_y);
     let mut b = ChartBuilder::on(&root);
     b.caption(&c.title, ("sans-serif", 22))
         .margin(14)
@@ -120,6 +151,8 @@ where
                 .configure_mesh()
                 .x_desc(&c.x_label)
                 .y_desc(&c.y_label)
+                .x_label_formatter(&|x| tick(*x))
+                .y_label_formatter(&|y| tick(*y))
                 .label_style(("sans-serif", 14))
                 .axis_desc_style(("sans-serif", 16))
                 .draw()
@@ -128,10 +161,15 @@ where
                 let col = COLORS[k % COLORS.len()];
                 if c.lines {
                     chart
-                        .draw_series(LineSeries::new(s.points.iter().copied(), col.stroke_width(2)))
+                        .draw_series(LineSeries::new(
+                            s.points.iter().copied(),
+                            col.stroke_width(2),
+                        ))
                         .map_err(|e| anyhow!("{e:?}"))?
                         .label(s.name.clone())
-                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2)));
+                        .legend(move |(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
+                        });
                     chart
                         .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, col.filled())))
                         .map_err(|e| anyhow!("{e:?}"))?;
@@ -144,22 +182,36 @@ where
                 }
             }
             if c.pareto {
-                let front = pareto_front(&c.series.iter().flat_map(|s| s.points.iter().copied()).collect::<Vec<_>>());
-                chart
-                    .draw_series(LineSeries::new(front.into_iter(), BLACK.stroke_width(1)))
-                    .map_err(|e| anyhow!("{e:?}"))?
-                    .label("Pareto front")
-                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1)));
+                // One front per series: configurations of one scene compete.
+                for (k, s) in c.series.iter().enumerate() {
+                    let col = COLORS[k % COLORS.len()];
+                    let front = pareto_front(&s.points);
+                    let e = chart
+                        .draw_series(LineSeries::new(front.into_iter(), col.stroke_width(1)))
+                        .map_err(|e| anyhow!("{e:?}"))?;
+                    if k == 0 {
+                        e.label("Pareto front (per scene)").legend(|(x, y)| {
+                            PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1))
+                        });
+                    }
+                }
             }
             for m in &c.marks {
                 chart
-                    .draw_series(std::iter::once(TriangleMarker::new((m.x, m.y), 8, RED.filled())))
+                    .draw_series(std::iter::once(TriangleMarker::new(
+                        (m.x, m.y),
+                        8,
+                        RED.filled(),
+                    )))
                     .map_err(|e| anyhow!("{e:?}"))?;
                 chart
                     .draw_series(std::iter::once(Text::new(
                         m.label.clone(),
                         (m.x, m.y),
-                        ("sans-serif", 14).into_font().color(&RED),
+                        ("sans-serif", 14)
+                            .into_font()
+                            .color(&RED)
+                            .pos(Pos::new(HPos::Right, VPos::Bottom)),
                     )))
                     .map_err(|e| anyhow!("{e:?}"))?;
             }
@@ -173,12 +225,24 @@ where
                 .map_err(|e| anyhow!("{e:?}"))?;
         }};
     }
-    if c.log_x {
-        body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
-            .map_err(|e| anyhow!("{e:?}"))?);
+    let (y0, y1) = if c.log_y {
+        (y0.max(1e-9), y1)
     } else {
-        body!(b.build_cartesian_2d(x0..x1, y0..y1).map_err(|e| anyhow!("{e:?}"))?);
+        (y0, y1)
+    };
+    match (c.log_x, c.log_y) {
+        (true, true) => body!(b
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(|e| anyhow!("{e:?}"))?),
+        (true, false) => body!(b
+            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+            .map_err(|e| anyhow!("{e:?}"))?),
+        (false, true) => body!(b
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+            .map_err(|e| anyhow!("{e:?}"))?),
+        (false, false) => body!(b
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|e| anyhow!("{e:?}"))?),
     }
     root.present().map_err(|e| anyhow!("{e:?}"))?;
     Ok(())
@@ -189,11 +253,17 @@ pub fn write(stem: &Path, c: &Chart) -> anyhow::Result<[PathBuf; 2]> {
     font();
     let (w, h) = (900u32, 560u32);
     let mut svg = String::new();
-    draw(SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area(), c)?;
+    draw(
+        SVGBackend::with_string(&mut svg, (w, h)).into_drawing_area(),
+        c,
+    )?;
     let svg_path = stem.with_extension("svg");
     crate::cmd_scene::write_atomic(&svg_path, svg.as_bytes())?;
     let mut buf = vec![0u8; (w * h * 3) as usize];
-    draw(BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area(), c)?;
+    draw(
+        BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area(),
+        c,
+    )?;
     let img = image::RgbImage::from_raw(w, h, buf).context("chart buffer size")?;
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
@@ -215,12 +285,23 @@ mod tests {
             y_label: "frames/s at 300 MHz".into(),
             series: vec![Series {
                 name: "default scene".into(),
-                points: vec![(4.0, 1.0), (8.0, 2.0), (16.0, 3.5), (32.0, 6.0), (64.0, 9.0)],
+                points: vec![
+                    (4.0, 1.0),
+                    (8.0, 2.0),
+                    (16.0, 3.5),
+                    (32.0, 6.0),
+                    (64.0, 9.0),
+                ],
             }],
-            marks: vec![Mark { label: "paper: 13.3".into(), x: 64.0, y: 13.3 }],
+            marks: vec![Mark {
+                label: "paper: 13.3".into(),
+                x: 64.0,
+                y: 13.3,
+            }],
             lines: true,
             log_x: true,
             pareto: false,
+            log_y: false,
         };
         let [svg, png] = write(&dir.path().join("fig8"), &c).unwrap();
         let s = std::fs::read_to_string(svg).unwrap();
@@ -237,7 +318,14 @@ mod tests {
 
     #[test]
     fn pareto_front_by_hand() {
-        let p = [(1.0, 5.0), (2.0, 4.0), (2.0, 3.0), (3.0, 1.0), (0.5, 0.5), (3.0, 0.5)];
+        let p = [
+            (1.0, 5.0),
+            (2.0, 4.0),
+            (2.0, 3.0),
+            (3.0, 1.0),
+            (0.5, 0.5),
+            (3.0, 0.5),
+        ];
         assert_eq!(pareto_front(&p), vec![(1.0, 5.0), (2.0, 4.0), (3.0, 1.0)]);
     }
 }
