@@ -73,7 +73,18 @@ pub struct TraceConfig {
     /// empty: everything.
     pub scope: String,
     pub clock_hz: u64,
+    /// The most cycles the run can take (its cycle budget), if known: with
+    /// an open-ended window the trace may cover all of them.
+    pub budget_cycles: Option<u64>,
+    /// Refuse, before writing anything, a trace whose estimated size
+    /// exceeds this (default 4 GiB).
+    pub max_bytes: u64,
 }
+
+/// Estimated VCD bytes per traced signal per cycle: about a quarter of the
+/// signals change in a typical cycle of the tracer, at about 8 bytes a
+/// change (measured on `morphosys run` and `render` traces: 1.5 to 2.5).
+pub const BYTES_PER_SIGNAL_CYCLE: f64 = 2.0;
 
 impl TraceConfig {
     pub fn new(path: impl Into<PathBuf>) -> TraceConfig {
@@ -83,6 +94,8 @@ impl TraceConfig {
             count: None,
             scope: String::new(),
             clock_hz: 300_000_000,
+            budget_cycles: None,
+            max_bytes: 4 << 30,
         }
     }
 }
@@ -130,6 +143,21 @@ pub struct Tracer {
     note: Option<String>,
     /// First I/O error met while declaring (the Probe calls cannot return it).
     err: Option<io::Error>,
+    /// Approximate bytes of value changes written so far.
+    bytes: u64,
+    /// Cycle at which the size limit stopped the trace.
+    truncated_at: Option<u64>,
+}
+
+fn human_bytes(b: f64) -> String {
+    let units = ["B", "KB", "MB", "GB", "TB", "PB"];
+    let mut v = b;
+    let mut u = 0;
+    while v >= 1000.0 && u + 1 < units.len() {
+        v /= 1000.0;
+        u += 1;
+    }
+    format!("{v:.1} {}", units[u])
 }
 
 /// Temporary files are created 0600; outputs are ordinary files (0644).
@@ -264,10 +292,34 @@ impl Tracer {
             last_cycle: None,
             note: None,
             err: None,
+            bytes: 0,
+            truncated_at: None,
         };
         top.trace(&mut t);
         if let Some(e) = t.err.take() {
             return Err(e);
+        }
+        // Refuse up front a trace that would fill the disk.
+        let cycles = match (t.cfg.count, t.cfg.budget_cycles) {
+            (Some(n), Some(b)) => Some(n.min(b.saturating_sub(t.cfg.first))),
+            (Some(n), None) => Some(n),
+            (None, Some(b)) => Some(b.saturating_sub(t.cfg.first)),
+            (None, None) => None,
+        };
+        if let Some(c) = cycles {
+            let est = (t.decls.len() + 2) as f64 * c as f64 * BYTES_PER_SIGNAL_CYCLE;
+            if est > t.cfg.max_bytes as f64 {
+                return Err(io::Error::new(
+                    io::ErrorKind::InvalidInput,
+                    format!(
+                        "tracing {} signals over up to {c} cycles would write about {}, over the {} limit; \
+                         narrow it with --trace-cycles and --trace-scope (e.g. `--trace-scope tinyrisc,array.rc_r0_c0`)",
+                        t.decls.len(),
+                        human_bytes(est),
+                        human_bytes(t.cfg.max_bytes as f64)
+                    ),
+                ));
+            }
         }
         t.w.upscope()?;
         t.w.enddefinitions()?;
@@ -285,7 +337,9 @@ impl Tracer {
     /// Is `cycle` inside the trace window?
     #[inline]
     pub fn in_window(&self, cycle: u64) -> bool {
-        cycle >= self.cfg.first && self.cfg.count.is_none_or(|n| cycle - self.cfg.first < n)
+        self.truncated_at.is_none()
+            && cycle >= self.cfg.first
+            && self.cfg.count.is_none_or(|n| cycle - self.cfg.first < n)
     }
 
     fn time(&self, cycle: u64) -> u64 {
@@ -308,6 +362,18 @@ impl Tracer {
         top.trace(self);
         if let Some(e) = self.err.take() {
             return Err(e);
+        }
+        if self.bytes > self.cfg.max_bytes {
+            // An open-ended trace that outgrew the limit stops here, and says so.
+            self.truncated_at = Some(cycle + 1);
+            let msg = format!(
+                "waveform stopped at cycle {} after {} (limit {}); narrow it with --trace-cycles and --trace-scope",
+                cycle + 1,
+                human_bytes(self.bytes as f64),
+                human_bytes(self.cfg.max_bytes as f64)
+            );
+            eprintln!("morphosys: warning: {msg}");
+            self.note.get_or_insert(msg);
         }
         self.w.timestamp(t + half)?;
         self.w.change_scalar(self.clk, vcd::Value::V0)?;
@@ -552,6 +618,7 @@ impl Probe for Tracer {
                         if let Display::Translate(_) = info.display {
                             self.seen[i].insert(v);
                         }
+                        self.bytes += info.width as u64 + 6;
                         let wr = self.w.writer();
                         let r = if info.width == 1 {
                             writeln!(wr, "{}{}", v, info.id)

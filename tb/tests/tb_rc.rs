@@ -229,3 +229,38 @@ fn window_and_scope_filter_limit_the_trace() {
     );
     assert_eq!(w.cycles, (100..150).collect::<Vec<u64>>());
 }
+
+#[test]
+fn oversized_traces_are_refused_up_front_or_stopped_at_the_limit() {
+    let dir = tempfile::tempdir().unwrap();
+    // An explicit window whose estimate exceeds the limit: refused, no file.
+    let mut cfg = TraceConfig::new(dir.path().join("huge.vcd"));
+    cfg.count = Some(1 << 40);
+    let chain = format!("{:#}", run(Some(cfg)).unwrap_err());
+    assert!(
+        chain.contains("waveform") || chain.contains("trace"),
+        "{chain}"
+    );
+    assert!(!dir.path().join("huge.vcd").exists());
+    assert_eq!(
+        std::fs::read_dir(dir.path()).unwrap().count(),
+        0,
+        "no temporary file left"
+    );
+    // An open-ended trace that outgrows the limit stops and says so.
+    let mut cfg = TraceConfig::new(dir.path().join("cut.vcd"));
+    cfg.max_bytes = 100_000;
+    let report = run(Some(cfg)).unwrap();
+    assert!(report.mismatches.is_empty());
+    let text = std::fs::read_to_string(dir.path().join("cut.vcd")).unwrap();
+    assert!(
+        text.contains("waveform stopped at cycle"),
+        "the VCD says it was cut"
+    );
+    let w = parse(&dir.path().join("cut.vcd"));
+    assert!(
+        w.cycles.len() > 10 && w.cycles.len() < stimulus().len(),
+        "{} cycles",
+        w.cycles.len()
+    );
+}

@@ -351,7 +351,9 @@ pub fn run(trace: Option<TraceConfig>) -> anyhow::Result<Report> {
 /// `morphosys tb rc`.
 pub fn command(vcd: Option<PathBuf>, window: crate::cli::TraceWindow) -> anyhow::Result<()> {
     let path = vcd.unwrap_or_else(|| PathBuf::from("waves/rc.vcd"));
-    let r = run(Some(window.config(path)))?;
+    let mut cfg = window.config(path);
+    cfg.budget_cycles = Some(stimulus().len() as u64);
+    let r = run(Some(cfg))?;
     println!(
         "rc testbench: {} cycles, {} contexts executed, {} values checked against the reference model",
         r.cycles, r.executed, r.checks
