@@ -6,3 +6,4 @@ pub mod asm;
 pub mod scene;
 pub mod bsp;
 pub mod scene_image;
+pub mod tracer;

@@ -6,15 +6,26 @@ use anyhow::bail;
 
 use crate::fuzz::{self, Target};
 
-pub fn command(targets: Vec<Target>, count: u64, seed: u64, save: Option<PathBuf>) -> anyhow::Result<()> {
-    let targets = if targets.is_empty() { fuzz::ALL.to_vec() } else { targets };
+pub fn command(
+    targets: Vec<Target>,
+    count: u64,
+    seed: u64,
+    save: Option<PathBuf>,
+) -> anyhow::Result<()> {
+    let targets = if targets.is_empty() {
+        fuzz::ALL.to_vec()
+    } else {
+        targets
+    };
     let mut total_findings = 0;
     for t in targets {
         let bar = indicatif::ProgressBar::new(count);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("{prefix:>6} [{bar:40}] {pos}/{len} inputs ({per_sec}, eta {eta})")
-                .unwrap()
-                .progress_chars("=> "),
+            indicatif::ProgressStyle::with_template(
+                "{prefix:>6} [{bar:40}] {pos}/{len} inputs ({per_sec}, eta {eta})",
+            )
+            .unwrap()
+            .progress_chars("=> "),
         );
         bar.set_prefix(t.name());
         let rep = fuzz::run(t, count, seed, |k| {

@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use firmware::asm::{self, Image};
-use firmware::scene::{nff, native};
+use firmware::scene::{native, nff};
 use firmware::scene_image::{compile, CompileOptions};
 
 /// What is fuzzed.
@@ -86,9 +86,32 @@ impl Rng {
 }
 
 const NUMBERS: &[&str] = &[
-    "nan", "NaN", "inf", "-inf", "1e308", "-1e308", "1e-308", "0", "-0", "1", "-1", "1e400",
-    "99999999999999999999", "4294967296", "-2147483649", "32768", "-32769", "0.0000001",
-    "65535", "0x7fffffff", "1.5e", "--1", "", "3.4.5", "1e9", "-1e9",
+    "nan",
+    "NaN",
+    "inf",
+    "-inf",
+    "1e308",
+    "-1e308",
+    "1e-308",
+    "0",
+    "-0",
+    "1",
+    "-1",
+    "1e400",
+    "99999999999999999999",
+    "4294967296",
+    "-2147483649",
+    "32768",
+    "-32769",
+    "0.0000001",
+    "65535",
+    "0x7fffffff",
+    "1.5e",
+    "--1",
+    "",
+    "3.4.5",
+    "1e9",
+    "-1e9",
 ];
 
 fn root() -> PathBuf {
@@ -179,7 +202,8 @@ pub fn mutate(g: &mut Rng, x: &[u8], other: &[u8]) -> Vec<u8> {
             }
             5 => {
                 // Duplicate, drop or swap lines.
-                let mut lines: Vec<Vec<u8>> = v.split(|b| *b == b'\n').map(|l| l.to_vec()).collect();
+                let mut lines: Vec<Vec<u8>> =
+                    v.split(|b| *b == b'\n').map(|l| l.to_vec()).collect();
                 if !lines.is_empty() {
                     let i = g.below(lines.len());
                     let j = g.below(lines.len());
@@ -220,7 +244,9 @@ pub fn mutate(g: &mut Rng, x: &[u8], other: &[u8]) -> Vec<u8> {
             _ => {
                 if !v.is_empty() {
                     let i = g.below(v.len());
-                    v[i] = [b'\n', b' ', b'#', b'-', b'.', b'e', b'[', b']', b'"', b'=', 0, 0xFF][g.below(12)];
+                    v[i] = [
+                        b'\n', b' ', b'#', b'-', b'.', b'e', b'[', b']', b'"', b'=', 0, 0xFF,
+                    ][g.below(12)];
                 }
             }
         }
@@ -269,7 +295,11 @@ pub fn check(t: Target, input: &[u8]) -> Result<bool, String> {
                 Ok(s) => s,
                 Err(e) => {
                     let m = e.to_string();
-                    return if has_location(&m, FILE) { Ok(false) } else { Err(format!("error without location: {m}")) };
+                    return if has_location(&m, FILE) {
+                        Ok(false)
+                    } else {
+                        Err(format!("error without location: {m}"))
+                    };
                 }
             };
             match compile(&scene, &CompileOptions::default()) {

@@ -3,11 +3,15 @@
 
 pub mod charts;
 pub mod cli;
-pub mod cmd_fuzz;
-pub mod fuzz;
 pub mod cmd_asm;
+pub mod cmd_bench;
+pub mod cmd_fuzz;
+pub mod cmd_render;
 pub mod cmd_run;
-pub mod testbench;
-pub mod reference;
 pub mod cmd_scene;
+pub mod cmd_sweep;
+pub mod fuzz;
 pub mod metrics;
+pub mod reference;
+pub mod render;
+pub mod testbench;

@@ -43,6 +43,33 @@ enum Command {
         #[command(flatten)]
         window: tb::cli::TraceWindow,
     },
+    /// Measure the simulator: array cycles per host second with tracing off
+    /// and on, and the speed-up on every core.
+    Bench {
+        /// Scene file (.nff or .toml); default scenes/default.toml.
+        scene: Option<PathBuf>,
+        /// Image size of the throughput workload (one chip instance).
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "64x32")]
+        size: (u32, u32),
+        /// Runs per configuration; the fastest counts.
+        #[arg(long, value_name = "N", default_value_t = 3)]
+        repeat: u32,
+        /// Write the figures as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
+    },
+    /// Render scenes under many configurations (ways, recursion, BSP depth,
+    /// leaf size, split rule) and chart frame rate against image quality.
+    Sweep {
+        /// Scene files (default: scenes/default.toml).
+        scenes: Vec<PathBuf>,
+        /// Where results.csv and the charts go.
+        #[arg(long, value_name = "DIR")]
+        out_dir: PathBuf,
+        /// Image size.
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
+        size: (u32, u32),
+    },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
     Fuzz {
@@ -116,6 +143,42 @@ enum Command {
         #[arg(long, value_name = "LAYOUT", value_parser = ["bit-vectors", "index-lists"])]
         layout: Option<String>,
     },
+    /// Render a scene with the paper's BSP ray tracer on the simulated chip;
+    /// report frames/s at 300 MHz and the error against the reference.
+    Render {
+        /// Scene file (.nff or .toml); default scenes/default.toml.
+        scene: Option<PathBuf>,
+        /// Image size WIDTHxHEIGHT (default 256x256).
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
+        size: Option<(u32, u32)>,
+        /// Rays traced in parallel: 4, 8, 16, 32 or 64.
+        #[arg(long, value_name = "N", default_value_t = 64)]
+        ways: u32,
+        /// Maximum ray depth; the eye ray is depth 1 (the paper's recursion
+        /// level 2).
+        #[arg(long, value_name = "N", default_value_t = 2)]
+        depth: u32,
+        /// Write the image here (default: <scene>-chip.png).
+        #[arg(long, value_name = "PNG")]
+        out: Option<PathBuf>,
+        /// Write the figures as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
+        /// Write the waveform of the first chip instance here.
+        #[arg(long, value_name = "PATH")]
+        vcd: Option<PathBuf>,
+        #[command(flatten)]
+        window: tb::cli::TraceWindow,
+        /// Write the generated firmware (assembly source) here.
+        #[arg(long, value_name = "PATH")]
+        emit_asm: Option<PathBuf>,
+        /// Maximum BSP depth.
+        #[arg(long, value_name = "N", default_value_t = 15)]
+        max_depth: u32,
+        /// Maximum objects per BSP leaf.
+        #[arg(long, value_name = "N", default_value_t = 5)]
+        max_leaf: usize,
+    },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
     Compare {
@@ -156,6 +219,26 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             vcd,
             window,
         } => tb::cmd_run::command(file, max_cycles, vcd, window),
+        Command::Bench {
+            scene,
+            size,
+            repeat,
+            json,
+        } => tb::cmd_bench::command(tb::cmd_bench::BenchArgs {
+            scene,
+            size,
+            repeat,
+            json,
+        }),
+        Command::Sweep {
+            scenes,
+            out_dir,
+            size,
+        } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
+            scenes,
+            out_dir,
+            size,
+        }),
         Command::Fuzz {
             targets,
             count,
@@ -205,6 +288,31 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 layout,
             })
         }
+        Command::Render {
+            scene,
+            size,
+            ways,
+            depth,
+            out,
+            json,
+            vcd,
+            window,
+            emit_asm,
+            max_depth,
+            max_leaf,
+        } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
+            scene,
+            size,
+            ways,
+            depth,
+            out,
+            json,
+            vcd,
+            window,
+            emit_asm,
+            max_depth,
+            max_leaf,
+        }),
         Command::Compare {
             a,
             b,

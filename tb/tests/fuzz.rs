@@ -17,8 +17,18 @@ fn every_target_survives_mutated_and_random_inputs() {
             rep.findings[0].what
         );
         // The mutations are not all rejected: the fuzzer reaches past the parser.
-        assert!(rep.accepted > 30, "{}: only {} accepted", t.name(), rep.accepted);
-        assert!(rep.rejected > 300, "{}: only {} rejected", t.name(), rep.rejected);
+        assert!(
+            rep.accepted > 30,
+            "{}: only {} accepted",
+            t.name(),
+            rep.accepted
+        );
+        assert!(
+            rep.rejected > 300,
+            "{}: only {} rejected",
+            t.name(),
+            rep.rejected
+        );
     }
 }
 
@@ -27,7 +37,11 @@ fn regression_corpus() {
     let mut n = 0;
     for t in ALL {
         let dir = corpus_dir(t);
-        let mut paths: Vec<_> = std::fs::read_dir(&dir).unwrap().flatten().map(|e| e.path()).collect();
+        let mut paths: Vec<_> = std::fs::read_dir(&dir)
+            .unwrap()
+            .flatten()
+            .map(|e| e.path())
+            .collect();
         paths.sort();
         for p in paths {
             let input = std::fs::read(&p).unwrap();

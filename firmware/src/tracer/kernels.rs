@@ -1,0 +1,993 @@
+//! The RC context kernels of the ray tracer, emitted as assembly text.
+//!
+//! Register convention in every RC (the "ray registers" live across
+//! kernels, the rest are temporaries of one kernel):
+//!
+//! | reg | holds |
+//! |---|---|
+//! | r0 | 0 (set once at start) |
+//! | r1..r3 | ray origin, scene format `Qm.n` |
+//! | r4..r6 | ray direction, unit, Q1.14 |
+//! | r7 | `tbest`: distance to the closest hit so far (scene format), 32767 = none |
+//! | r8..r15 | temporaries |
+//!
+//! Each kernel reads its object's record from one FB stream (set 0) in
+//! exactly the order its contexts read `fb0`; the record writers in
+//! [`super::layout`] follow the same order, and a test checks that every
+//! kernel reads exactly as many words as its record holds.
+//!
+//! Arithmetic never wraps silently: differences of coordinates fit by the
+//! two guard bits of the scene format, products go through the 32-bit
+//! accumulator and are saturated when scaled back to 16 bits, and a
+//! saturated value always fails the test it feeds (a saturated
+//! perpendicular distance is a miss, a saturated `t` is beyond `tbest`).
+
+use std::fmt::Write;
+
+/// RC RAM map (word addresses, 0..511).
+pub mod ram {
+    /// Reciprocal square root table, 128 words (index `X >> 8`, X in Q.11).
+    pub const RSQ: u32 = 0;
+    /// Reciprocal table, 128 words (index bits 13..7 of a normalised divisor).
+    pub const RCP: u32 = 128;
+    pub const C_ONE: u32 = 256;
+    pub const C_INF: u32 = 257;
+    pub const LANE_ROW: u32 = 258;
+    pub const LANE_COL: u32 = 259;
+    pub const LANE_ACT: u32 = 260;
+    /// The "vector" of the paper's Fig. 7: closest hit of the current pass.
+    pub const HIT_OBJ: u32 = 261;
+    pub const HIT_MAT: u32 = 262;
+    pub const HIT_N: u32 = 263; // 3
+    /// `tbest` at the start of the pass (a hit is `tbest < PASS_T0`).
+    pub const PASS_T0: u32 = 266;
+    /// Shading state of the current recursion level.
+    pub const SH_P: u32 = 267; // 3, hit point offset off the surface
+    pub const SH_N: u32 = 270; // 3
+    pub const SH_MAT: u32 = 273;
+    pub const SH_D: u32 = 274; // 3, direction of the ray that hit
+    pub const ACT: u32 = 277;
+    pub const COL: u32 = 278; // 3, colour of this level, Q3.12
+    pub const OUT_OBJ: u32 = 281;
+    pub const SH_KS: u32 = 282;
+    pub const SH_NL: u32 = 283;
+    pub const SH_RV: u32 = 284;
+    pub const LIT: u32 = 285;
+    pub const TMP0: u32 = 286;
+    pub const TMP1: u32 = 287;
+    pub const TMP2: u32 = 288;
+    pub const TMP3: u32 = 289;
+    pub const TMP4: u32 = 290;
+    /// The local stack: 4 words (colour r, g, b and reflection weight) per
+    /// recursion level.
+    pub const STACK: u32 = 300;
+    pub const STACK_FRAME: u32 = 4;
+}
+
+/// Offset of a spawned ray's origin along the normal, in LSBs: the bound of
+/// the hit point's rounding error (t to 1 LSB, each coordinate of
+/// `o + t d` to 1/2 LSB, the normal to 2^-13).
+pub const EPS_LSB: i32 = 3;
+/// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
+pub const INSIDE_TOL: i32 = 2;
+
+/// An emitter of context lines.
+#[derive(Default)]
+pub struct K {
+    pub lines: Vec<String>,
+    /// FB words read (for the record-length check).
+    pub fb_reads: usize,
+}
+
+impl K {
+    pub fn c(&mut self, s: impl AsRef<str>) -> &mut Self {
+        let s = s.as_ref();
+        self.fb_reads += s.matches("fb0").count();
+        self.lines.push(format!("        {s}"));
+        self
+    }
+    pub fn comment(&mut self, s: &str) -> &mut Self {
+        self.lines.push(format!("        ; {s}"));
+        self
+    }
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+    pub fn len(&self) -> usize {
+        self.lines
+            .iter()
+            .filter(|l| !l.trim_start().starts_with(';'))
+            .count()
+    }
+    pub fn text(&self, label: &str) -> String {
+        let mut s = String::new();
+        let _ = writeln!(s, "{label}:");
+        for l in &self.lines {
+            let _ = writeln!(s, "{l}");
+        }
+        let _ = writeln!(s, "{label}_end:");
+        s
+    }
+}
+
+fn r(k: u8) -> String {
+    format!("r{k}")
+}
+
+/// Normalise the vector in registers `v` in place to a unit Q1.14 vector;
+/// with `len`, also its length (in the input's units) into `t[0]`.
+/// Temporaries `t` (5 registers). Method: halve (so the largest component
+/// is below 2^14), shift left by `clz(max) - 2` (largest component in
+/// [2^13, 2^14)), `X = |v'|^2 >> 15` in Q.11 (range [1, 12)), reciprocal
+/// square root from the RSQ table (index X >> 8) and two Newton-Raphson
+/// steps `y += y (1 - X y^2) / 2`.
+pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
+    let [a, b, c] = v.map(r);
+    let [t0, t1, t2, t3, t4] = t.map(r);
+    k.comment("normalize");
+    for x in [&a, &b, &c] {
+        k.c(format!("sra {x}, {x}, #1"));
+    }
+    k.c(format!("abs {t0}, {a}"))
+        .c(format!("abs {t1}, {b}"))
+        .c(format!("max {t0}, {t0}, {t1}"))
+        .c(format!("abs {t1}, {c}"))
+        .c(format!("max {t0}, {t0}, {t1}"))
+        .c(format!("clz {t0}, {t0}"))
+        .c(format!("sub {t0}, {t0}, #2")); // t0 = sh
+    for x in [&a, &b, &c] {
+        k.c(format!("sll {x}, {x}, {t0}"));
+    }
+    k.c(format!("mul out, {a}, {a}"))
+        .c(format!("mac out, {b}, {b}"))
+        .c(format!("mac {t1}, {c}, {c}, >>15")) // X, Q.11
+        .c(format!("srl {t2}, {t1}, #8"))
+        .c(format!("ld {t2}, [{t2} + #{}]", ram::RSQ)) // y
+        .c(format!("ld {t4}, [r0 + #{}]", ram::C_ONE));
+    for _ in 0..nr {
+        k.c(format!("mul {t3}, {t2}, {t2}, >>14"))
+            .c(format!("mul {t3}, {t3}, {t1}, >>11"))
+            .c(format!("sub {t3}, {t3}, {t4}"))
+            .c(format!("ldacc {t2}, <<15"))
+            .c(format!("msu {t2}, {t2}, {t3}, >>15"));
+    }
+    if len {
+        // |v'| = X * y in units of v' (>> 12), then undo the shifts.
+        k.c(format!("mul {t1}, {t1}, {t2}, >>12"))
+            .c(format!("sra {t1}, {t1}, {t0}"))
+            .c(format!("adds {t0}, {t1}, {t1}"));
+    }
+    for x in [&a, &b, &c] {
+        k.c(format!("mul {x}, {x}, {t2}, >>13"));
+    }
+}
+
+/// `out = sqrt(s)` for `s` in Q.14 (0, 1], result Q.14. Method: clamp to
+/// 16383, shift left by an odd `e = (clz(s) - 2) | 1` so that `X = s << e`
+/// is in [2^13, 2^15), reciprocal square root of X (Q.11) from the RSQ
+/// table and two Newton-Raphson steps, `sqrt(X) = X * y` (Q.12), then
+/// shift right by `(e - 1) / 2` (since `s = X 2^-(3 + e)` in Q.11 units). Clobbers `t` (4 registers); `s` is kept.
+pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
+    let (s, o) = (r(s), r(out));
+    let [e, x, y, w] = t.map(r);
+    k.comment("sqrt");
+    k.c(format!("ld {w}, [r0 + #{}]", ram::C_ONE))
+        .c(format!("add {w}, {w}, #-1"))
+        .c(format!("min {o}, {s}, {w}"))
+        .c(format!("clz {e}, {o}"))
+        .c(format!("sub {e}, {e}, #2"))
+        .c(format!("or {e}, {e}, #1"))
+        .c(format!("sll {x}, {o}, {e}"))
+        .c(format!("srl {y}, {x}, #8"))
+        .c(format!("ld {y}, [{y} + #{}]", ram::RSQ))
+        .c(format!("ld {w}, [r0 + #{}]", ram::C_ONE));
+    for _ in 0..nr {
+        k.c(format!("mul {o}, {y}, {y}, >>14"))
+            .c(format!("mul {o}, {o}, {x}, >>11"))
+            .c(format!("sub {o}, {o}, {w}"))
+            .c(format!("ldacc {y}, <<15"))
+            .c(format!("msu {y}, {y}, {o}, >>15"));
+    }
+    k.c(format!("mul {o}, {x}, {y}, >>13")) // sqrt(X) in Q.12
+        .c(format!("sub {e}, {e}, #1"))
+        .c(format!("sra {e}, {e}, #1"))
+        .c(format!("sra {o}, {o}, {e}"));
+}
+
+/// `q = num * 2^14 / den` for `num >= 0`, `den` in (0, 16384] (Q.14), the
+/// caller having checked that the quotient is below 32768. Method:
+/// normalise `den` by `clz` into [2^14, 2^15), reciprocal `2^29 / den'` from
+/// the RCP table (index bits 13..7) and two Newton-Raphson steps
+/// `r -= r (den' r / 2^29 - 1)`, then `q = (num * r) >> (15 - sh)` from the
+/// two accumulator halves. Result into `num`'s register `out`; clobbers `t`.
+pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: u32) {
+    let (n, d, o) = (r(num), r(den), r(out));
+    let [sh, dn, rc, w, one] = t.map(r);
+    k.comment("divide");
+    k.c(format!("clz {sh}, {d}"))
+        .c(format!("sub {sh}, {sh}, #1"))
+        .c(format!("sll {dn}, {d}, {sh}"))
+        .c(format!("srl {rc}, {dn}, #7"))
+        .c(format!("and {rc}, {rc}, #127"))
+        .c(format!("ld {rc}, [{rc} + #{}]", ram::RCP))
+        .c(format!("ld {one}, [r0 + #{}]", ram::C_ONE));
+    for _ in 0..nr {
+        k.c(format!("mul {w}, {dn}, {rc}, >>15"))
+            .c(format!("sub {w}, {w}, {one}"))
+            .c(format!("ldacc {rc}, <<14"))
+            .c(format!("msu {rc}, {rc}, {w}, >>14"));
+    }
+    k.c(format!("mul out, {n}, {rc}"))
+        .c(format!("acch {w}"))
+        .c(format!("accl {dn}"))
+        .c(format!("add {one}, {sh}, #1"))
+        .c(format!("sll {w}, {w}, {one}"))
+        .c(format!("rsb {one}, {sh}, #15"))
+        .c(format!("srl {dn}, {dn}, {one}"))
+        .c(format!("or {o}, {w}, {dn}"));
+}
+
+/// `x^n` for `x` in Q.14 [0, 1] by square-and-multiply: `out = base^n`.
+pub fn pow_q14(k: &mut K, base: u8, out: u8, tmp: u8, n: u32) {
+    let (b, o, t) = (r(base), r(out), r(tmp));
+    k.comment(&format!("pow ^{n}"));
+    k.c(format!("ld {o}, [r0 + #{}]", ram::C_ONE));
+    if n == 0 {
+        return;
+    }
+    k.c(format!("mov {t}, {b}"));
+    let mut e = n;
+    loop {
+        if e & 1 == 1 {
+            k.c(format!("mul {o}, {o}, {t}, >>14"));
+        }
+        e >>= 1;
+        if e == 0 {
+            break;
+        }
+        k.c(format!("mul {t}, {t}, {t}, >>14"));
+    }
+}
+
+/// Store the candidate hit's normal (three words streamed), object and
+/// material (streamed) where F is set; `t` becomes `tbest`.
+fn commit_streamed_normal(k: &mut K, t: u8) {
+    k.c(format!("(f) mov r7, r{t}"));
+    for i in 0..3 {
+        k.c(format!("(f) st fb0, [#{}]", ram::HIT_N + i));
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+}
+
+/// Sphere. Record (8 words): `c.xyz, r, invr, sg, obj, mat`.
+/// `invr = 2^(14+ks) / r` (scene LSBs); `sg` = +16384 for a sphere seen from
+/// outside, -16384 for NFF's inside-visible sphere.
+///
+/// Perpendicular method: `b = (c - o).d`, `p = (c - o) - b d` kept with
+/// `ep` extra fraction bits (it saturates only beyond twice the largest
+/// radius, which is a miss), only `p / r` is squared: `s = 1 - |p / r|^2`,
+/// `t = b - sg r sqrt(s)`, and the normal follows without the hit point:
+/// `n = -(sg p / r + sqrt(s) d)`.
+pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
+    let mut k = K::default();
+    k.comment("sphere: oc = c - o");
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .c("mac r11, r10, r6, >>14"); // b
+    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
+        k.c(format!("ldacc r{x}, <<14"))
+            .c(format!("msu r{x}, r11, r{d}, >>{}", 14 - ep));
+    }
+    k.c("mov r12, fb0").c("mov r13, fb0"); // r, invr
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        k.c(format!("mul r{x}, r{x}, r13, >>{}", ks + ep))
+            .c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
+    }
+    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("ldacc r14, <<14")
+        .c("msu out, r8, r8")
+        .c("msu out, r9, r9")
+        .c("msu r15, r10, r10, >>14")
+        .c("cmp.gt r15, #0");
+    sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
+    k.c("mul r9, r12, r8, >>14") // h
+        .c("mov r10, fb0") // sg
+        .c("mul r9, r9, r10, >>14")
+        .c("sub r9, r11, r9") // t
+        .c("(f) cmp.gt r9, #0")
+        .c("(f) cmp.lt r9, r7");
+    k.comment("normal = -(sg p/r + sqrt(s) d)");
+    for (i, (x, d)) in [(11, 4), (12, 5), (13, 6)].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP0 + i as u32))
+            .c(format!("mul out, r8, r{d}"))
+            .c(format!("mac r{x}, r10, r{x}, >>14"))
+            .c(format!("neg r{x}, r{x}"));
+    }
+    k.c("(f) mov r7, r9");
+    for (i, x) in [11, 12, 13].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    k
+}
+
+/// Which inside test a planar kernel ends with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inside {
+    /// Barycentric: u >= 0, w >= 0, u + w <= 1.
+    Triangle,
+    /// 0 <= u <= 1, 0 <= w <= 1.
+    Rectangle,
+    /// u^2 + w^2 <= 1 (a cylinder's end cap).
+    Disc,
+}
+
+/// A one-sided planar primitive. Record (20 words):
+/// `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz, n.xyz, obj, mat`, where
+/// `u = (P - v0).eu`, `w = (P - v0).ew` (scaled by 2^kt) are the
+/// barycentric or edge coordinates in Q.14.
+///
+/// `den = -n.d > 0` (front face), `num = -n.(v0 - o) > 0`; the test
+/// `num 2^14 < tbest den` is done in the 32-bit accumulator before the
+/// division, so the quotient always fits.
+pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
+    let mut k = K::default();
+    k.comment("planar: den = n.d, num = n.(v0 - o)");
+    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .c("mac r11, r10, r6, >>14");
+    k.c("sub r12, fb0, r1")
+        .c("sub r13, fb0, r2")
+        .c("sub r14, fb0, r3");
+    k.c("mul out, r8, r12")
+        .c("mac out, r9, r13")
+        .c("mac r15, r10, r14, >>14");
+    k.c("neg r11, r11")
+        .c("neg r15, r15")
+        .c("cmp.gt r11, #0")
+        .c("(f) cmp.gt r15, #0")
+        .c("ldacc r15, <<14")
+        .c("msu out, r7, r11")
+        .c("acch r8")
+        .c("(f) cmp.lt r8, #0");
+    divide(&mut k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
+    k.comment("P - v0");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 10 + i;
+        k.c(format!("ldacc r{o}, <<14"))
+            .c(format!("mac r{x}, r9, r{d}, >>14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r13, fb0, r12, >>{kt}"));
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r14, fb0, r12, >>{kt}"));
+    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c(format!("add r8, r8, #{INSIDE_TOL}"));
+    match inside {
+        Inside::Triangle => {
+            k.c(format!("(f) cmp.ge r13, #-{INSIDE_TOL}"))
+                .c(format!("(f) cmp.ge r14, #-{INSIDE_TOL}"))
+                .c("adds r15, r13, r14")
+                .c("(f) cmp.le r15, r8");
+        }
+        Inside::Rectangle => {
+            k.c(format!("(f) cmp.ge r13, #-{INSIDE_TOL}"))
+                .c(format!("(f) cmp.ge r14, #-{INSIDE_TOL}"))
+                .c("(f) cmp.le r13, r8")
+                .c("(f) cmp.le r14, r8");
+        }
+        Inside::Disc => {
+            k.c("mul out, r13, r13")
+                .c("mac r15, r14, r14, >>14")
+                .c("(f) cmp.le r15, r8");
+        }
+    }
+    commit_streamed_normal(&mut k, 9);
+    k
+}
+
+/// Axis-aligned box, visible from outside (slab method, one section per
+/// axis). Record (24 words): per axis `a` (b, c the two others):
+/// `min_a, max_a, min_b - 1, max_b + 1, min_c - 1, max_c + 1, obj, mat`.
+/// Each RC picks the face of axis `a` that faces its ray with `sel`
+/// (`max_a` where `d_a < 0`), `t = |c - o_a| / |d_a|` by [`divide`] after the
+/// accumulator test, and accepts it where the hit point lies within the
+/// other two slabs; the normal is `-sign(d_a)` along `a`.
+pub fn aabox(nr: u32) -> K {
+    let mut k = K::default();
+    for a in 0..3u32 {
+        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+        let (oa, da) = (1 + a, 4 + a);
+        k.comment(&format!("box: faces across axis {a}"));
+        k.c(format!("cmp.lt r{da}, #0"))
+            .c(format!("ld r15, [r0 + #{}]", ram::C_ONE))
+            .c("(!f) neg r15, r15")
+            .c(format!("st r15, [#{}]", ram::TMP0))
+            .c("mov r8, fb0")
+            .c("sel r8, fb0, r8")
+            .c(format!("sub r8, r8, r{oa}"))
+            .c("(f) neg r8, r8")
+            .c(format!("abs r9, r{da}"))
+            .c("cmp.gt r9, #0")
+            .c("(f) cmp.gt r8, #0")
+            .c("ldacc r8, <<14")
+            .c("msu out, r7, r9")
+            .c("acch r10")
+            .c("(f) cmp.lt r10, #0");
+        divide(&mut k, 8, 9, 11, [10, 12, 13, 14, 15], nr);
+        k.c(format!("ldacc r{}, <<14", 1 + b))
+            .c(format!("mac r12, r11, r{}, >>14", 4 + b))
+            .c(format!("ldacc r{}, <<14", 1 + c))
+            .c(format!("mac r13, r11, r{}, >>14", 4 + c))
+            .c("(f) cmp.le fb0, r12")
+            .c("(f) cmp.ge fb0, r12")
+            .c("(f) cmp.le fb0, r13")
+            .c("(f) cmp.ge fb0, r13")
+            .c("(f) mov r7, r11")
+            .c(format!("ld r15, [r0 + #{}]", ram::TMP0))
+            .c(format!("(f) st r15, [#{}]", ram::HIT_N + a))
+            .c(format!("(f) st r0, [#{}]", ram::HIT_N + b))
+            .c(format!("(f) st r0, [#{}]", ram::HIT_N + c))
+            .c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
+            .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    }
+    k
+}
+
+/// Polygon, convex or concave (even-odd rule, as the reference): three
+/// runs. Head (9 words: `n.xyz, v0.xyz, v0.xyz`): the plane test and
+/// division of [`planar`], then `P - v0`, validity kept in RAM, parity
+/// cleared. Fan (6 words per triangle `v0, vk, vk+1`: `eu.xyz, ew.xyz`):
+/// the parity flips where `u > 0, w >= 0, u + w <= 1` (half-open, so a
+/// point on a shared diagonal counts once). Tail (5 words: `n.xyz, obj,
+/// mat`): commit where valid and the parity is odd.
+pub fn polygon_head(nr: u32) -> K {
+    let mut k = K::default();
+    k.comment("polygon head: the plane");
+    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .c("mac r11, r10, r6, >>14");
+    k.c("sub r12, fb0, r1")
+        .c("sub r13, fb0, r2")
+        .c("sub r14, fb0, r3");
+    k.c("mul out, r8, r12")
+        .c("mac out, r9, r13")
+        .c("mac r15, r10, r14, >>14");
+    k.c("neg r11, r11")
+        .c("neg r15, r15")
+        .c("cmp.gt r11, #0")
+        .c("(f) cmp.gt r15, #0")
+        .c("ldacc r15, <<14")
+        .c("msu out, r7, r11")
+        .c("acch r8")
+        .c("(f) cmp.lt r8, #0");
+    divide(&mut k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 10 + i;
+        k.c(format!("ldacc r{o}, <<14"))
+            .c(format!("mac r{x}, r9, r{d}, >>14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("movb r15, #0")
+        .c("(f) movb r15, #1")
+        .c(format!("st r15, [#{}]", ram::TMP0))
+        .c("movb r8, #0");
+    k
+}
+
+pub fn polygon_fan(kt: u32) -> K {
+    let mut k = K::default();
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r13, fb0, r12, >>{kt}"));
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r14, fb0, r12, >>{kt}"));
+    k.c("cmp.gt r13, #0")
+        .c("(f) cmp.ge r14, #0")
+        .c("adds r13, r13, r14")
+        .c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("(f) cmp.le r13, r14")
+        .c("(f) xor r8, r8, #1");
+    k
+}
+
+pub fn polygon_tail() -> K {
+    let mut k = K::default();
+    k.c(format!("ld r13, [r0 + #{}]", ram::TMP0))
+        .c("cmp.ne r13, #0")
+        .c("(f) cmp.ne r8, #0");
+    commit_streamed_normal(&mut k, 9);
+    k
+}
+
+/// Open cylinder body (the caps are [`Inside::Disc`] planar records).
+/// Record (34 words): `B.xyz, e1.xyz, e2.xyz, e1.xyz, e2.xyz, invr, r, sg,
+/// B.xyz, a.xyz, H+2, sg, (e1, e2) x, (e1, e2) y, (e1, e2) z, obj, mat`
+/// (e1, e2, a an orthonormal frame, a along the axis, B the base centre, H
+/// the height, scene units). The perpendicular vector keeps `ep` extra
+/// fraction bits, as the sphere's, and the normal follows from it without
+/// the hit point.
+///
+/// In the plane across the axis the ray is a 2D ray: its direction
+/// `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D problem is the
+/// sphere's perpendicular method, and `t = tau / |d2|` by [`divide`].
+pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
+    let mut k = K::default();
+    k.comment("cylinder: oc = B - o, projected on e1, e2");
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    k.c("mul out, fb0, r8")
+        .c("mac out, fb0, r9")
+        .c("mac r11, fb0, r10, >>14");
+    k.c("mul out, fb0, r8")
+        .c("mac out, fb0, r9")
+        .c("mac r12, fb0, r10, >>14");
+    k.c(format!("st r11, [#{}]", ram::TMP0))
+        .c(format!("st r12, [#{}]", ram::TMP1));
+    k.c("mul out, fb0, r4")
+        .c("mac out, fb0, r5")
+        .c("mac r8, fb0, r6, >>14");
+    k.c("mul out, fb0, r4")
+        .c("mac out, fb0, r5")
+        .c("mac r9, fb0, r6, >>14");
+    k.c("movb r10, #0");
+    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+    k.c("mov r10, r11") // |d2|, Q.14
+        .c(format!("st r8, [#{}]", ram::TMP2))
+        .c(format!("st r9, [#{}]", ram::TMP3));
+    k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
+        .c(format!("ld r12, [r0 + #{}]", ram::TMP1));
+    k.c("mul out, r11, r8").c("mac r13, r12, r9, >>14"); // b
+    k.c("ldacc r11, <<14")
+        .c(format!("msu r11, r13, r8, >>{}", 14 - ep));
+    k.c("ldacc r12, <<14")
+        .c(format!("msu r12, r13, r9, >>{}", 14 - ep));
+    k.c("mov r14, fb0")
+        .c(format!("mul r11, r11, r14, >>{}", ks + ep))
+        .c(format!("mul r12, r12, r14, >>{}", ks + ep))
+        .c(format!("st r11, [#{}]", ram::TMP0))
+        .c(format!("st r12, [#{}]", ram::TMP1));
+    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("ldacc r14, <<14")
+        .c("msu out, r11, r11")
+        .c("msu r15, r12, r12, >>14")
+        .c("cmp.gt r15, #0")
+        .c("(f) cmp.gt r10, #0");
+    sqrt_q14(&mut k, 15, 8, [9, 11, 12, 14], nr);
+    k.c(format!("st r8, [#{}]", ram::TMP4));
+    k.c("mov r9, fb0")
+        .c("mul r9, r9, r8, >>14") // h
+        .c("mov r11, fb0")
+        .c("mul r9, r9, r11, >>14")
+        .c("sub r9, r13, r9") // tau
+        .c("(f) cmp.gt r9, #0")
+        .c("ldacc r9, <<14")
+        .c("msu out, r7, r10")
+        .c("acch r11")
+        .c("(f) cmp.lt r11, #0");
+    divide(&mut k, 9, 10, 9, [8, 11, 12, 13, 14], nr);
+    k.comment("axial coordinate of the hit");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 11 + i;
+        k.c(format!("ldacc r{o}, <<14"))
+            .c(format!("mac r{x}, r9, r{d}, >>14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("mul out, fb0, r11")
+        .c("mac out, fb0, r12")
+        .c("mac r14, fb0, r13, >>14"); // z
+    k.c("(f) cmp.ge r14, #-2")
+        .c("mov r15, fb0")
+        .c("(f) cmp.le r14, r15");
+    k.comment("normal: n2 = -(sg p2 / r + sqrt(s) d2n) across the axis, n = n2.x e1 + n2.y e2");
+    k.c("(f) mov r7, r9")
+        .c("mov r15, fb0")
+        .c(format!("ld r8, [r0 + #{}]", ram::TMP4));
+    for (x, pn, dn) in [(11, ram::TMP0, ram::TMP2), (12, ram::TMP1, ram::TMP3)] {
+        k.c(format!("ld r{x}, [r0 + #{pn}]"))
+            .c(format!("ld r13, [r0 + #{dn}]"))
+            .c("mul out, r8, r13")
+            .c(format!("mac r{x}, r15, r{x}, >>14"))
+            .c(format!("neg r{x}, r{x}"));
+    }
+    for x in [13, 14, 15] {
+        k.c("mul out, fb0, r11")
+            .c(format!("mac r{x}, fb0, r12, >>14"));
+    }
+    for (i, x) in [13, 14, 15].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    k
+}
+
+/// Program start: RAM tables and constants from the FB (258 words).
+pub fn init() -> K {
+    let mut k = K::default();
+    k.c("movb r0, #0");
+    for a in 0..256 {
+        k.c(format!("st fb0, [#{a}]"));
+    }
+    k.c(format!("st fb0, [#{}]", ram::C_ONE))
+        .c(format!("st fb0, [#{}]", ram::C_INF));
+    k
+}
+
+/// Row-mode group: row i gets `movb r8, #i`.
+pub fn rows() -> K {
+    let mut k = K::default();
+    for i in 0..8 {
+        k.c(format!("movb r8, #{i}"));
+    }
+    k
+}
+
+/// Lane bookkeeping after the row/column groups: which RCs take part for
+/// the number of ways (`tw` x `th` tile), the others sleep for good.
+pub fn lanes(tw: u32, th: u32) -> K {
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::LANE_ROW))
+        .c(format!("ld r9, [r0 + #{}]", ram::LANE_COL))
+        .c("movb r10, #0")
+        .c(format!("cmp.lt r8, #{th}"))
+        .c(format!("(f) cmp.lt r9, #{tw}"))
+        .c("(f) movb r10, #1")
+        .c(format!("st r10, [#{}]", ram::LANE_ACT))
+        .c("(!f) sleep");
+    k
+}
+
+/// Wake every RC, then put the RCs that take no part back to sleep.
+pub fn wake_restore() -> K {
+    let mut k = K::default();
+    k.c("wake")
+        .c(format!("ld r8, [r0 + #{}]", ram::LANE_ACT))
+        .c("cmp.eq r8, #0")
+        .c("(f) sleep");
+    k
+}
+
+/// Sign of the ray direction along `axis` into F.
+pub fn sign(axis: u8) -> K {
+    let mut k = K::default();
+    k.c(format!("cmp.lt r{}, #0", 4 + axis));
+    k
+}
+
+/// BSP node status: does the segment `[o, o + tbest d]` reach below the
+/// split plane (F, read by TinyRISC) and above it (r13 threshold, second
+/// kernel [`classify_above`]). Stream: the split position.
+pub fn classify(axis: u8) -> K {
+    let (o, d) = (1 + axis, 4 + axis);
+    let mut k = K::default();
+    k.c(format!("ldacc r{o}, <<14"))
+        .c(format!("mac r8, r7, r{d}, >>14"))
+        .c(format!("min r9, r{o}, r8"))
+        .c(format!("max r10, r{o}, r8"))
+        .c("mov r11, fb0")
+        .c("add r12, r11, #1")
+        .c("sub r13, r11, #1")
+        .c("cmp.le r9, r12");
+    k
+}
+
+pub fn classify_above() -> K {
+    let mut k = K::default();
+    k.c("cmp.ge r10, r13");
+    k
+}
+
+/// At a leaf, closest-hit pass: RCs whose hit lies inside the leaf's cell
+/// (bounds streamed, widened by 2 LSB) sleep.
+pub fn leaf_closest() -> K {
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
+        .c("cmp.lt r7, r8");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        k.c(format!("ldacc r{o}, <<14"))
+            .c(format!("mac r{}, r7, r{d}, >>14", 9 + i));
+    }
+    for x in [9, 10, 11] {
+        k.c(format!("(f) cmp.le fb0, r{x}"));
+    }
+    for x in [9, 10, 11] {
+        k.c(format!("(f) cmp.ge fb0, r{x}"));
+    }
+    k.c("(f) sleep");
+    k
+}
+
+/// At a leaf, any-hit (shadow) pass: RCs that found any hit sleep.
+pub fn leaf_any() -> K {
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
+        .c("cmp.lt r7, r8")
+        .c("(f) sleep");
+    k
+}
+
+/// Eye rays. Stream: `px0, py0, from.xyz, (A, B, C) per axis`: the
+/// direction through pixel (i, j) is `A + i B + j C` with A in Q2.13 and
+/// B, C scaled by 2^kd; normalised in the RC.
+pub fn eye(kd: u32, nr: u32) -> K {
+    let sh = kd - 13;
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::LANE_COL))
+        .c("add r8, fb0, r8")
+        .c(format!("ld r9, [r0 + #{}]", ram::LANE_ROW))
+        .c("add r9, fb0, r9")
+        .c("mov r1, fb0")
+        .c("mov r2, fb0")
+        .c("mov r3, fb0");
+    for x in [10, 11, 12] {
+        k.c(format!("ldacc fb0, <<{sh}"))
+            .c("mac out, fb0, r8")
+            .c(format!("mac r{x}, fb0, r9, >>{sh}"));
+    }
+    normalize(&mut k, [10, 11, 12], [13, 14, 15, 8, 9], false, nr);
+    k.c("mov r4, r10").c("mov r5, r11").c("mov r6, r12");
+    new_level_common(&mut k);
+    k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::OUT_OBJ));
+    k
+}
+
+fn new_level_common(k: &mut K) {
+    k.c(format!("ld r7, [r0 + #{}]", ram::C_INF))
+        .c(format!("st r7, [#{}]", ram::PASS_T0))
+        .c("movb r8, #0");
+    for i in 0..3 {
+        k.c(format!("st r8, [#{}]", ram::COL + i));
+    }
+    for (i, d) in [4, 5, 6].into_iter().enumerate() {
+        k.c(format!("st r{d}, [#{}]", ram::SH_D + i as u32));
+    }
+}
+
+/// After a closest-hit pass: F = hit; keep the hit (offset point, normal,
+/// material, reflection weight) for shading; misses get the background.
+/// Stream: `bg.rgb, (mat id, ks) per material`.
+pub fn post(level0: bool, materials: usize, eps: i32) -> K {
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::C_INF))
+        .c("cmp.lt r7, r8")
+        .c("movb r9, #0")
+        .c("(f) movb r9, #1")
+        .c(format!("st r9, [#{}]", ram::ACT));
+    if level0 {
+        k.c(format!("ld r10, [r0 + #{}]", ram::HIT_OBJ))
+            .c("movb r11, #-1")
+            .c("(f) mov r11, r10")
+            .c(format!("st r11, [#{}]", ram::OUT_OBJ));
+    }
+    for i in 0..3 {
+        k.c(format!("(!f) st fb0, [#{}]", ram::COL + i));
+    }
+    k.c(format!("movb r12, #{eps}"));
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("ld r8, [r0 + #{}]", ram::HIT_N + i))
+            .c(format!("st r8, [#{}]", ram::SH_N + i))
+            .c(format!("ldacc r{o}, <<14"))
+            .c(format!("mac out, r7, r{d}"))
+            .c("mac r11, r8, r12, >>14")
+            .c(format!("st r11, [#{}]", ram::SH_P + i));
+    }
+    k.c(format!("ld r13, [r0 + #{}]", ram::HIT_MAT))
+        .c(format!("st r13, [#{}]", ram::SH_MAT))
+        .c("movb r14, #0")
+        .c(format!("st r14, [#{}]", ram::SH_KS));
+    for _ in 0..materials {
+        k.c("cmp.ne r9, #0")
+            .c("(f) cmp.eq fb0, r13")
+            .c(format!("(f) st fb0, [#{}]", ram::SH_KS));
+    }
+    k
+}
+
+/// Shadow ray towards a light (stream: the light's position): from the
+/// offset hit point, unit direction, `tbest` = distance - 2 LSB; RCs with
+/// no hit or with the light behind the surface (N.L <= 0, the SPD rule)
+/// sleep. Also keeps N.L and R.V for shading.
+pub fn light_setup(nr: u32) -> K {
+    let mut k = K::default();
+    for (i, o) in [1, 2, 3].into_iter().enumerate() {
+        k.c(format!("ld r{o}, [r0 + #{}]", ram::SH_P + i as u32));
+    }
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+    k.c("mov r4, r8").c("mov r5, r9").c("mov r6, r10");
+    k.c("sub r7, r11, #2")
+        .c(format!("st r7, [#{}]", ram::PASS_T0));
+    // nl = N.L
+    k.c(format!("ld r12, [r0 + #{}]", ram::SH_N))
+        .c("mul out, r12, r4")
+        .c(format!("ld r13, [r0 + #{}]", ram::SH_N + 1))
+        .c("mac out, r13, r5")
+        .c(format!("ld r14, [r0 + #{}]", ram::SH_N + 2))
+        .c("mac r15, r14, r6, >>14")
+        .c(format!("st r15, [#{}]", ram::SH_NL));
+    // nd = N.D, ld = L.D, rv = ld - 2 nl nd
+    k.c(format!("ld r8, [r0 + #{}]", ram::SH_D))
+        .c(format!("ld r9, [r0 + #{}]", ram::SH_D + 1))
+        .c(format!("ld r10, [r0 + #{}]", ram::SH_D + 2))
+        .c("mul out, r12, r8")
+        .c("mac out, r13, r9")
+        .c("mac r11, r14, r10, >>14") // nd
+        .c("mul out, r4, r8")
+        .c("mac out, r5, r9")
+        .c("mac r12, r6, r10, >>14") // ld
+        .c("ldacc r12, <<14")
+        .c("msu out, r15, r11")
+        .c("msu r12, r15, r11, >>14")
+        .c("max r12, r12, #0")
+        .c(format!("st r12, [#{}]", ram::SH_RV));
+    k.c(format!("ld r8, [r0 + #{}]", ram::ACT))
+        .c("cmp.ne r8, #0")
+        .c("(f) cmp.gt r15, #0")
+        .c("movb r9, #0")
+        .c("(f) movb r9, #1")
+        .c(format!("st r9, [#{}]", ram::LIT))
+        .c("(!f) sleep");
+    k
+}
+
+/// After a shadow pass: where the light is visible, add its Phong terms
+/// for the RC's material. Stream per material: `id`, with a fractional
+/// exponent `f` and `1 - f` (Q.14), then per channel `kd c lc, ks lc`
+/// (Q3.12); `shines[m]` the Phong exponent of material m as integer part
+/// and fraction: `x^(n+f)` is computed as `x^n (1 - f + f x)`.
+pub fn shade(shines: &[(u32, f64)]) -> K {
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::LIT))
+        .c("cmp.ne r8, #0")
+        .c(format!("ld r9, [r0 + #{}]", ram::PASS_T0))
+        .c("(f) cmp.ge r7, r9")
+        .c("movb r10, #0")
+        .c("(f) movb r10, #1")
+        .c(format!("ld r11, [r0 + #{}]", ram::SH_NL))
+        .c(format!("ld r12, [r0 + #{}]", ram::SH_RV))
+        .c(format!("ld r13, [r0 + #{}]", ram::SH_MAT));
+    for &(n, f) in shines {
+        k.c("cmp.ne r10, #0").c("(f) cmp.eq fb0, r13");
+        pow_q14(&mut k, 12, 14, 15, n);
+        if f > 0.0 {
+            k.c("mov r15, fb0")
+                .c("mul r15, r15, r12, >>14")
+                .c("add r15, fb0, r15")
+                .c("mul r14, r14, r15, >>14");
+        }
+        for c in 0..3 {
+            k.c("mul out, fb0, r11")
+                .c("mac r15, fb0, r14, >>14")
+                .c(format!("ld r9, [r0 + #{}]", ram::COL + c))
+                .c("adds r9, r9, r15")
+                .c(format!("(f) st r9, [#{}]", ram::COL + c));
+        }
+    }
+    k
+}
+
+/// Start recursion level `level + 1`: push the colour and the reflection
+/// weight of `level` onto the RC stack, and spawn the reflection ray
+/// `d - 2 (d.N) N` where the hit surface reflects (Ks > 0); the others sleep.
+pub fn reflect_setup(level: u32) -> K {
+    let base = ram::STACK + ram::STACK_FRAME * level;
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::SH_KS))
+        .c(format!("st r8, [#{}]", base + 3))
+        .c("movb r10, #0");
+    for c in 0..3 {
+        k.c(format!("ld r9, [r0 + #{}]", ram::COL + c))
+            .c(format!("st r9, [#{}]", base + c))
+            .c(format!("st r10, [#{}]", ram::COL + c));
+    }
+    for (i, o) in [1, 2, 3].into_iter().enumerate() {
+        k.c(format!("ld r{o}, [r0 + #{}]", ram::SH_P + i as u32));
+    }
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::SH_D + i as u32));
+    }
+    for (i, x) in [11, 12, 13].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::SH_N + i as u32));
+    }
+    k.c("mul out, r8, r11")
+        .c("mac out, r9, r12")
+        .c("mac r14, r10, r13, >>14"); // d.N
+    for (d, x, n) in [(4, 8, 11), (5, 9, 12), (6, 10, 13)] {
+        k.c(format!("ldacc r{x}, <<14"))
+            .c(format!("msu out, r14, r{n}"))
+            .c(format!("msu r{d}, r14, r{n}, >>14"));
+    }
+    k.c(format!("ld r7, [r0 + #{}]", ram::C_INF))
+        .c(format!("st r7, [#{}]", ram::PASS_T0));
+    for (i, d) in [4, 5, 6].into_iter().enumerate() {
+        k.c(format!("st r{d}, [#{}]", ram::SH_D + i as u32));
+    }
+    k.c(format!("ld r9, [r0 + #{}]", ram::ACT))
+        .c(format!("ld r8, [r0 + #{}]", ram::SH_KS))
+        .c("cmp.ne r9, #0")
+        .c("(f) cmp.gt r8, #0")
+        .c("(!f) sleep");
+    k
+}
+
+/// Return from level `level + 1`: pop, colour = pushed + weight * reflected.
+pub fn reflect_pop(level: u32) -> K {
+    let base = ram::STACK + ram::STACK_FRAME * level;
+    let mut k = K::default();
+    k.c(format!("ld r10, [r0 + #{}]", base + 3));
+    for c in 0..3 {
+        k.c(format!("ld r8, [r0 + #{}]", base + c))
+            .c(format!("ld r9, [r0 + #{}]", ram::COL + c))
+            .c("mul r9, r9, r10, >>12")
+            .c("adds r9, r8, r9")
+            .c(format!("st r9, [#{}]", ram::COL + c));
+    }
+    k
+}
+
+/// Put one output word (colour channel 0..2, or 3 = object id) into `out`.
+pub fn out_word(i: u32) -> K {
+    let mut k = K::default();
+    let a = if i < 3 { ram::COL + i } else { ram::OUT_OBJ };
+    k.c(format!("ld out, [r0 + #{a}]"));
+    k
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::tracer::layout::{CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_WORDS};
+
+    #[test]
+    fn every_kernel_reads_exactly_its_record() {
+        assert_eq!(sphere(8, 2, 2).fb_reads, SPHERE_WORDS);
+        for i in [Inside::Triangle, Inside::Rectangle, Inside::Disc] {
+            assert_eq!(planar(i, 9, 2).fb_reads, PLANAR_WORDS);
+        }
+        assert_eq!(cylinder(8, 2, 2).fb_reads, CYL_BODY_WORDS);
+        assert_eq!(polygon_head(2).fb_reads, 9);
+        assert_eq!(aabox(2).fb_reads, crate::tracer::layout::BOX_WORDS);
+        assert_eq!(polygon_fan(9).fb_reads, 6);
+        assert_eq!(polygon_tail().fb_reads, 5);
+        assert_eq!(init().fb_reads, 258);
+        assert_eq!(eye(20, 2).fb_reads, 14);
+        assert_eq!(light_setup(2).fb_reads, 3);
+        assert_eq!(post(true, 5, 3).fb_reads, 3 + 2 * 5);
+        assert_eq!(
+            shade(&[(1, 0.0), (10, 0.5), (200, 0.0)]).fb_reads,
+            7 * 3 + 2
+        );
+        assert_eq!(leaf_closest().fb_reads, 6);
+        assert_eq!(classify(2).fb_reads, 1);
+    }
+
+    #[test]
+    fn tables_match_their_definitions() {
+        use crate::tracer::layout::{rcp_table, rsq_table};
+        let rsq = rsq_table();
+        for (k, &y) in rsq.iter().enumerate().skip(8) {
+            let x = (k as f64 + 0.5) * 256.0 / 2048.0;
+            assert!((y as f64 / 16384.0 - 1.0 / x.sqrt()).abs() < 1e-4);
+        }
+        let rcp = rcp_table();
+        for (k, &r) in rcp.iter().enumerate() {
+            assert!(r > 16384 && r < 32768, "{k}");
+        }
+    }
+}

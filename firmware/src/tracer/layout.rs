@@ -1,0 +1,756 @@
+//! The frame-buffer image the tracer reads (FB set 0, word addresses):
+//!
+//! ```text
+//! 0     RSQ table (128) | RCP table (128) | 1.0 | 32767      init stream
+//! EYE   px0, py0 (written per tile), from.xyz, (A, B, C) x 3  eye stream
+//! POST  background.rgb, (material id, ks) per material
+//! LIGHT per light: position.xyz
+//! SHADE per light, per material: id, then per channel kd c lc, ks lc
+//! objects, grouped by type, fixed record size per type (kernels.rs;
+//!     polygons padded to the largest fan of the scene)
+//! BSP nodes (paper's Fig. 5): flags (bit 15 leaf, bits 1..0 axis), split,
+//!     left, right (FB addresses), cell bounds widened by 2 LSB (6 words),
+//!     one membership bit vector per type present (bit 15 of word 0 = the
+//!     type's object 0)
+//! mailboxes: one word per object, the number of the pass that last
+//!     tested it (object merging)
+//! ```
+
+use crate::scene::{PrimType, Scene, Shape, Vec3};
+use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
+
+use super::kernels::Inside;
+use super::Options;
+
+pub const FB_LIMIT: usize = 0x8000;
+pub const NODE_HEAD: usize = 10;
+
+/// The chip's object types, in test order (object test reordering).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ChipType {
+    Sphere,
+    Cylinder,
+    Box,
+    Rectangle,
+    Triangle,
+    Polygon,
+}
+
+impl ChipType {
+    pub const ALL: [ChipType; 6] = [
+        ChipType::Sphere,
+        ChipType::Cylinder,
+        ChipType::Box,
+        ChipType::Rectangle,
+        ChipType::Triangle,
+        ChipType::Polygon,
+    ];
+    pub fn name(self) -> &'static str {
+        match self {
+            ChipType::Sphere => "sphere",
+            ChipType::Cylinder => "cylinder",
+            ChipType::Box => "box",
+            ChipType::Rectangle => "rectangle",
+            ChipType::Triangle => "triangle",
+            ChipType::Polygon => "polygon",
+        }
+    }
+    fn of(p: PrimType) -> Option<ChipType> {
+        Some(match p {
+            PrimType::Sphere => ChipType::Sphere,
+            PrimType::Cylinder => ChipType::Cylinder,
+            PrimType::Cone => return None,
+            PrimType::Box => ChipType::Box,
+            PrimType::Rectangle => ChipType::Rectangle,
+            PrimType::Triangle => ChipType::Triangle,
+            PrimType::Polygon => ChipType::Polygon,
+        })
+    }
+}
+
+pub const SPHERE_WORDS: usize = 8;
+pub const PLANAR_WORDS: usize = 20;
+pub const CYL_BODY_WORDS: usize = 34;
+/// Cylinder group: caps flag, body, base cap, apex cap.
+pub const CYL_WORDS: usize = 1 + CYL_BODY_WORDS + 2 * PLANAR_WORDS;
+pub const BOX_WORDS: usize = 24;
+/// Polygon record: fan count, head, one fan part per triangle, tail.
+pub const POLY_HEAD_WORDS: usize = 9;
+pub const POLY_FAN_WORDS: usize = 6;
+pub const POLY_TAIL_WORDS: usize = 5;
+
+/// One type present in the scene.
+#[derive(Clone, Debug)]
+pub struct TypeInfo {
+    pub ty: ChipType,
+    /// Scene object indices, in slot order.
+    pub objects: Vec<usize>,
+    pub first: usize,
+    pub size: usize,
+    /// Offset of the type's bit vector in a node.
+    pub bv_offset: usize,
+    pub bv_words: usize,
+    pub mailbox: usize,
+    /// Polygons: fan triangles per record.
+    pub fan: usize,
+}
+
+/// The laid-out image and everything the generator needs to know of it.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    pub fb: Vec<u16>,
+    pub frac: u32,
+    pub eye: usize,
+    pub post: usize,
+    pub lights: Vec<usize>,
+    pub shades: Vec<usize>,
+    pub types: Vec<TypeInfo>,
+    pub root: usize,
+    pub node_words: usize,
+    pub mailbox: usize,
+    pub objects: usize,
+    pub materials: usize,
+    /// Phong exponents: integer part and fraction (see [`split_shine`]).
+    pub shines: Vec<(u32, f64)>,
+    /// Scale shifts of the kernels.
+    pub kd: u32,
+    pub ks_sphere: u32,
+    pub ks_cyl: u32,
+    /// Extra fraction bits of the sphere kernel's perpendicular vector.
+    pub ep_sphere: u32,
+    /// The same for the cylinder kernel.
+    pub ep_cyl: u32,
+    pub kt_rect: u32,
+    pub kt_tri: u32,
+    pub kt_disc: u32,
+}
+
+/// Reciprocal square root table: entry k = 1/sqrt(X) for X = (k + 0.5) 256
+/// in Q.11, Q1.14 (saturated below index 8, where it is never used).
+pub fn rsq_table() -> Vec<u16> {
+    (0..128)
+        .map(|k| {
+            let x = (k as f64 + 0.5) * 256.0 / 2048.0;
+            ((1.0 / x.sqrt()) * 16384.0).round().min(32767.0) as i16 as u16
+        })
+        .collect()
+}
+
+/// Reciprocal table: entry k = 2^29 / d for d = 2^14 + (k + 0.5) 128.
+pub fn rcp_table() -> Vec<u16> {
+    (0..128)
+        .map(|k| {
+            let d = 16384.0 + (k as f64 + 0.5) * 128.0;
+            ((1u64 << 29) as f64 / d).round().min(32767.0) as i16 as u16
+        })
+        .collect()
+}
+
+struct W {
+    fb: Vec<u16>,
+    s: f64,
+}
+
+fn sat(x: f64) -> u16 {
+    x.round().clamp(-32768.0, 32767.0) as i16 as u16
+}
+
+impl W {
+    fn coord(&mut self, x: f64) {
+        self.fb.push(sat(x * self.s));
+    }
+    fn point(&mut self, v: Vec3) {
+        for x in v.to_array() {
+            self.coord(x);
+        }
+    }
+    fn unit(&mut self, v: Vec3) {
+        for x in v.to_array() {
+            self.fb.push(sat(x * Q_UNIT.lsb().recip()));
+        }
+    }
+    fn col(&mut self, x: f64) {
+        self.fb.push(sat(x * Q_MATERIAL.lsb().recip()));
+    }
+    fn raw(&mut self, x: i64) {
+        self.fb.push(x.clamp(-32768, 32767) as i16 as u16);
+    }
+    fn scaled(&mut self, v: Vec3, scale: f64) {
+        for x in v.to_array() {
+            self.fb.push(sat(x * scale));
+        }
+    }
+}
+
+/// A planar record's geometry: normal, origin vertex, edge duals.
+#[derive(Clone, Copy)]
+struct Planar {
+    n: Vec3,
+    v0: Vec3,
+    eu: Vec3,
+    ew: Vec3,
+    kind: Inside,
+}
+
+fn triangle_planar(a: Vec3, b: Vec3, c: Vec3, n: Vec3) -> Planar {
+    let (e1, e2) = (b - a, c - a);
+    let x = e2.cross(n);
+    let y = n.cross(e1);
+    let (dx, dy) = (e1.dot(x), e2.dot(y));
+    if dx.abs() < 1e-300 || dy.abs() < 1e-300 {
+        // Degenerate: a record that never hits (zero normal).
+        return Planar {
+            n: Vec3::ZERO,
+            v0: a,
+            eu: Vec3::ZERO,
+            ew: Vec3::ZERO,
+            kind: Inside::Triangle,
+        };
+    }
+    Planar {
+        n,
+        v0: a,
+        eu: x * (1.0 / dx),
+        ew: y * (1.0 / dy),
+        kind: Inside::Triangle,
+    }
+}
+
+fn rect_planar(corner: Vec3, e1: Vec3, e2: Vec3, n: Vec3) -> Planar {
+    Planar {
+        n,
+        v0: corner,
+        eu: e1 * (1.0 / e1.dot(e1)),
+        ew: e2 * (1.0 / e2.dot(e2)),
+        kind: Inside::Rectangle,
+    }
+}
+
+fn perpendicular(a: Vec3) -> Vec3 {
+    let t = if a.x.abs() < 0.6 {
+        Vec3::new(1.0, 0.0, 0.0)
+    } else {
+        Vec3::new(0.0, 1.0, 0.0)
+    };
+    a.cross(t).normalized()
+}
+
+fn disc(center: Vec3, e1: Vec3, e2: Vec3, r: f64, n: Vec3) -> Planar {
+    Planar {
+        n,
+        v0: center,
+        eu: e1 * (1.0 / r),
+        ew: e2 * (1.0 / r),
+        kind: Inside::Disc,
+    }
+}
+
+/// A Phong exponent as integer part `n` and fraction `f` (0 when below
+/// 1/1024): the kernel computes `x^n (1 - f + f x)`, the linear blend of
+/// `x^n` and `x^(n+1)`, for `x^(n+f)`.
+pub fn split_shine(shine: f64) -> (u32, f64) {
+    let s = shine.clamp(0.0, 4096.0);
+    let n = s.floor();
+    let f = s - n;
+    if f < 1.0 / 1024.0 {
+        (n as u32, 0.0)
+    } else if f > 1.0 - 1.0 / 1024.0 {
+        (n as u32 + 1, 0.0)
+    } else {
+        (n as u32, f)
+    }
+}
+
+/// Largest shift `k` with `m * 2^k <= 32767` (clamped to 0..=max).
+fn fit_shift(m: f64, max: u32) -> u32 {
+    if m <= 0.0 {
+        return max;
+    }
+    let k = (32767.0 / m).log2().floor();
+    k.clamp(0.0, max as f64) as u32
+}
+
+/// The tracer's coordinate format: the finest `Qm.n` in which every object
+/// and the eye fit with two guard bits (so that differences of points and
+/// distances across the scene fit), and every light fits with the scene's
+/// extent added (so that `light - P` fits); never coarser than the scene
+/// compiler's format (whose BSP planes are snapped to its LSB, hence exact
+/// in a finer one). Lights need no guard bits of their own: only their
+/// difference to a point of the scene is ever formed.
+pub fn fit_frac(scene: &Scene, compiler_frac: u32, guard_bits: u32) -> u32 {
+    let mut m: f64 = scene.camera.from.max_abs();
+    for o in &scene.objects {
+        let b = o.shape.bounds();
+        m = m.max(b.min.max_abs()).max(b.max.max_abs());
+    }
+    let l = scene
+        .lights
+        .iter()
+        .map(|l| l.position.max_abs())
+        .fold(0.0f64, f64::max);
+    (compiler_frac..=14)
+        .rev()
+        .find(|&n| {
+            let range = ((15 - n) as f64).exp2() * 0.999;
+            m * (guard_bits as f64).exp2() < range && l + m < range
+        })
+        .unwrap_or(compiler_frac)
+}
+
+/// Lay out the scene.
+pub fn build(
+    scene: &Scene,
+    image: &SceneImage,
+    opt: &Options,
+    guard_bits: u32,
+) -> Result<Layout, String> {
+    let frac = fit_frac(scene, image.report.frac_bits, guard_bits);
+    let s = (frac as f64).exp2();
+    let err = |line: usize, m: String| {
+        if line > 0 {
+            format!("{}:{line}: {m}", scene.source)
+        } else {
+            format!("{}: {m}", scene.source)
+        }
+    };
+
+    // Objects by chip type.
+    let mut by: Vec<Vec<usize>> = vec![Vec::new(); 6];
+    let mut slot = vec![(0usize, 0usize); scene.objects.len()];
+    for (i, o) in scene.objects.iter().enumerate() {
+        let Some(t) = ChipType::of(o.shape.prim_type()) else {
+            return Err(err(
+                o.line,
+                "cones with unequal radii have no chip kernel (cylinders, spheres, boxes, rectangles, triangles and polygons do)"
+                    .into(),
+            ));
+        };
+        let ti = t as usize;
+        slot[i] = (ti, by[ti].len());
+        by[ti].push(i);
+    }
+    if scene.materials.len() > 1000 || scene.lights.len() > 64 {
+        return Err(err(0, "more than 1000 materials or 64 lights".into()));
+    }
+
+    // Planar geometry of every record, to fit the kernels' scale shifts.
+    let mut planars: Vec<Vec<Planar>> = vec![Vec::new(); scene.objects.len()];
+    let mut fan = 0usize;
+    let mut r_min_sph = f64::INFINITY;
+    let mut r_min_cyl = f64::INFINITY;
+    for (i, o) in scene.objects.iter().enumerate() {
+        match &o.shape {
+            Shape::Sphere { radius, .. } => r_min_sph = r_min_sph.min(radius.abs() * s),
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                ..
+            } => {
+                r_min_cyl = r_min_cyl.min(base_radius.abs() * s);
+                let a = (*apex - *base).normalized();
+                let e1 = perpendicular(a);
+                let e2 = a.cross(e1);
+                let r = base_radius.abs();
+                planars[i] = vec![disc(*base, e1, e2, r, -a), disc(*apex, e1, e2, r, a)];
+            }
+            Shape::Box { .. } => {}
+            Shape::Rectangle {
+                corner,
+                edge1,
+                edge2,
+            } => {
+                planars[i] = vec![rect_planar(
+                    *corner,
+                    *edge1,
+                    *edge2,
+                    edge1.cross(*edge2).normalized(),
+                )]
+            }
+            Shape::Triangle { v, .. } => {
+                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+                planars[i] = vec![triangle_planar(v[0], v[1], v[2], n)];
+            }
+            Shape::Polygon { v, .. } => {
+                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+                planars[i] = (1..v.len() - 1)
+                    .map(|k| triangle_planar(v[0], v[k], v[k + 1], n))
+                    .collect();
+                fan = fan.max(planars[i].len());
+            }
+        }
+    }
+    let mut m = [0.0f64; 3];
+    for p in planars.iter().flatten() {
+        let k = match p.kind {
+            Inside::Rectangle => 0,
+            Inside::Triangle => 1,
+            Inside::Disc => 2,
+        };
+        for x in p.eu.to_array().into_iter().chain(p.ew.to_array()) {
+            m[k] = m[k].max(x.abs() * (14.0 - frac as f64).exp2());
+        }
+    }
+    let kt = [
+        fit_shift(m[0], 24),
+        fit_shift(m[1], 24),
+        fit_shift(m[2], 24),
+    ];
+    let ks_of = |rmin: f64| {
+        if rmin.is_finite() {
+            fit_shift(16384.0 / rmin, 16)
+        } else {
+            8
+        }
+    };
+    let (ks_sphere, ks_cyl) = (ks_of(r_min_sph), ks_of(r_min_cyl));
+    // Extra fraction bits of the sphere's perpendicular vector: up to 4, as
+    // long as twice the largest radius still fits.
+    let r_max_sph = scene
+        .objects
+        .iter()
+        .filter_map(|o| match o.shape {
+            Shape::Sphere { radius, .. } => Some(radius.abs() * s),
+            _ => None,
+        })
+        .fold(1.0f64, f64::max);
+    let ep_sphere = fit_shift(2.0 * r_max_sph, 4);
+    let r_max_cyl = scene
+        .objects
+        .iter()
+        .filter_map(|o| match o.shape {
+            Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
+            _ => None,
+        })
+        .fold(1.0f64, f64::max);
+    let ep_cyl = fit_shift(2.0 * r_max_cyl, 4);
+
+    let mut w = W { fb: Vec::new(), s };
+    // Init stream.
+    w.fb.extend(rsq_table());
+    w.fb.extend(rcp_table());
+    w.raw(16384);
+    w.raw(32767);
+
+    // Camera: D(i, j) = A + i B + j C.
+    let c = &scene.camera;
+    let (wd, hd) = (opt.width.max(1), opt.height.max(1));
+    let ww = (c.at - c.from).normalized();
+    let uu = ww.cross(c.up).normalized();
+    let vv = uu.cross(ww);
+    let half = (c.angle.to_radians() / 2.0).tan();
+    let (ax, ay) = if wd >= hd {
+        (wd as f64 / hd as f64, 1.0)
+    } else {
+        (1.0, hd as f64 / wd as f64)
+    };
+    let mut a = ww;
+    let mut b = Vec3::ZERO;
+    let mut cc = Vec3::ZERO;
+    if wd > 1 {
+        a = a - uu * (ax * half);
+        b = uu * (ax * half * 2.0 / (wd - 1) as f64);
+    }
+    if hd > 1 {
+        a = a + vv * (ay * half);
+        cc = vv * (-ay * half * 2.0 / (hd - 1) as f64);
+    }
+    let max_bc = b.max_abs().max(cc.max_abs());
+    let kd = fit_shift(max_bc, 28).max(13);
+    let corner_far = a + b * (wd - 1) as f64 + cc * (hd - 1) as f64;
+    if a.max_abs() >= 3.9 || corner_far.max_abs() >= 3.9 {
+        return Err(err(
+            0,
+            format!(
+                "camera angle {} too wide for the chip's Q2.13 eye-ray directions",
+                c.angle
+            ),
+        ));
+    }
+    let eye = w.fb.len();
+    w.raw(0);
+    w.raw(0);
+    w.point(c.from);
+    for k in 0..3 {
+        w.fb.push(sat(a.axis(k) * 8192.0));
+        w.fb.push(sat(b.axis(k) * (kd as f64).exp2()));
+        w.fb.push(sat(cc.axis(k) * (kd as f64).exp2()));
+    }
+
+    // Post: background, (id, ks) per material.
+    let post = w.fb.len();
+    for x in scene.background.to_array() {
+        w.col(x);
+    }
+    for (i, mt) in scene.materials.iter().enumerate() {
+        w.raw(i as i64);
+        w.col(mt.ks);
+    }
+    // Lights and shading coefficients.
+    let nl = scene.lights.len().max(1) as f64;
+    let mut lights = Vec::new();
+    for l in &scene.lights {
+        lights.push(w.fb.len());
+        w.point(l.position);
+    }
+    let mut shades = Vec::new();
+    for l in &scene.lights {
+        shades.push(w.fb.len());
+        let lc = l.color.unwrap_or(Vec3::ONE * (1.0 / nl.sqrt()));
+        for (i, mt) in scene.materials.iter().enumerate() {
+            w.raw(i as i64);
+            let (_, f) = split_shine(mt.shine);
+            if f > 0.0 {
+                w.raw((f * 16384.0).round() as i64);
+                w.raw(((1.0 - f) * 16384.0).round() as i64);
+            }
+            // Per channel: kd c lc, then ks lc (the kernel's read order).
+            let k = mt.color.mul_elem(lc) * mt.kd;
+            let sp = lc * mt.ks;
+            for c in 0..3 {
+                w.col(k.axis(c));
+                w.col(sp.axis(c));
+            }
+        }
+    }
+    let shines: Vec<(u32, f64)> = scene
+        .materials
+        .iter()
+        .map(|m| split_shine(m.shine))
+        .collect();
+
+    // Object records.
+    let write_planar = |w: &mut W, p: &Planar, obj: usize, mat: usize| {
+        let k = match p.kind {
+            Inside::Rectangle => kt[0],
+            Inside::Triangle => kt[1],
+            Inside::Disc => kt[2],
+        };
+        let sc = (14.0 - frac as f64 + k as f64).exp2();
+        w.unit(p.n);
+        w.point(p.v0);
+        w.point(p.v0);
+        w.scaled(p.eu, sc);
+        w.scaled(p.ew, sc);
+        w.unit(p.n);
+        w.raw(obj as i64);
+        w.raw(mat as i64);
+    };
+    let mut types = Vec::new();
+    let mut bv_offset = NODE_HEAD;
+    let mut mailbox_slots = 0;
+    for t in ChipType::ALL {
+        let objs = &by[t as usize];
+        if objs.is_empty() {
+            continue;
+        }
+        let size = match t {
+            ChipType::Sphere => SPHERE_WORDS,
+            ChipType::Cylinder => CYL_WORDS,
+            ChipType::Box => BOX_WORDS,
+            ChipType::Rectangle | ChipType::Triangle => PLANAR_WORDS,
+            ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_FAN_WORDS + POLY_TAIL_WORDS,
+        };
+        let first = w.fb.len();
+        for &i in objs {
+            let o = &scene.objects[i];
+            let start = w.fb.len();
+            match (&o.shape, t) {
+                (
+                    Shape::Sphere {
+                        center,
+                        radius,
+                        inside,
+                    },
+                    _,
+                ) => {
+                    let rq = (radius.abs() * s).round().max(1.0);
+                    let invr = ((14 + ks_sphere) as f64).exp2() / rq;
+                    let sg = if *inside { -1.0 } else { 1.0 };
+                    w.point(*center);
+                    w.raw(rq as i64);
+                    w.raw(invr.round() as i64);
+                    w.raw((sg * 16384.0) as i64);
+                    w.raw(i as i64);
+                    w.raw(o.material as i64);
+                }
+                (
+                    Shape::Cone {
+                        base,
+                        base_radius,
+                        apex,
+                        inside,
+                        caps,
+                        ..
+                    },
+                    _,
+                ) => {
+                    let axis = *apex - *base;
+                    let h = axis.length();
+                    let av = axis * (1.0 / h);
+                    let e1 = perpendicular(av);
+                    let e2 = av.cross(e1);
+                    let rq = (base_radius.abs() * s).round().max(1.0);
+                    let invr = ((14 + ks_cyl) as f64).exp2() / rq;
+                    let sg = if *inside { -1.0 } else { 1.0 };
+                    w.raw(*caps as i64);
+                    w.point(*base);
+                    w.unit(e1);
+                    w.unit(e2);
+                    w.unit(e1);
+                    w.unit(e2);
+                    w.raw(invr.round() as i64);
+                    w.raw(rq as i64);
+                    w.raw((sg * 16384.0) as i64);
+                    w.point(*base);
+                    w.unit(av);
+                    w.raw((h * s).round() as i64 + 2);
+                    w.raw((sg * 16384.0) as i64);
+                    for c in 0..3 {
+                        w.fb.push(sat(e1.axis(c) * 16384.0));
+                        w.fb.push(sat(e2.axis(c) * 16384.0));
+                    }
+                    w.raw(i as i64);
+                    w.raw(o.material as i64);
+                    for p in &planars[i] {
+                        let mut p = *p;
+                        p.n = p.n * sg;
+                        write_planar(&mut w, &p, i, o.material);
+                    }
+                }
+                (Shape::Box { min, max }, _) => {
+                    let q = |x: f64| (x * s).round() as i64;
+                    for a in 0..3 {
+                        let (b, c) = ((a + 1) % 3, (a + 2) % 3);
+                        w.raw(q(min.axis(a)));
+                        w.raw(q(max.axis(a)));
+                        w.raw(q(min.axis(b)) - 1);
+                        w.raw(q(max.axis(b)) + 1);
+                        w.raw(q(min.axis(c)) - 1);
+                        w.raw(q(max.axis(c)) + 1);
+                        w.raw(i as i64);
+                        w.raw(o.material as i64);
+                    }
+                }
+                (Shape::Polygon { v, .. }, _) => {
+                    let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+                    let sc = (14.0 - frac as f64 + kt[1] as f64).exp2();
+                    w.raw(planars[i].len() as i64);
+                    w.unit(n);
+                    w.point(v[0]);
+                    w.point(v[0]);
+                    for p in &planars[i] {
+                        w.scaled(p.eu, sc);
+                        w.scaled(p.ew, sc);
+                    }
+                    w.unit(n);
+                    w.raw(i as i64);
+                    w.raw(o.material as i64);
+                    w.fb.resize(start + size, 0);
+                }
+                _ => {
+                    for p in &planars[i] {
+                        write_planar(&mut w, p, i, o.material);
+                    }
+                }
+            }
+            debug_assert_eq!(w.fb.len() - start, size, "{t:?}");
+            if w.fb.len() - start != size {
+                return Err(format!(
+                    "internal: {} record of {} words, expected {size}",
+                    t.name(),
+                    w.fb.len() - start
+                ));
+            }
+        }
+        let bv_words = objs.len().div_ceil(16);
+        types.push(TypeInfo {
+            ty: t,
+            objects: objs.clone(),
+            first,
+            size,
+            bv_offset,
+            bv_words,
+            mailbox: mailbox_slots,
+            fan,
+        });
+        bv_offset += bv_words;
+        mailbox_slots += objs.len();
+    }
+
+    // BSP nodes (Fig. 5).
+    let node_words = bv_offset;
+    let nodes = &image.bsp.nodes;
+    let root = w.fb.len();
+    let addr = |k: u32| root + k as usize * node_words;
+    let total = root + nodes.len() * node_words + mailbox_slots;
+    if total > FB_LIMIT {
+        return Err(err(
+            0,
+            format!(
+                "the scene needs {total} FB words (objects, {} BSP nodes, mailboxes); FB set 0 holds {FB_LIMIT}",
+                nodes.len()
+            ),
+        ));
+    }
+    for n in nodes {
+        match n.split {
+            Some(sp) => {
+                w.raw(sp.axis as i64);
+                w.coord(sp.position);
+                w.raw(addr(sp.children[0]) as i64);
+                w.raw(addr(sp.children[1]) as i64);
+            }
+            None => {
+                w.fb.push(0x8000);
+                w.raw(0);
+                w.raw(0);
+                w.raw(0);
+            }
+        }
+        for x in n.bounds.min.to_array() {
+            w.raw((x * s).floor() as i64 - 2);
+        }
+        for x in n.bounds.max.to_array() {
+            w.raw((x * s).ceil() as i64 + 2);
+        }
+        for ti in &types {
+            let mut words = vec![0u16; ti.bv_words];
+            for &o in &n.objects {
+                let (t, k) = slot[o as usize];
+                if t == ti.ty as usize {
+                    words[k / 16] |= 0x8000 >> (k % 16);
+                }
+            }
+            w.fb.extend(words);
+        }
+    }
+    let mailbox = w.fb.len();
+    w.fb.resize(mailbox + mailbox_slots, 0);
+    for t in &mut types {
+        t.mailbox += mailbox;
+    }
+    Ok(Layout {
+        fb: w.fb,
+        frac,
+        eye,
+        post,
+        lights,
+        shades,
+        types,
+        root,
+        node_words,
+        mailbox,
+        objects: scene.objects.len(),
+        materials: scene.materials.len(),
+        shines,
+        kd,
+        ks_sphere,
+        ks_cyl,
+        ep_sphere,
+        ep_cyl,
+        kt_rect: kt[0],
+        kt_tri: kt[1],
+        kt_disc: kt[2],
+    })
+}

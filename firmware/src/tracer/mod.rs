@@ -1,0 +1,167 @@
+//! The ray tracer firmware: a generator that writes, for one scene and one
+//! set of options, the TinyRISC program and the RC context kernels (one
+//! assembly source for [`crate::asm`]) and the frame-buffer image they read.
+//!
+//! What runs where (the paper's sections III to VIII):
+//!
+//! * **RCs** (one ray per RC, 8x8 tile = 64 rays): eye-ray generation and
+//!   normalisation, ray-object kernels ([`kernels`]: sphere, open cylinder
+//!   with optional end caps, box as its six faces, rectangle, triangle,
+//!   polygon as a fan of triangles), BSP node status (which side of the
+//!   split plane each ray's segment reaches), Phong shading, shadow and
+//!   reflection ray set-up, the local stack in RC RAM.
+//! * **TinyRISC** ([`control`]): the tile loop; depth-first BSP traversal
+//!   steered by the RCs' status (all rays agree: follow; they disagree:
+//!   test every object under the node via the Fig. 5 bit vectors and the
+//!   Fig. 6 address loop); mailboxes in the FB so an object is tested once
+//!   per pass (object merging); object tests grouped by type (reordering);
+//!   at a leaf the RCs whose hit is found sleep; pixels out through the FB
+//!   by DMA, overlapped with the next tile.
+//!
+//! Number formats: coordinates and distances in the scene's `Qm.n` (fitted
+//! with two guard bits by [`crate::scene_image`]), directions and normals
+//! Q1.14, colours Q3.12. Reciprocal and reciprocal square root: 128-entry
+//! tables in every RC's RAM plus two Newton-Raphson steps.
+
+pub mod control;
+pub mod kernels;
+pub mod layout;
+
+use crate::bsp::BspParams;
+use crate::scene::Scene;
+use crate::scene_image::{compile, CompileOptions, Report};
+
+/// Generator options.
+#[derive(Clone, Copy, Debug)]
+pub struct Options {
+    pub width: u32,
+    pub height: u32,
+    /// Rays traced in parallel: 4, 8, 16, 32 or 64.
+    pub ways: u32,
+    /// Maximum ray depth, the eye ray being depth 1 (the paper's recursion
+    /// level 2 = eye rays and one reflection).
+    pub depth: u32,
+    pub bsp: BspParams,
+}
+
+impl Default for Options {
+    fn default() -> Self {
+        Options {
+            width: 256,
+            height: 256,
+            ways: 64,
+            depth: 2,
+            bsp: BspParams::default(),
+        }
+    }
+}
+
+/// Numerical knobs of the generated kernels (for speed/accuracy studies);
+/// the defaults are the configuration measured in `docs/tracer.md`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Numerics {
+    /// Newton-Raphson steps after each table lookup (reciprocal and
+    /// reciprocal square root), 0..=3.
+    pub newton_steps: u32,
+    /// Guard bits of the coordinate format above the scene's largest
+    /// object or eye coordinate, 2..=4.
+    pub guard_bits: u32,
+    /// Offset of spawned rays along the normal, in LSBs, 1..=64.
+    pub eps_lsb: i32,
+}
+
+impl Default for Numerics {
+    fn default() -> Self {
+        Numerics {
+            newton_steps: 2,
+            guard_bits: 2,
+            eps_lsb: kernels::EPS_LSB,
+        }
+    }
+}
+
+/// Tile width and height for a number of ways.
+pub fn tile_shape(ways: u32) -> Option<(u32, u32)> {
+    match ways {
+        4 => Some((2, 2)),
+        8 => Some((4, 2)),
+        16 => Some((4, 4)),
+        32 => Some((8, 4)),
+        64 => Some((8, 8)),
+        _ => None,
+    }
+}
+
+/// Main-memory map of the program.
+pub mod mem {
+    pub const CTX_BASE: u32 = 0x2_0000;
+    /// The FB image, copied into the FB by DMA at start.
+    pub const FB_IMAGE: u32 = 0x4_0000;
+    /// Tile list: count, then (px0, py0, output address) words.
+    pub const TILE_LIST: u32 = 0x6_0000;
+    /// Output: 256 half-words per tile (R, G, B, object id; 64 lanes each).
+    pub const OUTPUT: u32 = 0x8_0000;
+    pub const OUT_TILE_BYTES: u32 = 512;
+}
+
+/// The generated firmware.
+#[derive(Clone, Debug)]
+pub struct Firmware {
+    /// The whole assembly source (TinyRISC code, data and contexts).
+    pub source: String,
+    /// The frame-buffer image (set 0), loaded at [`mem::FB_IMAGE`].
+    pub fb: Vec<u16>,
+    pub report: Report,
+    pub tile_w: u32,
+    pub tile_h: u32,
+    /// Fraction bits of the scene format.
+    pub frac: u32,
+    pub context_words: usize,
+    /// Names of the kernels loaded (types present only) and their lengths.
+    pub kernels: Vec<(String, usize)>,
+    /// Where everything is in the FB image, and the kernels' scale shifts.
+    pub layout: layout::Layout,
+}
+
+// The program leaves its statistics in main memory at the symbols
+// `T_START`, `T_END` (cycle counter at the start and the end of the tile
+// loop), `TESTS` (object tests broadcast) and `PASSES` (ray passes).
+
+/// Build the firmware for `scene`.
+pub fn build(scene: &Scene, opt: &Options) -> Result<Firmware, String> {
+    build_with(scene, opt, &Numerics::default())
+}
+
+/// Build the firmware for `scene` with explicit numerical knobs.
+pub fn build_with(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmware, String> {
+    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(1..=64).contains(&nm.eps_lsb) {
+        return Err(format!(
+            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 1..=64"
+        ));
+    }
+    let (tw, th) = tile_shape(opt.ways)
+        .ok_or_else(|| format!("--ways {}: must be 4, 8, 16, 32 or 64", opt.ways))?;
+    if opt.depth == 0 || opt.depth > 8 {
+        return Err(format!("--depth {}: must be 1..=8", opt.depth));
+    }
+    let copt = CompileOptions {
+        bsp: opt.bsp,
+        layout: Some(crate::scene_image::Layout::BitVectors),
+        guard_bits: nm.guard_bits,
+        ..CompileOptions::default()
+    };
+    let image = compile(scene, &copt).map_err(|e| e.to_string())?;
+    let lay = layout::build(scene, &image, opt, nm.guard_bits)?;
+    let prog = control::program(scene, &lay, opt, nm, tw, th)?;
+    Ok(Firmware {
+        source: prog.source,
+        fb: lay.fb.clone(),
+        report: image.report.clone(),
+        tile_w: tw,
+        tile_h: th,
+        frac: lay.frac,
+        context_words: prog.context_words,
+        kernels: prog.kernels,
+        layout: lay,
+    })
+}

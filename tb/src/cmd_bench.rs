@@ -1,0 +1,123 @@
+//! `morphosys bench`: how fast the simulator runs.
+//!
+//! The workload is the ray tracer itself: the default scene (or SCENE) at a
+//! small size, rendered on the simulated chip. Measured:
+//!
+//! * tracing off, one host thread: simulated chip (array) cycles per host
+//!   second, the figure the project's goal is stated in;
+//! * tracing on (a VCD of TinyRISC, the broadcast unit and one RC, the kind
+//!   of trace a user asks for), one host thread;
+//! * the speed-up of rendering a 128x128 frame on every core (independent
+//!   chip instances on groups of tiles) over one core.
+//!
+//! Each configuration runs `--repeat` times; the best (least disturbed) run
+//! counts. The reference render is not part of any timing.
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::{Context as _, Result};
+use firmware::bsp::BspParams;
+use firmware::tracer::Options;
+use serde_json::json;
+
+use crate::cmd_scene::{load_scene, write_atomic};
+use crate::render::render_chip;
+
+pub struct BenchArgs {
+    pub scene: Option<PathBuf>,
+    pub size: (u32, u32),
+    pub repeat: u32,
+    pub json: Option<PathBuf>,
+}
+
+fn pool(threads: usize) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .context("cannot start host threads")
+}
+
+pub fn command(a: BenchArgs) -> Result<()> {
+    let scene = load_scene(a.scene.as_deref())?;
+    let (width, height) = a.size;
+    let opt = Options {
+        width,
+        height,
+        ways: 64,
+        depth: 2,
+        bsp: BspParams::default(),
+    };
+    let repeat = a.repeat.max(1);
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    let tmp = tempfile::tempdir().context("cannot create a temporary directory")?;
+
+    // Each measurement: (chip cycles, best host seconds).
+    let measure = |opt: &Options, threads: usize, trace: bool| -> Result<(u64, f64)> {
+        let p = pool(threads)?;
+        let mut best = f64::INFINITY;
+        let mut cycles = 0;
+        for k in 0..repeat {
+            let cfg = trace.then(|| {
+                let mut c = rtl::trace::TraceConfig::new(tmp.path().join(format!("bench{k}.vcd")));
+                c.scope = "tinyrisc,broadcast,array.rc_r0_c0".into();
+                c
+            });
+            let t0 = Instant::now();
+            let r = p.install(|| render_chip(&scene, opt, false, cfg))?;
+            let s = t0.elapsed().as_secs_f64();
+            best = best.min(s);
+            cycles = r.stats.cycles;
+        }
+        Ok((cycles, best))
+    };
+    // Throughput on one chip instance; speed-up on a frame of many.
+    let (cycles, one) = measure(&opt, 1, false)?;
+    let (_, traced) = measure(&opt, 1, true)?;
+    let big = Options {
+        width: 128,
+        height: 128,
+        ..opt
+    };
+    let (big_cycles, big_one) = measure(&big, 1, false)?;
+    let (_, all) = measure(&big, cores, false)?;
+    let off = cycles as f64 / one;
+    let on = cycles as f64 / traced;
+    let speedup = big_one / all;
+    println!(
+        "workload                       {} at {width}x{height}, 64 ways: {cycles} chip cycles",
+        scene.source
+    );
+    println!(
+        "tracing off, 1 thread          {:.2} M array cycles per host second ({one:.3} s)",
+        off / 1e6
+    );
+    println!(
+        "tracing on, 1 thread           {:.2} M array cycles per host second ({traced:.3} s; VCD of tinyrisc, broadcast, rc_r0_c0 over the first chip instance)",
+        on / 1e6
+    );
+    println!(
+        "{cores} threads                      128x128 ({big_cycles} chip cycles, {} chip instances): {all:.3} s against {big_one:.3} s, speed-up {speedup:.2}x",
+        (128 / 8) * (128 / 8) / crate::render::TILES_PER_CHIP
+    );
+    if let Some(p) = &a.json {
+        let v = json!({
+            "scene": scene.source,
+            "width": width,
+            "height": height,
+            "chip_cycles": cycles,
+            "array_cycles_per_host_second": off,
+            "array_cycles_per_host_second_traced": on,
+            "host_seconds_1_thread": one,
+            "speedup_workload": "128x128",
+            "speedup_host_seconds_1_thread": big_one,
+            "host_seconds_all_threads": all,
+            "threads": cores,
+            "speedup": speedup,
+            "repeat": repeat,
+        });
+        write_atomic(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}

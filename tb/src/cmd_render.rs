@@ -1,0 +1,181 @@
+//! `morphosys render`: the paper's ray tracer on the simulated chip, its
+//! frame rate at 300 MHz and its error against the float reference.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use firmware::bsp::BspParams;
+use firmware::tracer::Options;
+use serde_json::json;
+
+use crate::cli::TraceWindow;
+use crate::cmd_scene::{load_scene, png_bytes, write_atomic};
+use crate::metrics;
+use crate::reference;
+use crate::render::render_chip;
+
+pub struct RenderArgs {
+    pub scene: Option<PathBuf>,
+    pub size: Option<(u32, u32)>,
+    pub ways: u32,
+    pub depth: u32,
+    pub out: Option<PathBuf>,
+    pub json: Option<PathBuf>,
+    pub vcd: Option<PathBuf>,
+    pub window: TraceWindow,
+    pub emit_asm: Option<PathBuf>,
+    pub max_depth: u32,
+    pub max_leaf: usize,
+}
+
+/// Everything `render` reports.
+pub struct RenderReport {
+    pub json: serde_json::Value,
+    pub rgb8: Vec<u8>,
+    pub reference_rgb8: Vec<u8>,
+}
+
+/// Render and measure; no files written.
+pub fn render(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    progress: bool,
+    trace: Option<rtl::trace::TraceConfig>,
+) -> Result<(crate::render::ChipRender, RenderReport)> {
+    let t0 = Instant::now();
+    let chip = render_chip(scene, opt, progress, trace)?;
+    let host = t0.elapsed().as_secs_f64();
+    let refimg = reference::render(
+        scene,
+        &reference::Options {
+            width: opt.width,
+            height: opt.height,
+            max_depth: opt.depth,
+            corners: false,
+            progress,
+        },
+    );
+    let ref8 = refimg.to_rgb8();
+    let psnr = metrics::psnr(&chip.rgb8, &ref8);
+    let agree = metrics::hit_agreement(&chip.hits, &refimg.hits);
+    let r = &chip.firmware.report;
+    let json = json!({
+        "scene": scene.source,
+        "cycles": chip.cycles,
+        "fps_at_300mhz": chip.fps_at(300_000_000),
+        "width": opt.width,
+        "height": opt.height,
+        "ways": opt.ways,
+        "depth": opt.depth,
+        "psnr_db": if psnr.is_finite() { psnr } else { 99.0 },
+        "hit_agreement": agree,
+        "active_rc_fraction": chip.stats.active_rc_fraction(),
+        "dma_stall_cycles": chip.stats.dma_stall_cycles,
+        "objects_tested_per_ray": chip.objects_tested_per_ray(),
+        "host_seconds": host,
+        "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
+        "startup_cycles": chip.startup_cycles,
+        "tiles": chip.tiles,
+        "chip_instances": chip.chips,
+        "passes": chip.passes,
+        "object_tests": chip.object_tests,
+        "array_busy_cycles": chip.stats.array_busy_cycles,
+        "dma_busy_cycles": chip.stats.dma_busy_cycles,
+        "format": format!("Q{}.{}", 15 - chip.firmware.frac, chip.firmware.frac),
+        "compiler_format": r.format,
+        "bsp_nodes": r.bsp.nodes,
+        "bsp_max_depth": r.bsp.max_depth,
+        "context_words": chip.firmware.context_words,
+        "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
+        "fb_words": chip.firmware.fb.len(),
+    });
+    let rep = RenderReport {
+        json,
+        rgb8: chip.rgb8.clone(),
+        reference_rgb8: ref8,
+    };
+    Ok((chip, rep))
+}
+
+fn default_out(scene: &Path) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_string_lossy().to_string())
+        .unwrap_or_else(|| "render".into());
+    PathBuf::from(format!("{stem}-chip.png"))
+}
+
+pub fn command(a: RenderArgs) -> Result<()> {
+    let scene = load_scene(a.scene.as_deref())?;
+    let (width, height) = a.size.unwrap_or((256, 256));
+    if width == 0 || height == 0 || width > 4096 || height > 4096 {
+        anyhow::bail!("--size {width}x{height}: each side must be 1..=4096");
+    }
+    let opt = Options {
+        width,
+        height,
+        ways: a.ways,
+        depth: a.depth,
+        bsp: BspParams {
+            max_depth: a.max_depth,
+            max_leaf: a.max_leaf,
+            ..BspParams::default()
+        },
+    };
+    if let Some(p) = &a.emit_asm {
+        let fw = firmware::tracer::build(&scene, &opt).map_err(|e| anyhow::anyhow!("{e}"))?;
+        write_atomic(p, fw.source.as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    let trace = a.vcd.map(|p| a.window.config(p));
+    let (chip, rep) = render(&scene, &opt, true, trace)?;
+    let out = a
+        .out
+        .unwrap_or_else(|| default_out(Path::new(&scene.source)));
+    write_atomic(&out, &png_bytes(width, height, &chip.rgb8)?)
+        .with_context(|| format!("writing {}", out.display()))?;
+    eprintln!("wrote {}", out.display());
+    let j = &rep.json;
+    println!("scene                    {}", scene.source);
+    println!(
+        "size                     {width}x{height}, {} ways, depth {}",
+        opt.ways, opt.depth
+    );
+    println!("cycles                   {}", j["cycles"]);
+    println!(
+        "fps at 300 MHz           {:.2}",
+        j["fps_at_300mhz"].as_f64().unwrap_or(0.0)
+    );
+    println!(
+        "psnr (dB)                {:.2}",
+        j["psnr_db"].as_f64().unwrap_or(0.0)
+    );
+    println!(
+        "hit agreement            {:.4}",
+        j["hit_agreement"].as_f64().unwrap_or(0.0)
+    );
+    println!(
+        "active RC fraction       {:.3}",
+        j["active_rc_fraction"].as_f64().unwrap_or(0.0)
+    );
+    println!("dma stall cycles         {}", j["dma_stall_cycles"]);
+    println!(
+        "objects tested per ray   {:.2}",
+        j["objects_tested_per_ray"].as_f64().unwrap_or(0.0)
+    );
+    println!(
+        "host seconds             {:.2}",
+        j["host_seconds"].as_f64().unwrap_or(0.0)
+    );
+    println!(
+        "array cycles / host s    {:.3e}",
+        j["array_cycles_per_host_second"].as_f64().unwrap_or(0.0)
+    );
+    if let Some(p) = &a.json {
+        let text = serde_json::to_string_pretty(j)?;
+        write_atomic(p, text.as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}

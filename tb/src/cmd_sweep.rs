@@ -1,0 +1,344 @@
+//! `morphosys sweep`: what every knob costs in frame rate and buys in image
+//! quality. Renders each scene on the simulated chip under a set of
+//! configurations, one knob varied at a time from the paper's configuration
+//! (256x256, 64 ways, recursion level 2, BSP depth 15, 5 objects per leaf,
+//! the paper's median split), and writes `results.csv` and the charts:
+//!
+//! * `fig8.{svg,png}`: frames/s at 300 MHz against ways (the paper's Fig. 8,
+//!   with its 13.3 frames/s at 64 ways marked), and `fig8_active.{svg,png}`,
+//!   the active-RC fraction against ways, which explains the sub-linear
+//!   growth;
+//! * `pareto.{svg,png}`: frames/s against PSNR over every configuration,
+//!   with the Pareto front;
+//! * `scaling.{svg,png}`: chip cycles per frame against primitive count.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context as _, Result};
+use firmware::bsp::{BspParams, SplitRule};
+use firmware::tracer::Options;
+
+use crate::charts::{self, Chart, Mark, Series};
+use crate::cmd_scene::{load_scene, write_atomic};
+
+pub struct SweepArgs {
+    pub scenes: Vec<PathBuf>,
+    pub out_dir: PathBuf,
+    pub size: (u32, u32),
+}
+
+/// One configuration: the knob it varies and the tracer options.
+#[derive(Clone, Debug)]
+struct Config {
+    knob: &'static str,
+    value: String,
+    opt: Options,
+}
+
+fn configs(width: u32, height: u32) -> Vec<Config> {
+    let base = Options {
+        width,
+        height,
+        ..Options::default()
+    };
+    let mut v = vec![Config {
+        knob: "paper",
+        value: "paper".into(),
+        opt: base,
+    }];
+    for ways in [4, 8, 16, 32, 64] {
+        v.push(Config {
+            knob: "ways",
+            value: ways.to_string(),
+            opt: Options { ways, ..base },
+        });
+    }
+    for depth in [1, 2, 3] {
+        v.push(Config {
+            knob: "recursion",
+            value: depth.to_string(),
+            opt: Options { depth, ..base },
+        });
+    }
+    for max_depth in [2, 4, 8, 15] {
+        v.push(Config {
+            knob: "bsp_depth",
+            value: max_depth.to_string(),
+            opt: Options {
+                bsp: BspParams {
+                    max_depth,
+                    ..base.bsp
+                },
+                ..base
+            },
+        });
+    }
+    for max_leaf in [1, 2, 5, 10] {
+        v.push(Config {
+            knob: "leaf_size",
+            value: max_leaf.to_string(),
+            opt: Options {
+                bsp: BspParams {
+                    max_leaf,
+                    ..base.bsp
+                },
+                ..base
+            },
+        });
+    }
+    v.push(Config {
+        knob: "split",
+        value: "sah".into(),
+        opt: Options {
+            bsp: BspParams {
+                rule: SplitRule::Sah,
+                ..base.bsp
+            },
+            ..base
+        },
+    });
+    v
+}
+
+/// A result row.
+#[derive(Clone, Debug, serde::Serialize)]
+struct Row {
+    scene: String,
+    primitives: usize,
+    knob: String,
+    value: String,
+    width: u32,
+    height: u32,
+    ways: u32,
+    recursion: u32,
+    bsp_max_depth: u32,
+    bsp_max_leaf: usize,
+    split: String,
+    cycles: u64,
+    fps_at_300mhz: f64,
+    psnr_db: f64,
+    hit_agreement: f64,
+    active_rc_fraction: f64,
+    objects_tested_per_ray: f64,
+    host_seconds: f64,
+}
+
+fn key(o: &Options) -> String {
+    format!(
+        "{}x{} w{} d{} bd{} bl{} {:?}",
+        o.width, o.height, o.ways, o.depth, o.bsp.max_depth, o.bsp.max_leaf, o.bsp.rule
+    )
+}
+
+pub fn command(a: SweepArgs) -> Result<()> {
+    let scenes: Vec<Option<PathBuf>> = if a.scenes.is_empty() {
+        vec![None]
+    } else {
+        a.scenes.iter().cloned().map(Some).collect()
+    };
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+    let cfgs = configs(a.size.0, a.size.1);
+    let mut rows: Vec<Row> = Vec::new();
+    let mut skipped = 0;
+    let bar = indicatif::ProgressBar::new((scenes.len() * cfgs.len()) as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    for s in &scenes {
+        let scene = load_scene(s.as_deref())?;
+        let prims = scene.objects.len();
+        let mut done: BTreeMap<String, Row> = BTreeMap::new();
+        for c in &cfgs {
+            bar.set_message(format!("{} {}={}", scene.source, c.knob, c.value));
+            let k = key(&c.opt);
+            let row = if let Some(r) = done.get(&k) {
+                Row {
+                    knob: c.knob.into(),
+                    value: c.value.clone(),
+                    ..r.clone()
+                }
+            } else {
+                let rep = match crate::cmd_render::render(&scene, &c.opt, false, None) {
+                    Ok((_, rep)) => rep,
+                    Err(e) => {
+                        // A configuration the chip cannot run (for example a
+                        // BSP too large for the FB) is reported and skipped.
+                        bar.suspend(|| {
+                            eprintln!(
+                                "skipped {} with {}={}: {e:#}",
+                                scene.source, c.knob, c.value
+                            )
+                        });
+                        skipped += 1;
+                        bar.inc(1);
+                        continue;
+                    }
+                };
+                let j = &rep.json;
+                let f = |n: &str| j[n].as_f64().unwrap_or(f64::NAN);
+                let r = Row {
+                    scene: scene.source.clone(),
+                    primitives: prims,
+                    knob: c.knob.into(),
+                    value: c.value.clone(),
+                    width: c.opt.width,
+                    height: c.opt.height,
+                    ways: c.opt.ways,
+                    recursion: c.opt.depth,
+                    bsp_max_depth: c.opt.bsp.max_depth,
+                    bsp_max_leaf: c.opt.bsp.max_leaf,
+                    split: format!("{:?}", c.opt.bsp.rule).to_lowercase(),
+                    cycles: j["cycles"].as_u64().unwrap_or(0),
+                    fps_at_300mhz: f("fps_at_300mhz"),
+                    psnr_db: f("psnr_db"),
+                    hit_agreement: f("hit_agreement"),
+                    active_rc_fraction: f("active_rc_fraction"),
+                    objects_tested_per_ray: f("objects_tested_per_ray"),
+                    host_seconds: f("host_seconds"),
+                };
+                done.insert(k, r.clone());
+                r
+            };
+            rows.push(row);
+            bar.inc(1);
+        }
+    }
+    bar.finish_and_clear();
+    if skipped > 0 {
+        eprintln!("{skipped} configurations skipped (see above)");
+    }
+
+    let mut w = csv::Writer::from_writer(Vec::new());
+    for r in &rows {
+        w.serialize(r)?;
+    }
+    let csv_path = a.out_dir.join("results.csv");
+    write_atomic(&csv_path, &w.into_inner().context("csv")?)?;
+    println!("wrote {}", csv_path.display());
+    for p in charts_for(&rows, &a.out_dir)? {
+        println!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+fn short(scene: &str) -> String {
+    Path::new(scene)
+        .file_stem()
+        .map_or(scene.to_string(), |s| s.to_string_lossy().into_owned())
+}
+
+fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
+    scenes.dedup();
+    let per = |knob: &str, y: &dyn Fn(&Row) -> f64| -> Vec<Series> {
+        scenes
+            .iter()
+            .map(|s| Series {
+                name: short(s),
+                points: rows
+                    .iter()
+                    .filter(|r| r.scene == *s && r.knob == knob)
+                    .map(|r| (r.ways as f64, y(r)))
+                    .collect(),
+            })
+            .collect()
+    };
+    let mut out = Vec::new();
+    let size = rows.first().map_or((256, 256), |r| (r.width, r.height));
+    out.extend(charts::write(
+        &dir.join("fig8"),
+        &Chart {
+            title: format!(
+                "Frame rate against rays in parallel ({}x{}, recursion level 2)",
+                size.0, size.1
+            ),
+            x_label: "rays traced in parallel (ways)".into(),
+            y_label: "frames/s at 300 MHz".into(),
+            series: per("ways", &|r| r.fps_at_300mhz),
+            marks: vec![Mark {
+                label: "paper: 13.3 frames/s".into(),
+                x: 64.0,
+                y: 13.3,
+            }],
+            lines: true,
+            log_x: true,
+            pareto: false,
+            log_y: true,
+        },
+    )?);
+    out.extend(charts::write(
+        &dir.join("fig8_active"),
+        &Chart {
+            title: "Active RCs against rays in parallel".into(),
+            x_label: "rays traced in parallel (ways)".into(),
+            y_label: "active RC fraction (of the ways)".into(),
+            series: per("ways", &|r| r.active_rc_fraction),
+            marks: vec![],
+            lines: true,
+            log_x: true,
+            pareto: false,
+            log_y: false,
+        },
+    )?);
+    let pareto: Vec<Series> = scenes
+        .iter()
+        .map(|s| Series {
+            name: short(s),
+            points: rows
+                .iter()
+                .filter(|r| r.scene == *s)
+                .map(|r| (r.fps_at_300mhz, r.psnr_db))
+                .collect(),
+        })
+        .collect();
+    let paper: Vec<Mark> = rows
+        .iter()
+        .filter(|r| r.knob == "paper")
+        .map(|r| Mark {
+            label: format!("paper config ({})", short(&r.scene)),
+            x: r.fps_at_300mhz,
+            y: r.psnr_db,
+        })
+        .collect();
+    out.extend(charts::write(
+        &dir.join("pareto"),
+        &Chart {
+            title: "Speed against accuracy over every configuration".into(),
+            x_label: "frames/s at 300 MHz".into(),
+            y_label: "PSNR against the f64 reference (dB)".into(),
+            series: pareto,
+            marks: paper,
+            lines: false,
+            log_x: false,
+            pareto: true,
+            log_y: false,
+        },
+    )?);
+    let scaling = vec![Series {
+        name: "paper configuration".into(),
+        points: rows
+            .iter()
+            .filter(|r| r.knob == "paper")
+            .map(|r| (r.primitives as f64, r.cycles as f64))
+            .collect(),
+    }];
+    out.extend(charts::write(
+        &dir.join("scaling"),
+        &Chart {
+            title: "Cycles per frame against primitive count".into(),
+            x_label: "primitives in the scene".into(),
+            y_label: "chip cycles per frame".into(),
+            series: scaling,
+            marks: vec![],
+            lines: false,
+            log_x: rows.iter().any(|r| r.primitives > 100),
+            pareto: false,
+            log_y: true,
+        },
+    )?);
+    Ok(out)
+}

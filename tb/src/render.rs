@@ -1,0 +1,294 @@
+//! Rendering on the simulated chip: compile the scene, generate and
+//! assemble the tracer firmware, run independent chip instances over
+//! groups of tiles (rayon), read the pixels back from main memory.
+//!
+//! Determinism: the tiles are cut into groups of a fixed size whatever the
+//! number of host threads, each group runs on its own fresh chip, and the
+//! results are placed by tile; the image and every figure are identical for
+//! any thread count. Cycle count of a frame: the start-up of one chip
+//! (loading the FB, the contexts and the RC tables) plus the tile loops of
+//! every group, as if one chip rendered every tile in sequence.
+
+use anyhow::{anyhow, Result};
+use firmware::asm::{self, Image};
+use firmware::scene::Scene;
+use firmware::tracer::{self, mem, Firmware, Numerics, Options};
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use rtl::chip::run_to_halt;
+use rtl::{Chip, Sim, Stats, Timing};
+
+use crate::reference::NO_HIT;
+
+/// Tiles per chip instance.
+pub const TILES_PER_CHIP: usize = 32;
+/// Cycle budget of one chip instance.
+pub const MAX_CYCLES_PER_CHIP: u64 = 2_000_000_000;
+
+/// The chip's image and figures.
+#[derive(Clone, Debug)]
+pub struct ChipRender {
+    pub width: u32,
+    pub height: u32,
+    pub rgb8: Vec<u8>,
+    /// Per pixel the object the eye ray hit ([`NO_HIT`] for none).
+    pub hits: Vec<u32>,
+    /// Frame cycles (start-up once plus every tile loop).
+    pub cycles: u64,
+    pub startup_cycles: u64,
+    pub stats: Stats,
+    pub object_tests: u64,
+    pub passes: u64,
+    pub tiles: usize,
+    pub chips: usize,
+    pub firmware: Firmware,
+}
+
+impl ChipRender {
+    pub fn fps_at(&self, clock_hz: u64) -> f64 {
+        if self.cycles == 0 {
+            0.0
+        } else {
+            clock_hz as f64 / self.cycles as f64
+        }
+    }
+    /// Objects each ray of a packet was tested against, averaged over the
+    /// packets' passes (eye, shadow and reflection).
+    pub fn objects_tested_per_ray(&self) -> f64 {
+        if self.passes == 0 {
+            0.0
+        } else {
+            self.object_tests as f64 / self.passes as f64
+        }
+    }
+}
+
+fn to8(v: i16) -> u8 {
+    ((v as f64 / 4096.0).clamp(0.0, 1.0) * 255.0).round() as u8
+}
+
+fn add_stats(a: &mut Stats, b: &Stats) {
+    a.cycles += b.cycles;
+    a.array_busy_cycles += b.array_busy_cycles;
+    a.active_rc_cycles += b.active_rc_cycles;
+    a.risc_instructions += b.risc_instructions;
+    a.risc_busy_cycles += b.risc_busy_cycles;
+    a.array_stall_cycles += b.array_stall_cycles;
+    a.dma_stall_cycles += b.dma_stall_cycles;
+    a.dma_busy_cycles += b.dma_busy_cycles;
+    a.dma_words += b.dma_words;
+    a.dma_transfers += b.dma_transfers;
+}
+
+fn sub_stats(a: &mut Stats, b: &Stats) {
+    a.cycles -= b.cycles.min(a.cycles);
+    a.array_busy_cycles -= b.array_busy_cycles.min(a.array_busy_cycles);
+    a.active_rc_cycles -= b.active_rc_cycles.min(a.active_rc_cycles);
+    a.risc_instructions -= b.risc_instructions.min(a.risc_instructions);
+    a.risc_busy_cycles -= b.risc_busy_cycles.min(a.risc_busy_cycles);
+    a.array_stall_cycles -= b.array_stall_cycles.min(a.array_stall_cycles);
+    a.dma_stall_cycles -= b.dma_stall_cycles.min(a.dma_stall_cycles);
+    a.dma_busy_cycles -= b.dma_busy_cycles.min(a.dma_busy_cycles);
+    a.dma_words -= b.dma_words.min(a.dma_words);
+    a.dma_transfers -= b.dma_transfers.min(a.dma_transfers);
+}
+
+struct Group {
+    start: u64,
+    end: u64,
+    tests: u64,
+    passes: u64,
+    stats: Stats,
+    /// Statistics at the start of the tile loop.
+    startup: Stats,
+    /// Per tile, the 256 output words.
+    out: Vec<Vec<i16>>,
+}
+
+fn sym(img: &Image, name: &str) -> Result<u32> {
+    img.symbol(name)
+        .map(|v| v as u32)
+        .ok_or_else(|| anyhow!("internal: firmware symbol {name} missing"))
+}
+
+fn run_group(
+    img: &Image,
+    fw: &Firmware,
+    tiles: &[(u32, u32)],
+    trace: Option<rtl::trace::TraceConfig>,
+) -> Result<Group> {
+    let mut chip = Chip::new(Timing::default(), rtl::memory::DEFAULT_SIZE);
+    img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
+    let fb: Vec<u8> = fw.fb.iter().flat_map(|w| w.to_le_bytes()).collect();
+    chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
+    let mut list = Vec::with_capacity(4 + 12 * tiles.len());
+    list.extend((tiles.len() as u32).to_le_bytes());
+    for (k, (x, y)) in tiles.iter().enumerate() {
+        list.extend(x.to_le_bytes());
+        list.extend(y.to_le_bytes());
+        list.extend((mem::OUTPUT + k as u32 * mem::OUT_TILE_BYTES).to_le_bytes());
+    }
+    chip.load(mem::TILE_LIST, &list)
+        .map_err(|f| anyhow!("{f}"))?;
+    let mut sim = Sim::new(chip);
+    if let Some(cfg) = trace {
+        let path = cfg.path.clone();
+        sim.trace(cfg, "morphosys")
+            .map_err(|e| anyhow!("creating {}: {e}", path.display()))?;
+    }
+    // Start-up (FB and context loads, RC tables) ends where the tile loop
+    // begins: its statistics are taken apart so that a frame counts one
+    // start-up whatever the number of chip instances.
+    let tile_pc = sym(img, "tile")?;
+    let mut startup = Stats::default();
+    let mut result = Ok(0);
+    while !sim.top.halted() {
+        if sim.top.risc.pc == tile_pc {
+            startup = sim.top.stats();
+            break;
+        }
+        if sim.cycle() >= MAX_CYCLES_PER_CHIP {
+            break;
+        }
+        if let Err(e) = sim.step() {
+            result = Err(rtl::chip::RunError::Step(e));
+            break;
+        }
+    }
+    if result.is_ok() {
+        result = run_to_halt(&mut sim, MAX_CYCLES_PER_CHIP);
+    }
+    let files = sim
+        .finish_trace()
+        .map_err(|e| anyhow!("writing the waveform: {e}"))?;
+    for f in files {
+        eprintln!("wrote {}", f.display());
+    }
+    result.map_err(|e| anyhow!("the tracer firmware stopped: {e}"))?;
+    let m = &sim.top.mem;
+    let rd = |name: &str| -> Result<u64> { Ok(m.read(sym(img, name)?, 4) as u64) };
+    let out = (0..tiles.len())
+        .map(|k| {
+            let base = mem::OUTPUT + k as u32 * mem::OUT_TILE_BYTES;
+            (0..256)
+                .map(|i| m.read(base + 2 * i, 2) as u16 as i16)
+                .collect()
+        })
+        .collect();
+    Ok(Group {
+        start: rd("T_START")?,
+        end: rd("T_END")?,
+        tests: rd("TESTS")?,
+        passes: rd("PASSES")?,
+        stats: sim.top.stats(),
+        startup,
+        out,
+    })
+}
+
+/// Render `scene` on the simulated chip.
+pub fn render_chip(
+    scene: &Scene,
+    opt: &Options,
+    progress: bool,
+    trace: Option<rtl::trace::TraceConfig>,
+) -> Result<ChipRender> {
+    render_chip_with(scene, opt, &Numerics::default(), progress, trace)
+}
+
+/// Render with explicit numerical knobs of the firmware (Newton steps,
+/// guard bits, ray offset).
+pub fn render_chip_with(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    progress: bool,
+    trace: Option<rtl::trace::TraceConfig>,
+) -> Result<ChipRender> {
+    let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    let img = asm::assemble(&fw.source, "tracer.s")
+        .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
+    let (w, h) = (opt.width, opt.height);
+    let (tw, th) = (fw.tile_w, fw.tile_h);
+    let mut tiles = Vec::new();
+    for ty in 0..h.div_ceil(th) {
+        for tx in 0..w.div_ceil(tw) {
+            tiles.push((tx * tw, ty * th));
+        }
+    }
+    let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
+    let bar = if progress && groups.len() > 1 {
+        let b = ProgressBar::new(tiles.len() as u64);
+        b.set_style(
+            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} tiles, {eta} left")
+                .unwrap_or_else(|_| ProgressStyle::default_bar()),
+        );
+        b.set_message("chip");
+        b
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut trace = trace;
+    let first_trace = trace.take();
+    let results: Vec<Result<Group>> = groups
+        .par_iter()
+        .enumerate()
+        .map(|(gi, g)| {
+            let t = if gi == 0 { first_trace.clone() } else { None };
+            let r = run_group(&img, &fw, g, t);
+            bar.inc(g.len() as u64);
+            r
+        })
+        .collect();
+    bar.finish_and_clear();
+    let mut rgb8 = vec![0u8; (w * h * 3) as usize];
+    let mut hits = vec![NO_HIT; (w * h) as usize];
+    let mut stats = Stats::default();
+    let (mut cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
+    for (gi, r) in results.into_iter().enumerate() {
+        let g = r?;
+        if gi == 0 {
+            startup = g.start;
+        }
+        cycles += g.end.saturating_sub(g.start);
+        tests += g.tests;
+        passes += g.passes;
+        add_stats(&mut stats, &g.stats);
+        if gi > 0 {
+            sub_stats(&mut stats, &g.startup);
+        }
+        for (k, out) in g.out.iter().enumerate() {
+            let (x0, y0) = groups[gi][k];
+            for lane in 0..64u32 {
+                let (row, col) = (lane / 8, lane % 8);
+                if row >= th || col >= tw {
+                    continue;
+                }
+                let (x, y) = (x0 + col, y0 + row);
+                if x >= w || y >= h {
+                    continue;
+                }
+                let p = (y * w + x) as usize;
+                for c in 0..3 {
+                    rgb8[3 * p + c] = to8(out[c * 64 + lane as usize]);
+                }
+                let id = out[192 + lane as usize];
+                hits[p] = if id < 0 { NO_HIT } else { id as u32 };
+            }
+        }
+    }
+    Ok(ChipRender {
+        width: w,
+        height: h,
+        rgb8,
+        hits,
+        cycles: startup + cycles,
+        startup_cycles: startup,
+        stats,
+        object_tests: tests,
+        passes,
+        tiles: tiles.len(),
+        chips: groups.len(),
+        firmware: fw,
+    })
+}

@@ -1,0 +1,261 @@
+//! The ray tracer on the simulated chip, at small sizes: image quality
+//! against the float reference, determinism, the number of ways, and the
+//! `morphosys render` command line.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use firmware::scene::Scene;
+use firmware::tracer::Options;
+use tb::cmd_render::render;
+
+fn scene_path(name: &str) -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    for p in [
+        root.join("scenes").join(name),
+        root.join("scenes/spd").join(name),
+        PathBuf::from("/work/shared/scenes").join(name),
+    ] {
+        if p.is_file() {
+            return p;
+        }
+    }
+    panic!("scene {name} not found under scenes/, scenes/spd/ or the shared scenes");
+}
+
+fn load(name: &str) -> Scene {
+    Scene::load(&scene_path(name)).unwrap()
+}
+
+fn opts(w: u32, h: u32) -> Options {
+    Options {
+        width: w,
+        height: h,
+        ..Options::default()
+    }
+}
+
+fn check_quality(name: &str, w: u32, h: u32, min_psnr: f64, min_hits: f64) {
+    let scene = load(name);
+    let (_, rep) = render(&scene, &opts(w, h), false, None).unwrap();
+    let j = &rep.json;
+    let psnr = j["psnr_db"].as_f64().unwrap();
+    let hits = j["hit_agreement"].as_f64().unwrap();
+    eprintln!(
+        "{name} {w}x{h}: {} cycles, {:.2} dB, hit agreement {hits:.4}",
+        j["cycles"], psnr
+    );
+    assert!(psnr >= min_psnr, "{name}: PSNR {psnr:.2} dB < {min_psnr}");
+    assert!(
+        hits >= min_hits,
+        "{name}: hit agreement {hits:.4} < {min_hits}"
+    );
+}
+
+#[test]
+fn default_scene_matches_the_reference() {
+    check_quality("default.toml", 48, 40, 30.0, 0.98);
+}
+
+#[test]
+fn jacks_matches_the_reference() {
+    check_quality("jacks-1.nff", 48, 48, 30.0, 0.98);
+}
+
+#[test]
+fn tetra_matches_the_reference() {
+    check_quality("tetra-1.nff", 48, 48, 30.0, 0.98);
+}
+
+#[test]
+fn json_has_every_key_and_sane_figures() {
+    let scene = load("default.toml");
+    let (chip, rep) = render(&scene, &opts(24, 16), false, None).unwrap();
+    let j = &rep.json;
+    for k in [
+        "cycles",
+        "fps_at_300mhz",
+        "width",
+        "height",
+        "ways",
+        "psnr_db",
+        "hit_agreement",
+        "active_rc_fraction",
+        "dma_stall_cycles",
+        "objects_tested_per_ray",
+        "host_seconds",
+        "array_cycles_per_host_second",
+    ] {
+        assert!(!j[k].is_null(), "missing key {k}");
+    }
+    assert_eq!(j["width"], 24);
+    assert_eq!(j["height"], 16);
+    assert_eq!(j["ways"], 64);
+    let f = j["active_rc_fraction"].as_f64().unwrap();
+    assert!(f > 0.0 && f <= 1.0);
+    assert!(chip.cycles > chip.startup_cycles);
+    assert!(j["objects_tested_per_ray"].as_f64().unwrap() > 0.0);
+    // The kernels of the types present only: the default scene has all
+    // five of the paper's types, jacks (spheres, cylinders) has no planar kernel.
+    let names: Vec<&str> = chip
+        .firmware
+        .kernels
+        .iter()
+        .map(|(n, _)| n.as_str())
+        .collect();
+    for k in ["k_sphere", "k_cyl", "k_box", "k_rect", "k_tri"] {
+        assert!(names.contains(&k), "{k} not loaded");
+    }
+    let jacks = tracer_kernels("jacks-1.nff");
+    assert!(jacks.contains(&"k_sphere".to_string()) && jacks.contains(&"k_cyl".to_string()));
+    assert!(!jacks.contains(&"k_rect".to_string()) && !jacks.contains(&"k_tri".to_string()));
+}
+
+fn tracer_kernels(name: &str) -> Vec<String> {
+    let fw = firmware::tracer::build(&load(name), &opts(8, 8)).unwrap();
+    fw.kernels.into_iter().map(|(n, _)| n).collect()
+}
+
+#[test]
+fn image_and_cycles_do_not_depend_on_host_threads() {
+    let scene = load("default.toml");
+    let run = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        // 40x40 = 25 tiles; with TILES_PER_CHIP 32 use a size spanning two
+        // chip instances.
+        pool.install(|| tb::render::render_chip(&scene, &opts(72, 64), false, None).unwrap())
+    };
+    let (a, b) = (run(1), run(2));
+    assert!(a.chips >= 2);
+    assert_eq!(a.rgb8, b.rgb8);
+    assert_eq!(a.hits, b.hits);
+    assert_eq!(a.cycles, b.cycles);
+    assert_eq!(a.stats, b.stats);
+}
+
+#[test]
+fn every_number_of_ways_gives_the_same_image_and_more_ways_are_faster() {
+    let scene = load("default.toml");
+    let mut prev: Option<(Vec<u8>, u64)> = None;
+    for ways in [4, 8, 16, 32, 64] {
+        let o = Options {
+            ways,
+            ..opts(16, 16)
+        };
+        let c = tb::render::render_chip(&scene, &o, false, None).unwrap();
+        if let Some((img, cycles)) = &prev {
+            assert_eq!(&c.rgb8, img, "{ways} ways: another image");
+            assert!(c.cycles < *cycles, "{ways} ways not faster");
+        }
+        prev = Some((c.rgb8, c.cycles));
+    }
+}
+
+#[test]
+fn bad_options_are_errors_not_panics() {
+    let scene = load("default.toml");
+    for (ways, depth) in [(3, 2), (128, 2), (64, 0), (64, 99)] {
+        let o = Options {
+            ways,
+            depth,
+            ..opts(8, 8)
+        };
+        let e = tb::render::render_chip(&scene, &o, false, None).unwrap_err();
+        assert!(e.to_string().contains("--"), "{e}");
+    }
+}
+
+fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+#[test]
+fn render_command_writes_png_json_asm_and_vcd() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "render",
+            "--size",
+            "16x8",
+            "--out",
+            "c.png",
+            "--json",
+            "c.json",
+            "--emit-asm",
+            "c.s",
+            "--vcd",
+            "c.vcd",
+            "--trace-cycles",
+            "200",
+            "--trace-scope",
+            "tinyrisc",
+        ],
+    );
+    assert!(ok, "{out}\n{err}");
+    assert!(out.contains("fps at 300 MHz"), "{out}");
+    for f in ["c.png", "c.json", "c.s", "c.vcd"] {
+        assert!(dir.path().join(f).is_file(), "{f} not written");
+    }
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("c.json")).unwrap()).unwrap();
+    assert_eq!(j["width"], 16);
+    assert!(j["cycles"].as_u64().unwrap() > 0);
+    // The emitted source assembles on its own.
+    firmware::asm::assemble_file(&dir.path().join("c.s")).unwrap();
+    let (ok, _, err) = morphosys(dir.path(), &["render", "--size", "8x8", "--ways", "5"]);
+    assert!(!ok);
+    assert!(err.contains("--ways 5"), "{err}");
+    assert_eq!(err.lines().count(), 1, "{err}");
+    let (ok, _, err) = morphosys(dir.path(), &["render", "missing.nff", "--size", "8x8"]);
+    assert!(!ok && err.contains("missing.nff"), "{err}");
+}
+
+#[test]
+fn numerical_knobs_render_and_trade_accuracy() {
+    use firmware::tracer::Numerics;
+    let scene = load("default.toml");
+    let reference = tb::reference::render(
+        &scene,
+        &tb::reference::Options {
+            width: 32,
+            height: 32,
+            max_depth: 2,
+            corners: false,
+            progress: false,
+        },
+    )
+    .to_rgb8();
+    let psnr = |nm: Numerics| {
+        let c = tb::render::render_chip_with(&scene, &opts(32, 32), &nm, false, None).unwrap();
+        tb::metrics::psnr(&c.rgb8, &reference)
+    };
+    let best = psnr(Numerics::default());
+    let no_newton = psnr(Numerics {
+        newton_steps: 0,
+        ..Numerics::default()
+    });
+    let coarse = psnr(Numerics {
+        guard_bits: 4,
+        ..Numerics::default()
+    });
+    eprintln!("PSNR: default {best:.2}, no Newton step {no_newton:.2}, 4 guard bits {coarse:.2}");
+    assert!(best >= 30.0 && best > no_newton && best >= coarse - 0.5);
+    let bad = Numerics {
+        newton_steps: 9,
+        ..Numerics::default()
+    };
+    assert!(tb::render::render_chip_with(&scene, &opts(8, 8), &bad, false, None).is_err());
+}
