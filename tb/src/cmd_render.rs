@@ -13,7 +13,6 @@ use crate::cli::TraceWindow;
 use crate::cmd_scene::{load_scene, png_bytes, write_atomic};
 use crate::metrics;
 use crate::reference;
-use crate::render::render_chip;
 
 pub struct RenderArgs {
     pub scene: Option<PathBuf>,
@@ -43,8 +42,20 @@ pub fn render(
     progress: bool,
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
+    render_with(scene, opt, &Default::default(), progress, trace)
+}
+
+/// [`render`] with the numeric knobs of the firmware (Newton steps, guard
+/// bits of the coordinate format, ray offset).
+pub fn render_with(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    nm: &firmware::tracer::Numerics,
+    progress: bool,
+    trace: Option<rtl::trace::TraceConfig>,
+) -> Result<(crate::render::ChipRender, RenderReport)> {
     let t0 = Instant::now();
-    let chip = render_chip(scene, opt, progress, trace)?;
+    let chip = crate::render::render_chip_with(scene, opt, nm, progress, trace)?;
     let host = t0.elapsed().as_secs_f64();
     let refimg = reference::render(
         scene,

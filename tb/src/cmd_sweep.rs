@@ -2,12 +2,12 @@
 //! quality. Renders each scene on the simulated chip under a set of
 //! configurations, one knob varied at a time from the paper's configuration
 //! (256x256, 64 ways, recursion level 2, BSP depth 15, 5 objects per leaf,
-//! the paper's median split), and writes `results.csv` and the charts:
+//! the paper's median split; 2 Newton steps, 2 guard bits, 3-LSB ray offset), and writes `results.csv` and the charts:
 //!
 //! * `fig8.{svg,png}`: frames/s at 300 MHz against ways (the paper's Fig. 8,
 //!   with its 13.3 frames/s at 64 ways marked), and `fig8_active.{svg,png}`,
-//!   the active-RC fraction against ways, which explains the sub-linear
-//!   growth;
+//!   the active RCs per ray lane (active-RC fraction x 64 / ways) against
+//!   ways, which explains the sub-linear growth;
 //! * `pareto.{svg,png}`: frames/s against PSNR over every configuration,
 //!   with the Pareto front;
 //! * `scaling.{svg,png}`: chip cycles per frame against primitive count.
@@ -17,7 +17,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result};
 use firmware::bsp::{BspParams, SplitRule};
-use firmware::tracer::Options;
+use firmware::tracer::{Numerics, Options};
 
 use crate::charts::{self, Chart, Mark, Series};
 use crate::cmd_scene::{load_scene, write_atomic};
@@ -34,6 +34,7 @@ struct Config {
     knob: &'static str,
     value: String,
     opt: Options,
+    nm: Numerics,
 }
 
 fn configs(width: u32, height: u32) -> Vec<Config> {
@@ -42,16 +43,44 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         height,
         ..Options::default()
     };
+    let nm = Numerics::default();
     let mut v = vec![Config {
         knob: "paper",
         value: "paper".into(),
         opt: base,
+        nm,
     }];
+    for newton_steps in [0, 1, 2, 3] {
+        v.push(Config {
+            knob: "newton_steps",
+            value: newton_steps.to_string(),
+            opt: base,
+            nm: Numerics { newton_steps, ..nm },
+        });
+    }
+    // More guard bits: a coarser coordinate format (fewer fraction bits).
+    for guard_bits in [2, 3, 4] {
+        v.push(Config {
+            knob: "guard_bits",
+            value: guard_bits.to_string(),
+            opt: base,
+            nm: Numerics { guard_bits, ..nm },
+        });
+    }
+    for eps_lsb in [1, 3, 8] {
+        v.push(Config {
+            knob: "ray_offset_lsb",
+            value: eps_lsb.to_string(),
+            opt: base,
+            nm: Numerics { eps_lsb, ..nm },
+        });
+    }
     for ways in [4, 8, 16, 32, 64] {
         v.push(Config {
             knob: "ways",
             value: ways.to_string(),
             opt: Options { ways, ..base },
+            nm,
         });
     }
     for depth in [1, 2, 3] {
@@ -59,6 +88,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
             knob: "recursion",
             value: depth.to_string(),
             opt: Options { depth, ..base },
+            nm,
         });
     }
     for max_depth in [2, 4, 8, 15] {
@@ -72,6 +102,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
                 },
                 ..base
             },
+            nm,
         });
     }
     for max_leaf in [1, 2, 5, 10] {
@@ -85,6 +116,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
                 },
                 ..base
             },
+            nm,
         });
     }
     v.push(Config {
@@ -97,6 +129,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
             },
             ..base
         },
+        nm,
     });
     v
 }
@@ -115,6 +148,10 @@ struct Row {
     bsp_max_depth: u32,
     bsp_max_leaf: usize,
     split: String,
+    newton_steps: u32,
+    guard_bits: u32,
+    ray_offset_lsb: i32,
+    format: String,
     cycles: u64,
     fps_at_300mhz: f64,
     psnr_db: f64,
@@ -124,10 +161,10 @@ struct Row {
     host_seconds: f64,
 }
 
-fn key(o: &Options) -> String {
+fn key(o: &Options, n: &Numerics) -> String {
     format!(
-        "{}x{} w{} d{} bd{} bl{} {:?}",
-        o.width, o.height, o.ways, o.depth, o.bsp.max_depth, o.bsp.max_leaf, o.bsp.rule
+        "{}x{} w{} d{} bd{} bl{} {:?} {:?}",
+        o.width, o.height, o.ways, o.depth, o.bsp.max_depth, o.bsp.max_leaf, o.bsp.rule, n
     )
 }
 
@@ -154,7 +191,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
         let mut done: BTreeMap<String, Row> = BTreeMap::new();
         for c in &cfgs {
             bar.set_message(format!("{} {}={}", scene.source, c.knob, c.value));
-            let k = key(&c.opt);
+            let k = key(&c.opt, &c.nm);
             let row = if let Some(r) = done.get(&k) {
                 Row {
                     knob: c.knob.into(),
@@ -162,7 +199,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     ..r.clone()
                 }
             } else {
-                let rep = match crate::cmd_render::render(&scene, &c.opt, false, None) {
+                let rep = match crate::cmd_render::render_with(&scene, &c.opt, &c.nm, false, None) {
                     Ok((_, rep)) => rep,
                     Err(e) => {
                         // A configuration the chip cannot run (for example a
@@ -192,6 +229,10 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     bsp_max_depth: c.opt.bsp.max_depth,
                     bsp_max_leaf: c.opt.bsp.max_leaf,
                     split: format!("{:?}", c.opt.bsp.rule).to_lowercase(),
+                    newton_steps: c.nm.newton_steps,
+                    guard_bits: c.nm.guard_bits,
+                    ray_offset_lsb: c.nm.eps_lsb,
+                    format: j["format"].as_str().unwrap_or("?").to_string(),
                     cycles: j["cycles"].as_u64().unwrap_or(0),
                     fps_at_300mhz: f("fps_at_300mhz"),
                     psnr_db: f("psnr_db"),
@@ -273,10 +314,10 @@ fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
     out.extend(charts::write(
         &dir.join("fig8_active"),
         &Chart {
-            title: "Active RCs against rays in parallel".into(),
+            title: "Utilisation of the ray lanes against rays in parallel".into(),
             x_label: "rays traced in parallel (ways)".into(),
-            y_label: "active RC fraction (of the ways)".into(),
-            series: per("ways", &|r| r.active_rc_fraction),
+            y_label: "active RCs / ways (while the array runs)".into(),
+            series: per("ways", &|r| r.active_rc_fraction * 64.0 / r.ways as f64),
             marks: vec![],
             lines: true,
             log_x: true,
@@ -313,7 +354,7 @@ fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             series: pareto,
             marks: paper,
             lines: false,
-            log_x: false,
+            log_x: true,
             pareto: true,
             log_y: false,
         },

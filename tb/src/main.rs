@@ -48,8 +48,8 @@ enum Command {
     Bench {
         /// Scene file (.nff or .toml); default scenes/default.toml.
         scene: Option<PathBuf>,
-        /// Image size of the throughput workload (one chip instance).
-        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "64x32")]
+        /// Image size of the throughput workload.
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "128x128")]
         size: (u32, u32),
         /// Runs per configuration; the fastest counts.
         #[arg(long, value_name = "N", default_value_t = 3)]
