@@ -121,14 +121,35 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 256x256, found '{s}'"))?;
-    let p = |v: &str| {
-        v.trim()
-            .parse::<u32>()
-            .ok()
-            .filter(|&n| (1..=16384).contains(&n))
-    };
-    match (p(w), p(h)) {
-        (Some(w), Some(h)) => Ok((w, h)),
+    let n = |v: &str| v.trim().parse::<u64>().ok();
+    match (n(w), n(h)) {
+        (Some(w), Some(h)) if (1..=16384).contains(&w) && (1..=16384).contains(&h) => {
+            Ok((w as u32, h as u32))
+        }
+        (Some(w), Some(h)) if w > 0 && h > 0 => {
+            // Say what the request would cost: about 40 bytes of host memory
+            // per pixel (images, hit maps, f64 colours) and, on the chip,
+            // about 140 cycles per pixel for the default scene (9.08 M cycles
+            // at 256x256) simulated at about 15 M cycles per host second.
+            let px = w as f64 * h as f64;
+            let mb = px * 40.0 / 1e6;
+            let secs = px * 140.0 / 15e6;
+            let mem = if mb >= 1000.0 {
+                format!("{:.0} GB", mb / 1000.0)
+            } else {
+                format!("{mb:.0} MB")
+            };
+            let time = if secs >= 7200.0 {
+                format!("{:.0} hours", secs / 3600.0)
+            } else if secs >= 120.0 {
+                format!("{:.0} minutes", secs / 60.0)
+            } else {
+                format!("{secs:.0} seconds")
+            };
+            Err(format!(
+                "{w}x{h} is too large: each side must be 1..=16384 (this would need about {mem} of memory and, on the simulated chip, about {time} of host time)"
+            ))
+        }
         _ => Err(format!(
             "expected WIDTHxHEIGHT with each between 1 and 16384, found '{s}'"
         )),
