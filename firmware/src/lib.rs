@@ -3,7 +3,7 @@
 //! host-side rendering.
 
 pub mod asm;
-pub mod scene;
 pub mod bsp;
+pub mod scene;
 pub mod scene_image;
 pub mod tracer;
