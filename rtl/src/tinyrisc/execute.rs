@@ -92,11 +92,17 @@ impl TinyRisc {
         self.ir = w;
         // Decoded-instruction cache: a stalled instruction is retried every
         // cycle, and loops run the same words again.
-        let i = match self.icache {
-            Some((pc, word, i)) if pc == self.pc && word == w => i,
+        // Decoded-instruction cache (the model's speed, not the chip's
+        // timing): keyed by pc and checked against the fetched word, so a
+        // store into the program is seen at once.
+        let slot = (self.pc >> 2) as usize % super::ICACHE;
+        let i = match self.icache.get(slot) {
+            Some(&(pc, word, i)) if pc == self.pc && word == w && w != 0 => i,
             _ => {
                 let i = Instr::decode(w).map_err(|e| fault(e.to_string()))?;
-                self.icache = Some((self.pc, w, i));
+                if let Some(e) = self.icache.get_mut(slot) {
+                    *e = (self.pc, w, i);
+                }
                 i
             }
         };

@@ -86,6 +86,9 @@ pub enum State {
     Halted = 4,
 }
 
+/// Entries of the decoded-instruction cache.
+pub(crate) const ICACHE: usize = 1024;
+
 #[derive(Default)]
 pub struct TinyRisc {
     pub pc: u32,
@@ -93,7 +96,10 @@ pub struct TinyRisc {
     pub timing: RiscTiming,
     busy: u32,
     halted: bool,
-    icache: Option<(u32, u32, Instr)>,
+    /// Decoded-instruction cache, direct-mapped on the word address:
+    /// (pc, word, decoded). Word 0 is never an instruction, so an empty
+    /// entry never matches a real fetch.
+    icache: Vec<(u32, u32, Instr)>,
     // ---- next state ----
     d_pc: u32,
     d_reg: Option<(u8, u32)>,
@@ -117,6 +123,7 @@ impl TinyRisc {
         TinyRisc {
             pc: entry,
             timing,
+            icache: vec![(0, 0, Instr::new(decode::Opcode::Nop, 0, 0, 0, 0)); ICACHE],
             ..TinyRisc::default()
         }
     }
