@@ -35,6 +35,9 @@ pub struct RenderReport {
     pub reference_rgb8: Vec<u8>,
 }
 
+/// Cycles a render traces when `--trace-cycles` is not given.
+pub const DEFAULT_TRACE_CYCLES: u64 = 100_000;
+
 /// Render and measure; no files written.
 pub fn render(
     scene: &firmware::scene::Scene,
@@ -100,6 +103,8 @@ pub fn render_with(
         "context_words": chip.firmware.context_words,
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
         "fb_words": chip.firmware.fb.len(),
+        "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
+        "stream_bytes": chip.firmware.layout.stream.as_ref().map_or(0, |s| s.image.len()),
     });
     let rep = RenderReport {
         json,
@@ -139,7 +144,21 @@ pub fn command(a: RenderArgs) -> Result<()> {
         write_atomic(p, fw.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
-    let trace = a.vcd.map(|p| a.window.config(p));
+    let trace = a.vcd.map(|p| {
+        let mut c = a.window.config(p);
+        // A frame runs for millions of cycles: without --trace-cycles the
+        // waveform covers a window of the first chip instance, not the whole
+        // frame (whose size would be refused anyway).
+        if c.count.is_none() {
+            c.count = Some(DEFAULT_TRACE_CYCLES);
+            eprintln!(
+                "tracing cycles {}..{} of the first chip instance (--trace-from / --trace-cycles to change)",
+                c.first,
+                c.first + DEFAULT_TRACE_CYCLES
+            );
+        }
+        c
+    });
     let (chip, rep) = render(&scene, &opt, true, trace)?;
     let out = a
         .out
@@ -171,6 +190,13 @@ pub fn command(a: RenderArgs) -> Result<()> {
         j["active_rc_fraction"].as_f64().unwrap_or(0.0)
     );
     println!("dma stall cycles         {}", j["dma_stall_cycles"]);
+    if let Some(st) = &chip.firmware.layout.stream {
+        println!(
+            "scene streamed           {} KiB in main memory ({} BSP nodes), leaf blocks by DMA into FB bank 1",
+            st.image.len().div_ceil(1024),
+            st.nodes
+        );
+    }
     println!(
         "objects tested per ray   {:.2}",
         j["objects_tested_per_ray"].as_f64().unwrap_or(0.0)
