@@ -121,6 +121,9 @@ fn run_group(
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
     let fb: Vec<u8> = fw.fb.iter().flat_map(|w| w.to_le_bytes()).collect();
     chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
+    if let Some(st) = &fw.layout.stream {
+        chip.load(st.base, &st.image).map_err(|f| anyhow!("{f}"))?;
+    }
     let mut list = Vec::with_capacity(4 + 12 * tiles.len());
     list.extend((tiles.len() as u32).to_le_bytes());
     for (k, (x, y)) in tiles.iter().enumerate() {
@@ -206,6 +209,27 @@ pub fn render_chip_with(
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<ChipRender> {
     let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    render_firmware(fw, opt, progress, trace)
+}
+
+/// Render with the streamed layout (scene in main memory, leaf blocks moved
+/// into FB bank 1 by DMA) even if the scene fits the FB.
+pub fn render_chip_streamed(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    progress: bool,
+) -> Result<ChipRender> {
+    let fw = tracer::build_streamed_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    render_firmware(fw, opt, progress, None)
+}
+
+fn render_firmware(
+    fw: Firmware,
+    opt: &Options,
+    progress: bool,
+    trace: Option<rtl::trace::TraceConfig>,
+) -> Result<ChipRender> {
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
     let (w, h) = (opt.width, opt.height);

@@ -259,3 +259,53 @@ fn numerical_knobs_render_and_trade_accuracy() {
     };
     assert!(tb::render::render_chip_with(&scene, &opts(8, 8), &bad, false, None).is_err());
 }
+
+/// A scene that does not fit the FB is streamed from main memory (leaf
+/// blocks by DMA into FB bank 1); the same firmware path on a small scene
+/// must give the resident image's quality.
+#[test]
+fn large_scene_is_streamed_and_matches_the_reference() {
+    let scene = load("balls-4.nff");
+    let fw = firmware::tracer::build(&scene, &opts(16, 16)).unwrap();
+    let st = fw.layout.stream.as_ref().expect("balls-4 must be streamed");
+    assert!(fw.fb.len() <= firmware::tracer::layout::STREAM_BANK);
+    assert!(st.largest_block <= firmware::tracer::layout::STREAM_BANK);
+    check_quality("balls-4.nff", 16, 16, 20.0, 0.98);
+}
+
+#[test]
+fn streamed_layout_matches_the_resident_one_on_a_small_scene() {
+    use firmware::tracer::Numerics;
+    let scene = load("jacks-1.nff");
+    let o = opts(24, 24);
+    let reference = tb::reference::render(
+        &scene,
+        &tb::reference::Options {
+            width: 24,
+            height: 24,
+            max_depth: o.depth,
+            corners: false,
+            progress: false,
+        },
+    );
+    let resident = tb::render::render_chip(&scene, &o, false, None).unwrap();
+    let streamed =
+        tb::render::render_chip_streamed(&scene, &o, &Numerics::default(), false).unwrap();
+    assert!(resident.firmware.layout.stream.is_none());
+    assert!(streamed.firmware.layout.stream.is_some());
+    let r8 = reference.to_rgb8();
+    let (pr, ps) = (
+        tb::metrics::psnr(&resident.rgb8, &r8),
+        tb::metrics::psnr(&streamed.rgb8, &r8),
+    );
+    let (hr, hs) = (
+        tb::metrics::hit_agreement(&resident.hits, &reference.hits),
+        tb::metrics::hit_agreement(&streamed.hits, &reference.hits),
+    );
+    eprintln!("jacks-1 24x24: resident {pr:.2} dB {hr:.4}, streamed {ps:.2} dB {hs:.4}");
+    assert!(
+        ps >= 30.0 && ps >= pr - 2.0,
+        "streamed {ps:.2} dB, resident {pr:.2} dB"
+    );
+    assert!(hs >= 0.98 && hs >= hr - 0.005);
+}

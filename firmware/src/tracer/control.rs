@@ -67,6 +67,14 @@ pub fn program(
         refl.push((format!("k_refl{l}"), k::reflect_setup(l)));
         refl.push((format!("k_pop{l}"), k::reflect_pop(l)));
     }
+    if lay.stream.is_some() {
+        refl.push(("k_leafcu".into(), k::leaf_closest_ordered()));
+        refl.push(("k_uzero".into(), k::unord_zero()));
+        for a in 0..3u8 {
+            refl.push((format!("k_uin{a}"), k::unord_count(a, 1)));
+            refl.push((format!("k_uout{a}"), k::unord_count(a, -1)));
+        }
+    }
     // Object kernels: only the types present.
     let mut objk: Vec<(&str, K)> = Vec::new();
     let has = |t: ChipType| lay.types.iter().any(|x| x.ty == t);
@@ -150,6 +158,14 @@ pub fn program(
 T_START: .word 0\nT_END:  .word 0\nTESTS:  .word 0\nPASSES: .word 0\nTL_PTR: .word 0\nTL_CNT: .word 0\nTL_BANK: .word 0\nCUR_OUT: .word 0\n\
 NSTACK: .space 256\n"
     );
+    if let Some(st) = &lay.stream {
+        let _ = writeln!(
+            w,
+            "UPTR:   .word 0\nUSTK:   .space 160\nCUR_BLK: .word 0\nSPLIT = {}\nSBANK = 0x{:x}",
+            st.split_slot,
+            super::layout::STREAM_BANK
+        );
+    }
 
     // ---- text ----
     let _ = writeln!(w, "        .text");
@@ -264,7 +280,8 @@ trace:  sw r15, SAVE_LR(r0)\n        lw r1, PASSES(r0)\n        addi r1, r1, 1\n
         cb(w, &format!("k_sign{a}"));
         let _ = writeln!(w, "        rcfl r2\n        rcfh r3\n        sw r2, NEG+{}(r0)\n        sw r3, NEG+{}(r0)", 8 * a, 8 * a + 4);
     }
-    let _ = writeln!(
+    if lay.stream.is_none() {
+        let _ = writeln!(
         w,
         "        jal awake\n        li r14, NSTACK\n        li r5, ROOT\n\
 visit:  lw r11, AWAKE(r0)\n        lw r12, AWAKE+4(r0)\n        or r1, r11, r12\n        beqz r1, done\n\
@@ -293,27 +310,31 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
         leafa = kaddr("k_leafa"),
         leafalen = klen("k_leafa"),
     );
+    } else {
+        stream_trace(w, lay);
+    }
     // awake: AWAKE = ~sleep (the lanes of the tile are the only ones awake
     // at a pass's start).
     let _ = writeln!(
         w,
         "awake:  rcsl r1\n        rcsh r2\n        nor r1, r1, r0\n        nor r2, r2, r0\n        sw r1, AWAKE(r0)\n        sw r2, AWAKE+4(r0)\n        ret\n"
     );
-    let _ = writeln!(
+    if lay.stream.is_none() {
+        let _ = writeln!(
         w,
         "clear_mailbox:\n        li r2, MAILBOX\n        li r3, NOBJ\n        beqz r3, cm_done\ncm_loop: sfb r0, 0(r2)\n        addi r2, r2, 1\n        addi r3, r3, -1\n        bnez r3, cm_loop\ncm_done: ret\n"
     );
 
-    // ---- test_objects: Fig. 6 for every type present ----
-    let _ = writeln!(
-        w,
-        "; test_objects: r5 = node; every object of the node's bit vectors not yet\n\
+        // ---- test_objects: Fig. 6 for every type present ----
+        let _ = writeln!(
+            w,
+            "; test_objects: r5 = node; every object of the node's bit vectors not yet\n\
 ; tested in this pass (mailbox) is broadcast with its type's kernel.\n\
 test_objects:\n        lw r13, PASS(r0)"
-    );
-    for t in &lay.types {
-        let n = t.ty.name();
-        let _ = writeln!(
+        );
+        for t in &lay.types {
+            let n = t.ty.name();
+            let _ = writeln!(
             w,
             "        addi r6, r5, {bv}\n        li r7, {first}\n        li r8, {mb}\n        li r9, {nw}\n\
 {n}_word:\n        lfb r10, 0(r6)\n        addi r6, r6, 1\n        slli r10, r10, 16\n        li r4, 16\n\
@@ -324,59 +345,59 @@ test_objects:\n        lw r13, PASS(r0)"
             mb = t.mailbox,
             nw = t.bv_words
         );
-        match t.ty {
-            ChipType::Sphere => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        sbcb r1, r7, {}",
-                    kaddr("k_sphere"),
-                    klen("k_sphere")
-                );
-            }
-            ChipType::Rectangle => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        sbcb r1, r7, {}",
-                    kaddr("k_rect"),
-                    klen("k_rect")
-                );
-            }
-            ChipType::Triangle => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        sbcb r1, r7, {}",
-                    kaddr("k_tri"),
-                    klen("k_tri")
-                );
-            }
-            ChipType::Box => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        sbcb r1, r7, {}",
-                    kaddr("k_box"),
-                    klen("k_box")
-                );
-            }
-            ChipType::Cylinder => {
-                let _ = writeln!(
+            match t.ty {
+                ChipType::Sphere => {
+                    let _ = writeln!(
+                        w,
+                        "        li r1, {}\n        sbcb r1, r7, {}",
+                        kaddr("k_sphere"),
+                        klen("k_sphere")
+                    );
+                }
+                ChipType::Rectangle => {
+                    let _ = writeln!(
+                        w,
+                        "        li r1, {}\n        sbcb r1, r7, {}",
+                        kaddr("k_rect"),
+                        klen("k_rect")
+                    );
+                }
+                ChipType::Triangle => {
+                    let _ = writeln!(
+                        w,
+                        "        li r1, {}\n        sbcb r1, r7, {}",
+                        kaddr("k_tri"),
+                        klen("k_tri")
+                    );
+                }
+                ChipType::Box => {
+                    let _ = writeln!(
+                        w,
+                        "        li r1, {}\n        sbcb r1, r7, {}",
+                        kaddr("k_box"),
+                        klen("k_box")
+                    );
+                }
+                ChipType::Cylinder => {
+                    let _ = writeln!(
                     w,
                     "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
                     kaddr("k_cyl"),
                     klen("k_cyl")
                 );
-                for c in 0..2 {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
-                        kaddr("k_disc"),
-                        1 + super::layout::CYL_BODY_WORDS + c * super::layout::PLANAR_WORDS,
-                        klen("k_disc")
-                    );
+                    for c in 0..2 {
+                        let _ = writeln!(
+                            w,
+                            "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
+                            kaddr("k_disc"),
+                            1 + super::layout::CYL_BODY_WORDS + c * super::layout::PLANAR_WORDS,
+                            klen("k_disc")
+                        );
+                    }
+                    let _ = writeln!(w, "{n}_nocap:");
                 }
-                let _ = writeln!(w, "{n}_nocap:");
-            }
-            ChipType::Polygon => {
-                let _ = writeln!(
+                ChipType::Polygon => {
+                    let _ = writeln!(
                     w,
                     "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        addi r2, r7, {}\n        li r1, {}\n\
 {n}_fan:\n        beqz r3, {n}_tail\n        sbcb r1, r2, {}\n        addi r2, r2, {}\n        addi r3, r3, -1\n        j {n}_fan\n\
@@ -390,17 +411,18 @@ test_objects:\n        lw r13, PASS(r0)"
                     kaddr("k_polyt"),
                     klen("k_polyt")
                 );
+                }
             }
-        }
-        let _ = writeln!(
+            let _ = writeln!(
             w,
             "{n}_next:\n        addi r7, r7, {size}\n        addi r8, r8, 1\n        slli r10, r10, 1\n        addi r4, r4, -1\n        bnez r4, {n}_bit\n        j {n}_wend\n\
 {n}_skip:\n        li r1, {size}\n        mul r1, r1, r4\n        add r7, r7, r1\n        add r8, r8, r4\n\
 {n}_wend:\n        addi r9, r9, -1\n        bnez r9, {n}_word",
             size = t.size
         );
+        }
+        let _ = writeln!(w, "        ret\n");
     }
-    let _ = writeln!(w, "        ret\n");
 
     // ---- contexts ----
     let _ = writeln!(w, "        .ctx\n        .org CTXBASE");
@@ -439,4 +461,143 @@ test_objects:\n        lw r13, PASS(r0)"
         context_words: words,
         kernels,
     })
+}
+
+/// The streamed traversal (scenes that do not fit FB set 0): nodes, leaf
+/// lists and mailboxes in main memory (read by TinyRISC), each leaf's block
+/// (bounds and records) moved into FB bank 1 by DMA before its objects are
+/// broadcast; the split value of a node is written into bank 0 for the
+/// classification kernel. Incoherent nodes are not resolved by testing the
+/// whole subtree (thousands of objects) but by visiting both children in a
+/// fixed order; inside such an unordered subtree the closest-hit pass does
+/// not put rays to sleep at a leaf (a nearer hit may lie in a cell not
+/// visited yet); the shadow pass does (any hit will do).
+fn stream_trace(w: &mut String, lay: &Layout) {
+    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
+    let klen = |n: &str| format!("({n}_end - {n}) / 4");
+    let _ = writeln!(
+        w,
+        "        jal awake\n        li r9, USTK\n        sw r9, UPTR(r0)\n        li r1, {uzero}\n        cbcast r1, {uzlen}\n        li r14, NSTACK\n        li r5, ROOT\n\
+visit:  lw r11, AWAKE(r0)\n        lw r12, AWAKE+4(r0)\n        or r1, r11, r12\n        beqz r1, done\n\
+        lw r6, 0(r5)\n        blt r6, r0, leaf\n        lw r1, 4(r5)\n        sfb r1, SPLIT(r0)\n        andi r7, r6, 3\n        li r1, {cls0}\n\
+        beqz r7, cls_go\n        li r1, {cls1}\n        slti r3, r7, 2\n        bnez r3, cls_go\n        li r1, {cls2}\n\
+cls_go: li r2, SPLIT\n        sbcb r1, r2, {len}\n        rcfl r1\n        rcfh r2\n        li r8, {clsr}\n        cbcast r8, 1\n        rcfl r3\n        rcfh r4\n\
+        and r1, r1, r11\n        and r2, r2, r12\n        and r3, r3, r11\n        and r4, r4, r12\n\
+        or r9, r3, r4\n        bnez r9, hasr\n        or r9, r1, r2\n        beqz r9, pop\n        lw r5, 8(r5)\n        j visit\n\
+hasr:   or r9, r1, r2\n        bnez r9, both\n        lw r5, 12(r5)\n        j visit\n\
+both:   slli r9, r7, 3\n        lw r10, NEG(r9)\n        lw r13, NEG+4(r9)\n\
+        and r10, r10, r11\n        and r13, r13, r12\n        or r9, r10, r13\n        beqz r9, posdir\n        bne r10, r11, mixed\n        bne r13, r12, mixed\n\
+        lw r9, 8(r5)\n        sw r9, 0(r14)\n        addi r14, r14, 4\n        lw r5, 12(r5)\n        j visit\n\
+mixed:  lw r9, UPTR(r0)\n        sw r14, 0(r9)\n        sw r7, 4(r9)\n        addi r9, r9, 8\n        sw r9, UPTR(r0)\n\
+        li r1, {uin0}\n        beqz r7, mx_go\n        li r1, {uin1}\n        slti r3, r7, 2\n        bnez r3, mx_go\n        li r1, {uin2}\n\
+mx_go:  cbcast r1, {ulen}\n\
+posdir: lw r9, 12(r5)\n        sw r9, 0(r14)\n        addi r14, r14, 4\n        lw r5, 8(r5)\n        j visit\n\
+leaf:   lw r1, 20(r5)\n        beqz r1, pop\n        jal test_objects\n        beqz r4, pop\n        lw r1, MODE(r0)\n        bnez r1, leaf_any\n\
+        li r1, {leafc}\n        sbcb r1, r4, {leafclen}\n        j leaf_aw\n\
+leaf_any: li r1, {leafa}\n        cbcast r1, {leafalen}\nleaf_aw: jal awake\n\
+pop:    lw r9, UPTR(r0)\n        li r8, USTK\n        beq r9, r8, pop2\n        lw r10, -8(r9)\n        bne r10, r14, pop2\n\
+        lw r7, -4(r9)\n        addi r9, r9, -8\n        sw r9, UPTR(r0)\n\
+        li r1, {uout0}\n        beqz r7, px_go\n        li r1, {uout1}\n        slti r3, r7, 2\n        bnez r3, px_go\n        li r1, {uout2}\n\
+px_go:  cbcast r1, {ulen}\n\
+pop2:   li r9, NSTACK\n        beq r14, r9, done\n        addi r14, r14, -4\n        lw r5, 0(r14)\n        j visit\n\
+done:   lw r15, SAVE_LR(r0)\n        ret\n",
+        uzero = kaddr("k_uzero"),
+        uzlen = klen("k_uzero"),
+        uin0 = kaddr("k_uin0"),
+        uin1 = kaddr("k_uin1"),
+        uin2 = kaddr("k_uin2"),
+        uout0 = kaddr("k_uout0"),
+        uout1 = kaddr("k_uout1"),
+        uout2 = kaddr("k_uout2"),
+        ulen = klen("k_uin0"),
+        cls0 = kaddr("k_cls0"),
+        cls1 = kaddr("k_cls1"),
+        cls2 = kaddr("k_cls2"),
+        len = klen("k_cls0"),
+        clsr = kaddr("k_clsr"),
+        leafc = kaddr("k_leafcu"),
+        leafclen = klen("k_leafcu"),
+        leafa = kaddr("k_leafa"),
+        leafalen = klen("k_leafa"),
+    );
+    let _ = writeln!(
+        w,
+        "clear_mailbox:\n        li r2, MAILBOX\n        li r3, NOBJ\n        beqz r3, cm_done\ncm_loop: sh r0, 0(r2)\n        addi r2, r2, 2\n        addi r3, r3, -1\n        bnez r3, cm_loop\ncm_done: ret\n"
+    );
+    // test_objects: r5 = leaf; its block is moved into bank 1 unless it is
+    // there already (the last block loaded), once the array is idle.
+    let _ = writeln!(
+        w,
+        "; test_objects (streamed): r5 = leaf node in main memory.\n\
+test_objects:\n        lw r9, 52(r5)\n        lw r6, 24(r5)\n        lw r13, PASS(r0)\n\
+to_scan: lw r2, 0(r6)\n        addi r6, r6, 4\n        lhu r1, 0(r2)\n        bne r1, r13, to_need\n        addi r9, r9, -1\n        bnez r9, to_scan\n        li r4, 0\n        ret\n\
+to_need: li r4, SBANK\n        lw r1, 16(r5)\n        lw r3, 20(r5)\n        lw r2, CUR_BLK(r0)\n        beq r1, r2, to_have\n\
+        rcany r2\n        li r2, SBANK\n        ldfb r1, r2, r3\n        dwait\n        sw r1, CUR_BLK(r0)\n\
+to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}",
+        head = super::layout::BLOCK_HEAD
+    );
+    for (j, t) in lay.types.iter().enumerate() {
+        let n = format!("s{}", t.ty.name());
+        let _ = writeln!(
+            w,
+            "        lw r9, {cnt}(r5)\n        beqz r9, {n}_end\n\
+{n}_loop:\n        lw r2, 0(r6)\n        addi r6, r6, 4\n        lhu r1, 0(r2)\n        beq r1, r13, {n}_next\n        sh r13, 0(r2)\n\
+        lw r1, TESTS(r0)\n        addi r1, r1, 1\n        sw r1, TESTS(r0)",
+            cnt = 28 + 4 * j
+        );
+        let one = |w: &mut String, kn: &str| {
+            let _ = writeln!(
+                w,
+                "        li r1, {}\n        sbcb r1, r7, {}",
+                kaddr(kn),
+                klen(kn)
+            );
+        };
+        match t.ty {
+            ChipType::Sphere => one(w, "k_sphere"),
+            ChipType::Rectangle => one(w, "k_rect"),
+            ChipType::Triangle => one(w, "k_tri"),
+            ChipType::Box => one(w, "k_box"),
+            ChipType::Cylinder => {
+                let _ = writeln!(
+                    w,
+                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
+                    kaddr("k_cyl"),
+                    klen("k_cyl")
+                );
+                for c in 0..2 {
+                    let _ = writeln!(
+                        w,
+                        "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
+                        kaddr("k_disc"),
+                        1 + super::layout::CYL_BODY_WORDS + c * super::layout::PLANAR_WORDS,
+                        klen("k_disc")
+                    );
+                }
+                let _ = writeln!(w, "{n}_nocap:");
+            }
+            ChipType::Polygon => {
+                let _ = writeln!(
+                    w,
+                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        addi r2, r7, {}\n        li r1, {}\n\
+{n}_fan:\n        beqz r3, {n}_tail\n        sbcb r1, r2, {}\n        addi r2, r2, {}\n        addi r3, r3, -1\n        j {n}_fan\n\
+{n}_tail:\n        li r1, {}\n        sbcb r1, r2, {}",
+                    kaddr("k_polyh"),
+                    klen("k_polyh"),
+                    1 + super::layout::POLY_HEAD_WORDS,
+                    kaddr("k_polyf"),
+                    klen("k_polyf"),
+                    super::layout::POLY_FAN_WORDS,
+                    kaddr("k_polyt"),
+                    klen("k_polyt")
+                );
+            }
+        }
+        let _ = writeln!(
+            w,
+            "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
+            size = t.size
+        );
+    }
+    let _ = writeln!(w, "        ret\n");
 }

@@ -62,6 +62,10 @@ pub mod ram {
     /// recursion level.
     pub const STACK: u32 = 300;
     pub const STACK_FRAME: u32 = 4;
+    /// Streamed layout: number of unordered BSP subtrees the ray is in
+    /// whose visiting order goes against its direction (it may only sleep
+    /// at a leaf when this is 0).
+    pub const UNORD: u32 = 340;
 }
 
 /// Offset of a spawned ray's origin along the normal, in LSBs: the bound of
@@ -707,6 +711,50 @@ pub fn leaf_closest() -> K {
         k.c(format!("(f) cmp.ge fb0, r{x}"));
     }
     k.c("(f) sleep");
+    k
+}
+
+/// Streamed layout: [`leaf_closest`] for rays not inside an unordered
+/// subtree visited against their direction (`ram::UNORD` = 0) only.
+pub fn leaf_closest_ordered() -> K {
+    let mut k = K::default();
+    k.c(format!("ld r12, [r0 + #{}]", ram::UNORD))
+        .c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
+        .c("cmp.lt r7, r8")
+        .c("(f) cmp.eq r12, #0");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        k.c(format!("ldacc r{o}, <<14"))
+            .c(format!("mac r{}, r7, r{d}, >>14", 9 + i));
+    }
+    for x in [9, 10, 11] {
+        k.c(format!("(f) cmp.le fb0, r{x}"));
+    }
+    for x in [9, 10, 11] {
+        k.c(format!("(f) cmp.ge fb0, r{x}"));
+    }
+    k.c("(f) sleep");
+    k
+}
+
+/// Streamed layout: entering (`delta` 1) or leaving (-1) an unordered
+/// subtree visited below-first: rays going down along `axis` count it.
+pub fn unord_count(axis: u8, delta: i32) -> K {
+    let mut k = K::default();
+    k.c(format!("cmp.lt r{}, #0", 4 + axis))
+        .c(format!("ld r8, [r0 + #{}]", ram::UNORD))
+        .c(if delta > 0 {
+            "(f) add r8, r8, #1"
+        } else {
+            "(f) sub r8, r8, #1"
+        })
+        .c(format!("st r8, [#{}]", ram::UNORD));
+    k
+}
+
+/// Streamed layout: no unordered subtree at a pass's start.
+pub fn unord_zero() -> K {
+    let mut k = K::default();
+    k.c("sub r8, r8, r8").c(format!("st r8, [#{}]", ram::UNORD));
     k
 }
 

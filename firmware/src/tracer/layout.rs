@@ -15,6 +15,11 @@
 //! mailboxes: one word per object, the number of the pass that last
 //!     tested it (object merging)
 //! ```
+//!
+//! A scene whose image does not fit FB set 0 gets the streamed layout
+//! ([`Stream`]): only the part up to SHADE stays in the FB (bank 0, plus
+//! one split word); nodes, per-leaf blocks of records and mailboxes go to
+//! main memory, and bank 1 is the streaming buffer.
 
 use crate::scene::{PrimType, Scene, Shape, Vec3};
 use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
@@ -123,6 +128,40 @@ pub struct Layout {
     pub kt_rect: u32,
     pub kt_tri: u32,
     pub kt_disc: u32,
+    /// The streamed layout (scenes that do not fit FB set 0), or `None`
+    /// when the whole scene is resident in the FB.
+    pub stream: Option<Stream>,
+}
+
+/// FB bank 1 (set 0): the streaming buffer of the streamed layout.
+pub const STREAM_BANK: usize = 0x4000;
+/// Words at the start of a streamed leaf block: the cell bounds.
+pub const BLOCK_HEAD: usize = 6;
+/// Bytes of a node record in main memory (streamed layout).
+pub const NODE_BYTES: usize = 64;
+
+/// The streamed layout: the scene lives in main memory and TinyRISC moves
+/// each leaf's block (cell bounds, then the records of its objects grouped
+/// by type) into FB bank 1 by DMA when the traversal reaches it.
+///
+/// Node record (32-bit words, main memory): flags (-32768 leaf, else the
+/// split axis), split (scene format), left, right (byte addresses), block
+/// address, block words, list address, then per type present the number
+/// of the leaf's objects of that type (words 7..12), their total (word 13).
+/// List: per object, the byte address
+/// of its mailbox half-word (number of the pass that last tested it).
+#[derive(Clone, Debug)]
+pub struct Stream {
+    /// Main-memory byte address of [`Stream::image`].
+    pub base: u32,
+    pub image: Vec<u8>,
+    pub root: u32,
+    pub mailbox: u32,
+    /// FB word (bank 0) the split value of the node being classified is
+    /// written to.
+    pub split_slot: usize,
+    pub nodes: usize,
+    pub largest_block: usize,
 }
 
 /// Reciprocal square root table: entry k = 1/sqrt(X) for X = (k + 0.5) 256
@@ -303,6 +342,27 @@ pub fn build(
     image: &SceneImage,
     opt: &Options,
     guard_bits: u32,
+    force_stream: bool,
+) -> Result<Layout, String> {
+    if !force_stream {
+        let lay = build_as(scene, image, opt, guard_bits, false)?;
+        if lay.stream.is_none() {
+            return Ok(lay);
+        }
+    }
+    // A streamed scene has thousands of objects, many of them a few LSB
+    // small: it is laid out again in the finest format with one guard bit
+    // (differences of two points of the scene still fit), the compiler's
+    // rule, and sphere records carry the unrounded radius's reciprocal.
+    build_as(scene, image, opt, guard_bits.min(1), true)
+}
+
+fn build_as(
+    scene: &Scene,
+    image: &SceneImage,
+    opt: &Options,
+    guard_bits: u32,
+    streamed: bool,
 ) -> Result<Layout, String> {
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits);
     let s = (frac as f64).exp2();
@@ -536,6 +596,7 @@ pub fn build(
         w.raw(obj as i64);
         w.raw(mat as i64);
     };
+    let records_start = w.fb.len();
     let mut types = Vec::new();
     let mut bv_offset = NODE_HEAD;
     let mut mailbox_slots = 0;
@@ -565,7 +626,8 @@ pub fn build(
                     _,
                 ) => {
                     let rq = (radius.abs() * s).round().max(1.0);
-                    let invr = ((14 + ks_sphere) as f64).exp2() / rq;
+                    let invr = ((14 + ks_sphere) as f64).exp2()
+                        / if streamed { radius.abs() * s } else { rq };
                     let sg = if *inside { -1.0 } else { 1.0 };
                     w.point(*center);
                     w.raw(rq as i64);
@@ -684,14 +746,150 @@ pub fn build(
     let root = w.fb.len();
     let addr = |k: u32| root + k as usize * node_words;
     let total = root + nodes.len() * node_words + mailbox_slots;
-    if total > FB_LIMIT {
-        return Err(err(
-            0,
-            format!(
-                "the scene needs {total} FB words (objects, {} BSP nodes, mailboxes); FB set 0 holds {FB_LIMIT}",
-                nodes.len()
-            ),
-        ));
+    let mut stream = None;
+    if total > FB_LIMIT || streamed {
+        // Streamed: only the tables, camera, lights and shading stay in the
+        // FB (bank 0); objects, nodes and mailboxes go to main memory.
+        let records = w.fb.split_off(records_start);
+        let split_slot = w.fb.len();
+        w.raw(0);
+        if w.fb.len() > STREAM_BANK {
+            return Err(err(
+                0,
+                format!(
+                    "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                    w.fb.len()
+                ),
+            ));
+        }
+        let base = super::mem::STREAM;
+        let nn = nodes.len();
+        let lists_at = NODE_BYTES * nn;
+        let list_bytes: usize = nodes
+            .iter()
+            .filter(|n| n.split.is_none())
+            .map(|n| 4 * n.objects.len())
+            .sum();
+        let blocks_at = lists_at + list_bytes;
+        let mut node_img = vec![0u8; lists_at];
+        let mut lists: Vec<u8> = Vec::with_capacity(list_bytes);
+        let mut blocks: Vec<u8> = Vec::new();
+        let mut largest = 0usize;
+        // Mailbox addresses are known once the blocks are laid out: lay
+        // the blocks out first, patch the lists after.
+        let mut list_objs: Vec<usize> = Vec::new();
+        for (k, n) in nodes.iter().enumerate() {
+            let mut f = [0i32; 16];
+            match n.split {
+                Some(sp) => {
+                    f[0] = sp.axis as i32;
+                    f[1] = sat(sp.position * s) as i16 as i32;
+                    f[2] = (base as usize + NODE_BYTES * sp.children[0] as usize) as i32;
+                    f[3] = (base as usize + NODE_BYTES * sp.children[1] as usize) as i32;
+                }
+                None => {
+                    f[0] = -32768;
+                    let list_addr = base as usize + lists_at + 4 * list_objs.len();
+                    let mut words: Vec<u16> = Vec::new();
+                    for x in n.bounds.min.to_array() {
+                        words.push(((x * s).floor() as i64 - 2).clamp(-32768, 32767) as i16 as u16);
+                    }
+                    for x in n.bounds.max.to_array() {
+                        words.push(((x * s).ceil() as i64 + 2).clamp(-32768, 32767) as i16 as u16);
+                    }
+                    for (j, ti) in types.iter().enumerate() {
+                        let mut cnt = 0;
+                        for &o in &n.objects {
+                            let (t, q) = slot[o as usize];
+                            if t == ti.ty as usize {
+                                let at = ti.first - records_start + q * ti.size;
+                                words.extend_from_slice(&records[at..at + ti.size]);
+                                list_objs.push(o as usize);
+                                cnt += 1;
+                            }
+                        }
+                        f[7 + j] = cnt;
+                    }
+                    if !n.objects.is_empty() {
+                        if words.len() > STREAM_BANK {
+                            return Err(err(
+                                0,
+                                format!(
+                                    "a BSP leaf of {} objects needs {} FB words; FB bank 1 holds {STREAM_BANK}",
+                                    n.objects.len(),
+                                    words.len()
+                                ),
+                            ));
+                        }
+                        largest = largest.max(words.len());
+                        f[4] = (base as usize + blocks_at + blocks.len()) as i32;
+                        f[5] = words.len() as i32;
+                        f[13] = n.objects.len() as i32;
+                        f[6] = list_addr as i32;
+                        blocks.extend(words.iter().flat_map(|x| x.to_le_bytes()));
+                    }
+                }
+            }
+            for (i, x) in f.iter().enumerate() {
+                node_img[NODE_BYTES * k + 4 * i..NODE_BYTES * k + 4 * i + 4]
+                    .copy_from_slice(&x.to_le_bytes());
+            }
+        }
+        let mb_at = (blocks_at + blocks.len()).next_multiple_of(4);
+        let mailbox = base as usize + mb_at;
+        for &o in &list_objs {
+            lists.extend(((mailbox + 2 * o) as u32).to_le_bytes());
+        }
+        let mut image = node_img;
+        image.extend(lists);
+        image.extend(blocks);
+        image.resize(mb_at, 0);
+        let end = base as usize + mb_at + 2 * scene.objects.len();
+        if end > super::mem::STREAM_END as usize {
+            return Err(err(
+                0,
+                format!(
+                    "the streamed scene needs {} bytes of main memory; {} are reserved",
+                    end - base as usize,
+                    super::mem::STREAM_END - base
+                ),
+            ));
+        }
+        stream = Some(Stream {
+            base,
+            image,
+            root: base,
+            mailbox: mailbox as u32,
+            split_slot,
+            nodes: nn,
+            largest_block: largest,
+        });
+    }
+    if let Some(st) = &stream {
+        return Ok(Layout {
+            fb: w.fb,
+            frac,
+            eye,
+            post,
+            lights,
+            shades,
+            types,
+            root: st.root as usize,
+            node_words: NODE_BYTES / 4,
+            mailbox: st.mailbox as usize,
+            objects: scene.objects.len(),
+            materials: scene.materials.len(),
+            shines,
+            kd,
+            ks_sphere,
+            ks_cyl,
+            ep_sphere,
+            ep_cyl,
+            kt_rect: kt[0],
+            kt_tri: kt[1],
+            kt_disc: kt[2],
+            stream,
+        });
     }
     for n in nodes {
         match n.split {
@@ -752,5 +950,6 @@ pub fn build(
         kt_rect: kt[0],
         kt_tri: kt[1],
         kt_disc: kt[2],
+        stream: None,
     })
 }

@@ -102,6 +102,10 @@ pub mod mem {
     /// Output: 256 half-words per tile (R, G, B, object id; 64 lanes each).
     pub const OUTPUT: u32 = 0x8_0000;
     pub const OUT_TILE_BYTES: u32 = 512;
+    /// The streamed layout's scene image (nodes, leaf lists, leaf blocks,
+    /// mailboxes), up to [`STREAM_END`].
+    pub const STREAM: u32 = 0x10_0000;
+    pub const STREAM_END: u32 = 0x100_0000;
 }
 
 /// The generated firmware.
@@ -134,6 +138,26 @@ pub fn build(scene: &Scene, opt: &Options) -> Result<Firmware, String> {
 
 /// Build the firmware for `scene` with explicit numerical knobs.
 pub fn build_with(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmware, String> {
+    build_as(scene, opt, nm, false)
+}
+
+/// Build the firmware with the streamed layout whether or not the scene
+/// fits the FB (for tests and comparisons; [`build_with`] streams only the
+/// scenes that do not fit).
+pub fn build_streamed_with(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+) -> Result<Firmware, String> {
+    build_as(scene, opt, nm, true)
+}
+
+fn build_as(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    force_stream: bool,
+) -> Result<Firmware, String> {
     if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(1..=64).contains(&nm.eps_lsb) {
         return Err(format!(
             "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 1..=64"
@@ -151,7 +175,7 @@ pub fn build_with(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmwar
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
-    let lay = layout::build(scene, &image, opt, nm.guard_bits)?;
+    let lay = layout::build(scene, &image, opt, nm.guard_bits, force_stream)?;
     let prog = control::program(scene, &lay, opt, nm, tw, th)?;
     Ok(Firmware {
         source: prog.source,
