@@ -53,7 +53,7 @@ impl Run {
                 context_memory::WORDS
             ));
         }
-        if self.mode != Mode::Simd && self.ctx % 8 != 0 {
+        if self.mode != Mode::Simd && !self.ctx.is_multiple_of(8) {
             return Err(format!(
                 "row/column-mode run at context address 0x{:04x} is not 8-aligned",
                 self.ctx

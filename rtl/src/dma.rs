@@ -89,7 +89,7 @@ impl DmaRequest {
     /// Range and alignment check, at issue.
     pub fn validate(&self, mem_size: usize) -> Result<(), String> {
         let wb = self.kind.word_bytes();
-        if self.mem % wb != 0 {
+        if !self.mem.is_multiple_of(wb) {
             return Err(format!(
                 "{}: main-memory address 0x{:08x} not {wb}-byte aligned",
                 self.kind.name(),

@@ -33,7 +33,7 @@ impl MainMemory {
     /// Check an access of `size` bytes (1, 2, 4): inside and aligned.
     #[inline]
     pub fn check(&self, addr: u32, size: u32) -> Result<(), Fault> {
-        if addr % size != 0 {
+        if !addr.is_multiple_of(size) {
             return Err(Fault::new(
                 "memory",
                 format!("misaligned {size}-byte access at 0x{addr:08x}"),

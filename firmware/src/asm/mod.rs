@@ -620,7 +620,7 @@ impl Asm {
             }
             ".ascii" => {
                 want(1)?;
-                match (&lc.toks[ops[0].0..ops[0].1]).first().map(|t| &t.tok) {
+                match lc.toks[ops[0].0..ops[0].1].first().map(|t| &t.tok) {
                     Some(Tok::Str(s)) if ops[0].1 - ops[0].0 == 1 => {
                         let b = s.clone().into_bytes();
                         self.emit(&b);

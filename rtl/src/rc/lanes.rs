@@ -49,7 +49,7 @@ pub fn select16<const N: usize>(dst: &mut [i16; N], mask: Mask, src: &[i16; N]) 
     if mask == full(N) {
         *dst = *src;
     } else if mask != 0 {
-        if N % 8 != 0 {
+        if !N.is_multiple_of(8) {
             return select(dst, mask, src);
         }
         let mut m = [0i16; N];

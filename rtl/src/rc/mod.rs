@@ -447,7 +447,7 @@ impl<const N: usize> Traced for RcArray<N> {
             if !open {
                 continue;
             }
-            let bit = |m: Mask| (m >> i & 1) as u64;
+            let bit = |m: Mask| m >> i & 1;
             p.signal("out", 16, Display::Signed, self.out[i] as u16 as u64);
             if p.scope(format_args!("alu")) {
                 p.signal("a", 16, Display::Signed, self.operand_a(i) as u16 as u64);
