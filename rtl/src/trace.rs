@@ -486,7 +486,9 @@ impl Tracer {
             }
             g
         };
-        let closed = groups.len() > 8;
+        // Groups open unless the trace is large (GTKWave 3.3 then shows a
+        // closed group as an empty pair of braces until it is opened).
+        let closed = self.decls.len() > 300;
         for (scope, sigs) in &groups {
             let label = if scope.is_empty() {
                 self.top.clone()
