@@ -331,17 +331,10 @@ pub enum Inside {
     Disc,
 }
 
-/// A one-sided planar primitive. Record (20 words):
-/// `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz, n.xyz, obj, mat`, where
-/// `u = (P - v0).eu`, `w = (P - v0).ew` (scaled by 2^kt) are the
-/// barycentric or edge coordinates in Q.14.
-///
-/// `den = -n.d > 0` (front face), `num = -n.(v0 - o) > 0`; the test
-/// `num 2^14 < tbest den` is done in the 32-bit accumulator before the
-/// division, so the quotient always fits.
-pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
-    let mut k = K::default();
-    k.comment("planar: den = n.d, num = n.(v0 - o)");
+/// The ray-plane part shared by the planar and polygon kernels: reads the
+/// plane normal and a vertex from FB set 0, and leaves `t = num / den` in
+/// r9 with F set where the plane is hit in front, closer than `tbest`.
+fn plane_hit(k: &mut K, nr: u32) {
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
@@ -360,7 +353,21 @@ pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
         .c("msu out, r7, r11")
         .c("acch r8")
         .c("(f) cmp.lt r8, #0");
-    divide(&mut k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
+    divide(k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
+}
+
+/// A one-sided planar primitive. Record (20 words):
+/// `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz, n.xyz, obj, mat`, where
+/// `u = (P - v0).eu`, `w = (P - v0).ew` (scaled by 2^kt) are the
+/// barycentric or edge coordinates in Q.14.
+///
+/// `den = -n.d > 0` (front face), `num = -n.(v0 - o) > 0`; the test
+/// `num 2^14 < tbest den` is done in the 32-bit accumulator before the
+/// division, so the quotient always fits.
+pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
+    let mut k = K::default();
+    k.comment("planar: den = n.d, num = n.(v0 - o)");
+    plane_hit(&mut k, nr);
     k.comment("P - v0");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
@@ -457,25 +464,7 @@ pub fn aabox(nr: u32) -> K {
 pub fn polygon_head(nr: u32) -> K {
     let mut k = K::default();
     k.comment("polygon head: the plane");
-    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
-    k.c("mul out, r8, r4")
-        .c("mac out, r9, r5")
-        .c("mac r11, r10, r6, >>14");
-    k.c("sub r12, fb0, r1")
-        .c("sub r13, fb0, r2")
-        .c("sub r14, fb0, r3");
-    k.c("mul out, r8, r12")
-        .c("mac out, r9, r13")
-        .c("mac r15, r10, r14, >>14");
-    k.c("neg r11, r11")
-        .c("neg r15, r15")
-        .c("cmp.gt r11, #0")
-        .c("(f) cmp.gt r15, #0")
-        .c("ldacc r15, <<14")
-        .c("msu out, r7, r11")
-        .c("acch r8")
-        .c("(f) cmp.lt r8, #0");
-    divide(&mut k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
+    plane_hit(&mut k, nr);
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
         k.c(format!("ldacc r{o}, <<14"))

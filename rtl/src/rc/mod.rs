@@ -72,8 +72,6 @@ pub struct RcArray<const N: usize> {
     d_f: Mask,
     pend: Pending,
     names: LaneNames,
-    /// Executing-RC count summed over cycles (for the active-RC fraction).
-    pub active_lane_cycles: u64,
 }
 
 fn op_text(v: u64) -> Option<String> {
@@ -119,7 +117,6 @@ impl<const N: usize> RcArray<N> {
             d_f: 0,
             pend: Pending::default(),
             names,
-            active_lane_cycles: 0,
         }
     }
 
@@ -230,7 +227,6 @@ impl<const N: usize> Clocked for RcArray<N> {
             self.pend = Pending::default();
             return Ok(());
         }
-        self.active_lane_cycles += en.count_ones() as u64;
         let imm;
         let a: &[i16; N] = match c.asrc {
             ASrc::Reg => &self.regs.r[c.ra as usize],
