@@ -217,6 +217,46 @@ impl Chip {
         }
     }
 
+    /// The fast path of a stall: while TinyRISC retries an instruction
+    /// that waits for the array or the DMA (`rcany`, `wfb`, `dwait`, a full
+    /// broadcast queue...), only the broadcast unit, the array and the DMA
+    /// change, so their cycles are run without evaluating TinyRISC. Exactly
+    /// the cycles [`Clocked::eval`] + [`Clocked::commit`] would give (the
+    /// stall counters included); stops when the wait is over, the
+    /// instruction word changed (a DMA store into the program), or after
+    /// `limit` cycles. Returns the cycles run.
+    pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        use crate::tinyrisc::{State, Wait};
+        let mut n = 0;
+        while n < limit
+            && matches!(self.risc.state, State::StallArray | State::StallDma)
+            && match self.risc.wait {
+                Wait::ArrayIdle => !self.bcast.idle(),
+                Wait::Issue => !self.bcast.can_issue(),
+                Wait::Dma => !self.dma.idle(),
+                Wait::None => false,
+            }
+            && self.mem.read(self.risc.pc, 4) == self.risc.ir
+        {
+            if let Err(f) = self.bcast.eval(
+                &self.ctx_mem,
+                &self.fb,
+                self.dma.owned_fb_banks(),
+                self.dma.owned_ctx_banks(),
+                &mut self.array,
+            ) {
+                return (n, Err(self.locate(f)));
+            }
+            if let Err(f) = self.array.eval() {
+                return (n, Err(self.locate(f)));
+            }
+            // TinyRISC's stalled eval left no command and no write-back.
+            self.commit();
+            n += 1;
+        }
+        (n, Ok(()))
+    }
+
     /// Add where TinyRISC is to a fault's message.
     fn locate(&self, mut f: Fault) -> Fault {
         let pc = self.risc.pc;
@@ -376,6 +416,16 @@ pub fn run_to_halt(sim: &mut Sim<Chip>, max_cycles: u64) -> Result<u64, RunError
                 pc,
                 text,
             });
+        }
+        if !sim.tracing() {
+            let limit = max_cycles - sim.cycle();
+            if sim
+                .fast_forward(|c| c.run_stalled(limit))
+                .map_err(RunError::Step)?
+                > 0
+            {
+                continue;
+            }
         }
         sim.step().map_err(RunError::Step)?;
     }

@@ -118,6 +118,30 @@ impl<T: Clocked + Traced> Sim<T> {
         Ok(())
     }
 
+    /// Is a waveform being written?
+    pub fn tracing(&self) -> bool {
+        self.tracer.is_some()
+    }
+
+    /// Advance by a fast path of the top module that simulates whole
+    /// cycles itself (`f` returns the cycles it completed and how it ended).
+    /// Only without a waveform: the fast path samples nothing.
+    pub fn fast_forward(
+        &mut self,
+        f: impl FnOnce(&mut T) -> (u64, Result<(), Fault>),
+    ) -> Result<u64, StepError> {
+        assert!(self.tracer.is_none(), "fast_forward while tracing");
+        let (n, r) = f(&mut self.top);
+        self.cycle += n;
+        match r {
+            Ok(()) => Ok(n),
+            Err(fault) => Err(StepError::Fault {
+                cycle: self.cycle,
+                fault,
+            }),
+        }
+    }
+
     /// Close the waveform, if any; returns the files written.
     pub fn finish_trace(&mut self) -> io::Result<Vec<std::path::PathBuf>> {
         match self.tracer.take() {

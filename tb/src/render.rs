@@ -117,7 +117,27 @@ fn run_group(
     tiles: &[(u32, u32)],
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<Group> {
-    let mut chip = Chip::new(Timing::default(), rtl::memory::DEFAULT_SIZE);
+    // Main memory as large as the program touches (its segments, the tile
+    // list, the output tiles and the streamed scene image), not the
+    // 16 MiB default: a fresh instance per group must not zero-fill memory
+    // nobody reads.
+    let ends = img
+        .segments
+        .iter()
+        .map(|s| s.addr as usize + s.data.len())
+        .chain([
+            mem::FB_IMAGE as usize + 2 * fw.fb.len(),
+            mem::TILE_LIST as usize + 4 + 12 * tiles.len(),
+            (mem::OUTPUT + tiles.len() as u32 * mem::OUT_TILE_BYTES) as usize,
+        ])
+        .chain(
+            fw.layout
+                .stream
+                .as_ref()
+                .map(|st| st.base as usize + st.image.len()),
+        );
+    let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
+    let mut chip = Chip::new(Timing::default(), mem_bytes);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
     let fb: Vec<u8> = fw.fb.iter().flat_map(|w| w.to_le_bytes()).collect();
     chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;

@@ -137,3 +137,64 @@ fn guarded_if_then_else_runs_the_then_and_else_parts_on_their_lanes_only() {
     // the 4 guarded contexts: 20 + 44 + 44 lanes... checked by the active count
     assert!(s.active_rc_fraction() < 1.0);
 }
+
+/// `run_to_halt` runs the cycles in which TinyRISC waits for the array or
+/// the DMA through a fast path (`Chip::run_stalled`). Every program of the
+/// suite, run that way and one cycle at a time through `Sim::step` (the
+/// plain two-phase kernel), must end in the same state: statistics (stall
+/// counters included), TinyRISC registers, RC outputs, registers, flags and
+/// RAM, the frame buffer and main memory.
+#[test]
+fn the_stall_fast_path_is_cycle_exact() {
+    let mut stalled = 0;
+    for name in LISTED.iter().chain(REPORTED) {
+        let img = load_program(&dir().join(name)).unwrap();
+        let fast = run_image(&img, Timing::default(), 2_000_000, None).unwrap();
+        assert!(fast.result.is_ok(), "{name}");
+        let mut chip = rtl::Chip::new(Timing::default(), tb::cmd_run::DEFAULT_MEMORY);
+        img.load(&mut chip).unwrap();
+        let mut slow = rtl::Sim::new(chip);
+        while !slow.top.halted() {
+            slow.step().unwrap();
+        }
+        let (f, s) = (&fast.sim.top, &slow.top);
+        assert_eq!(f.stats(), s.stats(), "{name}: statistics");
+        if f.stats().array_stall_cycles + f.stats().dma_stall_cycles > 0 {
+            stalled += 1;
+        }
+        assert_eq!(fast.sim.cycle(), slow.cycle(), "{name}: cycles");
+        for k in 0..16 {
+            assert_eq!(
+                f.risc.regs.read(k),
+                s.risc.regs.read(k),
+                "{name}: TinyRISC r{k}"
+            );
+        }
+        let (fr, sr) = (&f.array.rc, &s.array.rc);
+        assert_eq!(fr.out, sr.out, "{name}: RC outputs");
+        assert_eq!(fr.acc, sr.acc, "{name}: accumulators");
+        assert_eq!(
+            (fr.flags.f, fr.flags.c, fr.flags.v, fr.flags.sleep),
+            (sr.flags.f, sr.flags.c, sr.flags.v, sr.flags.sleep),
+            "{name}: flags"
+        );
+        for k in 0..16 {
+            assert_eq!(fr.regs.read(k), sr.regs.read(k), "{name}: RC r{k}");
+        }
+        for a in 0..512 {
+            for lane in 0..64 {
+                assert_eq!(fr.ram.read(lane, a), sr.ram.read(lane, a), "{name}: RAM");
+            }
+        }
+        for a in 0..=0xFFFFu16 {
+            assert_eq!(f.fb.read(a), s.fb.read(a), "{name}: FB word {a:#x}");
+        }
+        let n = f.mem.size();
+        assert!(
+            f.mem.bytes(0, n) == s.mem.bytes(0, n),
+            "{name}: main memory"
+        );
+    }
+    // The comparison means something only where the fast path ran.
+    assert!(stalled >= 10, "only {stalled} programs stall");
+}

@@ -67,6 +67,8 @@ pub struct RcArray<const N: usize> {
     res: [i16; N],
     acc_d: [i32; N],
     addr: [u16; N],
+    /// The RAM access of this cycle has one address in every lane.
+    uniform: bool,
     d_c: Mask,
     d_v: Mask,
     d_f: Mask,
@@ -112,6 +114,7 @@ impl<const N: usize> RcArray<N> {
             res: [0; N],
             acc_d: [0; N],
             addr: [0; N],
+            uniform: false,
             d_c: 0,
             d_v: 0,
             d_f: 0,
@@ -356,24 +359,38 @@ impl<const N: usize> Clocked for RcArray<N> {
             }
             Op::Ld | Op::St => {
                 let store = c.op == Op::St;
+                let mut addr = [0i32; N];
+                if store {
+                    map!(addr, |i| b[i] as i32);
+                } else {
+                    map!(addr, |i| a[i] as i32 + b[i] as i32);
+                }
+                let mut bad = [false; N];
                 for i in 0..N {
-                    let addr = if store {
-                        b[i] as i32
-                    } else {
-                        a[i] as i32 + b[i] as i32
-                    };
-                    if en >> i & 1 != 0 && !Ram::<N>::valid(addr) {
-                        let msg = format!("RAM address {addr} outside 0..=511");
-                        return Err(self.lane_fault(i, msg));
-                    }
-                    let addr = addr.clamp(0, 511) as u16;
-                    self.addr[i] = addr;
+                    bad[i] = !Ram::<N>::valid(addr[i]);
+                }
+                let bad = lanes::pack_bools(&bad) & en;
+                if bad != 0 {
+                    let i = bad.trailing_zeros() as usize;
+                    let msg = format!("RAM address {} outside 0..=511", addr[i]);
+                    return Err(self.lane_fault(i, msg));
+                }
+                // One address in every lane (constants, the stack, the hit
+                // record): a whole RAM row; otherwise one word per lane.
+                let a0 = addr[0];
+                self.uniform = addr.iter().all(|&x| x == a0);
+                for i in 0..N {
+                    self.addr[i] = addr[i].clamp(0, 511) as u16;
+                }
+                if store {
                     // A store has no result: `res` carries its data to the edge.
-                    res[i] = if store {
-                        a[i]
-                    } else {
-                        self.ram.read(i, addr as usize)
-                    };
+                    *res = *a;
+                } else if self.uniform {
+                    *res = *self.ram.row(self.addr[0] as usize);
+                } else {
+                    for i in 0..N {
+                        res[i] = self.ram.read(i, self.addr[i] as usize);
+                    }
                 }
                 self.pend.store = store;
             }
@@ -405,9 +422,13 @@ impl<const N: usize> Clocked for RcArray<N> {
             select(&mut self.acc, en, &self.acc_d);
         }
         if p.store {
-            for i in 0..N {
-                if en >> i & 1 != 0 {
-                    self.ram.write(i, self.addr[i] as usize, self.res[i]);
+            if self.uniform {
+                lanes::select16(self.ram.row_mut(self.addr[0] as usize), en, &self.res);
+            } else {
+                for i in 0..N {
+                    if en >> i & 1 != 0 {
+                        self.ram.write(i, self.addr[i] as usize, self.res[i]);
+                    }
                 }
             }
         }

@@ -7,14 +7,16 @@
 pub const WORDS: usize = 512;
 
 pub struct Ram<const N: usize> {
-    /// Lane-major: lane `i` owns `m[i * 512 .. (i + 1) * 512]`.
-    m: Vec<i16>,
+    /// Address-major: word `a` of every lane is the row `m[a]`, so an
+    /// access at the same address in every RC (the common case: constants,
+    /// the stack, the hit record) is one contiguous row.
+    m: Vec<[i16; N]>,
 }
 
 impl<const N: usize> Default for Ram<N> {
     fn default() -> Self {
         Ram {
-            m: vec![0; N * WORDS],
+            m: vec![[0; N]; WORDS],
         }
     }
 }
@@ -22,13 +24,25 @@ impl<const N: usize> Default for Ram<N> {
 impl<const N: usize> Ram<N> {
     #[inline(always)]
     pub fn read(&self, lane: usize, addr: usize) -> i16 {
-        self.m[lane * WORDS + addr]
+        self.m[addr][lane]
     }
 
     /// Write at the clock edge.
     #[inline(always)]
     pub fn write(&mut self, lane: usize, addr: usize, v: i16) {
-        self.m[lane * WORDS + addr] = v;
+        self.m[addr][lane] = v;
+    }
+
+    /// Word `addr` of every lane.
+    #[inline(always)]
+    pub fn row(&self, addr: usize) -> &[i16; N] {
+        &self.m[addr]
+    }
+
+    /// Word `addr` of every lane, for writing at the clock edge.
+    #[inline(always)]
+    pub fn row_mut(&mut self, addr: usize) -> &mut [i16; N] {
+        &mut self.m[addr]
     }
 
     /// Is `addr` (a 16-bit value read as unsigned) a valid word address?

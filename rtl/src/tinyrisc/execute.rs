@@ -11,7 +11,7 @@ use crate::dma::{DmaKind, DmaRequest};
 use crate::kernel::Fault;
 
 use super::decode::{Instr, Opcode};
-use super::{RiscTiming, State, TinyRisc};
+use super::{RiscTiming, State, TinyRisc, Wait};
 
 /// What TinyRISC may ask of the chip around it (all reads; the chip checks
 /// ranges and DMA ownership and faults on a violation).
@@ -115,19 +115,27 @@ impl TinyRisc {
             );
             let needs_issue = matches!(i.op, Cbcast | Sbcb | Dbcb | Cbcr | Cbcc);
             let needs_dma = matches!(i.op, Ldctxt | Ldfb | Stfb | Dwait);
-            if (needs_array_idle || i.op == Halt) && !m.array_idle()
-                || needs_issue && !m.array_can_issue()
-            {
-                self.state = State::StallArray;
-                self.d_busy = 0;
-                return Ok(());
-            }
-            if (needs_dma || i.op == Halt) && !m.dma_idle() {
-                self.state = State::StallDma;
+            let wait = if (needs_array_idle || i.op == Halt) && !m.array_idle() {
+                Wait::ArrayIdle
+            } else if needs_issue && !m.array_can_issue() {
+                Wait::Issue
+            } else if (needs_dma || i.op == Halt) && !m.dma_idle() {
+                Wait::Dma
+            } else {
+                Wait::None
+            };
+            if wait != Wait::None {
+                self.wait = wait;
+                self.state = if wait == Wait::Dma {
+                    State::StallDma
+                } else {
+                    State::StallArray
+                };
                 self.d_busy = 0;
                 return Ok(());
             }
         }
+        self.wait = Wait::None;
         let t = self.timing;
         let r = |k: u8| self.regs.read(k);
         let next = self.pc.wrapping_add(4);

@@ -71,6 +71,19 @@ impl Default for RiscTiming {
     }
 }
 
+/// What a stalled instruction waits for.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Wait {
+    #[default]
+    None,
+    /// The array idle (no run in progress or queued).
+    ArrayIdle,
+    /// A free broadcast slot.
+    Issue,
+    /// The DMA channel idle.
+    Dma,
+}
+
 /// What TinyRISC did in the cycle just evaluated.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum State {
@@ -109,6 +122,9 @@ pub struct TinyRisc {
     pub cmd: Command,
     /// What happened this cycle.
     pub state: State,
+    /// What a stalled instruction waits for (with `state` StallArray or
+    /// StallDma; `Wait::None` otherwise).
+    pub wait: Wait,
     /// Instruction word of the last issue (waveforms).
     pub ir: u32,
     // ---- statistics ----
