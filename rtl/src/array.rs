@@ -20,7 +20,7 @@ use crate::interconnect::Interconnect;
 use crate::kernel::{Clocked, Fault};
 use crate::rc::context::{ASrc, Context};
 use crate::rc::lanes::Mask;
-use crate::rc::{LaneNames, RcArray, CTX_FILTER};
+use crate::rc::{LaneNames, RcArray, Word, CTX_FILTER};
 use crate::trace::{Display, Probe, Traced};
 
 /// How a context (group) is broadcast.
@@ -46,27 +46,27 @@ pub fn group_mask(mode: Mode, i: usize) -> Mask {
     }
 }
 
-pub struct Array {
-    pub rc: RcArray<64>,
+pub struct Array<W: Word = i16> {
+    pub rc: RcArray<64, W>,
     ic: Interconnect,
     // ---- inputs of this cycle ----
     active: bool,
     mode: Mode,
     ctx: [Context; 8],
     words: [u32; 8],
-    fb: [i16; 2],
+    fb: [W; 2],
     /// RCs that executed in the cycle just evaluated.
     pub active_now: u32,
 }
 
-impl Default for Array {
+impl<W: Word> Default for Array<W> {
     fn default() -> Self {
         Self::new()
     }
 }
 
-impl Array {
-    pub fn new() -> Array {
+impl<W: Word> Array<W> {
+    pub fn new() -> Array<W> {
         Array {
             rc: RcArray::new(LaneNames::Grid),
             ic: Interconnect::new(),
@@ -74,7 +74,7 @@ impl Array {
             mode: Mode::Simd,
             ctx: [Context::NOP; 8],
             words: [Context::NOP.encode(); 8],
-            fb: [0; 2],
+            fb: [W::ZERO; 2],
             active_now: 0,
         }
     }
@@ -83,7 +83,7 @@ impl Array {
     /// context goes straight to the RCs and the interconnect computes their
     /// operand A now, from the start-of-cycle outputs (call during `eval`).
     #[inline(always)]
-    pub fn drive_simd(&mut self, word: u32, ctx: &Context, fb: [i16; 2]) {
+    pub fn drive_simd(&mut self, word: u32, ctx: &Context, fb: [W; 2]) {
         self.active = true;
         self.mode = Mode::Simd;
         self.words[0] = word;
@@ -95,7 +95,7 @@ impl Array {
     }
 
     /// Drive an 8-word group in row or column mode.
-    pub fn drive_group(&mut self, mode: Mode, words: [u32; 8], ctx: [Context; 8], fb: [i16; 2]) {
+    pub fn drive_group(&mut self, mode: Mode, words: [u32; 8], ctx: [Context; 8], fb: [W; 2]) {
         self.active = true;
         self.mode = mode;
         self.ctx = ctx;
@@ -173,7 +173,7 @@ impl Array {
     }
 }
 
-impl Clocked for Array {
+impl<W: Word> Clocked for Array<W> {
     #[inline]
     fn eval(&mut self) -> Result<(), Fault> {
         if !self.active {
@@ -218,7 +218,7 @@ impl Clocked for Array {
     }
 }
 
-impl Traced for Array {
+impl<W: Word> Traced for Array<W> {
     fn trace(&self, p: &mut dyn Probe) {
         p.signal("active", 1, Display::Bin, self.active as u64);
         p.signal("mode", 2, Display::Hex, self.mode as u64);
@@ -234,8 +234,10 @@ impl Traced for Array {
             };
             p.signal(name, 32, Display::Translate(&CTX_FILTER), v as u64);
         }
-        p.signal("fb0", 16, Display::Signed, self.fb[0] as u16 as u64);
-        p.signal("fb1", 16, Display::Signed, self.fb[1] as u16 as u64);
+        let bits = W::BITS;
+        let m = u64::MAX >> (64 - bits);
+        p.signal("fb0", bits, Display::Signed, self.fb[0].to_i64() as u64 & m);
+        p.signal("fb1", bits, Display::Signed, self.fb[1].to_i64() as u64 & m);
         self.rc.trace(p);
     }
 }

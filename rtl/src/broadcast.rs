@@ -22,6 +22,7 @@ use crate::context_memory::{self, ContextMemory};
 use crate::fb::{self, FrameBuffer};
 use crate::kernel::Fault;
 use crate::rc::context::{ASrc, Context};
+use crate::rc::Word;
 
 /// A run of contexts, as TinyRISC issues it.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -143,13 +144,13 @@ impl Broadcast {
 
     /// Drive the array for this cycle: fetch the context(s) and FB data.
     #[inline]
-    pub fn eval(
+    pub fn eval<W: Word>(
         &mut self,
         cm: &ContextMemory,
-        fbm: &FrameBuffer,
+        fbm: &FrameBuffer<W>,
         dma_fb_banks: u8,
         dma_ctx_banks: u8,
-        array: &mut Array,
+        array: &mut Array<W>,
     ) -> Result<(), Fault> {
         let Some(cur) = &self.cur else {
             array.idle();
@@ -180,7 +181,7 @@ impl Broadcast {
         if simd {
             // the hot path: one context
             let c = get(addr)?;
-            let mut fbd = [0i16; 2];
+            let mut fbd = [W::ZERO; 2];
             self.d_ptr = cur.ptr;
             if c.asrc == ASrc::Fb {
                 let s = (c.ra & 1) as usize;
@@ -198,7 +199,7 @@ impl Broadcast {
                 reads |= 1 << (c.ra & 1);
             }
         }
-        let mut fbd = [0i16; 2];
+        let mut fbd = [W::ZERO; 2];
         self.d_ptr = cur.ptr;
         for (s, d) in fbd.iter_mut().enumerate() {
             if reads >> s & 1 != 0 {
@@ -214,14 +215,14 @@ impl Broadcast {
     /// Read the next datum of FB stream `s` (and advance its pointer in the
     /// next state).
     #[inline]
-    fn stream(
+    fn stream<W: Word>(
         &mut self,
         s: usize,
         run: &Run,
         addr: u16,
-        fbm: &FrameBuffer,
+        fbm: &FrameBuffer<W>,
         dma_fb_banks: u8,
-    ) -> Result<i16, Fault> {
+    ) -> Result<W, Fault> {
         if run.fb[s].is_none() {
             return Err(Self::fault(
                 run,
@@ -298,7 +299,7 @@ mod tests {
         b: &mut Broadcast,
         cm: &ContextMemory,
         fbm: &FrameBuffer,
-        a: &mut Array,
+        a: &mut Array<i16>,
         dma_fb: u8,
     ) -> Result<(), Fault> {
         b.eval(cm, fbm, dma_fb, 0, a)?;

@@ -26,6 +26,7 @@ use crate::fb::{self, FrameBuffer};
 use crate::kernel::{Clocked, Fault, Sim, StepError};
 use crate::memory::MainMemory;
 use crate::rc::context::Context;
+use crate::rc::{Datapath, Word};
 use crate::tinyrisc::{decode, Command, Machine, RiscTiming, TinyRisc};
 use crate::trace::{Display, Probe, Traced};
 
@@ -83,12 +84,15 @@ impl Stats {
     }
 }
 
-pub struct Chip {
+/// The chip, generic over its datapath word: `Chip` (= `Chip<i16>`) is the
+/// paper's 16-bit chip, `Chip<i32>` the 32-bit variant ([`Chip::new_wide`]);
+/// see `docs/isa.md`, "The 32-bit datapath".
+pub struct Chip<W: Word = i16> {
     pub risc: TinyRisc,
     pub bcast: Broadcast,
-    pub array: Array,
+    pub array: Array<W>,
     pub ctx_mem: ContextMemory,
-    pub fb: FrameBuffer,
+    pub fb: FrameBuffer<W>,
     pub mem: MainMemory,
     pub dma: Dma,
     pub timing: Timing,
@@ -98,10 +102,10 @@ pub struct Chip {
 }
 
 /// TinyRISC's view of the chip.
-struct View<'a> {
-    array: &'a Array,
+struct View<'a, W: Word> {
+    array: &'a Array<W>,
     bcast: &'a Broadcast,
-    fb: &'a FrameBuffer,
+    fb: &'a FrameBuffer<W>,
     mem: &'a MainMemory,
     dma: &'a Dma,
     cycles: u64,
@@ -118,7 +122,7 @@ fn dma_conflict(dma: &Dma, bank: usize, what: &str) -> Fault {
     )
 }
 
-impl Machine for View<'_> {
+impl<W: Word> Machine for View<'_, W> {
     #[inline]
     fn fetch(&self, pc: u32) -> Result<u32, Fault> {
         self.mem
@@ -133,11 +137,11 @@ impl Machine for View<'_> {
     fn check_store(&self, addr: u32, size: u32) -> Result<(), Fault> {
         self.mem.check(addr, size)
     }
-    fn fb_read(&self, addr: u16) -> Result<i16, Fault> {
+    fn fb_read(&self, addr: u16) -> Result<i32, Fault> {
         if self.dma.owned_fb_banks() >> fb::bank(addr) & 1 != 0 {
             return Err(dma_conflict(self.dma, fb::bank(addr), "TinyRISC reads"));
         }
-        Ok(self.fb.read(addr))
+        Ok(self.fb.read(addr).to_i64() as i32)
     }
     fn check_fb_write(&self, addr: u16, words: u32) -> Result<(), Fault> {
         let last = (addr as u32 + words.max(1) - 1).min(0xFFFF) as u16;
@@ -148,8 +152,11 @@ impl Machine for View<'_> {
         }
         Ok(())
     }
-    fn rc_out(&self, lane: usize) -> i16 {
-        self.array.rc.out[lane]
+    fn rc_out(&self, lane: usize) -> i32 {
+        self.array.rc.out[lane].to_i64() as i32
+    }
+    fn fb_word_bytes(&self) -> u32 {
+        W::BITS / 8
     }
     fn rc_flags(&self) -> (u64, u64) {
         (self.array.rc.flags.f, self.array.rc.flags.sleep)
@@ -172,12 +179,27 @@ impl Machine for View<'_> {
 }
 
 impl Chip {
+    /// The paper's 16-bit chip.
     pub fn new(timing: Timing, mem_bytes: usize) -> Chip {
+        Chip::build(timing, mem_bytes)
+    }
+}
+
+impl Chip<i32> {
+    /// The 32-bit datapath variant.
+    pub fn new_wide(timing: Timing, mem_bytes: usize) -> Chip<i32> {
+        Chip::build(timing, mem_bytes)
+    }
+}
+
+impl<W: Word> Chip<W> {
+    /// A chip of datapath `W` (`i16` or `i32`).
+    pub fn build(timing: Timing, mem_bytes: usize) -> Chip<W> {
         Chip {
             risc: TinyRisc::new(0, timing.risc),
             bcast: Broadcast::default(),
             array: Array::new(),
-            ctx_mem: ContextMemory::default(),
+            ctx_mem: ContextMemory::for_datapath(W::DATAPATH == Datapath::W32),
             fb: FrameBuffer::default(),
             mem: MainMemory::new(mem_bytes),
             dma: Dma::new(timing.dma),
@@ -196,6 +218,11 @@ impl Chip {
     /// Set TinyRISC's start address.
     pub fn set_entry(&mut self, pc: u32) {
         self.risc.pc = pc;
+    }
+
+    /// The datapath width.
+    pub fn datapath(&self) -> Datapath {
+        W::DATAPATH
     }
 
     pub fn halted(&self) -> bool {
@@ -270,7 +297,7 @@ impl Chip {
     }
 }
 
-impl Clocked for Chip {
+impl<W: Word> Clocked for Chip<W> {
     #[inline]
     fn eval(&mut self) -> Result<(), Fault> {
         let view = View {
@@ -312,7 +339,7 @@ impl Clocked for Chip {
         match self.risc.cmd {
             Command::None => {}
             Command::Store { addr, size, value } => self.mem.write(addr, size, value),
-            Command::FbWrite { addr, value } => self.fb.write(addr, value),
+            Command::FbWrite { addr, value } => self.fb.write(addr, W::wrap(value as i64)),
             Command::Wfb { addr } => {
                 for (i, v) in self.array.rc.out.iter().enumerate() {
                     self.fb.write(addr + i as u16, *v);
@@ -326,7 +353,7 @@ impl Clocked for Chip {
     }
 }
 
-impl Traced for Chip {
+impl<W: Word> Traced for Chip<W> {
     fn trace(&self, p: &mut dyn Probe) {
         if p.scope(format_args!("tinyrisc")) {
             self.risc.trace(p);
@@ -402,7 +429,7 @@ impl std::fmt::Display for RunError {
 impl std::error::Error for RunError {}
 
 /// Run to `halt`; returns the cycles used (the halt's cycle included).
-pub fn run_to_halt(sim: &mut Sim<Chip>, max_cycles: u64) -> Result<u64, RunError> {
+pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
     while !sim.top.halted() {
         if sim.cycle() >= max_cycles {
             let pc = sim.top.risc.pc;

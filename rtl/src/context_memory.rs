@@ -26,6 +26,9 @@ pub const fn bank(addr: u16) -> usize {
 }
 
 pub struct ContextMemory {
+    /// Decode for the 32-bit datapath (`f[10]` is bit 5 of the multiplier
+    /// shift) rather than the 16-bit one (`f[10]` reserved).
+    wide: bool,
     words: Vec<u32>,
     decoded: Vec<Context>,
     /// `Some(error)` where the word does not decode.
@@ -36,6 +39,7 @@ impl Default for ContextMemory {
     fn default() -> Self {
         let nop = Context::NOP;
         ContextMemory {
+            wide: false,
             words: vec![nop.encode(); WORDS],
             decoded: vec![nop; WORDS],
             errors: vec![None; WORDS],
@@ -44,12 +48,20 @@ impl Default for ContextMemory {
 }
 
 impl ContextMemory {
+    /// The context memory of the 32-bit chip (or not).
+    pub fn for_datapath(wide: bool) -> ContextMemory {
+        ContextMemory {
+            wide,
+            ..ContextMemory::default()
+        }
+    }
+
     /// Write one word (at the clock edge): decoded here, once.
     #[inline]
     pub fn write(&mut self, addr: u16, word: u32) {
         let a = addr as usize;
         self.words[a] = word;
-        match Context::decode(word) {
+        match Context::decode_for(word, self.wide) {
             Ok(c) => {
                 self.decoded[a] = c;
                 self.errors[a] = None;

@@ -8,7 +8,8 @@
 //! **Timing model** ([`DmaTiming`], every parameter a user can change): a
 //! transfer issued in cycle `t` spends `setup_cycles` cycles on setup
 //! (address phase, external memory latency), then moves `bytes_per_cycle`
-//! bytes per cycle: an FB word is 2 bytes, a context word 4. The last word
+//! bytes per cycle: an FB word is 2 bytes (4 on the 32-bit chip), a context
+//! word 4. The last word
 //! lands at the clock edge of cycle `t + setup_cycles + ceil(bytes /
 //! bytes_per_cycle)`, so a transfer occupies the channel for
 //! [`DmaTiming::cycles`] cycles after its issue cycle.
@@ -20,6 +21,7 @@
 use crate::context_memory::{self, ContextMemory};
 use crate::fb::{self, FrameBuffer};
 use crate::memory::MainMemory;
+use crate::rc::Word;
 
 /// The DMA timing parameters.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -50,7 +52,7 @@ impl DmaTiming {
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DmaKind {
-    /// `ldfb`: main memory to frame buffer (16-bit words).
+    /// `ldfb`: main memory to frame buffer (FB words: 16 or 32 bits).
     MemToFb = 1,
     /// `stfb`: frame buffer to main memory.
     FbToMem = 2,
@@ -59,10 +61,16 @@ pub enum DmaKind {
 }
 
 impl DmaKind {
+    /// Bytes per word on the 16-bit chip.
     pub fn word_bytes(self) -> u32 {
+        self.word_bytes_for(2)
+    }
+
+    /// Bytes per word with FB words of `fb_word_bytes` (2 or 4) bytes.
+    pub fn word_bytes_for(self, fb_word_bytes: u32) -> u32 {
         match self {
             DmaKind::MemToCtx => 4,
-            _ => 2,
+            _ => fb_word_bytes,
         }
     }
     pub fn name(self) -> &'static str {
@@ -86,9 +94,15 @@ pub struct DmaRequest {
 }
 
 impl DmaRequest {
-    /// Range and alignment check, at issue.
+    /// Range and alignment check, at issue (16-bit chip).
     pub fn validate(&self, mem_size: usize) -> Result<(), String> {
-        let wb = self.kind.word_bytes();
+        self.validate_for(mem_size, 2)
+    }
+
+    /// Range and alignment check, at issue, with FB words of
+    /// `fb_word_bytes` bytes.
+    pub fn validate_for(&self, mem_size: usize, fb_word_bytes: u32) -> Result<(), String> {
+        let wb = self.kind.word_bytes_for(fb_word_bytes);
         if !self.mem.is_multiple_of(wb) {
             return Err(format!(
                 "{}: main-memory address 0x{:08x} not {wb}-byte aligned",
@@ -227,7 +241,12 @@ impl Dma {
 
     /// One clock edge of the channel.
     #[inline]
-    pub fn tick(&mut self, mem: &mut MainMemory, fbm: &mut FrameBuffer, cm: &mut ContextMemory) {
+    pub fn tick<W: Word>(
+        &mut self,
+        mem: &mut MainMemory,
+        fbm: &mut FrameBuffer<W>,
+        cm: &mut ContextMemory,
+    ) {
         let Some(a) = &mut self.active else {
             return;
         };
@@ -236,15 +255,15 @@ impl Dma {
             a.setup_left -= 1;
             return;
         }
-        let wb = a.req.kind.word_bytes();
+        let wb = a.req.kind.word_bytes_for(W::BITS / 8);
         a.credit += self.timing.bytes_per_cycle.max(1);
         while a.credit >= wb && a.done < a.req.words {
             a.credit -= wb;
             let m = a.req.mem + a.done * wb;
             let l = a.req.local + a.done;
             match a.req.kind {
-                DmaKind::MemToFb => fbm.write(l as u16, mem.read(m, 2) as u16 as i16),
-                DmaKind::FbToMem => mem.write(m, 2, fbm.read(l as u16) as u16 as u32),
+                DmaKind::MemToFb => fbm.write(l as u16, W::wrap(mem.read(m, wb) as i64)),
+                DmaKind::FbToMem => mem.write(m, wb, fbm.read(l as u16).to_i64() as u32),
                 DmaKind::MemToCtx => cm.write(l as u16, mem.read(m, 4)),
             }
             a.done += 1;
@@ -263,6 +282,13 @@ mod tests {
     use super::*;
 
     fn run(t: DmaTiming, req: DmaRequest) -> (u64, MainMemory, FrameBuffer, ContextMemory) {
+        run_w::<i16>(t, req)
+    }
+
+    fn run_w<W: Word>(
+        t: DmaTiming,
+        req: DmaRequest,
+    ) -> (u64, MainMemory, FrameBuffer<W>, ContextMemory) {
         let mut mem = MainMemory::new(1 << 16);
         for i in 0..4096u32 {
             mem.write(i * 4, 4, i.wrapping_mul(0x9E37_79B9));
@@ -270,7 +296,7 @@ mod tests {
         let mut fbm = FrameBuffer::default();
         let mut cm = ContextMemory::default();
         let mut d = Dma::new(t);
-        req.validate(mem.size()).unwrap();
+        req.validate_for(mem.size(), W::BITS / 8).unwrap();
         d.start(req, 0);
         let mut cycles = 0;
         while !d.idle() {

@@ -1,4 +1,5 @@
-//! The frame buffer: 2 sets x 2 banks x 16K x 16-bit.
+//! The frame buffer: 2 sets x 2 banks x 16K words of the datapath width
+//! (16-bit: 128 KB; 32-bit chip: 256 KB).
 //!
 //! An FB address is 16 bits: bit 15 the set, bit 14 the bank, bits 13..0
 //! the word in the bank; the bank index `addr >> 14` (0..3) names one of
@@ -18,6 +19,8 @@ pub const SET_WORDS: usize = 1 << 15;
 pub const BANK_WORDS: usize = 1 << 14;
 pub const WORDS: usize = 1 << 16;
 
+use crate::rc::Word;
+
 /// Bank index (0..3) of an FB address.
 #[inline(always)]
 pub const fn bank(addr: u16) -> usize {
@@ -30,34 +33,36 @@ pub const fn set(addr: u16) -> usize {
     (addr >> 15) as usize
 }
 
-pub struct FrameBuffer {
-    m: Vec<i16>,
+pub struct FrameBuffer<W: Word = i16> {
+    m: Vec<W>,
 }
 
-impl Default for FrameBuffer {
+impl<W: Word> Default for FrameBuffer<W> {
     fn default() -> Self {
-        FrameBuffer { m: vec![0; WORDS] }
+        FrameBuffer {
+            m: vec![W::ZERO; WORDS],
+        }
     }
 }
 
-impl FrameBuffer {
+impl<W: Word> FrameBuffer<W> {
     #[inline(always)]
-    pub fn read(&self, addr: u16) -> i16 {
+    pub fn read(&self, addr: u16) -> W {
         self.m[addr as usize]
     }
 
     /// Write (at the clock edge).
     #[inline(always)]
-    pub fn write(&mut self, addr: u16, v: i16) {
+    pub fn write(&mut self, addr: u16, v: W) {
         self.m[addr as usize] = v;
     }
 
     /// Testbench/loader access to a run of words.
-    pub fn slice(&self, addr: u16, n: usize) -> &[i16] {
+    pub fn slice(&self, addr: u16, n: usize) -> &[W] {
         &self.m[addr as usize..addr as usize + n]
     }
 
-    pub fn fill(&mut self, addr: u16, data: &[i16]) {
+    pub fn fill(&mut self, addr: u16, data: &[W]) {
         self.m[addr as usize..addr as usize + data.len()].copy_from_slice(data);
     }
 }
@@ -73,7 +78,7 @@ mod tests {
         assert_eq!((set(0x8000), bank(0x8000)), (1, 2));
         assert_eq!((set(0xFFFF), bank(0xFFFF)), (1, 3));
         assert_eq!(SET_WORDS * 2, WORDS);
-        let mut fb = FrameBuffer::default();
+        let mut fb = FrameBuffer::<i16>::default();
         fb.write(0xC001, -7);
         assert_eq!(fb.read(0xC001), -7);
         assert_eq!(fb.slice(0xC000, 2), &[0, -7]);

@@ -101,7 +101,14 @@ impl Interconnect {
     /// broadcasts) rather than a per-lane lookup; the tests check it against
     /// the routing tables.
     #[inline(always)]
-    pub fn drive(&self, asrc: ASrc, ra: u8, out: &[i16; 64], fb: [i16; 2], ext: &mut [i16; 64]) {
+    pub fn drive<T: Copy + Default>(
+        &self,
+        asrc: ASrc,
+        ra: u8,
+        out: &[T; 64],
+        fb: [T; 2],
+        ext: &mut [T; 64],
+    ) {
         match asrc {
             ASrc::Fb => *ext = [fb[(ra & 1) as usize]; 64],
             ASrc::Reg | ASrc::Out => {}
@@ -138,7 +145,9 @@ impl Interconnect {
             }
             ASrc::XCol => {
                 let k = (ra & 7) as usize;
-                let row: [i16; 8] = out[8 * k..8 * k + 8].try_into().unwrap_or([0; 8]);
+                let row: [T; 8] = out[8 * k..8 * k + 8]
+                    .try_into()
+                    .unwrap_or([T::default(); 8]);
                 for e in ext.chunks_exact_mut(8) {
                     e.copy_from_slice(&row);
                 }
@@ -164,13 +173,13 @@ impl Interconnect {
     }
 
     /// The same as [`Interconnect::drive`], by table lookup (reference).
-    pub fn drive_by_table(
+    pub fn drive_by_table<T: Copy + Default>(
         &self,
         asrc: ASrc,
         ra: u8,
-        out: &[i16; 64],
-        fb: [i16; 2],
-        ext: &mut [i16; 64],
+        out: &[T; 64],
+        fb: [T; 2],
+        ext: &mut [T; 64],
     ) {
         match self.route(asrc, ra) {
             Some(t) => {
@@ -183,14 +192,14 @@ impl Interconnect {
     }
 
     /// Compute operand A of the lanes in `lanes` only (row and column mode).
-    pub fn drive_lanes(
+    pub fn drive_lanes<T: Copy + Default>(
         &self,
         asrc: ASrc,
         ra: u8,
         lanes: &[usize],
-        out: &[i16; 64],
-        fb: [i16; 2],
-        ext: &mut [i16; 64],
+        out: &[T; 64],
+        fb: [T; 2],
+        ext: &mut [T; 64],
     ) {
         match asrc {
             ASrc::Fb => {

@@ -58,14 +58,14 @@ impl Machine for Double {
     fn check_store(&self, addr: u32, size: u32) -> Result<(), Fault> {
         self.load(addr, size).map(|_| ())
     }
-    fn fb_read(&self, addr: u16) -> Result<i16, Fault> {
-        Ok(addr as i16 ^ 0x5555)
+    fn fb_read(&self, addr: u16) -> Result<i32, Fault> {
+        Ok((addr as i16 ^ 0x5555) as i32)
     }
     fn check_fb_write(&self, _: u16, _: u32) -> Result<(), Fault> {
         Ok(())
     }
-    fn rc_out(&self, lane: usize) -> i16 {
-        -(lane as i16) * 100
+    fn rc_out(&self, lane: usize) -> i32 {
+        (-(lane as i16) * 100) as i32
     }
     fn rc_flags(&self) -> (u64, u64) {
         (self.f, self.sleep)

@@ -31,3 +31,14 @@ impl TraceWindow {
         c
     }
 }
+
+/// `--datapath 16|32`: the RC datapath width of the simulated chip.
+pub fn parse_datapath(s: &str) -> Result<rtl::rc::Datapath, String> {
+    s.trim()
+        .parse::<u32>()
+        .ok()
+        .and_then(rtl::rc::Datapath::from_bits)
+        .ok_or_else(|| {
+            format!("`{s}` is not a datapath width: 16 (the paper's chip) or 32 (the wide variant)")
+        })
+}

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, Context as _};
 use firmware::asm::{self, Image};
 use rtl::chip::{run_to_halt, RunError};
+use rtl::rc::{Datapath, Word};
 use rtl::{Chip, Sim, Stats, Timing};
 
 use crate::cli::TraceWindow;
@@ -26,14 +27,14 @@ pub fn load_program(path: &Path) -> anyhow::Result<Image> {
 }
 
 /// A finished (or stopped) run.
-pub struct Outcome {
-    pub sim: Sim<Chip>,
+pub struct Outcome<W: Word = i16> {
+    pub sim: Sim<Chip<W>>,
     /// `Ok(cycles)` at halt, or why it stopped.
     pub result: Result<u64, RunError>,
     pub files: Vec<PathBuf>,
 }
 
-impl Outcome {
+impl<W: Word> Outcome<W> {
     pub fn stats(&self) -> Stats {
         self.sim.top.stats()
     }
@@ -45,14 +46,24 @@ impl Outcome {
 
 pub const DEFAULT_MEMORY: usize = rtl::memory::DEFAULT_SIZE;
 
-/// Load `img` into a fresh chip and run it to halt.
+/// Load `img` into a fresh 16-bit chip and run it to halt.
 pub fn run_image(
     img: &Image,
     timing: Timing,
     max_cycles: u64,
     trace: Option<rtl::trace::TraceConfig>,
 ) -> anyhow::Result<Outcome> {
-    let mut chip = Chip::new(timing, DEFAULT_MEMORY);
+    run_image_on(img, timing, max_cycles, trace)
+}
+
+/// Load `img` into a fresh chip of datapath `W` and run it to halt.
+pub fn run_image_on<W: Word>(
+    img: &Image,
+    timing: Timing,
+    max_cycles: u64,
+    trace: Option<rtl::trace::TraceConfig>,
+) -> anyhow::Result<Outcome<W>> {
+    let mut chip = Chip::<W>::build(timing, DEFAULT_MEMORY);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
     let mut sim = Sim::new(chip);
     if let Some(cfg) = trace {
@@ -83,11 +94,24 @@ pub fn command(
     max_cycles: u64,
     vcd: Option<PathBuf>,
     window: TraceWindow,
+    datapath: Datapath,
+) -> anyhow::Result<()> {
+    match datapath {
+        Datapath::W16 => command_on::<i16>(file, max_cycles, vcd, window),
+        Datapath::W32 => command_on::<i32>(file, max_cycles, vcd, window),
+    }
+}
+
+fn command_on<W: Word>(
+    file: PathBuf,
+    max_cycles: u64,
+    vcd: Option<PathBuf>,
+    window: TraceWindow,
 ) -> anyhow::Result<()> {
     let img = load_program(&file)?;
     let trace = vcd.map(|p| window.config(p));
     let t0 = std::time::Instant::now();
-    let out = run_image(&img, Timing::default(), max_cycles, trace)?;
+    let out = run_image_on::<W>(&img, Timing::default(), max_cycles, trace)?;
     let secs = t0.elapsed().as_secs_f64();
     for f in &out.files {
         eprintln!("wrote {}", f.display());

@@ -42,6 +42,9 @@ enum Command {
         vcd: Option<PathBuf>,
         #[command(flatten)]
         window: tb::cli::TraceWindow,
+        /// RC datapath width in bits: 16 (the paper's chip) or 32.
+        #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath, default_value = "16")]
+        datapath: rtl::rc::Datapath,
     },
     /// Measure the simulator: array cycles per host second with tracing off
     /// and on, and the speed-up on every core.
@@ -218,7 +221,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_cycles,
             vcd,
             window,
-        } => tb::cmd_run::command(file, max_cycles, vcd, window),
+            datapath,
+        } => tb::cmd_run::command(file, max_cycles, vcd, window, datapath),
         Command::Bench {
             scene,
             size,

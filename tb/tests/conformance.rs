@@ -5,7 +5,7 @@
 use std::path::PathBuf;
 
 use rtl::Timing;
-use tb::cmd_run::{load_program, run_image, Outcome};
+use tb::cmd_run::{load_program, run_image, run_image_on, Outcome};
 
 fn dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance")
@@ -124,6 +124,7 @@ fn every_program_in_the_directory_is_in_the_suite() {
     let mut listed: Vec<String> = LISTED
         .iter()
         .chain(REPORTED)
+        .chain(WIDE)
         .map(|s| s.to_string())
         .collect();
     listed.sort();
@@ -136,6 +137,25 @@ fn guarded_if_then_else_runs_the_then_and_else_parts_on_their_lanes_only() {
     let s = out.stats();
     // the 4 guarded contexts: 20 + 44 + 44 lanes... checked by the active count
     assert!(s.active_rc_fraction() < 1.0);
+}
+
+/// The 32-bit datapath: 32-bit FB words through DMA, `lfb`/`sfb`, the FB
+/// stream, a multiplier shift of 40, `acch`/`accl` of the 64-bit
+/// accumulator, `rcrisc`, `wfb` (expected values computed outside the chip).
+/// Programs for the 32-bit chip (`.datapath 32`).
+const WIDE: &[&str] = &["wide.s"];
+
+#[test]
+fn wide_datapath_on_the_32_bit_chip() {
+    let img = load_program(&dir().join("wide.s")).unwrap();
+    let out = run_image_on::<i32>(&img, Timing::default(), 100_000, None).unwrap();
+    out.result.as_ref().unwrap();
+    assert_eq!(out.reg(1), 1, "failed check {}", out.reg(2));
+    // The same program on the 16-bit chip fails its first check: `ldfb`
+    // moves 16-bit words there.
+    let out16 = run_image(&img, Timing::default(), 100_000, None).unwrap();
+    out16.result.as_ref().unwrap();
+    assert_eq!((out16.reg(1), out16.reg(2)), (0xBAD, 1));
 }
 
 /// `run_to_halt` runs the cycles in which TinyRISC waits for the array or

@@ -118,8 +118,17 @@ pub(crate) fn context(asm: &Asm, lc: &LineCtx, mut i: usize) -> Result<u32, AsmE
                 return Err(lc.err_at(Some(a), format!("`{base}` shifts with `{want}SH`")));
             }
             let v = asm.value(lc, a + 1, b)?.unwrap_or(0);
-            if !(0..=31).contains(&v) {
-                return Err(lc.err_at(Some(a + 1), format!("shift {v} out of range 0..=31")));
+            let max = if asm.wide { 63 } else { 31 };
+            if !(0..=max).contains(&v) {
+                let hint = if asm.wide {
+                    ""
+                } else {
+                    " (0..=63 after `.datapath 32`)"
+                };
+                return Err(lc.err_at(
+                    Some(a + 1),
+                    format!("shift {v} out of range 0..={max}{hint}"),
+                ));
             }
             shift = v as u8;
             shift_at = Some(a);

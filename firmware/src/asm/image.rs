@@ -107,7 +107,7 @@ impl Image {
     }
 
     /// Copy the segments into a chip's main memory and set its entry.
-    pub fn load(&self, chip: &mut rtl::Chip) -> Result<(), rtl::Fault> {
+    pub fn load<W: rtl::rc::Word>(&self, chip: &mut rtl::Chip<W>) -> Result<(), rtl::Fault> {
         for s in &self.segments {
             chip.load(s.addr, &s.data)?;
         }

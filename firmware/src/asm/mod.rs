@@ -12,6 +12,8 @@
 //! * data: `.word`, `.half`, `.byte`, `.space N[, FILL]`, `.align N`,
 //!   `.ascii "..."`, `.rept N` ... `.endr`; `.entry EXPR` (default: `_start`, else the start of
 //!   `.text`);
+//! * `.datapath 16|32`: the RC datapath the contexts are for (default 16;
+//!   32 allows multiplier shifts up to 63, encoded with `f[10]`);
 //! * comments from `;` or `//` to the end of the line.
 //!
 //! The instruction syntax is exactly the disassembly of
@@ -104,6 +106,7 @@ pub fn assemble(src: &str, file: &str) -> Result<Image, AsmErrors> {
         sizes: HashMap::new(),
         segments: Vec::new(),
         entry: None,
+        wide: false,
         pending_equ: Vec::new(),
     };
     for (i, text) in src.lines().enumerate() {
@@ -200,6 +203,8 @@ struct Asm {
     sizes: HashMap<usize, u32>,
     segments: Vec<Segment>,
     entry: Option<i64>,
+    /// `.datapath 32`: contexts for the 32-bit chip.
+    pub(crate) wide: bool,
     /// (name, line index, first token of the expression, `.` there)
     pending_equ: Vec<(String, usize, usize, i64)>,
 }
@@ -324,6 +329,7 @@ impl Asm {
         self.pass = pass;
         self.loc = [TEXT_ORIGIN, DATA_ORIGIN, CTX_ORIGIN];
         self.section = Section::Text;
+        self.wide = false;
         for li in 0..self.lines.len() {
             if self.errors.len() >= MAX_ERRORS {
                 return;
@@ -642,6 +648,18 @@ impl Asm {
                 want(1)?;
                 if let Some(v) = self.value(lc, ops[0].0, ops[0].1)? {
                     self.entry = Some(v);
+                }
+            }
+            ".datapath" => {
+                want(1)?;
+                match self.value_now(lc, ops[0].0, ops[0].1, "the datapath width")? {
+                    16 => self.wide = false,
+                    32 => self.wide = true,
+                    v => {
+                        return Err(
+                            lc.err_at(Some(ops[0].0), format!("datapath {v}: 16 or 32 bits"))
+                        )
+                    }
                 }
             }
             ".global" | ".globl" => {}

@@ -379,3 +379,27 @@ fn never_panics_on_garbage() {
         }
     }
 }
+
+#[test]
+fn wide_multiplier_shifts_need_the_32_bit_datapath() {
+    // 16-bit (default): 0..=31, and the error names the directive.
+    let e = assemble(".ctx\nmul r1, r2, r3, >>40\n", "t.s").unwrap_err();
+    let msg = e.to_string();
+    assert!(msg.contains("t.s:2:") && msg.contains("0..=31"), "{msg}");
+    assert!(msg.contains(".datapath 32"), "{msg}");
+    // 32-bit: 0..=63, with bit 5 of the shift in f[10].
+    let img = assemble(
+        ".datapath 32\n.ctx\nmac.t r1, r2, r3, >>45\nldacc r4, <<63\n",
+        "t.s",
+    )
+    .unwrap();
+    let w = words(&img, Section::Ctx);
+    let c = Context::decode_wide(w[0]).unwrap();
+    assert_eq!((c.op, c.shift, c.trunc), (Op::Mac, 45, true));
+    assert_eq!(w[0] >> 10 & 1, 1);
+    assert_eq!(Context::decode_wide(w[1]).unwrap().shift, 63);
+    // the disassembly reads back
+    assert_eq!(c.to_string(), "mac.t r1, r2, r3, >>45");
+    assert!(assemble(".datapath 32\n.ctx\nmul r1, r2, r3, >>64\n", "t.s").is_err());
+    assert!(assemble(".datapath 24\n", "t.s").is_err());
+}

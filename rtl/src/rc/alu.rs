@@ -1,12 +1,13 @@
-//! The RC's arithmetic-logic unit: 16-bit two's complement.
+//! The RC's arithmetic-logic unit: 16-bit two's complement ([`w16`], the
+//! paper's chip) or 32-bit ([`w32`], the wide variant); one source for both.
 //!
 //! These scalar functions are the definition of every ALU operation; the
 //! lane-wise datapath in [`super::RcArray`] calls them once per active lane.
 //! Flag conventions (see `docs/isa.md`):
 //!
-//! * carry `C`: carry out of bit 15 for additions; **borrow** for
+//! * carry `C`: carry out of the top bit (15 or 31) for additions; **borrow** for
 //!   subtractions (`C = 1` when the unsigned subtrahend exceeds the minuend),
-//!   so `SUB` then `SBC` subtracts 32-bit values.
+//!   so `SUB` then `SBC` subtracts double-width values.
 //! * overflow `V`: signed overflow of the wrapped result; for the saturating
 //!   operations, `V = 1` when the result saturated.
 
@@ -14,107 +15,137 @@ use super::context::Cond;
 
 /// A result with its carry/borrow and overflow flags.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct Flagged {
-    pub value: i16,
+pub struct Flagged<T = i16> {
+    pub value: T,
     pub c: bool,
     pub v: bool,
 }
 
-#[inline(always)]
-pub fn add(a: i16, b: i16, cin: bool) -> Flagged {
-    let s = a as u16 as u32 + b as u16 as u32 + cin as u32;
-    let value = s as u16 as i16;
-    // Signed overflow: operands of equal sign, result of the other sign.
-    let v = ((a ^ value) & (b ^ value)) < 0;
-    Flagged {
-        value,
-        c: s > 0xFFFF,
-        v,
-    }
+/// One source for both datapath widths: `$t` the word, `$u` its unsigned
+/// pattern, `$uw` / `$sw` unsigned / signed types twice as wide.
+macro_rules! alu_unit {
+    ($m:ident, $t:ty, $u:ty, $uw:ty, $sw:ty, $doc:literal) => {
+        #[doc = $doc]
+        pub mod $m {
+            use super::{Cond, Flagged};
+
+            #[inline(always)]
+            pub fn add(a: $t, b: $t, cin: bool) -> Flagged<$t> {
+                let s = a as $u as $uw + b as $u as $uw + cin as $uw;
+                let value = s as $u as $t;
+                // Signed overflow: operands of equal sign, result of the other sign.
+                let v = ((a ^ value) & (b ^ value)) < 0;
+                Flagged {
+                    value,
+                    c: s > <$u>::MAX as $uw,
+                    v,
+                }
+            }
+
+            #[inline(always)]
+            pub fn sub(a: $t, b: $t, bin: bool) -> Flagged<$t> {
+                let value = (a as $u).wrapping_sub(b as $u).wrapping_sub(bin as $u) as $t;
+                let borrow = (a as $u as $uw) < (b as $u as $uw + bin as $uw);
+                let v = ((a ^ b) & (a ^ value)) < 0;
+                Flagged {
+                    value,
+                    c: borrow,
+                    v,
+                }
+            }
+
+            #[inline(always)]
+            fn sat(x: $sw) -> ($t, bool) {
+                if x > <$t>::MAX as $sw {
+                    (<$t>::MAX, true)
+                } else if x < <$t>::MIN as $sw {
+                    (<$t>::MIN, true)
+                } else {
+                    (x as $t, false)
+                }
+            }
+
+            /// Saturating addition; the flag is `true` when the result saturated.
+            #[inline(always)]
+            pub fn adds(a: $t, b: $t) -> ($t, bool) {
+                sat(a as $sw + b as $sw)
+            }
+
+            #[inline(always)]
+            pub fn subs(a: $t, b: $t) -> ($t, bool) {
+                sat(a as $sw - b as $sw)
+            }
+
+            /// `|a|`, saturating: `|MIN| = MAX` with the flag set.
+            #[inline(always)]
+            pub fn abs(a: $t) -> ($t, bool) {
+                sat((a as $sw).abs())
+            }
+
+            /// `|a - b|`, saturating.
+            #[inline(always)]
+            pub fn absd(a: $t, b: $t) -> ($t, bool) {
+                sat((a as $sw - b as $sw).abs())
+            }
+
+            #[inline(always)]
+            pub fn min(a: $t, b: $t) -> $t {
+                a.min(b)
+            }
+
+            #[inline(always)]
+            pub fn max(a: $t, b: $t) -> $t {
+                a.max(b)
+            }
+
+            /// Leading zeros of the word's bit pattern (the width for zero).
+            #[inline(always)]
+            pub fn clz(a: $t) -> $t {
+                (a as $u).leading_zeros() as $t
+            }
+
+            /// Condition evaluation of `CMP` (`c`, `v` are the RC's current flags).
+            #[inline(always)]
+            pub fn cond(c: Cond, a: $t, b: $t, cf: bool, vf: bool) -> bool {
+                let (ua, ub) = (a as $u, b as $u);
+                match c {
+                    Cond::Eq => a == b,
+                    Cond::Ne => a != b,
+                    Cond::Lt => a < b,
+                    Cond::Ge => a >= b,
+                    Cond::Le => a <= b,
+                    Cond::Gt => a > b,
+                    Cond::Ltu => ua < ub,
+                    Cond::Geu => ua >= ub,
+                    Cond::Leu => ua <= ub,
+                    Cond::Gtu => ua > ub,
+                    Cond::Cs => cf,
+                    Cond::Vs => vf,
+                    Cond::True => true,
+                    Cond::False => false,
+                    Cond::Bit => a & b != 0,
+                    Cond::Nbit => a & b == 0,
+                }
+            }
+        }
+    };
 }
 
-#[inline(always)]
-pub fn sub(a: i16, b: i16, bin: bool) -> Flagged {
-    let value = (a as u16).wrapping_sub(b as u16).wrapping_sub(bin as u16) as i16;
-    let borrow = (a as u16 as u32) < (b as u16 as u32 + bin as u32);
-    let v = ((a ^ b) & (a ^ value)) < 0;
-    Flagged {
-        value,
-        c: borrow,
-        v,
-    }
-}
+alu_unit!(
+    w16,
+    i16,
+    u16,
+    u32,
+    i32,
+    "The 16-bit ALU (the paper's chip)."
+);
+alu_unit!(
+    w32,
+    i32,
+    u32,
+    u64,
+    i64,
+    "The 32-bit ALU (the wide datapath variant)."
+);
 
-#[inline(always)]
-fn sat(x: i32) -> (i16, bool) {
-    if x > i16::MAX as i32 {
-        (i16::MAX, true)
-    } else if x < i16::MIN as i32 {
-        (i16::MIN, true)
-    } else {
-        (x as i16, false)
-    }
-}
-
-/// Saturating addition; the flag is `true` when the result saturated.
-#[inline(always)]
-pub fn adds(a: i16, b: i16) -> (i16, bool) {
-    sat(a as i32 + b as i32)
-}
-
-#[inline(always)]
-pub fn subs(a: i16, b: i16) -> (i16, bool) {
-    sat(a as i32 - b as i32)
-}
-
-/// `|a|`, saturating: `|-32768| = 32767` with the flag set.
-#[inline(always)]
-pub fn abs(a: i16) -> (i16, bool) {
-    sat((a as i32).abs())
-}
-
-/// `|a - b|`, saturating.
-#[inline(always)]
-pub fn absd(a: i16, b: i16) -> (i16, bool) {
-    sat((a as i32 - b as i32).abs())
-}
-
-#[inline(always)]
-pub fn min(a: i16, b: i16) -> i16 {
-    a.min(b)
-}
-
-#[inline(always)]
-pub fn max(a: i16, b: i16) -> i16 {
-    a.max(b)
-}
-
-/// Leading zeros of the 16-bit pattern (16 for zero).
-#[inline(always)]
-pub fn clz(a: i16) -> i16 {
-    (a as u16).leading_zeros() as i16
-}
-
-/// Condition evaluation of `CMP` (`c`, `v` are the RC's current flags).
-#[inline(always)]
-pub fn cond(c: Cond, a: i16, b: i16, cf: bool, vf: bool) -> bool {
-    let (ua, ub) = (a as u16, b as u16);
-    match c {
-        Cond::Eq => a == b,
-        Cond::Ne => a != b,
-        Cond::Lt => a < b,
-        Cond::Ge => a >= b,
-        Cond::Le => a <= b,
-        Cond::Gt => a > b,
-        Cond::Ltu => ua < ub,
-        Cond::Geu => ua >= ub,
-        Cond::Leu => ua <= ub,
-        Cond::Gtu => ua > ub,
-        Cond::Cs => cf,
-        Cond::Vs => vf,
-        Cond::True => true,
-        Cond::False => false,
-        Cond::Bit => a & b != 0,
-        Cond::Nbit => a & b == 0,
-    }
-}
+pub use w16::*;

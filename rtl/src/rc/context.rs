@@ -19,6 +19,8 @@
 //!           interconnect sources, the direction / lane index.
 //! * `bs`    0: operand B is register `f[3:0]`, `f[8:4]` is the multiplier
 //!           shift and `f[9]` selects truncation instead of rounding;
+//!           `f[10]` is reserved (0) on the 16-bit chip and bit 5 of the
+//!           shift (0..=63) on the 32-bit chip ([`Context::decode_wide`]);
 //!           1: operand B is the 11-bit signed immediate `f`.
 //!
 //! A context word is decoded once ([`Context::decode`]) into a [`Context`];
@@ -317,7 +319,8 @@ pub struct Context {
     pub asrc: ASrc,
     pub ra: u8,
     pub b: BSrc,
-    /// Multiplier shift amount, 0..=31 (register form only; 0 with an immediate).
+    /// Multiplier shift amount, 0..=31 on the 16-bit chip, 0..=63 on the
+    /// 32-bit chip (register form only; 0 with an immediate).
     pub shift: u8,
     /// Multiplier result truncated (floor) instead of rounded to nearest.
     pub trunc: bool,
@@ -337,7 +340,10 @@ impl fmt::Display for DecodeError {
         match self {
             DecodeError::IllegalOp(o) => write!(f, "illegal RC opcode 0x{o:02x}"),
             DecodeError::IllegalGuard => write!(f, "illegal guard field 3"),
-            DecodeError::ReservedBits => write!(f, "reserved context bits 10 set"),
+            DecodeError::ReservedBits => write!(
+                f,
+                "reserved context bit 10 set (a multiplier shift above 31 needs the 32-bit datapath)"
+            ),
         }
     }
 }
@@ -382,7 +388,19 @@ impl Context {
         }
     }
 
+    /// Decode for the 16-bit chip: `f[10]` of the register form is reserved.
     pub fn decode(w: u32) -> Result<Context, DecodeError> {
+        Self::decode_for(w, false)
+    }
+
+    /// Decode for the 32-bit chip: `f[10]` of the register form is bit 5 of
+    /// the multiplier shift (0..=63).
+    pub fn decode_wide(w: u32) -> Result<Context, DecodeError> {
+        Self::decode_for(w, true)
+    }
+
+    /// Decode for the datapath `wide` (32-bit) or not.
+    pub fn decode_for(w: u32, wide: bool) -> Result<Context, DecodeError> {
         let opb = (w >> 26) as u8;
         let op = Op::from_bits(opb).ok_or(DecodeError::IllegalOp(opb))?;
         let guard = match (w >> 24) & 3 {
@@ -396,12 +414,12 @@ impl Context {
             // sign-extend 11 bits
             (BSrc::Imm(((f << 5) as i16) >> 5), 0, false)
         } else {
-            if f & (1 << 10) != 0 {
+            if f & (1 << 10) != 0 && !wide {
                 return Err(DecodeError::ReservedBits);
             }
             (
                 BSrc::Reg((f & 15) as u8),
-                ((f >> 4) & 31) as u8,
+                ((f >> 4) & 31 | (f >> 5) & 32) as u8,
                 f & (1 << 9) != 0,
             )
         };
@@ -421,11 +439,12 @@ impl Context {
     /// Encode; panics only on a field out of range, which is a bug in the caller
     /// (the assembler range-checks user input before building a `Context`).
     pub fn encode(&self) -> u32 {
-        assert!(self.rd < 16 && self.ra < 16 && self.shift < 32);
+        assert!(self.rd < 16 && self.ra < 16 && self.shift < 64);
         let f = match self.b {
             BSrc::Reg(rb) => {
                 assert!(rb < 16);
-                rb as u32 | (self.shift as u32) << 4 | (self.trunc as u32) << 9
+                let sh = self.shift as u32;
+                rb as u32 | (sh & 31) << 4 | (self.trunc as u32) << 9 | (sh >> 5) << 10
             }
             BSrc::Imm(i) => {
                 assert!((-1024..=1023).contains(&i), "immediate {i} out of range");
@@ -536,5 +555,27 @@ mod tests {
         );
         assert_eq!(Context::decode(3 << 24), Err(DecodeError::IllegalGuard));
         assert_eq!(Context::decode(1 << 10), Err(DecodeError::ReservedBits));
+    }
+
+    #[test]
+    fn the_wide_decode_reads_bit_10_as_bit_5_of_the_shift() {
+        for sh in 0..64u8 {
+            let c = Context {
+                shift: sh,
+                trunc: sh % 3 == 0,
+                ..Context::rrr(Op::Mac, 4, 5, 6)
+            };
+            let w = c.encode();
+            assert_eq!(w >> 10 & 1, (sh >= 32) as u32);
+            assert_eq!(Context::decode_wide(w), Ok(c));
+            if sh < 32 {
+                assert_eq!(Context::decode(w), Ok(c));
+            } else {
+                assert_eq!(Context::decode(w), Err(DecodeError::ReservedBits));
+            }
+        }
+        // the immediate form is the same on both chips
+        let c = Context::rri(Op::Add, 1, 2, -1024);
+        assert_eq!(Context::decode_wide(c.encode()), Ok(c));
     }
 }

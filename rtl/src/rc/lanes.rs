@@ -2,6 +2,8 @@
 //! array). A `u64` holds every per-RC flag of the array, so "do all rays
 //! agree?" is one comparison.
 
+use super::word::Word;
+
 pub type Mask = u64;
 
 /// The mask with the low `n` lanes set.
@@ -27,39 +29,31 @@ pub fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, s
     }
 }
 
-/// Eight lanes of 0 / -1 for each byte of a mask.
-static EXPAND8: [[i16; 8]; 256] = {
-    let mut t = [[0i16; 8]; 256];
-    let mut b = 0;
-    while b < 256 {
-        let mut k = 0;
-        while k < 8 {
-            t[b][k] = if b >> k & 1 != 0 { -1 } else { 0 };
-            k += 1;
-        }
-        b += 1;
-    }
-    t
-};
-
-/// `select` for 16-bit lanes: the mask is expanded to 0 / -1 lanes by table
-/// and blended with bit operations, which vectorises.
+/// `select` for datapath words: the mask is expanded to 0 / -1 lanes by
+/// table ([`Word::expand8`]) and blended with bit operations, which
+/// vectorises.
 #[inline(always)]
-pub fn select16<const N: usize>(dst: &mut [i16; N], mask: Mask, src: &[i16; N]) {
+pub fn select_word<W: Word, const N: usize>(dst: &mut [W; N], mask: Mask, src: &[W; N]) {
     if mask == full(N) {
         *dst = *src;
     } else if mask != 0 {
         if !N.is_multiple_of(8) {
             return select(dst, mask, src);
         }
-        let mut m = [0i16; N];
+        let mut m = [W::ZERO; N];
         for c in 0..N / 8 {
-            m[c * 8..c * 8 + 8].copy_from_slice(&EXPAND8[(mask >> (c * 8)) as usize & 255]);
+            m[c * 8..c * 8 + 8].copy_from_slice(W::expand8((mask >> (c * 8)) as usize & 255));
         }
         for i in 0..N {
             dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
         }
     }
+}
+
+/// [`select_word`] for 16-bit lanes.
+#[inline(always)]
+pub fn select16<const N: usize>(dst: &mut [i16; N], mask: Mask, src: &[i16; N]) {
+    select_word(dst, mask, src)
 }
 
 /// One bool per lane from a mask.
@@ -128,6 +122,12 @@ mod tests {
             assert_eq!(pack_bools(&b5), x & 31);
             let b12: [bool; 12] = std::array::from_fn(|i| b[i]);
             assert_eq!(pack_bools(&b12), x & 0xFFF);
+            let mut d = [7i32; 64];
+            let src: [i32; 64] = std::array::from_fn(|i| i as i32 * 100_000 - 2_000_000);
+            select_word(&mut d, x, &src);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
         }
     }
 }

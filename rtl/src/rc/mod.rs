@@ -16,6 +16,7 @@ pub mod multiplier;
 pub mod ram;
 pub mod register_file;
 pub mod shifter;
+pub mod word;
 
 use std::fmt;
 
@@ -23,9 +24,10 @@ use crate::kernel::{Clocked, Fault};
 use crate::trace::{Display, Filter, Probe, Traced};
 use context::{ASrc, BSrc, Context, Guard, Op};
 use flags::Flags;
-use lanes::{full, select, Mask};
+use lanes::{full, select, select_word, Mask};
 use ram::Ram;
 use register_file::RegisterFile;
+pub use word::{Datapath, Word};
 
 /// How lanes are named in waveforms.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,26 +48,26 @@ struct Pending {
     store: bool,
 }
 
-pub struct RcArray<const N: usize> {
+pub struct RcArray<const N: usize, W: Word = i16> {
     // ---- registered state (q) ----
-    pub regs: RegisterFile<N>,
-    pub ram: Ram<N>,
-    pub acc: [i32; N],
-    pub out: [i16; N],
+    pub regs: RegisterFile<N, W>,
+    pub ram: Ram<N, W>,
+    pub acc: [W::Acc; N],
+    pub out: [W; N],
     pub flags: Flags,
     // ---- inputs for this cycle ----
     ctx: Context,
     ctx_word: u32,
     /// Operand A for the interconnect and frame-buffer sources, driven by
     /// the array around the RCs.
-    pub ext: [i16; N],
+    pub ext: [W; N],
     /// Lanes allowed to execute this cycle (all by default). Row and column
     /// broadcast modes run one context per row/column by restricting this.
     pub lane_enable: Mask,
     // ---- next state (d), computed by eval ----
     en: Mask,
-    res: [i16; N],
-    acc_d: [i32; N],
+    res: [W; N],
+    acc_d: [W::Acc; N],
     addr: [u16; N],
     /// The RAM access of this cycle has one address in every lane.
     uniform: bool,
@@ -81,7 +83,7 @@ fn op_text(v: u64) -> Option<String> {
 }
 
 fn ctx_text(v: u64) -> Option<String> {
-    Context::decode(v as u32).ok().map(|c| c.to_string())
+    Context::decode_wide(v as u32).ok().map(|c| c.to_string())
 }
 
 /// Translate filter: opcode field to mnemonic.
@@ -95,7 +97,7 @@ pub static CTX_FILTER: Filter = Filter {
     text: ctx_text,
 };
 
-impl<const N: usize> RcArray<N> {
+impl<const N: usize, W: Word> RcArray<N, W> {
     pub const FULL: Mask = full(N);
 
     pub fn new(names: LaneNames) -> Self {
@@ -103,16 +105,16 @@ impl<const N: usize> RcArray<N> {
         RcArray {
             regs: RegisterFile::default(),
             ram: Ram::default(),
-            acc: [0; N],
-            out: [0; N],
+            acc: [W::Acc::default(); N],
+            out: [W::ZERO; N],
             flags: Flags::default(),
             ctx: Context::NOP,
             ctx_word: Context::NOP.encode(),
-            ext: [0; N],
+            ext: [W::ZERO; N],
             lane_enable: full(N),
             en: 0,
-            res: [0; N],
-            acc_d: [0; N],
+            res: [W::ZERO; N],
+            acc_d: [W::Acc::default(); N],
             addr: [0; N],
             uniform: false,
             d_c: 0,
@@ -157,7 +159,7 @@ impl<const N: usize> RcArray<N> {
     }
 
     /// Operand A of lane `i` (for waveforms and testbenches).
-    pub fn operand_a(&self, i: usize) -> i16 {
+    pub fn operand_a(&self, i: usize) -> W {
         match self.ctx.asrc {
             ASrc::Reg => self.regs.read(self.ctx.ra)[i],
             ASrc::Out => self.out[i],
@@ -166,10 +168,10 @@ impl<const N: usize> RcArray<N> {
     }
 
     /// Operand B of lane `i`.
-    pub fn operand_b(&self, i: usize) -> i16 {
+    pub fn operand_b(&self, i: usize) -> W {
         match self.ctx.b {
             BSrc::Reg(r) => self.regs.read(r)[i],
-            BSrc::Imm(v) => v,
+            BSrc::Imm(v) => W::imm(v),
         }
     }
 
@@ -193,7 +195,10 @@ macro_rules! map {
 
 /// Run a flag-producing ALU function over every lane.
 #[inline(always)]
-fn cv<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> alu::Flagged) -> (Mask, Mask) {
+fn cv<W: Word, const N: usize>(
+    res: &mut [W; N],
+    f: impl Fn(usize) -> alu::Flagged<W>,
+) -> (Mask, Mask) {
     let mut c = [false; N];
     let mut v = [false; N];
     for i in 0..N {
@@ -207,7 +212,7 @@ fn cv<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> alu::Flagged) -> 
 
 /// Run a saturating function over every lane; returns the saturation mask.
 #[inline(always)]
-fn sat<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> (i16, bool)) -> Mask {
+fn sat<W: Word, const N: usize>(res: &mut [W; N], f: impl Fn(usize) -> (W, bool)) -> Mask {
     let mut v = [false; N];
     for i in 0..N {
         let (r, s) = f(i);
@@ -217,7 +222,7 @@ fn sat<const N: usize>(res: &mut [i16; N], f: impl Fn(usize) -> (i16, bool)) -> 
     lanes::pack_bools(&v)
 }
 
-impl<const N: usize> Clocked for RcArray<N> {
+impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
     fn eval(&mut self) -> Result<(), Fault> {
         let c = self.ctx;
         let en = self.enabled();
@@ -231,15 +236,15 @@ impl<const N: usize> Clocked for RcArray<N> {
             return Ok(());
         }
         let imm;
-        let a: &[i16; N] = match c.asrc {
+        let a: &[W; N] = match c.asrc {
             ASrc::Reg => &self.regs.r[c.ra as usize],
             ASrc::Out => &self.out,
             _ => &self.ext,
         };
-        let b: &[i16; N] = match c.b {
+        let b: &[W; N] = match c.b {
             BSrc::Reg(r) => &self.regs.r[r as usize],
             BSrc::Imm(v) => {
-                imm = [v; N];
+                imm = [W::imm(v); N];
                 &imm
             }
         };
@@ -249,47 +254,47 @@ impl<const N: usize> Clocked for RcArray<N> {
         match c.op {
             Op::Nop | Op::Sleep | Op::Wake => {}
             Op::Add => {
-                (self.d_c, self.d_v) = cv(res, |i| alu::add(a[i], b[i], false));
+                (self.d_c, self.d_v) = cv(res, |i| W::add(a[i], b[i], false));
                 self.pend.cv = true;
             }
             Op::Adc => {
-                (self.d_c, self.d_v) = cv(res, |i| alu::add(a[i], b[i], cin >> i & 1 != 0));
+                (self.d_c, self.d_v) = cv(res, |i| W::add(a[i], b[i], cin >> i & 1 != 0));
                 self.pend.cv = true;
             }
             Op::Sub => {
-                (self.d_c, self.d_v) = cv(res, |i| alu::sub(a[i], b[i], false));
+                (self.d_c, self.d_v) = cv(res, |i| W::sub(a[i], b[i], false));
                 self.pend.cv = true;
             }
             Op::Sbc => {
-                (self.d_c, self.d_v) = cv(res, |i| alu::sub(a[i], b[i], cin >> i & 1 != 0));
+                (self.d_c, self.d_v) = cv(res, |i| W::sub(a[i], b[i], cin >> i & 1 != 0));
                 self.pend.cv = true;
             }
             Op::Rsb => {
-                (self.d_c, self.d_v) = cv(res, |i| alu::sub(b[i], a[i], false));
+                (self.d_c, self.d_v) = cv(res, |i| W::sub(b[i], a[i], false));
                 self.pend.cv = true;
             }
             Op::Neg => {
-                (self.d_c, self.d_v) = cv(res, |i| alu::sub(0, a[i], false));
+                (self.d_c, self.d_v) = cv(res, |i| W::sub(W::ZERO, a[i], false));
                 self.pend.cv = true;
             }
             Op::Adds => {
-                self.d_v = sat(res, |i| alu::adds(a[i], b[i]));
+                self.d_v = sat(res, |i| W::adds(a[i], b[i]));
                 (self.d_c, self.pend.cv) = (0, true);
             }
             Op::Subs => {
-                self.d_v = sat(res, |i| alu::subs(a[i], b[i]));
+                self.d_v = sat(res, |i| W::subs(a[i], b[i]));
                 (self.d_c, self.pend.cv) = (0, true);
             }
             Op::Abs => {
-                self.d_v = sat(res, |i| alu::abs(a[i]));
+                self.d_v = sat(res, |i| W::abs(a[i]));
                 (self.d_c, self.pend.cv) = (0, true);
             }
             Op::Absd => {
-                self.d_v = sat(res, |i| alu::absd(a[i], b[i]));
+                self.d_v = sat(res, |i| W::absd(a[i], b[i]));
                 (self.d_c, self.pend.cv) = (0, true);
             }
             Op::Asl => {
-                self.d_v = sat(res, |i| shifter::asl(a[i], shifter::amount(b[i])));
+                self.d_v = sat(res, |i| W::asl(a[i], W::amount(b[i])));
                 (self.d_c, self.pend.cv) = (0, true);
             }
             Op::And => map!(res, |i| a[i] & b[i]),
@@ -298,9 +303,9 @@ impl<const N: usize> Clocked for RcArray<N> {
             Op::Not => map!(res, |i| !a[i]),
             Op::Mov => *res = *a,
             Op::Movb => *res = *b,
-            Op::Min => map!(res, |i| alu::min(a[i], b[i])),
-            Op::Max => map!(res, |i| alu::max(a[i], b[i])),
-            Op::Clz => map!(res, |i| alu::clz(a[i])),
+            Op::Min => map!(res, |i| a[i].min(b[i])),
+            Op::Max => map!(res, |i| a[i].max(b[i])),
+            Op::Clz => map!(res, |i| W::clz(a[i])),
             Op::Sel => {
                 let f = self.flags.f;
                 map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
@@ -308,13 +313,13 @@ impl<const N: usize> Clocked for RcArray<N> {
             Op::Cmp => {
                 let (cf, vf, cond) = (self.flags.c, self.flags.v, c.cond());
                 self.d_f = lanes::pack::<N>(|i| {
-                    alu::cond(cond, a[i], b[i], cf >> i & 1 != 0, vf >> i & 1 != 0)
+                    W::cond(cond, a[i], b[i], cf >> i & 1 != 0, vf >> i & 1 != 0)
                 });
                 self.pend.f = true;
             }
-            Op::Sll => map!(res, |i| shifter::sll(a[i], shifter::amount(b[i]))),
-            Op::Srl => map!(res, |i| shifter::srl(a[i], shifter::amount(b[i]))),
-            Op::Sra => map!(res, |i| shifter::sra(a[i], shifter::amount(b[i]))),
+            Op::Sll => map!(res, |i| W::sll(a[i], W::amount(b[i]))),
+            Op::Srl => map!(res, |i| W::srl(a[i], W::amount(b[i]))),
+            Op::Sra => map!(res, |i| W::sra(a[i], W::amount(b[i]))),
             Op::Mul | Op::Mac | Op::Msu => {
                 let acc = &self.acc;
                 let acc_d = &mut self.acc_d;
@@ -322,20 +327,20 @@ impl<const N: usize> Clocked for RcArray<N> {
                 match c.op {
                     Op::Mul => {
                         for i in 0..N {
-                            acc_d[i] = multiplier::product(a[i], b[i]);
+                            acc_d[i] = W::product(a[i], b[i]);
                         }
                     }
                     Op::Mac | Op::Msu => {
                         let sub = c.op == Op::Msu;
                         for i in 0..N {
-                            let p = multiplier::product(a[i], b[i]);
-                            (acc_d[i], s[i]) = multiplier::accumulate(acc[i], p, sub);
+                            let p = W::product(a[i], b[i]);
+                            (acc_d[i], s[i]) = W::accumulate(acc[i], p, sub);
                         }
                     }
                     _ => unreachable!(),
                 }
                 for i in 0..N {
-                    let (r, s2) = multiplier::scale(acc_d[i], sh, trunc);
+                    let (r, s2) = W::scale(acc_d[i], sh, trunc);
                     res[i] = r;
                     s[i] |= s2;
                 }
@@ -345,15 +350,15 @@ impl<const N: usize> Clocked for RcArray<N> {
             }
             Op::Acc => {
                 let acc = &self.acc;
-                self.d_v = sat(res, |i| multiplier::scale(acc[i], sh, trunc));
+                self.d_v = sat(res, |i| W::scale(acc[i], sh, trunc));
                 (self.d_c, self.pend.cv) = (0, true);
             }
-            Op::Acch => map!(res, |i| (self.acc[i] >> 16) as i16),
-            Op::Accl => map!(res, |i| self.acc[i] as i16),
+            Op::Acch => map!(res, |i| W::acch(self.acc[i])),
+            Op::Accl => map!(res, |i| W::accl(self.acc[i])),
             Op::Ldacc => {
                 let acc_d = &mut self.acc_d;
                 for i in 0..N {
-                    acc_d[i] = ((a[i] as i64) << sh).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+                    acc_d[i] = W::ldacc(a[i], sh);
                 }
                 self.pend.acc = true;
             }
@@ -361,13 +366,13 @@ impl<const N: usize> Clocked for RcArray<N> {
                 let store = c.op == Op::St;
                 let mut addr = [0i32; N];
                 if store {
-                    map!(addr, |i| b[i] as i32);
+                    map!(addr, |i| W::addr1(b[i]));
                 } else {
-                    map!(addr, |i| a[i] as i32 + b[i] as i32);
+                    map!(addr, |i| W::addr(a[i], b[i]));
                 }
                 let mut bad = [false; N];
                 for i in 0..N {
-                    bad[i] = !Ram::<N>::valid(addr[i]);
+                    bad[i] = !Ram::<N, W>::valid(addr[i]);
                 }
                 let bad = lanes::pack_bools(&bad) & en;
                 if bad != 0 {
@@ -406,7 +411,7 @@ impl<const N: usize> Clocked for RcArray<N> {
         let c = self.ctx;
         let p = self.pend;
         if p.result {
-            lanes::select16(&mut self.out, en, &self.res);
+            select_word(&mut self.out, en, &self.res);
             if c.we {
                 self.regs.write(c.rd, en, &self.res);
             }
@@ -423,7 +428,7 @@ impl<const N: usize> Clocked for RcArray<N> {
         }
         if p.store {
             if self.uniform {
-                lanes::select16(self.ram.row_mut(self.addr[0] as usize), en, &self.res);
+                select_word(self.ram.row_mut(self.addr[0] as usize), en, &self.res);
             } else {
                 for i in 0..N {
                     if en >> i & 1 != 0 {
@@ -445,7 +450,7 @@ const REG_NAMES: [&str; 16] = [
     "r15",
 ];
 
-impl<const N: usize> Traced for RcArray<N> {
+impl<const N: usize, W: Word> Traced for RcArray<N, W> {
     fn trace(&self, p: &mut dyn Probe) {
         let c = &self.ctx;
         p.signal(
@@ -456,6 +461,9 @@ impl<const N: usize> Traced for RcArray<N> {
         );
         p.signal("op", 6, Display::Translate(&OP_FILTER), c.op as u64);
         let en = self.enabled();
+        let bits = W::BITS;
+        let mask = |b: u32| if b >= 64 { u64::MAX } else { (1u64 << b) - 1 };
+        let sig = |x: W| x.to_i64() as u64 & mask(bits);
         for i in 0..N {
             let open = match self.names {
                 LaneNames::Single => p.scope(format_args!("rc")),
@@ -465,16 +473,21 @@ impl<const N: usize> Traced for RcArray<N> {
                 continue;
             }
             let bit = |m: Mask| m >> i & 1;
-            p.signal("out", 16, Display::Signed, self.out[i] as u16 as u64);
+            p.signal("out", bits, Display::Signed, sig(self.out[i]));
             if p.scope(format_args!("alu")) {
-                p.signal("a", 16, Display::Signed, self.operand_a(i) as u16 as u64);
-                p.signal("b", 16, Display::Signed, self.operand_b(i) as u16 as u64);
-                p.signal("result", 16, Display::Signed, self.res[i] as u16 as u64);
+                p.signal("a", bits, Display::Signed, sig(self.operand_a(i)));
+                p.signal("b", bits, Display::Signed, sig(self.operand_b(i)));
+                p.signal("result", bits, Display::Signed, sig(self.res[i]));
                 p.signal("en", 1, Display::Bin, bit(en));
                 p.end();
             }
             if p.scope(format_args!("mul")) {
-                p.signal("acc", 32, Display::Signed, self.acc[i] as u32 as u64);
+                p.signal(
+                    "acc",
+                    2 * bits,
+                    Display::Signed,
+                    W::acc_i128(self.acc[i]) as u64 & mask(2 * bits),
+                );
                 p.end();
             }
             if p.scope(format_args!("flags")) {
@@ -486,7 +499,7 @@ impl<const N: usize> Traced for RcArray<N> {
             }
             if p.scope(format_args!("regfile")) {
                 for (k, name) in REG_NAMES.iter().enumerate() {
-                    p.signal(name, 16, Display::Signed, self.regs.r[k][i] as u16 as u64);
+                    p.signal(name, bits, Display::Signed, sig(self.regs.r[k][i]));
                 }
                 p.end();
             }
@@ -506,12 +519,14 @@ impl<const N: usize> Traced for RcArray<N> {
     }
 }
 
-impl<const N: usize> fmt::Debug for RcArray<N> {
+impl<const N: usize, W: Word> fmt::Debug for RcArray<N, W> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(
             f,
-            "RcArray<{N}> {{ ctx: {}, flags: {:?} }}",
-            self.ctx, self.flags
+            "RcArray<{N}, {}> {{ ctx: {}, flags: {:?} }}",
+            W::DATAPATH,
+            self.ctx,
+            self.flags
         )
     }
 }

@@ -1,42 +1,91 @@
-//! The RC's 16x16 multiplier with a 32-bit accumulator.
+//! The RC's multiplier with its accumulator: 16x16 into 32 bits ([`w16`],
+//! the paper's chip) or 32x32 into 64 bits ([`w32`], the wide variant).
 //!
-//! * `MUL`: `acc = a * b` (the full 32-bit product; `(-32768)^2` fits).
-//! * `MAC` / `MSU`: `acc = acc ± a * b`, saturating at the 32-bit bounds.
-//! * Every multiplier operation also yields a 16-bit result
-//!   `sat16(acc >> sh)`, rounded to nearest (ties towards +inf: `+2^(sh-1)`
+//! * `MUL`: `acc = a * b` (the full product; `MIN^2` fits).
+//! * `MAC` / `MSU`: `acc = acc ± a * b`, saturating at the accumulator's bounds.
+//! * Every multiplier operation also yields a word-sized result
+//!   `sat(acc >> sh)`, rounded to nearest (ties towards +inf: `+2^(sh-1)`
 //!   before the arithmetic shift) or truncated towards -inf, so with `sh = n`
-//!   two Qm.n operands give a Qm.n result in 16 bits.
+//!   two Qm.n operands give a Qm.n result in one word. The shift is 0..=31
+//!   (16-bit) or 0..=63 (32-bit).
 //!
-//! `V` is set when the accumulator or the 16-bit result saturated.
+//! `V` is set when the accumulator or the result saturated.
 
-/// The full product of two 16-bit values.
-#[inline(always)]
-pub fn product(a: i16, b: i16) -> i32 {
-    a as i32 * b as i32
+/// `$t` the word, `$acc` the accumulator (twice as wide), `$w` wider still
+/// (exact sums and shifts), `$smask` the shift field mask.
+macro_rules! multiplier_unit {
+    ($m:ident, $t:ty, $acc:ty, $w:ty, $smask:expr, $doc:literal) => {
+        #[doc = $doc]
+        pub mod $m {
+            /// The full product of two words.
+            #[inline(always)]
+            pub fn product(a: $t, b: $t) -> $acc {
+                a as $acc * b as $acc
+            }
+
+            /// `acc + p` (or `acc - p` when `sub`), saturating at the
+            /// accumulator's bounds.
+            #[inline(always)]
+            pub fn accumulate(acc: $acc, p: $acc, sub: bool) -> ($acc, bool) {
+                // In the wider type the exact sum cannot overflow; clamp it (vectorises).
+                let p = if sub { -(p as $w) } else { p as $w };
+                let w = acc as $w + p;
+                let r = w.clamp(<$acc>::MIN as $w, <$acc>::MAX as $w);
+                (r as $acc, r != w)
+            }
+
+            /// Scale the accumulator to one word: shift right by `sh`, rounding
+            /// to nearest unless `trunc`, then saturate.
+            ///
+            /// Rounding adds `2^(sh-1)` before the shift; without overflow that
+            /// is `floor(acc / 2^sh)` plus bit `sh-1` of `acc`.
+            #[inline(always)]
+            pub fn scale(acc: $acc, sh: u32, trunc: bool) -> ($t, bool) {
+                let sh = sh & $smask;
+                let mut w = acc >> sh;
+                if !trunc && sh > 0 {
+                    w += (acc >> (sh - 1)) & 1;
+                }
+                let r = w.clamp(<$t>::MIN as $acc, <$t>::MAX as $acc);
+                (r as $t, r != w)
+            }
+
+            /// `ldacc`: `acc = sat(a * 2^sh)`.
+            #[inline(always)]
+            pub fn load(a: $t, sh: u32) -> $acc {
+                ((a as $w) << (sh & $smask)).clamp(<$acc>::MIN as $w, <$acc>::MAX as $w) as $acc
+            }
+
+            /// `acch`: the accumulator's upper word.
+            #[inline(always)]
+            pub fn high(acc: $acc) -> $t {
+                (acc >> <$t>::BITS) as $t
+            }
+
+            /// `accl`: the accumulator's lower word.
+            #[inline(always)]
+            pub fn low(acc: $acc) -> $t {
+                acc as $t
+            }
+        }
+    };
 }
 
-/// `acc + p` (or `acc - p` when `sub`), saturating at the 32-bit bounds.
-#[inline(always)]
-pub fn accumulate(acc: i32, p: i32, sub: bool) -> (i32, bool) {
-    // In 64 bits the exact sum cannot overflow; clamp it (vectorises).
-    let p = if sub { -(p as i64) } else { p as i64 };
-    let w = acc as i64 + p;
-    let r = w.clamp(i32::MIN as i64, i32::MAX as i64);
-    (r as i32, r != w)
-}
+multiplier_unit!(
+    w16,
+    i16,
+    i32,
+    i64,
+    31,
+    "16x16 multiplier, 32-bit accumulator."
+);
+multiplier_unit!(
+    w32,
+    i32,
+    i64,
+    i128,
+    63,
+    "32x32 multiplier, 64-bit accumulator."
+);
 
-/// Scale the accumulator to 16 bits: shift right by `sh` (0..=31), rounding
-/// to nearest unless `trunc`, then saturate.
-///
-/// Rounding adds `2^(sh-1)` before the shift; in 32 bits without overflow
-/// that is `floor(acc / 2^sh)` plus bit `sh-1` of `acc`.
-#[inline(always)]
-pub fn scale(acc: i32, sh: u32, trunc: bool) -> (i16, bool) {
-    let sh = sh & 31;
-    let mut w = acc >> sh;
-    if !trunc && sh > 0 {
-        w += (acc >> (sh - 1)) & 1;
-    }
-    let r = w.clamp(i16::MIN as i32, i16::MAX as i32);
-    (r as i16, r != w)
-}
+pub use w16::*;

@@ -22,12 +22,16 @@ pub trait Machine {
     fn load(&self, addr: u32, size: u32) -> Result<u32, Fault>;
     /// Would a store of `size` bytes at `addr` be legal?
     fn check_store(&self, addr: u32, size: u32) -> Result<(), Fault>;
-    /// One FB word (TinyRISC's FB port).
-    fn fb_read(&self, addr: u16) -> Result<i16, Fault>;
+    /// One FB word (TinyRISC's FB port), sign-extended to 32 bits.
+    fn fb_read(&self, addr: u16) -> Result<i32, Fault>;
     /// Would writing `words` FB words from `addr` be legal (no DMA conflict)?
     fn check_fb_write(&self, addr: u16, words: u32) -> Result<(), Fault>;
-    /// Output register of RC `lane` (row-major).
-    fn rc_out(&self, lane: usize) -> i16;
+    /// Output register of RC `lane` (row-major), sign-extended to 32 bits.
+    fn rc_out(&self, lane: usize) -> i32;
+    /// Bytes of an FB word: 2 on the 16-bit chip, 4 on the 32-bit chip.
+    fn fb_word_bytes(&self) -> u32 {
+        2
+    }
     /// (flag F mask, sleep mask) of the 64 RCs.
     fn rc_flags(&self) -> (u64, u64);
     /// Can a run be issued (the broadcast queue has room)?
@@ -50,9 +54,10 @@ pub enum Command {
         size: u32,
         value: u32,
     },
+    /// `sfb`: the chip keeps the low FB-word bits of `value`.
     FbWrite {
         addr: u16,
-        value: i16,
+        value: i32,
     },
     /// Write the 64 RC outputs to FB words `addr..addr + 64`.
     Wfb {
@@ -209,7 +214,7 @@ impl TinyRisc {
             }
             Lfb => {
                 let addr = fb_addr(b as i32 as i64 + imm as i64, "lfb")?;
-                wb = Some(m.fb_read(addr)? as i32 as u32);
+                wb = Some(m.fb_read(addr)? as u32);
                 cost = t.fb_load;
             }
             Sfb => {
@@ -217,7 +222,7 @@ impl TinyRisc {
                 m.check_fb_write(addr, 1)?;
                 self.cmd = Command::FbWrite {
                     addr,
-                    value: a as i16,
+                    value: a as i32,
                 };
                 cost = t.fb_store;
             }
@@ -266,7 +271,7 @@ impl TinyRisc {
                     local: b,
                     words: u32::try_from(words).unwrap_or(u32::MAX),
                 };
-                req.validate(m.mem_size())
+                req.validate_for(m.mem_size(), m.fb_word_bytes())
                     .map_err(|e| Fault::new("dma", e))?;
                 self.cmd = Command::Dma(req);
                 cost = t.dma_issue;
@@ -333,7 +338,7 @@ impl TinyRisc {
                 if lane >= 64 {
                     return Err(fault(format!("rcrisc: RC index {lane} outside 0..=63")));
                 }
-                wb = Some(m.rc_out(lane as usize) as i32 as u32);
+                wb = Some(m.rc_out(lane as usize) as u32);
                 cost = t.rcrisc;
             }
             Rcany | Rcall | Rcfl | Rcfh | Rcsl | Rcsh | Rcst => {
