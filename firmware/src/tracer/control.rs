@@ -111,7 +111,7 @@ pub fn program(
     }
     if has(ChipType::Polygon) {
         objk.push(("k_polyh", k::polygon_head(nm.newton_steps)));
-        objk.push(("k_polyf", k::polygon_fan(lay.kt_tri)));
+        objk.push(("k_polye", k::polygon_edge()));
         objk.push(("k_polyt", k::polygon_tail()));
     }
 
@@ -405,9 +405,9 @@ test_objects:\n        lw r13, PASS(r0)"
                     kaddr("k_polyh"),
                     klen("k_polyh"),
                     1 + super::layout::POLY_HEAD_WORDS,
-                    kaddr("k_polyf"),
-                    klen("k_polyf"),
-                    super::layout::POLY_FAN_WORDS,
+                    kaddr("k_polye"),
+                    klen("k_polye"),
+                    super::layout::POLY_EDGE_WORDS,
                     kaddr("k_polyt"),
                     klen("k_polyt")
                 );
@@ -585,9 +585,9 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
                     kaddr("k_polyh"),
                     klen("k_polyh"),
                     1 + super::layout::POLY_HEAD_WORDS,
-                    kaddr("k_polyf"),
-                    klen("k_polyf"),
-                    super::layout::POLY_FAN_WORDS,
+                    kaddr("k_polye"),
+                    klen("k_polye"),
+                    super::layout::POLY_EDGE_WORDS,
                     kaddr("k_polyt"),
                     klen("k_polyt")
                 );

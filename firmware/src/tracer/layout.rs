@@ -79,9 +79,10 @@ pub const CYL_BODY_WORDS: usize = 34;
 /// Cylinder group: caps flag, body, base cap, apex cap.
 pub const CYL_WORDS: usize = 1 + CYL_BODY_WORDS + 2 * PLANAR_WORDS;
 pub const BOX_WORDS: usize = 24;
-/// Polygon record: fan count, head, one fan part per triangle, tail.
-pub const POLY_HEAD_WORDS: usize = 9;
-pub const POLY_FAN_WORDS: usize = 6;
+/// Polygon record: edge count, head, one part per non-horizontal edge of the
+/// crossing test (padded to the scene's largest polygon), tail.
+pub const POLY_HEAD_WORDS: usize = 15;
+pub const POLY_EDGE_WORDS: usize = 5;
 pub const POLY_TAIL_WORDS: usize = 5;
 
 /// One type present in the scene.
@@ -96,7 +97,8 @@ pub struct TypeInfo {
     pub bv_offset: usize,
     pub bv_words: usize,
     pub mailbox: usize,
-    /// Polygons: fan triangles per record.
+    /// Polygons: edges per record (the largest polygon's non-horizontal
+    /// edges in its projection).
     pub fan: usize,
 }
 
@@ -219,6 +221,47 @@ impl W {
             self.fb.push(sat(x * scale));
         }
     }
+}
+
+/// A polygon's normal, as NFF and the reference take it: from its first
+/// three vertices.
+fn polygon_normal(v: &[Vec3]) -> Vec3 {
+    (v[1] - v[0]).cross(v[2] - v[0]).normalized()
+}
+
+/// The crossing test's data of a polygon: the two axes it is projected on
+/// (the normal's dominant axis dropped) and, per non-horizontal edge
+/// `vi -> vj` (vertices quantized to the scene format `s`, relative to
+/// `v0`), `[xi, yi, yj, s ey, s ex]` with `s = sign(ey)`.
+fn polygon_edges(v: &[Vec3], s: f64) -> ((usize, usize), Vec<[i64; 5]>) {
+    let n = polygon_normal(v);
+    // The normal's dominant axis is dropped (ties as the reference breaks
+    // them).
+    let drop = if n.x.abs() >= n.y.abs() && n.x.abs() >= n.z.abs() {
+        0
+    } else if n.y.abs() >= n.z.abs() {
+        1
+    } else {
+        2
+    };
+    let (ua, va) = ((drop + 1) % 3, (drop + 2) % 3);
+    let q = |x: f64| (x * s).round() as i64;
+    let p2 = |p: Vec3| {
+        (
+            q(p.axis(ua)) - q(v[0].axis(ua)),
+            q(p.axis(va)) - q(v[0].axis(va)),
+        )
+    };
+    let mut edges = Vec::new();
+    for k in 0..v.len() {
+        let ((xi, yi), (xj, yj)) = (p2(v[k]), p2(v[(k + 1) % v.len()]));
+        let (ex, ey) = (xj - xi, yj - yi);
+        if ey != 0 {
+            let sg = ey.signum();
+            edges.push([xi, yi, yj, sg * ey, sg * ex]);
+        }
+    }
+    ((ua, va), edges)
 }
 
 /// A planar record's geometry: normal, origin vertex, edge duals.
@@ -432,11 +475,7 @@ fn build_as(
                 planars[i] = vec![triangle_planar(v[0], v[1], v[2], n)];
             }
             Shape::Polygon { v, .. } => {
-                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-                planars[i] = (1..v.len() - 1)
-                    .map(|k| triangle_planar(v[0], v[k], v[k + 1], n))
-                    .collect();
-                fan = fan.max(planars[i].len());
+                fan = fan.max(polygon_edges(v, s).1.len());
             }
         }
     }
@@ -610,7 +649,7 @@ fn build_as(
             ChipType::Cylinder => CYL_WORDS,
             ChipType::Box => BOX_WORDS,
             ChipType::Rectangle | ChipType::Triangle => PLANAR_WORDS,
-            ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_FAN_WORDS + POLY_TAIL_WORDS,
+            ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS,
         };
         let first = w.fb.len();
         for &i in objs {
@@ -695,15 +734,25 @@ fn build_as(
                     }
                 }
                 (Shape::Polygon { v, .. }, _) => {
-                    let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-                    let sc = (14.0 - frac as f64 + kt[1] as f64).exp2();
-                    w.raw(planars[i].len() as i64);
+                    let n = polygon_normal(v);
+                    let ((ua, va), edges) = polygon_edges(v, s);
+                    w.raw(edges.len() as i64);
                     w.unit(n);
                     w.point(v[0]);
                     w.point(v[0]);
-                    for p in &planars[i] {
-                        w.scaled(p.eu, sc);
-                        w.scaled(p.ew, sc);
+                    let axis = |a: usize| {
+                        Vec3::new(
+                            (a == 0) as u8 as f64,
+                            (a == 1) as u8 as f64,
+                            (a == 2) as u8 as f64,
+                        )
+                    };
+                    w.unit(axis(ua));
+                    w.unit(axis(va));
+                    for e in &edges {
+                        for x in e {
+                            w.raw(*x);
+                        }
                     }
                     w.unit(n);
                     w.raw(i as i64);
