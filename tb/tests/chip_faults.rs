@@ -206,6 +206,9 @@ fn an_empty_program_is_refused_with_its_name_not_run() {
     let e = format!("{:#}", tb::cmd_run::load_program(&p).err().unwrap());
     assert_eq!(
         e,
-        format!("{}: empty program: no instructions or data to run", p.display())
+        format!(
+            "{}: empty program: no instructions or data to run",
+            p.display()
+        )
     );
 }
