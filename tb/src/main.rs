@@ -178,6 +178,10 @@ enum Command {
         /// Maximum objects per BSP leaf.
         #[arg(long, value_name = "N", default_value_t = 5)]
         max_leaf: usize,
+        /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
+        /// or compact (index lists); the same image either way.
+        #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
+        layout: firmware::tracer::NodeLayout,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -208,6 +212,10 @@ enum Bench {
         #[command(flatten)]
         window: tb::cli::TraceWindow,
     },
+}
+
+fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
+    s.parse()
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -300,6 +308,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            layout,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -312,6 +321,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            layout,
         }),
         Command::Compare {
             a,

@@ -9,7 +9,7 @@ use std::fmt::Write;
 
 use super::kernels::{self as k, Inside, K};
 use super::layout::{ChipType, Layout};
-use super::{mem, Numerics, Options};
+use super::{mem, NodeLayout, Numerics, Options};
 use crate::scene::Scene;
 
 pub struct Program {
@@ -328,13 +328,34 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
         // ---- test_objects: Fig. 6 for every type present ----
         let _ = writeln!(
             w,
-            "; test_objects: r5 = node; every object of the node's bit vectors not yet\n\
+            "; test_objects: r5 = node; every object of the node's {} not yet\n\
 ; tested in this pass (mailbox) is broadcast with its type's kernel.\n\
-test_objects:\n        lw r13, PASS(r0)"
+test_objects:\n        lw r13, PASS(r0)",
+            match lay.node_layout {
+                NodeLayout::Fig5 => "bit vectors",
+                NodeLayout::Compact => "index lists",
+            }
         );
+        let compact = lay.node_layout == NodeLayout::Compact;
+        if compact {
+            let _ = writeln!(w, "        addi r6, r5, {}", super::layout::NODE_HEAD);
+        }
         for t in &lay.types {
             let n = t.ty.name();
-            let _ = writeln!(
+            if compact {
+                // Per type: the count, then that many slot indices k;
+                // mailbox = MB + k, record = first + k size.
+                let _ = writeln!(
+                    w,
+                    "        lfb r9, 0(r6)\n        addi r6, r6, 1\n        beqz r9, {n}_wend\n        li r8, {mb}\n        li r10, {size}\n        li r12, {first}\n\
+{n}_bit:\n        lfb r1, 0(r6)\n        addi r6, r6, 1\n        add r2, r8, r1\n        lfb r3, 0(r2)\n        beq r3, r13, {n}_next\n        sfb r13, 0(r2)\n\
+        mul r7, r1, r10\n        add r7, r7, r12\n        lw r1, TESTS(r0)\n        addi r1, r1, 1\n        sw r1, TESTS(r0)",
+                    mb = t.mailbox,
+                    size = t.size,
+                    first = t.first
+                );
+            } else {
+                let _ = writeln!(
             w,
             "        addi r6, r5, {bv}\n        li r7, {first}\n        li r8, {mb}\n        li r9, {nw}\n\
 {n}_word:\n        lfb r10, 0(r6)\n        addi r6, r6, 1\n        slli r10, r10, 16\n        li r4, 16\n\
@@ -345,6 +366,7 @@ test_objects:\n        lw r13, PASS(r0)"
             mb = t.mailbox,
             nw = t.bv_words
         );
+            }
             match t.ty {
                 ChipType::Sphere => {
                     let _ = writeln!(
@@ -412,6 +434,13 @@ test_objects:\n        lw r13, PASS(r0)"
                     klen("k_polyt")
                 );
                 }
+            }
+            if compact {
+                let _ = writeln!(
+                    w,
+                    "{n}_next:\n        addi r9, r9, -1\n        bnez r9, {n}_bit\n{n}_wend:"
+                );
+                continue;
             }
             let _ = writeln!(
             w,

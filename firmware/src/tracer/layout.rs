@@ -11,7 +11,10 @@
 //! BSP nodes (paper's Fig. 5): flags (bit 15 leaf, bits 1..0 axis), split,
 //!     left, right (FB addresses), cell bounds widened by 2 LSB (6 words),
 //!     one membership bit vector per type present (bit 15 of word 0 = the
-//!     type's object 0)
+//!     type's object 0);
+//!     or, compact (`NodeLayout::Compact`), the same 10 head words, then
+//!     per type present the number of the node's objects of that type and
+//!     their slot indices, ascending (nodes of varying size)
 //! mailboxes: one word per object, the number of the pass that last
 //!     tested it (object merging)
 //! ```
@@ -25,7 +28,7 @@ use crate::scene::{PrimType, Scene, Shape, Vec3};
 use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
 
 use super::kernels::Inside;
-use super::Options;
+use super::{NodeLayout, Options};
 
 pub const FB_LIMIT: usize = 0x8000;
 pub const NODE_HEAD: usize = 10;
@@ -92,7 +95,7 @@ pub struct TypeInfo {
     pub objects: Vec<usize>,
     pub first: usize,
     pub size: usize,
-    /// Offset of the type's bit vector in a node.
+    /// Offset of the type's bit vector in a Fig. 5 node.
     pub bv_offset: usize,
     pub bv_words: usize,
     pub mailbox: usize,
@@ -111,7 +114,17 @@ pub struct Layout {
     pub shades: Vec<usize>,
     pub types: Vec<TypeInfo>,
     pub root: usize,
+    /// Words (32-bit words when streamed) of a node; 0 for compact nodes,
+    /// whose size varies.
     pub node_words: usize,
+    /// The node format of the resident layout (the option; the streamed
+    /// layout has per-leaf lists whichever it is).
+    pub node_layout: NodeLayout,
+    /// FB words the resident image needs with this node format (tables to
+    /// mailboxes), whether or not it fits and was used.
+    pub resident_words: usize,
+    /// Of those, the BSP nodes.
+    pub resident_node_words: usize,
     pub mailbox: usize,
     pub objects: usize,
     pub materials: usize,
@@ -740,12 +753,27 @@ fn build_as(
         mailbox_slots += objs.len();
     }
 
-    // BSP nodes (Fig. 5).
-    let node_words = bv_offset;
+    // BSP nodes: Fig. 5 (fixed size) or compact (head, then per type a
+    // count and the slot indices).
     let nodes = &image.bsp.nodes;
+    let node_layout = opt.layout;
+    let node_words = match node_layout {
+        NodeLayout::Fig5 => bv_offset,
+        NodeLayout::Compact => 0,
+    };
+    let mut node_at = Vec::with_capacity(nodes.len() + 1);
+    node_at.push(0usize);
+    for n in nodes {
+        let size = match node_layout {
+            NodeLayout::Fig5 => node_words,
+            NodeLayout::Compact => NODE_HEAD + types.len() + n.objects.len(),
+        };
+        node_at.push(node_at.last().copied().unwrap_or(0) + size);
+    }
+    let node_section = node_at[nodes.len()];
     let root = w.fb.len();
-    let addr = |k: u32| root + k as usize * node_words;
-    let total = root + nodes.len() * node_words + mailbox_slots;
+    let addr = |k: u32| root + node_at[k as usize];
+    let total = root + node_section + mailbox_slots;
     let mut stream = None;
     if total > FB_LIMIT || streamed {
         // Streamed: only the tables, camera, lights and shading stay in the
@@ -876,6 +904,9 @@ fn build_as(
             types,
             root: st.root as usize,
             node_words: NODE_BYTES / 4,
+            node_layout,
+            resident_words: total,
+            resident_node_words: node_section,
             mailbox: st.mailbox as usize,
             objects: scene.objects.len(),
             materials: scene.materials.len(),
@@ -913,16 +944,32 @@ fn build_as(
             w.raw((x * s).ceil() as i64 + 2);
         }
         for ti in &types {
-            let mut words = vec![0u16; ti.bv_words];
-            for &o in &n.objects {
+            // The node's objects of this type, ascending (the order the
+            // Fig. 6 loop meets them in).
+            let ks = n.objects.iter().filter_map(|&o| {
                 let (t, k) = slot[o as usize];
-                if t == ti.ty as usize {
-                    words[k / 16] |= 0x8000 >> (k % 16);
+                (t == ti.ty as usize).then_some(k)
+            });
+            match node_layout {
+                NodeLayout::Fig5 => {
+                    let mut words = vec![0u16; ti.bv_words];
+                    for k in ks {
+                        words[k / 16] |= 0x8000 >> (k % 16);
+                    }
+                    w.fb.extend(words);
+                }
+                NodeLayout::Compact => {
+                    let at = w.fb.len();
+                    w.raw(0);
+                    for k in ks {
+                        w.raw(k as i64);
+                    }
+                    w.fb[at] = (w.fb.len() - at - 1) as u16;
                 }
             }
-            w.fb.extend(words);
         }
     }
+    debug_assert_eq!(w.fb.len(), root + node_section);
     let mailbox = w.fb.len();
     w.fb.resize(mailbox + mailbox_slots, 0);
     for t in &mut types {
@@ -938,6 +985,9 @@ fn build_as(
         types,
         root,
         node_words,
+        node_layout,
+        resident_words: total,
+        resident_node_words: node_section,
         mailbox,
         objects: scene.objects.len(),
         materials: scene.materials.len(),
