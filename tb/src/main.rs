@@ -198,6 +198,17 @@ enum Command {
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
     },
+    /// Generate one of Eric Haines' Standard Procedural Databases in NFF
+    /// (balls, gears, jacks, lattice, mount, rings, shells, tetra, tree).
+    Spd {
+        name: String,
+        /// SPD size factor (default: the SPD program's default).
+        #[arg(long, value_name = "N")]
+        size: Option<u32>,
+        /// Write the NFF here (default: stdout).
+        #[arg(long, value_name = "FILE.nff")]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -333,6 +344,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let hits = hits.map(|h| (h[0].clone(), h[1].clone()));
             tb::cmd_scene::compare(&a, &b, threshold, hits, json)
         }
+        Command::Spd { name, size, out } => tb::cmd_spd::command(&name, size, out),
     }
 }
 
