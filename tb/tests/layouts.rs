@@ -8,7 +8,7 @@ use std::path::PathBuf;
 use std::process::Command;
 
 use firmware::scene::{native, Scene};
-use firmware::tracer::layout::NODE_HEAD;
+use firmware::tracer::layout::{COMPACT_INNER_HEAD, COMPACT_LEAF_HEAD, NODE_HEAD};
 use firmware::tracer::{NodeLayout, Options};
 
 fn load(name: &str) -> Scene {
@@ -161,13 +161,19 @@ fn both_node_images_name_exactly_the_bsp_objects() {
     let (l5, lc) = (&f5.layout, &cp.layout);
     assert_eq!(l5.types.len(), 3);
     // Node addresses: fixed-size Fig. 5 nodes; compact nodes one after the
-    // other (10 head words, then per type a count and the indices).
+    // other (4 head words for an inner node, 7 for a leaf, then per type a
+    // count and the indices).
     let a5: Vec<usize> = (0..nodes.len())
         .map(|k| l5.root + k * l5.node_words)
         .collect();
     let mut ac = vec![lc.root];
     for n in nodes {
-        ac.push(ac.last().unwrap() + NODE_HEAD + lc.types.len() + n.objects.len());
+        let head = if n.split.is_some() {
+            COMPACT_INNER_HEAD
+        } else {
+            COMPACT_LEAF_HEAD
+        };
+        ac.push(ac.last().unwrap() + head + lc.types.len() + n.objects.len());
     }
     assert_eq!(
         ac[nodes.len()],
@@ -177,17 +183,24 @@ fn both_node_images_name_exactly_the_bsp_objects() {
     assert_eq!(a5[nodes.len() - 1] + l5.node_words, l5.mailbox);
     for (i, n) in nodes.iter().enumerate() {
         let (h5, hc) = (&f5.fb[a5[i]..], &cp.fb[ac[i]..]);
-        // Flags, split and cell bounds agree; children point at the nodes.
-        assert_eq!(h5[..2], hc[..2]);
-        assert_eq!(h5[4..NODE_HEAD], hc[4..NODE_HEAD]);
-        if let Some(sp) = n.split {
-            for c in 0..2 {
-                let child = sp.children[c] as usize;
-                assert_eq!(h5[2 + c] as usize, a5[child]);
-                assert_eq!(hc[2 + c] as usize, ac[child]);
+        // Flags, split (inner) and cell bounds (leaves) agree; children
+        // point at the nodes.
+        assert_eq!(h5[0], hc[0]);
+        let mut p = match n.split {
+            Some(sp) => {
+                assert_eq!(h5[1], hc[1]);
+                for c in 0..2 {
+                    let child = sp.children[c] as usize;
+                    assert_eq!(h5[2 + c] as usize, a5[child]);
+                    assert_eq!(hc[2 + c] as usize, ac[child]);
+                }
+                COMPACT_INNER_HEAD
             }
-        }
-        let mut p = NODE_HEAD;
+            None => {
+                assert_eq!(h5[4..NODE_HEAD], hc[1..COMPACT_LEAF_HEAD]);
+                COMPACT_LEAF_HEAD
+            }
+        };
         for (j, t) in l5.types.iter().enumerate() {
             let want: Vec<usize> = n
                 .objects

@@ -280,6 +280,7 @@ trace:  sw r15, SAVE_LR(r0)\n        lw r1, PASSES(r0)\n        addi r1, r1, 1\n
         cb(w, &format!("k_sign{a}"));
         let _ = writeln!(w, "        rcfl r2\n        rcfh r3\n        sw r2, NEG+{}(r0)\n        sw r3, NEG+{}(r0)", 8 * a, 8 * a + 4);
     }
+    let compact = lay.node_layout == NodeLayout::Compact;
     if lay.stream.is_none() {
         let _ = writeln!(
         w,
@@ -295,8 +296,8 @@ both:   bne r1, r3, incoh\n        bne r2, r4, incoh\n        slli r9, r7, 3\n  
         and r10, r10, r11\n        and r13, r13, r12\n        or r9, r10, r13\n        beqz r9, posdir\n        bne r10, r11, incoh\n        bne r13, r12, incoh\n\
         lfb r9, 2(r5)\n        sw r9, 0(r14)\n        addi r14, r14, 4\n        lfb r5, 3(r5)\n        j visit\n\
 posdir: lfb r9, 3(r5)\n        sw r9, 0(r14)\n        addi r14, r14, 4\n        lfb r5, 2(r5)\n        j visit\n\
-incoh:  jal test_objects\n        j pop\n\
-leaf:   jal test_objects\n        lw r1, MODE(r0)\n        bnez r1, leaf_any\n        li r1, {leafc}\n        addi r2, r5, 4\n        sbcb r1, r2, {leafclen}\n        j leaf_aw\n\
+incoh:  {incoh_lists}jal test_objects\n        j pop\n\
+leaf:   {leaf_lists}jal test_objects\n        lw r1, MODE(r0)\n        bnez r1, leaf_any\n        li r1, {leafc}\n        addi r2, r5, {bounds}\n        sbcb r1, r2, {leafclen}\n        j leaf_aw\n\
 leaf_any: li r1, {leafa}\n        cbcast r1, {leafalen}\nleaf_aw: jal awake\n\
 pop:    li r9, NSTACK\n        beq r14, r9, done\n        addi r14, r14, -4\n        lw r5, 0(r14)\n        j visit\n\
 done:   lw r15, SAVE_LR(r0)\n        ret\n",
@@ -309,6 +310,20 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
         leafclen = klen("k_leafc"),
         leafa = kaddr("k_leafa"),
         leafalen = klen("k_leafa"),
+        // Compact nodes: r6 = the node's index lists, after a head whose
+        // size depends on the kind of node; the leaf's bounds follow its
+        // flags.
+        incoh_lists = if compact {
+            format!("addi r6, r5, {}\n        ", super::layout::COMPACT_INNER_HEAD)
+        } else {
+            String::new()
+        },
+        leaf_lists = if compact {
+            format!("addi r6, r5, {}\n        ", super::layout::COMPACT_LEAF_HEAD)
+        } else {
+            String::new()
+        },
+        bounds = if compact { 1 } else { 4 },
     );
     } else {
         stream_trace(w, lay);
@@ -328,7 +343,7 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
         // ---- test_objects: Fig. 6 for every type present ----
         let _ = writeln!(
             w,
-            "; test_objects: r5 = node; every object of the node's {} not yet\n\
+            "; test_objects: r5 = node (compact: r6 = its lists); every object of the node's {} not yet\n\
 ; tested in this pass (mailbox) is broadcast with its type's kernel.\n\
 test_objects:\n        lw r13, PASS(r0)",
             match lay.node_layout {
@@ -336,10 +351,6 @@ test_objects:\n        lw r13, PASS(r0)",
                 NodeLayout::Compact => "index lists",
             }
         );
-        let compact = lay.node_layout == NodeLayout::Compact;
-        if compact {
-            let _ = writeln!(w, "        addi r6, r5, {}", super::layout::NODE_HEAD);
-        }
         for t in &lay.types {
             let n = t.ty.name();
             if compact {

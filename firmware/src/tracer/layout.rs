@@ -12,9 +12,10 @@
 //!     left, right (FB addresses), cell bounds widened by 2 LSB (6 words),
 //!     one membership bit vector per type present (bit 15 of word 0 = the
 //!     type's object 0);
-//!     or, compact (`NodeLayout::Compact`), the same 10 head words, then
-//!     per type present the number of the node's objects of that type and
-//!     their slot indices, ascending (nodes of varying size)
+//!     or, compact (`NodeLayout::Compact`), an inner node's flags, split,
+//!     left, right or a leaf's flags and cell bounds, then per type present
+//!     the number of the node's objects of that type and their slot
+//!     indices, ascending (nodes of varying size)
 //! mailboxes: one word per object, the number of the pass that last
 //!     tested it (object merging)
 //! ```
@@ -31,7 +32,21 @@ use super::kernels::Inside;
 use super::{NodeLayout, Options};
 
 pub const FB_LIMIT: usize = 0x8000;
+/// Head words of a Fig. 5 node: flags, split, left, right, cell bounds.
 pub const NODE_HEAD: usize = 10;
+/// Head words of a compact inner node (flags, split, left, right) and
+/// leaf (flags, cell bounds); the index lists follow.
+pub const COMPACT_INNER_HEAD: usize = 4;
+pub const COMPACT_LEAF_HEAD: usize = 7;
+
+/// Head words of a compact node.
+pub fn compact_head(leaf: bool) -> usize {
+    if leaf {
+        COMPACT_LEAF_HEAD
+    } else {
+        COMPACT_INNER_HEAD
+    }
+}
 
 /// The chip's object types, in test order (object test reordering).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -766,7 +781,7 @@ fn build_as(
     for n in nodes {
         let size = match node_layout {
             NodeLayout::Fig5 => node_words,
-            NodeLayout::Compact => NODE_HEAD + types.len() + n.objects.len(),
+            NodeLayout::Compact => compact_head(n.split.is_none()) + types.len() + n.objects.len(),
         };
         node_at.push(node_at.last().copied().unwrap_or(0) + size);
     }
@@ -932,16 +947,22 @@ fn build_as(
             }
             None => {
                 w.fb.push(0x8000);
-                w.raw(0);
-                w.raw(0);
-                w.raw(0);
+                if node_layout == NodeLayout::Fig5 {
+                    w.raw(0);
+                    w.raw(0);
+                    w.raw(0);
+                }
             }
         }
-        for x in n.bounds.min.to_array() {
-            w.raw((x * s).floor() as i64 - 2);
-        }
-        for x in n.bounds.max.to_array() {
-            w.raw((x * s).ceil() as i64 + 2);
+        // Cell bounds: every Fig. 5 node; compact, leaves only (the only
+        // nodes whose bounds a kernel reads).
+        if node_layout == NodeLayout::Fig5 || n.split.is_none() {
+            for x in n.bounds.min.to_array() {
+                w.raw((x * s).floor() as i64 - 2);
+            }
+            for x in n.bounds.max.to_array() {
+                w.raw((x * s).ceil() as i64 + 2);
+            }
         }
         for ti in &types {
             // The node's objects of this type, ascending (the order the
