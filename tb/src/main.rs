@@ -69,6 +69,25 @@ enum Command {
         /// Image size.
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
+        /// Run only one part: `knobs` (every knob on SCENES) or `sizes` (the
+        /// SPD families at sizes 1..=--max-size, both node layouts).
+        #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes"])]
+        only: Option<String>,
+        /// SPD generators of the size sweep, comma-separated.
+        #[arg(
+            long,
+            value_name = "NAMES",
+            value_delimiter = ',',
+            default_value = "balls,tetra"
+        )]
+        families: Vec<String>,
+        /// Largest SPD size factor of the size sweep.
+        #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+        max_size: u32,
+        /// Image size of the size sweep (streamed scenes of thousands of
+        /// objects take minutes of host time at 256x256).
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "64x64")]
+        family_size: (u32, u32),
     },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
@@ -253,10 +272,22 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scenes,
             out_dir,
             size,
+            only,
+            families,
+            max_size,
+            family_size,
         } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
             scenes,
             out_dir,
             size,
+            knobs: only.as_deref() != Some("sizes"),
+            families: if only.as_deref() == Some("knobs") {
+                vec![]
+            } else {
+                families
+            },
+            max_size,
+            family_size,
         }),
         Command::Fuzz {
             targets,

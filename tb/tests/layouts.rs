@@ -251,3 +251,58 @@ fn render_refuses_an_unknown_layout() {
     assert!(!err.contains("panicked"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
+
+/// `morphosys sweep --only sizes`: one row per SPD size and layout, the
+/// two layouts giving the same image, and the scaling chart.
+#[test]
+fn size_sweep_writes_rows_for_both_layouts_and_the_chart() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .args([
+            "sweep",
+            "--only",
+            "sizes",
+            "--families",
+            "tetra",
+            "--max-size",
+            "2",
+            "--family-size",
+            "16x16",
+            "--out-dir",
+        ])
+        .arg(dir.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut rd = csv::Reader::from_path(dir.path().join("results.csv")).unwrap();
+    let head = rd.headers().unwrap().clone();
+    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
+    let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    assert_eq!(rows.len(), 4, "tetra 1 and 2, two layouts each");
+    for pair in rows.chunks(2) {
+        let (a, b) = (&pair[0], &pair[1]);
+        assert_eq!(a[col("scene")], b[col("scene")]);
+        assert_eq!(
+            (&a[col("layout")], &b[col("layout")]),
+            ("fig5", "compact")
+        );
+        assert_eq!(&a[col("width")], "16");
+        for r in pair {
+            let psnr: f64 = r[col("psnr_db")].parse().unwrap();
+            assert!(psnr >= 30.0, "{r:?}");
+            let words: usize = r[col("resident_fb_words")].parse().unwrap();
+            let streamed = &r[col("fb_layout")] == "streamed";
+            assert_eq!(streamed, words > 0x8000, "{r:?}");
+        }
+    }
+    // tetra-1 is resident either way: the same image.
+    assert_eq!(rows[0][col("psnr_db")], rows[1][col("psnr_db")]);
+    assert_eq!(rows[0][col("hit_agreement")], rows[1][col("hit_agreement")]);
+    let svg = std::fs::read_to_string(dir.path().join("scaling.svg")).unwrap();
+    assert!(svg.contains("Cycles per frame against primitive count (16x16"));
+    assert!(svg.contains("tetra, compact index lists"));
+}
