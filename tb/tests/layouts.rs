@@ -286,10 +286,7 @@ fn size_sweep_writes_rows_for_both_layouts_and_the_chart() {
     for pair in rows.chunks(2) {
         let (a, b) = (&pair[0], &pair[1]);
         assert_eq!(a[col("scene")], b[col("scene")]);
-        assert_eq!(
-            (&a[col("layout")], &b[col("layout")]),
-            ("fig5", "compact")
-        );
+        assert_eq!((&a[col("layout")], &b[col("layout")]), ("fig5", "compact"));
         assert_eq!(&a[col("width")], "16");
         for r in pair {
             let psnr: f64 = r[col("psnr_db")].parse().unwrap();
