@@ -220,9 +220,10 @@ enum Command {
     /// Generate one of Eric Haines' Standard Procedural Databases in NFF
     /// (balls, gears, jacks, lattice, mount, rings, shells, tetra, tree).
     Spd {
+        #[arg(value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names()))]
         name: String,
         /// SPD size factor (default: the SPD program's default).
-        #[arg(long, value_name = "N")]
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
         size: Option<u32>,
         /// Write the NFF here (default: stdout).
         #[arg(long, value_name = "FILE.nff")]

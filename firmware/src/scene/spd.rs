@@ -25,8 +25,8 @@ type C3 = [f64; 3];
 type C4 = [f64; 4];
 type Mat = [[f64; 4]; 4];
 
-/// The SPD's `PI` (def.h).
-const PI: f64 = 3.141592653589793;
+/// The SPD's `PI` (def.h's 3.141592653589793, the same double).
+use std::f64::consts::PI;
 /// def.h's `EPSILON` and `EPSILON2` (non-Mac values).
 const EPSILON: f64 = 1.0e-8;
 const EPSILON2: f64 = 1.0e-6;
@@ -1213,8 +1213,11 @@ fn mount(lib: &mut Lib, size: u32) {
             let iz = MOUNTAIN_NO + hash_rand(ll_x, ll_y + half, sf);
             let left_fz = (ul_fz + ll_fz) / 2.0 + rise_height * gauss_rand(iz);
             let iz = MOUNTAIN_NO + hash_rand(ll_x + half, ll_y + half, sf);
+            // mount.c's literal 1.4142136, not sqrt(2) to the last bit.
+            #[allow(clippy::approx_constant)]
+            const ROOT2: f64 = 1.4142136;
             let middle_fz =
-                (ll_fz + lr_fz + ur_fz + ul_fz) / 4.0 + 1.4142136 * rise_height * gauss_rand(iz);
+                (ll_fz + lr_fz + ur_fz + ul_fz) / 4.0 + ROOT2 * rise_height * gauss_rand(iz);
             grow_mountain(
                 lib, m, fnum_pts, half, ll_x, ll_y, ll_fz, lower_fz, middle_fz, left_fz,
             );
