@@ -69,6 +69,25 @@ enum Command {
         /// Image size.
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
+        /// Run only one part: `knobs` (every knob on SCENES) or `sizes` (the
+        /// SPD families at sizes 1..=--max-size, both node layouts).
+        #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes"])]
+        only: Option<String>,
+        /// SPD generators of the size sweep, comma-separated.
+        #[arg(
+            long,
+            value_name = "NAMES",
+            value_delimiter = ',',
+            default_value = "balls,tetra"
+        )]
+        families: Vec<String>,
+        /// Largest SPD size factor of the size sweep.
+        #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+        max_size: u32,
+        /// Image size of the size sweep (streamed scenes of thousands of
+        /// objects take minutes of host time at 256x256).
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "64x64")]
+        family_size: (u32, u32),
     },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
@@ -178,6 +197,10 @@ enum Command {
         /// Maximum objects per BSP leaf.
         #[arg(long, value_name = "N", default_value_t = 5)]
         max_leaf: usize,
+        /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
+        /// or compact (index lists); the same image either way.
+        #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
+        layout: firmware::tracer::NodeLayout,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -222,6 +245,10 @@ enum Bench {
     },
 }
 
+fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
+    s.parse()
+}
+
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
         Command::Asm { file, out } => tb::cmd_asm::command(file, out),
@@ -246,10 +273,22 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scenes,
             out_dir,
             size,
+            only,
+            families,
+            max_size,
+            family_size,
         } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
             scenes,
             out_dir,
             size,
+            knobs: only.as_deref() != Some("sizes"),
+            families: if only.as_deref() == Some("knobs") {
+                vec![]
+            } else {
+                families
+            },
+            max_size,
+            family_size,
         }),
         Command::Fuzz {
             targets,
@@ -312,6 +351,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            layout,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -324,6 +364,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            layout,
         }),
         Command::Compare {
             a,

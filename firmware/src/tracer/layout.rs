@@ -11,7 +11,11 @@
 //! BSP nodes (paper's Fig. 5): flags (bit 15 leaf, bits 1..0 axis), split,
 //!     left, right (FB addresses), cell bounds widened by 2 LSB (6 words),
 //!     one membership bit vector per type present (bit 15 of word 0 = the
-//!     type's object 0)
+//!     type's object 0);
+//!     or, compact (`NodeLayout::Compact`), an inner node's flags, split,
+//!     left, right or a leaf's flags and cell bounds, then per type present
+//!     the number of the node's objects of that type and their slot
+//!     indices, ascending (nodes of varying size)
 //! mailboxes: one word per object, the number of the pass that last
 //!     tested it (object merging)
 //! ```
@@ -25,10 +29,24 @@ use crate::scene::{PrimType, Scene, Shape, Vec3};
 use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
 
 use super::kernels::Inside;
-use super::Options;
+use super::{NodeLayout, Options};
 
 pub const FB_LIMIT: usize = 0x8000;
+/// Head words of a Fig. 5 node: flags, split, left, right, cell bounds.
 pub const NODE_HEAD: usize = 10;
+/// Head words of a compact inner node (flags, split, left, right) and
+/// leaf (flags, cell bounds); the index lists follow.
+pub const COMPACT_INNER_HEAD: usize = 4;
+pub const COMPACT_LEAF_HEAD: usize = 7;
+
+/// Head words of a compact node.
+pub fn compact_head(leaf: bool) -> usize {
+    if leaf {
+        COMPACT_LEAF_HEAD
+    } else {
+        COMPACT_INNER_HEAD
+    }
+}
 
 /// The chip's object types, in test order (object test reordering).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -93,7 +111,7 @@ pub struct TypeInfo {
     pub objects: Vec<usize>,
     pub first: usize,
     pub size: usize,
-    /// Offset of the type's bit vector in a node.
+    /// Offset of the type's bit vector in a Fig. 5 node.
     pub bv_offset: usize,
     pub bv_words: usize,
     pub mailbox: usize,
@@ -113,7 +131,17 @@ pub struct Layout {
     pub shades: Vec<usize>,
     pub types: Vec<TypeInfo>,
     pub root: usize,
+    /// Words (32-bit words when streamed) of a node; 0 for compact nodes,
+    /// whose size varies.
     pub node_words: usize,
+    /// The node format of the resident layout (the option; the streamed
+    /// layout has per-leaf lists whichever it is).
+    pub node_layout: NodeLayout,
+    /// FB words the resident image needs with this node format (tables to
+    /// mailboxes), whether or not it fits and was used.
+    pub resident_words: usize,
+    /// Of those, the BSP nodes.
+    pub resident_node_words: usize,
     pub mailbox: usize,
     pub objects: usize,
     pub materials: usize,
@@ -789,12 +817,27 @@ fn build_as(
         mailbox_slots += objs.len();
     }
 
-    // BSP nodes (Fig. 5).
-    let node_words = bv_offset;
+    // BSP nodes: Fig. 5 (fixed size) or compact (head, then per type a
+    // count and the slot indices).
     let nodes = &image.bsp.nodes;
+    let node_layout = opt.layout;
+    let node_words = match node_layout {
+        NodeLayout::Fig5 => bv_offset,
+        NodeLayout::Compact => 0,
+    };
+    let mut node_at = Vec::with_capacity(nodes.len() + 1);
+    node_at.push(0usize);
+    for n in nodes {
+        let size = match node_layout {
+            NodeLayout::Fig5 => node_words,
+            NodeLayout::Compact => compact_head(n.split.is_none()) + types.len() + n.objects.len(),
+        };
+        node_at.push(node_at.last().copied().unwrap_or(0) + size);
+    }
+    let node_section = node_at[nodes.len()];
     let root = w.fb.len();
-    let addr = |k: u32| root + k as usize * node_words;
-    let total = root + nodes.len() * node_words + mailbox_slots;
+    let addr = |k: u32| root + node_at[k as usize];
+    let total = root + node_section + mailbox_slots;
     let mut stream = None;
     if total > FB_LIMIT || streamed {
         // Streamed: only the tables, camera, lights and shading stay in the
@@ -925,6 +968,9 @@ fn build_as(
             types,
             root: st.root as usize,
             node_words: NODE_BYTES / 4,
+            node_layout,
+            resident_words: total,
+            resident_node_words: node_section,
             mailbox: st.mailbox as usize,
             objects: scene.objects.len(),
             materials: scene.materials.len(),
@@ -950,28 +996,50 @@ fn build_as(
             }
             None => {
                 w.fb.push(0x8000);
-                w.raw(0);
-                w.raw(0);
-                w.raw(0);
-            }
-        }
-        for x in n.bounds.min.to_array() {
-            w.raw((x * s).floor() as i64 - 2);
-        }
-        for x in n.bounds.max.to_array() {
-            w.raw((x * s).ceil() as i64 + 2);
-        }
-        for ti in &types {
-            let mut words = vec![0u16; ti.bv_words];
-            for &o in &n.objects {
-                let (t, k) = slot[o as usize];
-                if t == ti.ty as usize {
-                    words[k / 16] |= 0x8000 >> (k % 16);
+                if node_layout == NodeLayout::Fig5 {
+                    w.raw(0);
+                    w.raw(0);
+                    w.raw(0);
                 }
             }
-            w.fb.extend(words);
+        }
+        // Cell bounds: every Fig. 5 node; compact, leaves only (the only
+        // nodes whose bounds a kernel reads).
+        if node_layout == NodeLayout::Fig5 || n.split.is_none() {
+            for x in n.bounds.min.to_array() {
+                w.raw((x * s).floor() as i64 - 2);
+            }
+            for x in n.bounds.max.to_array() {
+                w.raw((x * s).ceil() as i64 + 2);
+            }
+        }
+        for ti in &types {
+            // The node's objects of this type, ascending (the order the
+            // Fig. 6 loop meets them in).
+            let ks = n.objects.iter().filter_map(|&o| {
+                let (t, k) = slot[o as usize];
+                (t == ti.ty as usize).then_some(k)
+            });
+            match node_layout {
+                NodeLayout::Fig5 => {
+                    let mut words = vec![0u16; ti.bv_words];
+                    for k in ks {
+                        words[k / 16] |= 0x8000 >> (k % 16);
+                    }
+                    w.fb.extend(words);
+                }
+                NodeLayout::Compact => {
+                    let at = w.fb.len();
+                    w.raw(0);
+                    for k in ks {
+                        w.raw(k as i64);
+                    }
+                    w.fb[at] = (w.fb.len() - at - 1) as u16;
+                }
+            }
         }
     }
+    debug_assert_eq!(w.fb.len(), root + node_section);
     let mailbox = w.fb.len();
     w.fb.resize(mailbox + mailbox_slots, 0);
     for t in &mut types {
@@ -987,6 +1055,9 @@ fn build_as(
         types,
         root,
         node_words,
+        node_layout,
+        resident_words: total,
+        resident_node_words: node_section,
         mailbox,
         objects: scene.objects.len(),
         materials: scene.materials.len(),
