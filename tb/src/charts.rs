@@ -21,10 +21,23 @@ fn font() {
 }
 
 /// A named series of (x, y) points.
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 pub struct Series {
     pub name: String,
     pub points: Vec<(f64, f64)>,
+    pub style: SeriesStyle,
+}
+
+/// How a series is drawn; the default is a solid line (or scatter) of
+/// filled circles in the series' own colour.
+#[derive(Clone, Debug, Default)]
+pub struct SeriesStyle {
+    /// Colour index into the palette (default: the series' position).
+    pub color: Option<usize>,
+    /// A dashed line (charts with `lines`).
+    pub dashed: bool,
+    /// Per point, whether its marker is hollow (missing: filled).
+    pub hollow: Vec<bool>,
 }
 
 /// A labelled point drawn on top of a chart (e.g. a published figure).
@@ -158,8 +171,36 @@ where
                 .draw()
                 .map_err(|e| anyhow!("{e:?}"))?;
             for (k, s) in c.series.iter().enumerate() {
-                let col = COLORS[k % COLORS.len()];
-                if c.lines {
+                let col = COLORS[s.style.color.unwrap_or(k) % COLORS.len()];
+                let marker = |(i, &p): (usize, &(f64, f64))| {
+                    if s.style.hollow.get(i).copied().unwrap_or(false) {
+                        Circle::new(p, 4, col.stroke_width(2))
+                    } else {
+                        Circle::new(p, 4, col.filled())
+                    }
+                };
+                if c.lines && s.style.dashed {
+                    chart
+                        .draw_series(DashedLineSeries::new(
+                            s.points.iter().copied(),
+                            8,
+                            5,
+                            col.stroke_width(2),
+                        ))
+                        .map_err(|e| anyhow!("{e:?}"))?
+                        .label(s.name.clone())
+                        .legend(move |(x, y)| {
+                            plotters::element::DashedPathElement::new(
+                                vec![(x, y), (x + 18, y)],
+                                5,
+                                3,
+                                col.stroke_width(2),
+                            )
+                        });
+                    chart
+                        .draw_series(s.points.iter().enumerate().map(marker))
+                        .map_err(|e| anyhow!("{e:?}"))?;
+                } else if c.lines {
                     chart
                         .draw_series(LineSeries::new(
                             s.points.iter().copied(),
@@ -171,7 +212,7 @@ where
                             PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
                         });
                     chart
-                        .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, col.filled())))
+                        .draw_series(s.points.iter().enumerate().map(marker))
                         .map_err(|e| anyhow!("{e:?}"))?;
                 } else {
                     chart
@@ -292,6 +333,11 @@ mod tests {
                     (32.0, 6.0),
                     (64.0, 9.0),
                 ],
+                style: SeriesStyle {
+                    dashed: true,
+                    hollow: vec![false, true],
+                    ..Default::default()
+                },
             }],
             marks: vec![Mark {
                 label: "paper: 13.3".into(),

@@ -26,6 +26,7 @@ pub struct RenderArgs {
     pub emit_asm: Option<PathBuf>,
     pub max_depth: u32,
     pub max_leaf: usize,
+    pub layout: firmware::tracer::NodeLayout,
 }
 
 /// Everything `render` reports.
@@ -103,6 +104,9 @@ pub fn render_with(
         "context_words": chip.firmware.context_words,
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
         "fb_words": chip.firmware.fb.len(),
+        "node_layout": opt.layout.name(),
+        "resident_fb_words": chip.firmware.layout.resident_words,
+        "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
         "stream_bytes": chip.firmware.layout.stream.as_ref().map_or(0, |s| s.image.len()),
     });
@@ -138,6 +142,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             max_leaf: a.max_leaf,
             ..BspParams::default()
         },
+        layout: a.layout,
     };
     if let Some(p) = &a.emit_asm {
         let fw = firmware::tracer::build(&scene, &opt).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -171,6 +176,17 @@ pub fn command(a: RenderArgs) -> Result<()> {
     println!(
         "size                     {width}x{height}, {} ways, depth {}",
         opt.ways, opt.depth
+    );
+    println!(
+        "node layout              {} ({} FB words of BSP nodes, {} in all{})",
+        opt.layout,
+        j["resident_node_words"],
+        j["resident_fb_words"],
+        if chip.firmware.layout.stream.is_some() {
+            ": over FB set 0, streamed"
+        } else {
+            ""
+        }
     );
     println!("cycles                   {}", j["cycles"]);
     println!(

@@ -23,7 +23,14 @@ pub fn load_program(path: &Path) -> anyhow::Result<Image> {
             path.display()
         )
     })?;
-    asm::assemble(&src, &path.display().to_string()).map_err(|e| anyhow!("{e}"))
+    let img = asm::assemble(&src, &path.display().to_string()).map_err(|e| anyhow!("{e}"))?;
+    if img.segments.iter().all(|s| s.data.is_empty()) {
+        return Err(anyhow!(
+            "{}: empty program: no instructions or data to run",
+            path.display()
+        ));
+    }
+    Ok(img)
 }
 
 /// A finished (or stopped) run.

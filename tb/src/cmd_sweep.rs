@@ -10,23 +10,37 @@
 //!   ways, which explains the sub-linear growth;
 //! * `pareto.{svg,png}`: frames/s against PSNR over every configuration,
 //!   with the Pareto front;
-//! * `scaling.{svg,png}`: chip cycles per frame against primitive count.
+//! * `scaling.{svg,png}`: chip cycles per frame against primitive count,
+//!   over SPD families generated at sizes 1 to `--max-size` (balls and
+//!   tetra by default, at a smaller image, 64x64), one series per family
+//!   and node layout (Fig. 5 bit vectors, compact index lists); hollow
+//!   markers are scenes streamed from main memory.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result};
 use firmware::bsp::{BspParams, SplitRule};
-use firmware::tracer::{Numerics, Options};
+use firmware::tracer::{NodeLayout, Numerics, Options};
 
-use crate::charts::{self, Chart, Mark, Series};
+use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
 use crate::cmd_scene::{load_scene, write_atomic};
 
 pub struct SweepArgs {
     pub scenes: Vec<PathBuf>,
     pub out_dir: PathBuf,
     pub size: (u32, u32),
+    /// Run the knob sweep over `scenes`.
+    pub knobs: bool,
+    /// Run the scene-size sweep: these SPD generators at sizes
+    /// 1..=`max_size`, both node layouts, at `family_size`.
+    pub families: Vec<String>,
+    pub max_size: u32,
+    pub family_size: (u32, u32),
 }
+
+/// Knob name of the rows of the scene-size sweep.
+const SCENE_SIZE: &str = "scene_size";
 
 /// One configuration: the knob it varies and the tracer options.
 #[derive(Clone, Debug)]
@@ -131,6 +145,15 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         },
         nm,
     });
+    v.push(Config {
+        knob: "layout",
+        value: NodeLayout::Compact.name().into(),
+        opt: Options {
+            layout: NodeLayout::Compact,
+            ..base
+        },
+        nm,
+    });
     v
 }
 
@@ -159,27 +182,101 @@ struct Row {
     active_rc_fraction: f64,
     objects_tested_per_ray: f64,
     host_seconds: f64,
+    /// Node layout (fig5 or compact), whether the scene was resident in
+    /// FB set 0 or streamed, and the FB words the resident image needs
+    /// (all, and the BSP nodes alone) with that layout.
+    layout: String,
+    fb_layout: String,
+    resident_fb_words: u64,
+    resident_node_words: u64,
 }
 
 fn key(o: &Options, n: &Numerics) -> String {
     format!(
-        "{}x{} w{} d{} bd{} bl{} {:?} {:?}",
-        o.width, o.height, o.ways, o.depth, o.bsp.max_depth, o.bsp.max_leaf, o.bsp.rule, n
+        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {}",
+        o.width,
+        o.height,
+        o.ways,
+        o.depth,
+        o.bsp.max_depth,
+        o.bsp.max_leaf,
+        o.bsp.rule,
+        n,
+        o.layout
     )
 }
 
+/// The scenes of the size sweep, generated: (family, size, scene).
+fn family_scenes(a: &SweepArgs) -> Result<Vec<(String, u32, firmware::scene::Scene)>> {
+    let mut v = Vec::new();
+    for f in &a.families {
+        firmware::scene::spd::default_size(f).map_err(|e| anyhow::anyhow!("--families: {e}"))?;
+        for size in 1..=a.max_size {
+            let s = firmware::scene::spd::scene(f, size)
+                .map_err(|e| anyhow::anyhow!("--max-size {}: {}", a.max_size, e.message))?;
+            v.push((f.clone(), size, s));
+        }
+    }
+    Ok(v)
+}
+
+fn row(
+    scene: &firmware::scene::Scene,
+    knob: &str,
+    value: String,
+    opt: &Options,
+    nm: &Numerics,
+    j: &serde_json::Value,
+) -> Row {
+    let f = |n: &str| j[n].as_f64().unwrap_or(f64::NAN);
+    let s = |n: &str| j[n].as_str().unwrap_or("?").to_string();
+    Row {
+        scene: scene.source.clone(),
+        primitives: scene.objects.len(),
+        knob: knob.into(),
+        value,
+        width: opt.width,
+        height: opt.height,
+        ways: opt.ways,
+        recursion: opt.depth,
+        bsp_max_depth: opt.bsp.max_depth,
+        bsp_max_leaf: opt.bsp.max_leaf,
+        split: format!("{:?}", opt.bsp.rule).to_lowercase(),
+        newton_steps: nm.newton_steps,
+        guard_bits: nm.guard_bits,
+        ray_offset_lsb: nm.eps_lsb,
+        format: s("format"),
+        cycles: j["cycles"].as_u64().unwrap_or(0),
+        fps_at_300mhz: f("fps_at_300mhz"),
+        psnr_db: f("psnr_db"),
+        hit_agreement: f("hit_agreement"),
+        active_rc_fraction: f("active_rc_fraction"),
+        objects_tested_per_ray: f("objects_tested_per_ray"),
+        host_seconds: f("host_seconds"),
+        layout: opt.layout.name().into(),
+        fb_layout: s("fb_layout"),
+        resident_fb_words: j["resident_fb_words"].as_u64().unwrap_or(0),
+        resident_node_words: j["resident_node_words"].as_u64().unwrap_or(0),
+    }
+}
+
 pub fn command(a: SweepArgs) -> Result<()> {
-    let scenes: Vec<Option<PathBuf>> = if a.scenes.is_empty() {
+    let scenes: Vec<Option<PathBuf>> = if !a.knobs {
+        vec![]
+    } else if a.scenes.is_empty() {
         vec![None]
     } else {
         a.scenes.iter().cloned().map(Some).collect()
     };
+    let families = family_scenes(&a)?;
     std::fs::create_dir_all(&a.out_dir)
         .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
     let cfgs = configs(a.size.0, a.size.1);
     let mut rows: Vec<Row> = Vec::new();
     let mut skipped = 0;
-    let bar = indicatif::ProgressBar::new((scenes.len() * cfgs.len()) as u64);
+    let bar = indicatif::ProgressBar::new(
+        (scenes.len() * cfgs.len() + families.len() * NodeLayout::ALL.len()) as u64,
+    );
     bar.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
@@ -187,7 +284,6 @@ pub fn command(a: SweepArgs) -> Result<()> {
     );
     for s in &scenes {
         let scene = load_scene(s.as_deref())?;
-        let prims = scene.objects.len();
         let mut done: BTreeMap<String, Row> = BTreeMap::new();
         for c in &cfgs {
             bar.set_message(format!("{} {}={}", scene.source, c.knob, c.value));
@@ -215,36 +311,41 @@ pub fn command(a: SweepArgs) -> Result<()> {
                         continue;
                     }
                 };
-                let j = &rep.json;
-                let f = |n: &str| j[n].as_f64().unwrap_or(f64::NAN);
-                let r = Row {
-                    scene: scene.source.clone(),
-                    primitives: prims,
-                    knob: c.knob.into(),
-                    value: c.value.clone(),
-                    width: c.opt.width,
-                    height: c.opt.height,
-                    ways: c.opt.ways,
-                    recursion: c.opt.depth,
-                    bsp_max_depth: c.opt.bsp.max_depth,
-                    bsp_max_leaf: c.opt.bsp.max_leaf,
-                    split: format!("{:?}", c.opt.bsp.rule).to_lowercase(),
-                    newton_steps: c.nm.newton_steps,
-                    guard_bits: c.nm.guard_bits,
-                    ray_offset_lsb: c.nm.eps_lsb,
-                    format: j["format"].as_str().unwrap_or("?").to_string(),
-                    cycles: j["cycles"].as_u64().unwrap_or(0),
-                    fps_at_300mhz: f("fps_at_300mhz"),
-                    psnr_db: f("psnr_db"),
-                    hit_agreement: f("hit_agreement"),
-                    active_rc_fraction: f("active_rc_fraction"),
-                    objects_tested_per_ray: f("objects_tested_per_ray"),
-                    host_seconds: f("host_seconds"),
-                };
+                let r = row(&scene, c.knob, c.value.clone(), &c.opt, &c.nm, &rep.json);
                 done.insert(k, r.clone());
                 r
             };
             rows.push(row);
+            bar.inc(1);
+        }
+    }
+    // The scene-size sweep: every family at every size, both layouts.
+    let nm = Numerics::default();
+    for (_, size, scene) in &families {
+        for layout in NodeLayout::ALL {
+            bar.set_message(format!("{} layout={layout}", scene.source));
+            let opt = Options {
+                width: a.family_size.0,
+                height: a.family_size.1,
+                layout,
+                ..Options::default()
+            };
+            match crate::cmd_render::render_with(scene, &opt, &nm, false, None) {
+                Ok((_, rep)) => rows.push(row(
+                    scene,
+                    SCENE_SIZE,
+                    size.to_string(),
+                    &opt,
+                    &nm,
+                    &rep.json,
+                )),
+                Err(e) => {
+                    bar.suspend(|| {
+                        eprintln!("skipped {} with layout {layout}: {e:#}", scene.source)
+                    });
+                    skipped += 1;
+                }
+            }
             bar.inc(1);
         }
     }
@@ -272,7 +373,21 @@ fn short(scene: &str) -> String {
         .map_or(scene.to_string(), |s| s.to_string_lossy().into_owned())
 }
 
-fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
+fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    let sizes: Vec<&Row> = all_rows.iter().filter(|r| r.knob == SCENE_SIZE).collect();
+    if !sizes.is_empty() {
+        out.extend(scaling_chart(&sizes, dir)?);
+    }
+    let rows: Vec<Row> = all_rows
+        .iter()
+        .filter(|r| r.knob != SCENE_SIZE)
+        .cloned()
+        .collect();
+    if rows.is_empty() {
+        return Ok(out);
+    }
+    let rows = &rows[..];
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
     let per = |knob: &str, y: &dyn Fn(&Row) -> f64| -> Vec<Series> {
@@ -285,10 +400,10 @@ fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
                     .filter(|r| r.scene == *s && r.knob == knob)
                     .map(|r| (r.ways as f64, y(r)))
                     .collect(),
+                style: SeriesStyle::default(),
             })
             .collect()
     };
-    let mut out = Vec::new();
     let size = rows.first().map_or((256, 256), |r| (r.width, r.height));
     out.extend(charts::write(
         &dir.join("fig8"),
@@ -334,6 +449,7 @@ fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
                 .filter(|r| r.scene == *s)
                 .map(|r| (r.fps_at_300mhz, r.psnr_db))
                 .collect(),
+            style: SeriesStyle::default(),
         })
         .collect();
     let paper: Vec<Mark> = rows
@@ -359,27 +475,103 @@ fn charts_for(rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             log_y: false,
         },
     )?);
-    let scaling = vec![Series {
-        name: "paper configuration".into(),
-        points: rows
-            .iter()
-            .filter(|r| r.knob == "paper")
-            .map(|r| (r.primitives as f64, r.cycles as f64))
-            .collect(),
-    }];
-    out.extend(charts::write(
+    if sizes.is_empty() {
+        // No size sweep: the scenes of the knob sweep, paper configuration.
+        let scaling = vec![Series {
+            name: "paper configuration".into(),
+            points: rows
+                .iter()
+                .filter(|r| r.knob == "paper")
+                .map(|r| (r.primitives as f64, r.cycles as f64))
+                .collect(),
+            style: SeriesStyle::default(),
+        }];
+        out.extend(charts::write(
+            &dir.join("scaling"),
+            &Chart {
+                title: format!(
+                    "Cycles per frame against primitive count ({}x{})",
+                    size.0, size.1
+                ),
+                x_label: "primitives in the scene".into(),
+                y_label: "chip cycles per frame".into(),
+                series: scaling,
+                marks: vec![],
+                lines: false,
+                log_x: rows.iter().any(|r| r.primitives > 100),
+                pareto: false,
+                log_y: true,
+            },
+        )?);
+    }
+    Ok(out)
+}
+
+/// Cycles per frame against primitive count over the families of the size
+/// sweep: one colour per family, solid Fig. 5, dashed compact, hollow
+/// markers for scenes streamed from main memory.
+fn scaling_chart(rows: &[&Row], dir: &Path) -> Result<[PathBuf; 2]> {
+    let mut families: Vec<String> = Vec::new();
+    for r in rows {
+        let f = family(&r.scene);
+        if !families.contains(&f) {
+            families.push(f);
+        }
+    }
+    let mut series = Vec::new();
+    for (k, f) in families.iter().enumerate() {
+        for layout in NodeLayout::ALL {
+            let mut pts: Vec<&Row> = rows
+                .iter()
+                .copied()
+                .filter(|r| family(&r.scene) == *f && r.layout == layout.name())
+                .collect();
+            pts.sort_by_key(|r| r.primitives);
+            series.push(Series {
+                name: format!(
+                    "{f}, {}",
+                    match layout {
+                        NodeLayout::Fig5 => "Fig. 5 bit vectors",
+                        NodeLayout::Compact => "compact index lists",
+                    }
+                ),
+                points: pts
+                    .iter()
+                    .map(|r| (r.primitives as f64, r.cycles as f64))
+                    .collect(),
+                style: SeriesStyle {
+                    color: Some(k),
+                    dashed: layout == NodeLayout::Compact,
+                    hollow: pts.iter().map(|r| r.fb_layout == "streamed").collect(),
+                },
+            });
+        }
+    }
+    let size = rows.first().map_or((64, 64), |r| (r.width, r.height));
+    charts::write(
         &dir.join("scaling"),
         &Chart {
-            title: "Cycles per frame against primitive count".into(),
-            x_label: "primitives in the scene".into(),
+            title: format!(
+                "Cycles per frame against primitive count ({}x{}; hollow: streamed)",
+                size.0, size.1
+            ),
+            x_label: "primitives in the scene (SPD sizes 1, 2, ...)".into(),
             y_label: "chip cycles per frame".into(),
-            series: scaling,
+            series,
             marks: vec![],
-            lines: false,
-            log_x: rows.iter().any(|r| r.primitives > 100),
+            lines: true,
+            log_x: true,
             pareto: false,
             log_y: true,
         },
-    )?);
-    Ok(out)
+    )
+}
+
+/// The SPD family of a generated scene's source name (`balls-3.nff`).
+fn family(scene: &str) -> String {
+    let s = short(scene);
+    match s.rsplit_once('-') {
+        Some((f, n)) if n.chars().all(|c| c.is_ascii_digit()) => f.to_string(),
+        _ => s,
+    }
 }

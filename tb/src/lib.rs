@@ -9,6 +9,7 @@ pub mod cmd_fuzz;
 pub mod cmd_render;
 pub mod cmd_run;
 pub mod cmd_scene;
+pub mod cmd_spd;
 pub mod cmd_sweep;
 pub mod fuzz;
 pub mod metrics;

@@ -72,6 +72,25 @@ enum Command {
         /// Image size.
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
+        /// Run only one part: `knobs` (every knob on SCENES) or `sizes` (the
+        /// SPD families at sizes 1..=--max-size, both node layouts).
+        #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes"])]
+        only: Option<String>,
+        /// SPD generators of the size sweep, comma-separated.
+        #[arg(
+            long,
+            value_name = "NAMES",
+            value_delimiter = ',',
+            default_value = "balls,tetra"
+        )]
+        families: Vec<String>,
+        /// Largest SPD size factor of the size sweep.
+        #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+        max_size: u32,
+        /// Image size of the size sweep (streamed scenes of thousands of
+        /// objects take minutes of host time at 256x256).
+        #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "64x64")]
+        family_size: (u32, u32),
     },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
@@ -181,6 +200,10 @@ enum Command {
         /// Maximum objects per BSP leaf.
         #[arg(long, value_name = "N", default_value_t = 5)]
         max_leaf: usize,
+        /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
+        /// or compact (index lists); the same image either way.
+        #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
+        layout: firmware::tracer::NodeLayout,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -197,6 +220,18 @@ enum Command {
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
     },
+    /// Generate one of Eric Haines' Standard Procedural Databases in NFF
+    /// (balls, gears, jacks, lattice, mount, rings, shells, tetra, tree).
+    Spd {
+        #[arg(value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names()))]
+        name: String,
+        /// SPD size factor (default: the SPD program's default).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+        size: Option<u32>,
+        /// Write the NFF here (default: stdout).
+        #[arg(long, value_name = "FILE.nff")]
+        out: Option<PathBuf>,
+    },
 }
 
 #[derive(Subcommand)]
@@ -211,6 +246,10 @@ enum Bench {
         #[command(flatten)]
         window: tb::cli::TraceWindow,
     },
+}
+
+fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
+    s.parse()
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -238,10 +277,22 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scenes,
             out_dir,
             size,
+            only,
+            families,
+            max_size,
+            family_size,
         } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
             scenes,
             out_dir,
             size,
+            knobs: only.as_deref() != Some("sizes"),
+            families: if only.as_deref() == Some("knobs") {
+                vec![]
+            } else {
+                families
+            },
+            max_size,
+            family_size,
         }),
         Command::Fuzz {
             targets,
@@ -304,6 +355,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            layout,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -316,6 +368,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            layout,
         }),
         Command::Compare {
             a,
@@ -327,6 +380,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let hits = hits.map(|h| (h[0].clone(), h[1].clone()));
             tb::cmd_scene::compare(&a, &b, threshold, hits, json)
         }
+        Command::Spd { name, size, out } => tb::cmd_spd::command(&name, size, out),
     }
 }
 

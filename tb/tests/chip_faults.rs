@@ -197,3 +197,18 @@ fn assembly_errors_name_file_line_and_column() {
     );
     assert!(e.contains("addi r1, r2"), "{e}");
 }
+
+#[test]
+fn an_empty_program_is_refused_with_its_name_not_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("empty.s");
+    std::fs::write(&p, "; only a comment\n\n").unwrap();
+    let e = format!("{:#}", tb::cmd_run::load_program(&p).err().unwrap());
+    assert_eq!(
+        e,
+        format!(
+            "{}: empty program: no instructions or data to run",
+            p.display()
+        )
+    );
+}

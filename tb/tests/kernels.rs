@@ -14,7 +14,7 @@ use firmware::asm;
 use firmware::scene::{Object, Scene, Shape, Vec3};
 use firmware::tracer::kernels::{self as k, ram, Inside};
 use firmware::tracer::layout::{
-    ChipType, CYL_BODY_WORDS, PLANAR_WORDS, POLY_FAN_WORDS, POLY_HEAD_WORDS,
+    ChipType, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
 };
 use firmware::tracer::{self, mem, Options};
 use rtl::{Chip, Sim, Timing};
@@ -67,14 +67,14 @@ fn run(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>, f64) {
             let mut runs = vec![("k_polyh", first + 1)];
             let fan0 = first + 1 + POLY_HEAD_WORDS as u32;
             for f in 0..t.fan as u32 {
-                runs.push(("k_polyf", fan0 + f * POLY_FAN_WORDS as u32));
+                runs.push(("k_polye", fan0 + f * POLY_EDGE_WORDS as u32));
             }
-            runs.push(("k_polyt", fan0 + t.fan as u32 * POLY_FAN_WORDS as u32));
+            runs.push(("k_polyt", fan0 + t.fan as u32 * POLY_EDGE_WORDS as u32));
             (
                 runs,
                 vec![
                     ("k_polyh", k::polygon_head(2)),
-                    ("k_polyf", k::polygon_fan(lay.kt_tri)),
+                    ("k_polye", k::polygon_edge()),
                     ("k_polyt", k::polygon_tail()),
                 ],
             )
@@ -314,4 +314,21 @@ fn concave_polygon_kernel_vs_float_polygon() {
         normals: None,
     };
     measure("concave polygon", s, 12.0, 1e-3);
+}
+
+#[test]
+fn gear_like_concave_polygon_kernel_vs_float_polygon() {
+    // A 40-tooth gear face (160 vertices, as the SPD's gears): a fan from v0
+    // would be 158 slivers; the crossing test must find no cracks along
+    // them and no false hits between the teeth.
+    let teeth = 40;
+    let mut v = Vec::new();
+    for t in 0..teeth {
+        for (k, r) in [(0.0, 0.85), (0.2, 1.0), (0.5, 1.0), (0.7, 0.85)] {
+            let a = std::f64::consts::TAU * (t as f64 + k) / teeth as f64;
+            v.push(Vec3::new(r * a.cos(), r * a.sin(), 0.0));
+        }
+    }
+    let s = Shape::Polygon { v, normals: None };
+    measure("gear polygon", s, 12.0, 1e-3);
 }

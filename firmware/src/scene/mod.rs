@@ -10,6 +10,7 @@
 
 pub mod native;
 pub mod nff;
+pub mod spd;
 
 use std::fmt;
 use std::ops::{Add, Div, Mul, Neg, Sub};

@@ -9,7 +9,7 @@ use std::fmt::Write;
 
 use super::kernels::{self as k, Inside, K};
 use super::layout::{ChipType, Layout};
-use super::{mem, Numerics, Options};
+use super::{mem, NodeLayout, Numerics, Options};
 use crate::scene::Scene;
 
 pub struct Program {
@@ -111,7 +111,7 @@ pub fn program(
     }
     if has(ChipType::Polygon) {
         objk.push(("k_polyh", k::polygon_head(nm.newton_steps)));
-        objk.push(("k_polyf", k::polygon_fan(lay.kt_tri)));
+        objk.push(("k_polye", k::polygon_edge()));
         objk.push(("k_polyt", k::polygon_tail()));
     }
 
@@ -280,6 +280,7 @@ trace:  sw r15, SAVE_LR(r0)\n        lw r1, PASSES(r0)\n        addi r1, r1, 1\n
         cb(w, &format!("k_sign{a}"));
         let _ = writeln!(w, "        rcfl r2\n        rcfh r3\n        sw r2, NEG+{}(r0)\n        sw r3, NEG+{}(r0)", 8 * a, 8 * a + 4);
     }
+    let compact = lay.node_layout == NodeLayout::Compact;
     if lay.stream.is_none() {
         let _ = writeln!(
         w,
@@ -295,8 +296,8 @@ both:   bne r1, r3, incoh\n        bne r2, r4, incoh\n        slli r9, r7, 3\n  
         and r10, r10, r11\n        and r13, r13, r12\n        or r9, r10, r13\n        beqz r9, posdir\n        bne r10, r11, incoh\n        bne r13, r12, incoh\n\
         lfb r9, 2(r5)\n        sw r9, 0(r14)\n        addi r14, r14, 4\n        lfb r5, 3(r5)\n        j visit\n\
 posdir: lfb r9, 3(r5)\n        sw r9, 0(r14)\n        addi r14, r14, 4\n        lfb r5, 2(r5)\n        j visit\n\
-incoh:  jal test_objects\n        j pop\n\
-leaf:   jal test_objects\n        lw r1, MODE(r0)\n        bnez r1, leaf_any\n        li r1, {leafc}\n        addi r2, r5, 4\n        sbcb r1, r2, {leafclen}\n        j leaf_aw\n\
+incoh:  {incoh_lists}jal test_objects\n        j pop\n\
+leaf:   {leaf_lists}jal test_objects\n        lw r1, MODE(r0)\n        bnez r1, leaf_any\n        li r1, {leafc}\n        addi r2, r5, {bounds}\n        sbcb r1, r2, {leafclen}\n        j leaf_aw\n\
 leaf_any: li r1, {leafa}\n        cbcast r1, {leafalen}\nleaf_aw: jal awake\n\
 pop:    li r9, NSTACK\n        beq r14, r9, done\n        addi r14, r14, -4\n        lw r5, 0(r14)\n        j visit\n\
 done:   lw r15, SAVE_LR(r0)\n        ret\n",
@@ -309,6 +310,20 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
         leafclen = klen("k_leafc"),
         leafa = kaddr("k_leafa"),
         leafalen = klen("k_leafa"),
+        // Compact nodes: r6 = the node's index lists, after a head whose
+        // size depends on the kind of node; the leaf's bounds follow its
+        // flags.
+        incoh_lists = if compact {
+            format!("addi r6, r5, {}\n        ", super::layout::COMPACT_INNER_HEAD)
+        } else {
+            String::new()
+        },
+        leaf_lists = if compact {
+            format!("addi r6, r5, {}\n        ", super::layout::COMPACT_LEAF_HEAD)
+        } else {
+            String::new()
+        },
+        bounds = if compact { 1 } else { 4 },
     );
     } else {
         stream_trace(w, lay);
@@ -328,13 +343,30 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
         // ---- test_objects: Fig. 6 for every type present ----
         let _ = writeln!(
             w,
-            "; test_objects: r5 = node; every object of the node's bit vectors not yet\n\
+            "; test_objects: r5 = node (compact: r6 = its lists); every object of the node's {} not yet\n\
 ; tested in this pass (mailbox) is broadcast with its type's kernel.\n\
-test_objects:\n        lw r13, PASS(r0)"
+test_objects:\n        lw r13, PASS(r0)",
+            match lay.node_layout {
+                NodeLayout::Fig5 => "bit vectors",
+                NodeLayout::Compact => "index lists",
+            }
         );
         for t in &lay.types {
             let n = t.ty.name();
-            let _ = writeln!(
+            if compact {
+                // Per type: the count, then that many slot indices k;
+                // mailbox = MB + k, record = first + k size.
+                let _ = writeln!(
+                    w,
+                    "        lfb r9, 0(r6)\n        addi r6, r6, 1\n        beqz r9, {n}_wend\n        li r8, {mb}\n        li r10, {size}\n        li r12, {first}\n\
+{n}_bit:\n        lfb r1, 0(r6)\n        addi r6, r6, 1\n        add r2, r8, r1\n        lfb r3, 0(r2)\n        beq r3, r13, {n}_next\n        sfb r13, 0(r2)\n\
+        mul r7, r1, r10\n        add r7, r7, r12\n        lw r1, TESTS(r0)\n        addi r1, r1, 1\n        sw r1, TESTS(r0)",
+                    mb = t.mailbox,
+                    size = t.size,
+                    first = t.first
+                );
+            } else {
+                let _ = writeln!(
             w,
             "        addi r6, r5, {bv}\n        li r7, {first}\n        li r8, {mb}\n        li r9, {nw}\n\
 {n}_word:\n        lfb r10, 0(r6)\n        addi r6, r6, 1\n        slli r10, r10, 16\n        li r4, 16\n\
@@ -345,6 +377,7 @@ test_objects:\n        lw r13, PASS(r0)"
             mb = t.mailbox,
             nw = t.bv_words
         );
+            }
             match t.ty {
                 ChipType::Sphere => {
                     let _ = writeln!(
@@ -405,13 +438,20 @@ test_objects:\n        lw r13, PASS(r0)"
                     kaddr("k_polyh"),
                     klen("k_polyh"),
                     1 + super::layout::POLY_HEAD_WORDS,
-                    kaddr("k_polyf"),
-                    klen("k_polyf"),
-                    super::layout::POLY_FAN_WORDS,
+                    kaddr("k_polye"),
+                    klen("k_polye"),
+                    super::layout::POLY_EDGE_WORDS,
                     kaddr("k_polyt"),
                     klen("k_polyt")
                 );
                 }
+            }
+            if compact {
+                let _ = writeln!(
+                    w,
+                    "{n}_next:\n        addi r9, r9, -1\n        bnez r9, {n}_bit\n{n}_wend:"
+                );
+                continue;
             }
             let _ = writeln!(
             w,
@@ -585,9 +625,9 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
                     kaddr("k_polyh"),
                     klen("k_polyh"),
                     1 + super::layout::POLY_HEAD_WORDS,
-                    kaddr("k_polyf"),
-                    klen("k_polyf"),
-                    super::layout::POLY_FAN_WORDS,
+                    kaddr("k_polye"),
+                    klen("k_polye"),
+                    super::layout::POLY_EDGE_WORDS,
                     kaddr("k_polyt"),
                     klen("k_polyt")
                 );

@@ -11,7 +11,11 @@
 //! BSP nodes (paper's Fig. 5): flags (bit 15 leaf, bits 1..0 axis), split,
 //!     left, right (FB addresses), cell bounds widened by 2 LSB (6 words),
 //!     one membership bit vector per type present (bit 15 of word 0 = the
-//!     type's object 0)
+//!     type's object 0);
+//!     or, compact (`NodeLayout::Compact`), an inner node's flags, split,
+//!     left, right or a leaf's flags and cell bounds, then per type present
+//!     the number of the node's objects of that type and their slot
+//!     indices, ascending (nodes of varying size)
 //! mailboxes: one word per object, the number of the pass that last
 //!     tested it (object merging)
 //! ```
@@ -25,10 +29,24 @@ use crate::scene::{PrimType, Scene, Shape, Vec3};
 use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
 
 use super::kernels::Inside;
-use super::Options;
+use super::{NodeLayout, Options};
 
 pub const FB_LIMIT: usize = 0x8000;
+/// Head words of a Fig. 5 node: flags, split, left, right, cell bounds.
 pub const NODE_HEAD: usize = 10;
+/// Head words of a compact inner node (flags, split, left, right) and
+/// leaf (flags, cell bounds); the index lists follow.
+pub const COMPACT_INNER_HEAD: usize = 4;
+pub const COMPACT_LEAF_HEAD: usize = 7;
+
+/// Head words of a compact node.
+pub fn compact_head(leaf: bool) -> usize {
+    if leaf {
+        COMPACT_LEAF_HEAD
+    } else {
+        COMPACT_INNER_HEAD
+    }
+}
 
 /// The chip's object types, in test order (object test reordering).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,9 +97,10 @@ pub const CYL_BODY_WORDS: usize = 34;
 /// Cylinder group: caps flag, body, base cap, apex cap.
 pub const CYL_WORDS: usize = 1 + CYL_BODY_WORDS + 2 * PLANAR_WORDS;
 pub const BOX_WORDS: usize = 24;
-/// Polygon record: fan count, head, one fan part per triangle, tail.
-pub const POLY_HEAD_WORDS: usize = 9;
-pub const POLY_FAN_WORDS: usize = 6;
+/// Polygon record: edge count, head, one part per non-horizontal edge of the
+/// crossing test (padded to the scene's largest polygon), tail.
+pub const POLY_HEAD_WORDS: usize = 15;
+pub const POLY_EDGE_WORDS: usize = 5;
 pub const POLY_TAIL_WORDS: usize = 5;
 
 /// One type present in the scene.
@@ -92,11 +111,12 @@ pub struct TypeInfo {
     pub objects: Vec<usize>,
     pub first: usize,
     pub size: usize,
-    /// Offset of the type's bit vector in a node.
+    /// Offset of the type's bit vector in a Fig. 5 node.
     pub bv_offset: usize,
     pub bv_words: usize,
     pub mailbox: usize,
-    /// Polygons: fan triangles per record.
+    /// Polygons: edges per record (the largest polygon's non-horizontal
+    /// edges in its projection).
     pub fan: usize,
 }
 
@@ -111,7 +131,17 @@ pub struct Layout {
     pub shades: Vec<usize>,
     pub types: Vec<TypeInfo>,
     pub root: usize,
+    /// Words (32-bit words when streamed) of a node; 0 for compact nodes,
+    /// whose size varies.
     pub node_words: usize,
+    /// The node format of the resident layout (the option; the streamed
+    /// layout has per-leaf lists whichever it is).
+    pub node_layout: NodeLayout,
+    /// FB words the resident image needs with this node format (tables to
+    /// mailboxes), whether or not it fits and was used.
+    pub resident_words: usize,
+    /// Of those, the BSP nodes.
+    pub resident_node_words: usize,
     pub mailbox: usize,
     pub objects: usize,
     pub materials: usize,
@@ -219,6 +249,47 @@ impl W {
             self.fb.push(sat(x * scale));
         }
     }
+}
+
+/// A polygon's normal, as NFF and the reference take it: from its first
+/// three vertices.
+fn polygon_normal(v: &[Vec3]) -> Vec3 {
+    (v[1] - v[0]).cross(v[2] - v[0]).normalized()
+}
+
+/// The crossing test's data of a polygon: the two axes it is projected on
+/// (the normal's dominant axis dropped) and, per non-horizontal edge
+/// `vi -> vj` (vertices quantized to the scene format `s`, relative to
+/// `v0`), `[xi, yi, yj, s ey, s ex]` with `s = sign(ey)`.
+fn polygon_edges(v: &[Vec3], s: f64) -> ((usize, usize), Vec<[i64; 5]>) {
+    let n = polygon_normal(v);
+    // The normal's dominant axis is dropped (ties as the reference breaks
+    // them).
+    let drop = if n.x.abs() >= n.y.abs() && n.x.abs() >= n.z.abs() {
+        0
+    } else if n.y.abs() >= n.z.abs() {
+        1
+    } else {
+        2
+    };
+    let (ua, va) = ((drop + 1) % 3, (drop + 2) % 3);
+    let q = |x: f64| (x * s).round() as i64;
+    let p2 = |p: Vec3| {
+        (
+            q(p.axis(ua)) - q(v[0].axis(ua)),
+            q(p.axis(va)) - q(v[0].axis(va)),
+        )
+    };
+    let mut edges = Vec::new();
+    for k in 0..v.len() {
+        let ((xi, yi), (xj, yj)) = (p2(v[k]), p2(v[(k + 1) % v.len()]));
+        let (ex, ey) = (xj - xi, yj - yi);
+        if ey != 0 {
+            let sg = ey.signum();
+            edges.push([xi, yi, yj, sg * ey, sg * ex]);
+        }
+    }
+    ((ua, va), edges)
 }
 
 /// A planar record's geometry: normal, origin vertex, edge duals.
@@ -432,11 +503,7 @@ fn build_as(
                 planars[i] = vec![triangle_planar(v[0], v[1], v[2], n)];
             }
             Shape::Polygon { v, .. } => {
-                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-                planars[i] = (1..v.len() - 1)
-                    .map(|k| triangle_planar(v[0], v[k], v[k + 1], n))
-                    .collect();
-                fan = fan.max(planars[i].len());
+                fan = fan.max(polygon_edges(v, s).1.len());
             }
         }
     }
@@ -610,7 +677,7 @@ fn build_as(
             ChipType::Cylinder => CYL_WORDS,
             ChipType::Box => BOX_WORDS,
             ChipType::Rectangle | ChipType::Triangle => PLANAR_WORDS,
-            ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_FAN_WORDS + POLY_TAIL_WORDS,
+            ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS,
         };
         let first = w.fb.len();
         for &i in objs {
@@ -695,15 +762,25 @@ fn build_as(
                     }
                 }
                 (Shape::Polygon { v, .. }, _) => {
-                    let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-                    let sc = (14.0 - frac as f64 + kt[1] as f64).exp2();
-                    w.raw(planars[i].len() as i64);
+                    let n = polygon_normal(v);
+                    let ((ua, va), edges) = polygon_edges(v, s);
+                    w.raw(edges.len() as i64);
                     w.unit(n);
                     w.point(v[0]);
                     w.point(v[0]);
-                    for p in &planars[i] {
-                        w.scaled(p.eu, sc);
-                        w.scaled(p.ew, sc);
+                    let axis = |a: usize| {
+                        Vec3::new(
+                            (a == 0) as u8 as f64,
+                            (a == 1) as u8 as f64,
+                            (a == 2) as u8 as f64,
+                        )
+                    };
+                    w.unit(axis(ua));
+                    w.unit(axis(va));
+                    for e in &edges {
+                        for x in e {
+                            w.raw(*x);
+                        }
                     }
                     w.unit(n);
                     w.raw(i as i64);
@@ -740,12 +817,27 @@ fn build_as(
         mailbox_slots += objs.len();
     }
 
-    // BSP nodes (Fig. 5).
-    let node_words = bv_offset;
+    // BSP nodes: Fig. 5 (fixed size) or compact (head, then per type a
+    // count and the slot indices).
     let nodes = &image.bsp.nodes;
+    let node_layout = opt.layout;
+    let node_words = match node_layout {
+        NodeLayout::Fig5 => bv_offset,
+        NodeLayout::Compact => 0,
+    };
+    let mut node_at = Vec::with_capacity(nodes.len() + 1);
+    node_at.push(0usize);
+    for n in nodes {
+        let size = match node_layout {
+            NodeLayout::Fig5 => node_words,
+            NodeLayout::Compact => compact_head(n.split.is_none()) + types.len() + n.objects.len(),
+        };
+        node_at.push(node_at.last().copied().unwrap_or(0) + size);
+    }
+    let node_section = node_at[nodes.len()];
     let root = w.fb.len();
-    let addr = |k: u32| root + k as usize * node_words;
-    let total = root + nodes.len() * node_words + mailbox_slots;
+    let addr = |k: u32| root + node_at[k as usize];
+    let total = root + node_section + mailbox_slots;
     let mut stream = None;
     if total > FB_LIMIT || streamed {
         // Streamed: only the tables, camera, lights and shading stay in the
@@ -876,6 +968,9 @@ fn build_as(
             types,
             root: st.root as usize,
             node_words: NODE_BYTES / 4,
+            node_layout,
+            resident_words: total,
+            resident_node_words: node_section,
             mailbox: st.mailbox as usize,
             objects: scene.objects.len(),
             materials: scene.materials.len(),
@@ -901,28 +996,50 @@ fn build_as(
             }
             None => {
                 w.fb.push(0x8000);
-                w.raw(0);
-                w.raw(0);
-                w.raw(0);
-            }
-        }
-        for x in n.bounds.min.to_array() {
-            w.raw((x * s).floor() as i64 - 2);
-        }
-        for x in n.bounds.max.to_array() {
-            w.raw((x * s).ceil() as i64 + 2);
-        }
-        for ti in &types {
-            let mut words = vec![0u16; ti.bv_words];
-            for &o in &n.objects {
-                let (t, k) = slot[o as usize];
-                if t == ti.ty as usize {
-                    words[k / 16] |= 0x8000 >> (k % 16);
+                if node_layout == NodeLayout::Fig5 {
+                    w.raw(0);
+                    w.raw(0);
+                    w.raw(0);
                 }
             }
-            w.fb.extend(words);
+        }
+        // Cell bounds: every Fig. 5 node; compact, leaves only (the only
+        // nodes whose bounds a kernel reads).
+        if node_layout == NodeLayout::Fig5 || n.split.is_none() {
+            for x in n.bounds.min.to_array() {
+                w.raw((x * s).floor() as i64 - 2);
+            }
+            for x in n.bounds.max.to_array() {
+                w.raw((x * s).ceil() as i64 + 2);
+            }
+        }
+        for ti in &types {
+            // The node's objects of this type, ascending (the order the
+            // Fig. 6 loop meets them in).
+            let ks = n.objects.iter().filter_map(|&o| {
+                let (t, k) = slot[o as usize];
+                (t == ti.ty as usize).then_some(k)
+            });
+            match node_layout {
+                NodeLayout::Fig5 => {
+                    let mut words = vec![0u16; ti.bv_words];
+                    for k in ks {
+                        words[k / 16] |= 0x8000 >> (k % 16);
+                    }
+                    w.fb.extend(words);
+                }
+                NodeLayout::Compact => {
+                    let at = w.fb.len();
+                    w.raw(0);
+                    for k in ks {
+                        w.raw(k as i64);
+                    }
+                    w.fb[at] = (w.fb.len() - at - 1) as u16;
+                }
+            }
         }
     }
+    debug_assert_eq!(w.fb.len(), root + node_section);
     let mailbox = w.fb.len();
     w.fb.resize(mailbox + mailbox_slots, 0);
     for t in &mut types {
@@ -938,6 +1055,9 @@ fn build_as(
         types,
         root,
         node_words,
+        node_layout,
+        resident_words: total,
+        resident_node_words: node_section,
         mailbox,
         objects: scene.objects.len(),
         materials: scene.materials.len(),

@@ -13,7 +13,8 @@
 //! * **TinyRISC** ([`control`]): the tile loop; depth-first BSP traversal
 //!   steered by the RCs' status (all rays agree: follow; they disagree:
 //!   test every object under the node via the Fig. 5 bit vectors and the
-//!   Fig. 6 address loop); mailboxes in the FB so an object is tested once
+//!   Fig. 6 address loop, or the node's index lists with
+//!   [`NodeLayout::Compact`]); mailboxes in the FB so an object is tested once
 //!   per pass (object merging); object tests grouped by type (reordering);
 //!   at a leaf the RCs whose hit is found sleep; pixels out through the FB
 //!   by DMA, overlapped with the next tile.
@@ -42,6 +43,9 @@ pub struct Options {
     /// level 2 = eye rays and one reflection).
     pub depth: u32,
     pub bsp: BspParams,
+    /// How a resident scene's BSP nodes name their objects (the paper's
+    /// Fig. 5 bit vectors by default).
+    pub layout: NodeLayout,
 }
 
 impl Default for Options {
@@ -52,7 +56,49 @@ impl Default for Options {
             ways: 64,
             depth: 2,
             bsp: BspParams::default(),
+            layout: NodeLayout::Fig5,
         }
+    }
+}
+
+/// How the BSP nodes of the resident layout name the objects under them
+/// (`layout.rs`; the streamed layout has no per-node object sets, only
+/// per-leaf lists, whichever is chosen).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum NodeLayout {
+    /// The paper's Fig. 5: per node, per type present, a membership bit
+    /// vector over all objects of that type, walked by the Fig. 6 loop.
+    #[default]
+    Fig5,
+    /// Per node, per type present, a count and the ascending slot indices
+    /// of the node's objects of that type (the set bits of the Fig. 5
+    /// vector, as a list): the same objects in the same order.
+    Compact,
+}
+
+impl NodeLayout {
+    pub const ALL: [NodeLayout; 2] = [NodeLayout::Fig5, NodeLayout::Compact];
+    pub fn name(self) -> &'static str {
+        match self {
+            NodeLayout::Fig5 => "fig5",
+            NodeLayout::Compact => "compact",
+        }
+    }
+}
+
+impl std::fmt::Display for NodeLayout {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for NodeLayout {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        NodeLayout::ALL
+            .into_iter()
+            .find(|l| l.name() == s)
+            .ok_or_else(|| format!("unknown node layout '{s}': expected fig5 or compact"))
     }
 }
 

@@ -1,0 +1,41 @@
+//! `morphosys spd NAME [--size N] [--out FILE.nff]`: run one of the ported
+//! Standard Procedural Databases generators (firmware::scene::spd) and print
+//! or write its NFF text.
+
+use std::path::PathBuf;
+
+use anyhow::{anyhow, Result};
+use firmware::scene::{spd, PrimType};
+
+use crate::cmd_scene::write_atomic;
+
+/// Generate `name` at `size` (default: the SPD program's default size) and
+/// write it to `out`, or to stdout without `out`.
+pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()> {
+    let size = match size {
+        Some(s) => s,
+        None => spd::default_size(name).map_err(|e| anyhow!(e))?,
+    };
+    let text = spd::generate(name, size).map_err(|e| anyhow!(e))?;
+    match out {
+        Some(path) => {
+            write_atomic(&path, text.as_bytes())?;
+            let scene = firmware::scene::nff::parse(&text, &path.display().to_string())?;
+            let c = scene.type_counts();
+            let parts: Vec<String> = PrimType::ALL
+                .iter()
+                .filter(|t| c[t.index()] > 0)
+                .map(|t| format!("{} {}", c[t.index()], t.name()))
+                .collect();
+            println!(
+                "{}: {name} size {size}: {} objects ({}), {} lights",
+                path.display(),
+                scene.objects.len(),
+                parts.join(", "),
+                scene.lights.len()
+            );
+        }
+        None => print!("{text}"),
+    }
+    Ok(())
+}
