@@ -50,6 +50,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
         depth: 2,
         bsp: BspParams::default(),
         layout: Default::default(),
+        datapath: Default::default(),
     };
     let repeat = a.repeat.max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

@@ -27,6 +27,7 @@ pub struct RenderArgs {
     pub max_depth: u32,
     pub max_leaf: usize,
     pub layout: firmware::tracer::NodeLayout,
+    pub datapath: rtl::rc::Datapath,
 }
 
 /// Everything `render` reports.
@@ -97,7 +98,8 @@ pub fn render_with(
         "object_tests": chip.object_tests,
         "array_busy_cycles": chip.stats.array_busy_cycles,
         "dma_busy_cycles": chip.stats.dma_busy_cycles,
-        "format": format!("Q{}.{}", 15 - chip.firmware.frac, chip.firmware.frac),
+        "datapath_bits": opt.datapath.bits(),
+        "format": chip.firmware.format(),
         "compiler_format": r.format,
         "bsp_nodes": r.bsp.nodes,
         "bsp_max_depth": r.bsp.max_depth,
@@ -143,6 +145,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             ..BspParams::default()
         },
         layout: a.layout,
+        datapath: a.datapath,
     };
     if let Some(p) = &a.emit_asm {
         let fw = firmware::tracer::build(&scene, &opt).map_err(|e| anyhow::anyhow!("{e}"))?;

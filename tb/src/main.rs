@@ -204,6 +204,11 @@ enum Command {
         /// or compact (index lists); the same image either way.
         #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
         layout: firmware::tracer::NodeLayout,
+        /// RC datapath width in bits: 16 (the paper's chip) or 32 (the
+        /// variant the paper announces; every format gets 16 more fraction
+        /// bits).
+        #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath, default_value = "16")]
+        datapath: rtl::rc::Datapath,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -356,6 +361,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_depth,
             max_leaf,
             layout,
+            datapath,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -369,6 +375,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_depth,
             max_leaf,
             layout,
+            datapath,
         }),
         Command::Compare {
             a,

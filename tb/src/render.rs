@@ -16,6 +16,7 @@ use firmware::tracer::{self, mem, Firmware, Numerics, Options};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use rtl::chip::run_to_halt;
+use rtl::rc::{Datapath, Word};
 use rtl::{Chip, Sim, Stats, Timing};
 
 use crate::reference::NO_HIT;
@@ -63,8 +64,10 @@ impl ChipRender {
     }
 }
 
-fn to8(v: i16) -> u8 {
-    ((v as f64 / 4096.0).clamp(0.0, 1.0) * 255.0).round() as u8
+/// A colour channel in Q3.12 (16-bit chip) or Q3.28 (32-bit chip) to 8 bits.
+fn to8(v: i32, datapath: Datapath) -> u8 {
+    let one = ((12 + datapath.bits() - 16) as f64).exp2();
+    ((v as f64 / one).clamp(0.0, 1.0) * 255.0).round() as u8
 }
 
 fn add_stats(a: &mut Stats, b: &Stats) {
@@ -102,7 +105,7 @@ struct Group {
     /// Statistics at the start of the tile loop.
     startup: Stats,
     /// Per tile, the 256 output words.
-    out: Vec<Vec<i16>>,
+    out: Vec<Vec<i32>>,
 }
 
 fn sym(img: &Image, name: &str) -> Result<u32> {
@@ -111,7 +114,7 @@ fn sym(img: &Image, name: &str) -> Result<u32> {
         .ok_or_else(|| anyhow!("internal: firmware symbol {name} missing"))
 }
 
-fn run_group(
+fn run_group<W: Word>(
     img: &Image,
     fw: &Firmware,
     tiles: &[(u32, u32)],
@@ -121,14 +124,15 @@ fn run_group(
     // list, the output tiles and the streamed scene image), not the
     // 16 MiB default: a fresh instance per group must not zero-fill memory
     // nobody reads.
+    let wb = fw.fb_word_bytes();
     let ends = img
         .segments
         .iter()
         .map(|s| s.addr as usize + s.data.len())
         .chain([
-            mem::FB_IMAGE as usize + 2 * fw.fb.len(),
+            mem::FB_IMAGE as usize + wb as usize * fw.fb.len(),
             mem::TILE_LIST as usize + 4 + 12 * tiles.len(),
-            (mem::OUTPUT + tiles.len() as u32 * mem::OUT_TILE_BYTES) as usize,
+            (mem::OUTPUT + tiles.len() as u32 * fw.out_tile_bytes()) as usize,
         ])
         .chain(
             fw.layout
@@ -137,9 +141,9 @@ fn run_group(
                 .map(|st| st.base as usize + st.image.len()),
         );
     let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
-    let mut chip = Chip::new(Timing::default(), mem_bytes);
+    let mut chip = Chip::<W>::build(Timing::default(), mem_bytes);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
-    let fb: Vec<u8> = fw.fb.iter().flat_map(|w| w.to_le_bytes()).collect();
+    let fb = fw.fb_bytes();
     chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
     if let Some(st) = &fw.layout.stream {
         chip.load(st.base, &st.image).map_err(|f| anyhow!("{f}"))?;
@@ -149,7 +153,7 @@ fn run_group(
     for (k, (x, y)) in tiles.iter().enumerate() {
         list.extend(x.to_le_bytes());
         list.extend(y.to_le_bytes());
-        list.extend((mem::OUTPUT + k as u32 * mem::OUT_TILE_BYTES).to_le_bytes());
+        list.extend((mem::OUTPUT + k as u32 * fw.out_tile_bytes()).to_le_bytes());
     }
     chip.load(mem::TILE_LIST, &list)
         .map_err(|f| anyhow!("{f}"))?;
@@ -192,9 +196,16 @@ fn run_group(
     let rd = |name: &str| -> Result<u64> { Ok(m.read(sym(img, name)?, 4) as u64) };
     let out = (0..tiles.len())
         .map(|k| {
-            let base = mem::OUTPUT + k as u32 * mem::OUT_TILE_BYTES;
+            let base = mem::OUTPUT + k as u32 * fw.out_tile_bytes();
             (0..256)
-                .map(|i| m.read(base + 2 * i, 2) as u16 as i16)
+                .map(|i| {
+                    let v = m.read(base + wb * i, wb);
+                    if wb == 2 {
+                        v as u16 as i16 as i32
+                    } else {
+                        v as i32
+                    }
+                })
                 .collect()
         })
         .collect();
@@ -279,7 +290,10 @@ fn render_firmware(
         .enumerate()
         .map(|(gi, g)| {
             let t = if gi == 0 { first_trace.clone() } else { None };
-            let r = run_group(&img, &fw, g, t);
+            let r = match fw.datapath {
+                Datapath::W16 => run_group::<i16>(&img, &fw, g, t),
+                Datapath::W32 => run_group::<i32>(&img, &fw, g, t),
+            };
             bar.inc(g.len() as u64);
             r
         })
@@ -314,7 +328,7 @@ fn render_firmware(
                 }
                 let p = (y * w + x) as usize;
                 for c in 0..3 {
-                    rgb8[3 * p + c] = to8(out[c * 64 + lane as usize]);
+                    rgb8[3 * p + c] = to8(out[c * 64 + lane as usize], fw.datapath);
                 }
                 let id = out[192 + lane as usize];
                 hits[p] = if id < 0 { NO_HIT } else { id as u32 };

@@ -124,16 +124,18 @@ pub fn program(
     );
     let _ = writeln!(
         w,
-        "; {}x{}, {} ways ({}x{} tiles), depth {}, scene format Q{}.{}",
+        "; {}x{}, {} ways ({}x{} tiles), depth {}, {} datapath, scene format Q{}.{}",
         opt.width,
         opt.height,
         opt.ways,
         tw,
         th,
         opt.depth,
-        15 - lay.frac,
+        opt.datapath,
+        opt.datapath.bits() - 1 - lay.frac,
         lay.frac
     );
+    let _ = writeln!(w, "        .datapath {}", opt.datapath.bits());
     let _ = writeln!(
         w,
         "; FB image ({} words) at 0x{:x}, tile list at 0x{:x}: loaded by the host.",

@@ -22,7 +22,40 @@
 //! saturated value always fails the test it feeds (a saturated
 //! perpendicular distance is a miss, a saturated `t` is beyond `tbest`).
 
+use std::cell::Cell;
 use std::fmt::Write;
+
+use rtl::rc::Datapath;
+
+thread_local! {
+    static EXTRA: Cell<u32> = const { Cell::new(0) };
+}
+
+/// Extra fraction bits of every fixed-point format on the datapath the
+/// kernels are being generated for: 0 on the 16-bit chip, 16 on the 32-bit
+/// chip (Q1.14 directions become Q1.30, Q3.12 colours Q3.28, the scene
+/// format gains 16 fraction bits, the tables' fixed points follow). Every
+/// format-dependent constant of a kernel is its 16-bit value plus these
+/// bits, written [`K::cq`] (a line's shifts and immediates) or [`q`];
+/// counts of integer bits (`clz` normalisations, halvings) do not change.
+pub fn extra_bits() -> u32 {
+    EXTRA.with(|e| e.get())
+}
+
+/// Generate kernels for `datapath` inside `f` (the generator sets this once
+/// per build; the default is the 16-bit chip).
+pub fn with_datapath<R>(datapath: Datapath, f: impl FnOnce() -> R) -> R {
+    let x = datapath.bits() - 16;
+    let old = EXTRA.with(|e| e.replace(x));
+    let r = f();
+    EXTRA.with(|e| e.set(old));
+    r
+}
+
+/// A format constant: its 16-bit value plus [`extra_bits`].
+pub fn q(n: u32) -> u32 {
+    n + extra_bits()
+}
 
 /// RC RAM map (word addresses, 0..511).
 pub mod ram {
@@ -90,6 +123,31 @@ impl K {
         self.lines.push(format!("        {s}"));
         self
     }
+    /// A context line whose shift amounts (`>>N`, `<<N`) and immediates
+    /// (`#N`) are fraction counts of the 16-bit formats: each gets the
+    /// datapath's [`extra_bits`] (none on the 16-bit chip).
+    pub fn cq(&mut self, s: impl AsRef<str>) -> &mut Self {
+        let x = extra_bits();
+        let s = s.as_ref();
+        if x == 0 {
+            return self.c(s);
+        }
+        let mut out = String::with_capacity(s.len() + 4);
+        let mut rest = s;
+        while let Some(i) = rest.find(|c: char| c.is_ascii_digit()) {
+            let (head, tail) = rest.split_at(i);
+            let n = tail.find(|c: char| !c.is_ascii_digit()).unwrap_or(tail.len());
+            let marked = head.ends_with(">>") || head.ends_with("<<") || head.ends_with('#');
+            out.push_str(head);
+            match tail[..n].parse::<u32>() {
+                Ok(v) if marked => out.push_str(&(v + x).to_string()),
+                _ => out.push_str(&tail[..n]),
+            }
+            rest = &tail[n..];
+        }
+        out.push_str(rest);
+        self.c(out)
+    }
     pub fn comment(&mut self, s: &str) -> &mut Self {
         self.lines.push(format!("        ; {s}"));
         self
@@ -144,25 +202,25 @@ pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
     }
     k.c(format!("mul out, {a}, {a}"))
         .c(format!("mac out, {b}, {b}"))
-        .c(format!("mac {t1}, {c}, {c}, >>15")) // X, Q.11
-        .c(format!("srl {t2}, {t1}, #8"))
+        .cq(format!("mac {t1}, {c}, {c}, >>15")) // X, Q.11
+        .cq(format!("srl {t2}, {t1}, #8"))
         .c(format!("ld {t2}, [{t2} + #{}]", ram::RSQ)) // y
         .c(format!("ld {t4}, [r0 + #{}]", ram::C_ONE));
     for _ in 0..nr {
-        k.c(format!("mul {t3}, {t2}, {t2}, >>14"))
-            .c(format!("mul {t3}, {t3}, {t1}, >>11"))
+        k.cq(format!("mul {t3}, {t2}, {t2}, >>14"))
+            .cq(format!("mul {t3}, {t3}, {t1}, >>11"))
             .c(format!("sub {t3}, {t3}, {t4}"))
-            .c(format!("ldacc {t2}, <<15"))
-            .c(format!("msu {t2}, {t2}, {t3}, >>15"));
+            .cq(format!("ldacc {t2}, <<15"))
+            .cq(format!("msu {t2}, {t2}, {t3}, >>15"));
     }
     if len {
         // |v'| = X * y in units of v' (>> 12), then undo the shifts.
-        k.c(format!("mul {t1}, {t1}, {t2}, >>12"))
+        k.cq(format!("mul {t1}, {t1}, {t2}, >>12"))
             .c(format!("sra {t1}, {t1}, {t0}"))
             .c(format!("adds {t0}, {t1}, {t1}"));
     }
     for x in [&a, &b, &c] {
-        k.c(format!("mul {x}, {x}, {t2}, >>13"));
+        k.cq(format!("mul {x}, {x}, {t2}, >>13"));
     }
 }
 
@@ -182,17 +240,17 @@ pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
         .c(format!("sub {e}, {e}, #2"))
         .c(format!("or {e}, {e}, #1"))
         .c(format!("sll {x}, {o}, {e}"))
-        .c(format!("srl {y}, {x}, #8"))
+        .cq(format!("srl {y}, {x}, #8"))
         .c(format!("ld {y}, [{y} + #{}]", ram::RSQ))
         .c(format!("ld {w}, [r0 + #{}]", ram::C_ONE));
     for _ in 0..nr {
-        k.c(format!("mul {o}, {y}, {y}, >>14"))
-            .c(format!("mul {o}, {o}, {x}, >>11"))
+        k.cq(format!("mul {o}, {y}, {y}, >>14"))
+            .cq(format!("mul {o}, {o}, {x}, >>11"))
             .c(format!("sub {o}, {o}, {w}"))
-            .c(format!("ldacc {y}, <<15"))
-            .c(format!("msu {y}, {y}, {o}, >>15"));
+            .cq(format!("ldacc {y}, <<15"))
+            .cq(format!("msu {y}, {y}, {o}, >>15"));
     }
-    k.c(format!("mul {o}, {x}, {y}, >>13")) // sqrt(X) in Q.12
+    k.cq(format!("mul {o}, {x}, {y}, >>13")) // sqrt(X) in Q.12
         .c(format!("sub {e}, {e}, #1"))
         .c(format!("sra {e}, {e}, #1"))
         .c(format!("sra {o}, {o}, {e}"));
@@ -211,22 +269,22 @@ pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: u32) {
     k.c(format!("clz {sh}, {d}"))
         .c(format!("sub {sh}, {sh}, #1"))
         .c(format!("sll {dn}, {d}, {sh}"))
-        .c(format!("srl {rc}, {dn}, #7"))
+        .cq(format!("srl {rc}, {dn}, #7"))
         .c(format!("and {rc}, {rc}, #127"))
         .c(format!("ld {rc}, [{rc} + #{}]", ram::RCP))
         .c(format!("ld {one}, [r0 + #{}]", ram::C_ONE));
     for _ in 0..nr {
-        k.c(format!("mul {w}, {dn}, {rc}, >>15"))
+        k.cq(format!("mul {w}, {dn}, {rc}, >>15"))
             .c(format!("sub {w}, {w}, {one}"))
-            .c(format!("ldacc {rc}, <<14"))
-            .c(format!("msu {rc}, {rc}, {w}, >>14"));
+            .cq(format!("ldacc {rc}, <<14"))
+            .cq(format!("msu {rc}, {rc}, {w}, >>14"));
     }
     k.c(format!("mul out, {n}, {rc}"))
         .c(format!("acch {w}"))
         .c(format!("accl {dn}"))
         .c(format!("add {one}, {sh}, #1"))
         .c(format!("sll {w}, {w}, {one}"))
-        .c(format!("rsb {one}, {sh}, #15"))
+        .cq(format!("rsb {one}, {sh}, #15"))
         .c(format!("srl {dn}, {dn}, {one}"))
         .c(format!("or {o}, {w}, {dn}"));
 }
@@ -243,13 +301,13 @@ pub fn pow_q14(k: &mut K, base: u8, out: u8, tmp: u8, n: u32) {
     let mut e = n;
     loop {
         if e & 1 == 1 {
-            k.c(format!("mul {o}, {o}, {t}, >>14"));
+            k.cq(format!("mul {o}, {o}, {t}, >>14"));
         }
         e >>= 1;
         if e == 0 {
             break;
         }
-        k.c(format!("mul {t}, {t}, {t}, >>14"));
+        k.cq(format!("mul {t}, {t}, {t}, >>14"));
     }
 }
 
@@ -281,10 +339,10 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
         .c("sub r10, fb0, r3");
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
-        .c("mac r11, r10, r6, >>14"); // b
+        .cq("mac r11, r10, r6, >>14"); // b
     for (x, d) in [(8, 4), (9, 5), (10, 6)] {
-        k.c(format!("ldacc r{x}, <<14"))
-            .c(format!("msu r{x}, r11, r{d}, >>{}", 14 - ep));
+        k.cq(format!("ldacc r{x}, <<14"))
+            .c(format!("msu r{x}, r11, r{d}, >>{}", q(14) - ep));
     }
     k.c("mov r12, fb0").c("mov r13, fb0"); // r, invr
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
@@ -292,15 +350,15 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
             .c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
     }
     k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
-        .c("ldacc r14, <<14")
+        .cq("ldacc r14, <<14")
         .c("msu out, r8, r8")
         .c("msu out, r9, r9")
-        .c("msu r15, r10, r10, >>14")
+        .cq("msu r15, r10, r10, >>14")
         .c("cmp.gt r15, #0");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
-    k.c("mul r9, r12, r8, >>14") // h
+    k.cq("mul r9, r12, r8, >>14") // h
         .c("mov r10, fb0") // sg
-        .c("mul r9, r9, r10, >>14")
+        .cq("mul r9, r9, r10, >>14")
         .c("sub r9, r11, r9") // t
         .c("(f) cmp.gt r9, #0")
         .c("(f) cmp.lt r9, r7");
@@ -308,7 +366,7 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
     for (i, (x, d)) in [(11, 4), (12, 5), (13, 6)].into_iter().enumerate() {
         k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP0 + i as u32))
             .c(format!("mul out, r8, r{d}"))
-            .c(format!("mac r{x}, r10, r{x}, >>14"))
+            .cq(format!("mac r{x}, r10, r{x}, >>14"))
             .c(format!("neg r{x}, r{x}"));
     }
     k.c("(f) mov r7, r9");
@@ -338,18 +396,18 @@ fn plane_hit(k: &mut K, nr: u32) {
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
-        .c("mac r11, r10, r6, >>14");
+        .cq("mac r11, r10, r6, >>14");
     k.c("sub r12, fb0, r1")
         .c("sub r13, fb0, r2")
         .c("sub r14, fb0, r3");
     k.c("mul out, r8, r12")
         .c("mac out, r9, r13")
-        .c("mac r15, r10, r14, >>14");
+        .cq("mac r15, r10, r14, >>14");
     k.c("neg r11, r11")
         .c("neg r15, r15")
         .c("cmp.gt r11, #0")
         .c("(f) cmp.gt r15, #0")
-        .c("ldacc r15, <<14")
+        .cq("ldacc r15, <<14")
         .c("msu out, r7, r11")
         .c("acch r8")
         .c("(f) cmp.lt r8, #0");
@@ -371,8 +429,8 @@ pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
     k.comment("P - v0");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
-        k.c(format!("ldacc r{o}, <<14"))
-            .c(format!("mac r{x}, r9, r{d}, >>14"))
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{x}, r9, r{d}, >>14"))
             .c(format!("rsb r{x}, fb0, r{x}"));
     }
     k.c("mul out, fb0, r10")
@@ -398,7 +456,7 @@ pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
         }
         Inside::Disc => {
             k.c("mul out, r13, r13")
-                .c("mac r15, r14, r14, >>14")
+                .cq("mac r15, r14, r14, >>14")
                 .c("(f) cmp.le r15, r8");
         }
     }
@@ -430,15 +488,15 @@ pub fn aabox(nr: u32) -> K {
             .c(format!("abs r9, r{da}"))
             .c("cmp.gt r9, #0")
             .c("(f) cmp.gt r8, #0")
-            .c("ldacc r8, <<14")
+            .cq("ldacc r8, <<14")
             .c("msu out, r7, r9")
             .c("acch r10")
             .c("(f) cmp.lt r10, #0");
         divide(&mut k, 8, 9, 11, [10, 12, 13, 14, 15], nr);
-        k.c(format!("ldacc r{}, <<14", 1 + b))
-            .c(format!("mac r12, r11, r{}, >>14", 4 + b))
-            .c(format!("ldacc r{}, <<14", 1 + c))
-            .c(format!("mac r13, r11, r{}, >>14", 4 + c))
+        k.cq(format!("ldacc r{}, <<14", 1 + b))
+            .cq(format!("mac r12, r11, r{}, >>14", 4 + b))
+            .cq(format!("ldacc r{}, <<14", 1 + c))
+            .cq(format!("mac r13, r11, r{}, >>14", 4 + c))
             .c("(f) cmp.le fb0, r12")
             .c("(f) cmp.ge fb0, r12")
             .c("(f) cmp.le fb0, r13")
@@ -483,8 +541,8 @@ pub fn polygon_head(nr: u32) -> K {
     plane_hit(&mut k, nr);
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
-        k.c(format!("ldacc r{o}, <<14"))
-            .c(format!("mac r{x}, r9, r{d}, >>14"))
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{x}, r9, r{d}, >>14"))
             .c(format!("subs r{x}, fb0, r{x}"));
     }
     k.c("movb r15, #0")
@@ -493,10 +551,10 @@ pub fn polygon_head(nr: u32) -> K {
     k.comment("v0 - P on the plane of U, V: -px in r10, -py in r11");
     k.c("mul out, fb0, r10")
         .c("mac out, fb0, r11")
-        .c("mac r13, fb0, r12, >>14");
+        .cq("mac r13, fb0, r12, >>14");
     k.c("mul out, fb0, r10")
         .c("mac out, fb0, r11")
-        .c("mac r11, fb0, r12, >>14")
+        .cq("mac r11, fb0, r12, >>14")
         .c("mov r10, r13")
         .c("movb r8, #0");
     k
@@ -549,18 +607,18 @@ pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
         .c("sub r10, fb0, r3");
     k.c("mul out, fb0, r8")
         .c("mac out, fb0, r9")
-        .c("mac r11, fb0, r10, >>14");
+        .cq("mac r11, fb0, r10, >>14");
     k.c("mul out, fb0, r8")
         .c("mac out, fb0, r9")
-        .c("mac r12, fb0, r10, >>14");
+        .cq("mac r12, fb0, r10, >>14");
     k.c(format!("st r11, [#{}]", ram::TMP0))
         .c(format!("st r12, [#{}]", ram::TMP1));
     k.c("mul out, fb0, r4")
         .c("mac out, fb0, r5")
-        .c("mac r8, fb0, r6, >>14");
+        .cq("mac r8, fb0, r6, >>14");
     k.c("mul out, fb0, r4")
         .c("mac out, fb0, r5")
-        .c("mac r9, fb0, r6, >>14");
+        .cq("mac r9, fb0, r6, >>14");
     k.c("movb r10, #0");
     normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
     k.c("mov r10, r11") // |d2|, Q.14
@@ -568,31 +626,31 @@ pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
         .c(format!("st r9, [#{}]", ram::TMP3));
     k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
         .c(format!("ld r12, [r0 + #{}]", ram::TMP1));
-    k.c("mul out, r11, r8").c("mac r13, r12, r9, >>14"); // b
-    k.c("ldacc r11, <<14")
-        .c(format!("msu r11, r13, r8, >>{}", 14 - ep));
-    k.c("ldacc r12, <<14")
-        .c(format!("msu r12, r13, r9, >>{}", 14 - ep));
+    k.cq("mul out, r11, r8").cq("mac r13, r12, r9, >>14"); // b
+    k.cq("ldacc r11, <<14")
+        .c(format!("msu r11, r13, r8, >>{}", q(14) - ep));
+    k.cq("ldacc r12, <<14")
+        .c(format!("msu r12, r13, r9, >>{}", q(14) - ep));
     k.c("mov r14, fb0")
         .c(format!("mul r11, r11, r14, >>{}", ks + ep))
         .c(format!("mul r12, r12, r14, >>{}", ks + ep))
         .c(format!("st r11, [#{}]", ram::TMP0))
         .c(format!("st r12, [#{}]", ram::TMP1));
     k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
-        .c("ldacc r14, <<14")
+        .cq("ldacc r14, <<14")
         .c("msu out, r11, r11")
-        .c("msu r15, r12, r12, >>14")
+        .cq("msu r15, r12, r12, >>14")
         .c("cmp.gt r15, #0")
         .c("(f) cmp.gt r10, #0");
     sqrt_q14(&mut k, 15, 8, [9, 11, 12, 14], nr);
     k.c(format!("st r8, [#{}]", ram::TMP4));
     k.c("mov r9, fb0")
-        .c("mul r9, r9, r8, >>14") // h
+        .cq("mul r9, r9, r8, >>14") // h
         .c("mov r11, fb0")
-        .c("mul r9, r9, r11, >>14")
+        .cq("mul r9, r9, r11, >>14")
         .c("sub r9, r13, r9") // tau
         .c("(f) cmp.gt r9, #0")
-        .c("ldacc r9, <<14")
+        .cq("ldacc r9, <<14")
         .c("msu out, r7, r10")
         .c("acch r11")
         .c("(f) cmp.lt r11, #0");
@@ -600,13 +658,13 @@ pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
     k.comment("axial coordinate of the hit");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 11 + i;
-        k.c(format!("ldacc r{o}, <<14"))
-            .c(format!("mac r{x}, r9, r{d}, >>14"))
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{x}, r9, r{d}, >>14"))
             .c(format!("rsb r{x}, fb0, r{x}"));
     }
     k.c("mul out, fb0, r11")
         .c("mac out, fb0, r12")
-        .c("mac r14, fb0, r13, >>14"); // z
+        .cq("mac r14, fb0, r13, >>14"); // z
     k.c("(f) cmp.ge r14, #-2")
         .c("mov r15, fb0")
         .c("(f) cmp.le r14, r15");
@@ -618,12 +676,12 @@ pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
         k.c(format!("ld r{x}, [r0 + #{pn}]"))
             .c(format!("ld r13, [r0 + #{dn}]"))
             .c("mul out, r8, r13")
-            .c(format!("mac r{x}, r15, r{x}, >>14"))
+            .cq(format!("mac r{x}, r15, r{x}, >>14"))
             .c(format!("neg r{x}, r{x}"));
     }
     for x in [13, 14, 15] {
         k.c("mul out, fb0, r11")
-            .c(format!("mac r{x}, fb0, r12, >>14"));
+            .cq(format!("mac r{x}, fb0, r12, >>14"));
     }
     for (i, x) in [13, 14, 15].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
@@ -692,8 +750,8 @@ pub fn sign(axis: u8) -> K {
 pub fn classify(axis: u8) -> K {
     let (o, d) = (1 + axis, 4 + axis);
     let mut k = K::default();
-    k.c(format!("ldacc r{o}, <<14"))
-        .c(format!("mac r8, r7, r{d}, >>14"))
+    k.cq(format!("ldacc r{o}, <<14"))
+        .cq(format!("mac r8, r7, r{d}, >>14"))
         .c(format!("min r9, r{o}, r8"))
         .c(format!("max r10, r{o}, r8"))
         .c("mov r11, fb0")
@@ -716,8 +774,8 @@ pub fn leaf_closest() -> K {
     k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
         .c("cmp.lt r7, r8");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
-        k.c(format!("ldacc r{o}, <<14"))
-            .c(format!("mac r{}, r7, r{d}, >>14", 9 + i));
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{}, r7, r{d}, >>14", 9 + i));
     }
     for x in [9, 10, 11] {
         k.c(format!("(f) cmp.le fb0, r{x}"));
@@ -738,8 +796,8 @@ pub fn leaf_closest_ordered() -> K {
         .c("cmp.lt r7, r8")
         .c("(f) cmp.eq r12, #0");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
-        k.c(format!("ldacc r{o}, <<14"))
-            .c(format!("mac r{}, r7, r{d}, >>14", 9 + i));
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{}, r7, r{d}, >>14", 9 + i));
     }
     for x in [9, 10, 11] {
         k.c(format!("(f) cmp.le fb0, r{x}"));
@@ -786,7 +844,7 @@ pub fn leaf_any() -> K {
 /// direction through pixel (i, j) is `A + i B + j C` with A in Q2.13 and
 /// B, C scaled by 2^kd; normalised in the RC.
 pub fn eye(kd: u32, nr: u32) -> K {
-    let sh = kd - 13;
+    let sh = kd - q(13);
     let mut k = K::default();
     k.c(format!("ld r8, [r0 + #{}]", ram::LANE_COL))
         .c("add r8, fb0, r8")
@@ -843,9 +901,9 @@ pub fn post(level0: bool, materials: usize, eps: i32) -> K {
         let i = i as u32;
         k.c(format!("ld r8, [r0 + #{}]", ram::HIT_N + i))
             .c(format!("st r8, [#{}]", ram::SH_N + i))
-            .c(format!("ldacc r{o}, <<14"))
+            .cq(format!("ldacc r{o}, <<14"))
             .c(format!("mac out, r7, r{d}"))
-            .c("mac r11, r8, r12, >>14")
+            .cq("mac r11, r8, r12, >>14")
             .c(format!("st r11, [#{}]", ram::SH_P + i));
     }
     k.c(format!("ld r13, [r0 + #{}]", ram::HIT_MAT))
@@ -882,7 +940,7 @@ pub fn light_setup(nr: u32) -> K {
         .c(format!("ld r13, [r0 + #{}]", ram::SH_N + 1))
         .c("mac out, r13, r5")
         .c(format!("ld r14, [r0 + #{}]", ram::SH_N + 2))
-        .c("mac r15, r14, r6, >>14")
+        .cq("mac r15, r14, r6, >>14")
         .c(format!("st r15, [#{}]", ram::SH_NL));
     // nd = N.D, ld = L.D, rv = ld - 2 nl nd
     k.c(format!("ld r8, [r0 + #{}]", ram::SH_D))
@@ -890,13 +948,13 @@ pub fn light_setup(nr: u32) -> K {
         .c(format!("ld r10, [r0 + #{}]", ram::SH_D + 2))
         .c("mul out, r12, r8")
         .c("mac out, r13, r9")
-        .c("mac r11, r14, r10, >>14") // nd
+        .cq("mac r11, r14, r10, >>14") // nd
         .c("mul out, r4, r8")
         .c("mac out, r5, r9")
-        .c("mac r12, r6, r10, >>14") // ld
-        .c("ldacc r12, <<14")
+        .cq("mac r12, r6, r10, >>14") // ld
+        .cq("ldacc r12, <<14")
         .c("msu out, r15, r11")
-        .c("msu r12, r15, r11, >>14")
+        .cq("msu r12, r15, r11, >>14")
         .c("max r12, r12, #0")
         .c(format!("st r12, [#{}]", ram::SH_RV));
     k.c(format!("ld r8, [r0 + #{}]", ram::ACT))
@@ -930,13 +988,13 @@ pub fn shade(shines: &[(u32, f64)]) -> K {
         pow_q14(&mut k, 12, 14, 15, n);
         if f > 0.0 {
             k.c("mov r15, fb0")
-                .c("mul r15, r15, r12, >>14")
+                .cq("mul r15, r15, r12, >>14")
                 .c("add r15, fb0, r15")
-                .c("mul r14, r14, r15, >>14");
+                .cq("mul r14, r14, r15, >>14");
         }
         for c in 0..3 {
             k.c("mul out, fb0, r11")
-                .c("mac r15, fb0, r14, >>14")
+                .cq("mac r15, fb0, r14, >>14")
                 .c(format!("ld r9, [r0 + #{}]", ram::COL + c))
                 .c("adds r9, r9, r15")
                 .c(format!("(f) st r9, [#{}]", ram::COL + c));
@@ -970,11 +1028,11 @@ pub fn reflect_setup(level: u32) -> K {
     }
     k.c("mul out, r8, r11")
         .c("mac out, r9, r12")
-        .c("mac r14, r10, r13, >>14"); // d.N
+        .cq("mac r14, r10, r13, >>14"); // d.N
     for (d, x, n) in [(4, 8, 11), (5, 9, 12), (6, 10, 13)] {
-        k.c(format!("ldacc r{x}, <<14"))
+        k.cq(format!("ldacc r{x}, <<14"))
             .c(format!("msu out, r14, r{n}"))
-            .c(format!("msu r{d}, r14, r{n}, >>14"));
+            .cq(format!("msu r{d}, r14, r{n}, >>14"));
     }
     k.c(format!("ld r7, [r0 + #{}]", ram::C_INF))
         .c(format!("st r7, [#{}]", ram::PASS_T0));
@@ -997,7 +1055,7 @@ pub fn reflect_pop(level: u32) -> K {
     for c in 0..3 {
         k.c(format!("ld r8, [r0 + #{}]", base + c))
             .c(format!("ld r9, [r0 + #{}]", ram::COL + c))
-            .c("mul r9, r9, r10, >>12")
+            .cq("mul r9, r9, r10, >>12")
             .c("adds r9, r8, r9")
             .c(format!("st r9, [#{}]", ram::COL + c));
     }

@@ -123,7 +123,10 @@ pub struct TypeInfo {
 /// The laid-out image and everything the generator needs to know of it.
 #[derive(Clone, Debug)]
 pub struct Layout {
-    pub fb: Vec<u16>,
+    /// FB words as values: 16-bit on the 16-bit chip; on the 32-bit chip
+    /// numeric words use the whole word and the others (flags, addresses,
+    /// bit vectors, counts) are the 16-bit words sign-extended.
+    pub fb: Vec<i32>,
     pub frac: u32,
     pub eye: usize,
     pub post: usize,
@@ -196,37 +199,72 @@ pub struct Stream {
 
 /// Reciprocal square root table: entry k = 1/sqrt(X) for X = (k + 0.5) 256
 /// in Q.11, Q1.14 (saturated below index 8, where it is never used).
-pub fn rsq_table() -> Vec<u16> {
+pub fn rsq_table() -> Vec<i32> {
+    rsq_table_for(0)
+}
+
+/// [`rsq_table`] with `x` extra fraction bits (16 on the 32-bit chip: the
+/// same entries in Q1.30, indexed by X in Q.27).
+pub fn rsq_table_for(x: u32) -> Vec<i32> {
+    let one = (14 + x) as f64;
     (0..128)
         .map(|k| {
-            let x = (k as f64 + 0.5) * 256.0 / 2048.0;
-            ((1.0 / x.sqrt()) * 16384.0).round().min(32767.0) as i16 as u16
+            let v = (k as f64 + 0.5) * 256.0 / 2048.0;
+            ((1.0 / v.sqrt()) * one.exp2()).round().min(word_max(x)) as i32
         })
         .collect()
 }
 
 /// Reciprocal table: entry k = 2^29 / d for d = 2^14 + (k + 0.5) 128.
-pub fn rcp_table() -> Vec<u16> {
+pub fn rcp_table() -> Vec<i32> {
+    rcp_table_for(0)
+}
+
+/// [`rcp_table`] with `x` extra fraction bits: `2^(29 + 2x) / d` for
+/// `d = 2^(14 + x) + (k + 0.5) 2^(7 + x)`.
+pub fn rcp_table_for(x: u32) -> Vec<i32> {
     (0..128)
         .map(|k| {
             let d = 16384.0 + (k as f64 + 0.5) * 128.0;
-            ((1u64 << 29) as f64 / d).round().min(32767.0) as i16 as u16
+            (((29 + x) as f64).exp2() / d).round().min(word_max(x)) as i32
         })
         .collect()
 }
 
-struct W {
-    fb: Vec<u16>,
-    s: f64,
+/// The largest word value with `x` extra bits (16-bit: 32767).
+fn word_max(x: u32) -> f64 {
+    ((15 + x) as f64).exp2() - 1.0
 }
 
-fn sat(x: f64) -> u16 {
-    x.round().clamp(-32768.0, 32767.0) as i16 as u16
+struct W {
+    fb: Vec<i32>,
+    s: f64,
+    /// Extra bits of the datapath (0 or 16).
+    x: u32,
 }
 
 impl W {
+    fn max(&self) -> f64 {
+        word_max(self.x)
+    }
+    /// Round and saturate to the word.
+    fn sat(&self, v: f64) -> i32 {
+        v.round().clamp(-self.max() - 1.0, self.max()) as i32
+    }
+    fn push(&mut self, v: f64) {
+        let v = self.sat(v);
+        self.fb.push(v);
+    }
+    /// A 16-bit structural word (flags, bit vectors), sign-extended.
+    fn word16(&mut self, v: u16) {
+        self.fb.push(v as i16 as i32);
+    }
+    /// One in Q1.14 (16-bit chip) or Q1.30.
+    fn one(&self) -> f64 {
+        ((14 + self.x) as f64).exp2()
+    }
     fn coord(&mut self, x: f64) {
-        self.fb.push(sat(x * self.s));
+        self.push(x * self.s);
     }
     fn point(&mut self, v: Vec3) {
         for x in v.to_array() {
@@ -234,20 +272,31 @@ impl W {
         }
     }
     fn unit(&mut self, v: Vec3) {
+        let k = Q_UNIT.lsb().recip() * (self.x as f64).exp2();
         for x in v.to_array() {
-            self.fb.push(sat(x * Q_UNIT.lsb().recip()));
+            self.push(x * k);
         }
     }
     fn col(&mut self, x: f64) {
-        self.fb.push(sat(x * Q_MATERIAL.lsb().recip()));
+        self.push(x * Q_MATERIAL.lsb().recip() * (self.x as f64).exp2());
     }
     fn raw(&mut self, x: i64) {
-        self.fb.push(x.clamp(-32768, 32767) as i16 as u16);
+        self.push(x as f64);
     }
     fn scaled(&mut self, v: Vec3, scale: f64) {
         for x in v.to_array() {
-            self.fb.push(sat(x * scale));
+            self.push(x * scale);
         }
+    }
+}
+
+/// FB words as the bytes DMA moves: 2 per word (16-bit chip, `x` = 0) or
+/// 4 (32-bit chip), little-endian.
+pub fn fb_word_bytes(words: &[i32], x: u32) -> Vec<u8> {
+    if x == 0 {
+        words.iter().flat_map(|w| (*w as i16).to_le_bytes()).collect()
+    } else {
+        words.iter().flat_map(|w| w.to_le_bytes()).collect()
     }
 }
 
@@ -371,12 +420,13 @@ pub fn split_shine(shine: f64) -> (u32, f64) {
     }
 }
 
-/// Largest shift `k` with `m * 2^k <= 32767` (clamped to 0..=max).
-fn fit_shift(m: f64, max: u32) -> u32 {
+/// Largest shift `k` with `m * 2^k` within the word (`<= 2^(15+x) - 1`:
+/// 32767 on the 16-bit chip), clamped to 0..=max.
+fn fit_shift_w(m: f64, max: u32, x: u32) -> u32 {
     if m <= 0.0 {
         return max;
     }
-    let k = (32767.0 / m).log2().floor();
+    let k = (word_max(x) / m).log2().floor();
     k.clamp(0.0, max as f64) as u32
 }
 
@@ -435,7 +485,10 @@ fn build_as(
     guard_bits: u32,
     streamed: bool,
 ) -> Result<Layout, String> {
-    let frac = fit_frac(scene, image.report.frac_bits, guard_bits);
+    // The 32-bit chip: every format gets `x` more fraction bits.
+    let xb = opt.datapath.bits() - 16;
+    let fit_shift = |m: f64, max: u32| fit_shift_w(m, max, xb);
+    let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
     let s = (frac as f64).exp2();
     let err = |line: usize, m: String| {
         if line > 0 {
@@ -515,17 +568,17 @@ fn build_as(
             Inside::Disc => 2,
         };
         for x in p.eu.to_array().into_iter().chain(p.ew.to_array()) {
-            m[k] = m[k].max(x.abs() * (14.0 - frac as f64).exp2());
+            m[k] = m[k].max(x.abs() * ((14 + xb) as f64 - frac as f64).exp2());
         }
     }
     let kt = [
-        fit_shift(m[0], 24),
-        fit_shift(m[1], 24),
-        fit_shift(m[2], 24),
+        fit_shift(m[0], 24 + xb),
+        fit_shift(m[1], 24 + xb),
+        fit_shift(m[2], 24 + xb),
     ];
     let ks_of = |rmin: f64| {
         if rmin.is_finite() {
-            fit_shift(16384.0 / rmin, 16)
+            fit_shift(((14 + xb) as f64).exp2() / rmin, 16 + xb)
         } else {
             8
         }
@@ -552,12 +605,16 @@ fn build_as(
         .fold(1.0f64, f64::max);
     let ep_cyl = fit_shift(2.0 * r_max_cyl, 4);
 
-    let mut w = W { fb: Vec::new(), s };
+    let mut w = W {
+        fb: Vec::new(),
+        s,
+        x: xb,
+    };
     // Init stream.
-    w.fb.extend(rsq_table());
-    w.fb.extend(rcp_table());
-    w.raw(16384);
-    w.raw(32767);
+    w.fb.extend(rsq_table_for(xb));
+    w.fb.extend(rcp_table_for(xb));
+    w.push(w.one());
+    w.push(w.max());
 
     // Camera: D(i, j) = A + i B + j C.
     let c = &scene.camera;
@@ -583,7 +640,7 @@ fn build_as(
         cc = vv * (-ay * half * 2.0 / (hd - 1) as f64);
     }
     let max_bc = b.max_abs().max(cc.max_abs());
-    let kd = fit_shift(max_bc, 28).max(13);
+    let kd = fit_shift(max_bc, 28 + xb).max(13 + xb);
     let corner_far = a + b * (wd - 1) as f64 + cc * (hd - 1) as f64;
     if a.max_abs() >= 3.9 || corner_far.max_abs() >= 3.9 {
         return Err(err(
@@ -599,9 +656,9 @@ fn build_as(
     w.raw(0);
     w.point(c.from);
     for k in 0..3 {
-        w.fb.push(sat(a.axis(k) * 8192.0));
-        w.fb.push(sat(b.axis(k) * (kd as f64).exp2()));
-        w.fb.push(sat(cc.axis(k) * (kd as f64).exp2()));
+        w.push(a.axis(k) * w.one() / 2.0);
+        w.push(b.axis(k) * (kd as f64).exp2());
+        w.push(cc.axis(k) * (kd as f64).exp2());
     }
 
     // Post: background, (id, ks) per material.
@@ -628,8 +685,8 @@ fn build_as(
             w.raw(i as i64);
             let (_, f) = split_shine(mt.shine);
             if f > 0.0 {
-                w.raw((f * 16384.0).round() as i64);
-                w.raw(((1.0 - f) * 16384.0).round() as i64);
+                w.push(f * w.one());
+                w.push((1.0 - f) * w.one());
             }
             // Per channel: kd c lc, then ks lc (the kernel's read order).
             let k = mt.color.mul_elem(lc) * mt.kd;
@@ -653,7 +710,7 @@ fn build_as(
             Inside::Triangle => kt[1],
             Inside::Disc => kt[2],
         };
-        let sc = (14.0 - frac as f64 + k as f64).exp2();
+        let sc = ((14 + xb) as f64 - frac as f64 + k as f64).exp2();
         w.unit(p.n);
         w.point(p.v0);
         w.point(p.v0);
@@ -693,13 +750,13 @@ fn build_as(
                     _,
                 ) => {
                     let rq = (radius.abs() * s).round().max(1.0);
-                    let invr = ((14 + ks_sphere) as f64).exp2()
+                    let invr = ((14 + xb + ks_sphere) as f64).exp2()
                         / if streamed { radius.abs() * s } else { rq };
                     let sg = if *inside { -1.0 } else { 1.0 };
                     w.point(*center);
-                    w.raw(rq as i64);
-                    w.raw(invr.round() as i64);
-                    w.raw((sg * 16384.0) as i64);
+                    w.push(rq);
+                    w.push(invr);
+                    w.push(sg * w.one());
                     w.raw(i as i64);
                     w.raw(o.material as i64);
                 }
@@ -720,7 +777,7 @@ fn build_as(
                     let e1 = perpendicular(av);
                     let e2 = av.cross(e1);
                     let rq = (base_radius.abs() * s).round().max(1.0);
-                    let invr = ((14 + ks_cyl) as f64).exp2() / rq;
+                    let invr = ((14 + xb + ks_cyl) as f64).exp2() / rq;
                     let sg = if *inside { -1.0 } else { 1.0 };
                     w.raw(*caps as i64);
                     w.point(*base);
@@ -728,16 +785,16 @@ fn build_as(
                     w.unit(e2);
                     w.unit(e1);
                     w.unit(e2);
-                    w.raw(invr.round() as i64);
-                    w.raw(rq as i64);
-                    w.raw((sg * 16384.0) as i64);
+                    w.push(invr);
+                    w.push(rq);
+                    w.push(sg * w.one());
                     w.point(*base);
                     w.unit(av);
                     w.raw((h * s).round() as i64 + 2);
-                    w.raw((sg * 16384.0) as i64);
+                    w.push(sg * w.one());
                     for c in 0..3 {
-                        w.fb.push(sat(e1.axis(c) * 16384.0));
-                        w.fb.push(sat(e2.axis(c) * 16384.0));
+                        w.push(e1.axis(c) * w.one());
+                        w.push(e2.axis(c) * w.one());
                     }
                     w.raw(i as i64);
                     w.raw(o.material as i64);
@@ -875,19 +932,19 @@ fn build_as(
             match n.split {
                 Some(sp) => {
                     f[0] = sp.axis as i32;
-                    f[1] = sat(sp.position * s) as i16 as i32;
+                    f[1] = w.sat(sp.position * s);
                     f[2] = (base as usize + NODE_BYTES * sp.children[0] as usize) as i32;
                     f[3] = (base as usize + NODE_BYTES * sp.children[1] as usize) as i32;
                 }
                 None => {
                     f[0] = -32768;
                     let list_addr = base as usize + lists_at + 4 * list_objs.len();
-                    let mut words: Vec<u16> = Vec::new();
-                    for x in n.bounds.min.to_array() {
-                        words.push(((x * s).floor() as i64 - 2).clamp(-32768, 32767) as i16 as u16);
+                    let mut words: Vec<i32> = Vec::new();
+                    for v in n.bounds.min.to_array() {
+                        words.push(w.sat((v * s).floor() - 2.0));
                     }
-                    for x in n.bounds.max.to_array() {
-                        words.push(((x * s).ceil() as i64 + 2).clamp(-32768, 32767) as i16 as u16);
+                    for v in n.bounds.max.to_array() {
+                        words.push(w.sat((v * s).ceil() + 2.0));
                     }
                     for (j, ti) in types.iter().enumerate() {
                         let mut cnt = 0;
@@ -918,7 +975,7 @@ fn build_as(
                         f[5] = words.len() as i32;
                         f[13] = n.objects.len() as i32;
                         f[6] = list_addr as i32;
-                        blocks.extend(words.iter().flat_map(|x| x.to_le_bytes()));
+                        blocks.extend(fb_word_bytes(&words, xb));
                     }
                 }
             }
@@ -995,7 +1052,7 @@ fn build_as(
                 w.raw(addr(sp.children[1]) as i64);
             }
             None => {
-                w.fb.push(0x8000);
+                w.word16(0x8000);
                 if node_layout == NodeLayout::Fig5 {
                     w.raw(0);
                     w.raw(0);
@@ -1006,11 +1063,11 @@ fn build_as(
         // Cell bounds: every Fig. 5 node; compact, leaves only (the only
         // nodes whose bounds a kernel reads).
         if node_layout == NodeLayout::Fig5 || n.split.is_none() {
-            for x in n.bounds.min.to_array() {
-                w.raw((x * s).floor() as i64 - 2);
+            for v in n.bounds.min.to_array() {
+                w.push((v * s).floor() - 2.0);
             }
-            for x in n.bounds.max.to_array() {
-                w.raw((x * s).ceil() as i64 + 2);
+            for v in n.bounds.max.to_array() {
+                w.push((v * s).ceil() + 2.0);
             }
         }
         for ti in &types {
@@ -1026,7 +1083,9 @@ fn build_as(
                     for k in ks {
                         words[k / 16] |= 0x8000 >> (k % 16);
                     }
-                    w.fb.extend(words);
+                    for b in words {
+                        w.word16(b);
+                    }
                 }
                 NodeLayout::Compact => {
                     let at = w.fb.len();
@@ -1034,7 +1093,7 @@ fn build_as(
                     for k in ks {
                         w.raw(k as i64);
                     }
-                    w.fb[at] = (w.fb.len() - at - 1) as u16;
+                    w.fb[at] = (w.fb.len() - at - 1) as i32;
                 }
             }
         }

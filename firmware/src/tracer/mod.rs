@@ -29,6 +29,7 @@ pub mod kernels;
 pub mod layout;
 
 use crate::bsp::BspParams;
+pub use rtl::rc::Datapath;
 use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
 
@@ -46,6 +47,9 @@ pub struct Options {
     /// How a resident scene's BSP nodes name their objects (the paper's
     /// Fig. 5 bit vectors by default).
     pub layout: NodeLayout,
+    /// The chip's RC datapath: the paper's 16-bit chip (default) or the
+    /// 32-bit variant, whose formats all have 16 more fraction bits.
+    pub datapath: Datapath,
 }
 
 impl Default for Options {
@@ -57,6 +61,7 @@ impl Default for Options {
             depth: 2,
             bsp: BspParams::default(),
             layout: NodeLayout::Fig5,
+            datapath: Datapath::W16,
         }
     }
 }
@@ -145,7 +150,9 @@ pub mod mem {
     pub const FB_IMAGE: u32 = 0x4_0000;
     /// Tile list: count, then (px0, py0, output address) words.
     pub const TILE_LIST: u32 = 0x6_0000;
-    /// Output: 256 half-words per tile (R, G, B, object id; 64 lanes each).
+    /// Output: 256 FB words per tile (R, G, B, object id; 64 lanes each),
+    /// half-words on the 16-bit chip, words on the 32-bit chip
+    /// ([`super::Firmware::out_tile_bytes`]).
     pub const OUTPUT: u32 = 0x8_0000;
     pub const OUT_TILE_BYTES: u32 = 512;
     /// The streamed layout's scene image (nodes, leaf lists, leaf blocks,
@@ -159,8 +166,11 @@ pub mod mem {
 pub struct Firmware {
     /// The whole assembly source (TinyRISC code, data and contexts).
     pub source: String,
-    /// The frame-buffer image (set 0), loaded at [`mem::FB_IMAGE`].
-    pub fb: Vec<u16>,
+    /// The frame-buffer image (set 0), loaded at [`mem::FB_IMAGE`] as
+    /// [`Firmware::fb_bytes`]: word values (16-bit, or 32-bit on the 32-bit
+    /// chip).
+    pub fb: Vec<i32>,
+    pub datapath: Datapath,
     pub report: Report,
     pub tile_w: u32,
     pub tile_h: u32,
@@ -171,6 +181,29 @@ pub struct Firmware {
     pub kernels: Vec<(String, usize)>,
     /// Where everything is in the FB image, and the kernels' scale shifts.
     pub layout: layout::Layout,
+}
+
+impl Firmware {
+    /// The FB image as main memory holds it for `ldfb`: 2 bytes per word on
+    /// the 16-bit chip, 4 on the 32-bit chip.
+    pub fn fb_bytes(&self) -> Vec<u8> {
+        layout::fb_word_bytes(&self.fb, self.datapath.bits() - 16)
+    }
+
+    /// Bytes of one FB word.
+    pub fn fb_word_bytes(&self) -> u32 {
+        self.datapath.fb_word_bytes()
+    }
+
+    /// Bytes of one tile's output in main memory (256 FB words).
+    pub fn out_tile_bytes(&self) -> u32 {
+        256 * self.fb_word_bytes()
+    }
+
+    /// The scene format `Qm.n` of this chip.
+    pub fn format(&self) -> String {
+        format!("Q{}.{}", self.datapath.bits() - 1 - self.frac, self.frac)
+    }
 }
 
 // The program leaves its statistics in main memory at the symbols
@@ -222,10 +255,13 @@ fn build_as(
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
     let lay = layout::build(scene, &image, opt, nm.guard_bits, force_stream)?;
-    let prog = control::program(scene, &lay, opt, nm, tw, th)?;
+    let prog = kernels::with_datapath(opt.datapath, || {
+        control::program(scene, &lay, opt, nm, tw, th)
+    })?;
     Ok(Firmware {
         source: prog.source,
         fb: lay.fb.clone(),
+        datapath: opt.datapath,
         report: image.report.clone(),
         tile_w: tw,
         tile_h: th,
