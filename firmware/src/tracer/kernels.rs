@@ -136,7 +136,9 @@ impl K {
         let mut rest = s;
         while let Some(i) = rest.find(|c: char| c.is_ascii_digit()) {
             let (head, tail) = rest.split_at(i);
-            let n = tail.find(|c: char| !c.is_ascii_digit()).unwrap_or(tail.len());
+            let n = tail
+                .find(|c: char| !c.is_ascii_digit())
+                .unwrap_or(tail.len());
             let marked = head.ends_with(">>") || head.ends_with("<<") || head.ends_with('#');
             out.push_str(head);
             match tail[..n].parse::<u32>() {

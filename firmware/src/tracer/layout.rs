@@ -294,7 +294,10 @@ impl W {
 /// 4 (32-bit chip), little-endian.
 pub fn fb_word_bytes(words: &[i32], x: u32) -> Vec<u8> {
     if x == 0 {
-        words.iter().flat_map(|w| (*w as i16).to_le_bytes()).collect()
+        words
+            .iter()
+            .flat_map(|w| (*w as i16).to_le_bytes())
+            .collect()
     } else {
         words.iter().flat_map(|w| w.to_le_bytes()).collect()
     }

@@ -29,9 +29,9 @@ pub mod kernels;
 pub mod layout;
 
 use crate::bsp::BspParams;
-pub use rtl::rc::Datapath;
 use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
+pub use rtl::rc::Datapath;
 
 /// Generator options.
 #[derive(Clone, Copy, Debug)]
