@@ -9,7 +9,9 @@
 //!   the active RCs per ray lane (active-RC fraction x 64 / ways) against
 //!   ways, which explains the sub-linear growth;
 //! * `pareto.{svg,png}`: frames/s against PSNR over every configuration,
-//!   with the Pareto front;
+//!   with the Pareto front; the datapath-width series (the paper's
+//!   configuration on the 16-bit chip and on the 32-bit variant) has hollow
+//!   markers for the 32-bit chip;
 //! * `scaling.{svg,png}`: chip cycles per frame against primitive count,
 //!   over SPD families generated at sizes 1 to `--max-size` (balls and
 //!   tetra by default, at a smaller image, 64x64), one series per family
@@ -21,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result};
 use firmware::bsp::{BspParams, SplitRule};
-use firmware::tracer::{NodeLayout, Numerics, Options};
+use firmware::tracer::{Datapath, NodeLayout, Numerics, Options};
 
 use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
 use crate::cmd_scene::{load_scene, write_atomic};
@@ -145,6 +147,14 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         },
         nm,
     });
+    for datapath in [Datapath::W16, Datapath::W32] {
+        v.push(Config {
+            knob: "datapath",
+            value: datapath.bits().to_string(),
+            opt: Options { datapath, ..base },
+            nm,
+        });
+    }
     v.push(Config {
         knob: "layout",
         value: NodeLayout::Compact.name().into(),
@@ -174,6 +184,8 @@ struct Row {
     newton_steps: u32,
     guard_bits: u32,
     ray_offset_lsb: i32,
+    /// RC datapath width: 16 (the paper's chip) or 32.
+    datapath_bits: u32,
     format: String,
     cycles: u64,
     fps_at_300mhz: f64,
@@ -193,7 +205,7 @@ struct Row {
 
 fn key(o: &Options, n: &Numerics) -> String {
     format!(
-        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {}",
+        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {}",
         o.width,
         o.height,
         o.ways,
@@ -202,7 +214,8 @@ fn key(o: &Options, n: &Numerics) -> String {
         o.bsp.max_leaf,
         o.bsp.rule,
         n,
-        o.layout
+        o.layout,
+        o.datapath
     )
 }
 
@@ -245,6 +258,7 @@ fn row(
         newton_steps: nm.newton_steps,
         guard_bits: nm.guard_bits,
         ray_offset_lsb: nm.eps_lsb,
+        datapath_bits: opt.datapath.bits(),
         format: s("format"),
         cycles: j["cycles"].as_u64().unwrap_or(0),
         fps_at_300mhz: f("fps_at_300mhz"),
@@ -449,7 +463,14 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
                 .filter(|r| r.scene == *s)
                 .map(|r| (r.fps_at_300mhz, r.psnr_db))
                 .collect(),
-            style: SeriesStyle::default(),
+            style: SeriesStyle {
+                hollow: rows
+                    .iter()
+                    .filter(|r| r.scene == *s)
+                    .map(|r| r.datapath_bits == 32)
+                    .collect(),
+                ..SeriesStyle::default()
+            },
         })
         .collect();
     let paper: Vec<Mark> = rows
@@ -464,7 +485,8 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
     out.extend(charts::write(
         &dir.join("pareto"),
         &Chart {
-            title: "Speed against accuracy over every configuration".into(),
+            title: "Speed against accuracy over every configuration (hollow: 32-bit datapath)"
+                .into(),
             x_label: "frames/s at 300 MHz".into(),
             y_label: "PSNR against the f64 reference (dB)".into(),
             series: pareto,

@@ -394,3 +394,49 @@ fn streamed_layout_on_the_32_bit_chip() {
     eprintln!("jacks-1 24x24 streamed, 32-bit: {p:.2} dB {h:.4}");
     assert!(p >= 45.0 && h >= 0.999, "{p:.2} dB {h:.4}");
 }
+
+/// `morphosys sweep` runs the paper's configuration on both datapath widths
+/// (the `datapath` knob, `datapath_bits` column) and charts them.
+#[test]
+fn sweep_has_the_datapath_width_series() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_path("tetra-1.nff");
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "sweep",
+            scene.to_str().unwrap(),
+            "--only",
+            "knobs",
+            "--size",
+            "16x16",
+            "--out-dir",
+            "sw",
+        ],
+    );
+    assert!(ok, "{out}\n{err}");
+    let mut rd = csv::Reader::from_path(dir.path().join("sw/results.csv")).unwrap();
+    let head = rd.headers().unwrap().clone();
+    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
+    let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    let by = |bits: &str| {
+        rows.iter()
+            .find(|r| &r[col("knob")] == "datapath" && &r[col("value")] == bits)
+            .unwrap_or_else(|| panic!("no datapath {bits} row"))
+            .clone()
+    };
+    let (r16, r32) = (by("16"), by("32"));
+    assert_eq!(
+        (&r16[col("datapath_bits")], &r32[col("datapath_bits")]),
+        ("16", "32")
+    );
+    assert_eq!(&r32[col("format")], "Q5.26");
+    let p = |r: &csv::StringRecord| r[col("psnr_db")].parse::<f64>().unwrap();
+    assert!(p(&r32) >= p(&r16), "{} < {}", p(&r32), p(&r16));
+    // every other knob runs on the 16-bit chip
+    assert!(rows
+        .iter()
+        .filter(|r| &r[col("knob")] != "datapath")
+        .all(|r| &r[col("datapath_bits")] == "16"));
+    assert!(dir.path().join("sw/pareto.png").is_file());
+}
