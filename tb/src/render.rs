@@ -138,7 +138,11 @@ fn run_group<W: Word>(
             fw.layout
                 .stream
                 .as_ref()
-                .map(|st| st.base as usize + st.image.len()),
+                // the image, then the mailboxes (a half-word per object)
+                .map(|st| {
+                    (st.base as usize + st.image.len())
+                        .max(st.mailbox as usize + 2 * fw.layout.objects)
+                }),
         );
     let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
     let mut chip = Chip::<W>::build(Timing::default(), mem_bytes);
