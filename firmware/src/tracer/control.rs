@@ -48,7 +48,10 @@ pub fn program(
         ("k_eye", k::eye(lay.kd, nm.newton_steps)),
         ("k_post0", k::post(true, lay.materials, nm.eps_lsb)),
         ("k_post1", k::post(false, lay.materials, nm.eps_lsb)),
-        ("k_light", k::light_setup(nm.newton_steps)),
+        (
+            "k_light",
+            k::light_setup(nm.newton_steps, lay.light_shifted),
+        ),
         ("k_shade", k::shade(&lay.shines)),
         ("k_out0", k::out_word(0)),
         ("k_out1", k::out_word(1)),
@@ -81,7 +84,12 @@ pub fn program(
     if has(ChipType::Sphere) {
         objk.push((
             "k_sphere",
-            k::sphere(lay.ks_sphere, lay.ep_sphere, nm.newton_steps),
+            k::sphere_with(
+                lay.ks_sphere,
+                lay.ep_sphere,
+                nm.newton_steps,
+                lay.sphere_fine,
+            ),
         ));
     }
     if has(ChipType::Cylinder) {

@@ -68,10 +68,14 @@ pub mod ram {
     pub const UNORD: u32 = 340;
 }
 
-/// Offset of a spawned ray's origin along the normal, in LSBs: the bound of
-/// the hit point's rounding error (t to 1 LSB, each coordinate of
-/// `o + t d` to 1/2 LSB, the normal to 2^-13).
-pub const EPS_LSB: i32 = 3;
+/// Offset of a spawned ray's origin along the normal, in LSBs. Default 0:
+/// every kernel is one-sided and its primitive convex (or planar), so a ray
+/// leaving the surface it starts on cannot hit that surface again however
+/// the hit point was rounded (the sphere's near root and a plane's
+/// back face are rejected), while an offset of a few LSB pushes the origin
+/// of a shadow ray off a small sphere into the neighbour it touches, whose
+/// kernel then rejects it (balls-4: 3 LSB cost 2 dB).
+pub const EPS_LSB: i32 = 0;
 /// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
 pub const INSIDE_TOL: i32 = 2;
 
@@ -274,6 +278,18 @@ fn commit_streamed_normal(k: &mut K, t: u8) {
 /// `t = b - sg r sqrt(s)`, and the normal follows without the hit point:
 /// `n = -(sg p / r + sqrt(s) d)`.
 pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
+    sphere_with(ks, ep, nr, false)
+}
+
+/// [`sphere`], with `fine`: spheres a few LSB across, whose rounded centre
+/// and radius would move their silhouettes and shadows by a sizeable part
+/// of their size. The record (11 words: `c.xyz, cl.xyz, r, invr, sg, obj,
+/// mat`) adds the centre's rounding remainder `cl` in units of 2^-14 LSB
+/// and holds `r` with `ep` extra fraction bits; the perpendicular vector is
+/// formed in the accumulator from the unrounded centre and the unrounded
+/// `b` (its remainder below 1 LSB, read back with `accl`, is subtracted
+/// along `d` as well): `p = (c - o) + cl - b d` to 2^-ep LSB.
+pub fn sphere_with(ks: u32, ep: u32, nr: u32, fine: bool) -> K {
     let mut k = K::default();
     k.comment("sphere: oc = c - o");
     k.c("sub r8, fb0, r1")
@@ -282,10 +298,25 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
         .c("mac r11, r10, r6, >>14"); // b
-    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
-        k.c(format!("ldacc r{x}, <<14"))
-            .c(format!("msu r{x}, r11, r{d}, >>{}", 14 - ep));
+    if fine {
+        // b's remainder: the accumulator minus round(b) 2^14, below 2^13
+        // in magnitude, so its low half is exact (the wrap is intended).
+        k.c("accl r12")
+            .c("sll r14, r11, #14")
+            .c("sub r12, r12, r14");
     }
+    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
+        if fine {
+            k.c(format!("mul r13, r12, r{d}, >>14"))
+                .c(format!("ldacc r{x}, <<14"))
+                .c("mac out, fb0, #1")
+                .c("msu out, r13, #1");
+        } else {
+            k.c(format!("ldacc r{x}, <<14"));
+        }
+        k.c(format!("msu r{x}, r11, r{d}, >>{}", 14 - ep));
+    }
+    let er = if fine { ep } else { 0 };
     k.c("mov r12, fb0").c("mov r13, fb0"); // r, invr
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
         k.c(format!("mul r{x}, r{x}, r13, >>{}", ks + ep))
@@ -298,7 +329,7 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
         .c("msu r15, r10, r10, >>14")
         .c("cmp.gt r15, #0");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
-    k.c("mul r9, r12, r8, >>14") // h
+    k.c(format!("mul r9, r12, r8, >>{}", 14 + er)) // h
         .c("mov r10, fb0") // sg
         .c("mul r9, r9, r10, >>14")
         .c("sub r9, r11, r9") // t
@@ -838,16 +869,35 @@ pub fn post(level0: bool, materials: usize, eps: i32) -> K {
 /// offset hit point, unit direction, `tbest` = distance - 2 LSB; RCs with
 /// no hit or with the light behind the surface (N.L <= 0, the SPD rule)
 /// sleep. Also keeps N.L and R.V for shading.
-pub fn light_setup(nr: u32) -> K {
+///
+/// `shifted`: the stream starts with a scale shift `k` and holds the
+/// light divided by `2^k` ([`super::layout::light_shift`]); the direction
+/// is that of `light / 2^k - P / 2^k`, and where `k > 0` (a light outside
+/// every object's reach) the segment is not cut at the light.
+pub fn light_setup(nr: u32, shifted: bool) -> K {
     let mut k = K::default();
     for (i, o) in [1, 2, 3].into_iter().enumerate() {
         k.c(format!("ld r{o}, [r0 + #{}]", ram::SH_P + i as u32));
     }
-    k.c("sub r8, fb0, r1")
-        .c("sub r9, fb0, r2")
-        .c("sub r10, fb0, r3");
+    if shifted {
+        k.c("mov r15, fb0");
+        for (x, o) in [(8, 1), (9, 2), (10, 3)] {
+            k.c(format!("sra r{x}, r{o}, r15"))
+                .c(format!("sub r{x}, fb0, r{x}"));
+        }
+        k.c(format!("st r15, [#{}]", ram::TMP0));
+    } else {
+        k.c("sub r8, fb0, r1")
+            .c("sub r9, fb0, r2")
+            .c("sub r10, fb0, r3");
+    }
     normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
     k.c("mov r4, r8").c("mov r5, r9").c("mov r6, r10");
+    if shifted {
+        k.c(format!("ld r15, [r0 + #{}]", ram::TMP0))
+            .c("cmp.gt r15, #0")
+            .c(format!("(f) ld r11, [r0 + #{}]", ram::C_INF));
+    }
     k.c("sub r7, r11, #2")
         .c(format!("st r7, [#{}]", ram::PASS_T0));
     // nl = N.L
@@ -989,11 +1039,12 @@ pub fn out_word(i: u32) -> K {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tracer::layout::{CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_WORDS};
+    use crate::tracer::layout::{CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_FINE_WORDS, SPHERE_WORDS};
 
     #[test]
     fn every_kernel_reads_exactly_its_record() {
         assert_eq!(sphere(8, 2, 2).fb_reads, SPHERE_WORDS);
+        assert_eq!(sphere_with(8, 2, 2, true).fb_reads, SPHERE_FINE_WORDS);
         for i in [Inside::Triangle, Inside::Rectangle, Inside::Disc] {
             assert_eq!(planar(i, 9, 2).fb_reads, PLANAR_WORDS);
         }
@@ -1004,7 +1055,8 @@ mod tests {
         assert_eq!(polygon_tail().fb_reads, 5);
         assert_eq!(init().fb_reads, 258);
         assert_eq!(eye(20, 2).fb_reads, 14);
-        assert_eq!(light_setup(2).fb_reads, 3);
+        assert_eq!(light_setup(2, false).fb_reads, 3);
+        assert_eq!(light_setup(2, true).fb_reads, 4);
         assert_eq!(post(true, 5, 3).fb_reads, 3 + 2 * 5);
         assert_eq!(
             shade(&[(1, 0.0), (10, 0.5), (200, 0.0)]).fb_reads,

@@ -66,7 +66,7 @@ pub struct Numerics {
     /// Guard bits of the coordinate format above the scene's largest
     /// object or eye coordinate, 2..=4.
     pub guard_bits: u32,
-    /// Offset of spawned rays along the normal, in LSBs, 1..=64.
+    /// Offset of spawned rays along the normal, in LSBs, 0..=64.
     pub eps_lsb: i32,
 }
 
@@ -158,9 +158,9 @@ fn build_as(
     nm: &Numerics,
     force_stream: bool,
 ) -> Result<Firmware, String> {
-    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(1..=64).contains(&nm.eps_lsb) {
+    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(0..=64).contains(&nm.eps_lsb) {
         return Err(format!(
-            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 1..=64"
+            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 0..=64"
         ));
     }
     let (tw, th) = tile_shape(opt.ways)
