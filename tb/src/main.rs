@@ -178,6 +178,14 @@ enum Command {
         /// Maximum objects per BSP leaf.
         #[arg(long, value_name = "N", default_value_t = 5)]
         max_leaf: usize,
+        /// Newton-Raphson steps after each reciprocal / square-root table
+        /// lookup (0..=3).
+        #[arg(long, value_name = "N", default_value_t = 2)]
+        newton_steps: u32,
+        /// Entries of the reciprocal and reciprocal square-root tables in
+        /// every RC's RAM: 16, 32, 64 or 128.
+        #[arg(long, value_name = "N", default_value_t = 128)]
+        table_entries: u32,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -300,6 +308,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            newton_steps,
+            table_entries,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -312,6 +322,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            newton_steps,
+            table_entries,
         }),
         Command::Compare {
             a,

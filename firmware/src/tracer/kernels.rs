@@ -79,6 +79,37 @@ pub const EPS_LSB: i32 = 0;
 /// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
 pub const INSIDE_TOL: i32 = 2;
 
+/// Entries of the reciprocal and reciprocal square root tables by default.
+pub const TABLE_ENTRIES: u32 = 128;
+/// Table sizes the RC RAM map has room for (each table has a 128-word
+/// slot; two of 256 would fill the whole 512-word RAM).
+pub const TABLE_SIZES: [u32; 4] = [16, 32, 64, 128];
+
+/// How the kernels approximate reciprocals and reciprocal square roots:
+/// table entries ([`TABLE_SIZES`]) and Newton-Raphson steps after the
+/// lookup. A plain `u32` is that many steps with the default table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Approx {
+    pub newton_steps: u32,
+    pub table_entries: u32,
+}
+
+impl From<u32> for Approx {
+    fn from(newton_steps: u32) -> Approx {
+        Approx {
+            newton_steps,
+            table_entries: TABLE_ENTRIES,
+        }
+    }
+}
+
+impl Approx {
+    /// Right shift of the table index against the 128-entry table.
+    fn coarse(self) -> u32 {
+        (TABLE_ENTRIES / self.table_entries.clamp(1, TABLE_ENTRIES)).trailing_zeros()
+    }
+}
+
 /// An emitter of context lines.
 #[derive(Default)]
 pub struct K {
@@ -129,7 +160,8 @@ fn r(k: u8) -> String {
 /// [2^13, 2^14)), `X = |v'|^2 >> 15` in Q.11 (range [1, 12)), reciprocal
 /// square root from the RSQ table (index X >> 8) and two Newton-Raphson
 /// steps `y += y (1 - X y^2) / 2`.
-pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
+pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let [a, b, c] = v.map(r);
     let [t0, t1, t2, t3, t4] = t.map(r);
     k.comment("normalize");
@@ -149,10 +181,10 @@ pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
     k.c(format!("mul out, {a}, {a}"))
         .c(format!("mac out, {b}, {b}"))
         .c(format!("mac {t1}, {c}, {c}, >>15")) // X, Q.11
-        .c(format!("srl {t2}, {t1}, #8"))
+        .c(format!("srl {t2}, {t1}, #{}", 8 + nr.coarse()))
         .c(format!("ld {t2}, [{t2} + #{}]", ram::RSQ)) // y
         .c(format!("ld {t4}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.c(format!("mul {t3}, {t2}, {t2}, >>14"))
             .c(format!("mul {t3}, {t3}, {t1}, >>11"))
             .c(format!("sub {t3}, {t3}, {t4}"))
@@ -175,7 +207,8 @@ pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
 /// is in [2^13, 2^15), reciprocal square root of X (Q.11) from the RSQ
 /// table and two Newton-Raphson steps, `sqrt(X) = X * y` (Q.12), then
 /// shift right by `(e - 1) / 2` (since `s = X 2^-(3 + e)` in Q.11 units). Clobbers `t` (4 registers); `s` is kept.
-pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
+pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let (s, o) = (r(s), r(out));
     let [e, x, y, w] = t.map(r);
     k.comment("sqrt");
@@ -186,10 +219,10 @@ pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
         .c(format!("sub {e}, {e}, #2"))
         .c(format!("or {e}, {e}, #1"))
         .c(format!("sll {x}, {o}, {e}"))
-        .c(format!("srl {y}, {x}, #8"))
+        .c(format!("srl {y}, {x}, #{}", 8 + nr.coarse()))
         .c(format!("ld {y}, [{y} + #{}]", ram::RSQ))
         .c(format!("ld {w}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.c(format!("mul {o}, {y}, {y}, >>14"))
             .c(format!("mul {o}, {o}, {x}, >>11"))
             .c(format!("sub {o}, {o}, {w}"))
@@ -208,18 +241,19 @@ pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
 /// the RCP table (index bits 13..7) and two Newton-Raphson steps
 /// `r -= r (den' r / 2^29 - 1)`, then `q = (num * r) >> (15 - sh)` from the
 /// two accumulator halves. Result into `num`'s register `out`; clobbers `t`.
-pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: u32) {
+pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let (n, d, o) = (r(num), r(den), r(out));
     let [sh, dn, rc, w, one] = t.map(r);
     k.comment("divide");
     k.c(format!("clz {sh}, {d}"))
         .c(format!("sub {sh}, {sh}, #1"))
         .c(format!("sll {dn}, {d}, {sh}"))
-        .c(format!("srl {rc}, {dn}, #7"))
-        .c(format!("and {rc}, {rc}, #127"))
+        .c(format!("srl {rc}, {dn}, #{}", 7 + nr.coarse()))
+        .c(format!("and {rc}, {rc}, #{}", nr.table_entries - 1))
         .c(format!("ld {rc}, [{rc} + #{}]", ram::RCP))
         .c(format!("ld {one}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.c(format!("mul {w}, {dn}, {rc}, >>15"))
             .c(format!("sub {w}, {w}, {one}"))
             .c(format!("ldacc {rc}, <<14"))
@@ -277,7 +311,8 @@ fn commit_streamed_normal(k: &mut K, t: u8) {
 /// radius, which is a miss), only `p / r` is squared: `s = 1 - |p / r|^2`,
 /// `t = b - sg r sqrt(s)`, and the normal follows without the hit point:
 /// `n = -(sg p / r + sqrt(s) d)`.
-pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
+pub fn sphere(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     sphere_with(ks, ep, nr, false)
 }
 
@@ -289,7 +324,8 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
 /// formed in the accumulator from the unrounded centre and the unrounded
 /// `b` (its remainder below 1 LSB, read back with `accl`, is subtracted
 /// along `d` as well): `p = (c - o) + cl - b d` to 2^-ep LSB.
-pub fn sphere_with(ks: u32, ep: u32, nr: u32, fine: bool) -> K {
+pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("sphere: oc = c - o");
     k.c("sub r8, fb0, r1")
@@ -365,7 +401,8 @@ pub enum Inside {
 /// The ray-plane part shared by the planar and polygon kernels: reads the
 /// plane normal and a vertex from FB set 0, and leaves `t = num / den` in
 /// r9 with F set where the plane is hit in front, closer than `tbest`.
-fn plane_hit(k: &mut K, nr: u32) {
+fn plane_hit(k: &mut K, nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
@@ -395,7 +432,8 @@ fn plane_hit(k: &mut K, nr: u32) {
 /// `den = -n.d > 0` (front face), `num = -n.(v0 - o) > 0`; the test
 /// `num 2^14 < tbest den` is done in the 32-bit accumulator before the
 /// division, so the quotient always fits.
-pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
+pub fn planar(inside: Inside, kt: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("planar: den = n.d, num = n.(v0 - o)");
     plane_hit(&mut k, nr);
@@ -444,7 +482,8 @@ pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
 /// (`max_a` where `d_a < 0`), `t = |c - o_a| / |d_a|` by [`divide`] after the
 /// accumulator test, and accepts it where the hit point lies within the
 /// other two slabs; the normal is `-sign(d_a)` along `a`.
-pub fn aabox(nr: u32) -> K {
+pub fn aabox(nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     for a in 0..3u32 {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
@@ -492,7 +531,8 @@ pub fn aabox(nr: u32) -> K {
 /// the parity flips where `u > 0, w >= 0, u + w <= 1` (half-open, so a
 /// point on a shared diagonal counts once). Tail (5 words: `n.xyz, obj,
 /// mat`): commit where valid and the parity is odd.
-pub fn polygon_head(nr: u32) -> K {
+pub fn polygon_head(nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("polygon head: the plane");
     plane_hit(&mut k, nr);
@@ -546,7 +586,8 @@ pub fn polygon_tail() -> K {
 /// In the plane across the axis the ray is a 2D ray: its direction
 /// `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D problem is the
 /// sphere's perpendicular method, and `t = tau / |d2|` by [`divide`].
-pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
+pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("cylinder: oc = B - o, projected on e1, e2");
     k.c("sub r8, fb0, r1")
@@ -790,7 +831,8 @@ pub fn leaf_any() -> K {
 /// Eye rays. Stream: `px0, py0, from.xyz, (A, B, C) per axis`: the
 /// direction through pixel (i, j) is `A + i B + j C` with A in Q2.13 and
 /// B, C scaled by 2^kd; normalised in the RC.
-pub fn eye(kd: u32, nr: u32) -> K {
+pub fn eye(kd: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let sh = kd - 13;
     let mut k = K::default();
     k.c(format!("ld r8, [r0 + #{}]", ram::LANE_COL))
@@ -874,7 +916,8 @@ pub fn post(level0: bool, materials: usize, eps: i32) -> K {
 /// light divided by `2^k` ([`super::layout::light_shift`]); the direction
 /// is that of `light / 2^k - P / 2^k`, and where `k > 0` (a light outside
 /// every object's reach) the segment is not cut at the light.
-pub fn light_setup(nr: u32, shifted: bool) -> K {
+pub fn light_setup(nr: impl Into<Approx>, shifted: bool) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     for (i, o) in [1, 2, 3].into_iter().enumerate() {
         k.c(format!("ld r{o}, [r0 + #{}]", ram::SH_P + i as u32));
@@ -1069,12 +1112,12 @@ mod tests {
     #[test]
     fn tables_match_their_definitions() {
         use crate::tracer::layout::{rcp_table, rsq_table};
-        let rsq = rsq_table();
+        let rsq = rsq_table(128);
         for (k, &y) in rsq.iter().enumerate().skip(8) {
             let x = (k as f64 + 0.5) * 256.0 / 2048.0;
             assert!((y as f64 / 16384.0 - 1.0 / x.sqrt()).abs() < 1e-4);
         }
-        let rcp = rcp_table();
+        let rcp = rcp_table(128);
         for (k, &r) in rcp.iter().enumerate() {
             assert!(r > 16384 && r < 32768, "{k}");
         }

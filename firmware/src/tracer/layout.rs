@@ -176,25 +176,38 @@ pub struct Stream {
     pub largest_block: usize,
 }
 
-/// Reciprocal square root table: entry k = 1/sqrt(X) for X = (k + 0.5) 256
-/// in Q.11, Q1.14 (saturated below index 8, where it is never used).
-pub fn rsq_table() -> Vec<u16> {
-    (0..128)
+/// Reciprocal square root table of `n` entries (a power of two up to 128):
+/// entry k = 1/sqrt(X) for X = (k + 0.5) 2^(15 - log2 n) in Q.11, Q1.14
+/// (saturated at the bottom, where it is never used).
+pub fn rsq_table(n: usize) -> Vec<u16> {
+    let w = 32768.0 / n as f64;
+    (0..n)
         .map(|k| {
-            let x = (k as f64 + 0.5) * 256.0 / 2048.0;
+            let x = (k as f64 + 0.5) * w / 2048.0;
             ((1.0 / x.sqrt()) * 16384.0).round().min(32767.0) as i16 as u16
         })
         .collect()
 }
 
-/// Reciprocal table: entry k = 2^29 / d for d = 2^14 + (k + 0.5) 128.
-pub fn rcp_table() -> Vec<u16> {
-    (0..128)
+/// Reciprocal table of `n` entries: entry k = 2^29 / d for
+/// d = 2^14 + (k + 0.5) 2^14 / n.
+pub fn rcp_table(n: usize) -> Vec<u16> {
+    let w = 16384.0 / n as f64;
+    (0..n)
         .map(|k| {
-            let d = 16384.0 + (k as f64 + 0.5) * 128.0;
+            let d = 16384.0 + (k as f64 + 0.5) * w;
             ((1u64 << 29) as f64 / d).round().min(32767.0) as i16 as u16
         })
         .collect()
+}
+
+/// The two 128-word table slots at the start of the init stream (RC RAM
+/// `RSQ` and `RCP`): tables of `n` entries, the rest of each slot zero.
+pub fn table_slots(n: usize) -> Vec<u16> {
+    let mut v = vec![0u16; 256];
+    v[..n].copy_from_slice(&rsq_table(n));
+    v[128..128 + n].copy_from_slice(&rcp_table(n));
+    v
 }
 
 struct W {
@@ -512,8 +525,7 @@ fn build_as(
 
     let mut w = W { fb: Vec::new(), s };
     // Init stream.
-    w.fb.extend(rsq_table());
-    w.fb.extend(rcp_table());
+    w.fb.extend(table_slots(128));
     w.raw(16384);
     w.raw(32767);
 
