@@ -201,6 +201,14 @@ enum Command {
         /// or compact (index lists); the same image either way.
         #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
         layout: firmware::tracer::NodeLayout,
+        /// Newton-Raphson steps after each reciprocal / square-root table
+        /// lookup (0..=3).
+        #[arg(long, value_name = "N", default_value_t = 2)]
+        newton_steps: u32,
+        /// Entries of the reciprocal and reciprocal square-root tables in
+        /// every RC's RAM: 16, 32, 64 or 128.
+        #[arg(long, value_name = "N", default_value_t = 128)]
+        table_entries: u32,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -352,6 +360,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_depth,
             max_leaf,
             layout,
+            newton_steps,
+            table_entries,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -365,6 +375,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_depth,
             max_leaf,
             layout,
+            newton_steps,
+            table_entries,
         }),
         Command::Compare {
             a,

@@ -52,7 +52,10 @@ fn run(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>, f64) {
     let (runs, kernels): (Runs, Kernels) = match t.ty {
         ChipType::Sphere => (
             vec![("k_sphere", first)],
-            vec![("k_sphere", k::sphere(lay.ks_sphere, lay.ep_sphere, 2))],
+            vec![(
+                "k_sphere",
+                k::sphere_with(lay.ks_sphere, lay.ep_sphere, 2, lay.sphere_fine),
+            )],
         ),
         ChipType::Rectangle => (
             vec![("k_rect", first)],
@@ -237,6 +240,20 @@ fn sphere_kernel_vs_float_sphere() {
         inside: false,
     };
     measure("sphere", s, 12.0, 0.02);
+}
+
+/// A sphere 6.3 LSB in radius with its centre off the LSB grid (a
+/// sphereflake leaf, balls-4): the fine record (centre remainder, radius
+/// with extra bits, unrounded `b`) keeps its silhouette and normals close to
+/// the true sphere's, not the rounded one's.
+#[test]
+fn tiny_sphere_kernel_vs_float_sphere() {
+    let s = Shape::Sphere {
+        center: Vec3::new(0.470715, 0.470715, 0.598245),
+        radius: 0.00617284,
+        inside: false,
+    };
+    measure("tiny sphere", s, 2.0, 0.1);
 }
 
 #[test]

@@ -309,3 +309,19 @@ fn streamed_layout_matches_the_resident_one_on_a_small_scene() {
     );
     assert!(hs >= 0.98 && hs >= hr - 0.005);
 }
+
+/// A light far outside the scene (tetra-1's light moved to 400 units) does
+/// not coarsen the coordinate format: the shadow-ray kernel forms
+/// `light / 2^k - P / 2^k`. The image still matches the reference.
+#[test]
+fn a_far_light_keeps_the_fine_format() {
+    let mut scene = load("tetra-1.nff");
+    scene.lights[0].position = scene.lights[0].position * 22.0;
+    assert!(scene.lights[0].position.max_abs() > 390.0);
+    let (chip, rep) = render(&scene, &opts(32, 32), false, None).unwrap();
+    assert!(chip.firmware.layout.light_shifted);
+    assert_eq!(rep.json["format"], "Q4.11", "the light set the format");
+    let psnr = rep.json["psnr_db"].as_f64().unwrap();
+    eprintln!("far light: {psnr:.2} dB");
+    assert!(psnr >= 30.0, "far light: PSNR {psnr:.2} dB");
+}
