@@ -7,7 +7,13 @@
 //! (ray incoherence, paper Fig. 4). Two split rules:
 //! - [`SplitRule::Median`], the paper's: the spatial median of the node's
 //!   box, the axis cycling x, y, z with depth; a node becomes a leaf when it
-//!   holds at most `max_leaf` objects or is at `max_depth`.
+//!   holds at most `max_leaf` objects or is at `max_depth`, or after three
+//!   splits in a row (one per axis) that separated nothing.
+//!
+//! An object goes to every child cell it may meet: its bounding box and,
+//! with [`Bsp::build_with`], a finer conservative test (the scene compiler
+//! uses [`crate::scene::Shape::may_overlap`]: a triangle goes only to the
+//! cells it meets).
 //! - [`SplitRule::Sah`]: the surface area heuristic (pbrt's kd-tree costs:
 //!   traversal 1, intersection 80, empty bonus 0.5) over 32 candidate planes
 //!   per axis; a node also becomes a leaf when no split is cheaper.
@@ -94,9 +100,27 @@ pub struct BspStats {
 impl Bsp {
     /// Build over objects with these bounding boxes, inside `bounds`.
     pub fn build(object_bounds: &[Aabb], bounds: Aabb, params: BspParams) -> Bsp {
+        Bsp::build_with(object_bounds, bounds, params, &|_, _| true)
+    }
+
+    /// Build with a finer test of which cells an object meets: object `i`
+    /// goes to a child when its bounding box meets the child's box and
+    /// `meets(i, box)` (which must be conservative: false only when the
+    /// object and the box are apart).
+    pub fn build_with(
+        object_bounds: &[Aabb],
+        bounds: Aabb,
+        params: BspParams,
+        meets: &dyn Fn(u32, &Aabb) -> bool,
+    ) -> Bsp {
         let mut nodes = Vec::new();
         let all: Vec<u32> = (0..object_bounds.len() as u32).collect();
-        build(&mut nodes, object_bounds, bounds, all, 0, &params);
+        let ctx = Ctx {
+            ob: object_bounds,
+            p: &params,
+            meets,
+        };
+        build(&mut nodes, &ctx, bounds, all, 0, 0);
         Bsp { nodes, params }
     }
 
@@ -142,14 +166,27 @@ fn child_box(b: Aabb, axis: usize, pos: f64, above: bool) -> Aabb {
     c
 }
 
+struct Ctx<'a> {
+    ob: &'a [Aabb],
+    p: &'a BspParams,
+    meets: &'a dyn Fn(u32, &Aabb) -> bool,
+}
+
+/// Splits in a row that separated nothing (both children kept every
+/// object) after which a node becomes a leaf: one per axis, so a cell
+/// where more than `max_leaf` objects meet at a point or an edge is not
+/// split down to `max_depth` for nothing.
+const FUTILE_SPLITS: u32 = 3;
+
 fn build(
     nodes: &mut Vec<Node>,
-    ob: &[Aabb],
+    cx: &Ctx,
     bounds: Aabb,
     objects: Vec<u32>,
     depth: u32,
-    p: &BspParams,
+    futile: u32,
 ) -> u32 {
+    let (ob, p) = (cx.ob, cx.p);
     let at = nodes.len() as u32;
     nodes.push(Node {
         bounds,
@@ -158,7 +195,7 @@ fn build(
         split: None,
     });
     let objects = &nodes[at as usize].objects;
-    if objects.len() <= p.max_leaf || depth >= p.max_depth {
+    if objects.len() <= p.max_leaf || depth >= p.max_depth || futile >= FUTILE_SPLITS {
         return at;
     }
     let choice = match p.rule {
@@ -178,32 +215,28 @@ fn build(
     if !(pos > lo && pos < hi) {
         return at; // the box is too thin to split (at the snapped precision)
     }
+    let (bl, bh) = (
+        child_box(bounds, axis, pos, false),
+        child_box(bounds, axis, pos, true),
+    );
     let below: Vec<u32> = objects
         .iter()
         .copied()
-        .filter(|&i| ob[i as usize].min.axis(axis) <= pos)
+        .filter(|&i| ob[i as usize].min.axis(axis) <= pos && (cx.meets)(i, &bl))
         .collect();
     let above: Vec<u32> = objects
         .iter()
         .copied()
-        .filter(|&i| ob[i as usize].max.axis(axis) >= pos)
+        .filter(|&i| ob[i as usize].max.axis(axis) >= pos && (cx.meets)(i, &bh))
         .collect();
-    let l = build(
-        nodes,
-        ob,
-        child_box(bounds, axis, pos, false),
-        below,
-        depth + 1,
-        p,
-    );
-    let r = build(
-        nodes,
-        ob,
-        child_box(bounds, axis, pos, true),
-        above,
-        depth + 1,
-        p,
-    );
+    let n = objects.len();
+    let futile = if below.len() == n && above.len() == n {
+        futile + 1
+    } else {
+        0
+    };
+    let l = build(nodes, cx, bl, below, depth + 1, futile);
+    let r = build(nodes, cx, bh, above, depth + 1, futile);
     nodes[at as usize].split = Some(Split {
         axis: axis as u8,
         position: pos,

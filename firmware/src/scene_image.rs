@@ -453,13 +453,23 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
             (b.max.z / lsb).ceil() * lsb,
         ),
     };
-    let bsp = Bsp::build(
+    // An object goes to the cells it may meet, with 2 LSB to spare for the
+    // kernels' rounding.
+    let meets = |i: u32, b: &Aabb| {
+        let m = Vec3::ONE * (2.0 * lsb);
+        scene.objects[i as usize].shape.may_overlap(&Aabb {
+            min: b.min - m,
+            max: b.max + m,
+        })
+    };
+    let bsp = Bsp::build_with(
         &bounds,
         snap_out(world),
         BspParams {
             snap: lsb,
             ..opt.bsp
         },
+        &meets,
     );
     if bsp.nodes.len() > NO_CHILD as usize {
         return Err(err(

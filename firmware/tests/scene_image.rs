@@ -3,7 +3,7 @@
 //! against a brute-force walk of the planes stored in the image.
 
 use firmware::bsp::{BspParams, SplitRule};
-use firmware::scene::{native, Scene};
+use firmware::scene::{native, Aabb, Scene, Shape, Vec3};
 use firmware::scene_image::{compile, CompileOptions, Layout, MAGIC, NO_CHILD};
 
 const HEAD: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nup = [0, 1, 0]\nangle = 45\n\
@@ -115,6 +115,29 @@ fn check_membership(s: &Scene, img: &firmware::scene_image::SceneImage) {
         }
         got.sort();
         got.dedup();
+        // The node's cell: the scene's box (snapped out to the format)
+        // cut by the ancestors' planes, with the compiler's 2-LSB margin.
+        let mut cell = s
+            .objects
+            .iter()
+            .fold(Aabb::EMPTY, |a, o| a.union(o.shape.bounds()));
+        for a in 0..3 {
+            let (lo, hi) = (cell.min.axis(a), cell.max.axis(a));
+            set_axis(&mut cell.min, a, (lo / lsb).floor() * lsb);
+            set_axis(&mut cell.max, a, (hi / lsb).ceil() * lsb);
+        }
+        for &(ax, pos, above) in &planes {
+            if above {
+                set_axis(&mut cell.min, ax, pos);
+            } else {
+                set_axis(&mut cell.max, ax, pos);
+            }
+        }
+        let m = Vec3::ONE * (2.0 * lsb);
+        let cell = Aabb {
+            min: cell.min - m,
+            max: cell.max + m,
+        };
         let want: Vec<usize> = (0..s.objects.len())
             .filter(|&i| {
                 let b = s.objects[i].shape.bounds();
@@ -124,7 +147,7 @@ fn check_membership(s: &Scene, img: &firmware::scene_image::SceneImage) {
                     } else {
                         b.min.axis(ax) <= pos
                     }
-                })
+                }) && s.objects[i].shape.may_overlap(&cell)
             })
             .collect();
         assert_eq!(got, want, "node {k}");
@@ -229,4 +252,89 @@ fn spd_scenes_compile() {
     assert_eq!(r.layout, Layout::IndexLists);
     assert!(r.bsp.max_depth <= 15);
     check_membership(&balls, &img);
+}
+
+fn set_axis(v: &mut Vec3, a: usize, x: f64) {
+    match a {
+        0 => v.x = x,
+        1 => v.y = x,
+        _ => v.z = x,
+    }
+}
+
+/// `Shape::may_overlap` against sampling: whenever a point of a triangle
+/// (a dense barycentric grid) or of a sphere (its centre and the point
+/// nearest the box centre) lies inside a box, the test must say "may
+/// overlap"; and triangles built to miss the box by a margin must be
+/// rejected (the test is not just "true").
+#[test]
+fn may_overlap_is_conservative_and_rejects_clear_misses() {
+    let mut seed = 12345u64;
+    let mut rnd = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    let (mut rejected, mut sampled_hits) = (0, 0);
+    for _ in 0..3000 {
+        let c = Vec3::new(rnd(), rnd(), rnd()) * 0.5;
+        let h = Vec3::new(rnd().abs(), rnd().abs(), rnd().abs()) * 0.4 + Vec3::ONE * 0.01;
+        let b = Aabb {
+            min: c - h,
+            max: c + h,
+        };
+        let v = [
+            Vec3::new(rnd(), rnd(), rnd()),
+            Vec3::new(rnd(), rnd(), rnd()),
+            Vec3::new(rnd(), rnd(), rnd()),
+        ];
+        let t = Shape::Triangle { v, normals: None };
+        let inside =
+            |p: Vec3| (0..3).all(|a| p.axis(a) >= b.min.axis(a) && p.axis(a) <= b.max.axis(a));
+        let n = 40;
+        let mut any = false;
+        for i in 0..=n {
+            for j in 0..=n - i {
+                let (u, w) = (i as f64 / n as f64, j as f64 / n as f64);
+                if inside(v[0] + (v[1] - v[0]) * u + (v[2] - v[0]) * w) {
+                    any = true;
+                }
+            }
+        }
+        let may = t.may_overlap(&b);
+        if any {
+            sampled_hits += 1;
+            assert!(may, "triangle {v:?} has a point in {b:?}");
+        }
+        if !may {
+            rejected += 1;
+        }
+    }
+    assert!(
+        sampled_hits > 300 && rejected > 300,
+        "{sampled_hits} {rejected}"
+    );
+    // A triangle whose bounding box covers the box but which passes 0.2
+    // beside it (the plane x + y + z = 2.2 against the unit cube).
+    let t = Shape::Triangle {
+        v: [
+            Vec3::new(2.2, 0.0, 0.0),
+            Vec3::new(0.0, 2.2, 0.0),
+            Vec3::new(0.0, 0.0, 2.2),
+        ],
+        normals: None,
+    };
+    let unit = Aabb {
+        min: Vec3::new(0.0, 0.0, 0.0),
+        max: Vec3::ONE * 0.7,
+    };
+    assert!(t.bounds().overlaps(&unit) && !t.may_overlap(&unit));
+    // Spheres: the exact distance test.
+    let s = |x: f64| Shape::Sphere {
+        center: Vec3::new(x, 0.35, 0.35),
+        radius: 0.3,
+        inside: false,
+    };
+    assert!(s(0.95).may_overlap(&unit) && !s(1.05).may_overlap(&unit));
 }

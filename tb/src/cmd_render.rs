@@ -28,6 +28,10 @@ pub struct RenderArgs {
     pub max_leaf: usize,
     pub layout: firmware::tracer::NodeLayout,
     pub datapath: rtl::rc::Datapath,
+    /// Newton-Raphson steps after each table lookup.
+    pub newton_steps: u32,
+    /// Entries of the reciprocal and reciprocal square root tables.
+    pub table_entries: u32,
 }
 
 /// Everything `render` reports.
@@ -84,6 +88,8 @@ pub fn render_with(
         "height": opt.height,
         "ways": opt.ways,
         "depth": opt.depth,
+        "newton_steps": nm.newton_steps,
+        "table_entries": nm.table_entries,
         "psnr_db": if psnr.is_finite() { psnr } else { 99.0 },
         "hit_agreement": agree,
         "active_rc_fraction": chip.stats.active_rc_fraction(),
@@ -147,8 +153,23 @@ pub fn command(a: RenderArgs) -> Result<()> {
         layout: a.layout,
         datapath: a.datapath,
     };
+    if a.newton_steps > 3 {
+        anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
+    }
+    if !firmware::tracer::kernels::TABLE_SIZES.contains(&a.table_entries) {
+        anyhow::bail!(
+            "--table-entries {}: must be 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM)",
+            a.table_entries
+        );
+    }
+    let nm = firmware::tracer::Numerics {
+        newton_steps: a.newton_steps,
+        table_entries: a.table_entries,
+        ..Default::default()
+    };
     if let Some(p) = &a.emit_asm {
-        let fw = firmware::tracer::build(&scene, &opt).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let fw =
+            firmware::tracer::build_with(&scene, &opt, &nm).map_err(|e| anyhow::anyhow!("{e}"))?;
         write_atomic(p, fw.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
@@ -167,7 +188,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         }
         c
     });
-    let (chip, rep) = render(&scene, &opt, true, trace)?;
+    let (chip, rep) = render_with(&scene, &opt, &nm, true, trace)?;
     let out = a
         .out
         .unwrap_or_else(|| default_out(Path::new(&scene.source)));

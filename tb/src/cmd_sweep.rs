@@ -83,6 +83,21 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
             nm: Numerics { guard_bits, ..nm },
         });
     }
+    // Reciprocal / square-root table size, with one and two Newton steps.
+    for table_entries in firmware::tracer::kernels::TABLE_SIZES {
+        for newton_steps in [1, 2] {
+            v.push(Config {
+                knob: "table_entries",
+                value: format!("{table_entries}/{newton_steps}"),
+                opt: base,
+                nm: Numerics {
+                    table_entries,
+                    newton_steps,
+                    ..nm
+                },
+            });
+        }
+    }
     for eps_lsb in [1, 3, 8] {
         v.push(Config {
             knob: "ray_offset_lsb",
@@ -182,6 +197,7 @@ struct Row {
     bsp_max_leaf: usize,
     split: String,
     newton_steps: u32,
+    table_entries: u32,
     guard_bits: u32,
     ray_offset_lsb: i32,
     /// RC datapath width: 16 (the paper's chip) or 32.
@@ -256,6 +272,7 @@ fn row(
         bsp_max_leaf: opt.bsp.max_leaf,
         split: format!("{:?}", opt.bsp.rule).to_lowercase(),
         newton_steps: nm.newton_steps,
+        table_entries: nm.table_entries,
         guard_bits: nm.guard_bits,
         ray_offset_lsb: nm.eps_lsb,
         datapath_bits: opt.datapath.bits(),
@@ -473,6 +490,17 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             },
         })
         .collect();
+    // The table-size knob as a series of its own per scene.
+    let tables = scenes.iter().map(|s| Series {
+        name: format!("{} table sizes", short(s)),
+        points: rows
+            .iter()
+            .filter(|r| r.scene == *s && r.knob == "table_entries")
+            .map(|r| (r.fps_at_300mhz, r.psnr_db))
+            .collect(),
+        style: Default::default(),
+    });
+    let pareto: Vec<Series> = pareto.into_iter().chain(tables).collect();
     let paper: Vec<Mark> = rows
         .iter()
         .filter(|r| r.knob == "paper")

@@ -209,6 +209,14 @@ enum Command {
         /// bits).
         #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath, default_value = "16")]
         datapath: rtl::rc::Datapath,
+        /// Newton-Raphson steps after each reciprocal / square-root table
+        /// lookup (0..=3).
+        #[arg(long, value_name = "N", default_value_t = 2)]
+        newton_steps: u32,
+        /// Entries of the reciprocal and reciprocal square-root tables in
+        /// every RC's RAM: 16, 32, 64 or 128.
+        #[arg(long, value_name = "N", default_value_t = 128)]
+        table_entries: u32,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -362,6 +370,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_leaf,
             layout,
             datapath,
+            newton_steps,
+            table_entries,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -376,6 +386,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_leaf,
             layout,
             datapath,
+            newton_steps,
+            table_entries,
         }),
         Command::Compare {
             a,

@@ -18,7 +18,7 @@ use firmware::tracer::layout::{
     ChipType, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
 };
 use firmware::tracer::{self, mem, Options};
-use rtl::rc::{Datapath, Word};
+use rtl::rc::Word;
 use rtl::{Chip, Sim, Timing};
 use tb::reference::shapes::{intersect, Ray};
 
@@ -63,7 +63,10 @@ fn run_in<W: Word>(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>,
     let (runs, kernels): (Runs, Kernels) = match t.ty {
         ChipType::Sphere => (
             vec![("k_sphere", first)],
-            vec![("k_sphere", k::sphere(lay.ks_sphere, lay.ep_sphere, 2))],
+            vec![(
+                "k_sphere",
+                k::sphere_with(lay.ks_sphere, lay.ep_sphere, 2, lay.sphere_fine),
+            )],
         ),
         ChipType::Rectangle => (
             vec![("k_rect", first)],
@@ -257,6 +260,20 @@ fn shape_sphere() -> Shape {
         radius: 1.1,
         inside: false,
     }
+}
+
+/// A sphere 6.3 LSB in radius with its centre off the LSB grid (a
+/// sphereflake leaf, balls-4): the fine record (centre remainder, radius
+/// with extra bits, unrounded `b`) keeps its silhouette and normals close to
+/// the true sphere's, not the rounded one's.
+#[test]
+fn tiny_sphere_kernel_vs_float_sphere() {
+    let s = Shape::Sphere {
+        center: Vec3::new(0.470715, 0.470715, 0.598245),
+        radius: 0.00617284,
+        inside: false,
+    };
+    measure("tiny sphere", s, 2.0, 0.1);
 }
 
 #[test]

@@ -430,7 +430,14 @@ fn sweep_has_the_datapath_width_series() {
         (&r16[col("datapath_bits")], &r32[col("datapath_bits")]),
         ("16", "32")
     );
-    assert_eq!(&r32[col("format")], "Q5.26");
+    // the same integer bits, 16 more fraction bits
+    let (i16b, f16b) = r16[col("format")][1..].split_once('.').unwrap();
+    let (i32b, f32b) = r32[col("format")][1..].split_once('.').unwrap();
+    assert_eq!(i16b, i32b);
+    assert_eq!(
+        f32b.parse::<u32>().unwrap(),
+        f16b.parse::<u32>().unwrap() + 16
+    );
     let p = |r: &csv::StringRecord| r[col("psnr_db")].parse::<f64>().unwrap();
     assert!(p(&r32) >= p(&r16), "{} < {}", p(&r32), p(&r16));
     // every other knob runs on the 16-bit chip
@@ -458,4 +465,20 @@ fn large_scene_on_the_32_bit_chip() {
     let hits = rep.json["hit_agreement"].as_f64().unwrap();
     eprintln!("balls-4 16x16, 32-bit: {psnr:.2} dB {hits:.4}");
     assert!(psnr >= 40.0 && hits >= 0.99, "{psnr:.2} dB {hits:.4}");
+}
+
+/// A light far outside the scene (tetra-1's light moved to 400 units) does
+/// not coarsen the coordinate format: the shadow-ray kernel forms
+/// `light / 2^k - P / 2^k`. The image still matches the reference.
+#[test]
+fn a_far_light_keeps_the_fine_format() {
+    let mut scene = load("tetra-1.nff");
+    scene.lights[0].position = scene.lights[0].position * 22.0;
+    assert!(scene.lights[0].position.max_abs() > 390.0);
+    let (chip, rep) = render(&scene, &opts(32, 32), false, None).unwrap();
+    assert!(chip.firmware.layout.light_shifted);
+    assert_eq!(rep.json["format"], "Q4.11", "the light set the format");
+    let psnr = rep.json["psnr_db"].as_f64().unwrap();
+    eprintln!("far light: {psnr:.2} dB");
+    assert!(psnr >= 30.0, "far light: PSNR {psnr:.2} dB");
 }

@@ -394,6 +394,49 @@ impl Shape {
         }
     }
 
+    /// May the shape meet the box `b`? Exact for spheres and planar convex
+    /// shapes (the separating axis test: the box's axes, the shape's
+    /// normal, and each edge crossed with each box axis), conservative
+    /// otherwise (concave polygons are tested as their convex hull would
+    /// be; boxes, cylinders and cones by their bounding boxes). The BSP
+    /// uses it so that a triangle goes only to the cells it meets, not to
+    /// every cell its bounding box meets.
+    pub fn may_overlap(&self, b: &Aabb) -> bool {
+        if !self.bounds().overlaps(b) {
+            return false;
+        }
+        let c = b.center();
+        let h = b.extent() * 0.5;
+        match self {
+            Shape::Sphere { center, radius, .. } => {
+                let mut d2 = 0.0;
+                for a in 0..3 {
+                    let x = center.axis(a);
+                    let e = (b.min.axis(a) - x).max(x - b.max.axis(a)).max(0.0);
+                    d2 += e * e;
+                }
+                d2 <= radius * radius
+            }
+            Shape::Triangle { v, .. } => sat_planar(&v[..], c, h),
+            Shape::Polygon { v, .. } => sat_planar(v, c, h),
+            Shape::Rectangle {
+                corner,
+                edge1,
+                edge2,
+            } => sat_planar(
+                &[
+                    *corner,
+                    *corner + *edge1,
+                    *corner + *edge1 + *edge2,
+                    *corner + *edge2,
+                ],
+                c,
+                h,
+            ),
+            Shape::Box { .. } | Shape::Cone { .. } => true,
+        }
+    }
+
     /// Every number that defines the shape (for the non-finite check).
     fn numbers(&self) -> Vec<f64> {
         let mut out = Vec::new();
@@ -761,4 +804,40 @@ mod tests {
         };
         assert!(s.degeneracy().unwrap().contains("non-finite"));
     }
+}
+
+/// Separating axis test of a planar polygon (vertices `v`) against the box
+/// of centre `c` and half-extent `h`: false only when an axis separates
+/// them (the box's axes are covered by the bounding-box test before).
+fn sat_planar(v: &[Vec3], c: Vec3, h: Vec3) -> bool {
+    let p: Vec<Vec3> = v.iter().map(|&x| x - c).collect();
+    let separates = |ax: Vec3| {
+        let r = h.x * ax.x.abs() + h.y * ax.y.abs() + h.z * ax.z.abs();
+        let (lo, hi) = p
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                let d = q.dot(ax);
+                (lo.min(d), hi.max(d))
+            });
+        lo > r || hi < -r
+    };
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if n.dot(n) > 0.0 && separates(n) {
+        return false;
+    }
+    let axes = [
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+    ];
+    for k in 0..p.len() {
+        let e = p[(k + 1) % p.len()] - p[k];
+        for a in axes {
+            let ax = e.cross(a);
+            if ax.dot(ax) > 0.0 && separates(ax) {
+                return false;
+            }
+        }
+    }
+    true
 }

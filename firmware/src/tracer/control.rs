@@ -45,10 +45,10 @@ pub fn program(
         ("k_clsr", k::classify_above()),
         ("k_leafc", k::leaf_closest()),
         ("k_leafa", k::leaf_any()),
-        ("k_eye", k::eye(lay.kd, nm.newton_steps)),
+        ("k_eye", k::eye(lay.kd, nm.approx())),
         ("k_post0", k::post(true, lay.materials, nm.eps_lsb)),
         ("k_post1", k::post(false, lay.materials, nm.eps_lsb)),
-        ("k_light", k::light_setup(nm.newton_steps)),
+        ("k_light", k::light_setup(nm.approx(), lay.light_shifted)),
         ("k_shade", k::shade(&lay.shines)),
         ("k_out0", k::out_word(0)),
         ("k_out1", k::out_word(1)),
@@ -81,36 +81,30 @@ pub fn program(
     if has(ChipType::Sphere) {
         objk.push((
             "k_sphere",
-            k::sphere(lay.ks_sphere, lay.ep_sphere, nm.newton_steps),
+            k::sphere_with(lay.ks_sphere, lay.ep_sphere, nm.approx(), lay.sphere_fine),
         ));
     }
     if has(ChipType::Cylinder) {
-        objk.push((
-            "k_cyl",
-            k::cylinder(lay.ks_cyl, lay.ep_cyl, nm.newton_steps),
-        ));
-        objk.push((
-            "k_disc",
-            k::planar(Inside::Disc, lay.kt_disc, nm.newton_steps),
-        ));
+        objk.push(("k_cyl", k::cylinder(lay.ks_cyl, lay.ep_cyl, nm.approx())));
+        objk.push(("k_disc", k::planar(Inside::Disc, lay.kt_disc, nm.approx())));
     }
     if has(ChipType::Box) {
-        objk.push(("k_box", k::aabox(nm.newton_steps)));
+        objk.push(("k_box", k::aabox(nm.approx())));
     }
     if has(ChipType::Rectangle) {
         objk.push((
             "k_rect",
-            k::planar(Inside::Rectangle, lay.kt_rect, nm.newton_steps),
+            k::planar(Inside::Rectangle, lay.kt_rect, nm.approx()),
         ));
     }
     if has(ChipType::Triangle) {
         objk.push((
             "k_tri",
-            k::planar(Inside::Triangle, lay.kt_tri, nm.newton_steps),
+            k::planar(Inside::Triangle, lay.kt_tri, nm.approx()),
         ));
     }
     if has(ChipType::Polygon) {
-        objk.push(("k_polyh", k::polygon_head(nm.newton_steps)));
+        objk.push(("k_polyh", k::polygon_head(nm.approx())));
         objk.push(("k_polye", k::polygon_edge()));
         objk.push(("k_polyt", k::polygon_tail()));
     }

@@ -101,12 +101,47 @@ pub mod ram {
     pub const UNORD: u32 = 340;
 }
 
-/// Offset of a spawned ray's origin along the normal, in LSBs: the bound of
-/// the hit point's rounding error (t to 1 LSB, each coordinate of
-/// `o + t d` to 1/2 LSB, the normal to 2^-13).
-pub const EPS_LSB: i32 = 3;
+/// Offset of a spawned ray's origin along the normal, in LSBs. Default 0:
+/// every kernel is one-sided and its primitive convex (or planar), so a ray
+/// leaving the surface it starts on cannot hit that surface again however
+/// the hit point was rounded (the sphere's near root and a plane's
+/// back face are rejected), while an offset of a few LSB pushes the origin
+/// of a shadow ray off a small sphere into the neighbour it touches, whose
+/// kernel then rejects it (balls-4: 3 LSB cost 2 dB).
+pub const EPS_LSB: i32 = 0;
 /// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
 pub const INSIDE_TOL: i32 = 2;
+
+/// Entries of the reciprocal and reciprocal square root tables by default.
+pub const TABLE_ENTRIES: u32 = 128;
+/// Table sizes the RC RAM map has room for (each table has a 128-word
+/// slot; two of 256 would fill the whole 512-word RAM).
+pub const TABLE_SIZES: [u32; 4] = [16, 32, 64, 128];
+
+/// How the kernels approximate reciprocals and reciprocal square roots:
+/// table entries ([`TABLE_SIZES`]) and Newton-Raphson steps after the
+/// lookup. A plain `u32` is that many steps with the default table.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Approx {
+    pub newton_steps: u32,
+    pub table_entries: u32,
+}
+
+impl From<u32> for Approx {
+    fn from(newton_steps: u32) -> Approx {
+        Approx {
+            newton_steps,
+            table_entries: TABLE_ENTRIES,
+        }
+    }
+}
+
+impl Approx {
+    /// Right shift of the table index against the 128-entry table.
+    fn coarse(self) -> u32 {
+        (TABLE_ENTRIES / self.table_entries.clamp(1, TABLE_ENTRIES)).trailing_zeros()
+    }
+}
 
 /// An emitter of context lines.
 #[derive(Default)]
@@ -185,7 +220,8 @@ fn r(k: u8) -> String {
 /// [2^13, 2^14)), `X = |v'|^2 >> 15` in Q.11 (range [1, 12)), reciprocal
 /// square root from the RSQ table (index X >> 8) and two Newton-Raphson
 /// steps `y += y (1 - X y^2) / 2`.
-pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
+pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let [a, b, c] = v.map(r);
     let [t0, t1, t2, t3, t4] = t.map(r);
     k.comment("normalize");
@@ -205,10 +241,10 @@ pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
     k.c(format!("mul out, {a}, {a}"))
         .c(format!("mac out, {b}, {b}"))
         .cq(format!("mac {t1}, {c}, {c}, >>15")) // X, Q.11
-        .cq(format!("srl {t2}, {t1}, #8"))
+        .c(format!("srl {t2}, {t1}, #{}", q(8) + nr.coarse()))
         .c(format!("ld {t2}, [{t2} + #{}]", ram::RSQ)) // y
         .c(format!("ld {t4}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.cq(format!("mul {t3}, {t2}, {t2}, >>14"))
             .cq(format!("mul {t3}, {t3}, {t1}, >>11"))
             .c(format!("sub {t3}, {t3}, {t4}"))
@@ -231,7 +267,8 @@ pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: u32) {
 /// is in [2^13, 2^15), reciprocal square root of X (Q.11) from the RSQ
 /// table and two Newton-Raphson steps, `sqrt(X) = X * y` (Q.12), then
 /// shift right by `(e - 1) / 2` (since `s = X 2^-(3 + e)` in Q.11 units). Clobbers `t` (4 registers); `s` is kept.
-pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
+pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let (s, o) = (r(s), r(out));
     let [e, x, y, w] = t.map(r);
     k.comment("sqrt");
@@ -242,10 +279,10 @@ pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
         .c(format!("sub {e}, {e}, #2"))
         .c(format!("or {e}, {e}, #1"))
         .c(format!("sll {x}, {o}, {e}"))
-        .cq(format!("srl {y}, {x}, #8"))
+        .c(format!("srl {y}, {x}, #{}", q(8) + nr.coarse()))
         .c(format!("ld {y}, [{y} + #{}]", ram::RSQ))
         .c(format!("ld {w}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.cq(format!("mul {o}, {y}, {y}, >>14"))
             .cq(format!("mul {o}, {o}, {x}, >>11"))
             .c(format!("sub {o}, {o}, {w}"))
@@ -264,18 +301,19 @@ pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: u32) {
 /// the RCP table (index bits 13..7) and two Newton-Raphson steps
 /// `r -= r (den' r / 2^29 - 1)`, then `q = (num * r) >> (15 - sh)` from the
 /// two accumulator halves. Result into `num`'s register `out`; clobbers `t`.
-pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: u32) {
+pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let (n, d, o) = (r(num), r(den), r(out));
     let [sh, dn, rc, w, one] = t.map(r);
     k.comment("divide");
     k.c(format!("clz {sh}, {d}"))
         .c(format!("sub {sh}, {sh}, #1"))
         .c(format!("sll {dn}, {d}, {sh}"))
-        .cq(format!("srl {rc}, {dn}, #7"))
-        .c(format!("and {rc}, {rc}, #127"))
+        .c(format!("srl {rc}, {dn}, #{}", q(7) + nr.coarse()))
+        .c(format!("and {rc}, {rc}, #{}", nr.table_entries - 1))
         .c(format!("ld {rc}, [{rc} + #{}]", ram::RCP))
         .c(format!("ld {one}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.cq(format!("mul {w}, {dn}, {rc}, >>15"))
             .c(format!("sub {w}, {w}, {one}"))
             .cq(format!("ldacc {rc}, <<14"))
@@ -333,7 +371,21 @@ fn commit_streamed_normal(k: &mut K, t: u8) {
 /// radius, which is a miss), only `p / r` is squared: `s = 1 - |p / r|^2`,
 /// `t = b - sg r sqrt(s)`, and the normal follows without the hit point:
 /// `n = -(sg p / r + sqrt(s) d)`.
-pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
+pub fn sphere(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
+    sphere_with(ks, ep, nr, false)
+}
+
+/// [`sphere`], with `fine`: spheres a few LSB across, whose rounded centre
+/// and radius would move their silhouettes and shadows by a sizeable part
+/// of their size. The record (11 words: `c.xyz, cl.xyz, r, invr, sg, obj,
+/// mat`) adds the centre's rounding remainder `cl` in units of 2^-14 LSB
+/// and holds `r` with `ep` extra fraction bits; the perpendicular vector is
+/// formed in the accumulator from the unrounded centre and the unrounded
+/// `b` (its remainder below 1 LSB, read back with `accl`, is subtracted
+/// along `d` as well): `p = (c - o) + cl - b d` to 2^-ep LSB.
+pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("sphere: oc = c - o");
     k.c("sub r8, fb0, r1")
@@ -342,10 +394,25 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
         .cq("mac r11, r10, r6, >>14"); // b
-    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
-        k.cq(format!("ldacc r{x}, <<14"))
-            .c(format!("msu r{x}, r11, r{d}, >>{}", q(14) - ep));
+    if fine {
+        // b's remainder: the accumulator minus round(b) 2^14, below 2^13
+        // in magnitude, so its low half is exact (the wrap is intended).
+        k.c("accl r12")
+            .cq("sll r14, r11, #14")
+            .c("sub r12, r12, r14");
     }
+    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
+        if fine {
+            k.cq(format!("mul r13, r12, r{d}, >>14"))
+                .cq(format!("ldacc r{x}, <<14"))
+                .c("mac out, fb0, #1")
+                .c("msu out, r13, #1");
+        } else {
+            k.cq(format!("ldacc r{x}, <<14"));
+        }
+        k.c(format!("msu r{x}, r11, r{d}, >>{}", q(14) - ep));
+    }
+    let er = if fine { ep } else { 0 };
     k.c("mov r12, fb0").c("mov r13, fb0"); // r, invr
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
         k.c(format!("mul r{x}, r{x}, r13, >>{}", ks + ep))
@@ -358,7 +425,7 @@ pub fn sphere(ks: u32, ep: u32, nr: u32) -> K {
         .cq("msu r15, r10, r10, >>14")
         .c("cmp.gt r15, #0");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
-    k.cq("mul r9, r12, r8, >>14") // h
+    k.c(format!("mul r9, r12, r8, >>{}", q(14) + er)) // h
         .c("mov r10, fb0") // sg
         .cq("mul r9, r9, r10, >>14")
         .c("sub r9, r11, r9") // t
@@ -394,7 +461,8 @@ pub enum Inside {
 /// The ray-plane part shared by the planar and polygon kernels: reads the
 /// plane normal and a vertex from FB set 0, and leaves `t = num / den` in
 /// r9 with F set where the plane is hit in front, closer than `tbest`.
-fn plane_hit(k: &mut K, nr: u32) {
+fn plane_hit(k: &mut K, nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
@@ -424,7 +492,8 @@ fn plane_hit(k: &mut K, nr: u32) {
 /// `den = -n.d > 0` (front face), `num = -n.(v0 - o) > 0`; the test
 /// `num 2^14 < tbest den` is done in the 32-bit accumulator before the
 /// division, so the quotient always fits.
-pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
+pub fn planar(inside: Inside, kt: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("planar: den = n.d, num = n.(v0 - o)");
     plane_hit(&mut k, nr);
@@ -473,7 +542,8 @@ pub fn planar(inside: Inside, kt: u32, nr: u32) -> K {
 /// (`max_a` where `d_a < 0`), `t = |c - o_a| / |d_a|` by [`divide`] after the
 /// accumulator test, and accepts it where the hit point lies within the
 /// other two slabs; the normal is `-sign(d_a)` along `a`.
-pub fn aabox(nr: u32) -> K {
+pub fn aabox(nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     for a in 0..3u32 {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
@@ -537,7 +607,8 @@ pub fn aabox(nr: u32) -> K {
 ///
 /// Tail (5 words: `n.xyz, obj, mat`): commit where valid and the parity
 /// is odd.
-pub fn polygon_head(nr: u32) -> K {
+pub fn polygon_head(nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("polygon head: the plane");
     plane_hit(&mut k, nr);
@@ -601,7 +672,8 @@ pub fn polygon_tail() -> K {
 /// In the plane across the axis the ray is a 2D ray: its direction
 /// `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D problem is the
 /// sphere's perpendicular method, and `t = tau / |d2|` by [`divide`].
-pub fn cylinder(ks: u32, ep: u32, nr: u32) -> K {
+pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("cylinder: oc = B - o, projected on e1, e2");
     k.c("sub r8, fb0, r1")
@@ -845,7 +917,8 @@ pub fn leaf_any() -> K {
 /// Eye rays. Stream: `px0, py0, from.xyz, (A, B, C) per axis`: the
 /// direction through pixel (i, j) is `A + i B + j C` with A in Q2.13 and
 /// B, C scaled by 2^kd; normalised in the RC.
-pub fn eye(kd: u32, nr: u32) -> K {
+pub fn eye(kd: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
     let sh = kd - q(13);
     let mut k = K::default();
     k.c(format!("ld r8, [r0 + #{}]", ram::LANE_COL))
@@ -924,16 +997,36 @@ pub fn post(level0: bool, materials: usize, eps: i32) -> K {
 /// offset hit point, unit direction, `tbest` = distance - 2 LSB; RCs with
 /// no hit or with the light behind the surface (N.L <= 0, the SPD rule)
 /// sleep. Also keeps N.L and R.V for shading.
-pub fn light_setup(nr: u32) -> K {
+///
+/// `shifted`: the stream starts with a scale shift `k` and holds the
+/// light divided by `2^k` ([`super::layout::light_shift`]); the direction
+/// is that of `light / 2^k - P / 2^k`, and where `k > 0` (a light outside
+/// every object's reach) the segment is not cut at the light.
+pub fn light_setup(nr: impl Into<Approx>, shifted: bool) -> K {
+    let nr: Approx = nr.into();
     let mut k = K::default();
     for (i, o) in [1, 2, 3].into_iter().enumerate() {
         k.c(format!("ld r{o}, [r0 + #{}]", ram::SH_P + i as u32));
     }
-    k.c("sub r8, fb0, r1")
-        .c("sub r9, fb0, r2")
-        .c("sub r10, fb0, r3");
+    if shifted {
+        k.c("mov r15, fb0");
+        for (x, o) in [(8, 1), (9, 2), (10, 3)] {
+            k.c(format!("sra r{x}, r{o}, r15"))
+                .c(format!("sub r{x}, fb0, r{x}"));
+        }
+        k.c(format!("st r15, [#{}]", ram::TMP0));
+    } else {
+        k.c("sub r8, fb0, r1")
+            .c("sub r9, fb0, r2")
+            .c("sub r10, fb0, r3");
+    }
     normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
     k.c("mov r4, r8").c("mov r5, r9").c("mov r6, r10");
+    if shifted {
+        k.c(format!("ld r15, [r0 + #{}]", ram::TMP0))
+            .c("cmp.gt r15, #0")
+            .c(format!("(f) ld r11, [r0 + #{}]", ram::C_INF));
+    }
     k.c("sub r7, r11, #2")
         .c(format!("st r7, [#{}]", ram::PASS_T0));
     // nl = N.L
@@ -1075,11 +1168,12 @@ pub fn out_word(i: u32) -> K {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tracer::layout::{CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_WORDS};
+    use crate::tracer::layout::{CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_FINE_WORDS, SPHERE_WORDS};
 
     #[test]
     fn every_kernel_reads_exactly_its_record() {
         assert_eq!(sphere(8, 2, 2).fb_reads, SPHERE_WORDS);
+        assert_eq!(sphere_with(8, 2, 2, true).fb_reads, SPHERE_FINE_WORDS);
         for i in [Inside::Triangle, Inside::Rectangle, Inside::Disc] {
             assert_eq!(planar(i, 9, 2).fb_reads, PLANAR_WORDS);
         }
@@ -1090,7 +1184,8 @@ mod tests {
         assert_eq!(polygon_tail().fb_reads, 5);
         assert_eq!(init().fb_reads, 258);
         assert_eq!(eye(20, 2).fb_reads, 14);
-        assert_eq!(light_setup(2).fb_reads, 3);
+        assert_eq!(light_setup(2, false).fb_reads, 3);
+        assert_eq!(light_setup(2, true).fb_reads, 4);
         assert_eq!(post(true, 5, 3).fb_reads, 3 + 2 * 5);
         assert_eq!(
             shade(&[(1, 0.0), (10, 0.5), (200, 0.0)]).fb_reads,
@@ -1103,12 +1198,12 @@ mod tests {
     #[test]
     fn tables_match_their_definitions() {
         use crate::tracer::layout::{rcp_table, rsq_table};
-        let rsq = rsq_table();
+        let rsq = rsq_table(128);
         for (k, &y) in rsq.iter().enumerate().skip(8) {
             let x = (k as f64 + 0.5) * 256.0 / 2048.0;
             assert!((y as f64 / 16384.0 - 1.0 / x.sqrt()).abs() < 1e-4);
         }
-        let rcp = rcp_table();
+        let rcp = rcp_table(128);
         for (k, &r) in rcp.iter().enumerate() {
             assert!(r > 16384 && r < 32768, "{k}");
         }

@@ -92,6 +92,12 @@ impl ChipType {
 }
 
 pub const SPHERE_WORDS: usize = 8;
+/// Sphere record with the centre's remainder ([`super::kernels::sphere_with`]).
+pub const SPHERE_FINE_WORDS: usize = 11;
+/// Spheres get the fine record when the smallest is under this many LSB in
+/// radius (the rounding of the centre, up to 0.87 LSB, is then over 1.4% of
+/// the radius).
+pub const SPHERE_FINE_BELOW_LSB: f64 = 64.0;
 pub const PLANAR_WORDS: usize = 20;
 pub const CYL_BODY_WORDS: usize = 34;
 /// Cylinder group: caps flag, body, base cap, apex cap.
@@ -156,11 +162,17 @@ pub struct Layout {
     pub ks_cyl: u32,
     /// Extra fraction bits of the sphere kernel's perpendicular vector.
     pub ep_sphere: u32,
+    /// Sphere records carry the centre's rounding remainder and the radius
+    /// with `ep_sphere` extra bits ([`SPHERE_FINE_BELOW_LSB`]).
+    pub sphere_fine: bool,
     /// The same for the cylinder kernel.
     pub ep_cyl: u32,
     pub kt_rect: u32,
     pub kt_tri: u32,
     pub kt_disc: u32,
+    /// Light records carry a scale shift (some light is too far for
+    /// `light - P` to fit the format, [`light_shift`]).
+    pub light_shifted: bool,
     /// The streamed layout (scenes that do not fit FB set 0), or `None`
     /// when the whole scene is resident in the FB.
     pub stream: Option<Stream>,
@@ -197,38 +209,56 @@ pub struct Stream {
     pub largest_block: usize,
 }
 
-/// Reciprocal square root table: entry k = 1/sqrt(X) for X = (k + 0.5) 256
-/// in Q.11, Q1.14 (saturated below index 8, where it is never used).
-pub fn rsq_table() -> Vec<i32> {
-    rsq_table_for(0)
+/// Reciprocal square root table of `n` entries (a power of two up to 128):
+/// entry k = 1/sqrt(X) for X = (k + 0.5) 2^(15 - log2 n) in Q.11, Q1.14
+/// (saturated at the bottom, where it is never used).
+pub fn rsq_table(n: usize) -> Vec<i32> {
+    rsq_table_for(n, 0)
 }
 
 /// [`rsq_table`] with `x` extra fraction bits (16 on the 32-bit chip: the
 /// same entries in Q1.30, indexed by X in Q.27).
-pub fn rsq_table_for(x: u32) -> Vec<i32> {
-    let one = (14 + x) as f64;
-    (0..128)
+pub fn rsq_table_for(n: usize, x: u32) -> Vec<i32> {
+    let w = 32768.0 / n as f64;
+    let one = ((14 + x) as f64).exp2();
+    (0..n)
         .map(|k| {
-            let v = (k as f64 + 0.5) * 256.0 / 2048.0;
-            ((1.0 / v.sqrt()) * one.exp2()).round().min(word_max(x)) as i32
+            let v = (k as f64 + 0.5) * w / 2048.0;
+            ((1.0 / v.sqrt()) * one).round().min(word_max(x)) as i32
         })
         .collect()
 }
 
-/// Reciprocal table: entry k = 2^29 / d for d = 2^14 + (k + 0.5) 128.
-pub fn rcp_table() -> Vec<i32> {
-    rcp_table_for(0)
+/// Reciprocal table of `n` entries: entry k = 2^29 / d for
+/// d = 2^14 + (k + 0.5) 2^14 / n.
+pub fn rcp_table(n: usize) -> Vec<i32> {
+    rcp_table_for(n, 0)
 }
 
 /// [`rcp_table`] with `x` extra fraction bits: `2^(29 + 2x) / d` for
-/// `d = 2^(14 + x) + (k + 0.5) 2^(7 + x)`.
-pub fn rcp_table_for(x: u32) -> Vec<i32> {
-    (0..128)
+/// `d = 2^(14 + x) + (k + 0.5) 2^(14 + x) / n`.
+pub fn rcp_table_for(n: usize, x: u32) -> Vec<i32> {
+    let w = 16384.0 / n as f64;
+    (0..n)
         .map(|k| {
-            let d = 16384.0 + (k as f64 + 0.5) * 128.0;
+            let d = 16384.0 + (k as f64 + 0.5) * w;
             (((29 + x) as f64).exp2() / d).round().min(word_max(x)) as i32
         })
         .collect()
+}
+
+/// The two 128-word table slots at the start of the init stream (RC RAM
+/// `RSQ` and `RCP`): tables of `n` entries, the rest of each slot zero.
+pub fn table_slots(n: usize) -> Vec<i32> {
+    table_slots_for(n, 0)
+}
+
+/// [`table_slots`] with `x` extra fraction bits (the 32-bit chip: 16).
+pub fn table_slots_for(n: usize, x: u32) -> Vec<i32> {
+    let mut v = vec![0i32; 256];
+    v[..n].copy_from_slice(&rsq_table_for(n, x));
+    v[128..128 + n].copy_from_slice(&rcp_table_for(n, x));
+    v
 }
 
 /// The largest word value with `x` extra bits (16-bit: 32767).
@@ -433,31 +463,48 @@ fn fit_shift_w(m: f64, max: u32, x: u32) -> u32 {
     k.clamp(0.0, max as f64) as u32
 }
 
-/// The tracer's coordinate format: the finest `Qm.n` in which every object
-/// and the eye fit with two guard bits (so that differences of points and
-/// distances across the scene fit), and every light fits with the scene's
-/// extent added (so that `light - P` fits); never coarser than the scene
-/// compiler's format (whose BSP planes are snapped to its LSB, hence exact
-/// in a finer one). Lights need no guard bits of their own: only their
-/// difference to a point of the scene is ever formed.
-pub fn fit_frac(scene: &Scene, compiler_frac: u32, guard_bits: u32) -> u32 {
+/// Largest absolute coordinate of the eye and of every object's bounds.
+fn extent(scene: &Scene) -> f64 {
     let mut m: f64 = scene.camera.from.max_abs();
     for o in &scene.objects {
         let b = o.shape.bounds();
         m = m.max(b.min.max_abs()).max(b.max.max_abs());
     }
-    let l = scene
-        .lights
-        .iter()
-        .map(|l| l.position.max_abs())
-        .fold(0.0f64, f64::max);
+    m
+}
+
+/// The tracer's coordinate format: the finest `Qm.n` in which every object
+/// and the eye fit with two guard bits (so that differences of points and
+/// distances across the scene fit); never coarser than the scene
+/// compiler's format (whose BSP planes are snapped to its LSB, hence exact
+/// in a finer one). Lights do not take part: only their difference to a
+/// point of the scene is ever formed, at a coarser scale when needed
+/// ([`light_shift`]).
+pub fn fit_frac(scene: &Scene, compiler_frac: u32, guard_bits: u32) -> u32 {
+    let m = extent(scene);
     (compiler_frac..=14)
         .rev()
-        .find(|&n| {
-            let range = ((15 - n) as f64).exp2() * 0.999;
-            m * (guard_bits as f64).exp2() < range && l + m < range
-        })
+        .find(|&n| m * (guard_bits as f64).exp2() < ((15 - n) as f64).exp2() * 0.999)
         .unwrap_or(compiler_frac)
+}
+
+/// Scale of a light in the shadow-ray kernel: the smallest `k` for which
+/// `(light - P) / 2^k` fits the format `frac` for every point `P` of the
+/// scene (`|P| <= m`, [`extent`]). The light is stored divided by `2^k`
+/// and the kernel forms `light / 2^k - P / 2^k`; its direction is all a
+/// shadow ray needs. A light with `k > 0` lies outside the box `[-m, m]^3`
+/// that holds every object (`l + m >= 2^(15 - frac) > 2 m`), so no object
+/// lies beyond it along the shadow ray and the ray's segment may end at
+/// "no hit" (32767) instead of at the light.
+pub fn light_shift(position: Vec3, m: f64, frac: u32) -> Option<u32> {
+    light_shift_w(position, m, frac, 0)
+}
+
+/// [`light_shift`] for words with `x` extra bits (`frac` includes them).
+pub fn light_shift_w(position: Vec3, m: f64, frac: u32, x: u32) -> Option<u32> {
+    let range = ((15 + x - frac) as f64).exp2() * 0.999;
+    let l = position.max_abs();
+    (0..=15u32).find(|&k| (l + m) < range * (k as f64).exp2())
 }
 
 /// Lay out the scene.
@@ -488,7 +535,7 @@ fn build_as(
     guard_bits: u32,
     streamed: bool,
 ) -> Result<Layout, String> {
-    // The 32-bit chip: every format gets `x` more fraction bits.
+    // The 32-bit chip: every format gets `xb` more fraction bits.
     let xb = opt.datapath.bits() - 16;
     let fit_shift = |m: f64, max: u32| fit_shift_w(m, max, xb);
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
@@ -598,6 +645,7 @@ fn build_as(
         })
         .fold(1.0f64, f64::max);
     let ep_sphere = fit_shift(2.0 * r_max_sph, 4);
+    let sphere_fine = r_min_sph < SPHERE_FINE_BELOW_LSB;
     let r_max_cyl = scene
         .objects
         .iter()
@@ -614,8 +662,7 @@ fn build_as(
         x: xb,
     };
     // Init stream.
-    w.fb.extend(rsq_table_for(xb));
-    w.fb.extend(rcp_table_for(xb));
+    w.fb.extend(table_slots_for(128, xb));
     w.push(w.one());
     w.push(w.max());
 
@@ -675,10 +722,27 @@ fn build_as(
     }
     // Lights and shading coefficients.
     let nl = scene.lights.len().max(1) as f64;
-    let mut lights = Vec::new();
+    let m = extent(scene);
+    let mut shifts = Vec::new();
     for l in &scene.lights {
+        shifts.push(light_shift_w(l.position, m, frac, xb).ok_or_else(|| {
+            err(
+                0,
+                format!(
+                    "light at {:?} too far from the scene for the format's differences",
+                    l.position.to_array()
+                ),
+            )
+        })?);
+    }
+    let light_shifted = shifts.iter().any(|&k| k > 0);
+    let mut lights = Vec::new();
+    for (l, &k) in scene.lights.iter().zip(&shifts) {
         lights.push(w.fb.len());
-        w.point(l.position);
+        if light_shifted {
+            w.raw(k as i64);
+        }
+        w.point(l.position * (-(k as f64)).exp2());
     }
     let mut shades = Vec::new();
     for l in &scene.lights {
@@ -733,6 +797,7 @@ fn build_as(
             continue;
         }
         let size = match t {
+            ChipType::Sphere if sphere_fine => SPHERE_FINE_WORDS,
             ChipType::Sphere => SPHERE_WORDS,
             ChipType::Cylinder => CYL_WORDS,
             ChipType::Box => BOX_WORDS,
@@ -754,10 +819,22 @@ fn build_as(
                 ) => {
                     let rq = (radius.abs() * s).round().max(1.0);
                     let invr = ((14 + xb + ks_sphere) as f64).exp2()
-                        / if streamed { radius.abs() * s } else { rq };
+                        / if streamed || sphere_fine {
+                            radius.abs() * s
+                        } else {
+                            rq
+                        };
                     let sg = if *inside { -1.0 } else { 1.0 };
                     w.point(*center);
-                    w.push(rq);
+                    if sphere_fine {
+                        for x in center.to_array() {
+                            let hi = w.sat(x * s) as f64;
+                            w.push((x * s - hi) * w.one());
+                        }
+                        w.push(radius.abs() * s * (ep_sphere as f64).exp2());
+                    } else {
+                        w.push(rq);
+                    }
                     w.push(invr);
                     w.push(sg * w.one());
                     w.raw(i as i64);
@@ -1039,10 +1116,12 @@ fn build_as(
             ks_sphere,
             ks_cyl,
             ep_sphere,
+            sphere_fine,
             ep_cyl,
             kt_rect: kt[0],
             kt_tri: kt[1],
             kt_disc: kt[2],
+            light_shifted,
             stream,
         });
     }
@@ -1128,10 +1207,12 @@ fn build_as(
         ks_sphere,
         ks_cyl,
         ep_sphere,
+        sphere_fine,
         ep_cyl,
         kt_rect: kt[0],
         kt_tri: kt[1],
         kt_disc: kt[2],
+        light_shifted,
         stream: None,
     })
 }

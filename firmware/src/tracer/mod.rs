@@ -21,8 +21,9 @@
 //!
 //! Number formats: coordinates and distances in the scene's `Qm.n` (fitted
 //! with two guard bits by [`crate::scene_image`]), directions and normals
-//! Q1.14, colours Q3.12. Reciprocal and reciprocal square root: 128-entry
-//! tables in every RC's RAM plus two Newton-Raphson steps.
+//! Q1.14, colours Q3.12. Reciprocal and reciprocal square root: tables of
+//! 128 entries (a knob: 16..=128) in every RC's RAM plus two Newton-Raphson
+//! steps.
 
 pub mod control;
 pub mod kernels;
@@ -117,8 +118,21 @@ pub struct Numerics {
     /// Guard bits of the coordinate format above the scene's largest
     /// object or eye coordinate, 2..=4.
     pub guard_bits: u32,
-    /// Offset of spawned rays along the normal, in LSBs, 1..=64.
+    /// Offset of spawned rays along the normal, in LSBs, 0..=64.
     pub eps_lsb: i32,
+    /// Entries of the reciprocal and reciprocal square root tables in every
+    /// RC's RAM: 16, 32, 64 or 128 ([`kernels::TABLE_SIZES`]).
+    pub table_entries: u32,
+}
+
+impl Numerics {
+    /// The kernels' reciprocal / square root approximation.
+    pub fn approx(&self) -> kernels::Approx {
+        kernels::Approx {
+            newton_steps: self.newton_steps,
+            table_entries: self.table_entries,
+        }
+    }
 }
 
 impl Default for Numerics {
@@ -127,6 +141,7 @@ impl Default for Numerics {
             newton_steps: 2,
             guard_bits: 2,
             eps_lsb: kernels::EPS_LSB,
+            table_entries: kernels::TABLE_ENTRIES,
         }
     }
 }
@@ -237,9 +252,15 @@ fn build_as(
     nm: &Numerics,
     force_stream: bool,
 ) -> Result<Firmware, String> {
-    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(1..=64).contains(&nm.eps_lsb) {
+    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(0..=64).contains(&nm.eps_lsb) {
         return Err(format!(
-            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 1..=64"
+            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 0..=64"
+        ));
+    }
+    if !kernels::TABLE_SIZES.contains(&nm.table_entries) {
+        return Err(format!(
+            "table size {}: must be 16, 32, 64 or 128 entries (each table has a 128-word slot of the RC's 512-word RAM)",
+            nm.table_entries
         ));
     }
     let (tw, th) = tile_shape(opt.ways)
@@ -254,7 +275,11 @@ fn build_as(
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
-    let lay = layout::build(scene, &image, opt, nm.guard_bits, force_stream)?;
+    let mut lay = layout::build(scene, &image, opt, nm.guard_bits, force_stream)?;
+    lay.fb[..256].copy_from_slice(&layout::table_slots_for(
+        nm.table_entries as usize,
+        opt.datapath.bits() - 16,
+    ));
     let prog = kernels::with_datapath(opt.datapath, || {
         control::program(scene, &lay, opt, nm, tw, th)
     })?;
