@@ -2,6 +2,9 @@
 //! independent references: i128 integer arithmetic and the `fixed` crate
 //! (I16F16, I8F24, I1F31 and I0F32 products; exact products in I64F64).
 
+// Lanes are compared index by index across several arrays.
+#![allow(clippy::needless_range_loop)]
+
 use fixed::types::{I0F32, I16F16, I1F31, I64F64, I8F24};
 use proptest::prelude::*;
 use rtl::kernel::Clocked;

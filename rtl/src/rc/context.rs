@@ -13,15 +13,15 @@
 //! * `op`    operation (see [`Op`]).
 //! * `guard` 0 always, 1 only where the flag F is set, 2 only where F is clear.
 //! * `we`    write the result to register `rd` (the output register is always
-//!           written by an operation that has a result).
+//!   written by an operation that has a result).
 //! * `rd`    destination register; for `CMP` the condition ([`Cond`]).
 //! * `asrc`  source of operand A ([`ASrc`]); `ra` is the register or, for the
-//!           interconnect sources, the direction / lane index.
+//!   interconnect sources, the direction / lane index.
 //! * `bs`    0: operand B is register `f[3:0]`, `f[8:4]` is the multiplier
-//!           shift and `f[9]` selects truncation instead of rounding;
-//!           `f[10]` is reserved (0) on the 16-bit chip and bit 5 of the
-//!           shift (0..=63) on the 32-bit chip ([`Context::decode_wide`]);
-//!           1: operand B is the 11-bit signed immediate `f`.
+//!   shift and `f[9]` selects truncation instead of rounding;
+//!   `f[10]` is reserved (0) on the 16-bit chip and bit 5 of the
+//!   shift (0..=63) on the 32-bit chip ([`Context::decode_wide`]);
+//!   1: operand B is the 11-bit signed immediate `f`.
 //!
 //! A context word is decoded once ([`Context::decode`]) into a [`Context`];
 //! the array executes the decoded form, so 64 RCs never decode 64 times.
