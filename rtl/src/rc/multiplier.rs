@@ -14,7 +14,7 @@
 /// `$t` the word, `$acc` the accumulator (twice as wide), `$w` wider still
 /// (exact sums and shifts), `$smask` the shift field mask.
 macro_rules! multiplier_unit {
-    ($m:ident, $t:ty, $acc:ty, $w:ty, $smask:expr, $doc:literal) => {
+    ($m:ident, $t:ty, $acc:ty, $w:ty, $smask:expr, $accumulate:ident, $doc:literal) => {
         #[doc = $doc]
         pub mod $m {
             /// The full product of two words.
@@ -27,11 +27,7 @@ macro_rules! multiplier_unit {
             /// accumulator's bounds.
             #[inline(always)]
             pub fn accumulate(acc: $acc, p: $acc, sub: bool) -> ($acc, bool) {
-                // In the wider type the exact sum cannot overflow; clamp it (vectorises).
-                let p = if sub { -(p as $w) } else { p as $w };
-                let w = acc as $w + p;
-                let r = w.clamp(<$acc>::MIN as $w, <$acc>::MAX as $w);
-                (r as $acc, r != w)
+                super::$accumulate(acc, p, sub)
             }
 
             /// Scale the accumulator to one word: shift right by `sh`, rounding
@@ -71,12 +67,40 @@ macro_rules! multiplier_unit {
     };
 }
 
+/// 32-bit accumulator: the exact sum in 64 bits, clamped (vectorises).
+#[inline(always)]
+fn accumulate32(acc: i32, p: i32, sub: bool) -> (i32, bool) {
+    let p = if sub { -(p as i64) } else { p as i64 };
+    let w = acc as i64 + p;
+    let r = w.clamp(i32::MIN as i64, i32::MAX as i64);
+    (r as i32, r != w)
+}
+
+/// 64-bit accumulator: a wrapping sum and its overflow flag (i128 sums do
+/// not vectorise). A product of two 32-bit words is at most 2^62 in
+/// magnitude, so `-p` never overflows, and an overflowing sum saturates
+/// towards the sign of `acc`.
+#[inline(always)]
+fn accumulate64(acc: i64, p: i64, sub: bool) -> (i64, bool) {
+    let (r, o) = if sub {
+        acc.overflowing_sub(p)
+    } else {
+        acc.overflowing_add(p)
+    };
+    if o {
+        (if acc < 0 { i64::MIN } else { i64::MAX }, true)
+    } else {
+        (r, false)
+    }
+}
+
 multiplier_unit!(
     w16,
     i16,
     i32,
     i64,
     31,
+    accumulate32,
     "16x16 multiplier, 32-bit accumulator."
 );
 multiplier_unit!(
@@ -85,6 +109,7 @@ multiplier_unit!(
     i64,
     i128,
     63,
+    accumulate64,
     "32x32 multiplier, 64-bit accumulator."
 );
 
