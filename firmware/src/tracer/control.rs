@@ -95,10 +95,7 @@ pub fn program(
         ));
     }
     if has(ChipType::Cone) {
-        objk.push((
-            "k_cone",
-            k::cone(lay.ks_cone, lay.ep_cone, nm.newton_steps),
-        ));
+        objk.push(("k_cone", k::cone(lay.ks_cone, lay.ep_cone, nm.newton_steps)));
         if !has(ChipType::Cylinder) {
             objk.push((
                 "k_disc",

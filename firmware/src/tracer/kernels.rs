@@ -717,7 +717,9 @@ pub fn cone(ks: u32, ep: u32, nr: u32) -> K {
         .c("msu r15, r10, r10, >>14") // 1/4 - |w|^2
         .c("cmp.ge r15, #0")
         .c(format!("st r11, [#{}]", ram::TMP0));
-    k.comment("frame: w.ce1 = -c qx, w.ce2 = -c qy, w.a = -qz; d.ce1 = c dx, d.ce2 = c dy, d.a = dz");
+    k.comment(
+        "frame: w.ce1 = -c qx, w.ce2 = -c qy, w.a = -qz; d.ce1 = c dx, d.ce2 = c dy, d.a = dz",
+    );
     for x in [12, 13, 14] {
         k.c("mul out, fb0, r8")
             .c("mac out, fb0, r9")

@@ -517,8 +517,7 @@ fn build_as(
         let Some(t) = ChipType::of(o.shape.prim_type()) else {
             return Err(err(
                 o.line,
-                "cones with unequal radii have no chip kernel (cylinders, spheres, boxes, rectangles, triangles and polygons do)"
-                    .into(),
+                "internal: a primitive type with no chip kernel".into(),
             ));
         };
         let ti = t as usize;
