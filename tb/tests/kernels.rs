@@ -15,7 +15,7 @@ use firmware::asm;
 use firmware::scene::{Object, Scene, Shape, Vec3};
 use firmware::tracer::kernels::{self as k, ram, Inside};
 use firmware::tracer::layout::{
-    ChipType, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
+    ChipType, CONE_BODY_WORDS, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
 };
 use firmware::tracer::{self, mem, Options};
 use rtl::rc::Word;
@@ -104,6 +104,22 @@ fn run_in<W: Word>(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>,
             ],
             vec![
                 ("k_cyl", k::cylinder(lay.ks_cyl, lay.ep_cyl, 2)),
+                ("k_disc", k::planar(Inside::Disc, lay.kt_disc, 2)),
+            ],
+        ),
+        ChipType::Cone => (
+            // The caps (discs) only where the record's caps flag says so,
+            // as the tracer does.
+            std::iter::once(("k_cone", first + 1))
+                .chain((0..2u32).filter(|_| lay.fb[t.first] != 0).map(|c| {
+                    (
+                        "k_disc",
+                        first + 1 + CONE_BODY_WORDS as u32 + c * PLANAR_WORDS as u32,
+                    )
+                }))
+                .collect(),
+            vec![
+                ("k_cone", k::cone(lay.ks_cone, lay.ep_cone, 2)),
                 ("k_disc", k::planar(Inside::Disc, lay.kt_disc, 2)),
             ],
         ),
@@ -304,6 +320,80 @@ fn shape_box() -> Shape {
     }
 }
 
+/// A tapered branch as the SPD tree's (half-angle 11 degrees), open.
+fn shape_cone() -> Shape {
+    Shape::Cone {
+        base: Vec3::new(-0.5, 0.2, 0.0),
+        base_radius: 0.7,
+        apex: Vec3::new(0.3, 0.6, 2.0),
+        apex_radius: 0.3,
+        inside: false,
+        caps: false,
+    }
+}
+
+/// A pointed cone, half-angle 63 degrees (radius 1.2 over height 0.6):
+/// many rays run steeper than its surface (A < 0) and hit the inside
+/// (back side, not seen) or the outside from below; capped.
+fn shape_steep_cone() -> Shape {
+    Shape::Cone {
+        base: Vec3::new(0.1, -0.2, 0.3),
+        base_radius: 1.2,
+        apex: Vec3::new(0.2, 0.0, 0.9),
+        apex_radius: 0.0,
+        inside: false,
+        caps: true,
+    }
+}
+
+/// Radii 0.5 and 0.49 over 2.5: the root formulas meet rays parallel to
+/// the surface (A near 0); `inside`: inside-visible (NFF negative radii).
+fn shape_nearly_cylindrical_cone(inside: bool) -> Shape {
+    Shape::Cone {
+        base: Vec3::new(0.0, -1.0, 0.2),
+        base_radius: 0.5,
+        apex: Vec3::new(0.4, 1.4, 0.0),
+        apex_radius: 0.49,
+        inside,
+        caps: false,
+    }
+}
+
+#[test]
+fn cone_kernel_vs_float_cone() {
+    let s = shape_cone();
+    // The largest error, 18 LSB, is one ray that grazes the surface nearly
+    // along a generator (A = 0.006, 4D = 6 LSB of Q.14): t is
+    // ill-conditioned there (half an LSB of the direction's Q1.14 moves it
+    // by 0.5 LSB, the rounding of 4D by 17); every other ray is within 6.
+    measure("cone", s, 24.0, 0.02);
+}
+
+#[test]
+fn steep_cone_kernel_vs_float_cone() {
+    let s = shape_steep_cone();
+    // Normals within 0.03: near the tip the radial direction of a hit a
+    // few dozen LSB off the axis turns with the hit's error along the ray.
+    measure("steep cone", s, 12.0, 0.03);
+}
+
+#[test]
+fn nearly_cylindrical_cone_kernel_vs_float_cone() {
+    for inside in [false, true] {
+        let s = shape_nearly_cylindrical_cone(inside);
+        measure(
+            if inside {
+                "nearly cylindrical cone, inside"
+            } else {
+                "nearly cylindrical cone"
+            },
+            s,
+            12.0,
+            0.02,
+        );
+    }
+}
+
 #[test]
 fn box_kernel_vs_float_aabox() {
     measure("box", shape_box(), 12.0, 1e-3);
@@ -404,7 +494,8 @@ fn gear_like_concave_polygon_kernel_vs_float_polygon() {
 /// Every kernel on the 32-bit chip (formats with 16 more fraction bits),
 /// against the same f64 shapes: errors of `t` in LSBs of its format (2^-16
 /// of the 16-bit chip's LSB) and normals within 1e-6 of the float ones
-/// (the 16-bit chip: 1e-3 to 0.02). The cylinder's `t` goes through a
+/// (the 16-bit chip: 1e-3 to 0.02; the cones: 8e-7 against 8e-3 to 0.02).
+/// The cylinder's `t` goes through a
 /// second normalisation and a division by `|d2|`: up to 56 LSB at grazing
 /// incidence (mean 1.6), still 2^10 finer than the 16-bit chip's LSB.
 #[test]
@@ -420,6 +511,23 @@ fn every_kernel_on_the_32_bit_chip() {
         (
             "gear polygon",
             shape_gear_like_concave_polygon(),
+            12.0,
+            1.5,
+            1e-6,
+        ),
+        // one ray grazing along a generator, as on the 16-bit chip
+        ("cone", shape_cone(), 24.0, 1.5, 1e-6),
+        ("steep cone", shape_steep_cone(), 12.0, 1.5, 1e-6),
+        (
+            "nearly cylindrical cone",
+            shape_nearly_cylindrical_cone(false),
+            12.0,
+            1.5,
+            1e-6,
+        ),
+        (
+            "inside cone",
+            shape_nearly_cylindrical_cone(true),
             12.0,
             1.5,
             1e-6,

@@ -337,13 +337,13 @@ fn streamed_layout_matches_the_resident_one_on_a_small_scene() {
 }
 
 /// The 32-bit chip (every format 16 fraction bits finer than the 16-bit
-/// chip's): 32x32 renders of the three small scenes against the float
+/// chip's): 32x32 renders of the small scenes (tree-1: cones) against the float
 /// reference, at 50 dB or more (the 16-bit chip's bar is 30 dB), and at
 /// least as close to the reference as the 16-bit chip at the same size.
 #[test]
 fn the_32_bit_chip_renders_the_small_scenes_closer_to_the_reference() {
     use firmware::tracer::Datapath;
-    for name in ["default.toml", "jacks-1.nff", "tetra-1.nff"] {
+    for name in ["default.toml", "jacks-1.nff", "tetra-1.nff", "tree-1.nff"] {
         let scene = load(name);
         let o16 = opts(32, 32);
         let o32 = Options {
@@ -481,4 +481,88 @@ fn a_far_light_keeps_the_fine_format() {
     let psnr = rep.json["psnr_db"].as_f64().unwrap();
     eprintln!("far light: {psnr:.2} dB");
     assert!(psnr >= 30.0, "far light: PSNR {psnr:.2} dB");
+}
+
+/// Every chip type in one scene (the default scene's five, plus a capped
+/// cone with unequal radii left of the big sphere and a concave polygon on
+/// the floor in front, both in view): resident with either node
+/// layout and streamed (the streamed node record then counts seven types),
+/// each against the f64 reference. Cone kernels load only where there are
+/// cones.
+#[test]
+fn all_seven_chip_types_resident_compact_and_streamed() {
+    use firmware::scene::{Object, Shape, Vec3};
+    use firmware::tracer::{NodeLayout, Numerics};
+    let mut scene = load("default.toml");
+    scene.objects.push(Object {
+        shape: Shape::Cone {
+            base: Vec3::new(-1.5, -1.0, 0.0),
+            base_radius: 0.45,
+            apex: Vec3::new(-1.3, -0.8, 1.3),
+            apex_radius: 0.15,
+            inside: false,
+            caps: true,
+        },
+        material: 2,
+        line: 0,
+    });
+    scene.objects.push(Object {
+        shape: Shape::Polygon {
+            v: vec![
+                Vec3::new(1.6, -4.4, 0.02),
+                Vec3::new(2.8, -4.4, 0.02),
+                Vec3::new(2.8, -3.2, 0.02),
+                Vec3::new(2.2, -3.8, 0.02),
+                Vec3::new(1.6, -3.2, 0.02),
+            ],
+            normals: None,
+        },
+        material: 0,
+        line: 0,
+    });
+    let (w, h) = (32, 32);
+    let reference = tb::reference::render(
+        &scene,
+        &tb::reference::Options {
+            width: w,
+            height: h,
+            max_depth: 2,
+            corners: false,
+            progress: false,
+        },
+    );
+    let r8 = reference.to_rgb8();
+    let compact = Options {
+        layout: NodeLayout::Compact,
+        ..opts(w, h)
+    };
+    let runs = [
+        (
+            "fig5",
+            tb::render::render_chip(&scene, &opts(w, h), false, None).unwrap(),
+        ),
+        (
+            "compact",
+            tb::render::render_chip(&scene, &compact, false, None).unwrap(),
+        ),
+        (
+            "streamed",
+            tb::render::render_chip_streamed(&scene, &opts(w, h), &Numerics::default(), false)
+                .unwrap(),
+        ),
+    ];
+    for (name, r) in &runs {
+        assert_eq!(r.firmware.layout.types.len(), 7, "{name}");
+        assert_eq!(r.firmware.layout.stream.is_some(), *name == "streamed");
+        let names: Vec<&str> = r.firmware.kernels.iter().map(|(n, _)| n.as_str()).collect();
+        assert!(names.contains(&"k_cone") && names.contains(&"k_disc"));
+        let psnr = tb::metrics::psnr(&r.rgb8, &r8);
+        let hits = tb::metrics::hit_agreement(&r.hits, &reference.hits);
+        eprintln!("seven types {w}x{h} {name}: {psnr:.2} dB, hit agreement {hits:.4}");
+        assert!(
+            psnr >= 30.0 && hits >= 0.99,
+            "{name}: {psnr:.2} dB, {hits:.4}"
+        );
+    }
+    assert!(!tracer_kernels("jacks-1.nff").contains(&"k_cone".to_string()));
 }

@@ -12,7 +12,6 @@
 //! - shells-1: its camera and light lie 60 and 100 units out and the shell
 //!   itself spans +-34, yet its smallest spheres have radius 0.0035, under
 //!   2 LSB of every 16-bit format that covers it (compile error).
-//! - tree-1: cones with unequal radii, which have no chip kernel.
 
 use std::path::PathBuf;
 
@@ -80,4 +79,11 @@ fn rings_1() {
 #[test]
 fn tetra_1() {
     check("tetra-1.nff");
+}
+
+#[test]
+fn tree_1() {
+    // A trunk and two branches: cones with unequal radii (the cone
+    // kernel), spheres at the joints, a polygon ground.
+    check("tree-1.nff");
 }

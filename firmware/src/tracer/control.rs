@@ -88,6 +88,15 @@ pub fn program(
         objk.push(("k_cyl", k::cylinder(lay.ks_cyl, lay.ep_cyl, nm.approx())));
         objk.push(("k_disc", k::planar(Inside::Disc, lay.kt_disc, nm.approx())));
     }
+    if has(ChipType::Cone) {
+        objk.push(("k_cone", k::cone(lay.ks_cone, lay.ep_cone, nm.newton_steps)));
+        if !has(ChipType::Cylinder) {
+            objk.push((
+                "k_disc",
+                k::planar(Inside::Disc, lay.kt_disc, nm.newton_steps),
+            ));
+        }
+    }
     if has(ChipType::Box) {
         objk.push(("k_box", k::aabox(nm.approx())));
     }
@@ -425,6 +434,24 @@ test_objects:\n        lw r13, PASS(r0)",
                     }
                     let _ = writeln!(w, "{n}_nocap:");
                 }
+                ChipType::Cone => {
+                    let _ = writeln!(
+                    w,
+                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
+                    kaddr("k_cone"),
+                    klen("k_cone")
+                );
+                    for c in 0..2 {
+                        let _ = writeln!(
+                            w,
+                            "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
+                            kaddr("k_disc"),
+                            1 + super::layout::CONE_BODY_WORDS + c * super::layout::PLANAR_WORDS,
+                            klen("k_disc")
+                        );
+                    }
+                    let _ = writeln!(w, "{n}_nocap:");
+                }
                 ChipType::Polygon => {
                     let _ = writeln!(
                     w,
@@ -565,7 +592,7 @@ done:   lw r15, SAVE_LR(r0)\n        ret\n",
     let _ = writeln!(
         w,
         "; test_objects (streamed): r5 = leaf node in main memory.\n\
-test_objects:\n        lw r9, 52(r5)\n        lw r6, 24(r5)\n        lw r13, PASS(r0)\n\
+test_objects:\n        lw r9, 56(r5)\n        lw r6, 24(r5)\n        lw r13, PASS(r0)\n\
 to_scan: lw r2, 0(r6)\n        addi r6, r6, 4\n        lhu r1, 0(r2)\n        bne r1, r13, to_need\n        addi r9, r9, -1\n        bnez r9, to_scan\n        li r4, 0\n        ret\n\
 to_need: li r4, SBANK\n        lw r1, 16(r5)\n        lw r3, 20(r5)\n        lw r2, CUR_BLK(r0)\n        beq r1, r2, to_have\n\
         rcany r2\n        li r2, SBANK\n        ldfb r1, r2, r3\n        dwait\n        sw r1, CUR_BLK(r0)\n\
@@ -607,6 +634,24 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
                         "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
                         kaddr("k_disc"),
                         1 + super::layout::CYL_BODY_WORDS + c * super::layout::PLANAR_WORDS,
+                        klen("k_disc")
+                    );
+                }
+                let _ = writeln!(w, "{n}_nocap:");
+            }
+            ChipType::Cone => {
+                let _ = writeln!(
+                    w,
+                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
+                    kaddr("k_cone"),
+                    klen("k_cone")
+                );
+                for c in 0..2 {
+                    let _ = writeln!(
+                        w,
+                        "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
+                        kaddr("k_disc"),
+                        1 + super::layout::CONE_BODY_WORDS + c * super::layout::PLANAR_WORDS,
                         klen("k_disc")
                     );
                 }

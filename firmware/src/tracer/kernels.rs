@@ -91,6 +91,9 @@ pub mod ram {
     pub const TMP2: u32 = 288;
     pub const TMP3: u32 = 289;
     pub const TMP4: u32 = 290;
+    /// The cone kernel's frame values and zoom (8 words, temporaries of
+    /// that kernel).
+    pub const CONE_TMP: u32 = 291;
     /// The local stack: 4 words (colour r, g, b and reflection weight) per
     /// recursion level.
     pub const STACK: u32 = 300;
@@ -325,6 +328,34 @@ pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: impl Into<Ap
         .c(format!("add {one}, {sh}, #1"))
         .c(format!("sll {w}, {w}, {one}"))
         .cq(format!("rsb {one}, {sh}, #15"))
+        .c(format!("srl {dn}, {dn}, {one}"))
+        .c(format!("or {o}, {w}, {dn}"));
+}
+
+/// [`divide`] with one more bit of range: `q = num * 2^13 / den` for `num >= 0`,
+/// `den` in (0, 32767], the caller having checked `num < 4 den`.
+pub fn divide_q13(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: u32) {
+    let (n, d, o) = (r(num), r(den), r(out));
+    let [sh, dn, rc, w, one] = t.map(r);
+    k.comment("divide (Q.13 quotient)");
+    k.c(format!("clz {sh}, {d}"))
+        .c(format!("sub {sh}, {sh}, #1"))
+        .c(format!("sll {dn}, {d}, {sh}"))
+        .cq(format!("srl {rc}, {dn}, #7"))
+        .c(format!("and {rc}, {rc}, #127"))
+        .c(format!("ld {rc}, [{rc} + #{}]", ram::RCP))
+        .c(format!("ld {one}, [r0 + #{}]", ram::C_ONE));
+    for _ in 0..nr {
+        k.cq(format!("mul {w}, {dn}, {rc}, >>15"))
+            .c(format!("sub {w}, {w}, {one}"))
+            .cq(format!("ldacc {rc}, <<14"))
+            .cq(format!("msu {rc}, {rc}, {w}, >>14"));
+    }
+    k.c(format!("mul out, {n}, {rc}"))
+        .c(format!("acch {w}"))
+        .c(format!("accl {dn}"))
+        .c(format!("sll {w}, {w}, {sh}"))
+        .cq(format!("rsb {one}, {sh}, #16"))
         .c(format!("srl {dn}, {dn}, {one}"))
         .c(format!("or {o}, {w}, {dn}"));
 }
@@ -765,6 +796,194 @@ pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
     k
 }
 
+/// Open cone body (unequal radii; caps, native format only, are
+/// [`Inside::Disc`] planar records as the cylinder's). Record (40 words):
+/// `M.xyz, invS, ce1.xyz, ce2.xyz, a.xyz, ce1.xyz, ce2.xyz, a.xyz, s, g,
+/// sg, R, hh, -sg c, -sg s, (e1, e2, a) x, (e1, e2, a) y, (e1, e2, a) z,
+/// obj, mat`: M the middle of the axis, R (scene LSBs) at least the radius
+/// of the cone's bounding sphere about M, `S = 4 R` the kernel's unit,
+/// `invS = 2^(14+ks) / S`; (e1, e2, a) an orthonormal frame, a from base to
+/// apex, `ce1 = c e1`, `ce2 = c e2` with `c = cos`, `s = sin` of the
+/// half-angle (`tan = (ra - rb) / h`); `g = c (rb + ra) / 2 / S`, `hh` half
+/// the height (plus 1 LSB) over S, all Q.14; `sg` +-16384 (NFF's inside-
+/// visible cone).
+///
+/// Method: the sphere's perpendicular method against the bounding sphere
+/// (`b = (M - o).d`, `w = ((M - o) - b d) / S`, miss where `|w| > 1/4`)
+/// moves the ray's origin to `o' = o + b d`, the point of its line closest
+/// to M; every quantity from there on is a Q.14 multiple of S bounded by 1,
+/// however far the ray came from. In the cone's frame, with `q = o' - M`,
+/// `G = c rho(q_z)` (`= g + s q_z`, the radius at q's height, scaled by c):
+/// `f(tau) = c^2 |q_perp + tau d_perp|^2 - (G + s tau d_z)^2 = A tau^2 +
+/// 2 B tau + C` (each coefficient one accumulator chain, all |.| <= 1),
+/// times `sg`. The visible side is where `f` falls along the ray, the root
+/// with `A tau + B = -sqrt(D)`, `D = B^2 - A C`, taken without cancellation:
+/// `tau = -(B + sqrt D) / A` where `B > 0`, else `C / (sqrt D - B)`, by
+/// [`divide`] after checking `|tau| <= 1/2` (a hit lies within `S / 4` of
+/// `o'`); so a ray parallel to the surface (`A = 0`) or down a steep cone
+/// (`A < 0`) needs no special case. `t = b + S tau`; the hit's height
+/// `|q_z + tau d_z| <= hh`; the normal is the gradient
+/// `sg (c^2 p_perp, -s c rho)` at the hit, normalised, in the scene's axes.
+pub fn cone(ks: u32, ep: u32, nr: u32) -> K {
+    let ct = ram::CONE_TMP;
+    let mut k = K::default();
+    k.comment("cone: bounding sphere about M: b = (M - o).d, p = (M - o) - b d");
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .cq("mac r11, r10, r6, >>14"); // b
+    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
+        k.cq(format!("ldacc r{x}, <<14"))
+            .c(format!("msu r{x}, r11, r{d}, >>{}", q(14) - ep));
+    }
+    k.c("mov r12, fb0"); // invS
+    for x in [8, 9, 10] {
+        k.c(format!("mul r{x}, r{x}, r12, >>{}", ks + ep)); // w = p / S
+    }
+    k.c("movb r15, #1")
+        .c(format!("ldacc r15, <<{}", 26 + 2 * extra_bits()))
+        .c("msu out, r8, r8")
+        .c("msu out, r9, r9")
+        .cq("msu r15, r10, r10, >>14") // 1/4 - |w|^2
+        .c("cmp.ge r15, #0")
+        .c(format!("st r11, [#{}]", ram::TMP0));
+    k.comment(
+        "frame: w.ce1 = -c qx, w.ce2 = -c qy, w.a = -qz; d.ce1 = c dx, d.ce2 = c dy, d.a = dz",
+    );
+    for x in [12, 13, 14] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r9")
+            .cq(format!("mac r{x}, fb0, r10, >>14"));
+    }
+    for x in [8, 9, 10] {
+        k.c("mul out, fb0, r4")
+            .c("mac out, fb0, r5")
+            .cq(format!("mac r{x}, fb0, r6, >>14"));
+    }
+    k.c(format!("st r14, [#{}]", ram::TMP1))
+        .c(format!("st r10, [#{}]", ram::TMP2))
+        .c("mov r11, fb0") // s
+        .cq("mul r10, r10, r11, >>14") // s dz
+        .cq("mul r14, r14, r11, >>14") // -s qz
+        .c("sub r14, fb0, r14"); // G = g + s qz
+    k.comment("zoom: (c q_perp, G) times 2^e into [1/8, 1/4), e = clz(max) - 4 in -3..=3");
+    k.c("abs r15, r12")
+        .c("abs r11, r13")
+        .c("max r15, r15, r11")
+        .c("abs r11, r14")
+        .c("max r15, r15, r11")
+        .c("clz r15, r15")
+        .c("sub r15, r15, #4")
+        .c("min r15, r15, #3")
+        .c("movb r11, #0")
+        .c("min r11, r15, r11")
+        .c("neg r11, r11") // max(-e, 0)
+        .c("max r15, r15, #0") // max(e, 0)
+        .c(format!("st r15, [#{}]", ct + 6))
+        .c(format!("st r11, [#{}]", ct + 7));
+    for x in [12, 13, 14] {
+        k.c(format!("sll r{x}, r{x}, r15"))
+            .c(format!("sra r{x}, r{x}, r11"));
+    }
+    for (i, x) in [8, 9, 10, 12, 13, 14].into_iter().enumerate() {
+        k.c(format!("st r{x}, [#{}]", ct + i as u32));
+    }
+    k.comment("A, -2B, 4C (zoomed: 2^e B, 2^2e C), times sg; 4D = 4B^2 - 4A C");
+    k.c("mul out, r8, r8")
+        .c("mac out, r9, r9")
+        .cq("msu r15, r10, r10, >>14") // A
+        .c("mul out, r8, r12")
+        .c("mac out, r9, r13")
+        .cq("mac r11, r10, r14, >>13") // -2B
+        .c("mul out, r12, r12")
+        .c("mac out, r13, r13")
+        .cq("msu r12, r14, r14, >>12") // 4C
+        .c("mov r13, fb0") // sg
+        .cq("mul r15, r15, r13, >>14")
+        .cq("mul r11, r11, r13, >>14")
+        .cq("mul r12, r12, r13, >>14")
+        .c("mul out, r11, r11")
+        .cq("msu r14, r15, r12, >>14") // D
+        .c("(f) cmp.ge r14, #0")
+        .c(format!("st r15, [#{}]", ram::TMP3));
+    sqrt_q14(&mut k, 14, 8, [9, 10, 13, 15], nr);
+    k.comment("tau' = 2^e tau = X / 2Y: B > 0: -(2B + sqrt 4D) / 2A, else 4C / 2(sqrt 4D - 2B)");
+    k.c("movb r9, #0")
+        .c("(f) movb r9, #1")
+        .c("cmp.lt r11, #0")
+        .c(format!("ld r10, [r0 + #{}]", ram::TMP3))
+        .c("sub r13, r11, r8")
+        .c("add r14, r11, r8")
+        .c("sel r13, r13, r12") // N
+        .c("sel r14, r10, r14") // Den
+        .c("xor r12, r13, r14")
+        .cq("sra r12, r12, #15") // -1 where tau < 0
+        .c("abs r10, r13")
+        .c("abs r15, r14")
+        .c("cmp.ne r9, #0")
+        .c("(f) cmp.gt r15, #0")
+        .c("asl r11, r15, #2")
+        .c("(f) cmp.lt r10, r11"); // |tau'| < 2
+    divide_q13(&mut k, 10, 15, 10, [8, 9, 11, 13, 14], nr);
+    k.c("xor r10, r10, r12").c("sub r10, r10, r12"); // tau'
+    k.comment("tau = tau' / 2^e (rounded); t = b + S tau, S = 2 R");
+    k.c(format!("ld r11, [r0 + #{}]", ct + 6))
+        .c("movb r12, #1")
+        .c("sll r12, r12, r11")
+        .c("sra r12, r12, #1")
+        .c("adds r13, r10, r12")
+        .c("sra r13, r13, r11")
+        .c(format!("ld r11, [r0 + #{}]", ct + 7))
+        .c("asl r13, r13, r11") // tau
+        .c("abs r12, r13")
+        .cq("sra r12, r12, #13")
+        .c("(f) cmp.eq r12, #0") // |tau| < 1/2: within the bounding sphere
+        .c(format!("ld r11, [r0 + #{}]", ram::TMP0))
+        .cq("ldacc r11, <<13")
+        .cq("mac r11, fb0, r13, >>13")
+        .c("(f) cmp.gt r11, #0")
+        .c("(f) cmp.lt r11, r7")
+        .c(format!("st r11, [#{}]", ram::TMP4));
+    k.comment("height of the hit: |qz + tau dz| <= hh");
+    k.c(format!("ld r12, [r0 + #{}]", ram::TMP1))
+        .c(format!("ld r14, [r0 + #{}]", ram::TMP2))
+        .cq("ldacc r12, <<14")
+        .cq("msu r12, r13, r14, >>14")
+        .c("abs r12, r12")
+        .c("(f) cmp.ge fb0, r12");
+    k.comment("normal: sg (c (c q_perp + tau c d_perp), -s (G + tau s dz)), zoomed, halved");
+    for (x, qa, da) in [(8, 3, 0), (9, 4, 1)] {
+        k.c(format!("ld r{x}, [r0 + #{}]", ct + qa))
+            .c(format!("ld r13, [r0 + #{}]", ct + da))
+            .cq(format!("ldacc r{x}, <<14"))
+            .cq(format!("msu r{x}, r10, r13, >>15")); // -(c q + tau c d) / 2
+    }
+    k.c(format!("ld r11, [r0 + #{}]", ct + 5))
+        .c(format!("ld r13, [r0 + #{}]", ct + 2))
+        .cq("ldacc r11, <<14")
+        .cq("mac r11, r10, r13, >>15") // c rho / 2 at the hit
+        .c("mov r13, fb0") // -sg c
+        .cq("mul r8, r8, r13, >>14")
+        .cq("mul r9, r9, r13, >>14")
+        .cq("mul r10, fb0, r11, >>14"); // -sg s c rho
+    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], false, nr);
+    for x in [11, 12, 13] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r9")
+            .cq(format!("mac r{x}, fb0, r10, >>14"));
+    }
+    k.c(format!("ld r14, [r0 + #{}]", ram::TMP4))
+        .c("(f) mov r7, r14");
+    for (i, x) in [11, 12, 13].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    k
+}
+
 /// Program start: RAM tables and constants from the FB (258 words).
 pub fn init() -> K {
     let mut k = K::default();
@@ -1168,7 +1387,9 @@ pub fn out_word(i: u32) -> K {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tracer::layout::{CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_FINE_WORDS, SPHERE_WORDS};
+    use crate::tracer::layout::{
+        CONE_BODY_WORDS, CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_FINE_WORDS, SPHERE_WORDS,
+    };
 
     #[test]
     fn every_kernel_reads_exactly_its_record() {
@@ -1178,6 +1399,7 @@ mod tests {
             assert_eq!(planar(i, 9, 2).fb_reads, PLANAR_WORDS);
         }
         assert_eq!(cylinder(8, 2, 2).fb_reads, CYL_BODY_WORDS);
+        assert_eq!(cone(8, 2, 2).fb_reads, CONE_BODY_WORDS);
         assert_eq!(polygon_head(2).fb_reads, 15);
         assert_eq!(aabox(2).fb_reads, crate::tracer::layout::BOX_WORDS);
         assert_eq!(polygon_edge().fb_reads, 5);

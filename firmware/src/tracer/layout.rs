@@ -57,12 +57,15 @@ pub enum ChipType {
     Rectangle,
     Triangle,
     Polygon,
+    /// Cones with unequal radii (tested after the cylinders).
+    Cone,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 6] = [
+    pub const ALL: [ChipType; 7] = [
         ChipType::Sphere,
         ChipType::Cylinder,
+        ChipType::Cone,
         ChipType::Box,
         ChipType::Rectangle,
         ChipType::Triangle,
@@ -76,13 +79,14 @@ impl ChipType {
             ChipType::Rectangle => "rectangle",
             ChipType::Triangle => "triangle",
             ChipType::Polygon => "polygon",
+            ChipType::Cone => "cone",
         }
     }
     fn of(p: PrimType) -> Option<ChipType> {
         Some(match p {
             PrimType::Sphere => ChipType::Sphere,
             PrimType::Cylinder => ChipType::Cylinder,
-            PrimType::Cone => return None,
+            PrimType::Cone => ChipType::Cone,
             PrimType::Box => ChipType::Box,
             PrimType::Rectangle => ChipType::Rectangle,
             PrimType::Triangle => ChipType::Triangle,
@@ -102,6 +106,9 @@ pub const PLANAR_WORDS: usize = 20;
 pub const CYL_BODY_WORDS: usize = 34;
 /// Cylinder group: caps flag, body, base cap, apex cap.
 pub const CYL_WORDS: usize = 1 + CYL_BODY_WORDS + 2 * PLANAR_WORDS;
+pub const CONE_BODY_WORDS: usize = 40;
+/// Cone group: caps flag, body, base cap, apex cap (as the cylinder's).
+pub const CONE_WORDS: usize = 1 + CONE_BODY_WORDS + 2 * PLANAR_WORDS;
 pub const BOX_WORDS: usize = 24;
 /// Polygon record: edge count, head, one part per non-horizontal edge of the
 /// crossing test (padded to the scene's largest polygon), tail.
@@ -167,6 +174,10 @@ pub struct Layout {
     pub sphere_fine: bool,
     /// The same for the cylinder kernel.
     pub ep_cyl: u32,
+    /// Scale shift of the cone kernel's `invS` and extra fraction bits of
+    /// its perpendicular vector.
+    pub ks_cone: u32,
+    pub ep_cone: u32,
     pub kt_rect: u32,
     pub kt_tri: u32,
     pub kt_disc: u32,
@@ -192,7 +203,7 @@ pub const NODE_BYTES: usize = 64;
 /// Node record (32-bit words, main memory): flags (-32768 leaf, else the
 /// split axis), split (scene format), left, right (byte addresses), block
 /// address, block words, list address, then per type present the number
-/// of the leaf's objects of that type (words 7..12), their total (word 13).
+/// of the leaf's objects of that type (words 7..13), their total (word 14).
 /// List: per object, the byte address
 /// of its mailbox half-word (number of the pass that last tested it).
 #[derive(Clone, Debug)]
@@ -453,6 +464,60 @@ pub fn split_shine(shine: f64) -> (u32, f64) {
     }
 }
 
+/// A cone's record geometry (see [`super::kernels::cone`]), in scene LSBs
+/// where not a ratio.
+struct ConeFit {
+    /// The middle of the axis, rounded to the scene format (LSBs).
+    m_q: Vec3,
+    e1: Vec3,
+    e2: Vec3,
+    a: Vec3,
+    /// Cosine and sine of the half-angle, `tan = (ra - rb) / h`.
+    c: f64,
+    s: f64,
+    /// Bounding radius about `m_q` (whole LSBs) and the kernel's unit 2 R.
+    r: f64,
+    big_s: f64,
+    /// `c (rb + ra) / 2 / S` and `(h / 2 + 1 LSB) / S`.
+    g: f64,
+    hh: f64,
+}
+
+impl ConeFit {
+    fn of(base: Vec3, rb: f64, apex: Vec3, ra: f64, scale: f64) -> ConeFit {
+        let axis = apex - base;
+        let h = axis.length();
+        let a = axis * (1.0 / h);
+        let e1 = perpendicular(a);
+        let e2 = a.cross(e1);
+        let alpha = ((ra - rb) / h).atan();
+        let (c, s) = (alpha.cos(), alpha.sin());
+        let m = (base + apex) * 0.5;
+        let m_q = Vec3::new(
+            (m.x * scale).round(),
+            (m.y * scale).round(),
+            (m.z * scale).round(),
+        );
+        // The cone lies within sqrt((h/2)^2 + max(rb, ra)^2) of its exact
+        // middle; 2 LSB more cover the rounding of M.
+        let bound = ((h / 2.0).powi(2) + rb.max(ra).powi(2)).sqrt() * scale;
+        let r = (bound + 2.0).ceil();
+        let big_s = 2.0 * r;
+        ConeFit {
+            m_q,
+            e1,
+            e2,
+            a,
+            c,
+            s,
+            r,
+            big_s,
+            g: c * (rb + ra) / 2.0 * scale / big_s,
+            hh: (h / 2.0 * scale + 1.0) / big_s,
+        }
+    }
+}
+
 /// Largest shift `k` with `m * 2^k` within the word (`<= 2^(15+x) - 1`:
 /// 32767 on the 16-bit chip), clamped to 0..=max.
 fn fit_shift_w(m: f64, max: u32, x: u32) -> u32 {
@@ -549,14 +614,13 @@ fn build_as(
     };
 
     // Objects by chip type.
-    let mut by: Vec<Vec<usize>> = vec![Vec::new(); 6];
+    let mut by: Vec<Vec<usize>> = vec![Vec::new(); ChipType::ALL.len()];
     let mut slot = vec![(0usize, 0usize); scene.objects.len()];
     for (i, o) in scene.objects.iter().enumerate() {
         let Some(t) = ChipType::of(o.shape.prim_type()) else {
             return Err(err(
                 o.line,
-                "cones with unequal radii have no chip kernel (cylinders, spheres, boxes, rectangles, triangles and polygons do)"
-                    .into(),
+                "internal: a primitive type with no chip kernel".into(),
             ));
         };
         let ti = t as usize;
@@ -572,9 +636,40 @@ fn build_as(
     let mut fan = 0usize;
     let mut r_min_sph = f64::INFINITY;
     let mut r_min_cyl = f64::INFINITY;
+    let mut cone_s_min = f64::INFINITY;
+    let mut cone_r_max = 1.0f64;
     for (i, o) in scene.objects.iter().enumerate() {
         match &o.shape {
             Shape::Sphere { radius, .. } => r_min_sph = r_min_sph.min(radius.abs() * s),
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+                ..
+            } if o.shape.prim_type() == PrimType::Cone => {
+                let f = ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
+                cone_s_min = cone_s_min.min(f.big_s);
+                cone_r_max = cone_r_max.max(f.r);
+                let disc_or_none = |c: Vec3, r: f64, n: Vec3| {
+                    if r * s >= 0.5 {
+                        disc(c, f.e1, f.e2, r, n)
+                    } else {
+                        // The tip of a pointed cone: a record that never hits.
+                        Planar {
+                            n: Vec3::ZERO,
+                            v0: c,
+                            eu: Vec3::ZERO,
+                            ew: Vec3::ZERO,
+                            kind: Inside::Disc,
+                        }
+                    }
+                };
+                planars[i] = vec![
+                    disc_or_none(*base, *base_radius, -f.a),
+                    disc_or_none(*apex, *apex_radius, f.a),
+                ];
+            }
             Shape::Cone {
                 base,
                 base_radius,
@@ -655,6 +750,10 @@ fn build_as(
         })
         .fold(1.0f64, f64::max);
     let ep_cyl = fit_shift(2.0 * r_max_cyl, 4);
+    // Cones: invS = 2^(14+ks) / S fits for the smallest S; the
+    // perpendicular vector saturates only beyond twice the largest R.
+    let ks_cone = ks_of(cone_s_min);
+    let ep_cone = fit_shift(2.0 * cone_r_max, 4);
 
     let mut w = W {
         fb: Vec::new(),
@@ -800,6 +899,7 @@ fn build_as(
             ChipType::Sphere if sphere_fine => SPHERE_FINE_WORDS,
             ChipType::Sphere => SPHERE_WORDS,
             ChipType::Cylinder => CYL_WORDS,
+            ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
             ChipType::Rectangle | ChipType::Triangle => PLANAR_WORDS,
             ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS,
@@ -809,6 +909,60 @@ fn build_as(
             let o = &scene.objects[i];
             let start = w.fb.len();
             match (&o.shape, t) {
+                (
+                    Shape::Cone {
+                        base,
+                        base_radius,
+                        apex,
+                        apex_radius,
+                        inside,
+                        caps,
+                    },
+                    ChipType::Cone,
+                ) => {
+                    let f = ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
+                    let inv_s = ((14 + xb + ks_cone) as f64).exp2() / f.big_s;
+                    if inv_s < 256.0 || f.r > 16383.0 * (xb as f64).exp2() {
+                        return Err(err(
+                            o.line,
+                            format!(
+                                "cone too large for the chip's cone kernel next to the scene's smallest cone (bounding radius {:.0} LSB)",
+                                f.r
+                            ),
+                        ));
+                    }
+                    let sg = if *inside { -1.0 } else { 1.0 };
+                    let one = w.one();
+                    w.raw(*caps as i64);
+                    w.push(f.m_q.x);
+                    w.push(f.m_q.y);
+                    w.push(f.m_q.z);
+                    w.push(inv_s);
+                    for _ in 0..2 {
+                        w.scaled(f.e1, one * f.c);
+                        w.scaled(f.e2, one * f.c);
+                        w.unit(f.a);
+                    }
+                    w.push(one * f.s);
+                    w.push(one * f.g);
+                    w.push(one * sg);
+                    w.raw(f.r as i64);
+                    w.push(one * f.hh);
+                    w.push(one * -sg * f.c);
+                    w.push(one * -sg * f.s);
+                    for c in 0..3 {
+                        w.push(one * f.e1.axis(c));
+                        w.push(one * f.e2.axis(c));
+                        w.push(one * f.a.axis(c));
+                    }
+                    w.raw(i as i64);
+                    w.raw(o.material as i64);
+                    for p in &planars[i] {
+                        let mut p = *p;
+                        p.n = p.n * sg;
+                        write_planar(&mut w, &p, i, o.material);
+                    }
+                }
                 (
                     Shape::Sphere {
                         center,
@@ -1053,7 +1207,7 @@ fn build_as(
                         largest = largest.max(words.len());
                         f[4] = (base as usize + blocks_at + blocks.len()) as i32;
                         f[5] = words.len() as i32;
-                        f[13] = n.objects.len() as i32;
+                        f[14] = n.objects.len() as i32;
                         f[6] = list_addr as i32;
                         blocks.extend(fb_word_bytes(&words, xb));
                     }
@@ -1118,6 +1272,8 @@ fn build_as(
             ep_sphere,
             sphere_fine,
             ep_cyl,
+            ks_cone,
+            ep_cone,
             kt_rect: kt[0],
             kt_tri: kt[1],
             kt_disc: kt[2],
@@ -1209,6 +1365,8 @@ fn build_as(
         ep_sphere,
         sphere_fine,
         ep_cyl,
+        ks_cone,
+        ep_cone,
         kt_rect: kt[0],
         kt_tri: kt[1],
         kt_disc: kt[2],
