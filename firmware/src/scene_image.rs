@@ -205,7 +205,7 @@ pub fn tessellated_triangles(s: &Shape) -> usize {
 }
 
 /// The smallest length that defines a shape.
-fn smallest_feature(s: &Shape) -> f64 {
+pub fn smallest_feature(s: &Shape) -> f64 {
     fn edges_and_height(v: &[Vec3]) -> f64 {
         let mut m = f64::INFINITY;
         let mut longest: f64 = 0.0;

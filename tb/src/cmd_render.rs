@@ -27,7 +27,7 @@ pub struct RenderArgs {
     pub max_depth: u32,
     pub max_leaf: usize,
     pub layout: firmware::tracer::NodeLayout,
-    pub datapath: rtl::rc::Datapath,
+    pub datapath: crate::cli::DatapathChoice,
     /// Newton-Raphson steps after each table lookup.
     pub newton_steps: u32,
     /// Entries of the reciprocal and reciprocal square root tables.
@@ -151,7 +151,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             ..BspParams::default()
         },
         layout: a.layout,
-        datapath: a.datapath,
+        datapath: rtl::rc::Datapath::W16,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
@@ -167,6 +167,47 @@ pub fn command(a: RenderArgs) -> Result<()> {
         table_entries: a.table_entries,
         ..Default::default()
     };
+    let mut opt = opt;
+    let datapath_reason;
+    match a.datapath {
+        crate::cli::DatapathChoice::Fixed(d) => {
+            opt.datapath = d;
+            datapath_reason = format!("--datapath {}", d.bits());
+        }
+        crate::cli::DatapathChoice::Auto => {
+            // The 16-bit firmware's format decides (its errors are the
+            // scene's: the scene compiler is 16-bit for either chip).
+            let fw = firmware::tracer::build_with(&scene, &opt, &nm)
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            let unit = (fw.frac as f64).exp2();
+            let small = scene
+                .objects
+                .iter()
+                .filter(|o| {
+                    firmware::scene_image::smallest_feature(&o.shape) * unit
+                        < crate::cli::AUTO_MIN_FEATURE_LSB
+                })
+                .count();
+            let share = small as f64 / scene.objects.len().max(1) as f64;
+            let r = &fw.report;
+            let why = format!(
+                "{small} of {} objects ({:.0}%) have a feature under {} LSB of the 16-bit format {} (the smallest: {:.1} LSB at {})",
+                scene.objects.len(),
+                100.0 * share,
+                crate::cli::AUTO_MIN_FEATURE_LSB,
+                fw.format(),
+                r.smallest_feature * unit,
+                r.smallest_feature_at
+            );
+            if share >= crate::cli::AUTO_SMALL_SHARE {
+                opt.datapath = rtl::rc::Datapath::W32;
+                datapath_reason =
+                    format!("auto: {why}; --datapath 16 forces the paper's chip");
+            } else {
+                datapath_reason = format!("auto: {why}");
+            }
+        }
+    }
     if let Some(p) = &a.emit_asm {
         let fw =
             firmware::tracer::build_with(&scene, &opt, &nm).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -188,7 +229,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
         }
         c
     });
-    let (chip, rep) = render_with(&scene, &opt, &nm, true, trace)?;
+    let (chip, mut rep) = render_with(&scene, &opt, &nm, true, trace)?;
+    rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     let out = a
         .out
         .unwrap_or_else(|| default_out(Path::new(&scene.source)));
@@ -200,6 +242,11 @@ pub fn command(a: RenderArgs) -> Result<()> {
     println!(
         "size                     {width}x{height}, {} ways, depth {}",
         opt.ways, opt.depth
+    );
+    println!(
+        "datapath                 {} bits ({datapath_reason}), format {}",
+        opt.datapath.bits(),
+        j["format"].as_str().unwrap_or("?")
     );
     println!(
         "node layout              {} ({} FB words of BSP nodes, {} in all{})",

@@ -204,11 +204,12 @@ enum Command {
         /// or compact (index lists); the same image either way.
         #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
         layout: firmware::tracer::NodeLayout,
-        /// RC datapath width in bits: 16 (the paper's chip) or 32 (the
+        /// RC datapath width in bits: 16 (the paper's chip), 32 (the
         /// variant the paper announces; every format gets 16 more fraction
-        /// bits).
-        #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath, default_value = "16")]
-        datapath: rtl::rc::Datapath,
+        /// bits), or auto: 16 unless the scene's smallest feature is under
+        /// 16 LSB of its 16-bit format.
+        #[arg(long, value_name = "auto|16|32", value_parser = tb::cli::parse_datapath_choice, default_value = "auto")]
+        datapath: tb::cli::DatapathChoice,
         /// Newton-Raphson steps after each reciprocal / square-root table
         /// lookup (0..=3).
         #[arg(long, value_name = "N", default_value_t = 2)]
