@@ -201,8 +201,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             );
             if share >= crate::cli::AUTO_SMALL_SHARE {
                 opt.datapath = rtl::rc::Datapath::W32;
-                datapath_reason =
-                    format!("auto: {why}; --datapath 16 forces the paper's chip");
+                datapath_reason = format!("auto: {why}; --datapath 16 forces the paper's chip");
             } else {
                 datapath_reason = format!("auto: {why}");
             }
