@@ -77,6 +77,11 @@ pub struct CompileOptions {
     pub guard_bits: u32,
     /// Refuse a scene whose smallest feature is below this many LSBs.
     pub min_feature_lsb: f64,
+    /// Fraction bits the chip's own records carry beyond this image's
+    /// (16 for the 32-bit datapath, whose tracer lays the objects out
+    /// again with 16 more): the smallest-feature and degeneracy checks then
+    /// apply at the chip's precision, not at the 16-bit image's.
+    pub target_extra_frac: u32,
 }
 
 impl Default for CompileOptions {
@@ -86,6 +91,7 @@ impl Default for CompileOptions {
             layout: None,
             guard_bits: 1,
             min_feature_lsb: 2.0,
+            target_extra_frac: 0,
         }
     }
 }
@@ -410,7 +416,7 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
         }
     }
     let at = format!("{}:{} ({})", scene.source, small.1, small.2);
-    if small.0 < opt.min_feature_lsb * lsb {
+    if small.0 < opt.min_feature_lsb * lsb * (-(opt.target_extra_frac as f64)).exp2() {
         return Err(err(
             small.1,
             format!(
@@ -672,6 +678,7 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
             // off the plane by a fraction of an LSB: harmless.)
             if let Some(why) = dq
                 .degeneracy()
+                .filter(|_| opt.target_extra_frac == 0)
                 .filter(|m| !m.contains("perpendicular") && !m.contains("not in the plane"))
             {
                 return Err(err(

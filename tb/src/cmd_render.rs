@@ -168,45 +168,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
         ..Default::default()
     };
     let mut opt = opt;
-    let datapath_reason;
-    match a.datapath {
-        crate::cli::DatapathChoice::Fixed(d) => {
-            opt.datapath = d;
-            datapath_reason = format!("--datapath {}", d.bits());
-        }
-        crate::cli::DatapathChoice::Auto => {
-            // The 16-bit firmware's format decides (its errors are the
-            // scene's: the scene compiler is 16-bit for either chip).
-            let fw = firmware::tracer::build_with(&scene, &opt, &nm)
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
-            let unit = (fw.frac as f64).exp2();
-            let small = scene
-                .objects
-                .iter()
-                .filter(|o| {
-                    firmware::scene_image::smallest_feature(&o.shape) * unit
-                        < crate::cli::AUTO_MIN_FEATURE_LSB
-                })
-                .count();
-            let share = small as f64 / scene.objects.len().max(1) as f64;
-            let r = &fw.report;
-            let why = format!(
-                "{small} of {} objects ({:.0}%) have a feature under {} LSB of the 16-bit format {} (the smallest: {:.1} LSB at {})",
-                scene.objects.len(),
-                100.0 * share,
-                crate::cli::AUTO_MIN_FEATURE_LSB,
-                fw.format(),
-                r.smallest_feature * unit,
-                r.smallest_feature_at
-            );
-            if share >= crate::cli::AUTO_SMALL_SHARE {
-                opt.datapath = rtl::rc::Datapath::W32;
-                datapath_reason = format!("auto: {why}; --datapath 16 forces the paper's chip");
-            } else {
-                datapath_reason = format!("auto: {why}");
-            }
-        }
-    }
+    let (datapath, datapath_reason) = choose_datapath(&scene, &opt, &nm, a.datapath)?;
+    opt.datapath = datapath;
     if let Some(p) = &a.emit_asm {
         let fw =
             firmware::tracer::build_with(&scene, &opt, &nm).map_err(|e| anyhow::anyhow!("{e}"))?;
@@ -301,4 +264,70 @@ pub fn command(a: RenderArgs) -> Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The chip `--datapath` asks for, and why (printed and in the JSON).
+fn choose_datapath(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    nm: &firmware::tracer::Numerics,
+    choice: crate::cli::DatapathChoice,
+) -> Result<(rtl::rc::Datapath, String)> {
+    use rtl::rc::Datapath;
+    let d = match choice {
+        crate::cli::DatapathChoice::Fixed(d) => {
+            return Ok((d, format!("--datapath {}", d.bits())));
+        }
+        crate::cli::DatapathChoice::Auto => Datapath::W16,
+    };
+    let opt16 = Options {
+        datapath: d,
+        ..*opt
+    };
+    let fw = match firmware::tracer::build_with(scene, &opt16, nm) {
+        Ok(fw) => fw,
+        Err(e16) => {
+            // A scene the 16-bit format cannot hold may still fit the
+            // 32-bit chip's (16 more fraction bits).
+            let opt32 = Options {
+                datapath: Datapath::W32,
+                ..*opt
+            };
+            if firmware::tracer::build_with(scene, &opt32, nm).is_err() {
+                anyhow::bail!("{e16}");
+            }
+            return Ok((
+                Datapath::W32,
+                "auto: the 16-bit chip cannot hold the scene (`--datapath 16` says why); the 32-bit chip can".into(),
+            ));
+        }
+    };
+    let unit = (fw.frac as f64).exp2();
+    let small = scene
+        .objects
+        .iter()
+        .filter(|o| {
+            firmware::scene_image::smallest_feature(&o.shape) * unit
+                < crate::cli::AUTO_MIN_FEATURE_LSB
+        })
+        .count();
+    let share = small as f64 / scene.objects.len().max(1) as f64;
+    let r = &fw.report;
+    let why = format!(
+        "{small} of {} objects ({:.0}%) have a feature under {} LSB of the 16-bit format {} (the smallest: {:.1} LSB at {})",
+        scene.objects.len(),
+        100.0 * share,
+        crate::cli::AUTO_MIN_FEATURE_LSB,
+        fw.format(),
+        r.smallest_feature * unit,
+        r.smallest_feature_at
+    );
+    Ok(if share >= crate::cli::AUTO_SMALL_SHARE {
+        (
+            Datapath::W32,
+            format!("auto: {why}; --datapath 16 forces the paper's chip"),
+        )
+    } else {
+        (Datapath::W16, format!("auto: {why}"))
+    })
 }

@@ -154,3 +154,48 @@ fn compile_reports_and_bad_scenes_fail_with_file_line() {
     );
     assert!(!ok && err.contains("nodir/a.png"), "{err}");
 }
+
+/// `render --datapath auto` (the default) keeps the paper's 16-bit chip for
+/// the default scene, moves a scene the 16-bit format cannot hold
+/// (shells-1) to the 32-bit chip, says so in the JSON, and `--datapath 16`
+/// on shells-1 is refused with the scene's own error.
+#[test]
+fn render_datapath_auto_picks_the_chip_and_says_why() {
+    let dir = tempfile::tempdir().unwrap();
+    let bits = |args: &[&str]| {
+        let mut a = vec![
+            "render", "--size", "8x8", "--out", "x.png", "--json", "x.json",
+        ];
+        a.extend_from_slice(args);
+        let (ok, _, err) = morphosys(dir.path(), &a);
+        assert!(ok, "{err}");
+        let j: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path().join("x.json")).unwrap()).unwrap();
+        (
+            j["datapath_bits"].as_u64().unwrap(),
+            j["datapath_choice"].as_str().unwrap().to_string(),
+        )
+    };
+    let (b, why) = bits(&[]);
+    assert_eq!(b, 16, "{why}");
+    assert!(why.starts_with("auto: 0 of 10 objects"), "{why}");
+    let shells = shared("shells-1.nff");
+    let (b, why) = bits(&[&shells]);
+    assert_eq!(b, 32, "{why}");
+    assert!(why.contains("16-bit chip cannot hold"), "{why}");
+    let (b, _) = bits(&["--datapath", "32"]);
+    assert_eq!(b, 32);
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &["render", &shells, "--size", "8x8", "--datapath", "16"],
+    );
+    assert!(
+        !ok && err.contains("shells-1.nff:11: cannot represent the scene in 16-bit"),
+        "{err}"
+    );
+    let (ok, _, err) = morphosys(dir.path(), &["render", "--datapath", "24"]);
+    assert!(
+        !ok && err.contains("--datapath") && err.lines().count() == 1,
+        "{err}"
+    );
+}

@@ -8,10 +8,11 @@
 //! depth 2 that changes no figure (the same scene with T 0 measures the
 //! same PSNR and hit agreement to 0.01).
 //!
-//! Left out, and why (docs/scenes.md has the figures):
-//! - shells-1: its camera and light lie 60 and 100 units out and the shell
-//!   itself spans +-34, yet its smallest spheres have radius 0.0035, under
-//!   2 LSB of every 16-bit format that covers it (compile error).
+//! shells-1 cannot be held by the 16-bit chip: its camera lies 60 units
+//! out and the shell spans +-34, yet its smallest spheres have radius
+//! 0.0035, under 2 LSB of every 16-bit format that covers it (compile
+//! error). It is rendered on the 32-bit chip, as `render --datapath auto`
+//! does.
 
 use std::path::PathBuf;
 
@@ -20,6 +21,10 @@ use firmware::tracer::Options;
 use tb::cmd_render::render;
 
 fn check(name: &str) {
+    check_on(name, rtl::rc::Datapath::W16);
+}
+
+fn check_on(name: &str, datapath: rtl::rc::Datapath) {
     let n = 48;
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../scenes/spd")
@@ -28,6 +33,7 @@ fn check(name: &str) {
     let opt = Options {
         width: n,
         height: n,
+        datapath,
         ..Options::default()
     };
     let (_, rep) = render(&scene, &opt, false, None).unwrap();
@@ -86,4 +92,9 @@ fn tree_1() {
     // A trunk and two branches: cones with unequal radii (the cone
     // kernel), spheres at the joints, a polygon ground.
     check("tree-1.nff");
+}
+
+#[test]
+fn shells_1_on_the_32_bit_chip() {
+    check_on("shells-1.nff", rtl::rc::Datapath::W32);
 }

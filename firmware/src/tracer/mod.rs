@@ -272,6 +272,7 @@ fn build_as(
         bsp: opt.bsp,
         layout: Some(crate::scene_image::Layout::BitVectors),
         guard_bits: nm.guard_bits,
+        target_extra_frac: opt.datapath.bits() - 16,
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
