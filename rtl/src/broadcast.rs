@@ -143,7 +143,7 @@ impl Broadcast {
     }
 
     /// Drive the array for this cycle: fetch the context(s) and FB data.
-    #[inline]
+    #[inline(always)]
     pub fn eval<W: Word>(
         &mut self,
         cm: &ContextMemory,
