@@ -115,7 +115,7 @@ fn the_timing_table_matches_the_defaults() {
     // field values from the Debug form of the defaults
     let mut vals: HashMap<String, String> = HashMap::new();
     let dbg = format!("{:?}", rtl::Timing::default());
-    for part in dbg.split(|c| c == '{' || c == '}' || c == ',') {
+    for part in dbg.split(['{', '}', ',']) {
         if let Some((k, v)) = part.split_once(':') {
             vals.insert(k.trim().to_string(), v.trim().to_string());
         }

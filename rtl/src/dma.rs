@@ -328,7 +328,7 @@ mod tests {
                 let (cycles, ..) = run(t, req);
                 // independent formula: setup + ceil(bytes / bpc)
                 let bytes = words as u64 * if kind == DmaKind::MemToCtx { 4 } else { 2 };
-                assert_eq!(cycles, setup as u64 + (bytes + bpc as u64 - 1) / bpc as u64);
+                assert_eq!(cycles, setup as u64 + bytes.div_ceil(bpc as u64));
                 assert_eq!(cycles, t.cycles(words, kind.word_bytes()));
             }
         }

@@ -9,6 +9,10 @@
 //! * [`tinyrisc`]: the control processor.
 //! * [`chip`]: the top module, its [`chip::Timing`] and [`chip::Stats`].
 
+// Lane loops index several per-lane arrays by the lane number on purpose:
+// that is the form the compiler vectorises.
+#![allow(clippy::needless_range_loop)]
+
 pub mod array;
 pub mod broadcast;
 pub mod chip;

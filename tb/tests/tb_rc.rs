@@ -59,12 +59,10 @@ fn parse(path: &Path) -> Wave {
     };
     for cmd in p {
         match cmd.expect("VCD body parses") {
-            vcd::Command::Timestamp(_) => {
-                if pending_edge {
-                    cycles.push(cur[&cyc]);
-                    edges.push(cur.clone());
-                    pending_edge = false;
-                }
+            vcd::Command::Timestamp(_) if pending_edge => {
+                cycles.push(cur[&cyc]);
+                edges.push(cur.clone());
+                pending_edge = false;
             }
             vcd::Command::ChangeScalar(id, v) => {
                 cur.insert(id, (v == vcd::Value::V1) as u64);
@@ -134,7 +132,7 @@ fn testbench_passes_and_its_waveform_matches_the_reference() {
         assert_eq!(w.at(k, "tb.rc.mul.acc"), r.acc, "acc during cycle {k}");
         assert_eq!(
             w.at(k, "tb.rc.flags.f"),
-            r.f as i64 * -1,
+            -(r.f as i64),
             "F during cycle {k}"
         ); // 1-bit sign-extends
         assert_eq!(

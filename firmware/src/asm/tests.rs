@@ -237,7 +237,7 @@ k1:     (f) mov out, e
     );
     assert_eq!(t[5], Instr::new(Opcode::Ori, 3, 3, 0, 0).encode().unwrap());
     assert_eq!(img.symbol("later"), Some(0x10000));
-    assert_eq!(img.symbol("tbl"), Some(0x10000 + 8 + 2 + 2 + 0));
+    assert_eq!(img.symbol("tbl"), Some(0x10000 + 8 + 2 + 2));
     let d = &img
         .segments
         .iter()

@@ -764,6 +764,42 @@ impl Scene {
     }
 }
 
+/// Separating axis test of a planar polygon (vertices `v`) against the box
+/// of centre `c` and half-extent `h`: false only when an axis separates
+/// them (the box's axes are covered by the bounding-box test before).
+fn sat_planar(v: &[Vec3], c: Vec3, h: Vec3) -> bool {
+    let p: Vec<Vec3> = v.iter().map(|&x| x - c).collect();
+    let separates = |ax: Vec3| {
+        let r = h.x * ax.x.abs() + h.y * ax.y.abs() + h.z * ax.z.abs();
+        let (lo, hi) = p
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
+                let d = q.dot(ax);
+                (lo.min(d), hi.max(d))
+            });
+        lo > r || hi < -r
+    };
+    let n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if n.dot(n) > 0.0 && separates(n) {
+        return false;
+    }
+    let axes = [
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 0.0, 1.0),
+    ];
+    for k in 0..p.len() {
+        let e = p[(k + 1) % p.len()] - p[k];
+        for a in axes {
+            let ax = e.cross(a);
+            if ax.dot(ax) > 0.0 && separates(ax) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -804,40 +840,4 @@ mod tests {
         };
         assert!(s.degeneracy().unwrap().contains("non-finite"));
     }
-}
-
-/// Separating axis test of a planar polygon (vertices `v`) against the box
-/// of centre `c` and half-extent `h`: false only when an axis separates
-/// them (the box's axes are covered by the bounding-box test before).
-fn sat_planar(v: &[Vec3], c: Vec3, h: Vec3) -> bool {
-    let p: Vec<Vec3> = v.iter().map(|&x| x - c).collect();
-    let separates = |ax: Vec3| {
-        let r = h.x * ax.x.abs() + h.y * ax.y.abs() + h.z * ax.z.abs();
-        let (lo, hi) = p
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), q| {
-                let d = q.dot(ax);
-                (lo.min(d), hi.max(d))
-            });
-        lo > r || hi < -r
-    };
-    let n = (p[1] - p[0]).cross(p[2] - p[0]);
-    if n.dot(n) > 0.0 && separates(n) {
-        return false;
-    }
-    let axes = [
-        Vec3::new(1.0, 0.0, 0.0),
-        Vec3::new(0.0, 1.0, 0.0),
-        Vec3::new(0.0, 0.0, 1.0),
-    ];
-    for k in 0..p.len() {
-        let e = p[(k + 1) % p.len()] - p[k];
-        for a in axes {
-            let ax = e.cross(a);
-            if ax.dot(ax) > 0.0 && separates(ax) {
-                return false;
-            }
-        }
-    }
-    true
 }
