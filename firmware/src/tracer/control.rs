@@ -383,92 +383,7 @@ test_objects:\n        lw r13, PASS(r0)",
             nw = t.bv_words
         );
             }
-            match t.ty {
-                ChipType::Sphere => {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        sbcb r1, r7, {}",
-                        kaddr("k_sphere"),
-                        klen("k_sphere")
-                    );
-                }
-                ChipType::Rectangle => {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        sbcb r1, r7, {}",
-                        kaddr("k_rect"),
-                        klen("k_rect")
-                    );
-                }
-                ChipType::Triangle => {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        sbcb r1, r7, {}",
-                        kaddr("k_tri"),
-                        klen("k_tri")
-                    );
-                }
-                ChipType::Box => {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        sbcb r1, r7, {}",
-                        kaddr("k_box"),
-                        klen("k_box")
-                    );
-                }
-                ChipType::Cylinder => {
-                    let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
-                    kaddr("k_cyl"),
-                    klen("k_cyl")
-                );
-                    for c in 0..2 {
-                        let _ = writeln!(
-                            w,
-                            "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
-                            kaddr("k_disc"),
-                            1 + super::layout::CYL_BODY_WORDS + c * super::layout::PLANAR_WORDS,
-                            klen("k_disc")
-                        );
-                    }
-                    let _ = writeln!(w, "{n}_nocap:");
-                }
-                ChipType::Cone => {
-                    let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
-                    kaddr("k_cone"),
-                    klen("k_cone")
-                );
-                    for c in 0..2 {
-                        let _ = writeln!(
-                            w,
-                            "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
-                            kaddr("k_disc"),
-                            1 + super::layout::CONE_BODY_WORDS + c * super::layout::PLANAR_WORDS,
-                            klen("k_disc")
-                        );
-                    }
-                    let _ = writeln!(w, "{n}_nocap:");
-                }
-                ChipType::Polygon => {
-                    let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        addi r2, r7, {}\n        li r1, {}\n\
-{n}_fan:\n        beqz r3, {n}_tail\n        sbcb r1, r2, {}\n        addi r2, r2, {}\n        addi r3, r3, -1\n        j {n}_fan\n\
-{n}_tail:\n        li r1, {}\n        sbcb r1, r2, {}",
-                    kaddr("k_polyh"),
-                    klen("k_polyh"),
-                    1 + super::layout::POLY_HEAD_WORDS,
-                    kaddr("k_polye"),
-                    klen("k_polye"),
-                    super::layout::POLY_EDGE_WORDS,
-                    kaddr("k_polyt"),
-                    klen("k_polyt")
-                );
-                }
-            }
+            broadcast_object(w, t.ty, &n);
             if compact {
                 let _ = writeln!(
                     w,
@@ -608,72 +523,7 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
         lw r1, TESTS(r0)\n        addi r1, r1, 1\n        sw r1, TESTS(r0)",
             cnt = 28 + 4 * j
         );
-        let one = |w: &mut String, kn: &str| {
-            let _ = writeln!(
-                w,
-                "        li r1, {}\n        sbcb r1, r7, {}",
-                kaddr(kn),
-                klen(kn)
-            );
-        };
-        match t.ty {
-            ChipType::Sphere => one(w, "k_sphere"),
-            ChipType::Rectangle => one(w, "k_rect"),
-            ChipType::Triangle => one(w, "k_tri"),
-            ChipType::Box => one(w, "k_box"),
-            ChipType::Cylinder => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
-                    kaddr("k_cyl"),
-                    klen("k_cyl")
-                );
-                for c in 0..2 {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
-                        kaddr("k_disc"),
-                        1 + super::layout::CYL_BODY_WORDS + c * super::layout::PLANAR_WORDS,
-                        klen("k_disc")
-                    );
-                }
-                let _ = writeln!(w, "{n}_nocap:");
-            }
-            ChipType::Cone => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
-                    kaddr("k_cone"),
-                    klen("k_cone")
-                );
-                for c in 0..2 {
-                    let _ = writeln!(
-                        w,
-                        "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
-                        kaddr("k_disc"),
-                        1 + super::layout::CONE_BODY_WORDS + c * super::layout::PLANAR_WORDS,
-                        klen("k_disc")
-                    );
-                }
-                let _ = writeln!(w, "{n}_nocap:");
-            }
-            ChipType::Polygon => {
-                let _ = writeln!(
-                    w,
-                    "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        addi r2, r7, {}\n        li r1, {}\n\
-{n}_fan:\n        beqz r3, {n}_tail\n        sbcb r1, r2, {}\n        addi r2, r2, {}\n        addi r3, r3, -1\n        j {n}_fan\n\
-{n}_tail:\n        li r1, {}\n        sbcb r1, r2, {}",
-                    kaddr("k_polyh"),
-                    klen("k_polyh"),
-                    1 + super::layout::POLY_HEAD_WORDS,
-                    kaddr("k_polye"),
-                    klen("k_polye"),
-                    super::layout::POLY_EDGE_WORDS,
-                    kaddr("k_polyt"),
-                    klen("k_polyt")
-                );
-            }
-        }
+        broadcast_object(w, t.ty, &n);
         let _ = writeln!(
             w,
             "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
@@ -681,4 +531,67 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
         );
     }
     let _ = writeln!(w, "        ret\n");
+}
+
+/// TinyRISC code that broadcasts the test of one object of type `ty`,
+/// whose FB record starts at the address in `r7`, by the kernels of its
+/// type (labels prefixed `n`; clobbers r1..r3). Shared by the resident
+/// Fig. 6 / compact loops and the streamed leaf loop.
+fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
+    use super::layout::{
+        CONE_BODY_WORDS, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
+    };
+    let kaddr = |k: &str| format!("({k} - CTXBASE) / 4");
+    let klen = |k: &str| format!("({k}_end - {k}) / 4");
+    let one = |w: &mut String, k: &str| {
+        let _ = writeln!(
+            w,
+            "        li r1, {}\n        sbcb r1, r7, {}",
+            kaddr(k),
+            klen(k)
+        );
+    };
+    // Body, then the two end caps as disc records where the caps word is set.
+    let capped = |w: &mut String, k: &str, body: usize| {
+        let _ = writeln!(
+            w,
+            "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
+            kaddr(k),
+            klen(k)
+        );
+        for c in 0..2 {
+            let _ = writeln!(
+                w,
+                "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
+                kaddr("k_disc"),
+                1 + body + c * PLANAR_WORDS,
+                klen("k_disc")
+            );
+        }
+        let _ = writeln!(w, "{n}_nocap:");
+    };
+    match ty {
+        ChipType::Sphere => one(w, "k_sphere"),
+        ChipType::Rectangle => one(w, "k_rect"),
+        ChipType::Triangle => one(w, "k_tri"),
+        ChipType::Box => one(w, "k_box"),
+        ChipType::Cylinder => capped(w, "k_cyl", CYL_BODY_WORDS),
+        ChipType::Cone => capped(w, "k_cone", CONE_BODY_WORDS),
+        ChipType::Polygon => {
+            let _ = writeln!(
+                w,
+                "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        addi r2, r7, {}\n        li r1, {}\n\
+{n}_fan:\n        beqz r3, {n}_tail\n        sbcb r1, r2, {}\n        addi r2, r2, {}\n        addi r3, r3, -1\n        j {n}_fan\n\
+{n}_tail:\n        li r1, {}\n        sbcb r1, r2, {}",
+                kaddr("k_polyh"),
+                klen("k_polyh"),
+                1 + POLY_HEAD_WORDS,
+                kaddr("k_polye"),
+                klen("k_polye"),
+                POLY_EDGE_WORDS,
+                kaddr("k_polyt"),
+                klen("k_polyt")
+            );
+        }
+    }
 }
