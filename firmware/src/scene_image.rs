@@ -41,6 +41,9 @@ pub const LIGHT_WORDS: usize = 6;
 pub const MATERIAL_WORDS: usize = 8;
 /// Child index of a leaf.
 pub const NO_CHILD: u16 = 0xFFFF;
+/// Deepest BSP the compiler builds (the packet traversal keeps one
+/// interval slot per level in every RC's RAM).
+pub const MAX_BSP_DEPTH: u32 = 32;
 /// Compact layout: object index bits of a list entry.
 pub const LIST_INDEX_BITS: u32 = 13;
 
@@ -391,11 +394,11 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
         col: 0,
         message,
     };
-    if !(1..=16).contains(&opt.bsp.max_depth) || opt.bsp.max_leaf == 0 {
+    if !(1..=MAX_BSP_DEPTH).contains(&opt.bsp.max_depth) || opt.bsp.max_leaf == 0 {
         return Err(err(
             0,
             format!(
-                "BSP max depth {} must be 1..=16 (node indices are 16-bit) and max objects per leaf {} at least 1",
+                "BSP max depth {} must be 1..={MAX_BSP_DEPTH} and max objects per leaf {} at least 1",
                 opt.bsp.max_depth, opt.bsp.max_leaf
             ),
         ));

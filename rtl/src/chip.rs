@@ -71,6 +71,30 @@ pub struct Stats {
     pub dma_busy_cycles: u64,
     pub dma_words: u64,
     pub dma_transfers: u64,
+    /// Per class of [`Watch`], runs started at a watched address and the
+    /// RCs that executed their first context.
+    pub watched_runs: [u64; 2],
+    pub watched_rcs: [u64; 2],
+}
+
+/// A simulator statistic, not a part of the chip: context addresses whose
+/// runs are counted when they start, with the RCs that execute their first
+/// context, in two classes (the ray tracer: the object tests' kernels, and
+/// the kernel that starts a ray pass). Costs nothing while empty.
+#[derive(Clone, Debug, Default)]
+pub struct Watch {
+    any: bool,
+    class: std::collections::HashMap<u16, usize>,
+    runs: [u64; 2],
+    rcs: [u64; 2],
+}
+
+impl Watch {
+    /// Count runs that start at `ctx` in `class` (0 or 1).
+    pub fn add(&mut self, ctx: u16, class: usize) {
+        self.class.insert(ctx, class.min(1));
+        self.any = true;
+    }
 }
 
 impl Stats {
@@ -99,6 +123,8 @@ pub struct Chip<W: Word = i16> {
     cycles: u64,
     array_busy: u64,
     active_rc: u64,
+    /// Runs counted for the statistics ([`Watch`]).
+    pub watch: Watch,
 }
 
 /// TinyRISC's view of the chip.
@@ -207,6 +233,7 @@ impl<W: Word> Chip<W> {
             cycles: 0,
             array_busy: 0,
             active_rc: 0,
+            watch: Watch::default(),
         }
     }
 
@@ -241,6 +268,8 @@ impl<W: Word> Chip<W> {
             dma_busy_cycles: self.dma.busy_cycles,
             dma_words: self.dma.words_moved,
             dma_transfers: self.dma.transfers,
+            watched_runs: self.watch.runs,
+            watched_rcs: self.watch.rcs,
         }
     }
 
@@ -282,6 +311,16 @@ impl<W: Word> Chip<W> {
             n += 1;
         }
         (n, Ok(()))
+    }
+
+    #[cold]
+    fn count_watched(&mut self) {
+        if let Some((run, 0, _)) = self.bcast.current() {
+            if let Some(&c) = self.watch.class.get(&run.ctx) {
+                self.watch.runs[c] += 1;
+                self.watch.rcs[c] += self.array.active_now as u64;
+            }
+        }
     }
 
     /// Add where TinyRISC is to a fault's message.
@@ -332,6 +371,9 @@ impl<W: Word> Clocked for Chip<W> {
         if self.array.is_active() {
             self.array_busy += 1;
             self.active_rc += self.array.active_now as u64;
+            if self.watch.any {
+                self.count_watched();
+            }
         }
         self.bcast.commit();
         self.dma

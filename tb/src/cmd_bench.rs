@@ -51,6 +51,8 @@ pub fn command(a: BenchArgs) -> Result<()> {
         bsp: BspParams::default(),
         layout: Default::default(),
         datapath: Default::default(),
+        traversal: Default::default(),
+        collapse: Default::default(),
     };
     let repeat = a.repeat.max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());

@@ -27,11 +27,48 @@ pub struct RenderArgs {
     pub max_depth: u32,
     pub max_leaf: usize,
     pub layout: firmware::tracer::NodeLayout,
+    pub traversal: firmware::tracer::Traversal,
+    pub collapse: firmware::tracer::Collapse,
     pub datapath: crate::cli::DatapathChoice,
     /// Newton-Raphson steps after each table lookup.
     pub newton_steps: u32,
     /// Entries of the reciprocal and reciprocal square root tables.
     pub table_entries: u32,
+    /// Profile every chip instance (cycles per kernel and per TinyRISC
+    /// label).
+    pub profile: bool,
+}
+
+fn profile_json(p: &crate::profile::Profile) -> serde_json::Value {
+    let rows = |v: &[(String, u64)]| {
+        v.iter()
+            .map(|(n, c)| json!({"name": n, "cycles": c}))
+            .collect::<Vec<_>>()
+    };
+    json!({
+        "cycles": p.cycles,
+        "kernels": rows(&p.kernels),
+        "control": rows(&p.control),
+    })
+}
+
+fn print_profile(p: &crate::profile::Profile) {
+    let pct = |c: u64| 100.0 * c as f64 / p.cycles.max(1) as f64;
+    let busy: u64 = p.kernels.iter().map(|x| x.1).sum();
+    println!(
+        "profile                  every chip instance's tile loop: {} cycles; array busy {:.1}%, idle {:.1}%",
+        p.cycles,
+        pct(busy),
+        pct(p.cycles - busy)
+    );
+    println!("  array busy in kernel          cycles      share");
+    for (n, c) in p.kernels.iter().take(14) {
+        println!("  {n:<24} {c:>12} {:>9.1}%", pct(*c));
+    }
+    println!("  array idle, TinyRISC at       cycles      share");
+    for (n, c) in p.control.iter().take(14) {
+        println!("  {n:<24} {c:>12} {:>9.1}%", pct(*c));
+    }
 }
 
 /// Everything `render` reports.
@@ -63,8 +100,28 @@ pub fn render_with(
     progress: bool,
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
+    render_as(
+        scene,
+        opt,
+        nm,
+        &crate::render::RenderSettings {
+            progress,
+            trace,
+            profile: false,
+        },
+    )
+}
+
+/// [`render_with`] with the host's settings (progress, waveform, profile).
+pub fn render_as(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    nm: &firmware::tracer::Numerics,
+    host: &crate::render::RenderSettings,
+) -> Result<(crate::render::ChipRender, RenderReport)> {
+    let progress = host.progress;
     let t0 = Instant::now();
-    let chip = crate::render::render_chip_with(scene, opt, nm, progress, trace)?;
+    let chip = crate::render::render_chip_as(scene, opt, nm, host)?;
     let host = t0.elapsed().as_secs_f64();
     let refimg = reference::render(
         scene,
@@ -95,6 +152,9 @@ pub fn render_with(
         "active_rc_fraction": chip.stats.active_rc_fraction(),
         "dma_stall_cycles": chip.stats.dma_stall_cycles,
         "objects_tested_per_ray": chip.objects_tested_per_ray(),
+        "ray_tests_per_ray": chip.tests_per_ray(),
+        "rays_traced": chip.stats.watched_rcs[1],
+        "ray_object_tests": chip.stats.watched_rcs[0],
         "host_seconds": host,
         "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
         "startup_cycles": chip.startup_cycles,
@@ -113,6 +173,8 @@ pub fn render_with(
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
         "fb_words": chip.firmware.fb.len(),
         "node_layout": opt.layout.name(),
+        "traversal": opt.traversal.name(),
+        "collapse": opt.collapse.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
@@ -152,6 +214,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
         },
         layout: a.layout,
         datapath: rtl::rc::Datapath::W16,
+        traversal: a.traversal,
+        collapse: a.collapse,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
@@ -191,7 +255,19 @@ pub fn command(a: RenderArgs) -> Result<()> {
         }
         c
     });
-    let (chip, mut rep) = render_with(&scene, &opt, &nm, true, trace)?;
+    let (chip, mut rep) = render_as(
+        &scene,
+        &opt,
+        &nm,
+        &crate::render::RenderSettings {
+            progress: true,
+            trace,
+            profile: a.profile,
+        },
+    )?;
+    if let Some(p) = &chip.profile {
+        rep.json["profile"] = profile_json(p);
+    }
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     let out = a
         .out
@@ -247,8 +323,9 @@ pub fn command(a: RenderArgs) -> Result<()> {
         );
     }
     println!(
-        "objects tested per ray   {:.2}",
-        j["objects_tested_per_ray"].as_f64().unwrap_or(0.0)
+        "objects tested per ray   {:.2} broadcast per packet pass, {:.2} tested per ray traced",
+        j["objects_tested_per_ray"].as_f64().unwrap_or(0.0),
+        j["ray_tests_per_ray"].as_f64().unwrap_or(0.0)
     );
     println!(
         "host seconds             {:.2}",
@@ -258,6 +335,9 @@ pub fn command(a: RenderArgs) -> Result<()> {
         "array cycles / host s    {:.3e}",
         j["array_cycles_per_host_second"].as_f64().unwrap_or(0.0)
     );
+    if let Some(p) = &chip.profile {
+        print_profile(p);
+    }
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(j)?;
         write_atomic(p, text.as_bytes())?;

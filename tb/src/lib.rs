@@ -13,6 +13,7 @@ pub mod cmd_spd;
 pub mod cmd_sweep;
 pub mod fuzz;
 pub mod metrics;
+pub mod profile;
 pub mod reference;
 pub mod render;
 pub mod testbench;

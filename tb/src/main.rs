@@ -204,6 +204,17 @@ enum Command {
         /// or compact (index lists); the same image either way.
         #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
         layout: firmware::tracer::NodeLayout,
+        /// BSP traversal: paper (the paper's: where the rays disagree, test
+        /// every object under the node) or packet (per-ray intervals; a
+        /// child is visited only by the rays that reach it).
+        #[arg(long, value_name = "paper|packet", default_value = "paper", value_parser = parse_traversal)]
+        traversal: firmware::tracer::Traversal,
+        /// Packet traversal: which BSP subtrees to walk as one leaf of all
+        /// their objects: auto (where that costs less than walking them, by
+        /// the cells' surface areas and the kernels' lengths) or N (those
+        /// with at most N objects; 0: none).
+        #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_collapse)]
+        collapse: firmware::tracer::Collapse,
         /// RC datapath width in bits: 16 (the paper's chip), 32 (the
         /// variant the paper announces; every format gets 16 more fraction
         /// bits), or auto: 16 unless the scene's smallest feature is under
@@ -218,6 +229,10 @@ enum Command {
         /// every RC's RAM: 16, 32, 64 or 128.
         #[arg(long, value_name = "N", default_value_t = 128)]
         table_entries: u32,
+        /// Print (and put in the JSON) where the frame's cycles go: per RC kernel while the array works, per TinyRISC
+        /// label while it waits (steps every cycle: several times slower).
+        #[arg(long)]
+        profile: bool,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -263,6 +278,14 @@ enum Bench {
 }
 
 fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
+    s.parse()
+}
+
+fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, String> {
+    s.parse()
+}
+
+fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
     s.parse()
 }
 
@@ -370,9 +393,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_depth,
             max_leaf,
             layout,
+            traversal,
+            collapse,
             datapath,
             newton_steps,
             table_entries,
+            profile,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -386,9 +412,12 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_depth,
             max_leaf,
             layout,
+            traversal,
+            collapse,
             datapath,
             newton_steps,
             table_entries,
+            profile,
         }),
         Command::Compare {
             a,

@@ -43,6 +43,20 @@ pub struct ChipRender {
     pub tiles: usize,
     pub chips: usize,
     pub firmware: Firmware,
+    /// With [`RenderSettings::profile`]: where the tile loops' cycles went
+    /// (every chip instance).
+    pub profile: Option<crate::profile::Profile>,
+}
+
+/// How the host runs a render (not part of the chip or the firmware).
+#[derive(Clone, Debug, Default)]
+pub struct RenderSettings {
+    pub progress: bool,
+    pub trace: Option<rtl::trace::TraceConfig>,
+    /// Charge every cycle of the tile loops to a kernel or a TinyRISC
+    /// label ([`crate::profile`]; steps cycle by cycle, several times
+    /// slower).
+    pub profile: bool,
 }
 
 impl ChipRender {
@@ -53,13 +67,27 @@ impl ChipRender {
             clock_hz as f64 / self.cycles as f64
         }
     }
-    /// Objects each ray of a packet was tested against, averaged over the
-    /// packets' passes (eye, shadow and reflection).
+    /// Objects broadcast to a packet, averaged over the packets' passes
+    /// (eye, shadow and reflection); each awake ray of the packet is tested
+    /// against each (the paper's traversal: every ray of the pass not yet
+    /// done; the packet traversal: the rays that reach the object's cell).
     pub fn objects_tested_per_ray(&self) -> f64 {
         if self.passes == 0 {
             0.0
         } else {
             self.object_tests as f64 / self.passes as f64
+        }
+    }
+
+    /// Ray-object tests the RCs executed per ray traced: the awake RCs at
+    /// the start of every object test over the rays that started a pass
+    /// (counted by the simulator, [`rtl::chip::Watch`]).
+    pub fn tests_per_ray(&self) -> f64 {
+        let rays = self.stats.watched_rcs[1];
+        if rays == 0 {
+            0.0
+        } else {
+            self.stats.watched_rcs[0] as f64 / rays as f64
         }
     }
 }
@@ -81,6 +109,10 @@ fn add_stats(a: &mut Stats, b: &Stats) {
     a.dma_busy_cycles += b.dma_busy_cycles;
     a.dma_words += b.dma_words;
     a.dma_transfers += b.dma_transfers;
+    for c in 0..2 {
+        a.watched_runs[c] += b.watched_runs[c];
+        a.watched_rcs[c] += b.watched_rcs[c];
+    }
 }
 
 fn sub_stats(a: &mut Stats, b: &Stats) {
@@ -94,6 +126,39 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     a.dma_busy_cycles -= b.dma_busy_cycles.min(a.dma_busy_cycles);
     a.dma_words -= b.dma_words.min(a.dma_words);
     a.dma_transfers -= b.dma_transfers.min(a.dma_transfers);
+    for c in 0..2 {
+        a.watched_runs[c] -= b.watched_runs[c].min(a.watched_runs[c]);
+        a.watched_rcs[c] -= b.watched_rcs[c].min(a.watched_rcs[c]);
+    }
+}
+
+/// Kernels whose runs start an object test (their RCs at the first context
+/// are the rays tested), and the kernel that starts a ray pass (its RCs are
+/// the pass's rays).
+const TEST_KERNELS: [&str; 7] = [
+    "k_sphere", "k_cyl", "k_cone", "k_box", "k_rect", "k_tri", "k_polyh",
+];
+
+fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
+    let mut w = rtl::chip::Watch::default();
+    let ctx = |n: &str| {
+        img.symbol(n)
+            .map(|v| ((v as u32 - mem::CTX_BASE) / 4) as u16)
+    };
+    for k in TEST_KERNELS {
+        if let Some(a) = ctx(k) {
+            w.add(a, 0);
+        }
+    }
+    let start = match fw.layout.traversal {
+        tracer::Traversal::Paper => "k_sign0",
+        tracer::Traversal::Packet if fw.layout.root_leaf => "k_sign0",
+        tracer::Traversal::Packet => "k_pinit",
+    };
+    if let Some(a) = ctx(start) {
+        w.add(a, 1);
+    }
+    w
 }
 
 struct Group {
@@ -106,6 +171,7 @@ struct Group {
     startup: Stats,
     /// Per tile, the 256 output words.
     out: Vec<Vec<i32>>,
+    profile: Option<crate::profile::Profile>,
 }
 
 fn sym(img: &Image, name: &str) -> Result<u32> {
@@ -119,6 +185,7 @@ fn run_group<W: Word>(
     fw: &Firmware,
     tiles: &[(u32, u32)],
     trace: Option<rtl::trace::TraceConfig>,
+    profile: bool,
 ) -> Result<Group> {
     // Main memory as large as the program touches (its segments, the tile
     // list, the output tiles and the streamed scene image), not the
@@ -143,10 +210,17 @@ fn run_group<W: Word>(
                     (st.base as usize + st.image.len())
                         .max(st.mailbox as usize + 2 * fw.layout.objects)
                 }),
+        )
+        .chain(
+            // the packet traversal's mailboxes (main memory, resident or
+            // streamed)
+            (fw.layout.traversal == tracer::Traversal::Packet)
+                .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
         );
     let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
     let mut chip = Chip::<W>::build(Timing::default(), mem_bytes);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
+    chip.watch = watch(img, fw);
     let fb = fw.fb_bytes();
     chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
     if let Some(st) = &fw.layout.stream {
@@ -186,8 +260,20 @@ fn run_group<W: Word>(
             break;
         }
     }
+    let mut prof = None;
     if result.is_ok() {
-        result = run_to_halt(&mut sim, MAX_CYCLES_PER_CHIP);
+        if profile {
+            let names = crate::profile::Names::new(img, &fw.source, mem::CTX_BASE);
+            match crate::profile::run(&mut sim, &names, MAX_CYCLES_PER_CHIP) {
+                Ok(p) => {
+                    result = Ok(p.cycles);
+                    prof = Some(p);
+                }
+                Err(e) => result = Err(e),
+            }
+        } else {
+            result = run_to_halt(&mut sim, MAX_CYCLES_PER_CHIP);
+        }
     }
     let files = sim
         .finish_trace()
@@ -221,6 +307,7 @@ fn run_group<W: Word>(
         stats: sim.top.stats(),
         startup,
         out,
+        profile: prof,
     })
 }
 
@@ -244,7 +331,27 @@ pub fn render_chip_with(
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<ChipRender> {
     let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
-    render_firmware(fw, opt, progress, trace)
+    render_firmware(
+        fw,
+        opt,
+        &RenderSettings {
+            progress,
+            trace,
+            profile: false,
+        },
+    )
+}
+
+/// [`render_chip_with`] with the host's settings (progress, waveform,
+/// profile).
+pub fn render_chip_as(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    host: &RenderSettings,
+) -> Result<ChipRender> {
+    let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    render_firmware(fw, opt, host)
 }
 
 /// Render with the streamed layout (scene in main memory, leaf blocks moved
@@ -256,15 +363,18 @@ pub fn render_chip_streamed(
     progress: bool,
 ) -> Result<ChipRender> {
     let fw = tracer::build_streamed_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
-    render_firmware(fw, opt, progress, None)
+    render_firmware(
+        fw,
+        opt,
+        &RenderSettings {
+            progress,
+            ..Default::default()
+        },
+    )
 }
 
-fn render_firmware(
-    fw: Firmware,
-    opt: &Options,
-    progress: bool,
-    trace: Option<rtl::trace::TraceConfig>,
-) -> Result<ChipRender> {
+fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
+    let progress = host.progress;
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
     let (w, h) = (opt.width, opt.height);
@@ -287,16 +397,16 @@ fn render_firmware(
     } else {
         ProgressBar::hidden()
     };
-    let mut trace = trace;
-    let first_trace = trace.take();
+    let first_trace = host.trace.clone();
     let results: Vec<Result<Group>> = groups
         .par_iter()
         .enumerate()
         .map(|(gi, g)| {
             let t = if gi == 0 { first_trace.clone() } else { None };
+            let p = host.profile;
             let r = match fw.datapath {
-                Datapath::W16 => run_group::<i16>(&img, &fw, g, t),
-                Datapath::W32 => run_group::<i32>(&img, &fw, g, t),
+                Datapath::W16 => run_group::<i16>(&img, &fw, g, t, p),
+                Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p),
             };
             bar.inc(g.len() as u64);
             r
@@ -307,8 +417,15 @@ fn render_firmware(
     let mut hits = vec![NO_HIT; (w * h) as usize];
     let mut stats = Stats::default();
     let (mut cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
+    let mut profile = None;
     for (gi, r) in results.into_iter().enumerate() {
-        let g = r?;
+        let mut g = r?;
+        if let Some(p) = g.profile.take() {
+            profile = Some(match profile {
+                None => p,
+                Some(q) => crate::profile::Profile::merge(q, p),
+            });
+        }
         if gi == 0 {
             startup = g.start;
         }
@@ -352,5 +469,6 @@ fn render_firmware(
         tiles: tiles.len(),
         chips: groups.len(),
         firmware: fw,
+        profile,
     })
 }

@@ -9,7 +9,7 @@ use std::fmt::Write;
 
 use super::kernels::{self as k, Inside, K};
 use super::layout::{ChipType, Layout};
-use super::{mem, NodeLayout, Numerics, Options};
+use super::{mem, NodeLayout, Numerics, Options, Traversal};
 use crate::scene::Scene;
 
 pub struct Program {
@@ -31,20 +31,50 @@ pub fn program(
     th: u32,
 ) -> Result<Program, String> {
     // ---- kernels ----
-    let mut ks: Vec<(&str, K)> = vec![
-        ("k_init", k::init()),
-        ("k_rows", k::rows()),
-        ("k_lanes", k::lanes(tw, th)),
-        ("k_wake", k::wake_restore()),
-        ("k_sign0", k::sign(0)),
-        ("k_sign1", k::sign(1)),
-        ("k_sign2", k::sign(2)),
-        ("k_cls0", k::classify(0)),
-        ("k_cls1", k::classify(1)),
-        ("k_cls2", k::classify(2)),
-        ("k_clsr", k::classify_above()),
-        ("k_leafc", k::leaf_closest()),
-        ("k_leafa", k::leaf_any()),
+    let packet = lay.traversal == Traversal::Packet;
+    let mut ks: Vec<(&str, K)> = if packet {
+        let mut init = k::init();
+        k::pk_init_ram(&mut init);
+        vec![
+            ("k_init", init),
+            ("k_rows", k::rows()),
+            ("k_lanes", k::lanes(tw, th)),
+            ("k_wake", k::pk_wake_restore()),
+            ("k_sign0", k::sign(0)),
+            ("k_sign1", k::sign(1)),
+            ("k_sign2", k::sign(2)),
+            ("k_pinit", k::pk_init(nm.approx())),
+            ("k_pn0b", k::pk_node(0, false)),
+            ("k_pn0a", k::pk_node(0, true)),
+            ("k_pn1b", k::pk_node(1, false)),
+            ("k_pn1a", k::pk_node(1, true)),
+            ("k_pn2b", k::pk_node(2, false)),
+            ("k_pn2a", k::pk_node(2, true)),
+            ("k_p2nd", k::pk_second()),
+            ("k_psl", k::pk_sleep_first()),
+            ("k_ptake", k::pk_take()),
+            ("k_ppush", k::pk_push()),
+            ("k_ppop", k::pk_pop()),
+            ("k_pleafa", k::pk_leaf_any()),
+        ]
+    } else {
+        vec![
+            ("k_init", k::init()),
+            ("k_rows", k::rows()),
+            ("k_lanes", k::lanes(tw, th)),
+            ("k_wake", k::wake_restore()),
+            ("k_sign0", k::sign(0)),
+            ("k_sign1", k::sign(1)),
+            ("k_sign2", k::sign(2)),
+            ("k_cls0", k::classify(0)),
+            ("k_cls1", k::classify(1)),
+            ("k_cls2", k::classify(2)),
+            ("k_clsr", k::classify_above()),
+            ("k_leafc", k::leaf_closest()),
+            ("k_leafa", k::leaf_any()),
+        ]
+    };
+    ks.extend([
         ("k_eye", k::eye(lay.kd, nm.approx())),
         ("k_post0", k::post(true, lay.materials, nm.eps_lsb)),
         ("k_post1", k::post(false, lay.materials, nm.eps_lsb)),
@@ -54,7 +84,7 @@ pub fn program(
         ("k_out1", k::out_word(1)),
         ("k_out2", k::out_word(2)),
         ("k_out3", k::out_word(3)),
-    ];
+    ]);
     let mut st_row = K::default();
     st_row.c(format!("st r8, [#{}]", k::ram::LANE_ROW));
     let mut st_col = K::default();
@@ -67,7 +97,7 @@ pub fn program(
         refl.push((format!("k_refl{l}"), k::reflect_setup(l)));
         refl.push((format!("k_pop{l}"), k::reflect_pop(l)));
     }
-    if lay.stream.is_some() {
+    if lay.stream.is_some() && !packet {
         refl.push(("k_leafcu".into(), k::leaf_closest_ordered()));
         refl.push(("k_uzero".into(), k::unord_zero()));
         for a in 0..3u8 {
@@ -163,7 +193,21 @@ pub fn program(
 T_START: .word 0\nT_END:  .word 0\nTESTS:  .word 0\nPASSES: .word 0\nTL_PTR: .word 0\nTL_CNT: .word 0\nTL_BANK: .word 0\nCUR_OUT: .word 0\n\
 NSTACK: .space 256\n"
     );
-    if let Some(st) = &lay.stream {
+    if packet {
+        let _ = writeln!(
+            w,
+            "NK:     .word 0, 0, 0\nNF:     .word 0, 0, 0\nNS:     .word 0, 0, 0\nCUR_BLK: .word 0\nROOTBOX = {}",
+            lay.root_box
+        );
+        if let Some(st) = &lay.stream {
+            let _ = writeln!(
+                w,
+                "SPLIT = {}\nSBANK = 0x{:x}",
+                st.split_slot,
+                super::layout::STREAM_BANK
+            );
+        }
+    } else if let Some(st) = &lay.stream {
         let _ = writeln!(
             w,
             "UPTR:   .word 0\nUSTK:   .space 160\nCUR_BLK: .word 0\nSPLIT = {}\nSBANK = 0x{:x}",
@@ -274,6 +318,63 @@ NSTACK: .space 256\n"
         "finish: dwait\n        rdcyc r1\n        sw r1, T_END(r0)\n        halt\n"
     );
 
+    if packet {
+        packet_trace(w, lay);
+    } else {
+        paper_trace(w, lay);
+    }
+
+    // ---- contexts ----
+    let _ = writeln!(w, "        .ctx\n        .org CTXBASE");
+    let mut kernels = Vec::new();
+    let mut words = 0usize;
+    // Row-mode group must be 8-aligned: put it first.
+    let mut all: Vec<(String, K)> = Vec::new();
+    let mut rows = None;
+    for (n, kk) in ks {
+        if n == "k_rows" {
+            rows = Some(kk);
+        } else {
+            all.push((n.to_string(), kk));
+        }
+    }
+    if let Some(r) = rows {
+        all.insert(0, ("k_rows".into(), r));
+    }
+    all.extend(refl);
+    for (n, kk) in objk {
+        all.push((n.to_string(), kk));
+    }
+    for (n, kk) in &all {
+        let _ = write!(w, "{}", kk.text(n));
+        kernels.push((n.clone(), kk.len()));
+        words += kk.len();
+    }
+    let _ = writeln!(w, "ctx_end:");
+    if words > 8192 {
+        return Err(format!(
+            "the kernels need {words} context words; the context memory holds 8192"
+        ));
+    }
+    Ok(Program {
+        source: s,
+        context_words: words,
+        kernels,
+    })
+}
+
+/// The paper's traversal (resident or streamed) and its object loops.
+fn paper_trace(w: &mut String, lay: &Layout) {
+    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
+    let klen = |n: &str| format!("({n}_end - {n}) / 4");
+    let cb = |w: &mut String, n: &str| {
+        let _ = writeln!(
+            w,
+            "        li r1, {}\n        cbcast r1, {}",
+            kaddr(n),
+            klen(n)
+        );
+    };
     // ---- trace: one ray pass over the BSP ----
     let _ = writeln!(
         w,
@@ -401,44 +502,264 @@ test_objects:\n        lw r13, PASS(r0)",
         }
         let _ = writeln!(w, "        ret\n");
     }
+}
 
-    // ---- contexts ----
-    let _ = writeln!(w, "        .ctx\n        .org CTXBASE");
-    let mut kernels = Vec::new();
-    let mut words = 0usize;
-    // Row-mode group must be 8-aligned: put it first.
-    let mut all: Vec<(String, K)> = Vec::new();
-    let mut rows = None;
-    for (n, kk) in ks {
-        if n == "k_rows" {
-            rows = Some(kk);
-        } else {
-            all.push((n.to_string(), kk));
+/// Popcount of `x` into `x` (SWAR), clobbering `t1`, `t2`.
+fn popcount(w: &mut String, x: &str, t1: &str, t2: &str) {
+    let _ = writeln!(
+        w,
+        "        srli {t1}, {x}, 1\n        li {t2}, 0x55555555\n        and {t1}, {t1}, {t2}\n        sub {x}, {x}, {t1}\n\
+        li {t2}, 0x33333333\n        and {t1}, {x}, {t2}\n        srli {x}, {x}, 2\n        and {x}, {x}, {t2}\n        add {x}, {x}, {t1}\n\
+        srli {t1}, {x}, 4\n        add {x}, {x}, {t1}\n        li {t2}, 0x0f0f0f0f\n        and {x}, {x}, {t2}\n\
+        li {t2}, 0x01010101\n        mul {x}, {x}, {t2}\n        srli {x}, {x}, 24"
+    );
+}
+
+/// The masked packet traversal ([`Traversal::Packet`]), resident or
+/// streamed. Per pass: `k_pinit` (every awake ray takes part; its interval
+/// starts as `[0, tbest]` clipped to the root cell), then per axis the
+/// order of the children, the one the majority of the awake rays meets
+/// first (`NK`: that axis's node kernel, `NF`/`NS`: offsets of the first
+/// and second child in a node record). At an inner node the node kernel
+/// splits every awake ray's interval and `rcst` says which children some
+/// awake ray reaches: none (pop), the second only (its intervals become
+/// current), some the first (the others sleep; the second is pushed) or
+/// all the first (one more `rcany` asks whether to push the second). A
+/// popped node wakes every RC; the rays not alive, or whose interval for
+/// it is empty or lies beyond their hit, sleep again, and a node no ray
+/// needs is skipped. TinyRISC registers: r5 node, r13 object tests of the
+/// pass, r14 node stack.
+fn packet_trace(w: &mut String, lay: &Layout) {
+    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
+    let klen = |n: &str| format!("({n}_end - {n}) / 4");
+    let streamed = lay.stream.is_some();
+    // Child offsets in a node record: FB words (resident) or bytes.
+    let (left, right) = if streamed { (16, 20) } else { (4, 5) };
+    let _ = writeln!(
+        w,
+        "; trace (packet traversal): the RCs hold o, d, tbest; MODE 0 closest hit, 1 any hit (shadow).\n\
+trace:  sw r15, SAVE_LR(r0)\n        lw r1, PASSES(r0)\n        addi r1, r1, 1\n        sw r1, PASSES(r0)\n\
+        lw r1, PASS(r0)\n        addi r1, r1, 1\n        sw r1, PASS(r0)\n        li r13, 0"
+    );
+    if lay.root_leaf {
+        // The whole tree is one leaf: its objects are tested by the awake
+        // rays, nothing to walk.
+        let _ = writeln!(
+            w,
+            "        li r5, ROOT\n        jal test_objects\n        j pdone"
+        );
+    }
+    let _ = writeln!(
+        w,
+        "        li r1, {pinit}\n        li r2, ROOTBOX\n        sbcb r1, r2, {pinitlen}",
+        pinit = kaddr("k_pinit"),
+        pinitlen = klen("k_pinit"),
+    );
+    for a in 0..3 {
+        let _ = writeln!(
+            w,
+            "        li r1, {sign}\n        cbcast r1, 1\n        rcst r3",
+            sign = kaddr(&format!("k_sign{a}"))
+        );
+        if a == 0 {
+            let _ = writeln!(w, "        li r4, 2\n        beq r3, r4, pdone");
         }
+        let _ = writeln!(
+            w,
+            "        li r8, 0\n        beqz r3, ord{a}\n        li r8, 1\n        li r4, 3\n        beq r3, r4, ord{a}\n        jal majority\n\
+ord{a}:   li r1, {nb}\n        li r2, {left}\n        li r3, {right}\n        beqz r8, ordb{a}\n        li r1, {na}\n        li r2, {right}\n        li r3, {left}\n\
+ordb{a}:  sw r1, NK+{o}(r0)\n        sw r2, NF+{o}(r0)\n        sw r3, NS+{o}(r0)",
+            nb = kaddr(&format!("k_pn{a}b")),
+            na = kaddr(&format!("k_pn{a}a")),
+            o = 4 * a,
+        );
     }
-    if let Some(r) = rows {
-        all.insert(0, ("k_rows".into(), r));
+    // The node loop. `dispatch`: r5 = a node, r6 = its flags; an inner
+    // node's kernel is issued (its split streamed), then `vnode` fetches
+    // the children and the first child's flags while it runs.
+    let ldn = if streamed { "lw" } else { "lfb" };
+    let dispatch = |w: &mut String| {
+        if streamed {
+            let _ = writeln!(
+                w,
+                "        blt r6, r0, leaf\n        lw r2, 8(r5)\n        sfb r2, SPLIT(r0)\n        slli r7, r6, 2\n        lw r1, NK(r7)\n        li r2, SPLIT\n        sbcb r1, r2, {nlen}\n        j vnode",
+                nlen = klen("k_pn0b")
+            );
+        } else {
+            let _ = writeln!(
+                w,
+                "        blt r6, r0, leaf\n        slli r7, r6, 2\n        lw r1, NK(r7)\n        addi r2, r5, 2\n        sbcb r1, r2, {nlen}\n        j vnode",
+                nlen = klen("k_pn0b")
+            );
+        }
+    };
+    // Push the second child (r10) with every awake ray's interval for it
+    // (the push kernel streams the node's slot address).
+    let push = |w: &mut String| {
+        if streamed {
+            let _ = writeln!(
+                w,
+                "        sfb r12, SPLIT+1(r0)\n        li r2, SPLIT+1\n        li r1, {push}\n        sbcb r1, r2, {pushlen}",
+                push = kaddr("k_ppush"),
+                pushlen = klen("k_ppush")
+            );
+        } else {
+            let _ = writeln!(
+                w,
+                "        li r1, {push}\n        sbcb r1, r12, {pushlen}",
+                push = kaddr("k_ppush"),
+                pushlen = klen("k_ppush")
+            );
+        }
+        let _ = writeln!(w, "        sw r10, 0(r14)\n        addi r14, r14, 4");
+    };
+    let _ = writeln!(
+        w,
+        "        li r14, NSTACK\n        li r5, ROOT\n        {ldn} r6, 0(r5)"
+    );
+    dispatch(w);
+    let _ = writeln!(
+        w,
+        "vnode:  lw r8, NF(r7)\n        add r8, r8, r5\n        {ldn} r9, 0(r8)\n        lw r10, NS(r7)\n        add r10, r10, r5\n        {ldn} r10, 0(r10)\n\
+        {ldn} r6, 0(r9)\n        {slot}\n\
+        rcst r3\n        addi r4, r3, -3\n        beqz r4, vall\n        addi r4, r3, -1\n        beqz r4, vboth\n        bnez r3, pop\n\
+        li r1, {take}\n        cbcast r1, {takelen}\n        mv r5, r10\n        {ldn} r6, 0(r5)",
+        slot = if streamed { "lw r12, 12(r5)" } else { "addi r12, r5, 3" },
+        take = kaddr("k_ptake"),
+        takelen = klen("k_ptake"),
+    );
+    dispatch(w);
+    let _ = writeln!(w, "vboth:");
+    push(w);
+    let _ = writeln!(
+        w,
+        "        li r1, {sl}\n        cbcast r1, 1\n        mv r5, r9",
+        sl = kaddr("k_psl")
+    );
+    dispatch(w);
+    let _ = writeln!(
+        w,
+        "vall:   li r1, {second}\n        cbcast r1, 1\n        rcany r3\n        beqz r3, vfirst",
+        second = kaddr("k_p2nd")
+    );
+    push(w);
+    let _ = writeln!(w, "vfirst: mv r5, r9");
+    dispatch(w);
+    let _ = writeln!(
+        w,
+        "leaf:   jal test_objects\n        lw r1, MODE(r0)\n        beqz r1, pop\n        li r1, {leafa}\n        cbcast r1, {leafalen}\n\
+pop:    li r9, NSTACK\n        beq r14, r9, pdone\n        addi r14, r14, -4\n        lw r5, 0(r14)\n        li r1, {pop}\n{pop_at}        sbcb r1, r2, {poplen}\n\
+        {ldn} r6, 0(r5)\n        rcany r3\n        beqz r3, pop",
+        leafa = kaddr("k_pleafa"),
+        leafalen = klen("k_pleafa"),
+        pop = kaddr("k_ppop"),
+        poplen = klen("k_ppop"),
+        pop_at = if streamed {
+            "        lw r2, 4(r5)\n        sfb r2, SPLIT+2(r0)\n        li r2, SPLIT+2\n"
+        } else {
+            "        addi r2, r5, 1\n"
+        },
+    );
+    dispatch(w);
+    let _ = writeln!(
+        w,
+        "pdone:  lw r1, TESTS(r0)\n        add r1, r1, r13\n        sw r1, TESTS(r0)\n        lw r15, SAVE_LR(r0)\n        ret\n"
+    );
+    // majority: r8 = 1 when more awake rays have F (a negative direction
+    // component) than not.
+    let _ = writeln!(
+        w,
+        "majority:\n        rcfl r1\n        rcfh r2\n        rcsl r3\n        rcsh r4\n        nor r3, r3, r0\n        nor r4, r4, r0\n\
+        and r5, r1, r3\n        and r6, r2, r4\n        nor r1, r1, r0\n        nor r2, r2, r0\n        and r1, r1, r3\n        and r2, r2, r4"
+    );
+    for x in ["r5", "r6", "r1", "r2"] {
+        popcount(w, x, "r9", "r10");
     }
-    all.extend(refl);
-    for (n, kk) in objk {
-        all.push((n.to_string(), kk));
+    let _ = writeln!(
+        w,
+        "        add r5, r5, r6\n        add r1, r1, r2\n        slt r8, r1, r5\n        ret\n"
+    );
+    // test_objects: every object of the leaf not yet tested by every awake
+    // ray in this pass, by type. Mailboxes (main memory, 16 bytes per
+    // object): the pass that last tested the object and which rays did.
+    // r4, r10 = awake mask, r11 = PASS.
+    let _ = writeln!(
+        w,
+        "; test_objects (packet): r5 = leaf. An object's mailbox holds the pass that last tested it\n\
+; and which rays did; it is broadcast unless every awake ray has tested it in this pass."
+    );
+    // The mailbox check of the object whose mailbox address is in r8: on
+    // to `{n}_next` when every awake ray has tested it in this pass, else
+    // the mailbox is updated and the object goes to `{n}_go`.
+    let check = |w: &mut String, n: &str| {
+        let _ = writeln!(
+            w,
+            "        lw r1, 0(r8)\n        bne r1, r11, {n}_fresh\n        lw r2, 4(r8)\n        lw r3, 8(r8)\n        \
+or r1, r2, r4\n        bne r1, r2, {n}_upd\n        or r1, r3, r10\n        beq r1, r3, {n}_next\n\
+{n}_upd: or r2, r2, r4\n        or r3, r3, r10\n        sw r2, 4(r8)\n        sw r3, 8(r8)\n        j {n}_go\n\
+{n}_fresh: sw r11, 0(r8)\n        sw r4, 4(r8)\n        sw r10, 8(r8)\n{n}_go:  addi r13, r13, 1"
+        );
+    };
+    let awake = "        rcsl r4\n        rcsh r10\n        nor r4, r4, r0\n        nor r10, r10, r0\n        or r1, r4, r10\n        beqz r1, pt_ret\n        lw r11, PASS(r0)";
+    if streamed {
+        // The block's DMA starts at once: the array reads bank 1 only in a
+        // leaf's object tests, and a pop or a node decision (which waits
+        // for the array) lies between two leaves; the mailbox scan runs
+        // while it moves, and `dwait` only comes before the first object.
+        // A leaf's further pieces wait for the array to finish the last.
+        let _ = writeln!(
+            w,
+            "test_objects:\n        lw r1, 56(r5)\n        beqz r1, pt_ret\n{awake}\n\
+pt_piece: lw r1, 16(r5)\n        lw r3, 20(r5)\n        lw r2, CUR_BLK(r0)\n        beq r1, r2, pt_scan0\n\
+        li r2, SBANK\n        ldfb r1, r2, r3\n        sw r1, CUR_BLK(r0)\n\
+pt_scan0: lw r6, 8(r5)\n        lw r9, 56(r5)\n\
+pt_scan: lw r8, 0(r6)\n        addi r6, r6, 4\n        beqz r8, pt_load\n        lw r1, 0(r8)\n        bne r1, r11, pt_load\n\
+        lw r2, 4(r8)\n        nor r2, r2, r0\n        and r2, r2, r4\n        bnez r2, pt_load\n\
+        lw r3, 8(r8)\n        nor r3, r3, r0\n        and r3, r3, r10\n        bnez r3, pt_load\n\
+        addi r9, r9, -1\n        bnez r9, pt_scan\n        j pt_nextp\n\
+pt_load: dwait\n        li r7, SBANK\n        lw r6, 8(r5)"
+        );
+        for (j, t) in lay.types.iter().enumerate() {
+            let n = format!("p{}", t.ty.name());
+            let _ = writeln!(
+                w,
+                "        lw r9, {cnt}(r5)\n        beqz r9, {n}_end\n{n}_loop:\n        lw r8, 0(r6)\n        addi r6, r6, 4\n        beqz r8, {n}_go",
+                cnt = 28 + 4 * j
+            );
+            check(w, &n);
+            broadcast_object(w, t.ty, n.as_str());
+            let _ = writeln!(
+                w,
+                "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
+                size = t.size
+            );
+        }
+        let _ = writeln!(
+            w,
+            "pt_nextp: lw r5, 24(r5)\n        beqz r5, pt_ret\n        rcany r2\n        j pt_piece\npt_ret: ret\n"
+        );
+    } else {
+        let _ = writeln!(
+            w,
+            "test_objects:\n        lfb r1, 2(r5)\n        beqz r1, pt_ret\n{awake}\n        li r12, MAILBOX\n        addi r6, r5, {head}",
+            head = super::layout::PK_LEAF_HEAD
+        );
+        for t in &lay.types {
+            let n = format!("p{}", t.ty.name());
+            let _ = writeln!(
+                w,
+                "        lfb r9, 0(r6)\n        addi r6, r6, 1\n        beqz r9, {n}_end\n\
+{n}_loop:\n        lfb r7, 0(r6)\n        lfb r8, 1(r6)\n        addi r6, r6, 2\n        blt r8, r0, {n}_go\n        slli r8, r8, 4\n        add r8, r8, r12"
+            );
+            check(w, &n);
+            broadcast_object(w, t.ty, n.as_str());
+            let _ = writeln!(
+                w,
+                "{n}_next:\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:"
+            );
+        }
+        let _ = writeln!(w, "pt_ret: ret\n");
     }
-    for (n, kk) in &all {
-        let _ = write!(w, "{}", kk.text(n));
-        kernels.push((n.clone(), kk.len()));
-        words += kk.len();
-    }
-    let _ = writeln!(w, "ctx_end:");
-    if words > 8192 {
-        return Err(format!(
-            "the kernels need {words} context words; the context memory holds 8192"
-        ));
-    }
-    Ok(Program {
-        source: s,
-        context_words: words,
-        kernels,
-    })
 }
 
 /// The streamed traversal (scenes that do not fit FB set 0): nodes, leaf
@@ -523,7 +844,7 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
         lw r1, TESTS(r0)\n        addi r1, r1, 1\n        sw r1, TESTS(r0)",
             cnt = 28 + 4 * j
         );
-        broadcast_object(w, t.ty, &n);
+        broadcast_object(w, t.ty, n.as_str());
         let _ = writeln!(
             w,
             "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",

@@ -102,6 +102,19 @@ pub mod ram {
     /// whose visiting order goes against its direction (it may only sleep
     /// at a leaf when this is 0).
     pub const UNORD: u32 = 340;
+    /// Packet traversal ([`super::super::Traversal::Packet`]): 1 while the
+    /// ray takes part in the current pass (it may be woken at a pop).
+    pub const P_ALIVE: u32 = 400;
+    /// Per axis, the direction's reciprocal as a shift `z - 1` and a signed
+    /// mantissa `R`, and the widening `dt` of a plane in `t` (see
+    /// [`super::pk_init`]).
+    pub const P_Z: u32 = 403; // 3
+    pub const P_R: u32 = 406; // 3
+    pub const P_DT: u32 = 409; // 3
+    /// The interval stack: one slot per BSP depth (the far child of the
+    /// node at depth d is pushed into slot d), words `tmax, tmin`.
+    pub const P_SLOT: u32 = 416; // 2 x 32
+    pub const P_SLOTS: u32 = crate::scene_image::MAX_BSP_DEPTH;
 }
 
 /// Offset of a spawned ray's origin along the normal, in LSBs. Default 0:
@@ -1382,6 +1395,236 @@ pub fn out_word(i: u32) -> K {
     let a = if i < 3 { ram::COL + i } else { ram::OUT_OBJ };
     k.c(format!("ld out, [r0 + #{a}]"));
     k
+}
+
+// ---- Packet traversal (`Traversal::Packet`, `control::packet_trace`) ----
+//
+// Every ray keeps its parametric interval `[tmin, tmax]` inside the cell
+// being visited in r8, r9 while the packet descends (no object kernel runs
+// between two inner nodes); its upper end is always taken together with
+// `tbest` (r7). The distance to a split plane at `x` along axis `a` is
+// `t(x) = (x - o_a) / d_a`, from the reciprocal of the direction computed
+// once per pass ([`pk_init`]): `|D|` (Q1.14, clamped to [1, 2^14 - 1]) is
+// normalised by `z = clz(|D|) - 1` into [2^14, 2^15), `R = ±2^29 / (|D|
+// << z)` (table and two Newton-Raphson steps, the sign of `d_a`), and
+// `t(x) = ((x - o_a) << (z - 1)) * R >> 14`. The shift saturates exactly
+// when `t` does (`|R| >= 2^14`), so a saturated `t` lies beyond every
+// segment. Every plane is widened by [`P_TOL`] LSB on both sides: a ray
+// meets the cell below for `t` up to `t(s) + dt` and the cell above from
+// `t(s) - dt` on, `dt = P_TOL / |d_a|`, more than the error of `t` (2.5
+// LSB at the end of the range), so an interval never misses a cell its
+// ray meets. The far child's intervals are pushed into RC RAM, one slot
+// per BSP depth (`P_SLOT`), only when TinyRISC pushes the child; a pop
+// reads and clears the slot in every RC.
+
+/// Widening of every split plane and of the root box in the packet
+/// traversal, in LSB of the scene format.
+pub const P_TOL: i32 = 4;
+
+/// Newton-Raphson steps of the traversal's direction reciprocals: the
+/// intervals' widening assumes a relative error under 2^-14, which one
+/// step reaches from the 128-entry table (0.4% before the step, 1.5e-5
+/// after) and two from any smaller one.
+fn p_newton(nr: Approx) -> u32 {
+    if nr.table_entries >= 128 {
+        1
+    } else {
+        2
+    }
+}
+
+/// `t(x)` for the operand `x` (a register or `fb0`) into `out`:
+/// `out = ((x - o) << zr) * rr >> 14`.
+fn pk_t(k: &mut K, out: u8, x: &str, o: u8, zr: u8, rr: u8) {
+    k.c(format!("sub r{out}, {x}, r{o}"))
+        .c(format!("asl r{out}, r{out}, r{zr}"))
+        .cq(format!("mul r{out}, r{out}, r{rr}, >>14"));
+}
+
+/// Start of a packet pass (stream: the root box widened by [`P_TOL`], per
+/// axis min then max). Every awake ray takes part (`P_ALIVE` = 1); per
+/// axis the direction's reciprocal (`P_Z`, `P_R`) and `dt` (`P_DT`) are
+/// computed, and the interval (r8, r9) is `[0, tbest]` clipped to the root
+/// box; a ray that misses the box is not alive and sleeps. `nr`: the
+/// reciprocal table's size (the Newton steps: [`p_newton`]).
+pub fn pk_init(nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
+    let mut k = K::default();
+    k.c("movb r8, #1").c(format!("st r8, [#{}]", ram::P_ALIVE));
+    k.c(format!("ld r9, [r0 + #{}]", ram::C_ONE))
+        .c("sub r9, r9, #1")
+        .c(format!("ld r15, [r0 + #{}]", ram::C_ONE));
+    for a in 0..3u32 {
+        let d = 4 + a;
+        k.comment(&format!("1 / d{a}"));
+        k.c(format!("abs r8, r{d}"))
+            .c("max r8, r8, #1")
+            .c("min r8, r8, r9")
+            .c("clz r10, r8")
+            .c("sub r10, r10, #1")
+            .c("sll r11, r8, r10")
+            .c(format!("srl r12, r11, #{}", q(7) + nr.coarse()))
+            .c(format!("and r12, r12, #{}", nr.table_entries - 1))
+            .c(format!("ld r12, [r12 + #{}]", ram::RCP));
+        for _ in 0..p_newton(nr) {
+            k.cq("mul r14, r11, r12, >>15")
+                .c("sub r14, r14, r15")
+                .cq("ldacc r12, <<14")
+                .cq("msu r12, r12, r14, >>14");
+        }
+        k.c("sub r10, r10, #1")
+            .c(format!("st r10, [#{}]", ram::P_Z + a))
+            .c(format!("movb r13, #{P_TOL}"))
+            .c("asl r13, r13, r10")
+            .cq("mul r13, r13, r12, >>14")
+            .c(format!("st r13, [#{}]", ram::P_DT + a))
+            .c(format!("cmp.lt r{d}, #0"))
+            .c("(f) neg r12, r12")
+            .c(format!("st r12, [#{}]", ram::P_R + a));
+    }
+    k.comment("root interval");
+    k.c("movb r8, #0").c("mov r9, r7");
+    for a in 0..3u32 {
+        k.c(format!("ld r12, [r0 + #{}]", ram::P_Z + a))
+            .c(format!("ld r13, [r0 + #{}]", ram::P_R + a));
+        pk_t(&mut k, 10, "fb0", 1 + a as u8, 12, 13);
+        pk_t(&mut k, 11, "fb0", 1 + a as u8, 12, 13);
+        k.c("min r14, r10, r11")
+            .c("max r10, r10, r11")
+            .c("max r8, r8, r14")
+            .c("min r9, r9, r10");
+    }
+    k.c("cmp.lt r8, r9")
+        .c("movb r10, #0")
+        .c(format!("(!f) st r10, [#{}]", ram::P_ALIVE))
+        .c("(!f) sleep");
+    k
+}
+
+/// Inner node on `axis` (stream: the split). Each awake ray cuts its
+/// interval (r8, r9) at the plane into the part below and the part above
+/// (each reaching [`P_TOL`] LSB past the plane); `first_above` names the
+/// child the packet visits first. The first child's interval becomes the
+/// current one (r8, r9), the second's is left in r11, r14 for
+/// [`pk_second`], [`pk_push`] and [`pk_take`]; rays that reach neither
+/// child sleep; F = reaches the first child.
+pub fn pk_node(axis: u8, first_above: bool) -> K {
+    let (o, d) = (1 + axis, 4 + axis);
+    let a = axis as u32;
+    let mut k = K::default();
+    k.c(format!("ld r12, [r0 + #{}]", ram::P_Z + a))
+        .c(format!("ld r13, [r0 + #{}]", ram::P_R + a));
+    pk_t(&mut k, 10, "fb0", o, 12, 13);
+    k.c(format!("ld r12, [r0 + #{}]", ram::P_DT + a))
+        .c("subs r11, r10, r12")
+        .c("adds r10, r10, r12")
+        .comment("near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]")
+        .c("min r9, r9, r7")
+        .c("min r12, r9, r10")
+        .c("max r13, r8, r11")
+        .c(if first_above {
+            format!("cmp.lt r{d}, #0")
+        } else {
+            format!("cmp.ge r{d}, #0")
+        })
+        .c("sel r10, r12, r9")
+        .c("sel r11, r13, r8")
+        .c("sel r14, r9, r12")
+        .c("sel r8, r8, r13")
+        .c("mov r9, r10")
+        .c("cmp.lt r11, r14")
+        .c("(!f) cmp.lt r8, r9")
+        .c("(!f) sleep")
+        .c("cmp.lt r8, r9");
+    k
+}
+
+/// After [`pk_node`], when every awake ray reaches the first child: F =
+/// reaches the second too.
+pub fn pk_second() -> K {
+    let mut k = K::default();
+    k.c("cmp.lt r11, r14");
+    k
+}
+
+/// After [`pk_node`], when the packet visits both children: the rays that
+/// do not reach the first sleep until the second is popped.
+pub fn pk_sleep_first() -> K {
+    let mut k = K::default();
+    k.c("(!f) sleep");
+    k
+}
+
+/// After [`pk_node`], the second child is pushed (stream: the node's slot
+/// address): every awake ray stores its interval for it, words `tmax, tmin`.
+pub fn pk_push() -> K {
+    let mut k = K::default();
+    k.c("mov r15, fb0")
+        .c("st r14, [r15]")
+        .c("add r15, r15, #1")
+        .c("st r11, [r15]");
+    k
+}
+
+/// After [`pk_node`], the packet visits the second child only (every awake
+/// ray reaches it): its interval becomes the current one.
+pub fn pk_take() -> K {
+    let mut k = K::default();
+    k.c("mov r8, r11").c("mov r9, r14");
+    k
+}
+
+/// A popped node (stream: the slot its parent pushed it with): every RC
+/// wakes, takes its interval from the slot and clears the slot; the rays
+/// that are not alive in this pass, or whose interval is empty or lies
+/// beyond their hit, sleep again (F = awake).
+pub fn pk_pop() -> K {
+    let mut k = K::default();
+    k.c("wake")
+        .c("mov r15, fb0")
+        .c("ld r9, [r15 + #0]")
+        .c("ld r8, [r15 + #1]")
+        .c("movb r10, #-1")
+        .c("st r10, [r15]")
+        .c("min r10, r9, r7")
+        .c(format!("ld r11, [r0 + #{}]", ram::P_ALIVE))
+        .c("cmp.ne r11, #0")
+        .c("(f) cmp.lt r8, r10")
+        .c("(!f) sleep");
+    k
+}
+
+/// Packet traversal, any-hit (shadow) pass, after a leaf: a ray that found
+/// a hit is done for the pass.
+pub fn pk_leaf_any() -> K {
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
+        .c("cmp.lt r7, r8")
+        .c("movb r9, #0")
+        .c(format!("(f) st r9, [#{}]", ram::P_ALIVE))
+        .c("(f) sleep");
+    k
+}
+
+/// [`wake_restore`] for the packet traversal: no ray is alive in a pass
+/// until the pass starts ([`pk_init`]).
+pub fn pk_wake_restore() -> K {
+    let mut k = K::default();
+    k.c("wake")
+        .c(format!("st r0, [#{}]", ram::P_ALIVE))
+        .c(format!("ld r8, [r0 + #{}]", ram::LANE_ACT))
+        .c("cmp.eq r8, #0")
+        .c("(f) sleep");
+    k
+}
+
+/// Appended to [`init`] for the packet traversal: no ray alive, every
+/// interval slot empty.
+pub fn pk_init_ram(k: &mut K) {
+    k.c(format!("st r0, [#{}]", ram::P_ALIVE)).c("movb r8, #-1");
+    for d in 0..ram::P_SLOTS {
+        k.c(format!("st r8, [#{}]", ram::P_SLOT + 2 * d));
+    }
 }
 
 #[cfg(test)]

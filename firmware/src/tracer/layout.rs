@@ -29,7 +29,7 @@ use crate::scene::{PrimType, Scene, Shape, Vec3};
 use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
 
 use super::kernels::Inside;
-use super::{NodeLayout, Options};
+use super::{NodeLayout, Options, Traversal};
 
 pub const FB_LIMIT: usize = 0x8000;
 /// Head words of a Fig. 5 node: flags, split, left, right, cell bounds.
@@ -153,6 +153,15 @@ pub struct Layout {
     /// The node format of the resident layout (the option; the streamed
     /// layout has per-leaf lists whichever it is).
     pub node_layout: NodeLayout,
+    /// The traversal the nodes are laid out for.
+    pub traversal: Traversal,
+    /// Packet traversal: FB address of the root cell widened by
+    /// [`super::kernels::P_TOL`] (6 words: per axis min, max).
+    pub root_box: usize,
+    /// Interval slots the packet traversal uses (one per BSP depth).
+    pub slots: u32,
+    /// Packet traversal: the tree it walks is a single leaf.
+    pub root_leaf: bool,
     /// FB words the resident image needs with this node format (tables to
     /// mailboxes), whether or not it fits and was used.
     pub resident_words: usize,
@@ -218,6 +227,9 @@ pub struct Stream {
     pub split_slot: usize,
     pub nodes: usize,
     pub largest_block: usize,
+    /// Packet traversal: leaf blocks beyond one per leaf (a leaf whose
+    /// records exceed FB bank 1 is moved in pieces).
+    pub extra_pieces: usize,
 }
 
 /// Reciprocal square root table of `n` entries (a power of two up to 128):
@@ -886,6 +898,21 @@ fn build_as(
         w.raw(obj as i64);
         w.raw(mat as i64);
     };
+    // Packet traversal: the root cell widened by the traversal's tolerance
+    // (the stream of its pass-start kernel), resident in either layout.
+    let packet = opt.traversal == Traversal::Packet;
+    let root_box = if packet {
+        let at = w.fb.len();
+        let b = image.bsp.nodes[0].bounds;
+        let tol = super::kernels::P_TOL as f64;
+        for a in 0..3 {
+            w.push((b.min.axis(a) * s).floor() - tol);
+            w.push((b.max.axis(a) * s).ceil() + tol);
+        }
+        at
+    } else {
+        0
+    };
     let records_start = w.fb.len();
     let mut types = Vec::new();
     let mut bv_offset = NODE_HEAD;
@@ -1108,9 +1135,52 @@ fn build_as(
         mailbox_slots += objs.len();
     }
 
+    let nodes = &image.bsp.nodes;
+    let fin = Finish {
+        frac,
+        eye,
+        post,
+        lights,
+        shades,
+        objects: scene.objects.len(),
+        materials: scene.materials.len(),
+        shines,
+        kd,
+        ks_sphere,
+        ks_cyl,
+        ep_sphere,
+        sphere_fine,
+        ep_cyl,
+        ks_cone,
+        ep_cone,
+        kt,
+        light_shifted,
+        node_layout: opt.layout,
+        traversal: opt.traversal,
+        root_box,
+        slots: nodes.iter().map(|n| n.depth + 1).max().unwrap_or(1),
+        collapse: opt.collapse,
+        cost: if packet {
+            object_costs(
+                scene,
+                s,
+                ks_sphere,
+                ep_sphere,
+                sphere_fine,
+                ks_cyl,
+                ep_cyl,
+                ks_cone,
+                ep_cone,
+            )
+        } else {
+            Vec::new()
+        },
+    };
+    if packet {
+        return packet_nodes(w, fin, types, nodes, &slot, records_start, streamed, &err);
+    }
     // BSP nodes: Fig. 5 (fixed size) or compact (head, then per type a
     // count and the slot indices).
-    let nodes = &image.bsp.nodes;
     let node_layout = opt.layout;
     let node_words = match node_layout {
         NodeLayout::Fig5 => bv_offset,
@@ -1246,40 +1316,21 @@ fn build_as(
             split_slot,
             nodes: nn,
             largest_block: largest,
+            extra_pieces: 0,
         });
     }
-    if let Some(st) = &stream {
-        return Ok(Layout {
-            fb: w.fb,
-            frac,
-            eye,
-            post,
-            lights,
-            shades,
+    if let Some(st) = stream {
+        let (root, mailbox) = (st.root as usize, st.mailbox as usize);
+        return Ok(fin.layout(
+            w.fb,
             types,
-            root: st.root as usize,
-            node_words: NODE_BYTES / 4,
-            node_layout,
-            resident_words: total,
-            resident_node_words: node_section,
-            mailbox: st.mailbox as usize,
-            objects: scene.objects.len(),
-            materials: scene.materials.len(),
-            shines,
-            kd,
-            ks_sphere,
-            ks_cyl,
-            ep_sphere,
-            sphere_fine,
-            ep_cyl,
-            ks_cone,
-            ep_cone,
-            kt_rect: kt[0],
-            kt_tri: kt[1],
-            kt_disc: kt[2],
-            light_shifted,
-            stream,
-        });
+            root,
+            NODE_BYTES / 4,
+            total,
+            node_section,
+            mailbox,
+            Some(st),
+        ));
     }
     for n in nodes {
         match n.split {
@@ -1342,35 +1393,508 @@ fn build_as(
     for t in &mut types {
         t.mailbox += mailbox;
     }
-    Ok(Layout {
-        fb: w.fb,
-        frac,
-        eye,
-        post,
-        lights,
-        shades,
+    Ok(fin.layout(
+        w.fb,
         types,
         root,
         node_words,
-        node_layout,
-        resident_words: total,
-        resident_node_words: node_section,
+        total,
+        node_section,
         mailbox,
-        objects: scene.objects.len(),
-        materials: scene.materials.len(),
-        shines,
-        kd,
-        ks_sphere,
-        ks_cyl,
-        ep_sphere,
-        sphere_fine,
-        ep_cyl,
-        ks_cone,
-        ep_cone,
-        kt_rect: kt[0],
-        kt_tri: kt[1],
-        kt_disc: kt[2],
-        light_shifted,
-        stream: None,
-    })
+        None,
+    ))
+}
+
+/// What every node format's [`Layout`] shares (the part laid out before
+/// the BSP nodes).
+struct Finish {
+    frac: u32,
+    eye: usize,
+    post: usize,
+    lights: Vec<usize>,
+    shades: Vec<usize>,
+    objects: usize,
+    materials: usize,
+    shines: Vec<(u32, f64)>,
+    kd: u32,
+    ks_sphere: u32,
+    ks_cyl: u32,
+    ep_sphere: u32,
+    sphere_fine: bool,
+    ep_cyl: u32,
+    ks_cone: u32,
+    ep_cone: u32,
+    kt: [u32; 3],
+    light_shifted: bool,
+    node_layout: NodeLayout,
+    traversal: Traversal,
+    root_box: usize,
+    slots: u32,
+    collapse: super::Collapse,
+    /// Per scene object, the array cycles of its test (kernel contexts and
+    /// the TinyRISC loop around them).
+    cost: Vec<f64>,
+}
+
+impl Finish {
+    #[allow(clippy::too_many_arguments)]
+    fn layout(
+        self,
+        fb: Vec<i32>,
+        types: Vec<TypeInfo>,
+        root: usize,
+        node_words: usize,
+        resident_words: usize,
+        resident_node_words: usize,
+        mailbox: usize,
+        stream: Option<Stream>,
+    ) -> Layout {
+        Layout {
+            fb,
+            frac: self.frac,
+            eye: self.eye,
+            post: self.post,
+            lights: self.lights,
+            shades: self.shades,
+            types,
+            root,
+            node_words,
+            node_layout: self.node_layout,
+            traversal: self.traversal,
+            root_box: self.root_box,
+            slots: self.slots,
+            root_leaf: false,
+            resident_words,
+            resident_node_words,
+            mailbox,
+            objects: self.objects,
+            materials: self.materials,
+            shines: self.shines,
+            kd: self.kd,
+            ks_sphere: self.ks_sphere,
+            ks_cyl: self.ks_cyl,
+            ep_sphere: self.ep_sphere,
+            sphere_fine: self.sphere_fine,
+            ep_cyl: self.ep_cyl,
+            ks_cone: self.ks_cone,
+            ep_cone: self.ep_cone,
+            kt_rect: self.kt[0],
+            kt_tri: self.kt[1],
+            kt_disc: self.kt[2],
+            light_shifted: self.light_shifted,
+            stream,
+        }
+    }
+}
+
+/// Array cycles a packet spends on an inner node (its kernel and
+/// TinyRISC's decision), for [`super::Collapse::Auto`].
+const PK_NODE_COST: f64 = 60.0;
+
+/// Per scene object, the array cycles of one test: its kernels' contexts
+/// (caps and polygon edges included) and about 12 cycles of TinyRISC's
+/// loop (mailbox and issue) that the array does not always hide.
+#[allow(clippy::too_many_arguments)]
+fn object_costs(
+    scene: &Scene,
+    s: f64,
+    ks_sphere: u32,
+    ep_sphere: u32,
+    fine: bool,
+    ks_cyl: u32,
+    ep_cyl: u32,
+    ks_cone: u32,
+    ep_cone: u32,
+) -> Vec<f64> {
+    use super::kernels as k;
+    let nr = 2u32;
+    let sphere = k::sphere_with(ks_sphere, ep_sphere, nr, fine).len();
+    let disc = k::planar(Inside::Disc, 8, nr).len();
+    let cyl = k::cylinder(ks_cyl, ep_cyl, nr).len();
+    let cone = k::cone(ks_cone, ep_cone, nr).len();
+    let boxk = k::aabox(nr).len();
+    let planar = k::planar(Inside::Triangle, 8, nr).len();
+    let (ph, pe, pt) = (
+        k::polygon_head(nr).len(),
+        k::polygon_edge().len(),
+        k::polygon_tail().len(),
+    );
+    scene
+        .objects
+        .iter()
+        .map(|o| {
+            let c = match &o.shape {
+                Shape::Sphere { .. } => sphere,
+                Shape::Cone { caps, .. } => {
+                    let body = if o.shape.prim_type() == PrimType::Cone {
+                        cone
+                    } else {
+                        cyl
+                    };
+                    body + if *caps { 2 * disc } else { 0 }
+                }
+                Shape::Box { .. } => boxk,
+                Shape::Rectangle { .. } | Shape::Triangle { .. } => planar,
+                Shape::Polygon { v, .. } => ph + pt + pe * polygon_edges(v, s).1.len(),
+            };
+            c as f64 + 12.0
+        })
+        .collect()
+}
+
+/// Words of a packet-traversal inner node: axis, parent's slot, split,
+/// own slot, left, right (FB addresses, or byte addresses when streamed).
+pub const PK_INNER: usize = 6;
+/// Words before a resident packet leaf's lists: flags, parent's slot,
+/// object count.
+pub const PK_LEAF_HEAD: usize = 3;
+/// Bytes of a packet-traversal mailbox in main memory: the pass that last
+/// tested the object, and which rays did (64-bit mask), padded.
+pub const PK_MAILBOX_BYTES: usize = 16;
+
+/// RC RAM address of the interval slot of BSP depth `d`.
+fn pk_slot(d: u32) -> i64 {
+    (super::kernels::ram::P_SLOT + 2 * d.min(super::kernels::ram::P_SLOTS - 1)) as i64
+}
+
+/// The BSP nodes for the packet traversal ([`Traversal::Packet`]): inner
+/// nodes carry their stack slots instead of the objects under them, leaves
+/// per type present a count and the FB addresses of their objects' records;
+/// no mailboxes. Resident when it fits FB set 0, else streamed (node
+/// records in main memory, each leaf's records a block moved into FB bank 1,
+/// a block larger than the bank cut into pieces).
+#[allow(clippy::too_many_arguments)]
+fn packet_nodes(
+    mut w: W,
+    fin: Finish,
+    types: Vec<TypeInfo>,
+    nodes: &[crate::bsp::Node],
+    slot: &[(usize, usize)],
+    records_start: usize,
+    streamed: bool,
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<Layout, String> {
+    // The tree the traversal walks: a subtree with at most `collapse`
+    // objects under it is one leaf of those objects (testing them all with
+    // the rays that reach it costs less than walking it).
+    let mut tree: Vec<crate::bsp::Node> = Vec::with_capacity(nodes.len());
+    // Expected cost (array cycles) of a packet that reaches node k:
+    // walking (a node visit, then each child with the probability that a
+    // ray through the cell meets the child's, its surface area over the
+    // cell's) or testing everything under it.
+    let test_all =
+        |n: &crate::bsp::Node| -> f64 { n.objects.iter().map(|&o| fin.cost[o as usize]).sum() };
+    let mut keep = vec![true; nodes.len()];
+    fn expect(
+        nodes: &[crate::bsp::Node],
+        k: usize,
+        test_all: &dyn Fn(&crate::bsp::Node) -> f64,
+        keep: &mut [bool],
+    ) -> f64 {
+        let n = &nodes[k];
+        let all = test_all(n);
+        let Some(sp) = n.split else { return all };
+        let area = n.bounds.surface_area().max(1e-300);
+        let mut walk = PK_NODE_COST;
+        for c in sp.children {
+            let ch = &nodes[c as usize];
+            walk += (ch.bounds.surface_area() / area).min(1.0)
+                * expect(nodes, c as usize, test_all, keep);
+        }
+        if all <= walk {
+            keep[k] = false;
+            all
+        } else {
+            walk
+        }
+    }
+    let collapse = match fin.collapse {
+        super::Collapse::Auto => {
+            expect(nodes, 0, &test_all, &mut keep);
+            // The root is walked whenever the BSP has one split: the pass's
+            // start clips the rays to the root cell, which culls the rays
+            // that miss the scene (the surface-area weights assume every
+            // ray meets the cell).
+            keep[0] = true;
+            usize::MAX
+        }
+        super::Collapse::Objects(c) => c,
+    };
+    fn walk(
+        nodes: &[crate::bsp::Node],
+        k: usize,
+        collapse: usize,
+        keep: &[bool],
+        out: &mut Vec<crate::bsp::Node>,
+    ) -> u32 {
+        let n = &nodes[k];
+        let at = out.len();
+        out.push(crate::bsp::Node {
+            split: None,
+            ..n.clone()
+        });
+        if let Some(sp) = n.split {
+            if keep[k] && (collapse == usize::MAX || n.objects.len() > collapse) {
+                let l = walk(nodes, sp.children[0] as usize, collapse, keep, out);
+                let r = walk(nodes, sp.children[1] as usize, collapse, keep, out);
+                out[at].split = Some(crate::bsp::Split {
+                    children: [l, r],
+                    ..sp
+                });
+            }
+        }
+        at as u32
+    }
+    walk(nodes, 0, collapse, &keep, &mut tree);
+    let nodes = &tree[..];
+    // An object in one leaf only is met once per pass (each node is
+    // visited at most once): it needs no mailbox.
+    let mut refs = vec![0u32; fin.objects];
+    for n in nodes.iter().filter(|n| n.split.is_none()) {
+        for &o in &n.objects {
+            refs[o as usize] += 1;
+        }
+    }
+    let size = |n: &crate::bsp::Node| match n.split {
+        Some(_) => PK_INNER,
+        None => PK_LEAF_HEAD + types.len() + 2 * n.objects.len(),
+    };
+    let mut node_at = Vec::with_capacity(nodes.len() + 1);
+    node_at.push(0usize);
+    for n in nodes {
+        node_at.push(node_at.last().copied().unwrap_or(0) + size(n));
+    }
+    let node_section = node_at[nodes.len()];
+    let root = w.fb.len();
+    let total = root + node_section;
+    let parent_slot = |n: &crate::bsp::Node| {
+        if n.depth == 0 {
+            0
+        } else {
+            pk_slot(n.depth - 1)
+        }
+    };
+    // A leaf's objects of each type, in slot order.
+    let per_type = |n: &crate::bsp::Node| -> Vec<Vec<usize>> {
+        types
+            .iter()
+            .map(|ti| {
+                n.objects
+                    .iter()
+                    .filter_map(|&o| {
+                        let (t, q) = slot[o as usize];
+                        (t == ti.ty as usize).then_some(q)
+                    })
+                    .collect()
+            })
+            .collect()
+    };
+    if total <= FB_LIMIT && !streamed {
+        for n in nodes {
+            match n.split {
+                Some(sp) => {
+                    w.raw(sp.axis as i64);
+                    w.raw(parent_slot(n));
+                    w.coord(sp.position);
+                    w.raw(pk_slot(n.depth));
+                    w.raw((root + node_at[sp.children[0] as usize]) as i64);
+                    w.raw((root + node_at[sp.children[1] as usize]) as i64);
+                }
+                None => {
+                    w.word16(0x8000);
+                    w.raw(parent_slot(n));
+                    w.raw(n.objects.len() as i64);
+                    for (ti, qs) in types.iter().zip(per_type(n)) {
+                        w.raw(qs.len() as i64);
+                        for q in qs {
+                            let o = ti.objects[q];
+                            w.raw((ti.first + q * ti.size) as i64);
+                            w.raw(if refs[o] > 1 { o as i64 } else { -1 });
+                        }
+                    }
+                }
+            }
+        }
+        debug_assert_eq!(w.fb.len(), total);
+        // The mailboxes (main memory, TinyRISC's), where the streamed
+        // image would start.
+        let mailbox = super::mem::STREAM as usize;
+        let mut lay = fin.layout(w.fb, types, root, 0, total, node_section, mailbox, None);
+        lay.root_leaf = nodes[0].split.is_none();
+        return Ok(lay);
+    }
+    // Streamed: records, nodes and leaf blocks leave the FB.
+    let records = w.fb.split_off(records_start);
+    let split_slot = w.fb.len();
+    w.raw(0); // split
+    w.raw(0); // its slot
+    w.raw(0); // a popped node's parent slot
+    if w.fb.len() > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                w.fb.len()
+            ),
+        ));
+    }
+    let base = super::mem::STREAM as usize;
+    // Leaf pieces: a leaf's records (grouped by type) cut where a block
+    // would exceed FB bank 1; each piece is a node record of its own,
+    // chained from the leaf (word 6).
+    let mut pieces: Vec<Vec<(usize, usize)>> = Vec::new(); // (type index, slot) per piece
+    let mut first_piece = vec![usize::MAX; nodes.len()];
+    for (k, n) in nodes.iter().enumerate() {
+        if n.split.is_some() || n.objects.is_empty() {
+            continue;
+        }
+        first_piece[k] = pieces.len();
+        let mut cur: Vec<(usize, usize)> = Vec::new();
+        let mut words = 0usize;
+        for (j, qs) in per_type(n).into_iter().enumerate() {
+            for q in qs {
+                let sz = types[j].size;
+                if sz > STREAM_BANK {
+                    return Err(err(
+                        0,
+                        format!(
+                            "a {} record of {sz} words exceeds FB bank 1",
+                            types[j].ty.name()
+                        ),
+                    ));
+                }
+                if words + sz > STREAM_BANK {
+                    pieces.push(std::mem::take(&mut cur));
+                    words = 0;
+                }
+                cur.push((j, q));
+                words += sz;
+            }
+        }
+        pieces.push(cur);
+    }
+    let nn = nodes.len();
+    let lists_at = NODE_BYTES * (nn + pieces.len());
+    let list_bytes: usize = pieces.iter().map(|p| 4 * p.len()).sum();
+    let blocks_at = lists_at + list_bytes;
+    let mut img = vec![0u8; blocks_at];
+    let mut lists: Vec<u32> = Vec::new();
+    let mut blocks: Vec<u8> = Vec::new();
+    let mut largest = 0usize;
+    let put = |img: &mut Vec<u8>, rec: usize, f: &[i32; 16]| {
+        for (i, x) in f.iter().enumerate() {
+            img[NODE_BYTES * rec + 4 * i..NODE_BYTES * rec + 4 * i + 4]
+                .copy_from_slice(&x.to_le_bytes());
+        }
+    };
+    // Piece records: block address and words, next piece, per-type counts.
+    let mut piece_rec = vec![[0i32; 16]; pieces.len()];
+    for (p, pc) in pieces.iter().enumerate() {
+        let mut words: Vec<i32> = Vec::new();
+        let mut counts = [0i32; 7];
+        for &(j, q) in pc {
+            let ti = &types[j];
+            let at = ti.first - records_start + q * ti.size;
+            words.extend_from_slice(&records[at..at + ti.size]);
+            counts[j] += 1;
+        }
+        largest = largest.max(words.len());
+        let f = &mut piece_rec[p];
+        f[0] = -32768;
+        f[2] = (base + lists_at + 4 * lists.len()) as i32;
+        for &(j, q) in pc {
+            lists.push(types[j].objects[q] as u32);
+        }
+        f[4] = (base + blocks_at + blocks.len()) as i32;
+        f[5] = words.len() as i32;
+        f[7..14].copy_from_slice(&counts);
+        f[14] = pc.len() as i32;
+        blocks.extend(fb_word_bytes(&words, w.x));
+    }
+    // Chain the pieces of each leaf (a leaf's pieces are consecutive).
+    for k in 0..nn {
+        let first = first_piece[k];
+        if first == usize::MAX {
+            continue;
+        }
+        let end = first_piece[k + 1..]
+            .iter()
+            .copied()
+            .find(|&p| p != usize::MAX)
+            .unwrap_or(pieces.len());
+        for (p, rec) in piece_rec.iter_mut().enumerate().take(end - 1).skip(first) {
+            rec[6] = (base + NODE_BYTES * (nn + p + 1)) as i32;
+        }
+    }
+    // The mailboxes follow the image; the lists hold their addresses.
+    let mailbox = (base + blocks_at + blocks.len()).next_multiple_of(PK_MAILBOX_BYTES);
+    for (i, o) in lists.iter().enumerate() {
+        let a = if refs[*o as usize] > 1 {
+            (mailbox + PK_MAILBOX_BYTES * *o as usize) as u32
+        } else {
+            0
+        };
+        img[lists_at + 4 * i..lists_at + 4 * i + 4].copy_from_slice(&a.to_le_bytes());
+    }
+    for (k, n) in nodes.iter().enumerate() {
+        let mut f = [0i32; 16];
+        f[1] = parent_slot(n) as i32;
+        match n.split {
+            Some(sp) => {
+                f[0] = sp.axis as i32;
+                f[2] = w.sat(sp.position * w.s);
+                f[3] = pk_slot(n.depth) as i32;
+                f[4] = (base + NODE_BYTES * sp.children[0] as usize) as i32;
+                f[5] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
+            }
+            None => {
+                f[0] = -32768;
+                if first_piece[k] != usize::MAX {
+                    // The leaf's record is its first piece's.
+                    let p = piece_rec[first_piece[k]];
+                    f[2] = p[2];
+                    f[4..16].copy_from_slice(&p[4..16]);
+                }
+            }
+        }
+        put(&mut img, k, &f);
+    }
+    for (p, f) in piece_rec.iter().enumerate() {
+        put(&mut img, nn + p, f);
+    }
+    img.extend(blocks);
+    let end = mailbox + PK_MAILBOX_BYTES * fin.objects;
+    if end > super::mem::STREAM_END as usize {
+        return Err(err(
+            0,
+            format!(
+                "the streamed scene needs {} bytes of main memory; {} are reserved",
+                end - base,
+                super::mem::STREAM_END as usize - base
+            ),
+        ));
+    }
+    let st = Stream {
+        base: base as u32,
+        image: img,
+        root: base as u32,
+        mailbox: mailbox as u32,
+        split_slot,
+        nodes: nn,
+        largest_block: largest,
+        extra_pieces: pieces.len() - first_piece.iter().filter(|&&p| p != usize::MAX).count(),
+    };
+    let root_leaf = nodes[0].split.is_none();
+    let mut lay = fin.layout(
+        w.fb,
+        types,
+        base,
+        NODE_BYTES / 4,
+        total,
+        node_section,
+        mailbox,
+        Some(st),
+    );
+    lay.root_leaf = root_leaf;
+    Ok(lay)
 }

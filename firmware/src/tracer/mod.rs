@@ -51,6 +51,12 @@ pub struct Options {
     /// The chip's RC datapath: the paper's 16-bit chip (default) or the
     /// 32-bit variant, whose formats all have 16 more fraction bits.
     pub datapath: Datapath,
+    /// How a packet walks the BSP tree: the paper's traversal, or masked
+    /// packet traversal with per-ray intervals.
+    pub traversal: Traversal,
+    /// Packet traversal: which BSP subtrees are walked as one leaf of all
+    /// the objects under them.
+    pub collapse: Collapse,
 }
 
 impl Default for Options {
@@ -63,7 +69,88 @@ impl Default for Options {
             bsp: BspParams::default(),
             layout: NodeLayout::Fig5,
             datapath: Datapath::W16,
+            traversal: Traversal::default(),
+            collapse: Collapse::Auto,
         }
+    }
+}
+
+/// Which BSP subtrees the packet traversal walks as one leaf of all the
+/// objects under them (testing them all with the rays that reach the
+/// subtree costs less than walking it).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Collapse {
+    /// Where the expected cost of walking the subtree (node kernels and the
+    /// leaves' object tests, weighted by the cells' surface areas) exceeds
+    /// the cost of testing every object under it.
+    #[default]
+    Auto,
+    /// Subtrees with at most this many objects (0: none).
+    Objects(usize),
+}
+
+impl std::fmt::Display for Collapse {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Collapse::Auto => f.write_str("auto"),
+            Collapse::Objects(n) => write!(f, "{n}"),
+        }
+    }
+}
+
+impl std::str::FromStr for Collapse {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(Collapse::Auto);
+        }
+        s.parse::<usize>()
+            .map(Collapse::Objects)
+            .map_err(|_| format!("collapse '{s}': expected auto or a number of objects (0: never)"))
+    }
+}
+
+/// How the 64 rays of a packet walk the BSP tree (`docs/tracer.md`,
+/// "Traversal").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Traversal {
+    /// The paper's: the packet's segments `[o, o + tbest d]` are classified
+    /// against each split plane; where the rays disagree, every object
+    /// under the node is tested (resident) or both children are visited
+    /// with every ray awake (streamed).
+    #[default]
+    Paper,
+    /// Masked packet traversal: each ray keeps its parametric interval
+    /// inside the current cell; a child is visited only by the rays whose
+    /// interval reaches it (the others sleep), near child first, the far
+    /// child pushed with every ray's interval; a ray whose hit lies before
+    /// a popped cell drops out.
+    Packet,
+}
+
+impl Traversal {
+    pub const ALL: [Traversal; 2] = [Traversal::Paper, Traversal::Packet];
+    pub fn name(self) -> &'static str {
+        match self {
+            Traversal::Paper => "paper",
+            Traversal::Packet => "packet",
+        }
+    }
+}
+
+impl std::fmt::Display for Traversal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for Traversal {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Traversal::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| format!("unknown traversal '{s}': expected paper or packet"))
     }
 }
 

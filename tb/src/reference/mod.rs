@@ -256,6 +256,26 @@ impl<'s> Tracer<'s> {
     }
 }
 
+/// The eye ray through pixel `(i, j)` of a `w` x `h` image, as
+/// [`render`] traces it (without `corners`).
+pub fn eye_ray(scene: &Scene, w: u32, h: u32, i: u32, j: u32) -> Ray {
+    let view = View::new(scene);
+    let (w, h) = (w.max(1), h.max(1));
+    let span = |i: u32, n: u32| {
+        if n <= 1 {
+            0.0
+        } else {
+            2.0 * i as f64 / (n - 1) as f64 - 1.0
+        }
+    };
+    let (ax, ay) = if w >= h {
+        (w as f64 / h as f64, 1.0)
+    } else {
+        (1.0, h as f64 / w as f64)
+    };
+    view.ray(span(i, w) * ax, -span(j, h) * ay)
+}
+
 /// Render a scene.
 pub fn render(scene: &Scene, opt: &Options) -> Image {
     let tracer = Tracer::new(scene);

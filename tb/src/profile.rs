@@ -1,0 +1,130 @@
+//! Where a chip instance's cycles go, for firmware authors: every cycle of
+//! the tile loop is charged to the RC kernel the array executes in it or,
+//! when the array idles, to the TinyRISC code (the label before its PC)
+//! that keeps it waiting. `morphosys render --profile` prints the table
+//! for the whole frame (every chip instance's tile loop).
+
+use std::collections::BTreeMap;
+
+use firmware::asm::Image;
+use rtl::rc::Word;
+use rtl::{Chip, Sim};
+
+/// Cycles charged to kernels (array busy) and to TinyRISC labels (array
+/// idle), largest first.
+#[derive(Clone, Debug, Default)]
+pub struct Profile {
+    pub cycles: u64,
+    pub kernels: Vec<(String, u64)>,
+    pub control: Vec<(String, u64)>,
+}
+
+impl Profile {
+    /// The sum of two profiles (two chip instances).
+    pub fn merge(a: Profile, b: Profile) -> Profile {
+        let add = |x: Vec<(String, u64)>, y: Vec<(String, u64)>| {
+            let mut m: BTreeMap<String, u64> = BTreeMap::new();
+            for (n, c) in x.into_iter().chain(y) {
+                *m.entry(n).or_default() += c;
+            }
+            sorted(m)
+        };
+        Profile {
+            cycles: a.cycles + b.cycles,
+            kernels: add(a.kernels, b.kernels),
+            control: add(a.control, b.control),
+        }
+    }
+}
+
+fn sorted<K: ToString>(m: BTreeMap<K, u64>) -> Vec<(String, u64)> {
+    let mut v: Vec<(String, u64)> = m.into_iter().map(|(n, x)| (n.to_string(), x)).collect();
+    v.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    v
+}
+
+/// Maps context addresses to kernel names and TinyRISC addresses to the
+/// code labels of the source.
+pub struct Names {
+    kernels: Vec<(u32, String)>,
+    labels: Vec<(u32, String)>,
+}
+
+impl Names {
+    pub fn new(img: &Image, source: &str, ctx_base: u32) -> Names {
+        let mut section = ".text";
+        let mut text_labels = Vec::new();
+        for line in source.lines() {
+            let l = line.trim_start();
+            if l.starts_with(".text") || l.starts_with(".data") || l.starts_with(".ctx") {
+                section = &l[..5.min(l.len())];
+                continue;
+            }
+            if section == ".text" && !line.starts_with(' ') {
+                if let Some((name, _)) = line.split_once(':') {
+                    if !name.is_empty() && name.chars().all(|c| c.is_alphanumeric() || c == '_') {
+                        text_labels.push(name.to_string());
+                    }
+                }
+            }
+        }
+        let mut labels: Vec<(u32, String)> = text_labels
+            .into_iter()
+            .filter_map(|n| img.symbol(&n).map(|v| (v as u32, n)))
+            .collect();
+        labels.sort();
+        let mut kernels: Vec<(u32, String)> = img
+            .symbols
+            .iter()
+            .filter(|(n, v)| n.starts_with("k_") && !n.ends_with("_end") && **v >= ctx_base as i64)
+            .map(|(n, v)| (((*v as u32) - ctx_base) / 4, n.clone()))
+            .collect();
+        kernels.sort();
+        Names { kernels, labels }
+    }
+
+    fn find(list: &[(u32, String)], a: u32) -> &str {
+        match list.partition_point(|(x, _)| *x <= a) {
+            0 => "?",
+            i => &list[i - 1].1,
+        }
+    }
+}
+
+/// Step `sim` to its halt (at most `max_cycles`), charging every cycle.
+pub fn run<W: Word>(
+    sim: &mut Sim<Chip<W>>,
+    names: &Names,
+    max_cycles: u64,
+) -> Result<Profile, rtl::chip::RunError> {
+    let mut k: BTreeMap<&str, u64> = BTreeMap::new();
+    let mut c: BTreeMap<&str, u64> = BTreeMap::new();
+    let mut cycles = 0u64;
+    while !sim.top.halted() {
+        if sim.cycle() >= max_cycles {
+            break;
+        }
+        match sim.top.bcast.current() {
+            Some((run, step, _)) => {
+                let group = if run.mode == rtl::array::Mode::Simd {
+                    1
+                } else {
+                    8
+                };
+                let a = run.ctx as u32 + group * step as u32;
+                *k.entry(Names::find(&names.kernels, a)).or_default() += 1;
+            }
+            None => {
+                *c.entry(Names::find(&names.labels, sim.top.risc.pc))
+                    .or_default() += 1;
+            }
+        }
+        cycles += 1;
+        sim.step().map_err(rtl::chip::RunError::Step)?;
+    }
+    Ok(Profile {
+        cycles,
+        kernels: sorted(k),
+        control: sorted(c),
+    })
+}

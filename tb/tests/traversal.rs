@@ -1,0 +1,251 @@
+//! The two BSP traversals (`--traversal paper|packet`): the paper's
+//! reproduces its published cycle counts exactly, both find the same hits
+//! up to ties, and the packet traversal culls rays per cell.
+
+use std::path::PathBuf;
+
+use firmware::scene::Scene;
+use firmware::tracer::{Options, Traversal};
+use tb::reference::{self, shapes, NO_HIT};
+use tb::render::render_chip;
+
+fn scene_path(name: &str) -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    for p in [
+        root.join("scenes").join(name),
+        root.join("scenes/spd").join(name),
+    ] {
+        if p.is_file() {
+            return p;
+        }
+    }
+    panic!("scene {name} not found under scenes/ or scenes/spd/");
+}
+
+fn load(name: &str) -> Scene {
+    Scene::load(&scene_path(name)).unwrap()
+}
+
+fn opts(w: u32, h: u32, traversal: Traversal) -> Options {
+    Options {
+        width: w,
+        height: h,
+        traversal,
+        ..Options::default()
+    }
+}
+
+/// The cycle counts published before the packet traversal existed
+/// (README, docs/tracer.md): the paper's traversal must keep them.
+#[test]
+fn paper_traversal_keeps_its_cycle_counts() {
+    for (name, cycles) in [
+        ("jacks-1.nff", 3_036_704u64),
+        ("tetra-1.nff", 1_234_920),
+        ("default.toml", 8_529_730),
+    ] {
+        let r = render_chip(&load(name), &opts(256, 256, Traversal::Paper), false, None).unwrap();
+        assert_eq!(r.cycles, cycles, "{name}");
+    }
+}
+
+/// Pixels whose eye ray hits different objects under the two traversals
+/// must be ties: both objects meet the (f64) eye ray at distances within a
+/// few LSB of the chip's format of each other (the traversals test objects
+/// in different orders, and the first of two equal `t` wins).
+fn same_hits_up_to_ties(name: &str, w: u32, h: u32) {
+    let scene = load(name);
+    let paper = render_chip(&scene, &opts(w, h, Traversal::Paper), false, None).unwrap();
+    let packet = render_chip(&scene, &opts(w, h, Traversal::Packet), false, None).unwrap();
+    let lsb = (-(packet.firmware.frac as f64)).exp2();
+    let mut differ = 0;
+    for j in 0..h {
+        for i in 0..w {
+            let p = (j * w + i) as usize;
+            let (a, b) = (paper.hits[p], packet.hits[p]);
+            if a == b {
+                continue;
+            }
+            differ += 1;
+            let ray = reference::eye_ray(&scene, w, h, i, j);
+            let t = |id: u32| {
+                if id == NO_HIT {
+                    return None;
+                }
+                shapes::intersect(
+                    &scene.objects[id as usize].shape,
+                    &ray,
+                    0.0,
+                    f64::INFINITY,
+                    true,
+                )
+                .map(|s| s.t)
+            };
+            match (t(a), t(b)) {
+                (Some(ta), Some(tb)) => assert!(
+                    (ta - tb).abs() <= 16.0 * lsb,
+                    "{name} pixel ({i}, {j}): paper hits object {a} at {ta}, packet object {b} at {tb}: not a tie"
+                ),
+                _ => panic!(
+                    "{name} pixel ({i}, {j}): paper hits {a:?}, packet {b:?}, and the f64 ray misses one of them"
+                ),
+            }
+        }
+    }
+    eprintln!("{name}: {differ} of {} pixels hit another object", w * h);
+    assert!(
+        differ * 1000 <= (w * h) as usize,
+        "{name}: {differ} of {} pixels hit another object",
+        w * h
+    );
+}
+
+#[test]
+fn same_hits_on_the_default_scene() {
+    same_hits_up_to_ties("default.toml", 64, 64);
+}
+
+#[test]
+fn same_hits_on_the_spd_size_1_scenes() {
+    for name in [
+        "balls-1.nff",
+        "gears-1.nff",
+        "jacks-1.nff",
+        "lattice-1.nff",
+        "mount-1.nff",
+        "rings-1.nff",
+        "tetra-1.nff",
+        "tree-1.nff",
+    ] {
+        same_hits_up_to_ties(name, 48, 48);
+    }
+}
+
+/// Two plates side by side facing the eye, each hiding a row of spheres
+/// that recedes behind it; the left half of the image sees one plate, the
+/// right half the other, so at the root split the packet's rays disagree.
+/// The paper's traversal then tests every object under the root with every
+/// ray; the packet traversal sends each half down its own side, where the
+/// plate ends every ray's interval before the spheres.
+#[test]
+fn rays_that_miss_a_subtree_do_not_test_it() {
+    let mut nff = String::from(
+        "v\nfrom 0 0 12\nat 0 0 0\nup 0 1 0\nangle 40\nhither 1\nresolution 8 8\nb 0 0 0\nl 0 10 12\nf 1 0 0 1 0 0 0 0\n",
+    );
+    for x in [-2.5, 2.5] {
+        nff.push_str(&format!(
+            "p 4\n{} -5 1\n{} -5 1\n{} 5 1\n{} 5 1\n",
+            x - 2.4,
+            x + 2.4,
+            x + 2.4,
+            x - 2.4
+        ));
+    }
+    for k in 0..10 {
+        for x in [-2.5, 2.5] {
+            nff.push_str(&format!("s {x} 0 {} 0.8\n", -2.0 * k as f64 - 1.0));
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("rows.nff");
+    std::fs::write(&path, nff).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    let paper = render_chip(&scene, &opts(8, 8, Traversal::Paper), false, None).unwrap();
+    let packet = render_chip(&scene, &opts(8, 8, Traversal::Packet), false, None).unwrap();
+    let (a, b) = (paper.tests_per_ray(), packet.tests_per_ray());
+    eprintln!(
+        "ray-object tests per ray: paper {a:.2}, packet {b:.2} (objects broadcast per packet pass: {:.2}, {:.2})",
+        paper.objects_tested_per_ray(),
+        packet.objects_tested_per_ray()
+    );
+    assert_eq!(paper.hits, packet.hits);
+    assert!(
+        a >= 20.0,
+        "the paper's traversal tests all 22 objects: {a:.2}"
+    );
+    assert!(b * 3.0 < a, "packet {b:.2} against paper {a:.2}");
+}
+
+/// The streamed layout (nodes in main memory, leaf blocks moved into FB
+/// bank 1): both traversals find the same hits up to ties there too.
+#[test]
+fn streamed_traversals_find_the_same_hits() {
+    use firmware::tracer::Numerics;
+    for name in ["default.toml", "jacks-1.nff", "rings-1.nff"] {
+        let scene = load(name);
+        let (w, h) = (32, 32);
+        let paper = tb::render::render_chip_streamed(
+            &scene,
+            &opts(w, h, Traversal::Paper),
+            &Numerics::default(),
+            false,
+        )
+        .unwrap();
+        let packet = tb::render::render_chip_streamed(
+            &scene,
+            &opts(w, h, Traversal::Packet),
+            &Numerics::default(),
+            false,
+        )
+        .unwrap();
+        assert!(packet.firmware.layout.stream.is_some());
+        let differ = paper
+            .hits
+            .iter()
+            .zip(&packet.hits)
+            .filter(|(a, b)| a != b)
+            .count();
+        eprintln!("{name} streamed: {differ} of {} pixels differ", w * h);
+        assert!(differ <= 2, "{name}: {differ} pixels hit another object");
+    }
+}
+
+/// A leaf whose records do not fit FB bank 1 (16K words) is moved and
+/// tested in pieces: 4,400 spheres under a BSP of depth 1 (two leaves of
+/// 2,200 spheres, 17,600 words each).
+#[test]
+fn a_leaf_larger_than_the_bank_is_streamed_in_pieces() {
+    let mut nff = String::from(
+        "v\nfrom 0 -3 30\nat 0 0 0\nup 0 1 0\nangle 30\nhither 1\nresolution 8 8\nb 0.1 0.1 0.1\nl 10 10 30\nf 1 1 0 0.8 0.2 10 0 0\n",
+    );
+    for i in 0..22 {
+        for j in 0..20 {
+            for k in 0..10 {
+                nff.push_str(&format!(
+                    "s {} {} {} 0.2\n",
+                    0.5 * i as f64 - 5.25,
+                    0.5 * j as f64 - 4.75,
+                    -0.5 * k as f64
+                ));
+            }
+        }
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("block.nff");
+    std::fs::write(&path, nff).unwrap();
+    let scene = Scene::load(&path).unwrap();
+    let mut o = opts(8, 8, Traversal::Packet);
+    o.bsp.max_depth = 1;
+    let (chip, rep) = tb::cmd_render::render(&scene, &o, false, None).unwrap();
+    let st = chip.firmware.layout.stream.as_ref().expect("streamed");
+    assert!(st.extra_pieces >= 2, "{} extra pieces", st.extra_pieces);
+    assert!(st.largest_block <= firmware::tracer::layout::STREAM_BANK);
+    let (psnr, agree) = (
+        rep.json["psnr_db"].as_f64().unwrap(),
+        rep.json["hit_agreement"].as_f64().unwrap(),
+    );
+    eprintln!(
+        "pieces: {} extra, {psnr:.2} dB, {agree:.4}",
+        st.extra_pieces
+    );
+    assert!(psnr >= 30.0 && agree >= 0.98, "{psnr:.2} dB, {agree:.4}");
+    // The paper's streamed layout has no pieces: it refuses the scene.
+    let paper = Options {
+        traversal: Traversal::Paper,
+        ..o
+    };
+    match firmware::tracer::build(&scene, &paper) {
+        Ok(_) => panic!("the paper's streamed layout took a leaf larger than FB bank 1"),
+        Err(e) => assert!(e.contains("FB bank 1 holds"), "{e}"),
+    }
+}
