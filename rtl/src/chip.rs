@@ -68,6 +68,9 @@ pub struct Stats {
     pub array_stall_cycles: u64,
     /// TinyRISC cycles lost waiting for the DMA channel.
     pub dma_stall_cycles: u64,
+    /// Cycles in which the array executed no context while TinyRISC was
+    /// not waiting for the DMA: the array waits for control.
+    pub array_idle_control_cycles: u64,
     pub dma_busy_cycles: u64,
     pub dma_words: u64,
     pub dma_transfers: u64,
@@ -123,6 +126,7 @@ pub struct Chip<W: Word = i16> {
     cycles: u64,
     array_busy: u64,
     active_rc: u64,
+    idle_control: u64,
     /// Runs counted for the statistics ([`Watch`]).
     pub watch: Watch,
 }
@@ -233,6 +237,7 @@ impl<W: Word> Chip<W> {
             cycles: 0,
             array_busy: 0,
             active_rc: 0,
+            idle_control: 0,
             watch: Watch::default(),
         }
     }
@@ -265,6 +270,7 @@ impl<W: Word> Chip<W> {
             risc_busy_cycles: self.risc.busy_cycles,
             array_stall_cycles: self.risc.stall_array,
             dma_stall_cycles: self.risc.stall_dma,
+            array_idle_control_cycles: self.idle_control,
             dma_busy_cycles: self.dma.busy_cycles,
             dma_words: self.dma.words_moved,
             dma_transfers: self.dma.transfers,
@@ -374,6 +380,8 @@ impl<W: Word> Clocked for Chip<W> {
             if self.watch.any {
                 self.count_watched();
             }
+        } else if self.risc.state != crate::tinyrisc::State::StallDma {
+            self.idle_control += 1;
         }
         self.bcast.commit();
         self.dma

@@ -137,6 +137,11 @@ pub fn render_as(
     let psnr = metrics::psnr(&chip.rgb8, &ref8);
     let agree = metrics::hit_agreement(&chip.hits, &refimg.hits);
     let r = &chip.firmware.report;
+    let idle_on_control = if chip.stats.cycles > 0 {
+        chip.stats.array_idle_control_cycles as f64 / chip.stats.cycles as f64
+    } else {
+        0.0
+    };
     let json = json!({
         "scene": scene.source,
         "cycles": chip.cycles,
@@ -151,6 +156,7 @@ pub fn render_as(
         "hit_agreement": agree,
         "active_rc_fraction": chip.stats.active_rc_fraction(),
         "dma_stall_cycles": chip.stats.dma_stall_cycles,
+        "array_idle_on_control": idle_on_control,
         "objects_tested_per_ray": chip.objects_tested_per_ray(),
         "ray_tests_per_ray": chip.tests_per_ray(),
         "rays_traced": chip.stats.watched_rcs[1],
@@ -315,6 +321,10 @@ pub fn command(a: RenderArgs) -> Result<()> {
         j["active_rc_fraction"].as_f64().unwrap_or(0.0)
     );
     println!("dma stall cycles         {}", j["dma_stall_cycles"]);
+    println!(
+        "array idle on control    {:.1}% of the cycles",
+        100.0 * j["array_idle_on_control"].as_f64().unwrap_or(0.0)
+    );
     if let Some(st) = &chip.firmware.layout.stream {
         println!(
             "scene streamed           {} KiB in main memory ({} BSP nodes), leaf blocks by DMA into FB bank 1",

@@ -1,5 +1,6 @@
 //! Testbenches, the float reference renderer, metrics, charts, and the
 //! pieces of the `morphosys` command.
+#![recursion_limit = "256"] // the `json!` of a render report
 
 pub mod charts;
 pub mod cli;

@@ -106,6 +106,7 @@ fn add_stats(a: &mut Stats, b: &Stats) {
     a.risc_busy_cycles += b.risc_busy_cycles;
     a.array_stall_cycles += b.array_stall_cycles;
     a.dma_stall_cycles += b.dma_stall_cycles;
+    a.array_idle_control_cycles += b.array_idle_control_cycles;
     a.dma_busy_cycles += b.dma_busy_cycles;
     a.dma_words += b.dma_words;
     a.dma_transfers += b.dma_transfers;
@@ -123,6 +124,7 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     a.risc_busy_cycles -= b.risc_busy_cycles.min(a.risc_busy_cycles);
     a.array_stall_cycles -= b.array_stall_cycles.min(a.array_stall_cycles);
     a.dma_stall_cycles -= b.dma_stall_cycles.min(a.dma_stall_cycles);
+    a.array_idle_control_cycles -= b.array_idle_control_cycles.min(a.array_idle_control_cycles);
     a.dma_busy_cycles -= b.dma_busy_cycles.min(a.dma_busy_cycles);
     a.dma_words -= b.dma_words.min(a.dma_words);
     a.dma_transfers -= b.dma_transfers.min(a.dma_transfers);

@@ -546,7 +546,8 @@ trace:  sw r15, SAVE_LR(r0)\n        lw r1, PASSES(r0)\n        addi r1, r1, 1\n
         // rays, nothing to walk.
         let _ = writeln!(
             w,
-            "        li r5, ROOT\n        jal test_objects\n        j pdone"
+            "        li r14, NSTACK\n        li r5, ROOT\n        rcsl r4\n        rcsh r10\n        nor r4, r4, r0\n        nor r10, r10, r0\n\
+        or r1, r4, r10\n        beqz r1, pdone\n        lw r11, PASS(r0)\n        j leaf_go"
         );
     }
     let _ = writeln!(
@@ -574,27 +575,36 @@ ordb{a}:  sw r1, NK+{o}(r0)\n        sw r2, NF+{o}(r0)\n        sw r3, NS+{o}(r0
             o = 4 * a,
         );
     }
-    // The node loop. `dispatch`: r5 = a node, r6 = its flags; an inner
-    // node's kernel is issued (its split streamed), then `vnode` fetches
-    // the children and the first child's flags while it runs.
+    // The node loop. `dispatch_full`: r5 = a node, r6 = its flags; an inner
+    // node's kernel is issued (its split streamed), then `vnode` fetches the
+    // children, the first child's flags, kernel (and split) while it runs,
+    // so that `dispatch_pre` issues the first child's kernel at once.
     let ldn = if streamed { "lw" } else { "lfb" };
-    let dispatch = |w: &mut String| {
-        if streamed {
-            let _ = writeln!(
-                w,
-                "        blt r6, r0, leaf\n        lw r2, 8(r5)\n        sfb r2, SPLIT(r0)\n        slli r7, r6, 2\n        lw r1, NK(r7)\n        li r2, SPLIT\n        sbcb r1, r2, {nlen}\n        j vnode",
-                nlen = klen("k_pn0b")
-            );
+    let nlen = klen("k_pn0b");
+    let dispatch_full = |w: &mut String| {
+        let split = if streamed {
+            "        lw r2, 8(r5)\n        sfb r2, SPLIT(r0)\n        li r2, SPLIT"
         } else {
-            let _ = writeln!(
-                w,
-                "        blt r6, r0, leaf\n        slli r7, r6, 2\n        lw r1, NK(r7)\n        addi r2, r5, 2\n        sbcb r1, r2, {nlen}\n        j vnode",
-                nlen = klen("k_pn0b")
-            );
-        }
+            "        addi r2, r5, 2"
+        };
+        let _ = writeln!(
+            w,
+            "        blt r6, r0, leaf\n        slli r7, r6, 2\n        lw r1, NK(r7)\n{split}\n        sbcb r1, r2, {nlen}\n        j vnode"
+        );
+    };
+    let dispatch_pre = |w: &mut String| {
+        let split = if streamed {
+            "        sfb r15, SPLIT(r0)\n        li r2, SPLIT"
+        } else {
+            "        addi r2, r5, 2"
+        };
+        let _ = writeln!(
+            w,
+            "        mv r5, r9\n        blt r6, r0, leaf\n        mv r7, r3\n{split}\n        sbcb r11, r2, {nlen}\n        j vnode"
+        );
     };
     // Push the second child (r10) with every awake ray's interval for it
-    // (the push kernel streams the node's slot address).
+    // (the push kernel streams the node's slot address, r12).
     let push = |w: &mut String| {
         if streamed {
             let _ = writeln!(
@@ -617,39 +627,123 @@ ordb{a}:  sw r1, NK+{o}(r0)\n        sw r2, NF+{o}(r0)\n        sw r3, NS+{o}(r0
         w,
         "        li r14, NSTACK\n        li r5, ROOT\n        {ldn} r6, 0(r5)"
     );
-    dispatch(w);
+    dispatch_full(w);
     let _ = writeln!(
         w,
         "vnode:  lw r8, NF(r7)\n        add r8, r8, r5\n        {ldn} r9, 0(r8)\n        lw r10, NS(r7)\n        add r10, r10, r5\n        {ldn} r10, 0(r10)\n\
-        {ldn} r6, 0(r9)\n        {slot}\n\
-        rcst r3\n        addi r4, r3, -3\n        beqz r4, vall\n        addi r4, r3, -1\n        beqz r4, vboth\n        bnez r3, pop\n\
+        {ldn} r6, 0(r9)\n        andi r3, r6, 3\n        slli r3, r3, 2\n        lw r11, NK(r3)\n{pre}        {slot}\n\
+        rcst r4\n        addi r1, r4, -3\n        beqz r1, vall\n        addi r1, r4, -1\n        beqz r1, vboth\n        bnez r4, pop\n\
         li r1, {take}\n        cbcast r1, {takelen}\n        mv r5, r10\n        {ldn} r6, 0(r5)",
+        pre = if streamed { "        lw r15, 8(r9)\n" } else { "" },
         slot = if streamed { "lw r12, 12(r5)" } else { "addi r12, r5, 3" },
         take = kaddr("k_ptake"),
         takelen = klen("k_ptake"),
     );
-    dispatch(w);
+    dispatch_full(w);
     let _ = writeln!(w, "vboth:");
     push(w);
     let _ = writeln!(
         w,
-        "        li r1, {sl}\n        cbcast r1, 1\n        mv r5, r9",
+        "        li r1, {sl}\n        cbcast r1, 1",
         sl = kaddr("k_psl")
     );
-    dispatch(w);
+    dispatch_pre(w);
     let _ = writeln!(
         w,
-        "vall:   li r1, {second}\n        cbcast r1, 1\n        rcany r3\n        beqz r3, vfirst",
+        "vall:   li r1, {second}\n        cbcast r1, 1\n        rcany r4\n        beqz r4, vfirst",
         second = kaddr("k_p2nd")
     );
     push(w);
-    let _ = writeln!(w, "vfirst: mv r5, r9");
-    dispatch(w);
+    let _ = writeln!(w, "vfirst:");
+    dispatch_pre(w);
+    // The leaf: every object not yet tested by every awake ray in this
+    // pass, by type. Mailboxes (main memory, 16 bytes per object in more
+    // than one leaf): the pass that last tested the object and which rays
+    // did; r4, r10 = the awake mask (read only for leaves with such
+    // objects), r11 = PASS.
+    let awake = "        rcsl r4\n        rcsh r10\n        nor r4, r4, r0\n        nor r10, r10, r0\n        lw r11, PASS(r0)";
+    // The mailbox check of the object whose mailbox address is in r8: on
+    // to `{n}_next` when every awake ray has tested it in this pass, else
+    // the mailbox is updated and the object goes to `{n}_go`.
+    let check = |w: &mut String, n: &str| {
+        let _ = writeln!(
+            w,
+            "        lw r1, 0(r8)\n        bne r1, r11, {n}_fresh\n        lw r2, 4(r8)\n        lw r3, 8(r8)\n        \
+or r1, r2, r4\n        bne r1, r2, {n}_upd\n        or r1, r3, r10\n        beq r1, r3, {n}_next\n\
+{n}_upd: or r2, r2, r4\n        or r3, r3, r10\n        sw r2, 4(r8)\n        sw r3, 8(r8)\n        j {n}_go\n\
+{n}_fresh: sw r11, 0(r8)\n        sw r4, 4(r8)\n        sw r10, 8(r8)\n{n}_go:  addi r13, r13, 1"
+        );
+    };
     let _ = writeln!(
         w,
-        "leaf:   jal test_objects\n        lw r1, MODE(r0)\n        beqz r1, pop\n        li r1, {leafa}\n        cbcast r1, {leafalen}\n\
+        "; The leaf (r5). An object in more than one leaf has a mailbox: the pass that last tested it and\n\
+; which rays did; it is broadcast unless every awake ray has tested it in this pass."
+    );
+    if streamed {
+        // The block's DMA starts at once: the array reads bank 1 only in a
+        // leaf's object tests, and a pop or a node decision (which waits
+        // for the array) lies between two leaves; the mailbox scan runs
+        // while it moves, and `dwait` only comes before the first object.
+        // A leaf's further pieces wait for the array to finish the last.
+        let _ = writeln!(
+            w,
+            "leaf:   lw r1, 56(r5)\n        beqz r1, lf_done\n        lw r1, 60(r5)\n        lw r2, 24(r5)\n        or r1, r1, r2\n        beqz r1, pt_piece\n{awake}\n\
+leaf_go:\n\
+pt_piece: lw r1, 16(r5)\n        lw r3, 20(r5)\n        lw r2, CUR_BLK(r0)\n        beq r1, r2, pt_scan0\n\
+        li r2, SBANK\n        ldfb r1, r2, r3\n        sw r1, CUR_BLK(r0)\n\
+pt_scan0: lw r6, 8(r5)\n        lw r9, 56(r5)\n\
+pt_scan: lw r8, 0(r6)\n        addi r6, r6, 4\n        beqz r8, pt_load\n        lw r1, 0(r8)\n        bne r1, r11, pt_load\n\
+        lw r2, 4(r8)\n        nor r2, r2, r0\n        and r2, r2, r4\n        bnez r2, pt_load\n\
+        lw r3, 8(r8)\n        nor r3, r3, r0\n        and r3, r3, r10\n        bnez r3, pt_load\n\
+        addi r9, r9, -1\n        bnez r9, pt_scan\n        j pt_nextp\n\
+pt_load: dwait\n        li r7, SBANK\n        lw r6, 8(r5)"
+        );
+        for (j, t) in lay.types.iter().enumerate() {
+            let n = format!("p{}", t.ty.name());
+            let _ = writeln!(
+                w,
+                "        lw r9, {cnt}(r5)\n        beqz r9, {n}_end\n{n}_loop:\n        lw r8, 0(r6)\n        addi r6, r6, 4\n        beqz r8, {n}_go",
+                cnt = 28 + 4 * j
+            );
+            check(w, &n);
+            broadcast_object(w, t.ty, &n);
+            let _ = writeln!(
+                w,
+                "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
+                size = t.size
+            );
+        }
+        let _ = writeln!(
+            w,
+            "pt_nextp: lw r5, 24(r5)\n        beqz r5, lf_done\n        rcany r2\n        j pt_piece"
+        );
+    } else {
+        let _ = writeln!(
+            w,
+            "leaf:   lfb r1, 2(r5)\n        beqz r1, lf_done\n        lfb r1, 3(r5)\n        beqz r1, leaf_go\n{awake}\n\
+leaf_go: li r12, MAILBOX\n        addi r6, r5, {head}",
+            head = super::layout::PK_LEAF_HEAD
+        );
+        for t in &lay.types {
+            let n = format!("p{}", t.ty.name());
+            let _ = writeln!(
+                w,
+                "        lfb r9, 0(r6)\n        addi r6, r6, 1\n        beqz r9, {n}_end\n\
+{n}_loop:\n        lfb r7, 0(r6)\n        lfb r8, 1(r6)\n        addi r6, r6, 2\n        blt r8, r0, {n}_go\n        slli r8, r8, 4\n        add r8, r8, r12"
+            );
+            check(w, &n);
+            broadcast_object(w, t.ty, &n);
+            let _ = writeln!(
+                w,
+                "{n}_next:\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:"
+            );
+        }
+    }
+    let _ = writeln!(
+        w,
+        "lf_done: lw r1, MODE(r0)\n        beqz r1, pop\n        li r1, {leafa}\n        cbcast r1, {leafalen}\n\
 pop:    li r9, NSTACK\n        beq r14, r9, pdone\n        addi r14, r14, -4\n        lw r5, 0(r14)\n        li r1, {pop}\n{pop_at}        sbcb r1, r2, {poplen}\n\
-        {ldn} r6, 0(r5)\n        rcany r3\n        beqz r3, pop",
+        {ldn} r6, 0(r5)\n        rcany r4\n        beqz r4, pop",
         leafa = kaddr("k_pleafa"),
         leafalen = klen("k_pleafa"),
         pop = kaddr("k_ppop"),
@@ -660,7 +754,7 @@ pop:    li r9, NSTACK\n        beq r14, r9, pdone\n        addi r14, r14, -4\n  
             "        addi r2, r5, 1\n"
         },
     );
-    dispatch(w);
+    dispatch_full(w);
     let _ = writeln!(
         w,
         "pdone:  lw r1, TESTS(r0)\n        add r1, r1, r13\n        sw r1, TESTS(r0)\n        lw r15, SAVE_LR(r0)\n        ret\n"
@@ -679,87 +773,6 @@ pop:    li r9, NSTACK\n        beq r14, r9, pdone\n        addi r14, r14, -4\n  
         w,
         "        add r5, r5, r6\n        add r1, r1, r2\n        slt r8, r1, r5\n        ret\n"
     );
-    // test_objects: every object of the leaf not yet tested by every awake
-    // ray in this pass, by type. Mailboxes (main memory, 16 bytes per
-    // object): the pass that last tested the object and which rays did.
-    // r4, r10 = awake mask, r11 = PASS.
-    let _ = writeln!(
-        w,
-        "; test_objects (packet): r5 = leaf. An object's mailbox holds the pass that last tested it\n\
-; and which rays did; it is broadcast unless every awake ray has tested it in this pass."
-    );
-    // The mailbox check of the object whose mailbox address is in r8: on
-    // to `{n}_next` when every awake ray has tested it in this pass, else
-    // the mailbox is updated and the object goes to `{n}_go`.
-    let check = |w: &mut String, n: &str| {
-        let _ = writeln!(
-            w,
-            "        lw r1, 0(r8)\n        bne r1, r11, {n}_fresh\n        lw r2, 4(r8)\n        lw r3, 8(r8)\n        \
-or r1, r2, r4\n        bne r1, r2, {n}_upd\n        or r1, r3, r10\n        beq r1, r3, {n}_next\n\
-{n}_upd: or r2, r2, r4\n        or r3, r3, r10\n        sw r2, 4(r8)\n        sw r3, 8(r8)\n        j {n}_go\n\
-{n}_fresh: sw r11, 0(r8)\n        sw r4, 4(r8)\n        sw r10, 8(r8)\n{n}_go:  addi r13, r13, 1"
-        );
-    };
-    let awake = "        rcsl r4\n        rcsh r10\n        nor r4, r4, r0\n        nor r10, r10, r0\n        or r1, r4, r10\n        beqz r1, pt_ret\n        lw r11, PASS(r0)";
-    if streamed {
-        // The block's DMA starts at once: the array reads bank 1 only in a
-        // leaf's object tests, and a pop or a node decision (which waits
-        // for the array) lies between two leaves; the mailbox scan runs
-        // while it moves, and `dwait` only comes before the first object.
-        // A leaf's further pieces wait for the array to finish the last.
-        let _ = writeln!(
-            w,
-            "test_objects:\n        lw r1, 56(r5)\n        beqz r1, pt_ret\n{awake}\n\
-pt_piece: lw r1, 16(r5)\n        lw r3, 20(r5)\n        lw r2, CUR_BLK(r0)\n        beq r1, r2, pt_scan0\n\
-        li r2, SBANK\n        ldfb r1, r2, r3\n        sw r1, CUR_BLK(r0)\n\
-pt_scan0: lw r6, 8(r5)\n        lw r9, 56(r5)\n\
-pt_scan: lw r8, 0(r6)\n        addi r6, r6, 4\n        beqz r8, pt_load\n        lw r1, 0(r8)\n        bne r1, r11, pt_load\n\
-        lw r2, 4(r8)\n        nor r2, r2, r0\n        and r2, r2, r4\n        bnez r2, pt_load\n\
-        lw r3, 8(r8)\n        nor r3, r3, r0\n        and r3, r3, r10\n        bnez r3, pt_load\n\
-        addi r9, r9, -1\n        bnez r9, pt_scan\n        j pt_nextp\n\
-pt_load: dwait\n        li r7, SBANK\n        lw r6, 8(r5)"
-        );
-        for (j, t) in lay.types.iter().enumerate() {
-            let n = format!("p{}", t.ty.name());
-            let _ = writeln!(
-                w,
-                "        lw r9, {cnt}(r5)\n        beqz r9, {n}_end\n{n}_loop:\n        lw r8, 0(r6)\n        addi r6, r6, 4\n        beqz r8, {n}_go",
-                cnt = 28 + 4 * j
-            );
-            check(w, &n);
-            broadcast_object(w, t.ty, n.as_str());
-            let _ = writeln!(
-                w,
-                "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
-                size = t.size
-            );
-        }
-        let _ = writeln!(
-            w,
-            "pt_nextp: lw r5, 24(r5)\n        beqz r5, pt_ret\n        rcany r2\n        j pt_piece\npt_ret: ret\n"
-        );
-    } else {
-        let _ = writeln!(
-            w,
-            "test_objects:\n        lfb r1, 2(r5)\n        beqz r1, pt_ret\n{awake}\n        li r12, MAILBOX\n        addi r6, r5, {head}",
-            head = super::layout::PK_LEAF_HEAD
-        );
-        for t in &lay.types {
-            let n = format!("p{}", t.ty.name());
-            let _ = writeln!(
-                w,
-                "        lfb r9, 0(r6)\n        addi r6, r6, 1\n        beqz r9, {n}_end\n\
-{n}_loop:\n        lfb r7, 0(r6)\n        lfb r8, 1(r6)\n        addi r6, r6, 2\n        blt r8, r0, {n}_go\n        slli r8, r8, 4\n        add r8, r8, r12"
-            );
-            check(w, &n);
-            broadcast_object(w, t.ty, n.as_str());
-            let _ = writeln!(
-                w,
-                "{n}_next:\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:"
-            );
-        }
-        let _ = writeln!(w, "pt_ret: ret\n");
-    }
 }
 
 /// The streamed traversal (scenes that do not fit FB set 0): nodes, leaf

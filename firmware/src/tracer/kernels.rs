@@ -1502,7 +1502,9 @@ pub fn pk_init(nr: impl Into<Approx>) -> K {
 }
 
 /// Inner node on `axis` (stream: the split). Each awake ray cuts its
-/// interval (r8, r9) at the plane into the part below and the part above
+/// interval (r8, r9; `r9 <= tbest`: the pass start and every pop clip it,
+/// and no hit is found between two inner nodes) at the plane into the part
+/// below and the part above
 /// (each reaching [`P_TOL`] LSB past the plane); `first_above` names the
 /// child the packet visits first. The first child's interval becomes the
 /// current one (r8, r9), the second's is left in r11, r14 for
@@ -1519,7 +1521,6 @@ pub fn pk_node(axis: u8, first_above: bool) -> K {
         .c("subs r11, r10, r12")
         .c("adds r10, r10, r12")
         .comment("near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]")
-        .c("min r9, r9, r7")
         .c("min r12, r9, r10")
         .c("max r13, r8, r11")
         .c(if first_above {
@@ -1527,11 +1528,10 @@ pub fn pk_node(axis: u8, first_above: bool) -> K {
         } else {
             format!("cmp.ge r{d}, #0")
         })
-        .c("sel r10, r12, r9")
-        .c("sel r11, r13, r8")
         .c("sel r14, r9, r12")
+        .c("sel r9, r12, r9")
+        .c("sel r11, r13, r8")
         .c("sel r8, r8, r13")
-        .c("mov r9, r10")
         .c("cmp.lt r11, r14")
         .c("(!f) cmp.lt r8, r9")
         .c("(!f) sleep")
@@ -1586,10 +1586,10 @@ pub fn pk_pop() -> K {
         .c("ld r8, [r15 + #1]")
         .c("movb r10, #-1")
         .c("st r10, [r15]")
-        .c("min r10, r9, r7")
+        .c("min r9, r9, r7")
         .c(format!("ld r11, [r0 + #{}]", ram::P_ALIVE))
         .c("cmp.ne r11, #0")
-        .c("(f) cmp.lt r8, r10")
+        .c("(f) cmp.lt r8, r9")
         .c("(!f) sleep");
     k
 }

@@ -530,6 +530,30 @@ impl ConeFit {
     }
 }
 
+/// The scene's distinct materials, and per scene material its index among
+/// them (materials equal in every field are one).
+fn distinct_materials(scene: &Scene) -> (Vec<usize>, Vec<crate::scene::Material>) {
+    let key = |m: &crate::scene::Material| {
+        [
+            m.color.x, m.color.y, m.color.z, m.kd, m.ks, m.shine, m.t, m.ior,
+        ]
+        .map(f64::to_bits)
+    };
+    let mut seen = std::collections::HashMap::new();
+    let mut mats = Vec::new();
+    let of = scene
+        .materials
+        .iter()
+        .map(|m| {
+            *seen.entry(key(m)).or_insert_with(|| {
+                mats.push(m.clone());
+                mats.len() - 1
+            })
+        })
+        .collect();
+    (of, mats)
+}
+
 /// Largest shift `k` with `m * 2^k` within the word (`<= 2^(15+x) - 1`:
 /// 32767 on the 16-bit chip), clamped to 0..=max.
 fn fit_shift_w(m: f64, max: u32, x: u32) -> u32 {
@@ -639,8 +663,15 @@ fn build_as(
         slot[i] = (ti, by[ti].len());
         by[ti].push(i);
     }
-    if scene.materials.len() > 1000 || scene.lights.len() > 64 {
-        return Err(err(0, "more than 1000 materials or 64 lights".into()));
+    // Materials: identical ones are one (an NFF file repeats its `f` line
+    // for every object: SPD rings, 841 lines, 7 materials); the kernels
+    // shade per distinct material.
+    let (mat_of, mats) = distinct_materials(scene);
+    if mats.len() > 1000 || scene.lights.len() > 64 {
+        return Err(err(
+            0,
+            "more than 1000 distinct materials or 64 lights".into(),
+        ));
     }
 
     // Planar geometry of every record, to fit the kernels' scale shifts.
@@ -827,7 +858,7 @@ fn build_as(
     for x in scene.background.to_array() {
         w.col(x);
     }
-    for (i, mt) in scene.materials.iter().enumerate() {
+    for (i, mt) in mats.iter().enumerate() {
         w.raw(i as i64);
         w.col(mt.ks);
     }
@@ -859,7 +890,7 @@ fn build_as(
     for l in &scene.lights {
         shades.push(w.fb.len());
         let lc = l.color.unwrap_or(Vec3::ONE * (1.0 / nl.sqrt()));
-        for (i, mt) in scene.materials.iter().enumerate() {
+        for (i, mt) in mats.iter().enumerate() {
             w.raw(i as i64);
             let (_, f) = split_shine(mt.shine);
             if f > 0.0 {
@@ -875,11 +906,7 @@ fn build_as(
             }
         }
     }
-    let shines: Vec<(u32, f64)> = scene
-        .materials
-        .iter()
-        .map(|m| split_shine(m.shine))
-        .collect();
+    let shines: Vec<(u32, f64)> = mats.iter().map(|m| split_shine(m.shine)).collect();
 
     // Object records.
     let write_planar = |w: &mut W, p: &Planar, obj: usize, mat: usize| {
@@ -983,11 +1010,11 @@ fn build_as(
                         w.push(one * f.a.axis(c));
                     }
                     w.raw(i as i64);
-                    w.raw(o.material as i64);
+                    w.raw(mat_of[o.material] as i64);
                     for p in &planars[i] {
                         let mut p = *p;
                         p.n = p.n * sg;
-                        write_planar(&mut w, &p, i, o.material);
+                        write_planar(&mut w, &p, i, mat_of[o.material]);
                     }
                 }
                 (
@@ -1019,7 +1046,7 @@ fn build_as(
                     w.push(invr);
                     w.push(sg * w.one());
                     w.raw(i as i64);
-                    w.raw(o.material as i64);
+                    w.raw(mat_of[o.material] as i64);
                 }
                 (
                     Shape::Cone {
@@ -1058,11 +1085,11 @@ fn build_as(
                         w.push(e2.axis(c) * w.one());
                     }
                     w.raw(i as i64);
-                    w.raw(o.material as i64);
+                    w.raw(mat_of[o.material] as i64);
                     for p in &planars[i] {
                         let mut p = *p;
                         p.n = p.n * sg;
-                        write_planar(&mut w, &p, i, o.material);
+                        write_planar(&mut w, &p, i, mat_of[o.material]);
                     }
                 }
                 (Shape::Box { min, max }, _) => {
@@ -1076,7 +1103,7 @@ fn build_as(
                         w.raw(q(min.axis(c)) - 1);
                         w.raw(q(max.axis(c)) + 1);
                         w.raw(i as i64);
-                        w.raw(o.material as i64);
+                        w.raw(mat_of[o.material] as i64);
                     }
                 }
                 (Shape::Polygon { v, .. }, _) => {
@@ -1102,12 +1129,12 @@ fn build_as(
                     }
                     w.unit(n);
                     w.raw(i as i64);
-                    w.raw(o.material as i64);
+                    w.raw(mat_of[o.material] as i64);
                     w.fb.resize(start + size, 0);
                 }
                 _ => {
                     for p in &planars[i] {
-                        write_planar(&mut w, p, i, o.material);
+                        write_planar(&mut w, p, i, mat_of[o.material]);
                     }
                 }
             }
@@ -1143,7 +1170,7 @@ fn build_as(
         lights,
         shades,
         objects: scene.objects.len(),
-        materials: scene.materials.len(),
+        materials: mats.len(),
         shines,
         kd,
         ks_sphere,
@@ -1546,8 +1573,8 @@ fn object_costs(
 /// own slot, left, right (FB addresses, or byte addresses when streamed).
 pub const PK_INNER: usize = 6;
 /// Words before a resident packet leaf's lists: flags, parent's slot,
-/// object count.
-pub const PK_LEAF_HEAD: usize = 3;
+/// object count, objects with a mailbox (in more than one leaf).
+pub const PK_LEAF_HEAD: usize = 4;
 /// Bytes of a packet-traversal mailbox in main memory: the pass that last
 /// tested the object, and which rays did (64-bit mask), padded.
 pub const PK_MAILBOX_BYTES: usize = 16;
@@ -1704,6 +1731,7 @@ fn packet_nodes(
                     w.word16(0x8000);
                     w.raw(parent_slot(n));
                     w.raw(n.objects.len() as i64);
+                    w.raw(n.objects.iter().filter(|&&o| refs[o as usize] > 1).count() as i64);
                     for (ti, qs) in types.iter().zip(per_type(n)) {
                         w.raw(qs.len() as i64);
                         for q in qs {
@@ -1809,6 +1837,10 @@ fn packet_nodes(
         f[5] = words.len() as i32;
         f[7..14].copy_from_slice(&counts);
         f[14] = pc.len() as i32;
+        f[15] = pc
+            .iter()
+            .filter(|&&(j, q)| refs[types[j].objects[q]] > 1)
+            .count() as i32;
         blocks.extend(fb_word_bytes(&words, w.x));
     }
     // Chain the pieces of each leaf (a leaf's pieces are consecutive).
