@@ -32,12 +32,18 @@ pub enum SplitRule {
     Median,
     /// Surface area heuristic.
     Sah,
+    /// Chosen by the user of the tree (the ray tracer: the paper's median
+    /// for the paper's traversal; for the packet traversal the cheaper of
+    /// median and SAH trees by its cost model). Built as `Median`.
+    Auto,
 }
 
 /// Build parameters.
 #[derive(Clone, Copy, Debug, serde::Serialize)]
 pub struct BspParams {
-    /// Deepest level; the root is level 0. The paper: 15.
+    /// Deepest level; the root is level 0. The paper: 15. 0: chosen by
+    /// the user of the tree (the ray tracer: [`auto_depth`] for the packet
+    /// traversal, 15 for the paper's); built as 15.
     pub max_depth: u32,
     /// A node with this many objects or fewer is a leaf. The paper: 5.
     pub max_leaf: usize,
@@ -115,6 +121,10 @@ impl Bsp {
     ) -> Bsp {
         let mut nodes = Vec::new();
         let all: Vec<u32> = (0..object_bounds.len() as u32).collect();
+        let mut params = params;
+        if params.max_depth == 0 {
+            params.max_depth = 15;
+        }
         let ctx = Ctx {
             ob: object_bounds,
             p: &params,
@@ -149,6 +159,14 @@ impl Bsp {
         }
         i
     }
+}
+
+/// A depth limit that grows with the scene, `8 + 1.3 log2(objects)` (pbrt's
+/// rule for kd-trees), between 15 and 32.
+pub fn auto_depth(objects: usize) -> u32 {
+    (8.0 + 1.3 * (objects.max(1) as f64).log2())
+        .round()
+        .clamp(15.0, crate::scene_image::MAX_BSP_DEPTH as f64) as u32
 }
 
 fn child_box(b: Aabb, axis: usize, pos: f64, above: bool) -> Aabb {
@@ -199,7 +217,7 @@ fn build(
         return at;
     }
     let choice = match p.rule {
-        SplitRule::Median => {
+        SplitRule::Median | SplitRule::Auto => {
             let axis = (depth % 3) as usize;
             Some((axis, bounds.center().axis(axis)))
         }

@@ -394,11 +394,11 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
         col: 0,
         message,
     };
-    if !(1..=MAX_BSP_DEPTH).contains(&opt.bsp.max_depth) || opt.bsp.max_leaf == 0 {
+    if !(0..=MAX_BSP_DEPTH).contains(&opt.bsp.max_depth) || opt.bsp.max_leaf == 0 {
         return Err(err(
             0,
             format!(
-                "BSP max depth {} must be 1..={MAX_BSP_DEPTH} and max objects per leaf {} at least 1",
+                "BSP max depth {} must be 1..={MAX_BSP_DEPTH} (0: automatic) and max objects per leaf {} at least 1",
                 opt.bsp.max_depth, opt.bsp.max_leaf
             ),
         ));

@@ -26,6 +26,8 @@ pub struct RenderArgs {
     pub emit_asm: Option<PathBuf>,
     pub max_depth: u32,
     pub max_leaf: usize,
+    /// BSP split rule: "median" or "sah".
+    pub split: String,
     pub layout: firmware::tracer::NodeLayout,
     pub traversal: firmware::tracer::Traversal,
     pub collapse: firmware::tracer::Collapse,
@@ -174,6 +176,8 @@ pub fn render_as(
         "format": chip.firmware.format(),
         "compiler_format": r.format,
         "bsp_nodes": r.bsp.nodes,
+        "bsp_split": chip.firmware.bsp.rule,
+        "bsp_depth_limit": chip.firmware.bsp.max_depth,
         "bsp_max_depth": r.bsp.max_depth,
         "context_words": chip.firmware.context_words,
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
@@ -216,6 +220,11 @@ pub fn command(a: RenderArgs) -> Result<()> {
         bsp: BspParams {
             max_depth: a.max_depth,
             max_leaf: a.max_leaf,
+            rule: match a.split.as_str() {
+                "sah" => firmware::bsp::SplitRule::Sah,
+                "median" => firmware::bsp::SplitRule::Median,
+                _ => firmware::bsp::SplitRule::Auto,
+            },
             ..BspParams::default()
         },
         layout: a.layout,
@@ -241,8 +250,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     let (datapath, datapath_reason) = choose_datapath(&scene, &opt, &nm, a.datapath)?;
     opt.datapath = datapath;
     if let Some(p) = &a.emit_asm {
-        let fw =
-            firmware::tracer::build_with(&scene, &opt, &nm).map_err(|e| anyhow::anyhow!("{e}"))?;
+        let fw = crate::render::choose_firmware(&scene, &opt, &nm)?;
         write_atomic(p, fw.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
@@ -302,6 +310,13 @@ pub fn command(a: RenderArgs) -> Result<()> {
         } else {
             ""
         }
+    );
+    println!(
+        "bsp                      {} split, depth limit {}: {} nodes, depth {}",
+        j["bsp_split"].as_str().unwrap_or("?"),
+        j["bsp_depth_limit"],
+        j["bsp_nodes"],
+        j["bsp_max_depth"]
     );
     println!("cycles                   {}", j["cycles"]);
     println!(

@@ -194,12 +194,20 @@ enum Command {
         /// Write the generated firmware (assembly source) here.
         #[arg(long, value_name = "PATH")]
         emit_asm: Option<PathBuf>,
-        /// Maximum BSP depth.
-        #[arg(long, value_name = "N", default_value_t = 15)]
+        /// Maximum BSP depth: a number (1..=32) or auto (the paper's 15 for
+        /// the paper's traversal; for the packet traversal 15 for a median
+        /// tree and 8 + 1.3 log2(objects) for an SAH tree).
+        #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_depth)]
         max_depth: u32,
         /// Maximum objects per BSP leaf.
         #[arg(long, value_name = "N", default_value_t = 5)]
         max_leaf: usize,
+        /// BSP split rule: median (the paper's spatial median, axes in turn),
+        /// sah (surface area heuristic) or auto (median for the paper's
+        /// traversal; for the packet traversal the cheaper of the two trees
+        /// by its cost model).
+        #[arg(long, value_name = "auto|median|sah", default_value = "auto", value_parser = ["auto", "median", "sah"])]
+        split: String,
         /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
         /// or compact (index lists); the same image either way.
         #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = parse_layout)]
@@ -279,6 +287,19 @@ enum Bench {
 
 fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
     s.parse()
+}
+
+fn parse_depth(s: &str) -> Result<u32, String> {
+    if s == "auto" {
+        return Ok(0);
+    }
+    match s.parse::<u32>() {
+        Ok(d) if (1..=firmware::scene_image::MAX_BSP_DEPTH).contains(&d) => Ok(d),
+        _ => Err(format!(
+            "expected auto or a depth 1..={}",
+            firmware::scene_image::MAX_BSP_DEPTH
+        )),
+    }
 }
 
 fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, String> {
@@ -392,6 +413,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            split,
             layout,
             traversal,
             collapse,
@@ -411,6 +433,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             emit_asm,
             max_depth,
             max_leaf,
+            split,
             layout,
             traversal,
             collapse,

@@ -332,7 +332,7 @@ pub fn render_chip_with(
     progress: bool,
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<ChipRender> {
-    let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    let fw = choose_firmware(scene, opt, nm)?;
     render_firmware(
         fw,
         opt,
@@ -352,8 +352,82 @@ pub fn render_chip_as(
     nm: &Numerics,
     host: &RenderSettings,
 ) -> Result<ChipRender> {
-    let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    let fw = choose_firmware(scene, opt, nm)?;
     render_firmware(fw, opt, host)
+}
+
+/// Every `PROBE_STRIDE`-th tile row and column (1/16 of the tiles) make
+/// the probe by which [`choose_firmware`] compares BSP trees.
+pub const PROBE_STRIDE: u32 = 4;
+
+/// The firmware for `opt`. Where the options leave the BSP to the tracer
+/// and it has more than one candidate ([`tracer::resolve_bsp`]: the packet
+/// traversal's median and SAH trees), each is run on a probe of the frame's
+/// tiles (every fourth row and column of tiles, at the frame's size, so
+/// each packet is as coherent as in the frame) and the one with the fewest
+/// cycles is kept; ties go to the first. Deterministic.
+pub fn choose_firmware(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmware> {
+    let cands = tracer::resolve_bsp(opt, scene.objects.len());
+    if cands.len() < 2 {
+        return tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"));
+    }
+    let mut best: Option<(u64, Firmware)> = None;
+    let mut first_err = None;
+    for bsp in cands {
+        let o = Options { bsp, ..*opt };
+        let fw = match tracer::build_with(scene, &o, nm) {
+            Ok(fw) => fw,
+            Err(e) => {
+                first_err.get_or_insert(e);
+                continue;
+            }
+        };
+        let (tw, th) = (fw.tile_w, fw.tile_h);
+        let (nx, ny) = (opt.width.div_ceil(tw), opt.height.div_ceil(th));
+        let pick = |n: u32| -> Vec<u32> {
+            let v: Vec<u32> = (0..n)
+                .filter(|k| k % PROBE_STRIDE == PROBE_STRIDE / 2)
+                .collect();
+            if v.is_empty() {
+                vec![n / 2]
+            } else {
+                v
+            }
+        };
+        let mut tiles = Vec::new();
+        for ty in pick(ny) {
+            for tx in pick(nx) {
+                tiles.push((tx * tw, ty * th));
+            }
+        }
+        let img = asm::assemble(&fw.source, "tracer.s")
+            .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
+        let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
+        let cycles: Vec<Result<u64>> = groups
+            .par_iter()
+            .map(|g| {
+                let r = match fw.datapath {
+                    Datapath::W16 => run_group::<i16>(&img, &fw, g, None, false),
+                    Datapath::W32 => run_group::<i32>(&img, &fw, g, None, false),
+                }?;
+                Ok(r.end.saturating_sub(r.start))
+            })
+            .collect();
+        let mut total = 0u64;
+        for c in cycles {
+            total += c?;
+        }
+        if best.as_ref().is_none_or(|(c, _)| total < *c) {
+            best = Some((total, fw));
+        }
+    }
+    match best {
+        Some((_, fw)) => Ok(fw),
+        None => Err(anyhow!(
+            "{}",
+            first_err.unwrap_or_else(|| "internal: no BSP to build".into())
+        )),
+    }
 }
 
 /// Render with the streamed layout (scene in main memory, leaf blocks moved

@@ -484,7 +484,7 @@ test_objects:\n        lw r13, PASS(r0)",
             nw = t.bv_words
         );
             }
-            broadcast_object(w, t.ty, &n);
+            broadcast_object(w, t.ty, n);
             if compact {
                 let _ = writeln!(
                     w,

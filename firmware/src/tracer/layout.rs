@@ -162,6 +162,10 @@ pub struct Layout {
     pub slots: u32,
     /// Packet traversal: the tree it walks is a single leaf.
     pub root_leaf: bool,
+    /// Packet traversal: the expected array cycles of a packet's walk from
+    /// the root, by the surface-area cost model of [`super::Collapse::Auto`]
+    /// (0 for the paper's traversal).
+    pub expected_cost: f64,
     /// FB words the resident image needs with this node format (tables to
     /// mailboxes), whether or not it fits and was used.
     pub resident_words: usize,
@@ -1491,6 +1495,7 @@ impl Finish {
             root_box: self.root_box,
             slots: self.slots,
             root_leaf: false,
+            expected_cost: 0.0,
             resident_words,
             resident_node_words,
             mailbox,
@@ -1635,9 +1640,11 @@ fn packet_nodes(
             walk
         }
     }
+    let mut model_keep = vec![true; nodes.len()];
+    let expected_cost = expect(nodes, 0, &test_all, &mut model_keep);
     let collapse = match fin.collapse {
         super::Collapse::Auto => {
-            expect(nodes, 0, &test_all, &mut keep);
+            keep = model_keep;
             // The root is walked whenever the BSP has one split: the pass's
             // start clips the rays to the root cell, which culls the rays
             // that miss the scene (the surface-area weights assume every
@@ -1749,6 +1756,7 @@ fn packet_nodes(
         let mailbox = super::mem::STREAM as usize;
         let mut lay = fin.layout(w.fb, types, root, 0, total, node_section, mailbox, None);
         lay.root_leaf = nodes[0].split.is_none();
+        lay.expected_cost = expected_cost;
         return Ok(lay);
     }
     // Streamed: records, nodes and leaf blocks leave the FB.
@@ -1928,5 +1936,6 @@ fn packet_nodes(
         Some(st),
     );
     lay.root_leaf = root_leaf;
+    lay.expected_cost = expected_cost;
     Ok(lay)
 }

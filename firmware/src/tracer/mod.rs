@@ -29,7 +29,7 @@ pub mod control;
 pub mod kernels;
 pub mod layout;
 
-use crate::bsp::BspParams;
+use crate::bsp::{BspParams, SplitRule};
 use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
 pub use rtl::rc::Datapath;
@@ -44,6 +44,11 @@ pub struct Options {
     /// Maximum ray depth, the eye ray being depth 1 (the paper's recursion
     /// level 2 = eye rays and one reflection).
     pub depth: u32,
+    /// The BSP. `max_depth` 0 and `SplitRule::Auto` (the default) are
+    /// resolved per traversal ([`resolve_bsp`]): the paper's median split
+    /// to depth 15 for the paper's traversal; for the packet traversal the
+    /// cheaper (by its cost model) of that tree and an SAH tree to
+    /// [`crate::bsp::auto_depth`].
     pub bsp: BspParams,
     /// How a resident scene's BSP nodes name their objects (the paper's
     /// Fig. 5 bit vectors by default).
@@ -66,7 +71,11 @@ impl Default for Options {
             height: 256,
             ways: 64,
             depth: 2,
-            bsp: BspParams::default(),
+            bsp: BspParams {
+                max_depth: 0,
+                rule: SplitRule::Auto,
+                ..BspParams::default()
+            },
             layout: NodeLayout::Fig5,
             datapath: Datapath::W16,
             traversal: Traversal::default(),
@@ -283,6 +292,8 @@ pub struct Firmware {
     pub kernels: Vec<(String, usize)>,
     /// Where everything is in the FB image, and the kernels' scale shifts.
     pub layout: layout::Layout,
+    /// The BSP built (the options' automatic choices resolved).
+    pub bsp: BspParams,
 }
 
 impl Firmware {
@@ -333,7 +344,58 @@ pub fn build_streamed_with(
     build_as(scene, opt, nm, true)
 }
 
+/// The BSP trees to try for `opt` (automatic choices resolved): one, or
+/// for the packet traversal with `SplitRule::Auto` the paper's median tree
+/// and an SAH tree, of which the build keeps the cheaper by the packet
+/// traversal's cost model.
+pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
+    let b = opt.bsp;
+    let depth = |rule: SplitRule| match (b.max_depth, rule) {
+        (0, SplitRule::Sah) => crate::bsp::auto_depth(objects),
+        (0, _) => 15,
+        (d, _) => d,
+    };
+    let with = |rule: SplitRule| BspParams {
+        rule,
+        max_depth: depth(rule),
+        ..b
+    };
+    match (opt.traversal, b.rule) {
+        (Traversal::Paper, SplitRule::Auto) => vec![with(SplitRule::Median)],
+        (Traversal::Packet, SplitRule::Auto) => {
+            vec![with(SplitRule::Median), with(SplitRule::Sah)]
+        }
+        (_, rule) => vec![with(rule)],
+    }
+}
+
 fn build_as(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    force_stream: bool,
+) -> Result<Firmware, String> {
+    let mut best: Option<Firmware> = None;
+    let mut first_err = None;
+    for bsp in resolve_bsp(opt, scene.objects.len()) {
+        match build_one(scene, &Options { bsp, ..*opt }, nm, force_stream) {
+            Ok(fw) => {
+                if best
+                    .as_ref()
+                    .is_none_or(|b| fw.layout.expected_cost < b.layout.expected_cost)
+                {
+                    best = Some(fw);
+                }
+            }
+            Err(e) => {
+                first_err.get_or_insert(e);
+            }
+        }
+    }
+    best.ok_or_else(|| first_err.unwrap_or_else(|| "internal: no BSP to build".into()))
+}
+
+fn build_one(
     scene: &Scene,
     opt: &Options,
     nm: &Numerics,
@@ -382,5 +444,6 @@ fn build_as(
         context_words: prog.context_words,
         kernels: prog.kernels,
         layout: lay,
+        bsp: opt.bsp,
     })
 }
