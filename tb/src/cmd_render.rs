@@ -182,7 +182,7 @@ pub fn render_as(
         "context_words": chip.firmware.context_words,
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
         "fb_words": chip.firmware.fb.len(),
-        "node_layout": opt.layout.name(),
+        "node_layout": if opt.traversal == firmware::tracer::Traversal::Packet { "packet" } else { opt.layout.name() },
         "traversal": opt.traversal.name(),
         "collapse": opt.collapse.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
@@ -302,7 +302,11 @@ pub fn command(a: RenderArgs) -> Result<()> {
     );
     println!(
         "node layout              {} ({} FB words of BSP nodes, {} in all{})",
-        opt.layout,
+        if opt.traversal == firmware::tracer::Traversal::Packet {
+            "packet".to_string()
+        } else {
+            opt.layout.to_string()
+        },
         j["resident_node_words"],
         j["resident_fb_words"],
         if chip.firmware.layout.stream.is_some() {

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context as _, Result};
 use firmware::bsp::{BspParams, SplitRule};
-use firmware::tracer::{Datapath, NodeLayout, Numerics, Options};
+use firmware::tracer::{Datapath, NodeLayout, Numerics, Options, Traversal};
 
 use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
 use crate::cmd_scene::{load_scene, write_atomic};
@@ -39,6 +39,9 @@ pub struct SweepArgs {
     pub families: Vec<String>,
     pub max_size: u32,
     pub family_size: (u32, u32),
+    /// A family's larger sizes are skipped once a render took longer than
+    /// this (host seconds).
+    pub size_seconds: f64,
 }
 
 /// Knob name of the rows of the scene-size sweep.
@@ -53,12 +56,31 @@ struct Config {
     nm: Numerics,
 }
 
-fn configs(width: u32, height: u32) -> Vec<Config> {
-    let base = Options {
+/// The paper's configuration at `width` x `height`: its traversal, its
+/// BSP (median split, depth 15, 5 objects per leaf), 64 ways, recursion
+/// level 2, the 16-bit chip.
+fn paper_config(width: u32, height: u32) -> Options {
+    Options {
         width,
         height,
+        traversal: Traversal::Paper,
+        bsp: BspParams::default(),
         ..Options::default()
-    };
+    }
+}
+
+/// The packet traversal with its defaults (its own choice of BSP).
+fn packet_config(width: u32, height: u32) -> Options {
+    Options {
+        width,
+        height,
+        traversal: Traversal::Packet,
+        ..Options::default()
+    }
+}
+
+fn configs(width: u32, height: u32) -> Vec<Config> {
+    let base = paper_config(width, height);
     let nm = Numerics::default();
     let mut v = vec![Config {
         knob: "paper",
@@ -171,6 +193,12 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         });
     }
     v.push(Config {
+        knob: "traversal",
+        value: Traversal::Packet.name().into(),
+        opt: packet_config(width, height),
+        nm,
+    });
+    v.push(Config {
         knob: "layout",
         value: NodeLayout::Compact.name().into(),
         opt: Options {
@@ -210,6 +238,15 @@ struct Row {
     active_rc_fraction: f64,
     objects_tested_per_ray: f64,
     host_seconds: f64,
+    /// Ray-object tests the RCs executed per ray traced, and the share of
+    /// cycles the array waited for TinyRISC.
+    ray_tests_per_ray: f64,
+    array_idle_on_control: f64,
+    /// The BSP traversal (paper or packet) and the tree built (the split
+    /// rule and depth limit it chose).
+    traversal: String,
+    bsp_split: String,
+    bsp_depth_limit: u32,
     /// Node layout (fig5 or compact), whether the scene was resident in
     /// FB set 0 or streamed, and the FB words the resident image needs
     /// (all, and the BSP nodes alone) with that layout.
@@ -221,7 +258,7 @@ struct Row {
 
 fn key(o: &Options, n: &Numerics) -> String {
     format!(
-        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {}",
+        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {} {} {}",
         o.width,
         o.height,
         o.ways,
@@ -231,7 +268,9 @@ fn key(o: &Options, n: &Numerics) -> String {
         o.bsp.rule,
         n,
         o.layout,
-        o.datapath
+        o.datapath,
+        o.traversal,
+        o.collapse
     )
 }
 
@@ -284,6 +323,11 @@ fn row(
         active_rc_fraction: f("active_rc_fraction"),
         objects_tested_per_ray: f("objects_tested_per_ray"),
         host_seconds: f("host_seconds"),
+        ray_tests_per_ray: f("ray_tests_per_ray"),
+        array_idle_on_control: f("array_idle_on_control"),
+        traversal: opt.traversal.name().into(),
+        bsp_split: s("bsp_split"),
+        bsp_depth_limit: j["bsp_depth_limit"].as_u64().unwrap_or(0) as u32,
         layout: opt.layout.name().into(),
         fb_layout: s("fb_layout"),
         resident_fb_words: j["resident_fb_words"].as_u64().unwrap_or(0),
@@ -306,7 +350,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
     let mut rows: Vec<Row> = Vec::new();
     let mut skipped = 0;
     let bar = indicatif::ProgressBar::new(
-        (scenes.len() * cfgs.len() + families.len() * NodeLayout::ALL.len()) as u64,
+        (scenes.len() * cfgs.len() + families.len() * Traversal::ALL.len()) as u64,
     );
     bar.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
@@ -350,29 +394,47 @@ pub fn command(a: SweepArgs) -> Result<()> {
             bar.inc(1);
         }
     }
-    // The scene-size sweep: every family at every size, both layouts.
+    // The scene-size sweep: every family at every size, both traversals
+    // (each with its own defaults). A family's next size is skipped once a
+    // render of it took more than --size-seconds of host time (sizes grow
+    // about 8x in objects).
     let nm = Numerics::default();
-    for (_, size, scene) in &families {
-        for layout in NodeLayout::ALL {
-            bar.set_message(format!("{} layout={layout}", scene.source));
-            let opt = Options {
-                width: a.family_size.0,
-                height: a.family_size.1,
-                layout,
-                ..Options::default()
+    let mut slow: BTreeMap<(String, &str), f64> = BTreeMap::new();
+    for (fam, size, scene) in &families {
+        for traversal in Traversal::ALL {
+            bar.set_message(format!("{} traversal={traversal}", scene.source));
+            let (w, h) = a.family_size;
+            let opt = match traversal {
+                Traversal::Paper => paper_config(w, h),
+                Traversal::Packet => packet_config(w, h),
             };
+            if let Some(t) = slow.get(&(fam.clone(), traversal.name())) {
+                bar.suspend(|| {
+                    eprintln!(
+                        "skipped {} with the {traversal} traversal: size {} took {t:.0} s (--size-seconds {})",
+                        scene.source,
+                        size - 1,
+                        a.size_seconds
+                    )
+                });
+                skipped += 1;
+                bar.inc(1);
+                continue;
+            }
             match crate::cmd_render::render_with(scene, &opt, &nm, false, None) {
-                Ok((_, rep)) => rows.push(row(
-                    scene,
-                    SCENE_SIZE,
-                    size.to_string(),
-                    &opt,
-                    &nm,
-                    &rep.json,
-                )),
+                Ok((_, rep)) => {
+                    let r = row(scene, SCENE_SIZE, size.to_string(), &opt, &nm, &rep.json);
+                    if r.host_seconds > a.size_seconds {
+                        slow.insert((fam.clone(), traversal.name()), r.host_seconds);
+                    }
+                    rows.push(r);
+                }
                 Err(e) => {
                     bar.suspend(|| {
-                        eprintln!("skipped {} with layout {layout}: {e:#}", scene.source)
+                        eprintln!(
+                            "skipped {} with the {traversal} traversal: {e:#}",
+                            scene.source
+                        )
                     });
                     skipped += 1;
                 }
@@ -557,9 +619,33 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// Least-squares slope of `log y` against `log x` (the exponent of a power
+/// law `y ~ x^k`), or `None` with fewer than two points.
+pub fn loglog_slope(points: &[(f64, f64)]) -> Option<f64> {
+    let p: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(x, y)| *x > 0.0 && *y > 0.0)
+        .map(|(x, y)| (x.ln(), y.ln()))
+        .collect();
+    if p.len() < 2 {
+        return None;
+    }
+    let n = p.len() as f64;
+    let (mx, my) = (
+        p.iter().map(|q| q.0).sum::<f64>() / n,
+        p.iter().map(|q| q.1).sum::<f64>() / n,
+    );
+    let sxx: f64 = p.iter().map(|q| (q.0 - mx).powi(2)).sum();
+    if sxx == 0.0 {
+        return None;
+    }
+    Some(p.iter().map(|q| (q.0 - mx) * (q.1 - my)).sum::<f64>() / sxx)
+}
+
 /// Cycles per frame against primitive count over the families of the size
-/// sweep: one colour per family, solid Fig. 5, dashed compact, hollow
-/// markers for scenes streamed from main memory.
+/// sweep, log-log: one colour per family, solid the packet traversal,
+/// dashed the paper's, hollow markers for scenes streamed from main memory;
+/// the legend gives each series' fitted slope (cycles ~ objects^slope).
 fn scaling_chart(rows: &[&Row], dir: &Path) -> Result<[PathBuf; 2]> {
     let mut families: Vec<String> = Vec::new();
     for r in rows {
@@ -570,28 +656,27 @@ fn scaling_chart(rows: &[&Row], dir: &Path) -> Result<[PathBuf; 2]> {
     }
     let mut series = Vec::new();
     for (k, f) in families.iter().enumerate() {
-        for layout in NodeLayout::ALL {
+        for traversal in Traversal::ALL {
             let mut pts: Vec<&Row> = rows
                 .iter()
                 .copied()
-                .filter(|r| family(&r.scene) == *f && r.layout == layout.name())
+                .filter(|r| family(&r.scene) == *f && r.traversal == traversal.name())
                 .collect();
+            if pts.is_empty() {
+                continue;
+            }
             pts.sort_by_key(|r| r.primitives);
+            let points: Vec<(f64, f64)> = pts
+                .iter()
+                .map(|r| (r.primitives as f64, r.cycles as f64))
+                .collect();
+            let slope = loglog_slope(&points).map_or(String::new(), |k| format!(", slope {k:.2}"));
             series.push(Series {
-                name: format!(
-                    "{f}, {}",
-                    match layout {
-                        NodeLayout::Fig5 => "Fig. 5 bit vectors",
-                        NodeLayout::Compact => "compact index lists",
-                    }
-                ),
-                points: pts
-                    .iter()
-                    .map(|r| (r.primitives as f64, r.cycles as f64))
-                    .collect(),
+                name: format!("{f}, {traversal}{slope}"),
+                points,
                 style: SeriesStyle {
                     color: Some(k),
-                    dashed: layout == NodeLayout::Compact,
+                    dashed: traversal == Traversal::Paper,
                     hollow: pts.iter().map(|r| r.fb_layout == "streamed").collect(),
                 },
             });
@@ -602,10 +687,10 @@ fn scaling_chart(rows: &[&Row], dir: &Path) -> Result<[PathBuf; 2]> {
         &dir.join("scaling"),
         &Chart {
             title: format!(
-                "Cycles per frame against primitive count ({}x{}; hollow: streamed)",
+                "Cycles per frame against objects ({}x{}; solid: packet, dashed: paper; hollow: streamed)",
                 size.0, size.1
             ),
-            x_label: "primitives in the scene (SPD sizes 1, 2, ...)".into(),
+            x_label: "objects in the scene (SPD sizes 1, 2, ...)".into(),
             y_label: "chip cycles per frame".into(),
             series,
             marks: vec![],

@@ -73,7 +73,7 @@ enum Command {
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
         /// Run only one part: `knobs` (every knob on SCENES) or `sizes` (the
-        /// SPD families at sizes 1..=--max-size, both node layouts).
+        /// SPD families at sizes 1..=--max-size, both traversals).
         #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes"])]
         only: Option<String>,
         /// SPD generators of the size sweep, comma-separated.
@@ -81,7 +81,7 @@ enum Command {
             long,
             value_name = "NAMES",
             value_delimiter = ',',
-            default_value = "balls,tetra"
+            default_value = "balls,tetra,rings,gears,lattice"
         )]
         families: Vec<String>,
         /// Largest SPD size factor of the size sweep.
@@ -91,6 +91,10 @@ enum Command {
         /// objects take minutes of host time at 256x256).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "64x64")]
         family_size: (u32, u32),
+        /// Skip a family's larger sizes (with a traversal) once one of its
+        /// renders took longer than this many host seconds.
+        #[arg(long, value_name = "S", default_value_t = 60.0)]
+        size_seconds: f64,
     },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
@@ -215,7 +219,7 @@ enum Command {
         /// BSP traversal: paper (the paper's: where the rays disagree, test
         /// every object under the node) or packet (per-ray intervals; a
         /// child is visited only by the rays that reach it).
-        #[arg(long, value_name = "paper|packet", default_value = "paper", value_parser = parse_traversal)]
+        #[arg(long, value_name = "paper|packet", default_value = "packet", value_parser = parse_traversal)]
         traversal: firmware::tracer::Traversal,
         /// Packet traversal: which BSP subtrees to walk as one leaf of all
         /// their objects: auto (where that costs less than walking them, by
@@ -339,6 +343,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             families,
             max_size,
             family_size,
+            size_seconds,
         } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
             scenes,
             out_dir,
@@ -351,6 +356,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             },
             max_size,
             family_size,
+            size_seconds,
         }),
         Command::Fuzz {
             targets,

@@ -67,11 +67,14 @@ vertices = [[-6, -6, 0], [6, -6, 0], [6, 6, 0], [0, 2, 0], [-6, 6, 0]]
     native::parse(&t, "grid.toml").unwrap()
 }
 
+/// The node layouts are the paper's traversal's (the packet traversal's
+/// leaves are always lists).
 fn opts(w: u32, h: u32, layout: NodeLayout) -> Options {
     Options {
         width: w,
         height: h,
         layout,
+        traversal: firmware::tracer::Traversal::Paper,
         ..Options::default()
     }
 }
@@ -252,10 +255,11 @@ fn render_refuses_an_unknown_layout() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
 
-/// `morphosys sweep --only sizes`: one row per SPD size and layout, the
-/// two layouts giving the same image, and the scaling chart.
+/// `morphosys sweep --only sizes`: one row per SPD size and traversal, both
+/// traversals rendering the same scene to the reference's quality, and the
+/// scaling chart with each series' fitted slope.
 #[test]
-fn size_sweep_writes_rows_for_both_layouts_and_the_chart() {
+fn size_sweep_writes_rows_for_both_traversals_and_the_chart() {
     let dir = tempfile::tempdir().unwrap();
     let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
         .args([
@@ -282,24 +286,34 @@ fn size_sweep_writes_rows_for_both_layouts_and_the_chart() {
     let head = rd.headers().unwrap().clone();
     let col = |n: &str| head.iter().position(|h| h == n).unwrap();
     let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
-    assert_eq!(rows.len(), 4, "tetra 1 and 2, two layouts each");
+    assert_eq!(rows.len(), 4, "tetra 1 and 2, two traversals each");
     for pair in rows.chunks(2) {
         let (a, b) = (&pair[0], &pair[1]);
         assert_eq!(a[col("scene")], b[col("scene")]);
-        assert_eq!((&a[col("layout")], &b[col("layout")]), ("fig5", "compact"));
+        assert_eq!(
+            (&a[col("traversal")], &b[col("traversal")]),
+            ("paper", "packet")
+        );
         assert_eq!(&a[col("width")], "16");
+        assert_eq!(&a[col("bsp_split")], "median");
         for r in pair {
             let psnr: f64 = r[col("psnr_db")].parse().unwrap();
             assert!(psnr >= 30.0, "{r:?}");
-            let words: usize = r[col("resident_fb_words")].parse().unwrap();
-            let streamed = &r[col("fb_layout")] == "streamed";
-            assert_eq!(streamed, words > 0x8000, "{r:?}");
         }
     }
-    // tetra-1 is resident either way: the same image.
-    assert_eq!(rows[0][col("psnr_db")], rows[1][col("psnr_db")]);
-    assert_eq!(rows[0][col("hit_agreement")], rows[1][col("hit_agreement")]);
     let svg = std::fs::read_to_string(dir.path().join("scaling.svg")).unwrap();
-    assert!(svg.contains("Cycles per frame against primitive count (16x16"));
-    assert!(svg.contains("tetra, compact index lists"));
+    assert!(svg.contains("Cycles per frame against objects (16x16"));
+    assert!(svg.contains("tetra, packet, slope "), "no fitted slope");
+    assert!(svg.contains("tetra, paper, slope "), "no fitted slope");
+}
+
+#[test]
+fn the_fitted_slope_is_the_power_law_exponent() {
+    let pts: Vec<(f64, f64)> = [1.0, 8.0, 64.0, 512.0]
+        .iter()
+        .map(|&x: &f64| (x, 3.0 * x.powf(0.75)))
+        .collect();
+    let k = tb::cmd_sweep::loglog_slope(&pts).unwrap();
+    assert!((k - 0.75).abs() < 1e-9, "{k}");
+    assert_eq!(tb::cmd_sweep::loglog_slope(&pts[..1]), None);
 }

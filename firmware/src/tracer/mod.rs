@@ -127,13 +127,13 @@ pub enum Traversal {
     /// against each split plane; where the rays disagree, every object
     /// under the node is tested (resident) or both children are visited
     /// with every ray awake (streamed).
-    #[default]
     Paper,
     /// Masked packet traversal: each ray keeps its parametric interval
     /// inside the current cell; a child is visited only by the rays whose
     /// interval reaches it (the others sleep), near child first, the far
     /// child pushed with every ray's interval; a ray whose hit lies before
-    /// a popped cell drops out.
+    /// a popped cell drops out. The default.
+    #[default]
     Packet,
 }
 
