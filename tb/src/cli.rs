@@ -46,23 +46,23 @@ pub fn parse_datapath(s: &str) -> Result<rtl::rc::Datapath, String> {
 /// `render --datapath`: a width, or `auto`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum DatapathChoice {
-    /// The paper's 16-bit chip unless at least [`AUTO_SMALL_SHARE`] of the
-    /// scene's objects have a feature (radius, edge, height) under
-    /// [`AUTO_MIN_FEATURE_LSB`] LSB of the 16-bit format the tracer fits to
-    /// it; then the 32-bit chip.
+    /// The paper's 16-bit chip unless it cannot hold the scene, or its
+    /// render of a probe of the frame (1/16 of the tiles) falls under
+    /// [`AUTO_MIN_PSNR`] dB or [`AUTO_MIN_HITS`] hit agreement against the
+    /// f64 reference while the 32-bit chip's does better; then the 32-bit
+    /// chip.
     Auto,
     Fixed(rtl::rc::Datapath),
 }
 
-/// A rule of thumb: a feature under 8 LSB is off by more than 6% of its
-/// size from rounding alone (half an LSB). balls-4, where 89% of the
-/// objects are 6.3-LSB spheres, measures 25 dB on the 16-bit chip (and the
-/// f64 renderer given the same scene rounded to Q5.10 only 26.4 dB), 64 dB
-/// on the 32-bit chip; tree-1, whose smallest parts are 8.6 LSB, stays on
-/// the 16-bit chip at 41.6 dB.
-pub const AUTO_MIN_FEATURE_LSB: f64 = 8.0;
-/// The share of such objects from which `--datapath auto` picks 32 bits.
-pub const AUTO_SMALL_SHARE: f64 = 0.25;
+/// The project's quality bar (every bundled scene meets it): the PSNR and
+/// hit agreement against the f64 reference under which `--datapath auto`
+/// tries the 32-bit chip. Measured, not guessed from feature sizes: tree-1,
+/// whose smallest parts are 8.6 LSB of its format, renders at 41.6 dB on
+/// the 16-bit chip, while SPD rings at its default size (cylinders of 38
+/// LSB) reaches 29 dB there and 59 dB on the 32-bit chip.
+pub const AUTO_MIN_PSNR: f64 = 30.0;
+pub const AUTO_MIN_HITS: f64 = 0.99;
 
 pub fn parse_datapath_choice(s: &str) -> Result<DatapathChoice, String> {
     if s.trim() == "auto" {

@@ -121,9 +121,23 @@ pub fn render_as(
     nm: &firmware::tracer::Numerics,
     host: &crate::render::RenderSettings,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
+    render_built(scene, opt, nm, host, None)
+}
+
+/// [`render_as`] with the firmware already built (`None`: built here).
+pub fn render_built(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    nm: &firmware::tracer::Numerics,
+    host: &crate::render::RenderSettings,
+    built: Option<firmware::tracer::Firmware>,
+) -> Result<(crate::render::ChipRender, RenderReport)> {
     let progress = host.progress;
     let t0 = Instant::now();
-    let chip = crate::render::render_chip_as(scene, opt, nm, host)?;
+    let chip = match built {
+        Some(fw) => crate::render::render_built(fw, opt, host)?,
+        None => crate::render::render_chip_as(scene, opt, nm, host)?,
+    };
     let host = t0.elapsed().as_secs_f64();
     let refimg = reference::render(
         scene,
@@ -247,11 +261,14 @@ pub fn command(a: RenderArgs) -> Result<()> {
         ..Default::default()
     };
     let mut opt = opt;
-    let (datapath, datapath_reason) = choose_datapath(&scene, &opt, &nm, a.datapath)?;
+    let (datapath, datapath_reason, built) = choose_datapath(&scene, &opt, &nm, a.datapath)?;
     opt.datapath = datapath;
+    let built = match built {
+        Some(fw) => fw,
+        None => crate::render::choose_firmware(&scene, &opt, &nm)?,
+    };
     if let Some(p) = &a.emit_asm {
-        let fw = crate::render::choose_firmware(&scene, &opt, &nm)?;
-        write_atomic(p, fw.source.as_bytes())?;
+        write_atomic(p, built.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     let trace = a.vcd.map(|p| {
@@ -269,7 +286,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         }
         c
     });
-    let (chip, mut rep) = render_as(
+    let (chip, mut rep) = render_built(
         &scene,
         &opt,
         &nm,
@@ -278,6 +295,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             trace,
             profile: a.profile,
         },
+        Some(built),
     )?;
     if let Some(p) = &chip.profile {
         rep.json["profile"] = profile_json(p);
@@ -375,68 +393,88 @@ pub fn command(a: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The chip `--datapath` asks for, and why (printed and in the JSON).
+/// The chip `--datapath` asks for, why (printed and in the JSON), and the
+/// firmware when the choice built it.
+///
+/// `auto`: the paper's 16-bit chip, unless it cannot hold the scene, or its
+/// render of the probe (1/16 of the frame's tiles, [`crate::render::probe`])
+/// falls under the project's bar ([`crate::cli::AUTO_MIN_PSNR`] dB and
+/// [`crate::cli::AUTO_MIN_HITS`] hit agreement against the f64 reference on
+/// the same pixels) while the 32-bit chip's does better.
 fn choose_datapath(
     scene: &firmware::scene::Scene,
     opt: &Options,
     nm: &firmware::tracer::Numerics,
     choice: crate::cli::DatapathChoice,
-) -> Result<(rtl::rc::Datapath, String)> {
+) -> Result<(
+    rtl::rc::Datapath,
+    String,
+    Option<firmware::tracer::Firmware>,
+)> {
+    use crate::cli::{AUTO_MIN_HITS, AUTO_MIN_PSNR};
     use rtl::rc::Datapath;
-    let d = match choice {
-        crate::cli::DatapathChoice::Fixed(d) => {
-            return Ok((d, format!("--datapath {}", d.bits())));
-        }
-        crate::cli::DatapathChoice::Auto => Datapath::W16,
-    };
-    let opt16 = Options {
+    if let crate::cli::DatapathChoice::Fixed(d) = choice {
+        return Ok((d, format!("--datapath {}", d.bits()), None));
+    }
+    let on = |d: Datapath| Options {
         datapath: d,
         ..*opt
     };
-    let fw = match firmware::tracer::build_with(scene, &opt16, nm) {
-        Ok(fw) => fw,
+    let measured = |d: Datapath| -> Result<(firmware::tracer::Firmware, f64, f64)> {
+        let (fw, p) = crate::render::choose_firmware_probed(scene, &on(d), nm)?;
+        let p = match p {
+            Some(p) => p,
+            None => crate::render::probe(&fw, &on(d))?,
+        };
+        let (r8, rh) = reference::render_pixels(scene, opt.width, opt.height, opt.depth, &p.pixels);
+        let psnr = metrics::psnr(&p.rgb8, &r8);
+        Ok((
+            fw,
+            if psnr.is_finite() { psnr } else { 99.0 },
+            metrics::hit_agreement(&p.hits, &rh),
+        ))
+    };
+    let (fw16, p16, h16) = match measured(Datapath::W16) {
+        Ok(m) => m,
         Err(e16) => {
             // A scene the 16-bit format cannot hold may still fit the
             // 32-bit chip's (16 more fraction bits).
-            let opt32 = Options {
-                datapath: Datapath::W32,
-                ..*opt
+            let Ok((fw32, ..)) = measured(Datapath::W32) else {
+                anyhow::bail!("{e16:#}");
             };
-            if firmware::tracer::build_with(scene, &opt32, nm).is_err() {
-                anyhow::bail!("{e16}");
-            }
             return Ok((
                 Datapath::W32,
                 "auto: the 16-bit chip cannot hold the scene (`--datapath 16` says why); the 32-bit chip can".into(),
+                Some(fw32),
             ));
         }
     };
-    let unit = (fw.frac as f64).exp2();
-    let small = scene
-        .objects
-        .iter()
-        .filter(|o| {
-            firmware::scene_image::smallest_feature(&o.shape) * unit
-                < crate::cli::AUTO_MIN_FEATURE_LSB
-        })
-        .count();
-    let share = small as f64 / scene.objects.len().max(1) as f64;
-    let r = &fw.report;
-    let why = format!(
-        "{small} of {} objects ({:.0}%) have a feature under {} LSB of the 16-bit format {} (the smallest: {:.1} LSB at {})",
-        scene.objects.len(),
-        100.0 * share,
-        crate::cli::AUTO_MIN_FEATURE_LSB,
-        fw.format(),
-        r.smallest_feature * unit,
-        r.smallest_feature_at
+    let m16 = format!(
+        "the 16-bit chip ({}) renders the probe (1/16 of the tiles) at {p16:.1} dB, {:.2}% hit agreement",
+        fw16.format(),
+        100.0 * h16
     );
-    Ok(if share >= crate::cli::AUTO_SMALL_SHARE {
-        (
+    if p16 >= AUTO_MIN_PSNR && h16 >= AUTO_MIN_HITS {
+        return Ok((Datapath::W16, format!("auto: {m16}"), Some(fw16)));
+    }
+    let bar = format!(
+        "under the {AUTO_MIN_PSNR} dB / {}% bar",
+        100.0 * AUTO_MIN_HITS
+    );
+    match measured(Datapath::W32) {
+        Ok((fw32, p32, h32)) if p32 > p16 => Ok((
             Datapath::W32,
-            format!("auto: {why}; --datapath 16 forces the paper's chip"),
-        )
-    } else {
-        (Datapath::W16, format!("auto: {why}"))
-    })
+            format!(
+                "auto: {m16}, {bar}; the 32-bit chip ({}) at {p32:.1} dB, {:.2}%; --datapath 16 forces the paper's chip",
+                fw32.format(),
+                100.0 * h32
+            ),
+            Some(fw32),
+        )),
+        _ => Ok((
+            Datapath::W16,
+            format!("auto: {m16}, {bar}, and the 32-bit chip does no better"),
+            Some(fw16),
+        )),
+    }
 }

@@ -357,21 +357,101 @@ pub fn render_chip_as(
 }
 
 /// Every `PROBE_STRIDE`-th tile row and column (1/16 of the tiles) make
-/// the probe by which [`choose_firmware`] compares BSP trees.
+/// the probe by which [`choose_firmware`] compares BSP trees and
+/// `render --datapath auto` the chips.
 pub const PROBE_STRIDE: u32 = 4;
+
+/// A render of the probe's tiles: their cycles, and their pixels (row by
+/// row within each tile, tiles in order) with the colours and hit objects.
+#[derive(Clone, Debug)]
+pub struct Probe {
+    pub cycles: u64,
+    pub pixels: Vec<(u32, u32)>,
+    pub rgb8: Vec<u8>,
+    pub hits: Vec<u32>,
+}
+
+/// Run the probe's tiles of `opt`'s frame on the chip with `fw`.
+pub fn probe(fw: &Firmware, opt: &Options) -> Result<Probe> {
+    let (tw, th) = (fw.tile_w, fw.tile_h);
+    let (nx, ny) = (opt.width.div_ceil(tw), opt.height.div_ceil(th));
+    let pick = |n: u32| -> Vec<u32> {
+        let v: Vec<u32> = (0..n)
+            .filter(|k| k % PROBE_STRIDE == PROBE_STRIDE / 2)
+            .collect();
+        if v.is_empty() {
+            vec![n / 2]
+        } else {
+            v
+        }
+    };
+    let mut tiles = Vec::new();
+    for ty in pick(ny) {
+        for tx in pick(nx) {
+            tiles.push((tx * tw, ty * th));
+        }
+    }
+    let img = asm::assemble(&fw.source, "tracer.s")
+        .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
+    let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
+    let runs: Vec<Result<Group>> = groups
+        .par_iter()
+        .map(|g| match fw.datapath {
+            Datapath::W16 => run_group::<i16>(&img, fw, g, None, false),
+            Datapath::W32 => run_group::<i32>(&img, fw, g, None, false),
+        })
+        .collect();
+    let mut p = Probe {
+        cycles: 0,
+        pixels: Vec::new(),
+        rgb8: Vec::new(),
+        hits: Vec::new(),
+    };
+    for (gi, r) in runs.into_iter().enumerate() {
+        let g = r?;
+        p.cycles += g.end.saturating_sub(g.start);
+        for (k, out) in g.out.iter().enumerate() {
+            let (x0, y0) = groups[gi][k];
+            for lane in 0..64u32 {
+                let (row, col) = (lane / 8, lane % 8);
+                let (x, y) = (x0 + col, y0 + row);
+                if row >= th || col >= tw || x >= opt.width || y >= opt.height {
+                    continue;
+                }
+                p.pixels.push((x, y));
+                for c in 0..3 {
+                    p.rgb8.push(to8(out[c * 64 + lane as usize], fw.datapath));
+                }
+                let id = out[192 + lane as usize];
+                p.hits.push(if id < 0 { NO_HIT } else { id as u32 });
+            }
+        }
+    }
+    Ok(p)
+}
 
 /// The firmware for `opt`. Where the options leave the BSP to the tracer
 /// and it has more than one candidate ([`tracer::resolve_bsp`]: the packet
-/// traversal's median and SAH trees), each is run on a probe of the frame's
-/// tiles (every fourth row and column of tiles, at the frame's size, so
-/// each packet is as coherent as in the frame) and the one with the fewest
-/// cycles is kept; ties go to the first. Deterministic.
+/// traversal's median and SAH trees), each is run on the probe (every
+/// fourth row and column of tiles, at the frame's size, so each packet is
+/// as coherent as in the frame) and the one with the fewest cycles is
+/// kept; ties go to the first. Deterministic.
 pub fn choose_firmware(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmware> {
+    Ok(choose_firmware_probed(scene, opt, nm)?.0)
+}
+
+/// [`choose_firmware`], with the chosen firmware's probe when one ran.
+pub fn choose_firmware_probed(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+) -> Result<(Firmware, Option<Probe>)> {
     let cands = tracer::resolve_bsp(opt, scene.objects.len());
     if cands.len() < 2 {
-        return tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"));
+        let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+        return Ok((fw, None));
     }
-    let mut best: Option<(u64, Firmware)> = None;
+    let mut best: Option<(Probe, Firmware)> = None;
     let mut first_err = None;
     for bsp in cands {
         let o = Options { bsp, ..*opt };
@@ -382,47 +462,13 @@ pub fn choose_firmware(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Fi
                 continue;
             }
         };
-        let (tw, th) = (fw.tile_w, fw.tile_h);
-        let (nx, ny) = (opt.width.div_ceil(tw), opt.height.div_ceil(th));
-        let pick = |n: u32| -> Vec<u32> {
-            let v: Vec<u32> = (0..n)
-                .filter(|k| k % PROBE_STRIDE == PROBE_STRIDE / 2)
-                .collect();
-            if v.is_empty() {
-                vec![n / 2]
-            } else {
-                v
-            }
-        };
-        let mut tiles = Vec::new();
-        for ty in pick(ny) {
-            for tx in pick(nx) {
-                tiles.push((tx * tw, ty * th));
-            }
-        }
-        let img = asm::assemble(&fw.source, "tracer.s")
-            .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
-        let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
-        let cycles: Vec<Result<u64>> = groups
-            .par_iter()
-            .map(|g| {
-                let r = match fw.datapath {
-                    Datapath::W16 => run_group::<i16>(&img, &fw, g, None, false),
-                    Datapath::W32 => run_group::<i32>(&img, &fw, g, None, false),
-                }?;
-                Ok(r.end.saturating_sub(r.start))
-            })
-            .collect();
-        let mut total = 0u64;
-        for c in cycles {
-            total += c?;
-        }
-        if best.as_ref().is_none_or(|(c, _)| total < *c) {
-            best = Some((total, fw));
+        let p = probe(&fw, opt)?;
+        if best.as_ref().is_none_or(|(b, _)| p.cycles < b.cycles) {
+            best = Some((p, fw));
         }
     }
     match best {
-        Some((_, fw)) => Ok(fw),
+        Some((p, fw)) => Ok((fw, Some(p))),
         None => Err(anyhow!(
             "{}",
             first_err.unwrap_or_else(|| "internal: no BSP to build".into())
@@ -430,23 +476,10 @@ pub fn choose_firmware(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Fi
     }
 }
 
-/// Render with the streamed layout (scene in main memory, leaf blocks moved
-/// into FB bank 1 by DMA) even if the scene fits the FB.
-pub fn render_chip_streamed(
-    scene: &Scene,
-    opt: &Options,
-    nm: &Numerics,
-    progress: bool,
-) -> Result<ChipRender> {
-    let fw = tracer::build_streamed_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
-    render_firmware(
-        fw,
-        opt,
-        &RenderSettings {
-            progress,
-            ..Default::default()
-        },
-    )
+/// Render with a firmware already built (for example by
+/// [`choose_firmware`]).
+pub fn render_built(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
+    render_firmware(fw, opt, host)
 }
 
 fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {

@@ -178,7 +178,30 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
     };
     let (b, why) = bits(&[]);
     assert_eq!(b, 16, "{why}");
-    assert!(why.starts_with("auto: 0 of 10 objects"), "{why}");
+    assert!(
+        why.starts_with("auto: the 16-bit chip (Q5.10) renders the probe"),
+        "{why}"
+    );
+    // SPD balls size 2 at 24x24: the 16-bit chip's probe (the middle tile)
+    // measures 28.6 dB against the reference, under the 30 dB bar.
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &["spd", "balls", "--size", "2", "--out", "b2.nff"],
+    );
+    assert!(ok, "{err}");
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &[
+            "render", "b2.nff", "--size", "24x24", "--out", "x.png", "--json", "x.json",
+        ],
+    );
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("x.json")).unwrap()).unwrap();
+    let why = j["datapath_choice"].as_str().unwrap();
+    assert_eq!(j["datapath_bits"], 32, "{why}");
+    assert!(why.contains("under the 30 dB / 99% bar"), "{why}");
+    assert!(j["psnr_db"].as_f64().unwrap() >= 30.0, "{j}");
     let shells = shared("shells-1.nff");
     let (b, why) = bits(&[&shells]);
     assert_eq!(b, 32, "{why}");

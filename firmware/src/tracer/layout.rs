@@ -621,7 +621,7 @@ pub fn build(
     force_stream: bool,
 ) -> Result<Layout, String> {
     if !force_stream {
-        let lay = build_as(scene, image, opt, guard_bits, false)?;
+        let lay = build_as(scene, image, opt, guard_bits, false, false)?;
         if lay.stream.is_none() {
             return Ok(lay);
         }
@@ -630,7 +630,26 @@ pub fn build(
     // small: it is laid out again in the finest format with one guard bit
     // (differences of two points of the scene still fit), the compiler's
     // rule, and sphere records carry the unrounded radius's reciprocal.
-    build_as(scene, image, opt, guard_bits.min(1), true)
+    build_as(scene, image, opt, guard_bits.min(1), true, true)
+}
+
+/// Lay out the scene for the packet traversal. `fine`: the format of the
+/// streamed layout (one guard bit, unrounded sphere radii), which the
+/// paper's layout takes for scenes it streams; the packet traversal's
+/// nodes are much smaller, so it keeps resident many scenes the paper's
+/// layout streams, but its format follows the paper's decision (the same
+/// numbers, hence the same hits up to ties). Streamed when it does not fit
+/// FB set 0 or with `force_stream`.
+pub fn build_packet(
+    scene: &Scene,
+    image: &SceneImage,
+    opt: &Options,
+    guard_bits: u32,
+    force_stream: bool,
+    fine: bool,
+) -> Result<Layout, String> {
+    let g = if fine { guard_bits.min(1) } else { guard_bits };
+    build_as(scene, image, opt, g, fine, force_stream)
 }
 
 fn build_as(
@@ -638,6 +657,7 @@ fn build_as(
     image: &SceneImage,
     opt: &Options,
     guard_bits: u32,
+    fine: bool,
     streamed: bool,
 ) -> Result<Layout, String> {
     // The 32-bit chip: every format gets `xb` more fraction bits.
@@ -1031,7 +1051,7 @@ fn build_as(
                 ) => {
                     let rq = (radius.abs() * s).round().max(1.0);
                     let invr = ((14 + xb + ks_sphere) as f64).exp2()
-                        / if streamed || sphere_fine {
+                        / if fine || sphere_fine {
                             radius.abs() * s
                         } else {
                             rq

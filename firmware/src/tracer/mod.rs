@@ -425,7 +425,41 @@ fn build_one(
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
-    let mut lay = layout::build(scene, &image, opt, nm.guard_bits, force_stream)?;
+    let mut lay = match opt.traversal {
+        Traversal::Paper => layout::build(scene, &image, opt, nm.guard_bits, force_stream)?,
+        Traversal::Packet => {
+            // The format of the paper's layout of this scene (its tree):
+            // the streamed one's where the paper's layout streams.
+            let fine = force_stream || {
+                let paper = CompileOptions {
+                    bsp: resolve_bsp(
+                        &Options {
+                            traversal: Traversal::Paper,
+                            bsp: BspParams {
+                                max_depth: 0,
+                                rule: SplitRule::Auto,
+                                ..opt.bsp
+                            },
+                            ..*opt
+                        },
+                        scene.objects.len(),
+                    )[0],
+                    ..copt
+                };
+                let paper_opt = Options {
+                    traversal: Traversal::Paper,
+                    bsp: paper.bsp,
+                    ..*opt
+                };
+                match compile(scene, &paper) {
+                    Ok(pi) => layout::build(scene, &pi, &paper_opt, nm.guard_bits, false)
+                        .map_or(true, |l| l.stream.is_some()),
+                    Err(_) => true,
+                }
+            };
+            layout::build_packet(scene, &image, opt, nm.guard_bits, force_stream, fine)?
+        }
+    };
     lay.fb[..256].copy_from_slice(&layout::table_slots_for(
         nm.table_entries as usize,
         opt.datapath.bits() - 16,

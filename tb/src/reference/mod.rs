@@ -276,6 +276,32 @@ pub fn eye_ray(scene: &Scene, w: u32, h: u32, i: u32, j: u32) -> Ray {
     view.ray(span(i, w) * ax, -span(j, h) * ay)
 }
 
+/// The 8-bit colour and hit object of the listed pixels of a `w` x `h`
+/// image, traced as [`render`] traces them (without `corners`).
+pub fn render_pixels(
+    scene: &Scene,
+    w: u32,
+    h: u32,
+    max_depth: u32,
+    pixels: &[(u32, u32)],
+) -> (Vec<u8>, Vec<u32>) {
+    let tracer = Tracer::new(scene);
+    let px: Vec<(Vec3, u32)> = pixels
+        .par_iter()
+        .map(|&(i, j)| {
+            let mut stats = RayStats::default();
+            let (c, id) = tracer.trace(&eye_ray(scene, w, h, i, j), 1, max_depth, &mut stats);
+            (c, id.map_or(NO_HIT, |i| i as u32))
+        })
+        .collect();
+    (
+        px.iter()
+            .flat_map(|(c, _)| [to8(c.x), to8(c.y), to8(c.z)])
+            .collect(),
+        px.iter().map(|p| p.1).collect(),
+    )
+}
+
 /// Render a scene.
 pub fn render(scene: &Scene, opt: &Options) -> Image {
     let tracer = Tracer::new(scene);
