@@ -476,6 +476,25 @@ pub fn choose_firmware_probed(
     }
 }
 
+/// Render with the streamed layout (scene in main memory, leaf blocks moved
+/// into FB bank 1 by DMA) even if the scene fits the FB.
+pub fn render_chip_streamed(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    progress: bool,
+) -> Result<ChipRender> {
+    let fw = tracer::build_streamed_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
+    render_firmware(
+        fw,
+        opt,
+        &RenderSettings {
+            progress,
+            ..Default::default()
+        },
+    )
+}
+
 /// Render with a firmware already built (for example by
 /// [`choose_firmware`]).
 pub fn render_built(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
