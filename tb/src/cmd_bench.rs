@@ -43,6 +43,8 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 pub fn command(a: BenchArgs) -> Result<()> {
     let scene = load_scene(a.scene.as_deref())?;
     let (width, height) = a.size;
+    // The paper's configuration (its traversal and BSP): the workload the
+    // simulator's speed has been measured on since the first bench.
     let opt = Options {
         width,
         height,
@@ -51,7 +53,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
         bsp: BspParams::default(),
         layout: Default::default(),
         datapath: Default::default(),
-        traversal: Default::default(),
+        traversal: firmware::tracer::Traversal::Paper,
         collapse: Default::default(),
     };
     let repeat = a.repeat.max(1);

@@ -544,10 +544,13 @@ trace:  sw r15, SAVE_LR(r0)\n        lw r1, PASSES(r0)\n        addi r1, r1, 1\n
     if lay.root_leaf {
         // The whole tree is one leaf: its objects are tested by the awake
         // rays, nothing to walk.
+        // (`k_sign0` runs only to mark the pass's start for the
+        // simulator's count of the rays traced: its RCs are the pass's.)
         let _ = writeln!(
             w,
-            "        li r14, NSTACK\n        li r5, ROOT\n        rcsl r4\n        rcsh r10\n        nor r4, r4, r0\n        nor r10, r10, r0\n\
-        or r1, r4, r10\n        beqz r1, pdone\n        lw r11, PASS(r0)\n        j leaf_go"
+            "        li r1, {sign}\n        cbcast r1, 1\n        li r14, NSTACK\n        li r5, ROOT\n        rcsl r4\n        rcsh r10\n        nor r4, r4, r0\n        nor r10, r10, r0\n\
+        or r1, r4, r10\n        beqz r1, pdone\n        lw r11, PASS(r0)\n        j leaf_go",
+            sign = kaddr("k_sign0")
         );
     }
     let _ = writeln!(
