@@ -426,7 +426,10 @@ fn choose_datapath(
             Some(p) => p,
             None => crate::render::probe(&fw, &on(d))?,
         };
-        let (r8, rh) = reference::render_pixels(scene, opt.width, opt.height, opt.depth, &p.pixels);
+        let (r8, rh) = match &p.reference {
+            Some(r) => r.clone(),
+            None => reference::render_pixels(scene, opt.width, opt.height, opt.depth, &p.pixels),
+        };
         let psnr = metrics::psnr(&p.rgb8, &r8);
         Ok((
             fw,
