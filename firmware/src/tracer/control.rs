@@ -22,6 +22,26 @@ pub struct Program {
 /// tile is written to the other).
 const OUT_BANK: [u32; 2] = [0x8000, 0xC000];
 
+/// A kernel's context-memory address, as an assembler expression.
+fn kaddr(n: &str) -> String {
+    format!("({n} - CTXBASE) / 4")
+}
+
+/// A kernel's length in contexts, as an assembler expression.
+fn klen(n: &str) -> String {
+    format!("({n}_end - {n}) / 4")
+}
+
+/// Broadcast kernel `n` (no FB stream).
+fn cb(w: &mut String, n: &str) {
+    let _ = writeln!(
+        w,
+        "        li r1, {}\n        cbcast r1, {}",
+        kaddr(n),
+        klen(n)
+    );
+}
+
 pub fn program(
     scene: &Scene,
     lay: &Layout,
@@ -218,16 +238,6 @@ NSTACK: .space 256\n"
 
     // ---- text ----
     let _ = writeln!(w, "        .text");
-    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
-    let klen = |n: &str| format!("({n}_end - {n}) / 4");
-    let cb = |w: &mut String, n: &str| {
-        let _ = writeln!(
-            w,
-            "        li r1, {}\n        cbcast r1, {}",
-            kaddr(n),
-            klen(n)
-        );
-    };
     let sb = |w: &mut String, n: &str, fb: String| {
         let _ = writeln!(
             w,
@@ -365,16 +375,6 @@ NSTACK: .space 256\n"
 
 /// The paper's traversal (resident or streamed) and its object loops.
 fn paper_trace(w: &mut String, lay: &Layout) {
-    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
-    let klen = |n: &str| format!("({n}_end - {n}) / 4");
-    let cb = |w: &mut String, n: &str| {
-        let _ = writeln!(
-            w,
-            "        li r1, {}\n        cbcast r1, {}",
-            kaddr(n),
-            klen(n)
-        );
-    };
     // ---- trace: one ray pass over the BSP ----
     let _ = writeln!(
         w,
@@ -530,8 +530,6 @@ fn popcount(w: &mut String, x: &str, t1: &str, t2: &str) {
 /// needs is skipped. TinyRISC registers: r5 node, r13 object tests of the
 /// pass, r14 node stack.
 fn packet_trace(w: &mut String, lay: &Layout) {
-    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
-    let klen = |n: &str| format!("({n}_end - {n}) / 4");
     let streamed = lay.stream.is_some();
     // Child offsets in a node record: FB words (resident) or bytes.
     let (left, right) = if streamed { (16, 20) } else { (4, 5) };
@@ -788,8 +786,6 @@ pop:    li r9, NSTACK\n        beq r14, r9, pdone\n        addi r14, r14, -4\n  
 /// not put rays to sleep at a leaf (a nearer hit may lie in a cell not
 /// visited yet); the shadow pass does (any hit will do).
 fn stream_trace(w: &mut String, lay: &Layout) {
-    let kaddr = |n: &str| format!("({n} - CTXBASE) / 4");
-    let klen = |n: &str| format!("({n}_end - {n}) / 4");
     let _ = writeln!(
         w,
         "        jal awake\n        li r9, USTK\n        sw r9, UPTR(r0)\n        li r1, {uzero}\n        cbcast r1, {uzlen}\n        li r14, NSTACK\n        li r5, ROOT\n\
@@ -878,8 +874,6 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
     use super::layout::{
         CONE_BODY_WORDS, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
     };
-    let kaddr = |k: &str| format!("({k} - CTXBASE) / 4");
-    let klen = |k: &str| format!("({k}_end - {k}) / 4");
     let one = |w: &mut String, k: &str| {
         let _ = writeln!(
             w,

@@ -256,11 +256,11 @@ impl<'s> Tracer<'s> {
     }
 }
 
-/// The eye ray through pixel `(i, j)` of a `w` x `h` image, as
-/// [`render`] traces it (without `corners`).
-pub fn eye_ray(scene: &Scene, w: u32, h: u32, i: u32, j: u32) -> Ray {
-    let view = View::new(scene);
-    let (w, h) = (w.max(1), h.max(1));
+/// The screen coordinates of sample `(i, j)` of `sw` x `sh` samples in an
+/// image of `w` x `h` pixels: the samples span [-1, 1] along the smaller
+/// image dimension (NFF: the angle is from the first to the last sample
+/// row).
+fn screen(w: u32, h: u32, sw: u32, sh: u32, i: u32, j: u32) -> (f64, f64) {
     let span = |i: u32, n: u32| {
         if n <= 1 {
             0.0
@@ -273,7 +273,15 @@ pub fn eye_ray(scene: &Scene, w: u32, h: u32, i: u32, j: u32) -> Ray {
     } else {
         (1.0, h as f64 / w as f64)
     };
-    view.ray(span(i, w) * ax, -span(j, h) * ay)
+    (span(i, sw) * ax, -span(j, sh) * ay)
+}
+
+/// The eye ray through pixel `(i, j)` of a `w` x `h` image, as
+/// [`render`] traces it (without `corners`).
+pub fn eye_ray(scene: &Scene, w: u32, h: u32, i: u32, j: u32) -> Ray {
+    let (w, h) = (w.max(1), h.max(1));
+    let (sx, sy) = screen(w, h, w, h, i, j);
+    View::new(scene).ray(sx, sy)
 }
 
 /// The 8-bit colour and hit object of the listed pixels of a `w` x `h`
@@ -286,11 +294,14 @@ pub fn render_pixels(
     pixels: &[(u32, u32)],
 ) -> (Vec<u8>, Vec<u32>) {
     let tracer = Tracer::new(scene);
+    let view = View::new(scene);
+    let (w, h) = (w.max(1), h.max(1));
     let px: Vec<(Vec3, u32)> = pixels
         .par_iter()
         .map(|&(i, j)| {
             let mut stats = RayStats::default();
-            let (c, id) = tracer.trace(&eye_ray(scene, w, h, i, j), 1, max_depth, &mut stats);
+            let (sx, sy) = screen(w, h, w, h, i, j);
+            let (c, id) = tracer.trace(&view.ray(sx, sy), 1, max_depth, &mut stats);
             (c, id.map_or(NO_HIT, |i| i as u32))
         })
         .collect();
@@ -308,20 +319,6 @@ pub fn render(scene: &Scene, opt: &Options) -> Image {
     let view = View::new(scene);
     let (w, h) = (opt.width.max(1), opt.height.max(1));
     let (sw, sh) = if opt.corners { (w + 1, h + 1) } else { (w, h) };
-    // Screen coordinates: the samples span [-1, 1] along the smaller image
-    // dimension (NFF: the angle is from the first to the last sample row).
-    let span = |i: u32, n: u32| {
-        if n <= 1 {
-            0.0
-        } else {
-            2.0 * i as f64 / (n - 1) as f64 - 1.0
-        }
-    };
-    let (ax, ay) = if w >= h {
-        (w as f64 / h as f64, 1.0)
-    } else {
-        (1.0, h as f64 / w as f64)
-    };
     let bar = if opt.progress && (sw as u64 * sh as u64) >= 1 << 16 {
         let b = ProgressBar::new(sh as u64);
         b.set_style(
@@ -340,7 +337,8 @@ pub fn render(scene: &Scene, opt: &Options) -> Image {
             let mut colors = Vec::with_capacity(sw as usize);
             let mut ids = Vec::with_capacity(sw as usize);
             for i in 0..sw {
-                let ray = view.ray(span(i, sw) * ax, -span(j, sh) * ay);
+                let (sx, sy) = screen(w, h, sw, sh, i, j);
+                let ray = view.ray(sx, sy);
                 stats.eye_rays += 1;
                 let (c, id) = tracer.trace(&ray, 1, opt.max_depth, &mut stats);
                 if id.is_some() {
