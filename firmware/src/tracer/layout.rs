@@ -158,8 +158,6 @@ pub struct Layout {
     /// Packet traversal: FB address of the root cell widened by
     /// [`super::kernels::P_TOL`] (6 words: per axis min, max).
     pub root_box: usize,
-    /// Interval slots the packet traversal uses (one per BSP depth).
-    pub slots: u32,
     /// Packet traversal: the tree it walks is a single leaf.
     pub root_leaf: bool,
     /// Packet traversal: the expected array cycles of a packet's walk from
@@ -1209,7 +1207,6 @@ fn build_as(
         node_layout: opt.layout,
         traversal: opt.traversal,
         root_box,
-        slots: nodes.iter().map(|n| n.depth + 1).max().unwrap_or(1),
         collapse: opt.collapse,
         cost: if packet {
             object_costs(
@@ -1480,7 +1477,6 @@ struct Finish {
     node_layout: NodeLayout,
     traversal: Traversal,
     root_box: usize,
-    slots: u32,
     collapse: super::Collapse,
     /// Per scene object, the array cycles of its test (kernel contexts and
     /// the TinyRISC loop around them).
@@ -1513,7 +1509,6 @@ impl Finish {
             node_layout: self.node_layout,
             traversal: self.traversal,
             root_box: self.root_box,
-            slots: self.slots,
             root_leaf: false,
             expected_cost: 0.0,
             resident_words,
