@@ -38,6 +38,9 @@ pub struct SeriesStyle {
     pub dashed: bool,
     /// Per point, whether its marker is hollow (missing: filled).
     pub hollow: Vec<bool>,
+    /// Per point, a label drawn beside it in the series' colour (missing or
+    /// empty: none).
+    pub labels: Vec<String>,
 }
 
 /// A labelled point drawn on top of a chart (e.g. a published figure).
@@ -216,10 +219,28 @@ where
                         .map_err(|e| anyhow!("{e:?}"))?;
                 } else {
                     chart
-                        .draw_series(s.points.iter().map(|&p| Circle::new(p, 4, col.filled())))
+                        .draw_series(s.points.iter().enumerate().map(marker))
                         .map_err(|e| anyhow!("{e:?}"))?
                         .label(s.name.clone())
                         .legend(move |(x, y)| Circle::new((x + 9, y), 4, col.filled()));
+                }
+            }
+            for (k, s) in c.series.iter().enumerate() {
+                let col = COLORS[s.style.color.unwrap_or(k) % COLORS.len()];
+                for (p, l) in s.points.iter().zip(&s.style.labels) {
+                    if l.is_empty() {
+                        continue;
+                    }
+                    chart
+                        .draw_series(std::iter::once(Text::new(
+                            l.clone(),
+                            *p,
+                            ("sans-serif", 13)
+                                .into_font()
+                                .color(&col)
+                                .pos(Pos::new(HPos::Left, VPos::Bottom)),
+                        )))
+                        .map_err(|e| anyhow!("{e:?}"))?;
                 }
             }
             if c.pareto {

@@ -24,13 +24,14 @@ use firmware::tracer::Options;
 use serde_json::json;
 
 use crate::cmd_scene::{load_scene, write_atomic};
-use crate::render::render_chip;
 
 pub struct BenchArgs {
     pub scene: Option<PathBuf>,
     pub size: (u32, u32),
     pub repeat: u32,
     pub json: Option<PathBuf>,
+    /// The chip's timing (`--timing FILE.toml`).
+    pub timing: Option<PathBuf>,
 }
 
 fn pool(threads: usize) -> Result<rayon::ThreadPool> {
@@ -42,6 +43,7 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 
 pub fn command(a: BenchArgs) -> Result<()> {
     let scene = load_scene(a.scene.as_deref())?;
+    let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     let (width, height) = a.size;
     // The paper's configuration (its traversal and BSP): the workload the
     // simulator's speed has been measured on since the first bench.
@@ -72,7 +74,18 @@ pub fn command(a: BenchArgs) -> Result<()> {
                 c
             });
             let t0 = Instant::now();
-            let r = p.install(|| render_chip(&scene, opt, false, cfg))?;
+            let r = p.install(|| {
+                crate::render::render_chip_as(
+                    &scene,
+                    opt,
+                    &Default::default(),
+                    &crate::render::RenderSettings {
+                        trace: cfg,
+                        timing,
+                        ..Default::default()
+                    },
+                )
+            })?;
             let s = t0.elapsed().as_secs_f64();
             best = best.min(s);
             cycles = r.cycles;

@@ -39,6 +39,11 @@ pub struct RenderArgs {
     /// Profile every chip instance (cycles per kernel and per TinyRISC
     /// label).
     pub profile: bool,
+    /// The chip's timing from a TOML file (`morphosys timing`).
+    pub timing: Option<PathBuf>,
+    /// Render with this program (an `--emit-asm` file, maybe edited)
+    /// instead of the generated one; the data image is built as usual.
+    pub firmware: Option<PathBuf>,
 }
 
 fn profile_json(p: &crate::profile::Profile) -> serde_json::Value {
@@ -109,7 +114,7 @@ pub fn render_with(
         &crate::render::RenderSettings {
             progress,
             trace,
-            profile: false,
+            ..Default::default()
         },
     )
 }
@@ -261,12 +266,40 @@ pub fn command(a: RenderArgs) -> Result<()> {
         ..Default::default()
     };
     let mut opt = opt;
-    let (datapath, datapath_reason, built) = choose_datapath(&scene, &opt, &nm, a.datapath)?;
-    opt.datapath = datapath;
-    let built = match built {
-        Some(fw) => fw,
-        None => crate::render::choose_firmware(&scene, &opt, &nm)?,
+    let timing = crate::timing::load_or_default(a.timing.as_deref())?;
+    // --firmware: the file's program on the chip its `.datapath` names.
+    let program = match &a.firmware {
+        Some(p) => Some((
+            p.display().to_string(),
+            std::fs::read_to_string(p)
+                .with_context(|| format!("{}: cannot read the firmware", p.display()))?,
+        )),
+        None => None,
     };
+    let mut choice = a.datapath;
+    if let Some((name, text)) = &program {
+        let d = crate::render::source_datapath(text);
+        match choice {
+            crate::cli::DatapathChoice::Fixed(f) if f != d => anyhow::bail!(
+                "{name}: the firmware is for the {}-bit datapath (`.datapath`), --datapath {} asks for {}",
+                d.bits(),
+                f.bits(),
+                f.bits()
+            ),
+            _ => choice = crate::cli::DatapathChoice::Fixed(d),
+        }
+    }
+    let (datapath, mut datapath_reason, built) =
+        choose_datapath(&scene, &opt, &nm, choice, &timing)?;
+    opt.datapath = datapath;
+    let mut built = match built {
+        Some(fw) => fw,
+        None => crate::render::choose_firmware(&scene, &opt, &nm, &timing)?,
+    };
+    if let Some((name, text)) = &program {
+        built = crate::render::firmware_from_source(built, text, name)?;
+        datapath_reason = format!("{name}: .datapath {}", datapath.bits());
+    }
     if let Some(p) = &a.emit_asm {
         write_atomic(p, built.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
@@ -294,9 +327,16 @@ pub fn command(a: RenderArgs) -> Result<()> {
             progress: true,
             trace,
             profile: a.profile,
+            timing,
         },
         Some(built),
     )?;
+    rep.json["timing"] = crate::timing::to_json(&timing);
+    rep.json["fps_at_clock"] = chip.fps_at(timing.clock_hz).into();
+    rep.json["firmware"] = match &a.firmware {
+        Some(p) => p.display().to_string().into(),
+        None => "generated".into(),
+    };
     if let Some(p) = &chip.profile {
         rep.json["profile"] = profile_json(p);
     }
@@ -345,6 +385,13 @@ pub fn command(a: RenderArgs) -> Result<()> {
         "fps at 300 MHz           {:.2}",
         j["fps_at_300mhz"].as_f64().unwrap_or(0.0)
     );
+    if timing.clock_hz != 300_000_000 {
+        println!(
+            "fps at {:<6} MHz        {:.2} (the timing file's clock)",
+            timing.clock_hz as f64 / 1e6,
+            j["fps_at_clock"].as_f64().unwrap_or(0.0)
+        );
+    }
     println!(
         "psnr (dB)                {:.2}",
         j["psnr_db"].as_f64().unwrap_or(0.0)
@@ -406,6 +453,7 @@ fn choose_datapath(
     opt: &Options,
     nm: &firmware::tracer::Numerics,
     choice: crate::cli::DatapathChoice,
+    timing: &rtl::Timing,
 ) -> Result<(
     rtl::rc::Datapath,
     String,
@@ -421,10 +469,10 @@ fn choose_datapath(
         ..*opt
     };
     let measured = |d: Datapath| -> Result<(firmware::tracer::Firmware, f64, f64)> {
-        let (fw, p) = crate::render::choose_firmware_probed(scene, &on(d), nm)?;
+        let (fw, p) = crate::render::choose_firmware_probed(scene, &on(d), nm, timing)?;
         let p = match p {
             Some(p) => p,
-            None => crate::render::probe(&fw, &on(d))?,
+            None => crate::render::probe(&fw, &on(d), timing)?,
         };
         let (r8, rh) = match &p.reference {
             Some(r) => r.clone(),

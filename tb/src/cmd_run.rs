@@ -102,10 +102,12 @@ pub fn command(
     vcd: Option<PathBuf>,
     window: TraceWindow,
     datapath: Datapath,
+    timing: Option<PathBuf>,
 ) -> anyhow::Result<()> {
+    let timing = crate::timing::load_or_default(timing.as_deref())?;
     match datapath {
-        Datapath::W16 => command_on::<i16>(file, max_cycles, vcd, window),
-        Datapath::W32 => command_on::<i32>(file, max_cycles, vcd, window),
+        Datapath::W16 => command_on::<i16>(file, max_cycles, vcd, window, timing),
+        Datapath::W32 => command_on::<i32>(file, max_cycles, vcd, window, timing),
     }
 }
 
@@ -114,11 +116,12 @@ fn command_on<W: Word>(
     max_cycles: u64,
     vcd: Option<PathBuf>,
     window: TraceWindow,
+    timing: Timing,
 ) -> anyhow::Result<()> {
     let img = load_program(&file)?;
     let trace = vcd.map(|p| window.config(p));
     let t0 = std::time::Instant::now();
-    let out = run_image_on::<W>(&img, Timing::default(), max_cycles, trace)?;
+    let out = run_image_on::<W>(&img, timing, max_cycles, trace)?;
     let secs = t0.elapsed().as_secs_f64();
     for f in &out.files {
         eprintln!("wrote {}", f.display());
@@ -126,8 +129,9 @@ fn command_on<W: Word>(
     match &out.result {
         Ok(cycles) => {
             println!(
-                "halted after {cycles} cycles ({:.3} us at 300 MHz)",
-                *cycles as f64 / 300.0
+                "halted after {cycles} cycles ({:.3} us at {} MHz)",
+                *cycles as f64 * 1e6 / timing.clock_hz as f64,
+                timing.clock_hz as f64 / 1e6
             );
             print_stats(&out.stats());
             let r = |k| out.reg(k);

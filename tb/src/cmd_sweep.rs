@@ -24,6 +24,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context as _, Result};
 use firmware::bsp::{BspParams, SplitRule};
 use firmware::tracer::{Datapath, NodeLayout, Numerics, Options, Traversal};
+use rtl::tinyrisc::IssueModel;
+use rtl::Timing;
 
 use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
 use crate::cmd_scene::{load_scene, write_atomic};
@@ -42,18 +44,49 @@ pub struct SweepArgs {
     /// A family's larger sizes are skipped once a render took longer than
     /// this (host seconds).
     pub size_seconds: f64,
+    /// Timing files: both traversals on each scene under each.
+    pub timing: Vec<PathBuf>,
+    /// Run only the issue-model comparison (`--only broadcast`): the
+    /// paper's configuration and the packet traversal under both models.
+    pub broadcast_only: bool,
 }
 
 /// Knob name of the rows of the scene-size sweep.
 const SCENE_SIZE: &str = "scene_size";
 
-/// One configuration: the knob it varies and the tracer options.
+/// One point of the knob sweep: the knob it varies and the tracer options.
+#[derive(Clone, Debug)]
+struct Knob {
+    knob: &'static str,
+    value: String,
+    opt: Options,
+    nm: Numerics,
+}
+
+/// One configuration: a knob's point on a chip timing.
 #[derive(Clone, Debug)]
 struct Config {
     knob: &'static str,
     value: String,
     opt: Options,
     nm: Numerics,
+    /// The chip's timing, and its name in the table ("default", "M1 issue"
+    /// or a timing file's name).
+    timing: Timing,
+    timing_name: String,
+}
+
+impl From<Knob> for Config {
+    fn from(k: Knob) -> Config {
+        Config {
+            knob: k.knob,
+            value: k.value,
+            opt: k.opt,
+            nm: k.nm,
+            timing: Timing::default(),
+            timing_name: "default".into(),
+        }
+    }
 }
 
 /// The paper's configuration at `width` x `height`: its traversal, its
@@ -79,17 +112,17 @@ fn packet_config(width: u32, height: u32) -> Options {
     }
 }
 
-fn configs(width: u32, height: u32) -> Vec<Config> {
+fn knobs(width: u32, height: u32) -> Vec<Knob> {
     let base = paper_config(width, height);
     let nm = Numerics::default();
-    let mut v = vec![Config {
+    let mut v = vec![Knob {
         knob: "paper",
         value: "paper".into(),
         opt: base,
         nm,
     }];
     for newton_steps in [0, 1, 2, 3] {
-        v.push(Config {
+        v.push(Knob {
             knob: "newton_steps",
             value: newton_steps.to_string(),
             opt: base,
@@ -98,7 +131,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
     }
     // More guard bits: a coarser coordinate format (fewer fraction bits).
     for guard_bits in [2, 3, 4] {
-        v.push(Config {
+        v.push(Knob {
             knob: "guard_bits",
             value: guard_bits.to_string(),
             opt: base,
@@ -108,7 +141,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
     // Reciprocal / square-root table size, with one and two Newton steps.
     for table_entries in firmware::tracer::kernels::TABLE_SIZES {
         for newton_steps in [1, 2] {
-            v.push(Config {
+            v.push(Knob {
                 knob: "table_entries",
                 value: format!("{table_entries}/{newton_steps}"),
                 opt: base,
@@ -121,7 +154,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         }
     }
     for eps_lsb in [1, 3, 8] {
-        v.push(Config {
+        v.push(Knob {
             knob: "ray_offset_lsb",
             value: eps_lsb.to_string(),
             opt: base,
@@ -129,7 +162,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         });
     }
     for ways in [4, 8, 16, 32, 64] {
-        v.push(Config {
+        v.push(Knob {
             knob: "ways",
             value: ways.to_string(),
             opt: Options { ways, ..base },
@@ -137,7 +170,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         });
     }
     for depth in [1, 2, 3] {
-        v.push(Config {
+        v.push(Knob {
             knob: "recursion",
             value: depth.to_string(),
             opt: Options { depth, ..base },
@@ -145,7 +178,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         });
     }
     for max_depth in [2, 4, 8, 15] {
-        v.push(Config {
+        v.push(Knob {
             knob: "bsp_depth",
             value: max_depth.to_string(),
             opt: Options {
@@ -159,7 +192,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         });
     }
     for max_leaf in [1, 2, 5, 10] {
-        v.push(Config {
+        v.push(Knob {
             knob: "leaf_size",
             value: max_leaf.to_string(),
             opt: Options {
@@ -172,7 +205,7 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
             nm,
         });
     }
-    v.push(Config {
+    v.push(Knob {
         knob: "split",
         value: "sah".into(),
         opt: Options {
@@ -185,20 +218,20 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         nm,
     });
     for datapath in [Datapath::W16, Datapath::W32] {
-        v.push(Config {
+        v.push(Knob {
             knob: "datapath",
             value: datapath.bits().to_string(),
             opt: Options { datapath, ..base },
             nm,
         });
     }
-    v.push(Config {
+    v.push(Knob {
         knob: "traversal",
         value: Traversal::Packet.name().into(),
         opt: packet_config(width, height),
         nm,
     });
-    v.push(Config {
+    v.push(Knob {
         knob: "layout",
         value: NodeLayout::Compact.name().into(),
         opt: Options {
@@ -207,6 +240,49 @@ fn configs(width: u32, height: u32) -> Vec<Config> {
         },
         nm,
     });
+    v
+}
+
+/// The knob sweep's configurations: every knob on the default timing,
+/// the broadcast knob (the paper's configuration and the packet traversal
+/// with the M1 chip's issue model) and, per timing file, both again.
+fn configs(width: u32, height: u32, files: &[(String, Timing)]) -> Vec<Config> {
+    let mut v: Vec<Config> = knobs(width, height).into_iter().map(Config::from).collect();
+    let nm = Numerics::default();
+    let both = [paper_config(width, height), packet_config(width, height)];
+    let m1 = Timing {
+        risc: rtl::tinyrisc::RiscTiming {
+            issue: rtl::tinyrisc::IssueModel::Instruction,
+            ..Timing::default().risc
+        },
+        ..Timing::default()
+    };
+    for opt in both {
+        v.push(Config {
+            timing: m1,
+            timing_name: "M1 issue".into(),
+            ..Config::from(Knob {
+                knob: "broadcast",
+                value: IssueModel::Instruction.name().into(),
+                opt,
+                nm,
+            })
+        });
+    }
+    for (name, t) in files {
+        for opt in both {
+            v.push(Config {
+                timing: *t,
+                timing_name: name.clone(),
+                ..Config::from(Knob {
+                    knob: "timing",
+                    value: name.clone(),
+                    opt,
+                    nm,
+                })
+            });
+        }
+    }
     v
 }
 
@@ -247,6 +323,10 @@ struct Row {
     traversal: String,
     bsp_split: String,
     bsp_depth_limit: u32,
+    /// The chip's issue model (run or instruction) and timing ("default",
+    /// "M1 issue" or a timing file's name).
+    issue: String,
+    timing: String,
     /// Node layout (fig5 or compact), whether the scene was resident in
     /// FB set 0 or streamed, and the FB words the resident image needs
     /// (all, and the BSP nodes alone) with that layout.
@@ -328,6 +408,8 @@ fn row(
         traversal: opt.traversal.name().into(),
         bsp_split: s("bsp_split"),
         bsp_depth_limit: j["bsp_depth_limit"].as_u64().unwrap_or(0) as u32,
+        issue: IssueModel::Run.name().into(),
+        timing: "default".into(),
         layout: opt.layout.name().into(),
         fb_layout: s("fb_layout"),
         resident_fb_words: j["resident_fb_words"].as_u64().unwrap_or(0),
@@ -346,7 +428,18 @@ pub fn command(a: SweepArgs) -> Result<()> {
     let families = family_scenes(&a)?;
     std::fs::create_dir_all(&a.out_dir)
         .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
-    let cfgs = configs(a.size.0, a.size.1);
+    let mut files = Vec::new();
+    for p in &a.timing {
+        let name = p.file_stem().map_or_else(
+            || p.display().to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        );
+        files.push((name, crate::timing::load(p)?));
+    }
+    let mut cfgs = configs(a.size.0, a.size.1, &files);
+    if a.broadcast_only {
+        cfgs.retain(|c| matches!(c.knob, "paper" | "traversal" | "broadcast" | "timing"));
+    }
     let mut rows: Vec<Row> = Vec::new();
     let mut skipped = 0;
     let bar = indicatif::ProgressBar::new(
@@ -362,7 +455,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
         let mut done: BTreeMap<String, Row> = BTreeMap::new();
         for c in &cfgs {
             bar.set_message(format!("{} {}={}", scene.source, c.knob, c.value));
-            let k = key(&c.opt, &c.nm);
+            let k = format!("{} {}", key(&c.opt, &c.nm), c.timing_name);
             let row = if let Some(r) = done.get(&k) {
                 Row {
                     knob: c.knob.into(),
@@ -370,7 +463,11 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     ..r.clone()
                 }
             } else {
-                let rep = match crate::cmd_render::render_with(&scene, &c.opt, &c.nm, false, None) {
+                let host = crate::render::RenderSettings {
+                    timing: c.timing,
+                    ..Default::default()
+                };
+                let rep = match crate::cmd_render::render_as(&scene, &c.opt, &c.nm, &host) {
                     Ok((_, rep)) => rep,
                     Err(e) => {
                         // A configuration the chip cannot run (for example a
@@ -386,7 +483,9 @@ pub fn command(a: SweepArgs) -> Result<()> {
                         continue;
                     }
                 };
-                let r = row(&scene, c.knob, c.value.clone(), &c.opt, &c.nm, &rep.json);
+                let mut r = row(&scene, c.knob, c.value.clone(), &c.opt, &c.nm, &rep.json);
+                r.issue = c.timing.risc.issue.name().into();
+                r.timing = c.timing_name.clone();
                 done.insert(k, r.clone());
                 r
             };
@@ -472,12 +571,19 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
     if !sizes.is_empty() {
         out.extend(scaling_chart(&sizes, dir)?);
     }
+    if all_rows.iter().any(|r| r.knob == "broadcast") {
+        out.extend(what_if_chart(all_rows, dir, "broadcast")?);
+    }
+    if all_rows.iter().any(|r| r.knob == "timing") {
+        out.extend(what_if_chart(all_rows, dir, "timing")?);
+    }
+    // The chip what-ifs have charts of their own.
     let rows: Vec<Row> = all_rows
         .iter()
-        .filter(|r| r.knob != SCENE_SIZE)
+        .filter(|r| !matches!(r.knob.as_str(), SCENE_SIZE | "broadcast" | "timing"))
         .cloned()
         .collect();
-    if rows.is_empty() {
+    if !rows.iter().any(|r| r.knob == "ways") {
         return Ok(out);
     }
     let rows = &rows[..];
@@ -619,6 +725,87 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
+/// A chip what-if against the default timing (`knob` "broadcast": the M1
+/// chip's issue model; "timing": each timing file): per scene and
+/// traversal, its frame rate on the default chip (x) and the ratio of the
+/// what-if's frame rate to it (y); one series per what-if and traversal
+/// (hollow: the paper's traversal), the scenes labelled.
+fn what_if_chart(rows: &[Row], dir: &Path, knob: &str) -> Result<[PathBuf; 2]> {
+    let base = |r: &Row| {
+        rows.iter().find(|b| {
+            b.scene == r.scene
+                && b.timing == "default"
+                && b.traversal == r.traversal
+                && match r.traversal.as_str() {
+                    "paper" => b.knob == "paper",
+                    _ => b.knob == "traversal",
+                }
+        })
+    };
+    let mut names: Vec<String> = Vec::new();
+    for r in rows.iter().filter(|r| r.knob == knob) {
+        if !names.contains(&r.timing) {
+            names.push(r.timing.clone());
+        }
+    }
+    let mut series = Vec::new();
+    for (k, name) in names.iter().enumerate() {
+        for traversal in Traversal::ALL {
+            let pts: Vec<(f64, f64, String)> = rows
+                .iter()
+                .filter(|r| r.knob == knob && &r.timing == name && r.traversal == traversal.name())
+                .filter_map(|r| {
+                    let b = base(r)?;
+                    Some((
+                        b.fps_at_300mhz,
+                        r.fps_at_300mhz / b.fps_at_300mhz,
+                        short(&r.scene),
+                    ))
+                })
+                .collect();
+            if pts.is_empty() {
+                continue;
+            }
+            let paper = traversal == Traversal::Paper;
+            series.push(Series {
+                name: format!("{name}, {traversal} traversal"),
+                points: pts.iter().map(|p| (p.0, p.1)).collect(),
+                style: SeriesStyle {
+                    color: Some(2 * k + paper as usize),
+                    dashed: false,
+                    hollow: vec![paper; pts.len()],
+                    labels: pts.iter().map(|p| format!(" {}", p.2)).collect(),
+                },
+            });
+        }
+    }
+    let size = rows.first().map_or((256, 256), |r| (r.width, r.height));
+    let title = match knob {
+        "broadcast" => format!(
+            "Frame rate with the M1 chip's issue model against the run broadcast ({}x{})",
+            size.0, size.1
+        ),
+        _ => format!(
+            "Frame rate with each timing file against the default timing ({}x{})",
+            size.0, size.1
+        ),
+    };
+    charts::write(
+        &dir.join(knob),
+        &Chart {
+            title,
+            x_label: "frames/s at 300 MHz, default timing".into(),
+            y_label: "frame rate relative to the default timing".into(),
+            series,
+            marks: vec![],
+            lines: false,
+            log_x: true,
+            pareto: false,
+            log_y: false,
+        },
+    )
+}
+
 /// Least-squares slope of `log y` against `log x` (the exponent of a power
 /// law `y ~ x^k`), or `None` with fewer than two points.
 pub fn loglog_slope(points: &[(f64, f64)]) -> Option<f64> {
@@ -678,6 +865,7 @@ fn scaling_chart(rows: &[&Row], dir: &Path) -> Result<[PathBuf; 2]> {
                     color: Some(k),
                     dashed: traversal == Traversal::Paper,
                     hollow: pts.iter().map(|r| r.fb_layout == "streamed").collect(),
+                    labels: vec![],
                 },
             });
         }

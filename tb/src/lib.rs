@@ -18,3 +18,4 @@ pub mod profile;
 pub mod reference;
 pub mod render;
 pub mod testbench;
+pub mod timing;

@@ -45,6 +45,10 @@ enum Command {
         /// RC datapath width in bits: 16 (the paper's chip) or 32.
         #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath, default_value = "16")]
         datapath: rtl::rc::Datapath,
+        /// The chip's timing from a TOML file (any subset of the fields
+        /// `morphosys timing` prints; the rest keep their defaults).
+        #[arg(long, value_name = "FILE.toml")]
+        timing: Option<PathBuf>,
     },
     /// Measure the simulator: array cycles per host second with tracing off
     /// and on, and the speed-up on every core.
@@ -60,6 +64,9 @@ enum Command {
         /// Write the figures as JSON here.
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
+        /// The chip's timing from a TOML file (`morphosys timing`).
+        #[arg(long, value_name = "FILE.toml")]
+        timing: Option<PathBuf>,
     },
     /// Render scenes under many configurations (ways, recursion, BSP depth,
     /// leaf size, split rule) and chart frame rate against image quality.
@@ -72,9 +79,10 @@ enum Command {
         /// Image size.
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
-        /// Run only one part: `knobs` (every knob on SCENES) or `sizes` (the
-        /// SPD families at sizes 1..=--max-size, both traversals).
-        #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes"])]
+        /// Run only one part: `knobs` (every knob on SCENES), `sizes` (the
+        /// SPD families at sizes 1..=--max-size, both traversals) or
+        /// `broadcast` (both traversals on SCENES under both issue models).
+        #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes", "broadcast"])]
         only: Option<String>,
         /// SPD generators of the size sweep, comma-separated.
         #[arg(
@@ -95,6 +103,18 @@ enum Command {
         /// renders took longer than this many host seconds.
         #[arg(long, value_name = "S", default_value_t = 60.0)]
         size_seconds: f64,
+        /// Timing files: the paper's configuration and the packet
+        /// traversal on each scene under each (the `timing` knob, one
+        /// series each in timing.png).
+        #[arg(long, value_name = "FILE.toml", num_args = 1..)]
+        timing: Vec<PathBuf>,
+    },
+    /// Print the chip's default timing as a TOML file, every field with
+    /// where its value comes from; edit a copy and pass it with --timing.
+    Timing {
+        /// Write it here instead of standard output.
+        #[arg(long, value_name = "FILE.toml")]
+        out: Option<PathBuf>,
     },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
@@ -246,6 +266,16 @@ enum Command {
         /// label while it waits (steps every cycle: several times slower).
         #[arg(long)]
         profile: bool,
+        /// The chip's timing from a TOML file (any subset of the fields
+        /// `morphosys timing` prints; the rest keep their defaults).
+        #[arg(long, value_name = "FILE.toml")]
+        timing: Option<PathBuf>,
+        /// Render with the program assembled from this file (what
+        /// `--emit-asm` writes, edited or not) instead of the generated
+        /// one; the scene's data image is built as usual, with the same
+        /// options the file was emitted with.
+        #[arg(long, value_name = "FILE.s")]
+        firmware: Option<PathBuf>,
     },
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
@@ -324,17 +354,20 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             vcd,
             window,
             datapath,
-        } => tb::cmd_run::command(file, max_cycles, vcd, window, datapath),
+            timing,
+        } => tb::cmd_run::command(file, max_cycles, vcd, window, datapath, timing),
         Command::Bench {
             scene,
             size,
             repeat,
             json,
+            timing,
         } => tb::cmd_bench::command(tb::cmd_bench::BenchArgs {
             scene,
             size,
             repeat,
             json,
+            timing,
         }),
         Command::Sweep {
             scenes,
@@ -345,20 +378,40 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             max_size,
             family_size,
             size_seconds,
+            timing,
         } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
             scenes,
             out_dir,
             size,
             knobs: only.as_deref() != Some("sizes"),
-            families: if only.as_deref() == Some("knobs") {
+            families: if only.is_some() && only.as_deref() != Some("sizes") {
                 vec![]
             } else {
                 families
             },
+            broadcast_only: only.as_deref() == Some("broadcast"),
             max_size,
             family_size,
             size_seconds,
+            timing,
         }),
+        Command::Timing { out } => {
+            let text = tb::timing::to_toml(&rtl::Timing::default());
+            match out {
+                Some(p) => {
+                    tb::cmd_scene::write_atomic(&p, text.as_bytes())?;
+                    eprintln!("wrote {}", p.display());
+                    Ok(())
+                }
+                None => {
+                    use std::io::Write;
+                    let mut o = std::io::stdout().lock();
+                    o.write_all(text.as_bytes())
+                        .and_then(|_| o.flush())
+                        .map_err(|e| anyhow::anyhow!("writing the timing to standard output: {e}"))
+                }
+            }
+        }
         Command::Fuzz {
             targets,
             count,
@@ -428,6 +481,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             newton_steps,
             table_entries,
             profile,
+            timing,
+            firmware,
         } => tb::cmd_render::command(tb::cmd_render::RenderArgs {
             scene,
             size,
@@ -448,6 +503,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             newton_steps,
             table_entries,
             profile,
+            timing,
+            firmware,
         }),
         Command::Compare {
             a,

@@ -57,6 +57,8 @@ pub struct RenderSettings {
     /// label ([`crate::profile`]; steps cycle by cycle, several times
     /// slower).
     pub profile: bool,
+    /// The chip's timing (`--timing FILE.toml`).
+    pub timing: Timing,
 }
 
 impl ChipRender {
@@ -188,6 +190,7 @@ fn run_group<W: Word>(
     tiles: &[(u32, u32)],
     trace: Option<rtl::trace::TraceConfig>,
     profile: bool,
+    timing: &Timing,
 ) -> Result<Group> {
     // Main memory as large as the program touches (its segments, the tile
     // list, the output tiles and the streamed scene image), not the
@@ -220,7 +223,7 @@ fn run_group<W: Word>(
                 .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
         );
     let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
-    let mut chip = Chip::<W>::build(Timing::default(), mem_bytes);
+    let mut chip = Chip::<W>::build(*timing, mem_bytes);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
     chip.watch = watch(img, fw);
     let fb = fw.fb_bytes();
@@ -332,14 +335,14 @@ pub fn render_chip_with(
     progress: bool,
     trace: Option<rtl::trace::TraceConfig>,
 ) -> Result<ChipRender> {
-    let fw = choose_firmware(scene, opt, nm)?;
+    let fw = choose_firmware(scene, opt, nm, &Timing::default())?;
     render_firmware(
         fw,
         opt,
         &RenderSettings {
             progress,
             trace,
-            profile: false,
+            ..Default::default()
         },
     )
 }
@@ -352,7 +355,7 @@ pub fn render_chip_as(
     nm: &Numerics,
     host: &RenderSettings,
 ) -> Result<ChipRender> {
-    let fw = choose_firmware(scene, opt, nm)?;
+    let fw = choose_firmware(scene, opt, nm, &host.timing)?;
     render_firmware(fw, opt, host)
 }
 
@@ -375,7 +378,7 @@ pub struct Probe {
 }
 
 /// Run the probe's tiles of `opt`'s frame on the chip with `fw`.
-pub fn probe(fw: &Firmware, opt: &Options) -> Result<Probe> {
+pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<Probe> {
     let (tw, th) = (fw.tile_w, fw.tile_h);
     let (nx, ny) = (opt.width.div_ceil(tw), opt.height.div_ceil(th));
     let pick = |n: u32| -> Vec<u32> {
@@ -400,8 +403,8 @@ pub fn probe(fw: &Firmware, opt: &Options) -> Result<Probe> {
     let runs: Vec<Result<Group>> = groups
         .par_iter()
         .map(|g| match fw.datapath {
-            Datapath::W16 => run_group::<i16>(&img, fw, g, None, false),
-            Datapath::W32 => run_group::<i32>(&img, fw, g, None, false),
+            Datapath::W16 => run_group::<i16>(&img, fw, g, None, false, timing),
+            Datapath::W32 => run_group::<i32>(&img, fw, g, None, false, timing),
         })
         .collect();
     let mut p = Probe {
@@ -444,8 +447,13 @@ pub fn probe(fw: &Firmware, opt: &Options) -> Result<Probe> {
 /// must not cost image quality: the trees find the same hits up to ties,
 /// but a tie between surfaces of different colours is visible); ties go
 /// to the first. Deterministic.
-pub fn choose_firmware(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmware> {
-    Ok(choose_firmware_probed(scene, opt, nm)?.0)
+pub fn choose_firmware(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    timing: &Timing,
+) -> Result<Firmware> {
+    Ok(choose_firmware_probed(scene, opt, nm, timing)?.0)
 }
 
 /// See [`choose_firmware`].
@@ -456,6 +464,7 @@ pub fn choose_firmware_probed(
     scene: &Scene,
     opt: &Options,
     nm: &Numerics,
+    timing: &Timing,
 ) -> Result<(Firmware, Option<Probe>)> {
     let cands = tracer::resolve_bsp(opt, scene.objects.len());
     if cands.len() < 2 {
@@ -474,7 +483,7 @@ pub fn choose_firmware_probed(
                 continue;
             }
         };
-        let mut p = probe(&fw, opt)?;
+        let mut p = probe(&fw, opt, timing)?;
         let (r8, rh) = reference.get_or_insert_with(|| {
             crate::reference::render_pixels(scene, opt.width, opt.height, opt.depth, &p.pixels)
         });
@@ -519,6 +528,96 @@ pub fn render_chip_streamed(
     )
 }
 
+/// The lines of a generated firmware's header that name the options it
+/// was generated for (size, ways, depth, datapath, format; traversal and
+/// BSP): a program written for other options reads another data image.
+fn header(source: &str) -> Vec<&str> {
+    source
+        .lines()
+        .take_while(|l| l.starts_with(';'))
+        .skip(1)
+        .take(2)
+        .collect()
+}
+
+/// The `.datapath` a firmware source declares (16 without the directive).
+pub fn source_datapath(source: &str) -> Datapath {
+    source
+        .lines()
+        .map(|l| l.split(';').next().unwrap_or("").trim())
+        .find_map(|l| l.strip_prefix(".datapath"))
+        .and_then(|v| v.trim().parse::<u32>().ok())
+        .and_then(Datapath::from_bits)
+        .unwrap_or(Datapath::W16)
+}
+
+/// `render --firmware FILE.s`: `fw` (generated for the same scene and
+/// options: its data image, FB and streamed, is kept) with its program
+/// replaced by the one assembled from `text`. Refused with the file's name
+/// when it does not assemble (file:line:col), was generated for other
+/// options (its header or the data image's addresses differ), or does not
+/// fit below the data the host loads.
+pub fn firmware_from_source(mut fw: Firmware, text: &str, name: &str) -> Result<Firmware> {
+    let img = asm::assemble(text, name).map_err(|e| anyhow!("{e}"))?;
+    let (want, got) = (header(&fw.source), header(text));
+    if want != got {
+        fn line<'a>(v: &[&'a str], k: usize) -> &'a str {
+            v.get(k).copied().unwrap_or("(no header line)")
+        }
+        let k = (0..2)
+            .find(|&k| line(&want, k) != line(&got, k))
+            .unwrap_or(0);
+        anyhow::bail!(
+            "{name}:{}: the firmware was generated for `{}`; these options give `{}` (render it with the options it was emitted with)",
+            k + 2,
+            line(&got, k).trim_start_matches("; "),
+            line(&want, k).trim_start_matches("; ")
+        );
+    }
+    let gen = asm::assemble(&fw.source, "generated")
+        .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
+    for sym in [
+        "FBIMG", "FBWORDS", "TILELIST", "FB_EYE", "FB_POST", "ROOT", "MAILBOX", "NOBJ", "ROOTBOX",
+        "SPLIT", "SBANK",
+    ] {
+        if gen.symbol(sym) != img.symbol(sym) {
+            anyhow::bail!(
+                "{name}: {sym} is {:?} in the file and {:?} in the data image of these options: the file was generated for another scene or options",
+                img.symbol(sym),
+                gen.symbol(sym)
+            );
+        }
+    }
+    // The program must end below the first data the host loads.
+    for seg in &img.segments {
+        let end = seg.addr as u64 + seg.data.len() as u64;
+        if seg.addr < mem::FB_IMAGE && end > mem::FB_IMAGE as u64 {
+            anyhow::bail!(
+                "{name}: the program's segment at 0x{:x} ends at 0x{end:x}, past 0x{:x} where the host loads the FB image (the context memory holds 8192 words: 0x{:x}..0x{:x})",
+                seg.addr,
+                mem::FB_IMAGE,
+                mem::CTX_BASE,
+                mem::CTX_BASE + 4 * 8192
+            );
+        }
+    }
+    // The kernels as the file lays them out: `k_NAME` .. `k_NAME_end`.
+    let mut kernels: Vec<(i64, String, usize)> = img
+        .symbols
+        .iter()
+        .filter(|(n, v)| n.starts_with("k_") && !n.ends_with("_end") && **v >= mem::CTX_BASE as i64)
+        .filter_map(|(n, v)| {
+            let e = img.symbol(&format!("{n}_end"))?;
+            Some((*v, n.clone(), ((e - v) / 4).max(0) as usize))
+        })
+        .collect();
+    kernels.sort();
+    fw.context_words = kernels.iter().map(|k| k.2).sum();
+    fw.kernels = kernels.into_iter().map(|(_, n, l)| (n, l)).collect();
+    fw.source = text.to_string();
+    Ok(fw)
+}
+
 /// Render with a firmware already built (for example by
 /// [`choose_firmware`]).
 pub fn render_built(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
@@ -557,8 +656,8 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             let t = if gi == 0 { first_trace.clone() } else { None };
             let p = host.profile;
             let r = match fw.datapath {
-                Datapath::W16 => run_group::<i16>(&img, &fw, g, t, p),
-                Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p),
+                Datapath::W16 => run_group::<i16>(&img, &fw, g, t, p, &host.timing),
+                Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p, &host.timing),
             };
             bar.inc(g.len() as u64);
             r

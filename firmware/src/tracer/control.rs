@@ -188,6 +188,19 @@ pub fn program(
         opt.datapath.bits() - 1 - lay.frac,
         lay.frac
     );
+    let _ = writeln!(
+        w,
+        "; {} traversal, BSP {} split to depth {}, at most {} objects per leaf{}",
+        opt.traversal,
+        format!("{:?}", opt.bsp.rule).to_lowercase(),
+        opt.bsp.max_depth,
+        opt.bsp.max_leaf,
+        if opt.traversal == Traversal::Packet {
+            format!(", collapse {}", opt.collapse)
+        } else {
+            format!(", {} nodes", opt.layout)
+        }
+    );
     let _ = writeln!(w, "        .datapath {}", opt.datapath.bits());
     let _ = writeln!(
         w,

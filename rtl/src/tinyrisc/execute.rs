@@ -319,7 +319,10 @@ impl TinyRisc {
                 };
                 run.validate().map_err(|e| Fault::new("broadcast", e))?;
                 self.cmd = Command::Run(run);
-                cost = t.broadcast_issue;
+                cost = match t.issue {
+                    super::IssueModel::Run => t.broadcast_issue,
+                    super::IssueModel::Instruction => t.broadcast_issue.max(count as u32),
+                };
             }
             Wfb => {
                 let addr = fb_addr(a as i64 + imm as i64, "wfb")?;

@@ -46,6 +46,45 @@ pub struct RiscTiming {
     /// `rcany`, `rcall`, `rcst`, `rcfl`, `rcfh`, `rcsl`, `rcsh`.
     pub status: u32,
     pub halt: u32,
+    /// How contexts reach the array (`docs/isa.md`, section 4).
+    pub issue: IssueModel,
+}
+
+/// How TinyRISC issues contexts to the array.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum IssueModel {
+    /// This model's choice (the default): a run instruction (`cbcast`,
+    /// `sbcb`, `dbcb`, `cbcr`, `cbcc`) takes `broadcast_issue` cycles and
+    /// the broadcast unit streams its contexts, one per cycle, while
+    /// TinyRISC goes on (one run in progress and one queued).
+    #[default]
+    Run,
+    /// As in the M1 chip, where TinyRISC issues each context by an
+    /// instruction: a run instruction keeps TinyRISC for one cycle per
+    /// context (or row/column group) it issues (at least
+    /// `broadcast_issue`), so the array waits whenever TinyRISC does
+    /// anything else.
+    Instruction,
+}
+
+impl IssueModel {
+    pub const ALL: [IssueModel; 2] = [IssueModel::Run, IssueModel::Instruction];
+    pub fn name(self) -> &'static str {
+        match self {
+            IssueModel::Run => "run",
+            IssueModel::Instruction => "instruction",
+        }
+    }
+}
+
+impl std::str::FromStr for IssueModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        IssueModel::ALL
+            .into_iter()
+            .find(|m| m.name() == s)
+            .ok_or_else(|| format!("unknown issue model '{s}': expected run or instruction"))
+    }
 }
 
 impl Default for RiscTiming {
@@ -67,6 +106,7 @@ impl Default for RiscTiming {
             rcrisc: 2,
             status: 2,
             halt: 1,
+            issue: IssueModel::Run,
         }
     }
 }

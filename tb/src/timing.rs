@@ -1,0 +1,326 @@
+//! The chip's timing as a file: `--timing FILE.toml` on `render`, `run`,
+//! `bench` and `sweep`, and `morphosys timing`, which prints every field
+//! with its default and where the value comes from.
+//!
+//! Any subset of the fields may be given; the rest keep their defaults.
+//! Unknown keys, wrong types and values out of range are refused with the
+//! file, line and column.
+
+use std::path::Path;
+
+use anyhow::{anyhow, Result};
+use rtl::tinyrisc::{IssueModel, RiscTiming};
+use rtl::Timing;
+use serde::Deserialize;
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct File {
+    clock_hz: Option<u64>,
+    issue: Option<String>,
+    risc: Option<Risc>,
+    dma: Option<Dma>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct Risc {
+    alu: Option<u32>,
+    mul: Option<u32>,
+    load: Option<u32>,
+    store: Option<u32>,
+    branch_taken: Option<u32>,
+    branch_not_taken: Option<u32>,
+    jump: Option<u32>,
+    fb_load: Option<u32>,
+    fb_store: Option<u32>,
+    dma_issue: Option<u32>,
+    dwait: Option<u32>,
+    broadcast_issue: Option<u32>,
+    wfb: Option<u32>,
+    rcrisc: Option<u32>,
+    status: Option<u32>,
+    halt: Option<u32>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct Dma {
+    setup_cycles: Option<u32>,
+    bytes_per_cycle: Option<u32>,
+}
+
+/// One field: its TOML table (`""` for the top level), key, the default
+/// as TOML, and where the value comes from.
+struct Field {
+    table: &'static str,
+    key: &'static str,
+    why: &'static str,
+}
+
+const FIELDS: &[Field] = &[
+    Field { table: "", key: "clock_hz", why: "the paper: \"MorphoSys is designed to be running at 300MHz\" (section IX); only frames/s and waveform time use it" },
+    Field { table: "", key: "issue", why: "ours (docs/isa.md, section 4): \"run\", one instruction streams a run of up to 4095 contexts while TinyRISC goes on; \"instruction\" is the M1 chip's, where TinyRISC issues each context by an instruction and the array waits while it does anything else" },
+    Field { table: "risc", key: "alu", why: "ours: a MIPS-like TinyRISC with a short pipeline (the M1 literature): one cycle for ALU, shift, lui, nop, rdcyc" },
+    Field { table: "risc", key: "mul", why: "ours: a 32x32 multiply in two cycles" },
+    Field { table: "risc", key: "load", why: "ours: main-memory loads (lw, lh, lhu, lb, lbu) with one load-use cycle" },
+    Field { table: "risc", key: "store", why: "ours: stores (sw, sh, sb) retire into a write buffer" },
+    Field { table: "risc", key: "branch_taken", why: "ours: one bubble for a taken branch (no delay slot, no prediction)" },
+    Field { table: "risc", key: "branch_not_taken", why: "ours: a not-taken branch falls through" },
+    Field { table: "risc", key: "jump", why: "ours: j, jal, jr, jalr, one bubble" },
+    Field { table: "risc", key: "fb_load", why: "ours: lfb reads the frame buffer like a load" },
+    Field { table: "risc", key: "fb_store", why: "ours: sfb writes the frame buffer like a store" },
+    Field { table: "risc", key: "dma_issue", why: "ours: ldctxt, ldfb, stfb issue a transfer that then runs on its own" },
+    Field { table: "risc", key: "dwait", why: "ours: dwait, once the channel is free" },
+    Field { table: "risc", key: "broadcast_issue", why: "ours: cbcast, sbcb, dbcb, cbcr, cbcc issue a run (with issue = \"instruction\": at least this, and one cycle per context)" },
+    Field { table: "risc", key: "wfb", why: "ours: 64 RC outputs into the FB, one row of 8 per cycle" },
+    Field { table: "risc", key: "rcrisc", why: "ours: one RC's output into a TinyRISC register, like a load" },
+    Field { table: "risc", key: "status", why: "ours: rcany, rcall, rcst, rcfl, rcfh, rcsl, rcsh: a 64-input reduction in two cycles (the paper: the status of all rays is sent to TinyRISC)" },
+    Field { table: "risc", key: "halt", why: "ours" },
+    Field { table: "dma", key: "setup_cycles", why: "ours: from a transfer's issue to its first word (an external memory's latency)" },
+    Field { table: "dma", key: "bytes_per_cycle", why: "ours: a 32-bit external bus, 2 FB words or 1 context word per cycle" },
+];
+
+/// The value of a field in `t`, as TOML.
+fn value(t: &Timing, table: &str, key: &str) -> String {
+    let r = &t.risc;
+    let n = match (table, key) {
+        ("", "clock_hz") => t.clock_hz,
+        ("", "issue") => return format!("\"{}\"", r.issue.name()),
+        ("risc", "alu") => r.alu as u64,
+        ("risc", "mul") => r.mul as u64,
+        ("risc", "load") => r.load as u64,
+        ("risc", "store") => r.store as u64,
+        ("risc", "branch_taken") => r.branch_taken as u64,
+        ("risc", "branch_not_taken") => r.branch_not_taken as u64,
+        ("risc", "jump") => r.jump as u64,
+        ("risc", "fb_load") => r.fb_load as u64,
+        ("risc", "fb_store") => r.fb_store as u64,
+        ("risc", "dma_issue") => r.dma_issue as u64,
+        ("risc", "dwait") => r.dwait as u64,
+        ("risc", "broadcast_issue") => r.broadcast_issue as u64,
+        ("risc", "wfb") => r.wfb as u64,
+        ("risc", "rcrisc") => r.rcrisc as u64,
+        ("risc", "status") => r.status as u64,
+        ("risc", "halt") => r.halt as u64,
+        ("dma", "setup_cycles") => t.dma.setup_cycles as u64,
+        ("dma", "bytes_per_cycle") => t.dma.bytes_per_cycle as u64,
+        _ => unreachable!("timing field {table}.{key}"),
+    };
+    n.to_string()
+}
+
+/// `t` as a commented TOML file (`morphosys timing`): every field, its
+/// value, and where it comes from. Read back, it gives `t`.
+pub fn to_toml(t: &Timing) -> String {
+    let mut s = String::from(
+        "# The chip's timing (morphosys timing). Give any subset of these fields to\n\
+         # --timing FILE.toml on render, run, bench and sweep; the rest keep these\n\
+         # defaults. Cycle counts are per instruction class of TinyRISC; the array\n\
+         # executes one context per cycle and the FB supplies one datum per set per\n\
+         # cycle whatever the file says (docs/isa.md, section 4).\n",
+    );
+    let mut table = "";
+    for f in FIELDS {
+        if f.table != table {
+            table = f.table;
+            s.push_str(&format!("\n[{table}]\n"));
+        }
+        s.push_str(&format!(
+            "# {}\n{} = {}\n",
+            f.why,
+            f.key,
+            value(t, f.table, f.key)
+        ));
+    }
+    s
+}
+
+/// `t` as JSON (the render report's `timing`).
+pub fn to_json(t: &Timing) -> serde_json::Value {
+    let mut top = serde_json::Map::new();
+    for f in FIELDS {
+        let v: serde_json::Value = match (f.table, f.key) {
+            ("", "issue") => t.risc.issue.name().into(),
+            _ => value(t, f.table, f.key)
+                .parse::<u64>()
+                .map_or(serde_json::Value::Null, Into::into),
+        };
+        if f.table.is_empty() {
+            top.insert(f.key.into(), v);
+        } else {
+            top.entry(f.table)
+                .or_insert_with(|| serde_json::Value::Object(Default::default()))
+                .as_object_mut()
+                .map(|m| m.insert(f.key.into(), v));
+        }
+    }
+    serde_json::Value::Object(top)
+}
+
+/// 1-based line and column of a byte offset.
+fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let before = &text[..offset.min(text.len())];
+    let line = before.matches('\n').count() + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) + 1;
+    (line, col)
+}
+
+/// Parse a timing file's text (`name` for the messages).
+pub fn parse(text: &str, name: &str) -> Result<Timing> {
+    let f: File = toml::from_str(text).map_err(|e| {
+        let msg = e.message().to_string();
+        match e.span() {
+            Some(sp) => {
+                let (l, c) = line_col(text, sp.start);
+                anyhow!("{name}:{l}:{c}: {msg}")
+            }
+            None => anyhow!("{name}: {msg}"),
+        }
+    })?;
+    // Where a key is written, for the range errors below.
+    let at = |table: &str, key: &str| -> String {
+        let mut cur = "";
+        for (k, line) in text.lines().enumerate() {
+            let l = line.trim();
+            if let Some(t) = l.strip_prefix('[').and_then(|l| l.strip_suffix(']')) {
+                cur = if t.trim() == table { table } else { "?" };
+                continue;
+            }
+            if cur == table && l.split('=').next().is_some_and(|k| k.trim() == key) {
+                return format!("{name}:{}", k + 1);
+            }
+        }
+        name.to_string()
+    };
+    let mut t = Timing::default();
+    if let Some(c) = f.clock_hz {
+        if c == 0 {
+            return Err(anyhow!(
+                "{}: clock_hz must be at least 1",
+                at("", "clock_hz")
+            ));
+        }
+        t.clock_hz = c;
+    }
+    if let Some(m) = &f.issue {
+        t.risc.issue = m
+            .parse::<IssueModel>()
+            .map_err(|e| anyhow!("{}: {e}", at("", "issue")))?;
+    }
+    if let Some(r) = f.risc {
+        let set = |v: Option<u32>, key: &str, slot: &mut u32| -> Result<()> {
+            if let Some(v) = v {
+                if v == 0 || v > 1_000_000 {
+                    return Err(anyhow!(
+                        "{}: risc.{key} = {v}: a cycle count must be 1..=1000000",
+                        at("risc", key)
+                    ));
+                }
+                *slot = v;
+            }
+            Ok(())
+        };
+        let x: &mut RiscTiming = &mut t.risc;
+        set(r.alu, "alu", &mut x.alu)?;
+        set(r.mul, "mul", &mut x.mul)?;
+        set(r.load, "load", &mut x.load)?;
+        set(r.store, "store", &mut x.store)?;
+        set(r.branch_taken, "branch_taken", &mut x.branch_taken)?;
+        set(
+            r.branch_not_taken,
+            "branch_not_taken",
+            &mut x.branch_not_taken,
+        )?;
+        set(r.jump, "jump", &mut x.jump)?;
+        set(r.fb_load, "fb_load", &mut x.fb_load)?;
+        set(r.fb_store, "fb_store", &mut x.fb_store)?;
+        set(r.dma_issue, "dma_issue", &mut x.dma_issue)?;
+        set(r.dwait, "dwait", &mut x.dwait)?;
+        set(r.broadcast_issue, "broadcast_issue", &mut x.broadcast_issue)?;
+        set(r.wfb, "wfb", &mut x.wfb)?;
+        set(r.rcrisc, "rcrisc", &mut x.rcrisc)?;
+        set(r.status, "status", &mut x.status)?;
+        set(r.halt, "halt", &mut x.halt)?;
+    }
+    if let Some(d) = f.dma {
+        if let Some(v) = d.setup_cycles {
+            if v > 1_000_000 {
+                return Err(anyhow!(
+                    "{}: dma.setup_cycles = {v}: must be 0..=1000000",
+                    at("dma", "setup_cycles")
+                ));
+            }
+            t.dma.setup_cycles = v;
+        }
+        if let Some(v) = d.bytes_per_cycle {
+            if !(1..=4096).contains(&v) {
+                return Err(anyhow!(
+                    "{}: dma.bytes_per_cycle = {v}: must be 1..=4096",
+                    at("dma", "bytes_per_cycle")
+                ));
+            }
+            t.dma.bytes_per_cycle = v;
+        }
+    }
+    Ok(t)
+}
+
+/// Read a timing file.
+pub fn load(path: &Path) -> Result<Timing> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| anyhow!("{}: cannot read the timing file: {e}", path.display()))?;
+    parse(&text, &path.display().to_string())
+}
+
+/// `--timing FILE`, or the defaults.
+pub fn load_or_default(path: Option<&Path>) -> Result<Timing> {
+    path.map_or_else(|| Ok(Timing::default()), load)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_printed_defaults_read_back_as_the_defaults() {
+        let t = parse(&to_toml(&Timing::default()), "t.toml").unwrap();
+        assert_eq!(t.risc, Timing::default().risc);
+        assert_eq!(t.dma, Timing::default().dma);
+        assert_eq!(t.clock_hz, Timing::default().clock_hz);
+    }
+
+    #[test]
+    fn a_subset_keeps_the_other_defaults() {
+        let t = parse("[dma]\nbytes_per_cycle = 8\n", "t.toml").unwrap();
+        assert_eq!(t.dma.bytes_per_cycle, 8);
+        assert_eq!(t.dma.setup_cycles, 10);
+        assert_eq!(t.risc, Timing::default().risc);
+        let t = parse("issue = \"instruction\"\n", "t.toml").unwrap();
+        assert_eq!(t.risc.issue, IssueModel::Instruction);
+    }
+
+    #[test]
+    fn bad_files_name_the_line() {
+        let e = parse("[risc]\nalu = 1\nbranch_taken = 2\nbrnch = 3\n", "a.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("a.toml:4:"), "{e}");
+        assert!(e.contains("brnch"), "{e}");
+        let e = parse("[risc]\nstatus = 0\n", "b.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("b.toml:2:"), "{e}");
+        let e = parse("[dma]\nsetup_cycles = \"ten\"\n", "c.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("c.toml:2:"), "{e}");
+        let e = parse("issue = \"pipelined\"\n", "d.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("d.toml:1") && e.contains("run or instruction"),
+            "{e}"
+        );
+    }
+}

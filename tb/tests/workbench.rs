@@ -1,0 +1,236 @@
+//! The architect's workbench end to end: render an emitted (and edited)
+//! firmware with `--firmware`, the chip's timing from a file, the M1 issue
+//! model, and the sweep's timing and broadcast knobs.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
+
+fn scene(name: &str) -> String {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let p = [
+        root.join("scenes").join(name),
+        root.join("scenes/spd").join(name),
+    ]
+    .into_iter()
+    .find(|p| p.is_file())
+    .unwrap();
+    p.display().to_string()
+}
+
+/// `render ARGS --json NAME.json`: the report.
+fn render(dir: &Path, name: &str, args: &[&str]) -> serde_json::Value {
+    let json = format!("{name}.json");
+    let png = format!("{name}.png");
+    let mut a = vec!["render", "--size", "32x32", "--out", &png, "--json", &json];
+    a.extend_from_slice(args);
+    let (ok, _, err) = morphosys(dir, &a);
+    assert!(ok, "render {args:?}: {err}");
+    serde_json::from_slice(&std::fs::read(dir.join(json)).unwrap()).unwrap()
+}
+
+fn cycles(j: &serde_json::Value) -> u64 {
+    j["cycles"].as_u64().unwrap()
+}
+
+#[test]
+fn an_emitted_firmware_renders_the_same_and_an_edited_one_differs() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene("default.toml");
+    let a = render(d, "a", &[&s, "--emit-asm", "fw.s"]);
+    let b = render(d, "b", &[&s, "--firmware", "fw.s"]);
+    assert_eq!(cycles(&a), cycles(&b));
+    assert_eq!(b["firmware"], "fw.s");
+    assert_eq!(
+        std::fs::read(d.join("a.png")).unwrap(),
+        std::fs::read(d.join("b.png")).unwrap()
+    );
+    let fw = std::fs::read_to_string(d.join("fw.s")).unwrap();
+    // Drop the first Newton-Raphson step of the sphere kernel's square
+    // root: five contexts fewer per sphere test.
+    let at =
+        fw.find("k_sphere:").unwrap() + fw[fw.find("k_sphere:").unwrap()..].find("; sqrt").unwrap();
+    let step = "        mul r8, r13, r13, >>14\n        mul r8, r8, r10, >>11\n        sub r8, r8, r14\n        ldacc r13, <<15\n        msu r13, r13, r8, >>15\n";
+    let k = at + fw[at..].find(step).unwrap();
+    let edited = format!("{}{}", &fw[..k], &fw[k + step.len()..]);
+    std::fs::write(d.join("nr1.s"), edited).unwrap();
+    let c = render(d, "c", &[&s, "--firmware", "nr1.s"]);
+    assert!(cycles(&c) < cycles(&a), "{} !< {}", cycles(&c), cycles(&a));
+    let len = |j: &serde_json::Value| {
+        j["kernels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|k| k["name"] == "k_sphere")
+            .unwrap()["contexts"]
+            .as_u64()
+            .unwrap()
+    };
+    assert_eq!(len(&c) + 5, len(&a));
+    // Output green as red: the same cycles, another image.
+    let swapped = fw.replacen(
+        "k_out0:\n        ld out, [r0 + #278]",
+        "k_out0:\n        ld out, [r0 + #279]",
+        1,
+    );
+    assert_ne!(swapped, fw, "k_out0 reads COL (RAM 278)");
+    std::fs::write(d.join("swap.s"), swapped).unwrap();
+    let e = render(d, "e", &[&s, "--firmware", "swap.s"]);
+    assert_eq!(cycles(&e), cycles(&a));
+    assert!(e["psnr_db"].as_f64().unwrap() < a["psnr_db"].as_f64().unwrap() - 3.0);
+    // Errors name the file: a bad line, and options the file was not
+    // emitted for.
+    std::fs::write(
+        d.join("bad.s"),
+        fw.replacen("sub r8, fb0, r1", "sub r8, fb0, r99", 1),
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(d, &["render", &s, "--size", "32x32", "--firmware", "bad.s"]);
+    assert!(
+        !ok && err.contains("bad.s:") && err.contains("expected operand B"),
+        "{err}"
+    );
+    let (ok, _, err) = morphosys(d, &["render", &s, "--size", "16x16", "--firmware", "fw.s"]);
+    assert!(
+        !ok && err.contains("fw.s:2: the firmware was generated for `32x32"),
+        "{err}"
+    );
+    // A fault stops with the cycle and the PC, and no image is written.
+    let fault = fw.replacen("ld r13, [r13 + #0]", "ld r13, [r13 + #600]", 1);
+    std::fs::write(d.join("fault.s"), fault).unwrap();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "render",
+            &s,
+            "--size",
+            "32x32",
+            "--firmware",
+            "fault.s",
+            "--out",
+            "f.png",
+        ],
+    );
+    assert!(
+        !ok && err.contains("cycle ") && err.contains("[pc 0x"),
+        "{err}"
+    );
+    assert!(err.contains("RAM address 629"), "{err}");
+    assert!(!d.join("f.png").exists());
+}
+
+#[test]
+fn timing_files_change_the_chip_and_are_checked() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene("jacks-1.nff");
+    // `morphosys timing` read back: the default cycles, echoed in the JSON.
+    let (ok, text, err) = morphosys(d, &["timing"]);
+    assert!(ok, "{err}");
+    assert!(text.contains("status = 2") && text.contains("issue = \"run\""));
+    std::fs::write(d.join("t.toml"), &text).unwrap();
+    let a = render(d, "a", &[&s]);
+    let b = render(d, "b", &[&s, "--timing", "t.toml"]);
+    assert_eq!(cycles(&a), cycles(&b));
+    assert_eq!(b["timing"]["risc"]["status"], 2);
+    // Twice the status read latency: more cycles.
+    std::fs::write(d.join("slow.toml"), "[risc]\nstatus = 4\n").unwrap();
+    let c = render(d, "c", &[&s, "--timing", "slow.toml"]);
+    assert!(cycles(&c) > cycles(&a));
+    assert_eq!(c["timing"]["risc"]["status"], 4);
+    // A twice as wide external bus: no more cycles.
+    std::fs::write(d.join("wide.toml"), "[dma]\nbytes_per_cycle = 8\n").unwrap();
+    assert!(cycles(&render(d, "w", &[&s, "--timing", "wide.toml"])) <= cycles(&a));
+    // The M1 chip's issue model: TinyRISC busy for every context.
+    std::fs::write(d.join("m1.toml"), "issue = \"instruction\"\n").unwrap();
+    let m = render(d, "m", &[&s, "--timing", "m1.toml"]);
+    assert!(cycles(&m) > cycles(&a));
+    assert_eq!(m["timing"]["issue"], "instruction");
+    // Unknown keys and bad values: one line naming the file and line.
+    std::fs::write(d.join("bad.toml"), "[risc]\nalu = 1\nstats = 4\n").unwrap();
+    let (ok, _, err) = morphosys(d, &["render", &s, "--size", "8x8", "--timing", "bad.toml"]);
+    assert!(
+        !ok && err.contains("bad.toml:3:") && err.contains("stats"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+    std::fs::write(d.join("zero.toml"), "[dma]\nbytes_per_cycle = 0\n").unwrap();
+    let (ok, _, err) = morphosys(d, &["render", &s, "--size", "8x8", "--timing", "zero.toml"]);
+    assert!(!ok && err.contains("zero.toml:2"), "{err}");
+    // `run` takes the same file: a program's cycles follow its ALU cost.
+    let dct = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
+    let dct = dct.to_str().unwrap();
+    std::fs::write(d.join("alu2.toml"), "[risc]\nalu = 2\n").unwrap();
+    let halted = |out: &str| -> u64 {
+        out.lines()
+            .find_map(|l| l.strip_prefix("halted after "))
+            .and_then(|l| l.split(' ').next())
+            .and_then(|n| n.parse().ok())
+            .unwrap()
+    };
+    let (ok1, o1, e1) = morphosys(d, &["run", dct]);
+    let (ok2, o2, e2) = morphosys(d, &["run", dct, "--timing", "alu2.toml"]);
+    assert!(ok1 && ok2, "{e1}{e2}");
+    assert!(halted(&o2) > halted(&o1), "{o1}\n{o2}");
+}
+
+#[test]
+fn the_sweep_charts_the_issue_models_and_timing_files() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene("tetra-1.nff");
+    std::fs::write(d.join("dma8.toml"), "[dma]\nbytes_per_cycle = 8\n").unwrap();
+    let (ok, out, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            &s,
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--out-dir",
+            "sw",
+            "--timing",
+            "dma8.toml",
+        ],
+    );
+    assert!(ok, "{out}\n{err}");
+    let mut rd = csv::Reader::from_path(d.join("sw/results.csv")).unwrap();
+    let head = rd.headers().unwrap().clone();
+    let col = |n: &str| head.iter().position(|h| h == n).unwrap();
+    let rows: Vec<csv::StringRecord> = rd.records().map(|r| r.unwrap()).collect();
+    let find = |knob: &str, traversal: &str| {
+        rows.iter()
+            .find(|r| &r[col("knob")] == knob && &r[col("traversal")] == traversal)
+            .unwrap_or_else(|| panic!("no {knob} row for {traversal}"))
+    };
+    let cyc = |r: &csv::StringRecord| r[col("cycles")].parse::<u64>().unwrap();
+    for t in ["paper", "packet"] {
+        let base = if t == "paper" {
+            find("paper", t)
+        } else {
+            find("traversal", t)
+        };
+        let m1 = find("broadcast", t);
+        assert_eq!(&m1[col("issue")], "instruction");
+        assert!(cyc(m1) > cyc(base), "{t}: {} !> {}", cyc(m1), cyc(base));
+        let f = find("timing", t);
+        assert_eq!(&f[col("timing")], "dma8");
+    }
+    assert!(d.join("sw/broadcast.png").is_file());
+    assert!(d.join("sw/timing.png").is_file());
+}
