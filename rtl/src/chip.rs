@@ -78,24 +78,48 @@ pub struct Stats {
     /// RCs that executed their first context.
     pub watched_runs: [u64; 2],
     pub watched_rcs: [u64; 2],
+    /// `watched_rcs` split by the [`Watch`] tag in effect when the run
+    /// started.
+    pub watched_rcs_by_tag: [[u64; WATCH_TAGS]; 2],
 }
+
+/// Tags a [`Watch`] can split its counts by.
+pub const WATCH_TAGS: usize = 4;
 
 /// A simulator statistic, not a part of the chip: context addresses whose
 /// runs are counted when they start, with the RCs that execute their first
 /// context, in two classes (the ray tracer: the object tests' kernels, and
-/// the kernel that starts a ray pass). Costs nothing while empty.
+/// the kernel that starts a ray pass), and split by a tag: a run that
+/// starts at a tagging address sets the tag for the runs that follow (the
+/// ray tracer: the kernels that set up eye, shadow and reflected rays).
+/// Costs nothing while empty.
 #[derive(Clone, Debug, Default)]
 pub struct Watch {
     any: bool,
-    class: std::collections::HashMap<u16, usize>,
+    class: std::collections::HashMap<u16, WatchEntry>,
+    tag: usize,
     runs: [u64; 2],
     rcs: [u64; 2],
+    rcs_by_tag: [[u64; WATCH_TAGS]; 2],
+}
+
+#[derive(Clone, Copy, Debug, Default)]
+struct WatchEntry {
+    class: Option<usize>,
+    tag: Option<usize>,
 }
 
 impl Watch {
     /// Count runs that start at `ctx` in `class` (0 or 1).
     pub fn add(&mut self, ctx: u16, class: usize) {
-        self.class.insert(ctx, class.min(1));
+        self.class.entry(ctx).or_default().class = Some(class.min(1));
+        self.any = true;
+    }
+
+    /// A run that starts at `ctx` sets the tag (0..[`WATCH_TAGS`]) under
+    /// which the runs that follow are counted; the tag is 0 until then.
+    pub fn tag(&mut self, ctx: u16, tag: usize) {
+        self.class.entry(ctx).or_default().tag = Some(tag.min(WATCH_TAGS - 1));
         self.any = true;
     }
 }
@@ -276,6 +300,7 @@ impl<W: Word> Chip<W> {
             dma_transfers: self.dma.transfers,
             watched_runs: self.watch.runs,
             watched_rcs: self.watch.rcs,
+            watched_rcs_by_tag: self.watch.rcs_by_tag,
         }
     }
 
@@ -322,9 +347,16 @@ impl<W: Word> Chip<W> {
     #[cold]
     fn count_watched(&mut self) {
         if let Some((run, 0, _)) = self.bcast.current() {
-            if let Some(&c) = self.watch.class.get(&run.ctx) {
-                self.watch.runs[c] += 1;
-                self.watch.rcs[c] += self.array.active_now as u64;
+            if let Some(&e) = self.watch.class.get(&run.ctx) {
+                if let Some(t) = e.tag {
+                    self.watch.tag = t;
+                }
+                if let Some(c) = e.class {
+                    let n = self.array.active_now as u64;
+                    self.watch.runs[c] += 1;
+                    self.watch.rcs[c] += n;
+                    self.watch.rcs_by_tag[c][self.watch.tag] += n;
+                }
             }
         }
     }

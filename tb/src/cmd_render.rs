@@ -163,8 +163,16 @@ pub fn render_built(
     } else {
         0.0
     };
+    let census = chip.ray_census();
+    let warnings: Vec<firmware::scene::Warning> = scene
+        .warnings
+        .iter()
+        .cloned()
+        .chain(firmware::tracer::chip_warnings(scene, opt, &r.notes))
+        .collect();
     let json = json!({
         "scene": scene.source,
+        "warnings": warnings,
         "cycles": chip.cycles,
         "fps_at_300mhz": chip.fps_at(300_000_000),
         "width": opt.width,
@@ -175,6 +183,12 @@ pub fn render_built(
         "table_entries": nm.table_entries,
         "psnr_db": if psnr.is_finite() { psnr } else { 99.0 },
         "hit_agreement": agree,
+        "eye_misclassified": 1.0 - agree,
+        "eye_rays": census[crate::render::RAY_EYE],
+        "shadow_rays": census[crate::render::RAY_SHADOW],
+        "reflect_rays": census[crate::render::RAY_REFLECT],
+        "refract_rays": census[crate::render::RAY_REFRACT],
+        "reference_rays": refimg.stats,
         "active_rc_fraction": chip.stats.active_rc_fraction(),
         "dma_stall_cycles": chip.stats.dma_stall_cycles,
         "array_idle_on_control": idle_on_control,
@@ -300,6 +314,9 @@ pub fn command(a: RenderArgs) -> Result<()> {
         built = crate::render::firmware_from_source(built, text, name)?;
         datapath_reason = format!("{name}: .datapath {}", datapath.bits());
     }
+    for w in firmware::tracer::chip_warnings(&scene, &opt, &built.report.notes) {
+        eprintln!("{w}");
+    }
     if let Some(p) = &a.emit_asm {
         write_atomic(p, built.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
@@ -399,6 +416,16 @@ pub fn command(a: RenderArgs) -> Result<()> {
     println!(
         "hit agreement            {:.4}",
         j["hit_agreement"].as_f64().unwrap_or(0.0)
+    );
+    println!(
+        "eye rays misclassified   {:.3}% (hit a different object than the reference's)",
+        100.0 * j["eye_misclassified"].as_f64().unwrap_or(0.0)
+    );
+    let rs = &j["reference_rays"];
+    println!(
+        "rays traced on the chip  eye {}, shadow {}, reflect {}, refract {} (reference: {}, {}, {}, {})",
+        j["eye_rays"], j["shadow_rays"], j["reflect_rays"], j["refract_rays"],
+        rs["eye_rays"], rs["shadow_rays"], rs["reflect_rays"], rs["refract_rays"]
     );
     println!(
         "active RC fraction       {:.3}",

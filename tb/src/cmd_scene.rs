@@ -27,7 +27,11 @@ pub fn default_scene() -> PathBuf {
 /// Load a scene (or the default one), errors as `file:line:col: ...`.
 pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     let path = path.map_or_else(default_scene, Path::to_path_buf);
-    Ok(Scene::load(&path)?)
+    let scene = Scene::load(&path)?;
+    for w in &scene.warnings {
+        eprintln!("{w}");
+    }
+    Ok(scene)
 }
 
 /// Write a file atomically: into a temporary file beside it, renamed into
@@ -179,8 +183,9 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
         let (w, h) = a.size.unwrap_or(scene.camera.resolution);
         (w, h, a.depth.unwrap_or(5), false)
     };
-    if max_depth == 0 {
-        bail!("--depth must be at least 1 (the eye ray)");
+    let cap = firmware::tracer::MAX_RAY_DEPTH;
+    if max_depth == 0 || max_depth > cap {
+        bail!("--depth {max_depth}: must be 1..={cap} (the eye ray is depth 1; the chip's limit, so reference and chip images always compare)");
     }
     let out = a.out.clone().or_else(|| {
         (!a.spd_stats).then(|| {

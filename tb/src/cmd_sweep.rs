@@ -169,7 +169,7 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
-    for depth in [1, 2, 3] {
+    for depth in [1, 2, 3, 5] {
         v.push(Knob {
             knob: "recursion",
             value: depth.to_string(),

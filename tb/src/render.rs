@@ -81,6 +81,13 @@ impl ChipRender {
         }
     }
 
+    /// The rays the chip traced, by kind: the RCs awake at the start of
+    /// each pass, counted by the simulator under the kind of the kernel
+    /// that set the pass up (eye, shadow, reflect, refract).
+    pub fn ray_census(&self) -> [u64; 4] {
+        self.stats.watched_rcs_by_tag[1]
+    }
+
     /// Ray-object tests the RCs executed per ray traced: the awake RCs at
     /// the start of every object test over the rays that started a pass
     /// (counted by the simulator, [`rtl::chip::Watch`]).
@@ -115,6 +122,9 @@ fn add_stats(a: &mut Stats, b: &Stats) {
     for c in 0..2 {
         a.watched_runs[c] += b.watched_runs[c];
         a.watched_rcs[c] += b.watched_rcs[c];
+        for t in 0..rtl::chip::WATCH_TAGS {
+            a.watched_rcs_by_tag[c][t] += b.watched_rcs_by_tag[c][t];
+        }
     }
 }
 
@@ -133,6 +143,10 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     for c in 0..2 {
         a.watched_runs[c] -= b.watched_runs[c].min(a.watched_runs[c]);
         a.watched_rcs[c] -= b.watched_rcs[c].min(a.watched_rcs[c]);
+        for t in 0..rtl::chip::WATCH_TAGS {
+            a.watched_rcs_by_tag[c][t] -=
+                b.watched_rcs_by_tag[c][t].min(a.watched_rcs_by_tag[c][t]);
+        }
     }
 }
 
@@ -162,8 +176,29 @@ fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
     if let Some(a) = ctx(start) {
         w.add(a, 1);
     }
+    // The ray census: the kernels that set up each kind of ray tag the
+    // passes that follow ([`RAY_EYE`] ...).
+    if let Some(a) = ctx("k_eye") {
+        w.tag(a, RAY_EYE);
+    }
+    if let Some(a) = ctx("k_light") {
+        w.tag(a, RAY_SHADOW);
+    }
+    for l in 0.. {
+        match ctx(&format!("k_refl{l}")) {
+            Some(a) => w.tag(a, RAY_REFLECT),
+            None => break,
+        }
+    }
     w
 }
+
+/// Tags of the simulator's ray census ([`rtl::chip::Watch::tag`]): the
+/// kind of the rays of a pass.
+pub const RAY_EYE: usize = 0;
+pub const RAY_SHADOW: usize = 1;
+pub const RAY_REFLECT: usize = 2;
+pub const RAY_REFRACT: usize = 3;
 
 struct Group {
     start: u64,

@@ -4,9 +4,13 @@
 //! Scenes come from two readers: [`nff`] (Eric Haines' Neutral File Format,
 //! the SPD's) and [`native`] (TOML, which adds boxes, rectangles, cones with
 //! end caps). Both report errors as `file:line:col: what was expected`, and
-//! both run [`Scene::validate`], so a degenerate primitive (zero radius,
-//! collinear polygon, coincident cone ends) or a non-finite number is an
-//! error, never a garbage image.
+//! both run [`Scene::validate`], so a malformed primitive (zero radius,
+//! coincident cone ends, a non-planar polygon) or a non-finite number is an
+//! error, never a garbage image. A polygon, triangle or rectangle of zero
+//! area (collinear or coincident vertices, a zero-length vertex normal) is
+//! skipped with one warning per file, as classical SPD renderers skip it
+//! ([`Scene::skip_degenerate`]); the scene is refused only when nothing is
+//! left.
 
 pub mod native;
 pub mod nff;
@@ -484,6 +488,87 @@ impl Shape {
         out
     }
 
+    /// A polygon with the same outline, its vertices rotated so that the
+    /// first three make a convex corner that is not collinear (the
+    /// renderers take the plane's normal from them), and 3-vertex polygons
+    /// as triangles. Vertices are not changed or dropped; a polygon of zero
+    /// area is returned as it is (and [`Shape::zero_area`] names it).
+    pub fn polygon(v: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Shape {
+        if v.len() == 3 {
+            return Shape::Triangle {
+                v: [v[0], v[1], v[2]],
+                normals: normals.map(|n| [n[0], n[1], n[2]]),
+            };
+        }
+        let n = v.len();
+        if n < 3 || v.iter().any(|p| !p.is_finite()) {
+            return Shape::Polygon { v, normals };
+        }
+        // Newell's normal: the outline's orientation, whatever its corners.
+        let newell = (0..n).fold(Vec3::ZERO, |a, i| a + v[i].cross(v[(i + 1) % n]));
+        let b = Aabb::from_points(v.iter().copied());
+        let scale = b.min.max_abs().max(b.max.max_abs()).max(1e-300);
+        let tiny = scale * scale * 1e-12;
+        let corner = |k: usize| (v[(k + 1) % n] - v[k]).cross(v[(k + 2) % n] - v[k]);
+        let Some(k) = (0..n).find(|&k| {
+            let c = corner(k);
+            c.length() > tiny && c.dot(newell) > 0.0
+        }) else {
+            return Shape::Polygon { v, normals };
+        };
+        let rot = |mut x: Vec<Vec3>| {
+            x.rotate_left(k);
+            x
+        };
+        Shape::Polygon {
+            v: rot(v),
+            normals: normals.map(rot),
+        }
+    }
+
+    /// Why this shape has no area to render, if so: a polygon or triangle
+    /// whose vertices are collinear or coincident (or with a zero-length
+    /// vertex normal), a rectangle with a zero-length edge. Such a shape is
+    /// skipped with a warning ([`Scene::skip_degenerate`]), not refused.
+    pub fn zero_area(&self) -> Option<&'static str> {
+        if self.numbers().iter().any(|x| !x.is_finite()) {
+            return None; // refused by `degeneracy`
+        }
+        let b = self.bounds();
+        let scale = b.min.max_abs().max(b.max.max_abs()).max(1e-300);
+        let tiny = scale * 1e-12;
+        let zero_normal = |ns: &[Vec3]| ns.iter().any(|n| n.length() <= 0.0);
+        match self {
+            Shape::Triangle { v, normals } => {
+                if (v[1] - v[0]).cross(v[2] - v[0]).length() <= tiny * scale {
+                    Some("collinear or coincident vertices")
+                } else if normals.as_ref().is_some_and(|n| zero_normal(n)) {
+                    Some("a zero-length vertex normal")
+                } else {
+                    None
+                }
+            }
+            Shape::Polygon { v, normals } => {
+                let n = v.len();
+                let newell = (0..n).fold(Vec3::ZERO, |a, i| a + v[i].cross(v[(i + 1) % n]));
+                if n >= 3 && newell.length() <= tiny * scale {
+                    Some("collinear or coincident vertices")
+                } else if n >= 3 && (v[1] - v[0]).cross(v[2] - v[0]).length() <= tiny * scale {
+                    // no convex corner found: a sliver
+                    Some("collinear or coincident vertices")
+                } else if normals.as_ref().is_some_and(|n| zero_normal(n)) {
+                    Some("a zero-length vertex normal")
+                } else {
+                    None
+                }
+            }
+            Shape::Rectangle { edge1, edge2, .. } => {
+                (edge1.length() <= tiny || edge2.length() <= tiny).then_some("a zero-length edge")
+            }
+            _ => None,
+        }
+    }
+
     /// Why this shape cannot be rendered, if it cannot.
     pub fn degeneracy(&self) -> Option<String> {
         if self.numbers().iter().any(|x| !x.is_finite()) {
@@ -599,6 +684,36 @@ pub struct Scene {
     pub lights: Vec<Light>,
     pub materials: Vec<Material>,
     pub objects: Vec<Object>,
+    /// What the readers skipped or changed, for the user (one entry per
+    /// kind, with the count and the first line).
+    pub warnings: Vec<Warning>,
+}
+
+/// Something a scene asks for that is not rendered as asked: skipped
+/// degenerate objects, or (from the scene compiler) features the chip does
+/// not implement. One per kind: the count of objects and the first line.
+#[derive(Clone, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Warning {
+    /// A short, stable name of the kind (`degenerate`, `refraction`, ...).
+    pub feature: String,
+    /// The file the scene came from.
+    pub file: String,
+    /// 1-based line of the first object concerned (0: none or unknown).
+    pub line: usize,
+    /// Objects concerned.
+    pub count: usize,
+    /// What happens, in a sentence.
+    pub message: String,
+}
+
+impl fmt::Display for Warning {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.line > 0 {
+            write!(f, "{}:{}: warning: {}", self.file, self.line, self.message)
+        } else {
+            write!(f, "{}: warning: {}", self.file, self.message)
+        }
+    }
 }
 
 /// An error in a scene file: `file:line:col: message`.
@@ -655,6 +770,54 @@ impl Scene {
                 message: "unknown scene format: expected a .nff or .toml file".into(),
             }),
         }
+    }
+
+    /// Drop every polygon, triangle and rectangle of zero area
+    /// ([`Shape::zero_area`]) and say so in one warning (the count and the
+    /// first line); refused when nothing is left to render.
+    pub fn skip_degenerate(&mut self) -> Result<(), SceneError> {
+        let before = self.objects.len();
+        let mut first: Option<(usize, &'static str)> = None;
+        self.objects.retain(|o| match o.shape.zero_area() {
+            Some(why) => {
+                first.get_or_insert((o.line, why));
+                false
+            }
+            None => true,
+        });
+        let Some((line, why)) = first else {
+            return Ok(());
+        };
+        let count = before - self.objects.len();
+        let what = if count == 1 {
+            "1 degenerate polygon".to_string()
+        } else {
+            format!("{count} degenerate polygons")
+        };
+        if self.objects.is_empty() {
+            return Err(SceneError {
+                file: self.source.clone(),
+                line,
+                col: 0,
+                message: if count == 1 {
+                    format!("nothing to render: the only object is a degenerate polygon ({why})")
+                } else {
+                    format!(
+                        "nothing to render: all {count} objects are degenerate polygons (the first, here, has {why})"
+                    )
+                },
+            });
+        }
+        self.warnings.push(Warning {
+            feature: "degenerate".into(),
+            file: self.source.clone(),
+            line,
+            count,
+            message: format!(
+                "skipped {what} (triangles, polygons or rectangles of zero area; the first, here, has {why}); the reference skips them too"
+            ),
+        });
+        Ok(())
     }
 
     /// Check every number and primitive; the first problem is reported with
@@ -737,7 +900,11 @@ impl Scene {
             }
         }
         for o in &self.objects {
-            if let Some(msg) = o.shape.degeneracy() {
+            if let Some(msg) = o
+                .shape
+                .degeneracy()
+                .filter(|_| o.shape.zero_area().is_none())
+            {
                 return Err(err(o.line, msg));
             }
             if o.material >= self.materials.len() {

@@ -216,7 +216,7 @@ fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
                 (_, n) if n < 3 => {
                     return Err(format!("a polygon needs at least 3 vertices, found {n}"))
                 }
-                _ => Shape::Polygon { v, normals: None },
+                _ => Shape::polygon(v, None),
             }
         }
     })
@@ -295,7 +295,8 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                 known.join(", ")
             )));
         };
-        if let Some(msg) = shape.degeneracy() {
+        // zero area: skipped after reading, with one warning
+        if let Some(msg) = shape.degeneracy().filter(|_| shape.zero_area().is_none()) {
             return Err(err(msg));
         }
         scene.objects.push(Object {
@@ -304,6 +305,7 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
             line,
         });
     }
+    scene.skip_degenerate()?;
     scene.validate()?;
     Ok(scene)
 }

@@ -351,7 +351,8 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                     }
                 }
                 let shape = polygon_shape(v, if patch { Some(normals) } else { None });
-                if let Some(msg) = shape.degeneracy() {
+                // zero area: skipped after reading, with one warning
+                if let Some(msg) = shape.degeneracy().filter(|_| shape.zero_area().is_none()) {
                     return Err(r.err_at(line, col, msg));
                 }
                 add(&mut scene, shape);
@@ -375,18 +376,13 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
             message: "no viewpoint ('v' entity)".into(),
         });
     }
+    scene.skip_degenerate()?;
     scene.validate()?;
     Ok(scene)
 }
 
 /// Triangle, rectangle or general polygon from NFF vertices.
 fn polygon_shape(v: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Shape {
-    if v.len() == 3 {
-        return Shape::Triangle {
-            v: [v[0], v[1], v[2]],
-            normals: normals.map(|n| [n[0], n[1], n[2]]),
-        };
-    }
     if v.len() == 4 && normals.is_none() {
         let (e1, e2) = (v[1] - v[0], v[3] - v[0]);
         let scale = e1.length().max(e2.length());
@@ -400,7 +396,7 @@ fn polygon_shape(v: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Shape {
             };
         }
     }
-    Shape::Polygon { v, normals }
+    Shape::polygon(v, normals)
 }
 
 #[cfg(test)]
@@ -444,6 +440,68 @@ mod tests {
             }
         ));
         assert_eq!(s.objects[6].line, 23);
+    }
+
+    #[test]
+    fn degenerate_polygons_are_skipped_with_one_warning() {
+        // line 8: a good sphere; 9-12: collinear; 13-16: coincident; 17-21: a
+        // pp triangle with a zero normal; 21: a good one.
+        let text = format!(
+            "{HEAD}s 0 0 0 1\np 3\n0 0 0\n1 1 1\n2 2 2\np 3\n1 0 0\n1 0 0\n0 1 0\n\
+             pp 3\n0 0 0 0 0 1\n1 0 0 0 0 0\n0 1 0 0 0 1\np 3 0 0 0 1 0 0 0 1 0\n"
+        );
+        let s = parse(&text, "d.nff").unwrap();
+        assert_eq!(s.objects.len(), 2);
+        assert_eq!((s.objects[0].line, s.objects[1].line), (8, 21));
+        assert_eq!(s.warnings.len(), 1, "{:?}", s.warnings);
+        let w = &s.warnings[0];
+        assert_eq!((w.line, w.count, w.feature.as_str()), (9, 3, "degenerate"));
+        assert!(
+            w.to_string()
+                .starts_with("d.nff:9: warning: skipped 3 degenerate polygons"),
+            "{w}"
+        );
+        // Nothing left: refused, naming the first.
+        let e = parse(&format!("{HEAD}p 3\n0 0 0\n1 1 1\n2 2 2\n"), "e.nff").unwrap_err();
+        assert!(
+            e.to_string().starts_with("e.nff:8: nothing to render"),
+            "{e}"
+        );
+        // A scene without degenerate objects has no warning.
+        assert!(parse(&format!("{HEAD}s 0 0 0 1\n"), "ok.nff")
+            .unwrap()
+            .warnings
+            .is_empty());
+    }
+
+    #[test]
+    fn polygons_start_at_a_convex_corner() {
+        // An L-shaped hexagon, counter-clockwise seen from +z, listed from
+        // its reflex corner (1, 1): the first three vertices would give a
+        // normal pointing to -z. Also one with collinear first vertices.
+        let text = format!(
+            "{HEAD}p 6\n1 1 0\n0 1 0\n0 0 0\n2 0 0\n2 2 0\n1 2 0\n\
+             p 5\n0 0 0\n1 0 0\n2 0 0\n2 2 0\n0 2 0\n"
+        );
+        let s = parse(&text, "l.nff").unwrap();
+        assert!(s.warnings.is_empty());
+        for o in &s.objects {
+            let Shape::Polygon { v, .. } = &o.shape else {
+                panic!("{:?}", o.shape)
+            };
+            let n = (v[1] - v[0]).cross(v[2] - v[0]);
+            assert!(n.z > 0.0, "line {}: {v:?}", o.line);
+        }
+        // The outline is unchanged: the same vertices in the same cyclic order.
+        let Shape::Polygon { v, .. } = &s.objects[0].shape else {
+            unreachable!()
+        };
+        let i = v
+            .iter()
+            .position(|p| *p == Vec3::new(1.0, 1.0, 0.0))
+            .unwrap();
+        assert_eq!(v[(i + 1) % 6], Vec3::new(0.0, 1.0, 0.0));
+        assert_eq!(v.len(), 6);
     }
 
     #[test]

@@ -323,6 +323,11 @@ impl Firmware {
 // `T_START`, `T_END` (cycle counter at the start and the end of the tile
 // loop), `TESTS` (object tests broadcast) and `PASSES` (ray passes).
 
+/// The deepest ray tree the tracer builds (the eye ray is depth 1; the
+/// SPD's scenes ask for 5): a stack frame per level in RC RAM. The
+/// reference renderer takes the same limit, so the two always compare.
+pub const MAX_RAY_DEPTH: u32 = 8;
+
 /// Build the firmware for `scene`.
 pub fn build(scene: &Scene, opt: &Options) -> Result<Firmware, String> {
     build_with(scene, opt, &Numerics::default())
@@ -414,8 +419,11 @@ fn build_one(
     }
     let (tw, th) = tile_shape(opt.ways)
         .ok_or_else(|| format!("--ways {}: must be 4, 8, 16, 32 or 64", opt.ways))?;
-    if opt.depth == 0 || opt.depth > 8 {
-        return Err(format!("--depth {}: must be 1..=8", opt.depth));
+    if opt.depth == 0 || opt.depth > MAX_RAY_DEPTH {
+        return Err(format!(
+            "--depth {}: must be 1..={MAX_RAY_DEPTH}",
+            opt.depth
+        ));
     }
     let copt = CompileOptions {
         bsp: opt.bsp,
@@ -480,4 +488,94 @@ fn build_one(
         layout: lay,
         bsp: opt.bsp,
     })
+}
+
+/// What the chip does not render as `scene` asks, one [`Warning`] per
+/// feature (the count of objects and the first line): transmitting
+/// materials (no refracted rays; one-sided where the reference makes such
+/// objects two-sided), `pp` vertex normals (shaded with the face normal),
+/// and values the scene compiler clamped to its formats (`notes`, from
+/// [`Report::notes`]). The scene's own warnings (skipped degenerate
+/// objects) are in [`Scene::warnings`].
+///
+/// [`Warning`]: crate::scene::Warning
+pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crate::scene::Warning> {
+    use crate::scene::{Shape, Warning};
+    let mut out = Vec::new();
+    let mut add = |feature: &str, hits: Vec<usize>, message: String| {
+        if let Some(&line) = hits.first() {
+            out.push(Warning {
+                feature: feature.into(),
+                file: scene.source.clone(),
+                line,
+                count: hits.len(),
+                message,
+            });
+        }
+    };
+    let plural = |n: usize, one: &str, many: &str| {
+        if n == 1 {
+            format!("1 {one}")
+        } else {
+            format!("{n} {many}")
+        }
+    };
+    let transmit: Vec<usize> = scene
+        .objects
+        .iter()
+        .filter(|o| scene.materials[o.material].t > 0.0)
+        .map(|o| o.line)
+        .collect();
+    let n = transmit.len();
+    let them = if n == 1 { "it" } else { "them" };
+    add(
+        "refraction",
+        transmit,
+        if opt.depth >= 2 {
+            format!(
+                "{} a transmitting material (T > 0): the chip traces no refracted rays and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
+                plural(n, "object has", "objects have"),
+                if n == 1 { "it renders" } else { "they render" }
+            )
+        } else {
+            format!(
+                "{} a transmitting material (T > 0): the chip tests {them} one-sided (the reference makes {them} two-sided)",
+                plural(n, "object has", "objects have"),
+            )
+        },
+    );
+    let smooth: Vec<usize> = scene
+        .objects
+        .iter()
+        .filter(|o| {
+            matches!(
+                o.shape,
+                Shape::Triangle {
+                    normals: Some(_),
+                    ..
+                }
+            )
+        })
+        .map(|o| o.line)
+        .collect();
+    let n = smooth.len();
+    add(
+        "vertex-normals",
+        smooth,
+        format!(
+            "{} vertex normals (NFF pp): the chip shades {} with the face normal where the reference interpolates them",
+            plural(n, "triangle has", "triangles have"),
+            if n == 1 { "it" } else { "them" }
+        ),
+    );
+    for note in notes.iter().filter(|n| !n.starts_with("vertex normals")) {
+        out.push(Warning {
+            feature: "clamped".into(),
+            file: scene.source.clone(),
+            line: 0,
+            count: 1,
+            message: format!("scene compiler: {note}"),
+        });
+    }
+    out
 }

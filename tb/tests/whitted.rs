@@ -1,0 +1,146 @@
+//! Whitted on the chip (issue 13): what the chip cannot render as the
+//! scene asks is named in a warning (stderr and the JSON's `warnings`),
+//! degenerate polygons are skipped by both renderers alike, and the chip's
+//! ray census agrees with the f64 reference's independent count.
+
+use std::path::Path;
+use std::process::Command;
+
+fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
+    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .unwrap();
+    (
+        out.status.success(),
+        String::from_utf8_lossy(&out.stdout).into(),
+        String::from_utf8_lossy(&out.stderr).into(),
+    )
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+const HEAD: &str = "v\nfrom 0 0 8\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 32 32\n\
+                    b 0.1 0.2 0.3\nl 4 5 9\n";
+
+/// Render `text` (an NFF scene) at 32x32, depth `depth`: the JSON, stderr.
+fn render(text: &str, depth: u32) -> (serde_json::Value, String) {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(dir.path().join("s.nff"), text).unwrap();
+    let d = depth.to_string();
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "render", "s.nff", "--size", "32x32", "--depth", &d, "--out", "s.png", "--json",
+            "s.json",
+        ],
+    );
+    assert!(ok, "{out}{err}");
+    (json(&dir.path().join("s.json")), err)
+}
+
+#[test]
+fn degenerate_triangles_are_skipped_and_the_rest_rendered() {
+    // Lines 10, 11 (material, sphere), 12-15 a good triangle, 16-19 a
+    // collinear one, 20-23 one with two coincident vertices.
+    let text = format!(
+        "{HEAD}f 0.8 0.4 0.2 1 0 0 0 0\ns 0.8 0 0 1\np 3\n-2.5 -1 0\n-0.5 -1 0\n-1.5 1 0\n\
+         p 3\n0 0 1\n1 1 1\n2 2 1\np 3\n0 -2 1\n0 -2 1\n1 -1 1\n"
+    );
+    let (j, err) = render(&text, 2);
+    assert!(
+        err.contains("s.nff:16: warning: skipped 2 degenerate polygons"),
+        "{err}"
+    );
+    let w = j["warnings"].as_array().unwrap();
+    assert_eq!(w.len(), 1, "{w:?}");
+    assert_eq!(w[0]["feature"], "degenerate");
+    assert_eq!(
+        (w[0]["line"].as_u64(), w[0]["count"].as_u64()),
+        (Some(16), Some(2))
+    );
+    // The rest renders, as the reference (which skipped the same) does.
+    assert!(j["psnr_db"].as_f64().unwrap() > 33.0, "{j}");
+    assert!(j["hit_agreement"].as_f64().unwrap() > 0.99, "{j}");
+    // Nothing else left: refused with the line, no image.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("e.nff"),
+        format!("{HEAD}p 3\n0 0 1\n1 1 1\n2 2 1\n"),
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(dir.path(), &["render", "e.nff", "--out", "e.png"]);
+    assert!(!ok);
+    assert!(err.contains("e.nff:10: nothing to render"), "{err}");
+    assert!(!dir.path().join("e.png").exists());
+}
+
+#[test]
+fn what_the_chip_does_not_render_is_named() {
+    // A glass sphere (line 11) and two pp triangles (12-15, 16-19).
+    let text = format!(
+        "{HEAD}f 1 1 1 0.1 0.1 30 0.9 1.5\ns 0 0 0 1\nf 0.8 0.4 0.2 1 0 0 0 0\n\
+         pp 3\n-3 -2 -1 0 0 1\n3 -2 -1 0 0 1\n0 -2 -4 0 1 0\n\
+         pp 3\n-3 2 -1 0 0 1\n0 2 -4 0 -1 0\n3 2 -1 0 0 1\n"
+    );
+    let (j, err) = render(&text, 2);
+    assert!(
+        err.contains("s.nff:11: warning: 1 object has a transmitting material (T > 0): the chip traces no refracted rays"),
+        "{err}"
+    );
+    assert!(
+        err.contains("s.nff:13: warning: 2 triangles have vertex normals (NFF pp)"),
+        "{err}"
+    );
+    let w = j["warnings"].as_array().unwrap();
+    let find = |f: &str| {
+        w.iter()
+            .find(|x| x["feature"] == f)
+            .unwrap_or_else(|| panic!("{f}: {w:?}"))
+    };
+    assert_eq!(find("refraction")["count"], 1);
+    assert_eq!(find("refraction")["line"], 11);
+    assert_eq!(find("vertex-normals")["count"], 2);
+    assert_eq!(find("vertex-normals")["line"], 13);
+    // The reference refracts: its census has refracted rays the chip's has not.
+    assert!(
+        j["reference_rays"]["refract_rays"].as_u64().unwrap() > 0,
+        "{j}"
+    );
+    assert_eq!(j["refract_rays"], 0);
+}
+
+#[test]
+fn a_scene_the_chip_renders_as_asked_has_no_warnings() {
+    let (j, err) = render(
+        &format!("{HEAD}f 0.8 0.4 0.2 0.7 0.3 20 0 1\ns 0 0 0 1\n"),
+        2,
+    );
+    assert!(!err.contains("warning"), "{err}");
+    assert_eq!(j["warnings"].as_array().map(|w| w.len()), Some(0), "{j}");
+}
+
+#[test]
+fn ray_census_agrees_with_the_reference() {
+    // Two mirrors and a diffuse sphere at depth 4: eye, shadow and
+    // reflected rays at every level, counted on the chip (RCs awake at each
+    // pass's start) and by the f64 reference's own recursion.
+    let text = format!(
+        "{HEAD}l -6 2 6\nf 0.9 0.9 0.9 0.3 0.7 40 0 1\ns -1.2 0 0 1\ns 1.2 0.3 -0.5 1\n\
+         f 0.2 0.8 0.3 1 0 0 0 1\np 4\n-6 -1.5 -6\n-6 -1.5 6\n6 -1.5 6\n6 -1.5 -6\n"
+    );
+    let (j, _) = render(&text, 4);
+    let r = &j["reference_rays"];
+    for k in ["eye_rays", "shadow_rays", "reflect_rays"] {
+        let (c, f) = (j[k].as_f64().unwrap(), r[k].as_f64().unwrap());
+        assert!(f > 100.0, "{k}: reference {f}");
+        assert!((c - f).abs() <= 0.1 * f, "{k}: chip {c}, reference {f}");
+    }
+    assert_eq!(j["eye_rays"], 1024);
+    let mis = j["eye_misclassified"].as_f64().unwrap();
+    assert!((mis - (1.0 - j["hit_agreement"].as_f64().unwrap())).abs() < 1e-12);
+    assert!(mis < 0.01, "{j}");
+}
