@@ -658,12 +658,9 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
                     w.point(*edge2);
                     w.word(mat);
                 }
-                Shape::Triangle { v, normals } => {
+                Shape::Triangle { v, .. } => {
                     v.iter().for_each(|v| w.point(*v));
                     w.word(mat);
-                    if normals.is_some() && !notes.iter().any(|n| n.starts_with("vertex normals")) {
-                        notes.push("vertex normals (NFF pp) are not stored: the chip shades with face normals".into());
-                    }
                 }
                 Shape::Polygon { v, .. } => {
                     w.word(mat);

@@ -153,8 +153,8 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
 /// Kernels whose runs start an object test (their RCs at the first context
 /// are the rays tested), and the kernel that starts a ray pass (its RCs are
 /// the pass's rays).
-const TEST_KERNELS: [&str; 7] = [
-    "k_sphere", "k_cyl", "k_cone", "k_box", "k_rect", "k_tri", "k_polyh",
+const TEST_KERNELS: [&str; 8] = [
+    "k_sphere", "k_cyl", "k_cone", "k_box", "k_rect", "k_tri", "k_tris", "k_polyh",
 ];
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {

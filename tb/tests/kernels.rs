@@ -76,6 +76,10 @@ fn run_in<W: Word>(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>,
             vec![("k_tri", first)],
             vec![("k_tri", k::planar(Inside::Triangle, lay.kt_tri, 2))],
         ),
+        ChipType::SmoothTriangle => (
+            vec![("k_tris", first)],
+            vec![("k_tris", k::smooth_triangle(lay.kt_tri, 2))],
+        ),
         ChipType::Box => (vec![("k_box", first)], vec![("k_box", k::aabox(2))]),
         ChipType::Polygon => {
             let mut runs = vec![("k_polyh", first + 1)];
@@ -179,11 +183,17 @@ wait:   lw r1, GO(r0)\n        beqz r1, wait\n",
     sim.top.mem.write(go, 4, 1);
     rtl::chip::run_to_halt(&mut sim, 10_000_000).unwrap();
     let rc = &sim.top.array.rc;
+    // A smooth triangle's shading normal (the face normal is in HIT_N).
+    let at = if t.ty == ChipType::SmoothTriangle {
+        ram::HIT_NS
+    } else {
+        ram::HIT_N
+    };
     let out = (0..64)
         .map(|i| {
             let t = rc.regs.read(7)[i].to_i64() as f64;
             (t < max).then(|| {
-                let n = |k: u32| rc.ram.read(i, (ram::HIT_N + k) as usize).to_i64() as f64 / one;
+                let n = |k: u32| rc.ram.read(i, (at + k) as usize).to_i64() as f64 / one;
                 (t, Vec3::new(n(0), n(1), n(2)))
             })
         })
@@ -249,7 +259,9 @@ fn measure_on<W: Word>(name: &str, shape: Shape, max_t_lsb: f64, max_mean: f64, 
                     let e = (f.t / lsb - t).abs();
                     worst_t = worst_t.max(e);
                     sum_t += e;
-                    worst_n = worst_n.max((f.n - *n).length());
+                    // The shading normal: the geometric one but for `pp`
+                    // triangles.
+                    worst_n = worst_n.max((f.ns - *n).length());
                     hits += 1;
                 }
                 (None, None) => {}
@@ -426,6 +438,37 @@ fn shape_triangle() -> Shape {
 #[test]
 fn triangle_kernel_vs_float_triangle() {
     measure("triangle", shape_triangle(), 12.0, 1e-3);
+}
+
+/// The triangle with vertex normals tilted up to `tilt` off its face
+/// normal, from `seed`.
+fn shape_smooth_triangle(seed: u64, tilt: f64) -> Shape {
+    let Shape::Triangle { v, .. } = shape_triangle() else {
+        unreachable!()
+    };
+    let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+    let mut g = Lcg(seed);
+    let normals = [0; 3].map(|_| {
+        let d = Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0));
+        // Unnormalised on purpose: the compiler normalises, as the reference.
+        (n + d * tilt) * g.range(0.5, 2.0)
+    });
+    Shape::Triangle {
+        v,
+        normals: Some(normals),
+    }
+}
+
+/// Barycentric interpolation of the vertex normals (NFF `pp`) in the
+/// smooth triangle kernel against the reference's f64 interpolation, on
+/// random normals and rays, on both datapaths.
+#[test]
+fn smooth_triangle_kernel_vs_float_interpolation() {
+    for seed in 1..=6 {
+        let s = shape_smooth_triangle(seed, 0.6);
+        measure("smooth triangle", s.clone(), 12.0, 2e-3);
+        measure_on::<i32>("smooth triangle", s, 12.0 * 65536.0, 1.5 * 65536.0, 1e-6);
+    }
 }
 
 fn shape_polygon() -> Shape {

@@ -94,10 +94,18 @@ pub fn program(
             ("k_leafa", k::leaf_any()),
         ]
     };
+    // Smooth triangles: the shading normal and the reflection's fallback.
+    let smooth = lay.types.iter().any(|x| x.ty == ChipType::SmoothTriangle);
+    let post = if smooth { k::post_smooth } else { k::post };
+    let reflect_setup = if smooth {
+        k::reflect_setup_smooth
+    } else {
+        k::reflect_setup
+    };
     ks.extend([
         ("k_eye", k::eye(lay.kd, nm.approx())),
-        ("k_post0", k::post(true, lay.materials, nm.eps_lsb)),
-        ("k_post1", k::post(false, lay.materials, nm.eps_lsb)),
+        ("k_post0", post(true, lay.materials, nm.eps_lsb)),
+        ("k_post1", post(false, lay.materials, nm.eps_lsb)),
         ("k_light", k::light_setup(nm.approx(), lay.light_shifted)),
         ("k_shade", k::shade(&lay.shines)),
         ("k_out0", k::out_word(0)),
@@ -114,7 +122,7 @@ pub fn program(
     let levels = opt.depth;
     let mut refl: Vec<(String, K)> = Vec::new();
     for l in 0..levels.saturating_sub(1) {
-        refl.push((format!("k_refl{l}"), k::reflect_setup(l)));
+        refl.push((format!("k_refl{l}"), reflect_setup(l)));
         refl.push((format!("k_pop{l}"), k::reflect_pop(l)));
     }
     if lay.stream.is_some() && !packet {
@@ -161,6 +169,9 @@ pub fn program(
             "k_tri",
             k::planar(Inside::Triangle, lay.kt_tri, nm.approx()),
         ));
+    }
+    if has(ChipType::SmoothTriangle) {
+        objk.push(("k_tris", k::smooth_triangle(lay.kt_tri, nm.approx())));
     }
     if has(ChipType::Polygon) {
         objk.push(("k_polyh", k::polygon_head(nm.approx())));
@@ -918,6 +929,7 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::Sphere => one(w, "k_sphere"),
         ChipType::Rectangle => one(w, "k_rect"),
         ChipType::Triangle => one(w, "k_tri"),
+        ChipType::SmoothTriangle => one(w, "k_tris"),
         ChipType::Box => one(w, "k_box"),
         ChipType::Cylinder => capped(w, "k_cyl", CYL_BODY_WORDS),
         ChipType::Cone => capped(w, "k_cone", CONE_BODY_WORDS),

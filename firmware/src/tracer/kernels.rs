@@ -102,6 +102,13 @@ pub mod ram {
     /// whose visiting order goes against its direction (it may only sleep
     /// at a leaf when this is 0).
     pub const UNORD: u32 = 340;
+    /// Smooth triangles ([`super::smooth_triangle`]): the interpolated
+    /// shading normal of the closest smooth triangle hit so far and its
+    /// object id (it is the hit's shading normal when the id is the hit's),
+    /// and the geometric normal of the hit being shaded.
+    pub const HIT_NS: u32 = 341; // 3
+    pub const HIT_NS_OBJ: u32 = 344;
+    pub const SH_NG: u32 = 345; // 3
     /// Packet traversal ([`super::super::Traversal::Packet`]): 1 while the
     /// ray takes part in the current pass (it may be woken at a pop).
     pub const P_ALIVE: u32 = 400;
@@ -576,6 +583,88 @@ pub fn planar(inside: Inside, kt: u32, nr: impl Into<Approx>) -> K {
         }
     }
     commit_streamed_normal(&mut k, 9);
+    k
+}
+
+/// A triangle with vertex normals (NFF `pp`), shaded smoothly as the
+/// reference shades it: the planar test of [`planar`] (the same first 15
+/// record words), then at the hit the unit vertex normals, streamed per
+/// axis (`n0.a, n1.a, n2.a`, Q1.14), weighted by the barycentric
+/// coordinates `(1 - u - w, u, w)` in the accumulator and normalised into
+/// `ram::HIT_NS` (with the object id in `ram::HIT_NS_OBJ`); the face
+/// normal goes to `ram::HIT_N` as every kernel's does ([`post_smooth`]
+/// picks the shading normal). Record ([`super::layout::SMOOTH_WORDS`], 29
+/// words): `n.xyz, v0.xyz, v0.xyz, eu.xyz, ew.xyz, (n0, n1, n2).x, .y, .z,
+/// n.xyz, obj, mat`.
+pub fn smooth_triangle(kt: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
+    let mut k = K::default();
+    k.comment("smooth triangle: den = n.d, num = n.(v0 - o)");
+    plane_hit(&mut k, nr);
+    k.comment("P - v0");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 10 + i;
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{x}, r9, r{d}, >>14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r13, fb0, r12, >>{kt}"));
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r14, fb0, r12, >>{kt}"));
+    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c(format!("add r8, r8, #{INSIDE_TOL}"))
+        .c(format!("(f) cmp.ge r13, #-{INSIDE_TOL}"))
+        .c(format!("(f) cmp.ge r14, #-{INSIDE_TOL}"))
+        .c("adds r15, r13, r14")
+        .c("(f) cmp.le r15, r8");
+    k.comment("Ns = (1 - u - w) n0 + u n1 + w n2, normalised");
+    k.c("(f) mov r7, r9")
+        .c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c("sub r8, r8, r15");
+    for x in [10, 11, 12] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r13")
+            .cq(format!("mac r{x}, fb0, r14, >>14"));
+    }
+    normalize(&mut k, [10, 11, 12], [9, 8, 13, 14, 15], false, nr);
+    for (i, x) in [10, 11, 12].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_NS + i as u32));
+    }
+    for i in 0..3 {
+        k.c(format!("(f) st fb0, [#{}]", ram::HIT_N + i));
+    }
+    k.c("mov r8, fb0")
+        .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ))
+        .c(format!("(f) st r8, [#{}]", ram::HIT_NS_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    k
+}
+
+/// [`post`] for scenes with smooth triangles: the geometric normal is kept
+/// in `ram::SH_NG` (for [`reflect_setup_smooth`]) and the shading normal
+/// `SH_N` becomes the interpolated one where the hit is a smooth triangle
+/// (`HIT_NS_OBJ` = the hit's id) and it lies on the face's side (the
+/// reference's rule: otherwise the face normal).
+pub fn post_smooth(level0: bool, materials: usize, eps: i32) -> K {
+    let mut k = post(level0, materials, eps);
+    for i in 0..3 {
+        k.c(format!("ld r{}, [r0 + #{}]", 8 + i, ram::HIT_N + i))
+            .c(format!("st r{}, [#{}]", 8 + i, ram::SH_NG + i))
+            .c(format!("ld r{}, [r0 + #{}]", 11 + i, ram::HIT_NS + i));
+    }
+    k.c("mul out, r8, r11")
+        .c("mac out, r9, r12")
+        .cq("mac r14, r10, r13, >>14")
+        .c(format!("ld r15, [r0 + #{}]", ram::HIT_NS_OBJ))
+        .c(format!("ld r8, [r0 + #{}]", ram::HIT_OBJ))
+        .c("cmp.eq r15, r8")
+        .c("(f) cmp.gt r14, #0");
+    for i in 0..3 {
+        k.c(format!("(f) st r{}, [#{}]", 11 + i, ram::SH_N + i));
+    }
     k
 }
 
@@ -1334,6 +1423,18 @@ pub fn shade(shines: &[(u32, f64)]) -> K {
 /// weight of `level` onto the RC stack, and spawn the reflection ray
 /// `d - 2 (d.N) N` where the hit surface reflects (Ks > 0); the others sleep.
 pub fn reflect_setup(level: u32) -> K {
+    reflect_setup_with(level, false)
+}
+
+/// [`reflect_setup`] for scenes with smooth triangles: where the mirror
+/// direction about the shading normal would go below the surface
+/// (`r.Ng <= 0`), the mirror direction about the geometric normal
+/// `ram::SH_NG`, as the reference does.
+pub fn reflect_setup_smooth(level: u32) -> K {
+    reflect_setup_with(level, true)
+}
+
+fn reflect_setup_with(level: u32, smooth: bool) -> K {
     let base = ram::STACK + ram::STACK_FRAME * level;
     let mut k = K::default();
     k.c(format!("ld r8, [r0 + #{}]", ram::SH_KS))
@@ -1360,6 +1461,24 @@ pub fn reflect_setup(level: u32) -> K {
         k.cq(format!("ldacc r{x}, <<14"))
             .c(format!("msu out, r14, r{n}"))
             .cq(format!("msu r{d}, r14, r{n}, >>14"));
+    }
+    if smooth {
+        for (i, n) in [11, 12, 13].into_iter().enumerate() {
+            k.c(format!("ld r{n}, [r0 + #{}]", ram::SH_NG + i as u32));
+        }
+        k.c("mul out, r4, r11")
+            .c("mac out, r5, r12")
+            .cq("mac r15, r6, r13, >>14")
+            .c("mul out, r8, r11")
+            .c("mac out, r9, r12")
+            .cq("mac r14, r10, r13, >>14")
+            .c("cmp.le r15, #0");
+        for (d, x, n) in [(4, 8, 11), (5, 9, 12), (6, 10, 13)] {
+            k.cq(format!("ldacc r{x}, <<14"))
+                .c(format!("msu out, r14, r{n}"))
+                .cq(format!("msu r15, r14, r{n}, >>14"))
+                .c(format!("(f) mov r{d}, r15"));
+        }
     }
     k.c(format!("ld r7, [r0 + #{}]", ram::C_INF))
         .c(format!("st r7, [#{}]", ram::PASS_T0));

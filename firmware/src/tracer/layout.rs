@@ -59,16 +59,20 @@ pub enum ChipType {
     Polygon,
     /// Cones with unequal radii (tested after the cylinders).
     Cone,
+    /// Triangles with vertex normals (NFF `pp`): the planar test, then the
+    /// normals interpolated at the hit ([`super::kernels::smooth_triangle`]).
+    SmoothTriangle,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 7] = [
+    pub const ALL: [ChipType; 8] = [
         ChipType::Sphere,
         ChipType::Cylinder,
         ChipType::Cone,
         ChipType::Box,
         ChipType::Rectangle,
         ChipType::Triangle,
+        ChipType::SmoothTriangle,
         ChipType::Polygon,
     ];
     pub fn name(self) -> &'static str {
@@ -80,6 +84,17 @@ impl ChipType {
             ChipType::Triangle => "triangle",
             ChipType::Polygon => "polygon",
             ChipType::Cone => "cone",
+            ChipType::SmoothTriangle => "smooth_triangle",
+        }
+    }
+    /// The chip type of an object: its primitive's, and smooth triangles
+    /// apart.
+    fn of_shape(s: &Shape) -> Option<ChipType> {
+        match s {
+            Shape::Triangle {
+                normals: Some(_), ..
+            } => Some(ChipType::SmoothTriangle),
+            _ => ChipType::of(s.prim_type()),
         }
     }
     fn of(p: PrimType) -> Option<ChipType> {
@@ -103,6 +118,9 @@ pub const SPHERE_FINE_WORDS: usize = 11;
 /// the radius).
 pub const SPHERE_FINE_BELOW_LSB: f64 = 64.0;
 pub const PLANAR_WORDS: usize = 20;
+/// Smooth triangle: the planar record with the vertex normals (per axis
+/// `n0, n1, n2`, Q1.14) before the face normal at its end.
+pub const SMOOTH_WORDS: usize = PLANAR_WORDS + 9;
 pub const CYL_BODY_WORDS: usize = 34;
 /// Cylinder group: caps flag, body, base cap, apex cap.
 pub const CYL_WORDS: usize = 1 + CYL_BODY_WORDS + 2 * PLANAR_WORDS;
@@ -331,6 +349,10 @@ impl W {
         for x in v.to_array() {
             self.push(x * k);
         }
+    }
+    /// One component of a unit vector (Q1.14).
+    fn unit_axis(&mut self, x: f64) {
+        self.push(x * Q_UNIT.lsb().recip() * (self.x as f64).exp2());
     }
     fn col(&mut self, x: f64) {
         self.push(x * Q_MATERIAL.lsb().recip() * (self.x as f64).exp2());
@@ -675,7 +697,7 @@ fn build_as(
     let mut by: Vec<Vec<usize>> = vec![Vec::new(); ChipType::ALL.len()];
     let mut slot = vec![(0usize, 0usize); scene.objects.len()];
     for (i, o) in scene.objects.iter().enumerate() {
-        let Some(t) = ChipType::of(o.shape.prim_type()) else {
+        let Some(t) = ChipType::of_shape(&o.shape) else {
             return Err(err(
                 o.line,
                 "internal: a primitive type with no chip kernel".into(),
@@ -978,6 +1000,7 @@ fn build_as(
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
             ChipType::Rectangle | ChipType::Triangle => PLANAR_WORDS,
+            ChipType::SmoothTriangle => SMOOTH_WORDS,
             ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS,
         };
         let first = w.fb.len();
@@ -1153,6 +1176,28 @@ fn build_as(
                     w.raw(i as i64);
                     w.raw(mat_of[o.material] as i64);
                     w.fb.resize(start + size, 0);
+                }
+                (
+                    Shape::Triangle {
+                        normals: Some(ns), ..
+                    },
+                    ChipType::SmoothTriangle,
+                ) => {
+                    // The planar record up to its face normal, the unit
+                    // vertex normals by axis (the kernel's read order), then
+                    // the face normal, obj, mat.
+                    let p = &planars[i][0];
+                    write_planar(&mut w, p, i, mat_of[o.material]);
+                    w.fb.truncate(w.fb.len() - 5);
+                    let ns = ns.map(|n| n.normalized());
+                    for c in 0..3 {
+                        for n in &ns {
+                            w.unit_axis(n.axis(c));
+                        }
+                    }
+                    w.unit(p.n);
+                    w.raw(i as i64);
+                    w.raw(mat_of[o.material] as i64);
                 }
                 _ => {
                     for p in &planars[i] {

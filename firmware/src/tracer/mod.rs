@@ -493,14 +493,14 @@ fn build_one(
 /// What the chip does not render as `scene` asks, one [`Warning`] per
 /// feature (the count of objects and the first line): transmitting
 /// materials (no refracted rays; one-sided where the reference makes such
-/// objects two-sided), `pp` vertex normals (shaded with the face normal),
-/// and values the scene compiler clamped to its formats (`notes`, from
+/// objects two-sided) and values the scene compiler clamped to its formats
+/// (`notes`, from
 /// [`Report::notes`]). The scene's own warnings (skipped degenerate
 /// objects) are in [`Scene::warnings`].
 ///
 /// [`Warning`]: crate::scene::Warning
 pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crate::scene::Warning> {
-    use crate::scene::{Shape, Warning};
+    use crate::scene::Warning;
     let mut out = Vec::new();
     let mut add = |feature: &str, hits: Vec<usize>, message: String| {
         if let Some(&line) = hits.first() {
@@ -544,31 +544,7 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
             )
         },
     );
-    let smooth: Vec<usize> = scene
-        .objects
-        .iter()
-        .filter(|o| {
-            matches!(
-                o.shape,
-                Shape::Triangle {
-                    normals: Some(_),
-                    ..
-                }
-            )
-        })
-        .map(|o| o.line)
-        .collect();
-    let n = smooth.len();
-    add(
-        "vertex-normals",
-        smooth,
-        format!(
-            "{} vertex normals (NFF pp): the chip shades {} with the face normal where the reference interpolates them",
-            plural(n, "triangle has", "triangles have"),
-            if n == 1 { "it" } else { "them" }
-        ),
-    );
-    for note in notes.iter().filter(|n| !n.starts_with("vertex normals")) {
+    for note in notes {
         out.push(Warning {
             feature: "clamped".into(),
             file: scene.source.clone(),
