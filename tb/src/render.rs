@@ -153,8 +153,16 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
 /// Kernels whose runs start an object test (their RCs at the first context
 /// are the rays tested), and the kernel that starts a ray pass (its RCs are
 /// the pass's rays).
-const TEST_KERNELS: [&str; 8] = [
-    "k_sphere", "k_cyl", "k_cone", "k_box", "k_rect", "k_tri", "k_tris", "k_polyh",
+const TEST_KERNELS: [&str; 9] = [
+    "k_sphere",
+    "k_gsphere",
+    "k_cyl",
+    "k_cone",
+    "k_box",
+    "k_rect",
+    "k_tri",
+    "k_tris",
+    "k_polyh",
 ];
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
@@ -188,6 +196,9 @@ fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
         match ctx(&format!("k_refl{l}")) {
             Some(a) => w.tag(a, RAY_REFLECT),
             None => break,
+        }
+        if let Some(a) = ctx(&format!("k_refr{l}")) {
+            w.tag(a, RAY_REFRACT);
         }
     }
     w

@@ -39,12 +39,21 @@ impl Lcg {
 /// Run the kernels of `shape` (in a one-object scene) for 64 rays on the
 /// chip of datapath `W`. Returns per lane (t in scene LSBs or None,
 /// normal), and the LSB.
-fn run<W: Word>(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>, f64) {
-    k::with_datapath(W::DATAPATH, || run_in::<W>(shape, rays))
+fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(f64, Vec3)>>, f64) {
+    k::with_datapath(W::DATAPATH, || run_in::<W>(shape, rays, transmit))
 }
 
-fn run_in<W: Word>(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>, f64) {
+/// `transmit`: the object's material transmits (two-sided kernels).
+fn run_in<W: Word>(
+    shape: Shape,
+    rays: &[Ray; 64],
+    transmit: bool,
+) -> (Vec<Option<(f64, Vec3)>>, f64) {
     let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
+    if transmit {
+        scene.materials[0].t = 0.8;
+        scene.materials[0].ior = 1.5;
+    }
     scene.objects = vec![Object {
         shape,
         material: 0,
@@ -75,6 +84,13 @@ fn run_in<W: Word>(shape: Shape, rays: &[Ray; 64]) -> (Vec<Option<(f64, Vec3)>>,
         ChipType::Triangle => (
             vec![("k_tri", first)],
             vec![("k_tri", k::planar(Inside::Triangle, lay.kt_tri, 2))],
+        ),
+        ChipType::GlassSphere => (
+            vec![("k_gsphere", first)],
+            vec![(
+                "k_gsphere",
+                k::sphere_two_sided(lay.ks_sphere, lay.ep_sphere, 2, lay.sphere_fine),
+            )],
         ),
         ChipType::SmoothTriangle => (
             vec![("k_tris", first)],
@@ -238,11 +254,37 @@ fn measure(name: &str, shape: Shape, max_t_lsb: f64, max_n: f64) {
 /// Measure the kernel on the chip of datapath `W`: errors of `t` in LSBs of
 /// that chip's scene format.
 fn measure_on<W: Word>(name: &str, shape: Shape, max_t_lsb: f64, max_mean: f64, max_n: f64) {
+    measure_sides::<W>(name, shape, false, max_t_lsb, max_mean, max_n)
+}
+
+/// [`measure_on`]; `two_sided`: the object transmits (its kernel and the
+/// reference test both sides) and half the rays start inside it.
+fn measure_sides<W: Word>(
+    name: &str,
+    shape: Shape,
+    two_sided: bool,
+    max_t_lsb: f64,
+    max_mean: f64,
+    max_n: f64,
+) {
     let mut disagree = 0;
     let (mut worst_t, mut sum_t, mut worst_n, mut hits) = (0.0f64, 0.0f64, 0.0f64, 0);
     for seed in 1..=4u64 {
-        let rs = rays(&shape, seed);
-        let (chip, lsb) = run::<W>(shape.clone(), &rs);
+        let mut rs = rays(&shape, seed);
+        if two_sided {
+            // Half the rays from inside: from the centre region outwards.
+            let c = shape.bounds().center();
+            let e = shape.bounds().extent() * 0.2;
+            let mut g = Lcg(seed * 77);
+            for r in rs.iter_mut().skip(32) {
+                r.o = c + Vec3::new(
+                    e.x * g.range(-1.0, 1.0),
+                    e.y * g.range(-1.0, 1.0),
+                    e.z * g.range(-1.0, 1.0),
+                );
+            }
+        }
+        let (chip, lsb) = run::<W>(shape.clone(), &rs, two_sided);
         for (r, c) in rs.iter().zip(&chip) {
             // The float reference on the ray the chip actually traced.
             let ro = Ray {
@@ -253,15 +295,18 @@ fn measure_on<W: Word>(name: &str, shape: Shape, max_t_lsb: f64, max_mean: f64, 
                 ),
                 d: r.d,
             };
-            let f = intersect(&shape, &ro, 0.0, f64::INFINITY, false);
+            let f = intersect(&shape, &ro, 0.0, f64::INFINITY, two_sided);
             match (f, c) {
                 (Some(f), Some((t, n))) => {
                     let e = (f.t / lsb - t).abs();
                     worst_t = worst_t.max(e);
                     sum_t += e;
                     // The shading normal: the geometric one but for `pp`
-                    // triangles.
-                    worst_n = worst_n.max((f.ns - *n).length());
+                    // triangles; turned to the ray's side (the chip's
+                    // normal faces the ray, as the tracer turns the
+                    // reference's).
+                    let ns = if f.front { f.ns } else { -f.ns };
+                    worst_n = worst_n.max((ns - *n).length());
                     hits += 1;
                 }
                 (None, None) => {}
@@ -307,6 +352,22 @@ fn tiny_sphere_kernel_vs_float_sphere() {
 #[test]
 fn sphere_kernel_vs_float_sphere() {
     measure("sphere", shape_sphere(), 12.0, 0.02);
+}
+
+/// The transmitting sphere's two-sided kernel: rays from outside hit the
+/// near side, rays from inside the far side with the normal turned
+/// inwards, as the reference's two-sided test; on both datapaths.
+#[test]
+fn glass_sphere_kernel_vs_float_two_sided_sphere() {
+    measure_sides::<i16>("glass sphere", shape_sphere(), true, 12.0, 1.5, 0.02);
+    measure_sides::<i32>(
+        "glass sphere",
+        shape_sphere(),
+        true,
+        12.0 * 65536.0,
+        1.5 * 65536.0,
+        1e-4,
+    );
 }
 
 fn shape_cylinder() -> Shape {

@@ -28,18 +28,27 @@ const HEAD: &str = "v\nfrom 0 0 8\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nre
 
 /// Render `text` (an NFF scene) at 32x32, depth `depth`: the JSON, stderr.
 fn render(text: &str, depth: u32) -> (serde_json::Value, String) {
+    render_with(text, &["--size", "32x32", "--depth", &depth.to_string()])
+}
+
+/// Render `text` (an NFF scene) with `args`: the JSON, stderr.
+fn render_with(text: &str, args: &[&str]) -> (serde_json::Value, String) {
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(dir.path().join("s.nff"), text).unwrap();
-    let d = depth.to_string();
-    let (ok, out, err) = morphosys(
-        dir.path(),
-        &[
-            "render", "s.nff", "--size", "32x32", "--depth", &d, "--out", "s.png", "--json",
-            "s.json",
-        ],
-    );
+    let mut a = vec!["render", "s.nff", "--out", "s.png", "--json", "s.json"];
+    a.extend_from_slice(args);
+    let (ok, out, err) = morphosys(dir.path(), &a);
     assert!(ok, "{out}{err}");
     (json(&dir.path().join("s.json")), err)
+}
+
+/// Chip and reference counts of `kind` within `tol` (a fraction).
+fn census_close(j: &serde_json::Value, kind: &str, tol: f64) {
+    let (c, r) = (
+        j[kind].as_f64().unwrap(),
+        j["reference_rays"][kind].as_f64().unwrap(),
+    );
+    assert!((c - r).abs() <= tol * r, "{kind}: chip {c}, reference {r}");
 }
 
 #[test]
@@ -80,13 +89,14 @@ fn degenerate_triangles_are_skipped_and_the_rest_rendered() {
 
 #[test]
 fn what_the_chip_does_not_render_is_named() {
-    // A glass sphere (line 11) beside a diffuse one.
+    // A glass triangle (line 11; the chip refracts through spheres only so
+    // far) before a diffuse sphere.
     let text = format!(
-        "{HEAD}f 1 1 1 0.1 0.1 30 0.9 1.5\ns 0 0 0 1\nf 0.8 0.4 0.2 1 0 0 0 0\ns 2 0 -1 1\n"
+        "{HEAD}f 1 1 1 0.1 0.1 30 0.9 1.5\np 3\n-2 -2 1\n2 -2 1\n0 2 1\nf 0.8 0.4 0.2 1 0 0 0 0\ns 0 0 -1 1\n"
     );
     let (j, err) = render(&text, 2);
     assert!(
-        err.contains("s.nff:11: warning: 1 object has a transmitting material (T > 0): the chip traces no refracted rays"),
+        err.contains("s.nff:11: warning: 1 object that is not a sphere has a transmitting material (T > 0): the chip refracts only through spheres so far"),
         "{err}"
     );
     let w = j["warnings"].as_array().unwrap();
@@ -102,6 +112,72 @@ fn what_the_chip_does_not_render_is_named() {
         "{j}"
     );
     assert_eq!(j["refract_rays"], 0);
+}
+
+/// A glass sphere before a checkered wall: seen through it, the wall
+/// appears inverted and magnified, as in the reference; refracted rays to
+/// depth 5 (the SPD's) on both datapaths.
+#[test]
+fn glass_sphere_before_a_checkered_wall() {
+    let mut text = String::from(
+        "v\nfrom 0 0.5 6\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 64 64\n\
+         b 0.2 0.3 0.5\nl 3 6 8\nf 1 1 1 0.1 0.2 60 0.85 1.5\ns 0 0 0 1\n",
+    );
+    for (k, colour) in ["0.9 0.1 0.1", "0.9 0.9 0.9"].into_iter().enumerate() {
+        text += &format!("f {colour} 1 0 0 0 1\n");
+        for i in -4..4i32 {
+            for j in -4..4i32 {
+                if (i + j).rem_euclid(2) as usize == k {
+                    let (a, b) = (i as f64, j as f64);
+                    let (a1, b1) = (a + 1.0, b + 1.0);
+                    text += &format!("p 4\n{a} {b} -3\n{a1} {b} -3\n{a1} {b1} -3\n{a} {b1} -3\n");
+                }
+            }
+        }
+    }
+    // (16-bit: 29.5 dB at 64x64, 33.0 at 128x128: the sphere magnifies
+    // direction rounding near its rim.)
+    for (datapath, min_db) in [("16", 27.0), ("32", 60.0)] {
+        let (j, err) = render_with(
+            &text,
+            &["--size", "64x64", "--depth", "5", "--datapath", datapath],
+        );
+        assert!(!err.contains("warning"), "{err}");
+        let psnr = j["psnr_db"].as_f64().unwrap();
+        assert!(psnr >= min_db, "{datapath}-bit: {psnr:.2} dB\n{j}");
+        assert!(j["refract_rays"].as_u64().unwrap() > 500, "{j}");
+        for k in ["eye_rays", "shadow_rays", "reflect_rays", "refract_rays"] {
+            census_close(&j, k, 0.1);
+        }
+    }
+}
+
+/// Rays inside a glass sphere meeting its surface at grazing angles are
+/// totally reflected (no refracted ray), the others leave it: the camera
+/// sits inside, near the top, looking along it.
+#[test]
+fn total_internal_reflection_at_grazing_angles() {
+    let text = "v\nfrom 0 0 0.75\nat 1 0 0.75\nup 0 0 1\nangle 90\nhither 0.01\nresolution 64 64\n\
+                b 0.2 0.3 0.5\nl 0 0 0.5\nf 1 1 1 0.1 0.3 40 0.8 1.5\ns 0 0 0 1\n\
+                f 0.9 0.2 0.1 1 0 0 0 0\ns 3 0 0 1\ns 0 3 0 1\ns 0 -3 0 1\n";
+    let (j, _) = render_with(
+        text,
+        &["--size", "64x64", "--depth", "3", "--datapath", "32"],
+    );
+    let r = &j["reference_rays"];
+    let (refl, refr) = (
+        r["reflect_rays"].as_u64().unwrap(),
+        r["refract_rays"].as_u64().unwrap(),
+    );
+    // Some rays refract, many are totally reflected.
+    assert!(refr > 1000 && refr < refl / 2, "{r}");
+    census_close(&j, "refract_rays", 0.01);
+    assert!(j["psnr_db"].as_f64().unwrap() >= 60.0, "{j}");
+    let (j16, _) = render_with(
+        text,
+        &["--size", "64x64", "--depth", "3", "--datapath", "16"],
+    );
+    census_close(&j16, "refract_rays", 0.1);
 }
 
 /// The bundled `pp` mesh (a torus of 576 triangles with vertex normals):

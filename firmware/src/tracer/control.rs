@@ -96,7 +96,14 @@ pub fn program(
     };
     // Smooth triangles: the shading normal and the reflection's fallback.
     let smooth = lay.types.iter().any(|x| x.ty == ChipType::SmoothTriangle);
-    let post = if smooth { k::post_smooth } else { k::post };
+    let refract = lay.refract;
+    let post = |level0: bool, m: usize, eps: i32| {
+        if smooth || refract {
+            k::post_ext(level0, m, eps, smooth, refract)
+        } else {
+            k::post(level0, m, eps)
+        }
+    };
     let reflect_setup = if smooth {
         k::reflect_setup_smooth
     } else {
@@ -124,6 +131,14 @@ pub fn program(
     for l in 0..levels.saturating_sub(1) {
         refl.push((format!("k_refl{l}"), reflect_setup(l)));
         refl.push((format!("k_pop{l}"), k::reflect_pop(l)));
+        if refract {
+            refl.push((
+                format!("k_tset{l}"),
+                k::refract_prepare(l, lay.transmit_materials, nm.approx()),
+            ));
+            refl.push((format!("k_refr{l}"), k::refract_setup(l)));
+            refl.push((format!("k_rpop{l}"), k::refract_pop(l)));
+        }
     }
     if lay.stream.is_some() && !packet {
         refl.push(("k_leafcu".into(), k::leaf_closest_ordered()));
@@ -140,6 +155,12 @@ pub fn program(
         objk.push((
             "k_sphere",
             k::sphere_with(lay.ks_sphere, lay.ep_sphere, nm.approx(), lay.sphere_fine),
+        ));
+    }
+    if has(ChipType::GlassSphere) {
+        objk.push((
+            "k_gsphere",
+            k::sphere_two_sided(lay.ks_sphere, lay.ep_sphere, nm.approx(), lay.sphere_fine),
         ));
     }
     if has(ChipType::Cylinder) {
@@ -319,14 +340,54 @@ NSTACK: .space 256\n"
             sb(w, "k_shade", format!("{}", lay.shades[i]));
         }
     };
-    shade_level(w, 0);
-    for l in 0..levels.saturating_sub(1) {
-        cb(w, &format!("k_refl{l}"));
-        shade_level(w, l + 1);
+    // The ray tree, depth first: a level's shading, then its reflected
+    // ray's subtree and, where the scene refracts, its refracted ray's
+    // (skipped when no ray of the tile refracts there).
+    fn tree(
+        w: &mut String,
+        level: u32,
+        levels: u32,
+        refract: bool,
+        transmit: usize,
+        skips: &mut u32,
+        shade_level: &dyn Fn(&mut String, u32),
+    ) {
+        shade_level(w, level);
+        if level + 1 >= levels {
+            return;
+        }
+        if refract {
+            let _ = writeln!(
+                w,
+                "        li r1, {}\n        li r2, {transmit}\n        sbcb r1, r2, {}",
+                kaddr(&format!("k_tset{level}")),
+                klen(&format!("k_tset{level}"))
+            );
+        }
+        cb(w, &format!("k_refl{level}"));
+        tree(w, level + 1, levels, refract, transmit, skips, shade_level);
+        cb(w, &format!("k_pop{level}"));
+        if refract {
+            *skips += 1;
+            let skip = format!("norefr{}", *skips);
+            cb(w, &format!("k_refr{level}"));
+            let _ = writeln!(w, "        rcany r1\n        beqz r1, {skip}");
+            tree(w, level + 1, levels, refract, transmit, skips, shade_level);
+            let _ = writeln!(w, "{skip}:");
+            cb(w, "k_wake");
+            cb(w, &format!("k_rpop{level}"));
+        }
     }
-    for l in (0..levels.saturating_sub(1)).rev() {
-        cb(w, &format!("k_pop{l}"));
-    }
+    let mut skips = 0;
+    tree(
+        w,
+        0,
+        levels.max(1),
+        lay.refract,
+        lay.transmit,
+        &mut skips,
+        &shade_level,
+    );
     // Output: four words per lane through the FB, then DMA to memory.
     let _ = writeln!(
         w,
@@ -927,6 +988,7 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
     };
     match ty {
         ChipType::Sphere => one(w, "k_sphere"),
+        ChipType::GlassSphere => one(w, "k_gsphere"),
         ChipType::Rectangle => one(w, "k_rect"),
         ChipType::Triangle => one(w, "k_tri"),
         ChipType::SmoothTriangle => one(w, "k_tris"),

@@ -109,6 +109,16 @@ pub mod ram {
     pub const HIT_NS: u32 = 341; // 3
     pub const HIT_NS_OBJ: u32 = 344;
     pub const SH_NG: u32 = 345; // 3
+    /// Two-sided (transmitting) objects: the id of the closest one hit
+    /// from its back so far (-1: none), and whether the hit being shaded
+    /// is such a back hit (the ray leaves the object).
+    pub const HIT_BACK_OBJ: u32 = 348;
+    pub const SH_BACK: u32 = 349;
+    /// The refraction stack: per recursion level, the refracted ray's
+    /// origin (3), direction (3) and weight T (0: none), set up before the
+    /// level's reflection and traced after it.
+    pub const REFR: u32 = 350;
+    pub const REFR_FRAME: u32 = 7;
     /// Packet traversal ([`super::super::Traversal::Packet`]): 1 while the
     /// ray takes part in the current pass (it may be woken at a pop).
     pub const P_ALIVE: u32 = 400;
@@ -436,6 +446,25 @@ pub fn sphere(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
 /// `b` (its remainder below 1 LSB, read back with `accl`, is subtracted
 /// along `d` as well): `p = (c - o) + cl - b d` to 2^-ep LSB.
 pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
+    sphere_sides(ks, ep, nr, fine, false)
+}
+
+/// A ray starting on a two-sided surface ignores hits closer than this
+/// (LSB of the 16-bit chip's scene format; the same distance on the 32-bit
+/// chip): its own surface, however the start point was rounded (the
+/// reference nudges the start off the surface instead).
+pub const SELF_LSB: i32 = 4;
+
+/// The sphere of a transmitting material, visible from both sides (the
+/// reference's rule): where the near root is not ahead of the ray (by
+/// more than [`SELF_LSB`]) the far root, with the normal turned to the
+/// ray; a hit on the far side records the object in `ram::HIT_BACK_OBJ`.
+/// The record is the sphere's ([`sphere_with`]).
+pub fn sphere_two_sided(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
+    sphere_sides(ks, ep, nr, fine, true)
+}
+
+fn sphere_sides(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, two: bool) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("sphere: oc = c - o");
@@ -476,12 +505,35 @@ pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
         .cq("msu r15, r10, r10, >>14")
         .c("cmp.gt r15, #0");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
-    k.c(format!("mul r9, r12, r8, >>{}", q(14) + er)) // h
-        .c("mov r10, fb0") // sg
-        .cq("mul r9, r9, r10, >>14")
-        .c("sub r9, r11, r9") // t
-        .c("(f) cmp.gt r9, #0")
-        .c("(f) cmp.lt r9, r7");
+    if two {
+        k.c(format!("mul r9, r12, r8, >>{}", q(14) + er)) // h
+            .c("mov r10, fb0") // sg
+            .cq("mul r14, r9, r10, >>14")
+            .c("sub r9, r11, r14") // t1 = b - sg h
+            .c("movb r15, #0")
+            .c("(f) movb r15, #1")
+            .c("movb r12, #0")
+            .c(format!("movb r13, #{SELF_LSB}"));
+        if extra_bits() > 0 {
+            // the margin in LSB of the 16-bit chip's format
+            k.c(format!("sll r13, r13, #{}", extra_bits()));
+        }
+        k.c("cmp.le r9, r13")
+            .c("(f) add r9, r11, r14") // t2 = b + sg h
+            .c("(f) neg r10, r10")
+            .c("(f) movb r12, #1")
+            .c(format!("st r12, [#{}]", ram::TMP3))
+            .c("cmp.ne r15, #0")
+            .c("(f) cmp.gt r9, r13")
+            .c("(f) cmp.lt r9, r7");
+    } else {
+        k.c(format!("mul r9, r12, r8, >>{}", q(14) + er)) // h
+            .c("mov r10, fb0") // sg
+            .cq("mul r9, r9, r10, >>14")
+            .c("sub r9, r11, r9") // t
+            .c("(f) cmp.gt r9, #0")
+            .c("(f) cmp.lt r9, r7");
+    }
     k.comment("normal = -(sg p/r + sqrt(s) d)");
     for (i, (x, d)) in [(11, 4), (12, 5), (13, 6)].into_iter().enumerate() {
         k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP0 + i as u32))
@@ -493,8 +545,20 @@ pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
     for (i, x) in [11, 12, 13].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
-        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    if two {
+        // HIT_BACK_OBJ = obj where the far side was hit, else -1.
+        k.c("mov r8, fb0")
+            .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ))
+            .c(format!("ld r9, [r0 + #{}]", ram::TMP3))
+            .c("neg r9, r9")
+            .c("add r13, r8, #1")
+            .c("and r13, r13, r9")
+            .c("sub r13, r13, #1")
+            .c(format!("(f) st r13, [#{}]", ram::HIT_BACK_OBJ));
+    } else {
+        k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
     k
 }
 
@@ -650,6 +714,30 @@ pub fn smooth_triangle(kt: u32, nr: impl Into<Approx>) -> K {
 /// reference's rule: otherwise the face normal).
 pub fn post_smooth(level0: bool, materials: usize, eps: i32) -> K {
     let mut k = post(level0, materials, eps);
+    smooth_normal(&mut k);
+    k
+}
+
+/// [`post`] with the extensions the scene's types need: smooth triangles
+/// ([`post_smooth`]) and refraction (whether the hit is on an object's
+/// back, `ram::SH_BACK`, for the index of refraction).
+pub fn post_ext(level0: bool, materials: usize, eps: i32, smooth: bool, refract: bool) -> K {
+    let mut k = post(level0, materials, eps);
+    if smooth {
+        smooth_normal(&mut k);
+    }
+    if refract {
+        k.c(format!("ld r8, [r0 + #{}]", ram::HIT_BACK_OBJ))
+            .c(format!("ld r9, [r0 + #{}]", ram::HIT_OBJ))
+            .c("movb r10, #0")
+            .c("cmp.eq r8, r9")
+            .c("(f) movb r10, #1")
+            .c(format!("st r10, [#{}]", ram::SH_BACK));
+    }
+    k
+}
+
+fn smooth_normal(k: &mut K) {
     for i in 0..3 {
         k.c(format!("ld r{}, [r0 + #{}]", 8 + i, ram::HIT_N + i))
             .c(format!("st r{}, [#{}]", 8 + i, ram::SH_NG + i))
@@ -665,7 +753,6 @@ pub fn post_smooth(level0: bool, materials: usize, eps: i32) -> K {
     for i in 0..3 {
         k.c(format!("(f) st r{}, [#{}]", 11 + i, ram::SH_N + i));
     }
-    k
 }
 
 /// Axis-aligned box, visible from outside (slab method, one section per
@@ -1490,6 +1577,116 @@ fn reflect_setup_with(level: u32, smooth: bool) -> K {
         .c("cmp.ne r9, #0")
         .c("(f) cmp.gt r8, #0")
         .c("(!f) sleep");
+    k
+}
+
+/// Refraction set-up of recursion level `level` (before its reflection):
+/// where the hit surface transmits (stream per transmitting material: `id,
+/// T, 1/ior, ior`, Q3.12), the refracted direction by Snell's law,
+/// `eta = 1/ior` entering (a front hit) and `ior` leaving (a back hit,
+/// `ram::SH_BACK`), `c1 = -d.N`, `k = 1 - eta^2 (1 - c1^2)`,
+/// `T = eta d + (eta c1 - sqrt(k)) N` (normalised); none where `k <= 0`
+/// (total internal reflection). Pushed into `ram::REFR` with the hit point
+/// and the weight (0 where no ray is spawned) for [`refract_setup`].
+pub fn refract_prepare(level: u32, materials: usize, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
+    let rf = ram::REFR + ram::REFR_FRAME * level;
+    let mut k = K::default();
+    k.c(format!("ld r8, [r0 + #{}]", ram::ACT))
+        .c(format!("ld r9, [r0 + #{}]", ram::SH_MAT))
+        .c(format!("ld r10, [r0 + #{}]", ram::SH_BACK))
+        .c("movb r12, #0")
+        .c("movb r13, #0");
+    for _ in 0..materials {
+        k.c("cmp.ne r8, #0")
+            .c("(f) cmp.eq fb0, r9")
+            .c("(f) mov r12, fb0")
+            .c("(f) mov r13, fb0")
+            .c("(f) cmp.ne r10, #0")
+            .c("(f) mov r13, fb0");
+    }
+    k.comment("c1 = -d.N, k = 1 - eta^2 (1 - c1^2)");
+    for (i, x) in [1, 2, 3].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::SH_D + i as u32));
+    }
+    for (i, x) in [4, 5, 6].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::SH_N + i as u32));
+    }
+    k.c("mul out, r1, r4")
+        .c("mac out, r2, r5")
+        .cq("mac r7, r3, r6, >>14")
+        .c("neg r7, r7")
+        .cq("mul r11, r7, r7, >>14")
+        .c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("sub r11, r14, r11")
+        .cq("mul r11, r13, r11, >>14")
+        .cq("ldacc r14, <<10")
+        .cq("msu r15, r13, r11, >>10")
+        .c("cmp.le r15, #0")
+        .c("(f) movb r12, #0")
+        .c("max r15, r15, #1");
+    sqrt_q14(&mut k, 15, 11, [8, 9, 10, 14], nr);
+    k.comment("T = eta d + (eta c1 - sqrt(k)) N");
+    k.cq("mul r10, r13, r7, >>14")
+        .c("sra r11, r11, #2")
+        .c("sub r10, r10, r11");
+    for (x, d, n) in [(8, 1, 4), (9, 2, 5), (14, 3, 6)] {
+        k.c(format!("mul out, r13, r{d}"))
+            .cq(format!("mac r{x}, r10, r{n}, >>12"));
+    }
+    normalize(&mut k, [8, 9, 14], [1, 2, 3, 4, 5], false, nr);
+    for i in 0..3 {
+        k.c(format!("ld r1, [r0 + #{}]", ram::SH_P + i))
+            .c(format!("st r1, [#{}]", rf + i));
+    }
+    k.c(format!("st r8, [#{}]", rf + 3))
+        .c(format!("st r9, [#{}]", rf + 4))
+        .c(format!("st r14, [#{}]", rf + 5))
+        .c(format!("st r12, [#{}]", rf + 6));
+    k
+}
+
+/// After the reflection of level `level` returned: push the colour so far
+/// and spawn the refracted ray that [`refract_prepare`] set up; the rays
+/// with none sleep (F = 1 on the awake ones, for `rcany`).
+pub fn refract_setup(level: u32) -> K {
+    let base = ram::STACK + ram::STACK_FRAME * level;
+    let rf = ram::REFR + ram::REFR_FRAME * level;
+    let mut k = K::default();
+    k.c("movb r10, #0");
+    for c in 0..3 {
+        k.c(format!("ld r9, [r0 + #{}]", ram::COL + c))
+            .c(format!("st r9, [#{}]", base + c))
+            .c(format!("st r10, [#{}]", ram::COL + c));
+    }
+    for (i, x) in [1, 2, 3, 4, 5, 6].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", rf + i as u32));
+    }
+    k.c(format!("ld r7, [r0 + #{}]", ram::C_INF))
+        .c(format!("st r7, [#{}]", ram::PASS_T0));
+    for (i, d) in [4, 5, 6].into_iter().enumerate() {
+        k.c(format!("st r{d}, [#{}]", ram::SH_D + i as u32));
+    }
+    k.c(format!("ld r8, [r0 + #{}]", rf + 6))
+        .c("cmp.gt r8, #0")
+        .c("(!f) sleep");
+    k
+}
+
+/// Return from the refracted ray of level `level`: colour = pushed +
+/// T * refracted.
+pub fn refract_pop(level: u32) -> K {
+    let base = ram::STACK + ram::STACK_FRAME * level;
+    let rf = ram::REFR + ram::REFR_FRAME * level;
+    let mut k = K::default();
+    k.c(format!("ld r10, [r0 + #{}]", rf + 6));
+    for c in 0..3 {
+        k.c(format!("ld r8, [r0 + #{}]", base + c))
+            .c(format!("ld r9, [r0 + #{}]", ram::COL + c))
+            .cq("mul r9, r9, r10, >>12")
+            .c("adds r9, r8, r9")
+            .c(format!("st r9, [#{}]", ram::COL + c));
+    }
     k
 }
 

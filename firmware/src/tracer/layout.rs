@@ -62,11 +62,15 @@ pub enum ChipType {
     /// Triangles with vertex normals (NFF `pp`): the planar test, then the
     /// normals interpolated at the hit ([`super::kernels::smooth_triangle`]).
     SmoothTriangle,
+    /// Spheres of a transmitting material: two-sided, for rays that enter
+    /// and leave them ([`super::kernels::sphere_two_sided`]).
+    GlassSphere,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 8] = [
+    pub const ALL: [ChipType; 9] = [
         ChipType::Sphere,
+        ChipType::GlassSphere,
         ChipType::Cylinder,
         ChipType::Cone,
         ChipType::Box,
@@ -85,17 +89,24 @@ impl ChipType {
             ChipType::Polygon => "polygon",
             ChipType::Cone => "cone",
             ChipType::SmoothTriangle => "smooth_triangle",
+            ChipType::GlassSphere => "glass_sphere",
         }
     }
-    /// The chip type of an object: its primitive's, and smooth triangles
-    /// apart.
-    fn of_shape(s: &Shape) -> Option<ChipType> {
+    /// The chip type of an object: its primitive's, with smooth triangles
+    /// and transmitting (two-sided) spheres apart.
+    fn of_object(s: &Shape, transmits: bool) -> Option<ChipType> {
         match s {
             Shape::Triangle {
                 normals: Some(_), ..
             } => Some(ChipType::SmoothTriangle),
+            Shape::Sphere { .. } if transmits => Some(ChipType::GlassSphere),
             _ => ChipType::of(s.prim_type()),
         }
+    }
+    /// Types whose kernels test both sides (the reference's rule for
+    /// transmitting objects) and refract.
+    pub fn refracts(self) -> bool {
+        self == ChipType::GlassSphere
     }
     fn of(p: PrimType) -> Option<ChipType> {
         Some(match p {
@@ -161,6 +172,12 @@ pub struct Layout {
     pub frac: u32,
     pub eye: usize,
     pub post: usize,
+    /// FB address of the refraction table (`id, T, 1/ior, ior` per
+    /// transmitting material) and its entries; `refract`: the scene has
+    /// refracting objects (the ray tree branches).
+    pub transmit: usize,
+    pub transmit_materials: usize,
+    pub refract: bool,
     pub lights: Vec<usize>,
     pub shades: Vec<usize>,
     pub types: Vec<TypeInfo>,
@@ -697,7 +714,7 @@ fn build_as(
     let mut by: Vec<Vec<usize>> = vec![Vec::new(); ChipType::ALL.len()];
     let mut slot = vec![(0usize, 0usize); scene.objects.len()];
     for (i, o) in scene.objects.iter().enumerate() {
-        let Some(t) = ChipType::of_shape(&o.shape) else {
+        let Some(t) = ChipType::of_object(&o.shape, scene.materials[o.material].t > 0.0) else {
             return Err(err(
                 o.line,
                 "internal: a primitive type with no chip kernel".into(),
@@ -906,6 +923,25 @@ fn build_as(
         w.raw(i as i64);
         w.col(mt.ks);
     }
+    // Refraction: per transmitting material `id, T, 1/ior, ior` (the
+    // stream of `k_tset`), only when a refracting object uses one.
+    let refract = by.iter().enumerate().any(|(t, v)| {
+        !v.is_empty()
+            && ChipType::ALL
+                .iter()
+                .any(|c| *c as usize == t && c.refracts())
+    });
+    let transmit = w.fb.len();
+    let mut transmit_materials = 0;
+    if refract {
+        for (i, mt) in mats.iter().enumerate().filter(|(_, m)| m.t > 0.0) {
+            w.raw(i as i64);
+            w.col(mt.t);
+            w.col(1.0 / mt.ior);
+            w.col(mt.ior);
+            transmit_materials += 1;
+        }
+    }
     // Lights and shading coefficients.
     let nl = scene.lights.len().max(1) as f64;
     let m = extent(scene);
@@ -994,8 +1030,8 @@ fn build_as(
             continue;
         }
         let size = match t {
-            ChipType::Sphere if sphere_fine => SPHERE_FINE_WORDS,
-            ChipType::Sphere => SPHERE_WORDS,
+            ChipType::Sphere | ChipType::GlassSphere if sphere_fine => SPHERE_FINE_WORDS,
+            ChipType::Sphere | ChipType::GlassSphere => SPHERE_WORDS,
             ChipType::Cylinder => CYL_WORDS,
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
@@ -1238,6 +1274,9 @@ fn build_as(
         shades,
         objects: scene.objects.len(),
         materials: mats.len(),
+        transmit,
+        transmit_materials,
+        refract,
         shines,
         kd,
         ks_sphere,
@@ -1504,6 +1543,9 @@ struct Finish {
     frac: u32,
     eye: usize,
     post: usize,
+    transmit: usize,
+    transmit_materials: usize,
+    refract: bool,
     lights: Vec<usize>,
     shades: Vec<usize>,
     objects: usize,
@@ -1546,6 +1588,9 @@ impl Finish {
             frac: self.frac,
             eye: self.eye,
             post: self.post,
+            transmit: self.transmit,
+            transmit_materials: self.transmit_materials,
+            refract: self.refract,
             lights: self.lights,
             shades: self.shades,
             types,

@@ -524,6 +524,8 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         .objects
         .iter()
         .filter(|o| scene.materials[o.material].t > 0.0)
+        // spheres refract on the chip (two-sided `k_gsphere`)
+        .filter(|o| !matches!(o.shape, crate::scene::Shape::Sphere { .. }))
         .map(|o| o.line)
         .collect();
     let n = transmit.len();
@@ -533,14 +535,14 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         transmit,
         if opt.depth >= 2 {
             format!(
-                "{} a transmitting material (T > 0): the chip traces no refracted rays and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
-                plural(n, "object has", "objects have"),
+                "{} a transmitting material (T > 0): the chip refracts only through spheres so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
+                plural(n, "object that is not a sphere has", "objects that are not spheres have"),
                 if n == 1 { "it renders" } else { "they render" }
             )
         } else {
             format!(
                 "{} a transmitting material (T > 0): the chip tests {them} one-sided (the reference makes {them} two-sided)",
-                plural(n, "object has", "objects have"),
+                plural(n, "object that is not a sphere has", "objects that are not spheres have"),
             )
         },
     );
