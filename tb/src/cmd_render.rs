@@ -423,10 +423,18 @@ pub fn command(a: RenderArgs) -> Result<()> {
     );
     let rs = &j["reference_rays"];
     println!(
-        "rays traced on the chip  eye {}, shadow {}, reflect {}, refract {} (reference: {}, {}, {}, {})",
+        "rays traced on the chip  eye {}, shadow {}, reflect {}, refract {} (reference: {}, {}, {}, {}",
         j["eye_rays"], j["shadow_rays"], j["reflect_rays"], j["refract_rays"],
-        rs["eye_rays"], rs["shadow_rays"], rs["reflect_rays"], rs["refract_rays"]
+        rs["eye_rays"], rs["live_shadow_rays"], rs["live_reflect_rays"], rs["live_refract_rays"]
     );
+    if rs["reflect_rays"] != rs["live_reflect_rays"] {
+        println!(
+            "                         counted as the SPD does, with the zero-weight reflections of Ks = 0 surfaces: {}, {}, {})",
+            rs["shadow_rays"], rs["reflect_rays"], rs["refract_rays"]
+        );
+    } else {
+        println!("                         )");
+    }
     println!(
         "active RC fraction       {:.3}",
         j["active_rc_fraction"].as_f64().unwrap_or(0.0)

@@ -110,7 +110,7 @@ pub fn program(
         k::reflect_setup
     };
     ks.extend([
-        ("k_eye", k::eye(lay.kd, nm.approx())),
+        ("k_eye", k::eye_ext(lay.kd, nm.approx(), refract)),
         ("k_post0", post(true, lay.materials, nm.eps_lsb)),
         ("k_post1", post(false, lay.materials, nm.eps_lsb)),
         ("k_light", k::light_setup(nm.approx(), lay.light_shifted)),
@@ -198,6 +198,26 @@ pub fn program(
         objk.push(("k_polyh", k::polygon_head(nm.approx())));
         objk.push(("k_polye", k::polygon_edge()));
         objk.push(("k_polyt", k::polygon_tail()));
+    }
+    // Transmitting (two-sided) planar types.
+    if has(ChipType::GlassRectangle) {
+        objk.push((
+            "k_grect",
+            k::planar_two_sided(Inside::Rectangle, lay.kt_rect, nm.approx()),
+        ));
+    }
+    if has(ChipType::GlassTriangle) {
+        objk.push((
+            "k_gtri",
+            k::planar_two_sided(Inside::Triangle, lay.kt_tri, nm.approx()),
+        ));
+    }
+    if has(ChipType::GlassPolygon) {
+        objk.push(("k_gpolyh", k::polygon_head_two_sided(nm.approx())));
+        if !has(ChipType::Polygon) {
+            objk.push(("k_polye", k::polygon_edge()));
+        }
+        objk.push(("k_gpolyt", k::polygon_tail_two_sided()));
     }
 
     let mut s = String::new();
@@ -995,20 +1015,27 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::Box => one(w, "k_box"),
         ChipType::Cylinder => capped(w, "k_cyl", CYL_BODY_WORDS),
         ChipType::Cone => capped(w, "k_cone", CONE_BODY_WORDS),
-        ChipType::Polygon => {
+        ChipType::GlassRectangle => one(w, "k_grect"),
+        ChipType::GlassTriangle => one(w, "k_gtri"),
+        ChipType::Polygon | ChipType::GlassPolygon => {
+            let (head, tail) = if ty == ChipType::Polygon {
+                ("k_polyh", "k_polyt")
+            } else {
+                ("k_gpolyh", "k_gpolyt")
+            };
             let _ = writeln!(
                 w,
                 "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        addi r2, r7, {}\n        li r1, {}\n\
 {n}_fan:\n        beqz r3, {n}_tail\n        sbcb r1, r2, {}\n        addi r2, r2, {}\n        addi r3, r3, -1\n        j {n}_fan\n\
 {n}_tail:\n        li r1, {}\n        sbcb r1, r2, {}",
-                kaddr("k_polyh"),
-                klen("k_polyh"),
+                kaddr(head),
+                klen(head),
                 1 + POLY_HEAD_WORDS,
                 kaddr("k_polye"),
                 klen("k_polye"),
                 POLY_EDGE_WORDS,
-                kaddr("k_polyt"),
-                klen("k_polyt")
+                kaddr(tail),
+                klen(tail)
             );
         }
     }

@@ -119,6 +119,11 @@ pub mod ram {
     /// level's reflection and traced after it.
     pub const REFR: u32 = 350;
     pub const REFR_FRAME: u32 = 7;
+    /// Two-sided planar objects: the object the current rays leave (-1:
+    /// none, eye rays), which they do not hit again; per recursion level
+    /// the one the refracted ray leaves.
+    pub const ORIG_OBJ: u32 = 299;
+    pub const ORIG_STACK: u32 = 480; // 8
     /// Packet traversal ([`super::super::Traversal::Packet`]): 1 while the
     /// ray takes part in the current pass (it may be woken at a pop).
     pub const P_ALIVE: u32 = 400;
@@ -577,6 +582,19 @@ pub enum Inside {
 /// plane normal and a vertex from FB set 0, and leaves `t = num / den` in
 /// r9 with F set where the plane is hit in front, closer than `tbest`.
 fn plane_hit(k: &mut K, nr: impl Into<Approx>) {
+    plane_hit_sides(k, nr, false)
+}
+
+/// [`plane_hit`]; `two`: both sides (a transmitting object, the
+/// reference's rule): where the plane is seen from its back, `den` and
+/// `num` change sign (`ram::TMP3` = 1: a back hit). A ray leaving the
+/// object does not hit it again ([`commit_streamed_normal_two`] compares
+/// the object with `ram::ORIG_OBJ`; a distance margin would also drop the
+/// hits of rays starting near an edge on the next face).
+fn plane_hit_sides(k: &mut K, nr: impl Into<Approx>, two: bool) {
+    if two {
+        return plane_hit_two(k, nr);
+    }
     let nr: Approx = nr.into();
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
@@ -599,6 +617,61 @@ fn plane_hit(k: &mut K, nr: impl Into<Approx>) {
     divide(k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
 }
 
+fn plane_hit_two(k: &mut K, nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
+    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .cq("mac r11, r10, r6, >>14");
+    k.c("sub r12, fb0, r1")
+        .c("sub r13, fb0, r2")
+        .c("sub r14, fb0, r3");
+    k.c("mul out, r8, r12")
+        .c("mac out, r9, r13")
+        .cq("mac r15, r10, r14, >>14");
+    k.c("neg r11, r11")
+        .c("neg r15, r15")
+        .c("movb r12, #0")
+        .c("cmp.lt r11, #0")
+        .c("(f) movb r12, #1")
+        .c("(f) neg r11, r11")
+        .c("(f) neg r15, r15")
+        .c(format!("st r12, [#{}]", ram::TMP3))
+        .c("cmp.gt r11, #0")
+        .c("(f) cmp.gt r15, #0")
+        .cq("ldacc r15, <<14")
+        .c("msu out, r7, r11")
+        .c("acch r8")
+        .c("(f) cmp.lt r8, #0");
+    divide(k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
+}
+
+/// [`commit_streamed_normal`] of a two-sided kernel: the streamed normal
+/// turned where the back was hit (`ram::TMP3`), and `ram::HIT_BACK_OBJ`.
+fn commit_streamed_normal_two(k: &mut K, t: u8) {
+    k.c(format!("ld r12, [r0 + #{}]", ram::TMP3))
+        .c("movb r14, #1")
+        .c("sub r14, r14, r12")
+        .c("sub r14, r14, r12") // 1 - 2 back
+        .c("mul r10, fb0, r14")
+        .c("mul r11, fb0, r14")
+        .c("mul r13, fb0, r14")
+        .c("mov r8, fb0")
+        .c(format!("ld r15, [r0 + #{}]", ram::ORIG_OBJ))
+        .c("(f) cmp.ne r8, r15")
+        .c(format!("(f) mov r7, r{t}"));
+    for (i, x) in [10, 11, 13].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+    k.c(format!("(f) st r8, [#{}]", ram::HIT_OBJ))
+        .c("neg r12, r12")
+        .c("add r13, r8, #1")
+        .c("and r13, r13, r12")
+        .c("sub r13, r13, #1")
+        .c(format!("(f) st r13, [#{}]", ram::HIT_BACK_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+}
+
 /// A one-sided planar primitive. Record (20 words):
 /// `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz, n.xyz, obj, mat`, where
 /// `u = (P - v0).eu`, `w = (P - v0).ew` (scaled by 2^kt) are the
@@ -608,10 +681,20 @@ fn plane_hit(k: &mut K, nr: impl Into<Approx>) {
 /// `num 2^14 < tbest den` is done in the 32-bit accumulator before the
 /// division, so the quotient always fits.
 pub fn planar(inside: Inside, kt: u32, nr: impl Into<Approx>) -> K {
+    planar_sides(inside, kt, nr, false)
+}
+
+/// [`planar`] for a transmitting object: both sides ([`plane_hit_sides`]),
+/// the normal turned to the ray, back hits recorded.
+pub fn planar_two_sided(inside: Inside, kt: u32, nr: impl Into<Approx>) -> K {
+    planar_sides(inside, kt, nr, true)
+}
+
+fn planar_sides(inside: Inside, kt: u32, nr: impl Into<Approx>, two: bool) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("planar: den = n.d, num = n.(v0 - o)");
-    plane_hit(&mut k, nr);
+    plane_hit_sides(&mut k, nr, two);
     k.comment("P - v0");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
@@ -646,7 +729,11 @@ pub fn planar(inside: Inside, kt: u32, nr: impl Into<Approx>) -> K {
                 .c("(f) cmp.le r15, r8");
         }
     }
-    commit_streamed_normal(&mut k, 9);
+    if two {
+        commit_streamed_normal_two(&mut k, 9);
+    } else {
+        commit_streamed_normal(&mut k, 9);
+    }
     k
 }
 
@@ -732,7 +819,22 @@ pub fn post_ext(level0: bool, materials: usize, eps: i32, smooth: bool, refract:
             .c("movb r10, #0")
             .c("cmp.eq r8, r9")
             .c("(f) movb r10, #1")
-            .c(format!("st r10, [#{}]", ram::SH_BACK));
+            .c(format!("st r10, [#{}]", ram::SH_BACK))
+            // the rays this hit spawns leave its object
+            .c(format!("ld r8, [r0 + #{}]", ram::ACT))
+            .c("cmp.eq r8, #0")
+            .c("(f) movb r9, #-1")
+            .c(format!("st r9, [#{}]", ram::ORIG_OBJ));
+    }
+    k
+}
+
+/// [`eye`] for scenes with two-sided planar objects: eye rays leave no
+/// object (`ram::ORIG_OBJ` = -1).
+pub fn eye_ext(kd: u32, nr: impl Into<Approx>, refract: bool) -> K {
+    let mut k = eye(kd, nr);
+    if refract {
+        k.c(format!("st r8, [#{}]", ram::ORIG_OBJ));
     }
     k
 }
@@ -828,10 +930,20 @@ pub fn aabox(nr: impl Into<Approx>) -> K {
 /// Tail (5 words: `n.xyz, obj, mat`): commit where valid and the parity
 /// is odd.
 pub fn polygon_head(nr: impl Into<Approx>) -> K {
+    polygon_head_sides(nr, false)
+}
+
+/// [`polygon_head`] for a transmitting polygon: both sides
+/// ([`plane_hit_sides`]); its tail is [`polygon_tail_two_sided`].
+pub fn polygon_head_two_sided(nr: impl Into<Approx>) -> K {
+    polygon_head_sides(nr, true)
+}
+
+fn polygon_head_sides(nr: impl Into<Approx>, two: bool) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("polygon head: the plane");
-    plane_hit(&mut k, nr);
+    plane_hit_sides(&mut k, nr, two);
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
         k.cq(format!("ldacc r{o}, <<14"))
@@ -878,6 +990,17 @@ pub fn polygon_tail() -> K {
         .c("cmp.ne r13, #0")
         .c("(f) cmp.ne r8, #0");
     commit_streamed_normal(&mut k, 9);
+    k
+}
+
+/// [`polygon_tail`] of a transmitting polygon: the normal turned where
+/// the back was hit.
+pub fn polygon_tail_two_sided() -> K {
+    let mut k = K::default();
+    k.c(format!("ld r13, [r0 + #{}]", ram::TMP0))
+        .c("cmp.ne r13, #0")
+        .c("(f) cmp.ne r8, #0");
+    commit_streamed_normal_two(&mut k, 9);
     k
 }
 
@@ -1642,7 +1765,9 @@ pub fn refract_prepare(level: u32, materials: usize, nr: impl Into<Approx>) -> K
     k.c(format!("st r8, [#{}]", rf + 3))
         .c(format!("st r9, [#{}]", rf + 4))
         .c(format!("st r14, [#{}]", rf + 5))
-        .c(format!("st r12, [#{}]", rf + 6));
+        .c(format!("st r12, [#{}]", rf + 6))
+        .c(format!("ld r1, [r0 + #{}]", ram::ORIG_OBJ))
+        .c(format!("st r1, [#{}]", ram::ORIG_STACK + level));
     k
 }
 
@@ -1667,7 +1792,9 @@ pub fn refract_setup(level: u32) -> K {
     for (i, d) in [4, 5, 6].into_iter().enumerate() {
         k.c(format!("st r{d}, [#{}]", ram::SH_D + i as u32));
     }
-    k.c(format!("ld r8, [r0 + #{}]", rf + 6))
+    k.c(format!("ld r8, [r0 + #{}]", ram::ORIG_STACK + level))
+        .c(format!("st r8, [#{}]", ram::ORIG_OBJ))
+        .c(format!("ld r8, [r0 + #{}]", rf + 6))
         .c("cmp.gt r8, #0")
         .c("(!f) sleep");
     k

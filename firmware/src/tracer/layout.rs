@@ -65,10 +65,16 @@ pub enum ChipType {
     /// Spheres of a transmitting material: two-sided, for rays that enter
     /// and leave them ([`super::kernels::sphere_two_sided`]).
     GlassSphere,
+    /// Rectangles, triangles and polygons of a transmitting material
+    /// (two-sided: [`super::kernels::planar_two_sided`],
+    /// [`super::kernels::polygon_head_two_sided`]).
+    GlassRectangle,
+    GlassTriangle,
+    GlassPolygon,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 9] = [
+    pub const ALL: [ChipType; 12] = [
         ChipType::Sphere,
         ChipType::GlassSphere,
         ChipType::Cylinder,
@@ -78,6 +84,9 @@ impl ChipType {
         ChipType::Triangle,
         ChipType::SmoothTriangle,
         ChipType::Polygon,
+        ChipType::GlassRectangle,
+        ChipType::GlassTriangle,
+        ChipType::GlassPolygon,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -90,6 +99,9 @@ impl ChipType {
             ChipType::Cone => "cone",
             ChipType::SmoothTriangle => "smooth_triangle",
             ChipType::GlassSphere => "glass_sphere",
+            ChipType::GlassRectangle => "glass_rectangle",
+            ChipType::GlassTriangle => "glass_triangle",
+            ChipType::GlassPolygon => "glass_polygon",
         }
     }
     /// The chip type of an object: its primitive's, with smooth triangles
@@ -100,13 +112,22 @@ impl ChipType {
                 normals: Some(_), ..
             } => Some(ChipType::SmoothTriangle),
             Shape::Sphere { .. } if transmits => Some(ChipType::GlassSphere),
+            Shape::Rectangle { .. } if transmits => Some(ChipType::GlassRectangle),
+            Shape::Triangle { .. } if transmits => Some(ChipType::GlassTriangle),
+            Shape::Polygon { .. } if transmits => Some(ChipType::GlassPolygon),
             _ => ChipType::of(s.prim_type()),
         }
     }
     /// Types whose kernels test both sides (the reference's rule for
     /// transmitting objects) and refract.
     pub fn refracts(self) -> bool {
-        self == ChipType::GlassSphere
+        matches!(
+            self,
+            ChipType::GlassSphere
+                | ChipType::GlassRectangle
+                | ChipType::GlassTriangle
+                | ChipType::GlassPolygon
+        )
     }
     fn of(p: PrimType) -> Option<ChipType> {
         Some(match p {
@@ -1035,9 +1056,14 @@ fn build_as(
             ChipType::Cylinder => CYL_WORDS,
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
-            ChipType::Rectangle | ChipType::Triangle => PLANAR_WORDS,
+            ChipType::Rectangle
+            | ChipType::Triangle
+            | ChipType::GlassRectangle
+            | ChipType::GlassTriangle => PLANAR_WORDS,
             ChipType::SmoothTriangle => SMOOTH_WORDS,
-            ChipType::Polygon => 1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS,
+            ChipType::Polygon | ChipType::GlassPolygon => {
+                1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS
+            }
         };
         let first = w.fb.len();
         for &i in objs {

@@ -524,8 +524,18 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         .objects
         .iter()
         .filter(|o| scene.materials[o.material].t > 0.0)
-        // spheres refract on the chip (two-sided `k_gsphere`)
-        .filter(|o| !matches!(o.shape, crate::scene::Shape::Sphere { .. }))
+        // spheres, rectangles, flat triangles and polygons refract on the
+        // chip (their two-sided kernels)
+        .filter(|o| {
+            use crate::scene::Shape;
+            !matches!(
+                o.shape,
+                Shape::Sphere { .. }
+                    | Shape::Rectangle { .. }
+                    | Shape::Triangle { normals: None, .. }
+                    | Shape::Polygon { .. }
+            )
+        })
         .map(|o| o.line)
         .collect();
     let n = transmit.len();
@@ -535,14 +545,14 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         transmit,
         if opt.depth >= 2 {
             format!(
-                "{} a transmitting material (T > 0): the chip refracts only through spheres so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
-                plural(n, "object that is not a sphere has", "objects that are not spheres have"),
+                "{} a transmitting material (T > 0): the chip refracts only through spheres, rectangles, flat triangles and polygons so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
+                plural(n, "cone, cylinder, box or smooth triangle has", "cones, cylinders, boxes or smooth triangles have"),
                 if n == 1 { "it renders" } else { "they render" }
             )
         } else {
             format!(
                 "{} a transmitting material (T > 0): the chip tests {them} one-sided (the reference makes {them} two-sided)",
-                plural(n, "object that is not a sphere has", "objects that are not spheres have"),
+                plural(n, "cone, cylinder, box or smooth triangle has", "cones, cylinders, boxes or smooth triangles have"),
             )
         },
     );

@@ -52,6 +52,12 @@ pub struct RayStats {
     pub reflect_rays: u64,
     pub refract_rays: u64,
     pub shadow_rays: u64,
+    /// The rays whose colour reaches a pixel: the SPD counts a reflection
+    /// ray from every surface with Ks > 0 or T > 0, so also those of weight
+    /// Ks = 0 and everything under them; the chip traces only these.
+    pub live_reflect_rays: u64,
+    pub live_refract_rays: u64,
+    pub live_shadow_rays: u64,
 }
 
 impl std::ops::AddAssign for RayStats {
@@ -60,6 +66,9 @@ impl std::ops::AddAssign for RayStats {
         self.eye_hit_rays += o.eye_hit_rays;
         self.reflect_rays += o.reflect_rays;
         self.refract_rays += o.refract_rays;
+        self.live_reflect_rays += o.live_reflect_rays;
+        self.live_refract_rays += o.live_refract_rays;
+        self.live_shadow_rays += o.live_shadow_rays;
         self.shadow_rays += o.shadow_rays;
     }
 }
@@ -174,6 +183,19 @@ impl<'s> Tracer<'s> {
         max_depth: u32,
         stats: &mut RayStats,
     ) -> (Vec3, Option<usize>) {
+        self.trace_live(r, depth, max_depth, true, stats)
+    }
+
+    /// [`Tracer::trace`]; `live`: the ray's colour reaches the pixel (no
+    /// zero weight above it), for the `live_*` counts.
+    fn trace_live(
+        &self,
+        r: &Ray,
+        depth: u32,
+        max_depth: u32,
+        live: bool,
+        stats: &mut RayStats,
+    ) -> (Vec3, Option<usize>) {
         let Some((id, h)) = self.closest(r) else {
             return (self.scene.background, None);
         };
@@ -193,6 +215,7 @@ impl<'s> Tracer<'s> {
                 continue; // the SPD's rule: no shadow ray
             }
             stats.shadow_rays += 1;
+            stats.live_shadow_rays += live as u64;
             let o = self.offset(p, n, l);
             let shadow = Ray { o, d: l };
             if self
@@ -213,6 +236,8 @@ impl<'s> Tracer<'s> {
         }
         if depth < max_depth && (m.ks > 0.0 || m.t > 0.0) {
             stats.reflect_rays += 1;
+            let live = live && m.ks > 0.0;
+            stats.live_reflect_rays += live as u64;
             let d = r.d - ns * (2.0 * r.d.dot(ns));
             let d = if d.dot(n) > 0.0 {
                 d
@@ -223,7 +248,7 @@ impl<'s> Tracer<'s> {
                 o: self.offset(p, n, d),
                 d: d.normalized(),
             };
-            let (c, _) = self.trace(&refl, depth + 1, max_depth, stats);
+            let (c, _) = self.trace_live(&refl, depth + 1, max_depth, live, stats);
             color = color + c * m.ks;
         }
         if depth < max_depth && m.t > 0.0 {
@@ -233,12 +258,13 @@ impl<'s> Tracer<'s> {
             let k = 1.0 - eta * eta * (1.0 - cos_i * cos_i);
             if k >= 0.0 {
                 stats.refract_rays += 1;
+                stats.live_refract_rays += live as u64;
                 let d = (r.d * eta + ns * (eta * cos_i - k.sqrt())).normalized();
                 let refr = Ray {
                     o: self.offset(p, n, d),
                     d,
                 };
-                let (c, _) = self.trace(&refr, depth + 1, max_depth, stats);
+                let (c, _) = self.trace_live(&refr, depth + 1, max_depth, live, stats);
                 color = color + c * m.t;
             }
         }
