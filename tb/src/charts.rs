@@ -139,6 +139,45 @@ fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     }
 }
 
+/// The corner of the plot where the legend hides the fewest points (a
+/// box of 40% of the width and 25% of the height, on the axes' scales);
+/// upper left on a tie.
+fn legend_corner(
+    points: &[(f64, f64)],
+    (x0, x1, log_x): (f64, f64, bool),
+    (y0, y1, log_y): (f64, f64, bool),
+) -> SeriesLabelPosition {
+    let unit = |v: f64, a: f64, b: f64, log: bool| {
+        if log {
+            (v.max(1e-300).ln() - a.max(1e-300).ln()) / (b.max(1e-300).ln() - a.max(1e-300).ln())
+        } else {
+            (v - a) / (b - a)
+        }
+    };
+    let corners = [
+        (SeriesLabelPosition::UpperLeft, false, true),
+        (SeriesLabelPosition::UpperRight, true, true),
+        (SeriesLabelPosition::LowerRight, true, false),
+        (SeriesLabelPosition::LowerLeft, false, false),
+    ];
+    let hidden = |right: bool, upper: bool| {
+        points
+            .iter()
+            .filter(|p| {
+                let (u, v) = (unit(p.0, x0, x1, log_x), unit(p.1, y0, y1, log_y));
+                let inx = if right { u >= 0.6 } else { u <= 0.4 };
+                let iny = if upper { v >= 0.75 } else { v <= 0.25 };
+                inx && iny
+            })
+            .count()
+    };
+    corners
+        .into_iter()
+        .min_by_key(|&(_, r, u)| hidden(r, u))
+        .map(|c| c.0)
+        .unwrap_or(SeriesLabelPosition::UpperLeft)
+}
+
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     c: &Chart,
@@ -155,6 +194,7 @@ where
         .collect();
     let (x0, x1) = range(all.iter().map(|p| p.0), c.log_x);
     let (y0, y1) = range(all.iter().map(|p| p.1), c.log_y);
+    let corner = legend_corner(&all, (x0, x1, c.log_x), (y0, y1, c.log_y));
     let mut b = ChartBuilder::on(&root);
     b.caption(&c.title, ("sans-serif", 22))
         .margin(14)
@@ -282,7 +322,7 @@ where
                 .background_style(WHITE.mix(0.85))
                 .border_style(BLACK.mix(0.4))
                 .label_font(("sans-serif", 14))
-                .position(SeriesLabelPosition::UpperLeft)
+                .position(corner)
                 .draw()
                 .map_err(|e| anyhow!("{e:?}"))?;
         }};

@@ -153,16 +153,19 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
 /// Kernels whose runs start an object test (their RCs at the first context
 /// are the rays tested), and the kernel that starts a ray pass (its RCs are
 /// the pass's rays).
-const TEST_KERNELS: [&str; 9] = [
+const TEST_KERNELS: [&str; 12] = [
     "k_sphere",
     "k_gsphere",
     "k_cyl",
     "k_cone",
     "k_box",
     "k_rect",
+    "k_grect",
     "k_tri",
+    "k_gtri",
     "k_tris",
     "k_polyh",
+    "k_gpolyh",
 ];
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {

@@ -262,6 +262,27 @@ fn smooth_shading_of_a_pp_mesh() {
     );
 }
 
+/// A Phong exponent over the kernel's 4096 is named where it shows (Ks >
+/// 0), not on the SPD's many Ks = 0 surfaces with exponent 100000.
+#[test]
+fn large_phong_exponents_are_named_where_they_show() {
+    let (j, err) = render(
+        &format!("{HEAD}f 0.8 0.4 0.2 0.7 0.3 100000 0 1\ns 0 0 0 1\n"),
+        2,
+    );
+    assert!(
+        err.contains("s.nff:11: warning: 1 object has a Phong exponent over 4096"),
+        "{err}"
+    );
+    assert_eq!(j["warnings"][0]["feature"], "phong-exponent");
+    let (j, err) = render(
+        &format!("{HEAD}f 0.8 0.4 0.2 1 0 100000 0 1\ns 0 0 0 1\n"),
+        2,
+    );
+    assert!(!err.contains("warning"), "{err}");
+    assert_eq!(j["warnings"].as_array().map(|w| w.len()), Some(0));
+}
+
 #[test]
 fn a_scene_the_chip_renders_as_asked_has_no_warnings() {
     let (j, err) = render(

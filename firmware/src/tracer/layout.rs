@@ -522,11 +522,15 @@ fn disc(center: Vec3, e1: Vec3, e2: Vec3, r: f64, n: Vec3) -> Planar {
     }
 }
 
+/// The largest Phong exponent the shading kernel raises to (a larger one
+/// is clamped; `tracer::chip_warnings` names it where Ks > 0).
+pub const MAX_SHINE: f64 = 4096.0;
+
 /// A Phong exponent as integer part `n` and fraction `f` (0 when below
 /// 1/1024): the kernel computes `x^n (1 - f + f x)`, the linear blend of
 /// `x^n` and `x^(n+1)`, for `x^(n+f)`.
 pub fn split_shine(shine: f64) -> (u32, f64) {
-    let s = shine.clamp(0.0, 4096.0);
+    let s = shine.clamp(0.0, MAX_SHINE);
     let n = s.floor();
     let f = s - n;
     if f < 1.0 / 1024.0 {

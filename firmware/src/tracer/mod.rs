@@ -556,12 +556,46 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
             )
         },
     );
-    for note in notes {
+    // Phong exponents over the shading kernel's: only where Ks > 0 (the
+    // SPD writes 100000 for many surfaces without highlights).
+    let shiny: Vec<usize> = scene
+        .objects
+        .iter()
+        .filter(|o| {
+            let m = &scene.materials[o.material];
+            m.ks > 0.0 && m.shine > layout::MAX_SHINE
+        })
+        .map(|o| o.line)
+        .collect();
+    let n = shiny.len();
+    add(
+        "phong-exponent",
+        shiny,
+        format!(
+            "{} a Phong exponent over {}: the chip's highlight is computed with {} (wider where R.V is within a few 1/{} of 1)",
+            plural(n, "object has", "objects have"),
+            layout::MAX_SHINE,
+            layout::MAX_SHINE,
+            layout::MAX_SHINE
+        ),
+    );
+    // One warning per distinct note of the scene compiler (the exponent is
+    // the tracer's own, above).
+    let notes: Vec<&String> = notes
+        .iter()
+        .filter(|n| !n.starts_with("Phong exponent"))
+        .collect();
+    let mut seen: Vec<&String> = Vec::new();
+    for note in notes.iter().copied() {
+        if seen.contains(&note) {
+            continue;
+        }
+        seen.push(note);
         out.push(Warning {
             feature: "clamped".into(),
             file: scene.source.clone(),
             line: 0,
-            count: 1,
+            count: notes.iter().filter(|n| **n == note).count(),
             message: format!("scene compiler: {note}"),
         });
     }
