@@ -153,7 +153,7 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
 /// Kernels whose runs start an object test (their RCs at the first context
 /// are the rays tested), and the kernel that starts a ray pass (its RCs are
 /// the pass's rays).
-const TEST_KERNELS: [&str; 12] = [
+const TEST_KERNELS: [&str; 13] = [
     "k_sphere",
     "k_gsphere",
     "k_cyl",
@@ -166,6 +166,7 @@ const TEST_KERNELS: [&str; 12] = [
     "k_tris",
     "k_polyh",
     "k_gpolyh",
+    "k_gbox",
 ];
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {

@@ -127,6 +127,10 @@ fn run_in<W: Word>(
             )
         }
         ChipType::Box => (vec![("k_box", first)], vec![("k_box", k::aabox(2))]),
+        ChipType::GlassBox => (
+            vec![("k_gbox", first)],
+            vec![("k_gbox", k::aabox_two_sided(2))],
+        ),
         ChipType::Polygon => {
             let mut runs = vec![("k_polyh", first + 1)];
             let fan0 = first + 1 + POLY_HEAD_WORDS as u32;
@@ -311,7 +315,7 @@ fn measure_sides<W: Word>(
     let (mut worst_t, mut sum_t, mut worst_n, mut hits) = (0.0f64, 0.0f64, 0.0f64, 0);
     for seed in 1..=4u64 {
         let mut rs = rays(&shape, seed);
-        if two_sided && matches!(shape, Shape::Sphere { .. }) {
+        if two_sided && matches!(shape, Shape::Sphere { .. } | Shape::Box { .. }) {
             // Half the rays from inside a solid: from the centre region
             // outwards. (Planar shapes: the rays come from both sides.)
             let c = shape.bounds().center();
@@ -575,6 +579,21 @@ fn smooth_triangle_kernel_vs_float_interpolation() {
 
 /// The transmitting planar kernels: rays from both sides (the `rays`
 /// come from all around), back hits with the normal turned to the ray.
+/// The transmitting box: entry faces from outside, exit faces from inside
+/// (the normal turned to the ray), as the reference's two-sided box.
+#[test]
+fn glass_box_kernel_vs_float_two_sided_box() {
+    measure_sides::<i16>("glass box", shape_box(), true, 12.0, 1.5, 1e-6);
+    measure_sides::<i32>(
+        "glass box",
+        shape_box(),
+        true,
+        12.0 * 65536.0,
+        1.5 * 65536.0,
+        1e-6,
+    );
+}
+
 #[test]
 fn glass_planar_kernels_vs_float_two_sided() {
     for (name, shape) in [

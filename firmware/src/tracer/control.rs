@@ -212,6 +212,9 @@ pub fn program(
             k::planar_two_sided(Inside::Triangle, lay.kt_tri, nm.approx()),
         ));
     }
+    if has(ChipType::GlassBox) {
+        objk.push(("k_gbox", k::aabox_two_sided(nm.approx())));
+    }
     if has(ChipType::GlassPolygon) {
         objk.push(("k_gpolyh", k::polygon_head_two_sided(nm.approx())));
         if !has(ChipType::Polygon) {
@@ -1017,6 +1020,7 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::Cone => capped(w, "k_cone", CONE_BODY_WORDS),
         ChipType::GlassRectangle => one(w, "k_grect"),
         ChipType::GlassTriangle => one(w, "k_gtri"),
+        ChipType::GlassBox => one(w, "k_gbox"),
         ChipType::Polygon | ChipType::GlassPolygon => {
             let (head, tail) = if ty == ChipType::Polygon {
                 ("k_polyh", "k_polyt")

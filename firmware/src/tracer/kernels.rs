@@ -869,26 +869,79 @@ fn smooth_normal(k: &mut K) {
 pub fn aabox(nr: impl Into<Approx>) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
+    aabox_faces(&mut k, nr, false);
+    k
+}
+
+/// The box of a transmitting material, visible from both sides: the
+/// entry faces of [`aabox`] (skipping the box a ray leaves,
+/// `ram::ORIG_OBJ`: a ray starting on a convex box cannot enter it again),
+/// then the exit faces (the face each axis's direction leads to, more
+/// than [`SELF_LSB`] ahead; a back hit, the normal turned to the ray).
+/// Record: the box's, twice (48 words).
+pub fn aabox_two_sided(nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
+    let mut k = K::default();
+    aabox_faces(&mut k, nr, true);
+    k
+}
+
+/// The per-axis sections of the box kernels; `two`: entry faces skipping
+/// `ORIG_OBJ`, then exit faces.
+fn aabox_faces(k: &mut K, nr: Approx, two: bool) {
     for a in 0..3u32 {
+        box_face(k, nr, a, two, false);
+    }
+    if two {
+        for a in 0..3u32 {
+            box_face(k, nr, a, true, true);
+        }
+    }
+}
+
+fn box_face(k: &mut K, nr: Approx, a: u32, two: bool, exit: bool) {
+    {
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         let (oa, da) = (1 + a, 4 + a);
-        k.comment(&format!("box: faces across axis {a}"));
-        k.c(format!("cmp.lt r{da}, #0"))
+        k.comment(&match (two, exit) {
+            (false, _) => format!("box: faces across axis {a}"),
+            (true, false) => format!("box: entry faces across axis {a}"),
+            (true, true) => format!("box: exit faces across axis {a}"),
+        });
+        // F: the max face is the one (entry: d_a < 0; exit: d_a > 0).
+        k.c(format!("cmp.{} r{da}, #0", if exit { "gt" } else { "lt" }))
             .c(format!("ld r15, [r0 + #{}]", ram::C_ONE))
-            .c("(!f) neg r15, r15")
+            .c(if exit {
+                "(f) neg r15, r15"
+            } else {
+                "(!f) neg r15, r15"
+            })
             .c(format!("st r15, [#{}]", ram::TMP0))
             .c("mov r8, fb0")
             .c("sel r8, fb0, r8")
             .c(format!("sub r8, r8, r{oa}"))
-            .c("(f) neg r8, r8")
-            .c(format!("abs r9, r{da}"))
-            .c("cmp.gt r9, #0")
+            .c(if exit {
+                "(!f) neg r8, r8"
+            } else {
+                "(f) neg r8, r8"
+            })
+            .c(format!("abs r9, r{da}"));
+        k.c("cmp.gt r9, #0")
             .c("(f) cmp.gt r8, #0")
             .cq("ldacc r8, <<14")
             .c("msu out, r7, r9")
             .c("acch r10")
             .c("(f) cmp.lt r10, #0");
-        divide(&mut k, 8, 9, 11, [10, 12, 13, 14, 15], nr);
+        divide(k, 8, 9, 11, [10, 12, 13, 14, 15], nr);
+        if exit {
+            // more than SELF_LSB ahead along the ray (not along the axis:
+            // a grazing ray may start within an LSB of the face's plane)
+            k.c(format!("movb r14, #{SELF_LSB}"));
+            if extra_bits() > 0 {
+                k.c(format!("sll r14, r14, #{}", extra_bits()));
+            }
+            k.c("(f) cmp.gt r11, r14");
+        }
         k.cq(format!("ldacc r{}, <<14", 1 + b))
             .cq(format!("mac r12, r11, r{}, >>14", 4 + b))
             .cq(format!("ldacc r{}, <<14", 1 + c))
@@ -896,16 +949,33 @@ pub fn aabox(nr: impl Into<Approx>) -> K {
             .c("(f) cmp.le fb0, r12")
             .c("(f) cmp.ge fb0, r12")
             .c("(f) cmp.le fb0, r13")
-            .c("(f) cmp.ge fb0, r13")
-            .c("(f) mov r7, r11")
+            .c("(f) cmp.ge fb0, r13");
+        if two {
+            k.c("mov r8, fb0");
+            if !exit {
+                k.c(format!("ld r14, [r0 + #{}]", ram::ORIG_OBJ))
+                    .c("(f) cmp.ne r8, r14");
+            }
+        }
+        k.c("(f) mov r7, r11")
             .c(format!("ld r15, [r0 + #{}]", ram::TMP0))
             .c(format!("(f) st r15, [#{}]", ram::HIT_N + a))
             .c(format!("(f) st r0, [#{}]", ram::HIT_N + b))
-            .c(format!("(f) st r0, [#{}]", ram::HIT_N + c))
-            .c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
-            .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+            .c(format!("(f) st r0, [#{}]", ram::HIT_N + c));
+        if two {
+            // HIT_BACK_OBJ: the box on an exit face, else -1.
+            k.c(format!("(f) st r8, [#{}]", ram::HIT_OBJ));
+            if exit {
+                k.c(format!("(f) st r8, [#{}]", ram::HIT_BACK_OBJ));
+            } else {
+                k.c("movb r9, #-1")
+                    .c(format!("(f) st r9, [#{}]", ram::HIT_BACK_OBJ));
+            }
+        } else {
+            k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
+        }
+        k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
     }
-    k
 }
 
 /// Polygon, convex or concave (even-odd rule, as the reference), by the

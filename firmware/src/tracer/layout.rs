@@ -71,10 +71,13 @@ pub enum ChipType {
     GlassRectangle,
     GlassTriangle,
     GlassPolygon,
+    /// Boxes of a transmitting material: entry and exit faces
+    /// ([`super::kernels::aabox_two_sided`]), the record twice.
+    GlassBox,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 12] = [
+    pub const ALL: [ChipType; 13] = [
         ChipType::Sphere,
         ChipType::GlassSphere,
         ChipType::Cylinder,
@@ -87,6 +90,7 @@ impl ChipType {
         ChipType::GlassRectangle,
         ChipType::GlassTriangle,
         ChipType::GlassPolygon,
+        ChipType::GlassBox,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -102,6 +106,7 @@ impl ChipType {
             ChipType::GlassRectangle => "glass_rectangle",
             ChipType::GlassTriangle => "glass_triangle",
             ChipType::GlassPolygon => "glass_polygon",
+            ChipType::GlassBox => "glass_box",
         }
     }
     /// The chip type of an object: its primitive's, with smooth triangles
@@ -115,6 +120,7 @@ impl ChipType {
             Shape::Rectangle { .. } if transmits => Some(ChipType::GlassRectangle),
             Shape::Triangle { .. } if transmits => Some(ChipType::GlassTriangle),
             Shape::Polygon { .. } if transmits => Some(ChipType::GlassPolygon),
+            Shape::Box { .. } if transmits => Some(ChipType::GlassBox),
             _ => ChipType::of(s.prim_type()),
         }
     }
@@ -127,6 +133,7 @@ impl ChipType {
                 | ChipType::GlassRectangle
                 | ChipType::GlassTriangle
                 | ChipType::GlassPolygon
+                | ChipType::GlassBox
         )
     }
     fn of(p: PrimType) -> Option<ChipType> {
@@ -1060,6 +1067,7 @@ fn build_as(
             ChipType::Cylinder => CYL_WORDS,
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
+            ChipType::GlassBox => 2 * BOX_WORDS,
             ChipType::Rectangle
             | ChipType::Triangle
             | ChipType::GlassRectangle
@@ -1205,7 +1213,9 @@ fn build_as(
                 }
                 (Shape::Box { min, max }, _) => {
                     let q = |x: f64| (x * s).round() as i64;
-                    for a in 0..3 {
+                    // A transmitting box: the sections twice (entry, exit).
+                    let copies = if t == ChipType::GlassBox { 2 } else { 1 };
+                    for a in (0..3).cycle().take(3 * copies) {
                         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
                         w.raw(q(min.axis(a)));
                         w.raw(q(max.axis(a)));

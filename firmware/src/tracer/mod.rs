@@ -534,6 +534,7 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
                     | Shape::Rectangle { .. }
                     | Shape::Triangle { normals: None, .. }
                     | Shape::Polygon { .. }
+                    | Shape::Box { .. }
             )
         })
         .map(|o| o.line)
@@ -545,14 +546,14 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         transmit,
         if opt.depth >= 2 {
             format!(
-                "{} a transmitting material (T > 0): the chip refracts only through spheres, rectangles, flat triangles and polygons so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
-                plural(n, "cone, cylinder, box or smooth triangle has", "cones, cylinders, boxes or smooth triangles have"),
+                "{} a transmitting material (T > 0): the chip refracts only through spheres, boxes, rectangles, flat triangles and polygons so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
+                plural(n, "cone, cylinder or smooth triangle has", "cones, cylinders or smooth triangles have"),
                 if n == 1 { "it renders" } else { "they render" }
             )
         } else {
             format!(
                 "{} a transmitting material (T > 0): the chip tests {them} one-sided (the reference makes {them} two-sided)",
-                plural(n, "cone, cylinder, box or smooth triangle has", "cones, cylinders, boxes or smooth triangles have"),
+                plural(n, "cone, cylinder or smooth triangle has", "cones, cylinders or smooth triangles have"),
             )
         },
     );
