@@ -127,6 +127,28 @@ fn run_in<W: Word>(
             )
         }
         ChipType::Box => (vec![("k_box", first)], vec![("k_box", k::aabox(2))]),
+        ChipType::GlassCylinder => (
+            std::iter::once(("k_gcylf", first + 1))
+                .chain(std::iter::once((
+                    "k_gcylb",
+                    first + 1 + CYL_BODY_WORDS as u32,
+                )))
+                .chain((0..2u32).filter(|_| lay.fb[t.first] != 0).map(|c| {
+                    (
+                        "k_gdisc",
+                        first + 1 + 2 * CYL_BODY_WORDS as u32 + c * PLANAR_WORDS as u32,
+                    )
+                }))
+                .collect(),
+            vec![
+                (
+                    "k_gcylf",
+                    k::cylinder_side(lay.ks_cyl, lay.ep_cyl, 2, false),
+                ),
+                ("k_gcylb", k::cylinder_side(lay.ks_cyl, lay.ep_cyl, 2, true)),
+                ("k_gdisc", k::planar_two_sided(Inside::Disc, lay.kt_disc, 2)),
+            ],
+        ),
         ChipType::GlassBox => (
             vec![("k_gbox", first)],
             vec![("k_gbox", k::aabox_two_sided(2))],
@@ -315,7 +337,12 @@ fn measure_sides<W: Word>(
     let (mut worst_t, mut sum_t, mut worst_n, mut hits) = (0.0f64, 0.0f64, 0.0f64, 0);
     for seed in 1..=4u64 {
         let mut rs = rays(&shape, seed);
-        if two_sided && matches!(shape, Shape::Sphere { .. } | Shape::Box { .. }) {
+        if two_sided
+            && matches!(
+                shape,
+                Shape::Sphere { .. } | Shape::Box { .. } | Shape::Cone { .. }
+            )
+        {
             // Half the rays from inside a solid: from the centre region
             // outwards. (Planar shapes: the rays come from both sides.)
             let c = shape.bounds().center();
@@ -579,6 +606,21 @@ fn smooth_triangle_kernel_vs_float_interpolation() {
 
 /// The transmitting planar kernels: rays from both sides (the `rays`
 /// come from all around), back hits with the normal turned to the ray.
+/// The transmitting cylinder: its body from outside and inside (two runs,
+/// the record's body twice), as the reference's two-sided cylinder.
+#[test]
+fn glass_cylinder_kernel_vs_float_two_sided_cylinder() {
+    measure_sides::<i16>("glass cylinder", shape_cylinder(), true, 12.0, 1.5, 0.02);
+    measure_sides::<i32>(
+        "glass cylinder",
+        shape_cylinder(),
+        true,
+        12.0 * 65536.0,
+        1.5 * 65536.0,
+        1e-4,
+    );
+}
+
 /// The transmitting box: entry faces from outside, exit faces from inside
 /// (the normal turned to the ray), as the reference's two-sided box.
 #[test]

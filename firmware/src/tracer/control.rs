@@ -212,6 +212,20 @@ pub fn program(
             k::planar_two_sided(Inside::Triangle, lay.kt_tri, nm.approx()),
         ));
     }
+    if has(ChipType::GlassCylinder) {
+        objk.push((
+            "k_gcylf",
+            k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), false),
+        ));
+        objk.push((
+            "k_gcylb",
+            k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), true),
+        ));
+        objk.push((
+            "k_gdisc",
+            k::planar_two_sided(Inside::Disc, lay.kt_disc, nm.approx()),
+        ));
+    }
     if has(ChipType::GlassBox) {
         objk.push(("k_gbox", k::aabox_two_sided(nm.approx())));
     }
@@ -1021,6 +1035,28 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::GlassRectangle => one(w, "k_grect"),
         ChipType::GlassTriangle => one(w, "k_gtri"),
         ChipType::GlassBox => one(w, "k_gbox"),
+        ChipType::GlassCylinder => {
+            // Both bodies, then the caps as two-sided discs where set.
+            let _ = writeln!(
+                w,
+                "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
+                kaddr("k_gcylf"),
+                klen("k_gcylf"),
+                kaddr("k_gcylb"),
+                1 + CYL_BODY_WORDS,
+                klen("k_gcylb")
+            );
+            for c in 0..2 {
+                let _ = writeln!(
+                    w,
+                    "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
+                    kaddr("k_gdisc"),
+                    1 + 2 * CYL_BODY_WORDS + c * PLANAR_WORDS,
+                    klen("k_gdisc")
+                );
+            }
+            let _ = writeln!(w, "{n}_nocap:");
+        }
         ChipType::Polygon | ChipType::GlassPolygon => {
             let (head, tail) = if ty == ChipType::Polygon {
                 ("k_polyh", "k_polyt")

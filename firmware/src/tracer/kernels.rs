@@ -1088,6 +1088,20 @@ pub fn polygon_tail_two_sided() -> K {
 /// `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D problem is the
 /// sphere's perpendicular method, and `t = tau / |d2|` by [`divide`].
 pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
+    cylinder_sides(ks, ep, nr, None)
+}
+
+/// The body of a transmitting cylinder, one side per run: its record holds
+/// the body twice, with `sg` and `-sg` (the far root, normal turned
+/// inwards), so the two runs together test both sides; `back` says which
+/// run this is (recorded in `ram::HIT_BACK_OBJ`). Both accept a root only
+/// more than [`SELF_LSB`] ahead along the ray (a ray starting on the
+/// surface, however rounded, does not hit it there again).
+pub fn cylinder_side(ks: u32, ep: u32, nr: impl Into<Approx>, back: bool) -> K {
+    cylinder_sides(ks, ep, nr, Some(back))
+}
+
+fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("cylinder: oc = B - o, projected on e1, e2");
@@ -1144,6 +1158,13 @@ pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
         .c("acch r11")
         .c("(f) cmp.lt r11, #0");
     divide(&mut k, 9, 10, 9, [8, 11, 12, 13, 14], nr);
+    if back.is_some() {
+        k.c(format!("movb r8, #{SELF_LSB}"));
+        if extra_bits() > 0 {
+            k.c(format!("sll r8, r8, #{}", extra_bits()));
+        }
+        k.c("(f) cmp.gt r9, r8");
+    }
     k.comment("axial coordinate of the hit");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 11 + i;
@@ -1175,8 +1196,20 @@ pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
     for (i, x) in [13, 14, 15].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
-        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    match back {
+        None => {
+            k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
+        }
+        Some(b) => {
+            k.c("mov r8, fb0")
+                .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ));
+            if !b {
+                k.c("movb r8, #-1");
+            }
+            k.c(format!("(f) st r8, [#{}]", ram::HIT_BACK_OBJ));
+        }
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
     k
 }
 

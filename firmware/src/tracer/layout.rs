@@ -74,10 +74,13 @@ pub enum ChipType {
     /// Boxes of a transmitting material: entry and exit faces
     /// ([`super::kernels::aabox_two_sided`]), the record twice.
     GlassBox,
+    /// Cylinders of a transmitting material: the body twice (outside and
+    /// inside, [`super::kernels::cylinder_side`]), two-sided caps.
+    GlassCylinder,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 13] = [
+    pub const ALL: [ChipType; 14] = [
         ChipType::Sphere,
         ChipType::GlassSphere,
         ChipType::Cylinder,
@@ -91,6 +94,7 @@ impl ChipType {
         ChipType::GlassTriangle,
         ChipType::GlassPolygon,
         ChipType::GlassBox,
+        ChipType::GlassCylinder,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -107,6 +111,7 @@ impl ChipType {
             ChipType::GlassTriangle => "glass_triangle",
             ChipType::GlassPolygon => "glass_polygon",
             ChipType::GlassBox => "glass_box",
+            ChipType::GlassCylinder => "glass_cylinder",
         }
     }
     /// The chip type of an object: its primitive's, with smooth triangles
@@ -121,6 +126,9 @@ impl ChipType {
             Shape::Triangle { .. } if transmits => Some(ChipType::GlassTriangle),
             Shape::Polygon { .. } if transmits => Some(ChipType::GlassPolygon),
             Shape::Box { .. } if transmits => Some(ChipType::GlassBox),
+            Shape::Cone { .. } if transmits && s.prim_type() == PrimType::Cylinder => {
+                Some(ChipType::GlassCylinder)
+            }
             _ => ChipType::of(s.prim_type()),
         }
     }
@@ -134,6 +142,7 @@ impl ChipType {
                 | ChipType::GlassTriangle
                 | ChipType::GlassPolygon
                 | ChipType::GlassBox
+                | ChipType::GlassCylinder
         )
     }
     fn of(p: PrimType) -> Option<ChipType> {
@@ -1065,6 +1074,7 @@ fn build_as(
             ChipType::Sphere | ChipType::GlassSphere if sphere_fine => SPHERE_FINE_WORDS,
             ChipType::Sphere | ChipType::GlassSphere => SPHERE_WORDS,
             ChipType::Cylinder => CYL_WORDS,
+            ChipType::GlassCylinder => CYL_WORDS + CYL_BODY_WORDS,
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
             ChipType::GlassBox => 2 * BOX_WORDS,
@@ -1187,24 +1197,34 @@ fn build_as(
                     let invr = ((14 + xb + ks_cyl) as f64).exp2() / rq;
                     let sg = if *inside { -1.0 } else { 1.0 };
                     w.raw(*caps as i64);
-                    w.point(*base);
-                    w.unit(e1);
-                    w.unit(e2);
-                    w.unit(e1);
-                    w.unit(e2);
-                    w.push(invr);
-                    w.push(rq);
-                    w.push(sg * w.one());
-                    w.point(*base);
-                    w.unit(av);
-                    w.raw((h * s).round() as i64 + 2);
-                    w.push(sg * w.one());
-                    for c in 0..3 {
-                        w.push(e1.axis(c) * w.one());
-                        w.push(e2.axis(c) * w.one());
+                    // A transmitting cylinder: the body twice, the second
+                    // seen from the other side.
+                    let sides: &[f64] = if t == ChipType::GlassCylinder {
+                        &[1.0, -1.0]
+                    } else {
+                        &[1.0]
+                    };
+                    for &side in sides {
+                        let sg = sg * side;
+                        w.point(*base);
+                        w.unit(e1);
+                        w.unit(e2);
+                        w.unit(e1);
+                        w.unit(e2);
+                        w.push(invr);
+                        w.push(rq);
+                        w.push(sg * w.one());
+                        w.point(*base);
+                        w.unit(av);
+                        w.raw((h * s).round() as i64 + 2);
+                        w.push(sg * w.one());
+                        for c in 0..3 {
+                            w.push(e1.axis(c) * w.one());
+                            w.push(e2.axis(c) * w.one());
+                        }
+                        w.raw(i as i64);
+                        w.raw(mat_of[o.material] as i64);
                     }
-                    w.raw(i as i64);
-                    w.raw(mat_of[o.material] as i64);
                     for p in &planars[i] {
                         let mut p = *p;
                         p.n = p.n * sg;

@@ -524,18 +524,18 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         .objects
         .iter()
         .filter(|o| scene.materials[o.material].t > 0.0)
-        // spheres, rectangles, flat triangles and polygons refract on the
-        // chip (their two-sided kernels)
+        // every type but cones and smooth triangles refracts on the chip
+        // (their two-sided kernels)
         .filter(|o| {
-            use crate::scene::Shape;
-            !matches!(
-                o.shape,
-                Shape::Sphere { .. }
-                    | Shape::Rectangle { .. }
-                    | Shape::Triangle { normals: None, .. }
-                    | Shape::Polygon { .. }
-                    | Shape::Box { .. }
-            )
+            use crate::scene::{PrimType, Shape};
+            o.shape.prim_type() == PrimType::Cone
+                || matches!(
+                    o.shape,
+                    Shape::Triangle {
+                        normals: Some(_),
+                        ..
+                    }
+                )
         })
         .map(|o| o.line)
         .collect();
@@ -546,14 +546,14 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
         transmit,
         if opt.depth >= 2 {
             format!(
-                "{} a transmitting material (T > 0): the chip refracts only through spheres, boxes, rectangles, flat triangles and polygons so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
-                plural(n, "cone, cylinder or smooth triangle has", "cones, cylinders or smooth triangles have"),
+                "{} a transmitting material (T > 0): the chip refracts only through spheres, cylinders, boxes, rectangles, flat triangles and polygons so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
+                plural(n, "cone or smooth triangle has", "cones or smooth triangles have"),
                 if n == 1 { "it renders" } else { "they render" }
             )
         } else {
             format!(
                 "{} a transmitting material (T > 0): the chip tests {them} one-sided (the reference makes {them} two-sided)",
-                plural(n, "cone, cylinder or smooth triangle has", "cones, cylinders or smooth triangles have"),
+                plural(n, "cone or smooth triangle has", "cones or smooth triangles have"),
             )
         },
     );
