@@ -168,7 +168,7 @@ pub fn render_built(
         .warnings
         .iter()
         .cloned()
-        .chain(firmware::tracer::chip_warnings(scene, opt, &r.notes))
+        .chain(firmware::tracer::chip_warnings(scene, &r.notes))
         .collect();
     let json = json!({
         "scene": scene.source,
@@ -314,7 +314,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         built = crate::render::firmware_from_source(built, text, name)?;
         datapath_reason = format!("{name}: .datapath {}", datapath.bits());
     }
-    for w in firmware::tracer::chip_warnings(&scene, &opt, &built.report.notes) {
+    for w in firmware::tracer::chip_warnings(&scene, &built.report.notes) {
         eprintln!("{w}");
     }
     if let Some(p) = &a.emit_asm {

@@ -153,7 +153,7 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
 /// Kernels whose runs start an object test (their RCs at the first context
 /// are the rays tested), and the kernel that starts a ray pass (its RCs are
 /// the pass's rays).
-const TEST_KERNELS: [&str; 14] = [
+const TEST_KERNELS: [&str; 16] = [
     "k_sphere",
     "k_gsphere",
     "k_cyl",
@@ -168,6 +168,8 @@ const TEST_KERNELS: [&str; 14] = [
     "k_gpolyh",
     "k_gbox",
     "k_gcylf",
+    "k_gconef",
+    "k_gtris",
 ];
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {

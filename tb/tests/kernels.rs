@@ -149,6 +149,29 @@ fn run_in<W: Word>(
                 ("k_gdisc", k::planar_two_sided(Inside::Disc, lay.kt_disc, 2)),
             ],
         ),
+        ChipType::GlassCone => (
+            std::iter::once(("k_gconef", first + 1))
+                .chain(std::iter::once((
+                    "k_gconeb",
+                    first + 1 + CONE_BODY_WORDS as u32,
+                )))
+                .chain((0..2u32).filter(|_| lay.fb[t.first] != 0).map(|c| {
+                    (
+                        "k_gdisc",
+                        first + 1 + 2 * CONE_BODY_WORDS as u32 + c * PLANAR_WORDS as u32,
+                    )
+                }))
+                .collect(),
+            vec![
+                ("k_gconef", k::cone_side(lay.ks_cone, lay.ep_cone, 2, false)),
+                ("k_gconeb", k::cone_side(lay.ks_cone, lay.ep_cone, 2, true)),
+                ("k_gdisc", k::planar_two_sided(Inside::Disc, lay.kt_disc, 2)),
+            ],
+        ),
+        ChipType::GlassSmoothTriangle => (
+            vec![("k_gtris", first)],
+            vec![("k_gtris", k::smooth_triangle_two_sided(lay.kt_tri, 2))],
+        ),
         ChipType::GlassBox => (
             vec![("k_gbox", first)],
             vec![("k_gbox", k::aabox_two_sided(2))],
@@ -265,7 +288,10 @@ wait:   lw r1, GO(r0)\n        beqz r1, wait\n",
     rtl::chip::run_to_halt(&mut sim, 10_000_000).unwrap();
     let rc = &sim.top.array.rc;
     // A smooth triangle's shading normal (the face normal is in HIT_N).
-    let at = if t.ty == ChipType::SmoothTriangle {
+    let at = if matches!(
+        t.ty,
+        ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle
+    ) {
         ram::HIT_NS
     } else {
         ram::HIT_N
@@ -619,6 +645,40 @@ fn glass_cylinder_kernel_vs_float_two_sided_cylinder() {
         1.5 * 65536.0,
         1e-4,
     );
+}
+
+/// The transmitting cone (tapered, capped): its body from outside and
+/// inside (two runs), caps two-sided.
+#[test]
+fn glass_cone_kernel_vs_float_two_sided_cone() {
+    // (18 LSB: the grazing ray of cone_kernel_vs_float_cone)
+    measure_sides::<i16>("glass cone", shape_cone(), true, 24.0, 1.5, 0.02);
+    measure_sides::<i32>(
+        "glass cone",
+        shape_cone(),
+        true,
+        12.0 * 65536.0,
+        1.5 * 65536.0,
+        1e-3,
+    );
+}
+
+/// The transmitting smooth triangle: both sides, the interpolated normal
+/// turned to the ray on a back hit.
+#[test]
+fn glass_smooth_triangle_kernel_vs_float_two_sided() {
+    for seed in 1..=3 {
+        let s = shape_smooth_triangle(seed, 0.6);
+        measure_sides::<i16>("glass smooth triangle", s.clone(), true, 12.0, 1.5, 2e-3);
+        measure_sides::<i32>(
+            "glass smooth triangle",
+            s,
+            true,
+            12.0 * 65536.0,
+            1.5 * 65536.0,
+            1e-6,
+        );
+    }
 }
 
 /// The transmitting box: entry faces from outside, exit faces from inside

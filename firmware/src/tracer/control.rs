@@ -95,7 +95,12 @@ pub fn program(
         ]
     };
     // Smooth triangles: the shading normal and the reflection's fallback.
-    let smooth = lay.types.iter().any(|x| x.ty == ChipType::SmoothTriangle);
+    let smooth = lay.types.iter().any(|x| {
+        matches!(
+            x.ty,
+            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle
+        )
+    });
     let refract = lay.refract;
     let post = |level0: bool, m: usize, eps: i32| {
         if smooth || refract {
@@ -221,9 +226,27 @@ pub fn program(
             "k_gcylb",
             k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), true),
         ));
+    }
+    if has(ChipType::GlassCone) {
+        objk.push((
+            "k_gconef",
+            k::cone_side(lay.ks_cone, lay.ep_cone, nm.newton_steps, false),
+        ));
+        objk.push((
+            "k_gconeb",
+            k::cone_side(lay.ks_cone, lay.ep_cone, nm.newton_steps, true),
+        ));
+    }
+    if has(ChipType::GlassCylinder) || has(ChipType::GlassCone) {
         objk.push((
             "k_gdisc",
             k::planar_two_sided(Inside::Disc, lay.kt_disc, nm.approx()),
+        ));
+    }
+    if has(ChipType::GlassSmoothTriangle) {
+        objk.push((
+            "k_gtris",
+            k::smooth_triangle_two_sided(lay.kt_tri, nm.approx()),
         ));
     }
     if has(ChipType::GlassBox) {
@@ -1035,23 +1058,29 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::GlassRectangle => one(w, "k_grect"),
         ChipType::GlassTriangle => one(w, "k_gtri"),
         ChipType::GlassBox => one(w, "k_gbox"),
-        ChipType::GlassCylinder => {
+        ChipType::GlassSmoothTriangle => one(w, "k_gtris"),
+        ChipType::GlassCylinder | ChipType::GlassCone => {
             // Both bodies, then the caps as two-sided discs where set.
+            let (front, back, body) = if ty == ChipType::GlassCylinder {
+                ("k_gcylf", "k_gcylb", CYL_BODY_WORDS)
+            } else {
+                ("k_gconef", "k_gconeb", CONE_BODY_WORDS)
+            };
             let _ = writeln!(
                 w,
                 "        li r1, {}\n        addi r2, r7, 1\n        sbcb r1, r2, {}\n        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}\n        lfb r3, 0(r7)\n        beqz r3, {n}_nocap",
-                kaddr("k_gcylf"),
-                klen("k_gcylf"),
-                kaddr("k_gcylb"),
-                1 + CYL_BODY_WORDS,
-                klen("k_gcylb")
+                kaddr(front),
+                klen(front),
+                kaddr(back),
+                1 + body,
+                klen(back)
             );
             for c in 0..2 {
                 let _ = writeln!(
                     w,
                     "        li r1, {}\n        addi r2, r7, {}\n        sbcb r1, r2, {}",
                     kaddr("k_gdisc"),
-                    1 + 2 * CYL_BODY_WORDS + c * PLANAR_WORDS,
+                    1 + 2 * body + c * PLANAR_WORDS,
                     klen("k_gdisc")
                 );
             }

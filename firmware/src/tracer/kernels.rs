@@ -796,6 +796,79 @@ pub fn smooth_triangle(kt: u32, nr: impl Into<Approx>) -> K {
     k
 }
 
+/// [`smooth_triangle`] of a transmitting material: both sides (as
+/// [`planar_two_sided`]: the plane seen from its back, the triangle the ray
+/// leaves skipped), both normals turned to the ray on a back hit. The
+/// record is the smooth triangle's.
+pub fn smooth_triangle_two_sided(kt: u32, nr: impl Into<Approx>) -> K {
+    let nr: Approx = nr.into();
+    let mut k = K::default();
+    k.comment("smooth triangle, two-sided: den = n.d, num = n.(v0 - o)");
+    plane_hit_sides(&mut k, nr, true);
+    k.comment("P - v0");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 10 + i;
+        k.cq(format!("ldacc r{o}, <<14"))
+            .cq(format!("mac r{x}, r9, r{d}, >>14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r13, fb0, r12, >>{kt}"));
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r14, fb0, r12, >>{kt}"));
+    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c(format!("add r8, r8, #{INSIDE_TOL}"))
+        .c(format!("(f) cmp.ge r13, #-{INSIDE_TOL}"))
+        .c(format!("(f) cmp.ge r14, #-{INSIDE_TOL}"))
+        .c("adds r15, r13, r14")
+        .c("(f) cmp.le r15, r8");
+    k.comment("Ns = (1 - u - w) n0 + u n1 + w n2, normalised");
+    k.c(format!("st r9, [#{}]", ram::TMP4))
+        .c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c("sub r8, r8, r15");
+    for x in [10, 11, 12] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r13")
+            .cq(format!("mac r{x}, fb0, r14, >>14"));
+    }
+    normalize(&mut k, [10, 11, 12], [9, 8, 13, 14, 15], false, nr);
+    k.comment("turned to the ray on a back hit; the face normal, obj");
+    k.c(format!("ld r15, [r0 + #{}]", ram::TMP3))
+        .c("movb r14, #1")
+        .c("sub r14, r14, r15")
+        .c("sub r14, r14, r15"); // 1 - 2 back
+    for x in [10, 11, 12] {
+        k.c(format!("mul r{x}, r{x}, r14"));
+    }
+    k.c("mul r8, fb0, r14")
+        .c("mul r9, fb0, r14")
+        .c("mul r13, fb0, r14")
+        .c(format!("st r13, [#{}]", ram::TMP2))
+        .c("mov r13, fb0")
+        .c(format!("ld r14, [r0 + #{}]", ram::ORIG_OBJ))
+        .c("(f) cmp.ne r13, r14")
+        .c(format!("ld r14, [r0 + #{}]", ram::TMP4))
+        .c("(f) mov r7, r14");
+    for (i, x) in [10, 11, 12].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_NS + i as u32));
+    }
+    k.c(format!("(f) st r8, [#{}]", ram::HIT_N))
+        .c(format!("(f) st r9, [#{}]", ram::HIT_N + 1))
+        .c(format!("ld r8, [r0 + #{}]", ram::TMP2))
+        .c(format!("(f) st r8, [#{}]", ram::HIT_N + 2))
+        .c(format!("(f) st r13, [#{}]", ram::HIT_OBJ))
+        .c(format!("(f) st r13, [#{}]", ram::HIT_NS_OBJ))
+        .c("neg r15, r15")
+        .c("add r14, r13, #1")
+        .c("and r14, r14, r15")
+        .c("sub r14, r14, #1")
+        .c(format!("(f) st r14, [#{}]", ram::HIT_BACK_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    k
+}
+
 /// [`post`] for scenes with smooth triangles: the geometric normal is kept
 /// in `ram::SH_NG` (for [`reflect_setup_smooth`]) and the shading normal
 /// `SH_N` becomes the interpolated one where the hit is a smooth triangle
@@ -1242,6 +1315,16 @@ fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -
 /// `|q_z + tau d_z| <= hh`; the normal is the gradient
 /// `sg (c^2 p_perp, -s c rho)` at the hit, normalised, in the scene's axes.
 pub fn cone(ks: u32, ep: u32, nr: u32) -> K {
+    cone_sides(ks, ep, nr, None)
+}
+
+/// The body of a transmitting cone, one side per run (its record holds the
+/// body twice, with `sg` and `-sg`), as [`cylinder_side`].
+pub fn cone_side(ks: u32, ep: u32, nr: u32, back: bool) -> K {
+    cone_sides(ks, ep, nr, Some(back))
+}
+
+fn cone_sides(ks: u32, ep: u32, nr: u32, back: Option<bool>) -> K {
     let ct = ram::CONE_TMP;
     let mut k = K::default();
     k.comment("cone: bounding sphere about M: b = (M - o).d, p = (M - o) - b d");
@@ -1359,9 +1442,17 @@ pub fn cone(ks: u32, ep: u32, nr: u32) -> K {
         .c("(f) cmp.eq r12, #0") // |tau| < 1/2: within the bounding sphere
         .c(format!("ld r11, [r0 + #{}]", ram::TMP0))
         .cq("ldacc r11, <<13")
-        .cq("mac r11, fb0, r13, >>13")
-        .c("(f) cmp.gt r11, #0")
-        .c("(f) cmp.lt r11, r7")
+        .cq("mac r11, fb0, r13, >>13");
+    if back.is_some() {
+        k.c(format!("movb r12, #{SELF_LSB}"));
+        if extra_bits() > 0 {
+            k.c(format!("sll r12, r12, #{}", extra_bits()));
+        }
+        k.c("(f) cmp.gt r11, r12");
+    } else {
+        k.c("(f) cmp.gt r11, #0");
+    }
+    k.c("(f) cmp.lt r11, r7")
         .c(format!("st r11, [#{}]", ram::TMP4));
     k.comment("height of the hit: |qz + tau dz| <= hh");
     k.c(format!("ld r12, [r0 + #{}]", ram::TMP1))
@@ -1396,8 +1487,20 @@ pub fn cone(ks: u32, ep: u32, nr: u32) -> K {
     for (i, x) in [11, 12, 13].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ))
-        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    match back {
+        None => {
+            k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
+        }
+        Some(b) => {
+            k.c("mov r8, fb0")
+                .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ));
+            if !b {
+                k.c("movb r8, #-1");
+            }
+            k.c(format!("(f) st r8, [#{}]", ram::HIT_BACK_OBJ));
+        }
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
     k
 }
 

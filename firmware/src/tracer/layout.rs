@@ -77,10 +77,16 @@ pub enum ChipType {
     /// Cylinders of a transmitting material: the body twice (outside and
     /// inside, [`super::kernels::cylinder_side`]), two-sided caps.
     GlassCylinder,
+    /// Cones of a transmitting material, as the cylinders
+    /// ([`super::kernels::cone_side`]).
+    GlassCone,
+    /// Smooth triangles of a transmitting material
+    /// ([`super::kernels::smooth_triangle_two_sided`]).
+    GlassSmoothTriangle,
 }
 
 impl ChipType {
-    pub const ALL: [ChipType; 14] = [
+    pub const ALL: [ChipType; 16] = [
         ChipType::Sphere,
         ChipType::GlassSphere,
         ChipType::Cylinder,
@@ -95,6 +101,8 @@ impl ChipType {
         ChipType::GlassPolygon,
         ChipType::GlassBox,
         ChipType::GlassCylinder,
+        ChipType::GlassCone,
+        ChipType::GlassSmoothTriangle,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -112,12 +120,17 @@ impl ChipType {
             ChipType::GlassPolygon => "glass_polygon",
             ChipType::GlassBox => "glass_box",
             ChipType::GlassCylinder => "glass_cylinder",
+            ChipType::GlassCone => "glass_cone",
+            ChipType::GlassSmoothTriangle => "glass_smooth_triangle",
         }
     }
     /// The chip type of an object: its primitive's, with smooth triangles
     /// and transmitting (two-sided) spheres apart.
     fn of_object(s: &Shape, transmits: bool) -> Option<ChipType> {
         match s {
+            Shape::Triangle {
+                normals: Some(_), ..
+            } if transmits => Some(ChipType::GlassSmoothTriangle),
             Shape::Triangle {
                 normals: Some(_), ..
             } => Some(ChipType::SmoothTriangle),
@@ -129,6 +142,7 @@ impl ChipType {
             Shape::Cone { .. } if transmits && s.prim_type() == PrimType::Cylinder => {
                 Some(ChipType::GlassCylinder)
             }
+            Shape::Cone { .. } if transmits => Some(ChipType::GlassCone),
             _ => ChipType::of(s.prim_type()),
         }
     }
@@ -143,6 +157,8 @@ impl ChipType {
                 | ChipType::GlassPolygon
                 | ChipType::GlassBox
                 | ChipType::GlassCylinder
+                | ChipType::GlassCone
+                | ChipType::GlassSmoothTriangle
         )
     }
     fn of(p: PrimType) -> Option<ChipType> {
@@ -1075,6 +1091,7 @@ fn build_as(
             ChipType::Sphere | ChipType::GlassSphere => SPHERE_WORDS,
             ChipType::Cylinder => CYL_WORDS,
             ChipType::GlassCylinder => CYL_WORDS + CYL_BODY_WORDS,
+            ChipType::GlassCone => CONE_WORDS + CONE_BODY_WORDS,
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
             ChipType::GlassBox => 2 * BOX_WORDS,
@@ -1082,7 +1099,7 @@ fn build_as(
             | ChipType::Triangle
             | ChipType::GlassRectangle
             | ChipType::GlassTriangle => PLANAR_WORDS,
-            ChipType::SmoothTriangle => SMOOTH_WORDS,
+            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => SMOOTH_WORDS,
             ChipType::Polygon | ChipType::GlassPolygon => {
                 1 + POLY_HEAD_WORDS + fan * POLY_EDGE_WORDS + POLY_TAIL_WORDS
             }
@@ -1101,7 +1118,7 @@ fn build_as(
                         inside,
                         caps,
                     },
-                    ChipType::Cone,
+                    ChipType::Cone | ChipType::GlassCone,
                 ) => {
                     let f = ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
                     let inv_s = ((14 + xb + ks_cone) as f64).exp2() / f.big_s;
@@ -1117,29 +1134,39 @@ fn build_as(
                     let sg = if *inside { -1.0 } else { 1.0 };
                     let one = w.one();
                     w.raw(*caps as i64);
-                    w.push(f.m_q.x);
-                    w.push(f.m_q.y);
-                    w.push(f.m_q.z);
-                    w.push(inv_s);
-                    for _ in 0..2 {
-                        w.scaled(f.e1, one * f.c);
-                        w.scaled(f.e2, one * f.c);
-                        w.unit(f.a);
+                    // A transmitting cone: the body twice, the second seen
+                    // from the other side.
+                    let sides: &[f64] = if t == ChipType::GlassCone {
+                        &[1.0, -1.0]
+                    } else {
+                        &[1.0]
+                    };
+                    for &side in sides {
+                        let sg = sg * side;
+                        w.push(f.m_q.x);
+                        w.push(f.m_q.y);
+                        w.push(f.m_q.z);
+                        w.push(inv_s);
+                        for _ in 0..2 {
+                            w.scaled(f.e1, one * f.c);
+                            w.scaled(f.e2, one * f.c);
+                            w.unit(f.a);
+                        }
+                        w.push(one * f.s);
+                        w.push(one * f.g);
+                        w.push(one * sg);
+                        w.raw(f.r as i64);
+                        w.push(one * f.hh);
+                        w.push(one * -sg * f.c);
+                        w.push(one * -sg * f.s);
+                        for c in 0..3 {
+                            w.push(one * f.e1.axis(c));
+                            w.push(one * f.e2.axis(c));
+                            w.push(one * f.a.axis(c));
+                        }
+                        w.raw(i as i64);
+                        w.raw(mat_of[o.material] as i64);
                     }
-                    w.push(one * f.s);
-                    w.push(one * f.g);
-                    w.push(one * sg);
-                    w.raw(f.r as i64);
-                    w.push(one * f.hh);
-                    w.push(one * -sg * f.c);
-                    w.push(one * -sg * f.s);
-                    for c in 0..3 {
-                        w.push(one * f.e1.axis(c));
-                        w.push(one * f.e2.axis(c));
-                        w.push(one * f.a.axis(c));
-                    }
-                    w.raw(i as i64);
-                    w.raw(mat_of[o.material] as i64);
                     for p in &planars[i] {
                         let mut p = *p;
                         p.n = p.n * sg;
@@ -1277,7 +1304,7 @@ fn build_as(
                     Shape::Triangle {
                         normals: Some(ns), ..
                     },
-                    ChipType::SmoothTriangle,
+                    ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle,
                 ) => {
                     // The planar record up to its face normal, the unit
                     // vertex normals by axis (the kernel's read order), then

@@ -491,15 +491,14 @@ fn build_one(
 }
 
 /// What the chip does not render as `scene` asks, one [`Warning`] per
-/// feature (the count of objects and the first line): transmitting
-/// materials (no refracted rays; one-sided where the reference makes such
-/// objects two-sided) and values the scene compiler clamped to its formats
-/// (`notes`, from
+/// feature (the count of objects and the first line): Phong exponents over
+/// the shading kernel's where they show, and values the scene compiler
+/// clamped to its formats (`notes`, from
 /// [`Report::notes`]). The scene's own warnings (skipped degenerate
 /// objects) are in [`Scene::warnings`].
 ///
 /// [`Warning`]: crate::scene::Warning
-pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crate::scene::Warning> {
+pub fn chip_warnings(scene: &Scene, notes: &[String]) -> Vec<crate::scene::Warning> {
     use crate::scene::Warning;
     let mut out = Vec::new();
     let mut add = |feature: &str, hits: Vec<usize>, message: String| {
@@ -520,43 +519,6 @@ pub fn chip_warnings(scene: &Scene, opt: &Options, notes: &[String]) -> Vec<crat
             format!("{n} {many}")
         }
     };
-    let transmit: Vec<usize> = scene
-        .objects
-        .iter()
-        .filter(|o| scene.materials[o.material].t > 0.0)
-        // every type but cones and smooth triangles refracts on the chip
-        // (their two-sided kernels)
-        .filter(|o| {
-            use crate::scene::{PrimType, Shape};
-            o.shape.prim_type() == PrimType::Cone
-                || matches!(
-                    o.shape,
-                    Shape::Triangle {
-                        normals: Some(_),
-                        ..
-                    }
-                )
-        })
-        .map(|o| o.line)
-        .collect();
-    let n = transmit.len();
-    let them = if n == 1 { "it" } else { "them" };
-    add(
-        "refraction",
-        transmit,
-        if opt.depth >= 2 {
-            format!(
-                "{} a transmitting material (T > 0): the chip refracts only through spheres, cylinders, boxes, rectangles, flat triangles and polygons so far, and tests {them} one-sided (the reference refracts and makes {them} two-sided), so {} opaque",
-                plural(n, "cone or smooth triangle has", "cones or smooth triangles have"),
-                if n == 1 { "it renders" } else { "they render" }
-            )
-        } else {
-            format!(
-                "{} a transmitting material (T > 0): the chip tests {them} one-sided (the reference makes {them} two-sided)",
-                plural(n, "cone or smooth triangle has", "cones or smooth triangles have"),
-            )
-        },
-    );
     // Phong exponents over the shading kernel's: only where Ks > 0 (the
     // SPD writes 100000 for many surfaces without highlights).
     let shiny: Vec<usize> = scene
