@@ -816,3 +816,132 @@ fn every_kernel_on_the_32_bit_chip() {
         measure_on::<i32>(name, shape, max_t, max_mean, max_n);
     }
 }
+
+/// Snell's law in the RC (`kernels::refract_prepare`, which `k_tset`
+/// runs): for 64 random incident directions and normals facing them,
+/// entering (eta = 1/ior) or leaving (eta = ior) a material of index
+/// `ior`, the refracted direction and total internal reflection against
+/// f64, on both datapaths. Rays within 2e-3 of the critical angle may
+/// disagree on TIR.
+fn snell_on<W: Word>(ior: f64, seed: u64) -> (usize, f64) {
+    k::with_datapath(W::DATAPATH, || {
+        let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
+        scene.materials[0].t = 0.8;
+        scene.materials[0].ior = ior;
+        scene.objects = vec![Object {
+            shape: shape_sphere(),
+            material: 0,
+            line: 1,
+        }];
+        let opt = Options {
+            datapath: W::DATAPATH,
+            depth: 2,
+            ..Options::default()
+        };
+        let fw = tracer::build(&scene, &opt).unwrap();
+        let lay = &fw.layout;
+        assert!(lay.refract && lay.transmit_materials == 1);
+        let src = format!(
+            "        .datapath {}\nCTXBASE = 0x{:x}\n        .data\nGO:     .word 0\n        .text\n\
+_start: li r1, 0x{:x}\n        li r2, 0\n        li r3, {}\n        ldfb r1, r2, r3\n        dwait\n\
+        li r1, CTXBASE\n        li r2, 0\n        li r3, (ctx_end - CTXBASE) / 4\n        ldctxt r1, r2, r3\n        dwait\n\
+        li r1, (k_init - CTXBASE) / 4\n        li r2, 0\n        sbcb r1, r2, (k_init_end - k_init) / 4\n        rcany r1\n\
+wait:   lw r1, GO(r0)\n        beqz r1, wait\n\
+        li r1, (k_tset - CTXBASE) / 4\n        li r2, {}\n        sbcb r1, r2, (k_tset_end - k_tset) / 4\n\
+        rcany r1\n        halt\n        .ctx\n        .org CTXBASE\n{}{}ctx_end:\n",
+            W::BITS,
+            mem::CTX_BASE,
+            mem::FB_IMAGE,
+            fw.fb.len(),
+            lay.transmit,
+            k::init().text("k_init"),
+            k::refract_prepare(0, 1, 2).text("k_tset"),
+        );
+        let img = asm::assemble(&src, "snell-test.s").unwrap();
+        let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
+        img.load(&mut chip).unwrap();
+        chip.load(mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
+        let mut sim = Sim::new(chip);
+        let wait = img.symbol("wait").unwrap() as u32;
+        while sim.top.risc.pc != wait {
+            sim.step().unwrap();
+        }
+        let one = ((W::BITS - 2) as f64).exp2();
+        let max = ((W::BITS - 1) as f64).exp2() - 1.0;
+        let u = |x: f64| W::wrap((x * one).round().clamp(-max - 1.0, max) as i64);
+        let mut g = Lcg(seed);
+        let mut cases = Vec::new();
+        for lane in 0..64 {
+            let n =
+                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+            let mut d =
+                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+            if d.dot(n) > -0.02 {
+                d = (d - n * (d.dot(n) + 0.3)).normalized();
+            }
+            let back = lane % 2 == 1;
+            let ram = &mut sim.top.array.rc.ram;
+            for i in 0..3 {
+                ram.write(lane, (ram::SH_D + i) as usize, u(d.axis(i as usize)));
+                ram.write(lane, (ram::SH_N + i) as usize, u(n.axis(i as usize)));
+                ram.write(lane, (ram::SH_P + i) as usize, W::wrap(0));
+            }
+            ram.write(lane, ram::ACT as usize, W::wrap(1));
+            ram.write(lane, ram::SH_MAT as usize, W::wrap(0));
+            ram.write(lane, ram::SH_BACK as usize, W::wrap(back as i64));
+            cases.push((d, n, back));
+        }
+        let go = img.symbol("GO").unwrap() as u32;
+        sim.top.mem.write(go, 4, 1);
+        rtl::chip::run_to_halt(&mut sim, 1_000_000).unwrap();
+        let rc = &sim.top.array.rc;
+        let rf = ram::REFR as usize;
+        let (mut disagree, mut worst) = (0, 0.0f64);
+        for (lane, (d, n, back)) in cases.into_iter().enumerate() {
+            // The f64 rule on the directions the chip holds (rounded).
+            let r = |v: Vec3| {
+                Vec3::new(
+                    (v.x * one).round() / one,
+                    (v.y * one).round() / one,
+                    (v.z * one).round() / one,
+                )
+            };
+            let (d, n) = (r(d), r(n));
+            let eta = if back { ior } else { 1.0 / ior };
+            let c1 = -d.dot(n);
+            let kk = 1.0 - eta * eta * (1.0 - c1 * c1);
+            let weight = rc.ram.read(lane, rf + 6).to_i64();
+            let tir_chip = weight == 0;
+            if (kk <= 0.0) != tir_chip {
+                if kk.abs() > 2e-3 {
+                    disagree += 1;
+                }
+                continue;
+            }
+            if kk > 0.0 {
+                let t = (d * eta + n * (eta * c1 - kk.sqrt())).normalized();
+                let c = Vec3::new(
+                    rc.ram.read(lane, rf + 3).to_i64() as f64 / one,
+                    rc.ram.read(lane, rf + 4).to_i64() as f64 / one,
+                    rc.ram.read(lane, rf + 5).to_i64() as f64 / one,
+                );
+                worst = worst.max((t - c).length());
+            }
+        }
+        (disagree, worst)
+    })
+}
+
+#[test]
+fn snell_refraction_kernel_vs_f64() {
+    for (ior, seed) in [(1.5, 1u64), (1.1, 2), (2.4, 3), (1.33, 4)] {
+        let (dis16, w16) = snell_on::<i16>(ior, seed);
+        let (dis32, w32) = snell_on::<i32>(ior, seed);
+        eprintln!(
+            "ior {ior}: 16-bit direction error max {w16:.2e} ({dis16} TIR disagreements), 32-bit {w32:.2e} ({dis32})"
+        );
+        assert_eq!((dis16, dis32), (0, 0), "ior {ior}");
+        assert!(w16 < 4e-3, "ior {ior}: 16-bit direction error {w16}");
+        assert!(w32 < 1e-5, "ior {ior}: 32-bit direction error {w32}");
+    }
+}
