@@ -521,6 +521,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 }
 
 fn main() -> ExitCode {
+    stdout_errors_are_errors();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return usage_error(e),
@@ -532,6 +533,27 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
+}
+
+/// Standard output that cannot be written (a reader that went away, a
+/// full disk) ends the command with one error line and exit code 1, not a
+/// panic: `print!` panics on a write error, and this hook turns that panic
+/// into the message (every other panic keeps the default report).
+fn stdout_errors_are_errors() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let p = info.payload();
+        let msg = p
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| p.downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if let Some(why) = msg.strip_prefix("failed printing to stdout: ") {
+            eprintln!("morphosys: error: writing to standard output: {why}");
+            std::process::exit(1);
+        }
+        default(info)
+    }));
 }
 
 /// Help and version go to stdout as clap renders them; a usage error becomes

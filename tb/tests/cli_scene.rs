@@ -222,3 +222,42 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
         "{err}"
     );
 }
+
+/// Standard output that cannot be written ends with one error line and exit
+/// code 1, never a panic: a reader that goes away (`| head -c 10`) and a
+/// full device (`> /dev/full`).
+#[test]
+fn unwritable_stdout_is_an_error_not_a_panic() {
+    use std::process::Stdio;
+    let dir = tempfile::tempdir().unwrap();
+    // A reader that closes at once: several MB of NFF into a closed pipe.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(dir.path())
+        .args(["spd", "balls", "--size", "3"])
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    drop(child.stdout.take());
+    let out = child.wait_with_output().unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.contains("morphosys: error: writing to standard output:") && !err.contains("panicked"),
+        "{err}"
+    );
+    if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
+        let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+            .current_dir(dir.path())
+            .args(["timing"])
+            .stdout(full)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(
+            err.contains("No space left on device") && !err.contains("panicked"),
+            "{err}"
+        );
+    }
+}
