@@ -146,8 +146,9 @@ enum Command {
         /// Image size WIDTHxHEIGHT (default: the scene's resolution).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
         size: Option<(u32, u32)>,
-        /// Maximum ray depth; the eye ray is depth 1 (default 5).
-        #[arg(long, value_name = "N")]
+        /// Maximum ray depth 1..=8; the eye ray is depth 1 (default 5, the
+        /// SPD's; `render` defaults to 2, the paper's).
+        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
         depth: Option<u32>,
         /// Write the image here (default: <scene>-reference.png).
         #[arg(long, value_name = "PNG")]
@@ -198,11 +199,11 @@ enum Command {
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
         size: Option<(u32, u32)>,
         /// Rays traced in parallel: 4, 8, 16, 32 or 64.
-        #[arg(long, value_name = "N", default_value_t = 64)]
+        #[arg(long, value_name = "N", default_value_t = 64, value_parser = parse_ways)]
         ways: u32,
-        /// Maximum ray depth; the eye ray is depth 1 (the paper's recursion
-        /// level 2).
-        #[arg(long, value_name = "N", default_value_t = 2)]
+        /// Maximum ray depth 1..=8; the eye ray is depth 1 (default: the
+        /// paper's recursion level 2; the SPD's is 5).
+        #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
         depth: u32,
         /// Write the image here (default: <scene>-chip.png).
         #[arg(long, value_name = "PNG")]
@@ -256,7 +257,7 @@ enum Command {
         datapath: tb::cli::DatapathChoice,
         /// Newton-Raphson steps after each reciprocal / square-root table
         /// lookup (0..=3).
-        #[arg(long, value_name = "N", default_value_t = 2)]
+        #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=3))]
         newton_steps: u32,
         /// Entries of the reciprocal and reciprocal square-root tables in
         /// every RC's RAM: 16, 32, 64 or 128.
@@ -322,6 +323,14 @@ enum Bench {
 
 fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
     s.parse()
+}
+
+/// `--ways`: 4, 8, 16, 32 or 64 rays in flight (a tile of 2x2 .. 8x8).
+fn parse_ways(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n @ (4 | 8 | 16 | 32 | 64)) => Ok(n),
+        _ => Err(format!("expected 4, 8, 16, 32 or 64, found '{s}'")),
+    }
 }
 
 fn parse_depth(s: &str) -> Result<u32, String> {
@@ -572,11 +581,21 @@ fn usage_error(e: clap::Error) -> ExitCode {
         };
     }
     let text = e.render().to_string();
-    let first = text
-        .lines()
-        .find(|l| !l.trim().is_empty())
+    let mut lines = text.lines().skip_while(|l| l.trim().is_empty());
+    let mut first = lines
+        .next()
         .unwrap_or("bad arguments")
-        .trim_start_matches("error: ");
+        .trim_start_matches("error: ")
+        .to_string();
+    // "the following required arguments were not provided:" lists them on
+    // the lines below: keep them on the one line.
+    if first.ends_with(':') {
+        let items: Vec<&str> = lines
+            .take_while(|l| !l.trim().is_empty())
+            .map(str::trim)
+            .collect();
+        first = format!("{} {}", first, items.join(", "));
+    }
     let tip = text
         .lines()
         .find_map(|l| l.trim().strip_prefix("tip: "))

@@ -261,3 +261,47 @@ fn unwritable_stdout_is_an_error_not_a_panic() {
         );
     }
 }
+
+/// A usage error names the argument on one line and exits 2, whether clap
+/// or a value range catches it (issue 17: missing arguments were cut from
+/// the message, and --ways / --depth errors exited 1).
+#[test]
+fn usage_errors_name_the_argument_and_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, want) in [
+        (
+            &["sweep"][..],
+            "required arguments were not provided: --out-dir <DIR>",
+        ),
+        (
+            &["compare"][..],
+            "required arguments were not provided: <A>, <B>",
+        ),
+        (
+            &["render", "--ways", "3"][..],
+            "'--ways <N>': expected 4, 8, 16, 32 or 64",
+        ),
+        (
+            &["render", "--depth", "0"][..],
+            "'--depth <N>': 0 is not in 1..=8",
+        ),
+        (
+            &["render", "--newton-steps", "4"][..],
+            "'--newton-steps <N>': 4 is not in 0..=3",
+        ),
+        (
+            &["reference", "--depth", "9"][..],
+            "'--depth <N>': 9 is not in 1..=8",
+        ),
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+            .current_dir(dir.path())
+            .args(args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(want), "{args:?}: {err}");
+        assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+    }
+}

@@ -217,7 +217,7 @@ fn render_command_writes_png_json_asm_and_vcd() {
     firmware::asm::assemble_file(&dir.path().join("c.s")).unwrap();
     let (ok, _, err) = morphosys(dir.path(), &["render", "--size", "8x8", "--ways", "5"]);
     assert!(!ok);
-    assert!(err.contains("--ways 5"), "{err}");
+    assert!(err.contains("'--ways <N>'") && err.contains("'5'"), "{err}");
     assert_eq!(err.lines().count(), 1, "{err}");
     let (ok, _, err) = morphosys(dir.path(), &["render", "missing.nff", "--size", "8x8"]);
     assert!(!ok && err.contains("missing.nff"), "{err}");
