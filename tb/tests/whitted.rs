@@ -108,30 +108,39 @@ fn glass_of_every_type_renders_without_warnings() {
     assert!(j["psnr_db"].as_f64().unwrap() >= 27.0, "{j}");
 }
 
-/// A glass sphere before a checkered wall: seen through it, the wall
-/// appears inverted and magnified, as in the reference; refracted rays to
-/// depth 5 (the SPD's) on both datapaths.
-#[test]
-fn glass_sphere_before_a_checkered_wall() {
-    let text = String::from(
-        "v\nfrom 0 0.5 6\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 64 64\n\
-         b 0.2 0.3 0.5\nl 3 6 8\nf 1 1 1 0.1 0.2 60 0.85 1.5\ns 0 0 0 1\n",
-    ) + &checkered_wall();
-    // (16-bit: 29.5 dB at 64x64, 33.0 at 128x128: the sphere magnifies
-    // direction rounding near its rim.)
-    for (datapath, min_db) in [("16", 27.0), ("32", 60.0)] {
+/// The glass scenes' view: camera, light, background and the glass
+/// material (Kd 0.1, Ks 0.2, T 0.85, ior 1.5); the objects follow.
+const GLASS_HEAD: &str =
+    "v\nfrom 0 0.5 6\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 64 64\n\
+                          b 0.2 0.3 0.5\nl 3 6 8\nf 1 1 1 0.1 0.2 60 0.85 1.5\n";
+
+/// Render an NFF glass scene at 64x64, depth 5, on each datapath with its
+/// PSNR floor: no warning, the floor held, the census within 10%.
+fn glass_renders(text: &str, floors: [(&str, f64); 2]) {
+    for (datapath, min_db) in floors {
         let (j, err) = render_with(
-            &text,
+            text,
             &["--size", "64x64", "--depth", "5", "--datapath", datapath],
         );
         assert!(!err.contains("warning"), "{err}");
         let psnr = j["psnr_db"].as_f64().unwrap();
         assert!(psnr >= min_db, "{datapath}-bit: {psnr:.2} dB\n{j}");
-        assert!(j["refract_rays"].as_u64().unwrap() > 500, "{j}");
+        assert!(j["refract_rays"].as_u64().unwrap() > 200, "{j}");
         for k in ["eye_rays", "shadow_rays", "reflect_rays", "refract_rays"] {
             census_close(&j, k, 0.1);
         }
     }
+}
+
+/// A glass sphere before a checkered wall: seen through it, the wall
+/// appears inverted and magnified, as in the reference; refracted rays to
+/// depth 5 (the SPD's) on both datapaths.
+#[test]
+fn glass_sphere_before_a_checkered_wall() {
+    // (16-bit: 29.5 dB at 64x64, 33.0 at 128x128: the sphere magnifies
+    // direction rounding near its rim.)
+    let text = format!("{GLASS_HEAD}s 0 0 0 1\n{}", checkered_wall());
+    glass_renders(&text, [("16", 27.0), ("32", 60.0)]);
 }
 
 /// A glass slab (six rectangles, two-sided) before the checkered wall:
@@ -160,18 +169,7 @@ fn glass_slab_before_a_checkered_wall() {
         }
     }
     text += &checkered_wall();
-    for (datapath, min_db) in [("16", 25.0), ("32", 60.0)] {
-        let (j, err) = render_with(
-            &text,
-            &["--size", "64x64", "--depth", "5", "--datapath", datapath],
-        );
-        assert!(!err.contains("warning"), "{err}");
-        let psnr = j["psnr_db"].as_f64().unwrap();
-        assert!(psnr >= min_db, "{datapath}-bit: {psnr:.2} dB\n{j}");
-        for k in ["eye_rays", "shadow_rays", "reflect_rays", "refract_rays"] {
-            census_close(&j, k, 0.1);
-        }
-    }
+    glass_renders(&text, [("16", 25.0), ("32", 60.0)]);
 }
 
 /// A wall of 64 squares at z = -3, red and white.
@@ -196,46 +194,24 @@ fn checkered_wall() -> String {
 /// body from outside and from inside, as the reference's two-sided test.
 #[test]
 fn glass_cylinder_before_a_checkered_wall() {
-    let text = String::from(
-        "v\nfrom 0 0.5 6\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 64 64\n\
-         b 0.2 0.3 0.5\nl 3 6 8\nf 1 1 1 0.1 0.2 60 0.85 1.5\nc\n-1 -0.5 0 0.6\n1 0.5 0 0.6\n",
-    ) + &checkered_wall();
     // (16-bit: 31.9 dB; 32-bit: the reference's image)
-    for (datapath, min_db) in [("16", 28.0), ("32", 60.0)] {
-        let (j, err) = render_with(
-            &text,
-            &["--size", "64x64", "--depth", "5", "--datapath", datapath],
-        );
-        assert!(!err.contains("warning"), "{err}");
-        let psnr = j["psnr_db"].as_f64().unwrap();
-        assert!(psnr >= min_db, "{datapath}-bit: {psnr:.2} dB");
-        for k in ["shadow_rays", "reflect_rays", "refract_rays"] {
-            census_close(&j, k, 0.1);
-        }
-    }
+    let text = format!(
+        "{GLASS_HEAD}c\n-1 -0.5 0 0.6\n1 0.5 0 0.6\n{}",
+        checkered_wall()
+    );
+    glass_renders(&text, [("16", 28.0), ("32", 60.0)]);
 }
 
 /// A glass (open) cone across the view before the checkered wall, both
 /// sides of its body.
 #[test]
 fn glass_cone_before_a_checkered_wall() {
-    let text = String::from(
-        "v\nfrom 0 0.5 6\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 64 64\n\
-         b 0.2 0.3 0.5\nl 3 6 8\nf 1 1 1 0.1 0.2 60 0.85 1.5\nc\n-1 -0.5 0 0.8\n1 0.5 0 0.3\n",
-    ) + &checkered_wall();
     // (16-bit: 32.5 dB; 32-bit: 89.0)
-    for (datapath, min_db) in [("16", 28.0), ("32", 60.0)] {
-        let (j, err) = render_with(
-            &text,
-            &["--size", "64x64", "--depth", "5", "--datapath", datapath],
-        );
-        assert!(!err.contains("warning"), "{err}");
-        let psnr = j["psnr_db"].as_f64().unwrap();
-        assert!(psnr >= min_db, "{datapath}-bit: {psnr:.2} dB");
-        for k in ["shadow_rays", "reflect_rays", "refract_rays"] {
-            census_close(&j, k, 0.1);
-        }
-    }
+    let text = format!(
+        "{GLASS_HEAD}c\n-1 -0.5 0 0.8\n1 0.5 0 0.3\n{}",
+        checkered_wall()
+    );
+    glass_renders(&text, [("16", 28.0), ("32", 60.0)]);
 }
 
 /// Rays inside a glass sphere meeting its surface at grazing angles are

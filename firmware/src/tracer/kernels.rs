@@ -697,6 +697,21 @@ fn planar_sides(inside: Inside, kt: u32, nr: impl Into<Approx>, two: bool) -> K 
     let mut k = K::default();
     k.comment("planar: den = n.d, num = n.(v0 - o)");
     plane_hit_sides(&mut k, nr, two);
+    inside_test(&mut k, inside, kt);
+    if two {
+        commit_streamed_normal_two(&mut k, 9);
+    } else {
+        commit_streamed_normal(&mut k, 9);
+    }
+    k
+}
+
+/// After [`plane_hit`]: the hit point relative to `v0` (the stream's
+/// `v0.xyz`), its coordinates `u` (r13), `w` (r14) along the record's dual
+/// edge vectors (scaled by `2^kt`), and F kept only where they are inside
+/// the primitive (`u + w` in r15 for a triangle), with a tolerance of
+/// [`INSIDE_TOL`].
+fn inside_test(k: &mut K, inside: Inside, kt: u32) {
     k.comment("P - v0");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
@@ -731,12 +746,20 @@ fn planar_sides(inside: Inside, kt: u32, nr: impl Into<Approx>, two: bool) -> K 
                 .c("(f) cmp.le r15, r8");
         }
     }
-    if two {
-        commit_streamed_normal_two(&mut k, 9);
-    } else {
-        commit_streamed_normal(&mut k, 9);
+}
+
+/// The smooth triangle's shading normal: with `u` (r13), `w` (r14), `u + w`
+/// (r15) from [`inside_test`], the streamed unit vertex normals weighted by
+/// `(1 - u - w, u, w)` into r10..r12, normalised (clobbers r8, r9, r13..r15).
+fn interpolate_normal(k: &mut K, nr: Approx) {
+    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c("sub r8, r8, r15");
+    for x in [10, 11, 12] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r13")
+            .cq(format!("mac r{x}, fb0, r14, >>14"));
     }
-    k
+    normalize(k, [10, 11, 12], [9, 8, 13, 14, 15], false, nr);
 }
 
 /// A triangle with vertex normals (NFF `pp`), shaded smoothly as the
@@ -754,35 +777,10 @@ pub fn smooth_triangle(kt: u32, nr: impl Into<Approx>) -> K {
     let mut k = K::default();
     k.comment("smooth triangle: den = n.d, num = n.(v0 - o)");
     plane_hit(&mut k, nr);
-    k.comment("P - v0");
-    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
-        let x = 10 + i;
-        k.cq(format!("ldacc r{o}, <<14"))
-            .cq(format!("mac r{x}, r9, r{d}, >>14"))
-            .c(format!("rsb r{x}, fb0, r{x}"));
-    }
-    k.c("mul out, fb0, r10")
-        .c("mac out, fb0, r11")
-        .c(format!("mac r13, fb0, r12, >>{kt}"));
-    k.c("mul out, fb0, r10")
-        .c("mac out, fb0, r11")
-        .c(format!("mac r14, fb0, r12, >>{kt}"));
-    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
-        .c(format!("add r8, r8, #{INSIDE_TOL}"))
-        .c(format!("(f) cmp.ge r13, #-{INSIDE_TOL}"))
-        .c(format!("(f) cmp.ge r14, #-{INSIDE_TOL}"))
-        .c("adds r15, r13, r14")
-        .c("(f) cmp.le r15, r8");
+    inside_test(&mut k, Inside::Triangle, kt);
     k.comment("Ns = (1 - u - w) n0 + u n1 + w n2, normalised");
-    k.c("(f) mov r7, r9")
-        .c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
-        .c("sub r8, r8, r15");
-    for x in [10, 11, 12] {
-        k.c("mul out, fb0, r8")
-            .c("mac out, fb0, r13")
-            .cq(format!("mac r{x}, fb0, r14, >>14"));
-    }
-    normalize(&mut k, [10, 11, 12], [9, 8, 13, 14, 15], false, nr);
+    k.c("(f) mov r7, r9");
+    interpolate_normal(&mut k, nr);
     for (i, x) in [10, 11, 12].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_NS + i as u32));
     }
@@ -805,35 +803,10 @@ pub fn smooth_triangle_two_sided(kt: u32, nr: impl Into<Approx>) -> K {
     let mut k = K::default();
     k.comment("smooth triangle, two-sided: den = n.d, num = n.(v0 - o)");
     plane_hit_sides(&mut k, nr, true);
-    k.comment("P - v0");
-    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
-        let x = 10 + i;
-        k.cq(format!("ldacc r{o}, <<14"))
-            .cq(format!("mac r{x}, r9, r{d}, >>14"))
-            .c(format!("rsb r{x}, fb0, r{x}"));
-    }
-    k.c("mul out, fb0, r10")
-        .c("mac out, fb0, r11")
-        .c(format!("mac r13, fb0, r12, >>{kt}"));
-    k.c("mul out, fb0, r10")
-        .c("mac out, fb0, r11")
-        .c(format!("mac r14, fb0, r12, >>{kt}"));
-    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
-        .c(format!("add r8, r8, #{INSIDE_TOL}"))
-        .c(format!("(f) cmp.ge r13, #-{INSIDE_TOL}"))
-        .c(format!("(f) cmp.ge r14, #-{INSIDE_TOL}"))
-        .c("adds r15, r13, r14")
-        .c("(f) cmp.le r15, r8");
+    inside_test(&mut k, Inside::Triangle, kt);
     k.comment("Ns = (1 - u - w) n0 + u n1 + w n2, normalised");
-    k.c(format!("st r9, [#{}]", ram::TMP4))
-        .c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
-        .c("sub r8, r8, r15");
-    for x in [10, 11, 12] {
-        k.c("mul out, fb0, r8")
-            .c("mac out, fb0, r13")
-            .cq(format!("mac r{x}, fb0, r14, >>14"));
-    }
-    normalize(&mut k, [10, 11, 12], [9, 8, 13, 14, 15], false, nr);
+    k.c(format!("st r9, [#{}]", ram::TMP4));
+    interpolate_normal(&mut k, nr);
     k.comment("turned to the ray on a back hit; the face normal, obj");
     k.c(format!("ld r15, [r0 + #{}]", ram::TMP3))
         .c("movb r14, #1")
