@@ -241,6 +241,21 @@ fn default_out(scene: &Path) -> PathBuf {
 
 pub fn command(a: RenderArgs) -> Result<()> {
     let scene = load_scene(a.scene.as_deref())?;
+    // Every output checked before the frame is rendered.
+    let out_path = a
+        .out
+        .clone()
+        .unwrap_or_else(|| default_out(Path::new(&scene.source)));
+    crate::cmd_scene::check_writable(&out_path, "--out")?;
+    for (p, what) in [
+        (&a.json, "--json"),
+        (&a.vcd, "--vcd"),
+        (&a.emit_asm, "--emit-asm"),
+    ] {
+        if let Some(p) = p {
+            crate::cmd_scene::check_writable(p, what)?;
+        }
+    }
     let (width, height) = a.size.unwrap_or((256, 256));
     if width == 0 || height == 0 || width > 4096 || height > 4096 {
         anyhow::bail!("--size {width}x{height}: each side must be 1..=4096");
@@ -358,9 +373,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         rep.json["profile"] = profile_json(p);
     }
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
-    let out = a
-        .out
-        .unwrap_or_else(|| default_out(Path::new(&scene.source)));
+    let out = out_path;
     write_atomic(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;
     eprintln!("wrote {}", out.display());

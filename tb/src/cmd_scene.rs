@@ -34,6 +34,32 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(scene)
 }
 
+/// Check before the work that `path` can be written: its folder exists and
+/// takes a new file (a temporary one, removed at once). `what` names the
+/// argument in the error.
+pub fn check_writable(path: &Path, what: &str) -> Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    if !dir.is_dir() {
+        anyhow::bail!(
+            "{what} {}: the folder {} does not exist",
+            path.display(),
+            dir.display()
+        );
+    }
+    tempfile::NamedTempFile::new_in(dir)
+        .map(drop)
+        .with_context(|| {
+            format!(
+                "{what} {}: cannot write in {}",
+                path.display(),
+                dir.display()
+            )
+        })
+}
+
 /// Write a file atomically: into a temporary file beside it, renamed into
 /// place, so a failed run never leaves half a file.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
@@ -195,6 +221,12 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
             PathBuf::from(format!("{stem}-reference.png"))
         })
     });
+    // Every output checked before the image is rendered.
+    for (p, what) in [(&out, "--out"), (&a.json, "--json"), (&a.hits, "--hits")] {
+        if let Some(p) = p {
+            check_writable(p, what)?;
+        }
+    }
     let t0 = Instant::now();
     let img = render(
         &scene,

@@ -305,3 +305,35 @@ fn usage_errors_name_the_argument_and_exit_2() {
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
     }
 }
+
+/// Output paths are checked before the work (issue 17: a render into a
+/// missing folder ran the whole frame, then failed): one line naming the
+/// argument, no output, at once.
+#[test]
+fn output_paths_are_checked_before_the_work() {
+    let dir = tempfile::tempdir().unwrap();
+    for (args, want) in [
+        (
+            &["render", "--out", "missing/x.png"][..],
+            "--out missing/x.png: the folder missing does not exist",
+        ),
+        (
+            &["render", "--size", "8x8", "--json", "missing/x.json"][..],
+            "--json missing/x.json: the folder missing does not exist",
+        ),
+        (
+            &["reference", "--hits", "missing/h.hits"][..],
+            "--hits missing/h.hits: the folder missing does not exist",
+        ),
+    ] {
+        let (ok, out, err) = morphosys(dir.path(), args);
+        assert!(!ok, "{args:?}");
+        assert!(
+            err.contains(want) && err.lines().count() == 1,
+            "{args:?}: {err}"
+        );
+        // Nothing rendered: no figures, no files.
+        assert!(!out.contains("fps") && !out.contains("eye rays"), "{out}");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+    }
+}
