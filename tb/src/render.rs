@@ -244,6 +244,7 @@ fn run_group<W: Word>(
     trace: Option<rtl::trace::TraceConfig>,
     profile: bool,
     timing: &Timing,
+    say_files: bool,
 ) -> Result<Group> {
     // Main memory as large as the program touches (its segments, the tile
     // list, the output tiles and the streamed scene image), not the
@@ -336,8 +337,11 @@ fn run_group<W: Word>(
     let files = sim
         .finish_trace()
         .map_err(|e| anyhow!("writing the waveform: {e}"))?;
-    for f in files {
-        eprintln!("wrote {}", f.display());
+    // (Not for `bench`, whose waveforms are temporary.)
+    if say_files {
+        for f in files {
+            eprintln!("wrote {}", f.display());
+        }
     }
     result.map_err(|e| anyhow!("the tracer firmware stopped: {e}"))?;
     let m = &sim.top.mem;
@@ -456,8 +460,8 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<Probe> {
     let runs: Vec<Result<Group>> = groups
         .par_iter()
         .map(|g| match fw.datapath {
-            Datapath::W16 => run_group::<i16>(&img, fw, g, None, false, timing),
-            Datapath::W32 => run_group::<i32>(&img, fw, g, None, false, timing),
+            Datapath::W16 => run_group::<i16>(&img, fw, g, None, false, timing, false),
+            Datapath::W32 => run_group::<i32>(&img, fw, g, None, false, timing, false),
         })
         .collect();
     let mut p = Probe {
@@ -709,8 +713,8 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             let t = if gi == 0 { first_trace.clone() } else { None };
             let p = host.profile;
             let r = match fw.datapath {
-                Datapath::W16 => run_group::<i16>(&img, &fw, g, t, p, &host.timing),
-                Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p, &host.timing),
+                Datapath::W16 => run_group::<i16>(&img, &fw, g, t, p, &host.timing, progress),
+                Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p, &host.timing, progress),
             };
             bar.inc(g.len() as u64);
             r

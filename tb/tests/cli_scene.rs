@@ -230,10 +230,11 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
 fn unwritable_stdout_is_an_error_not_a_panic() {
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
-    // A reader that closes at once: several MB of NFF into a closed pipe.
+    // A reader that closes at once: 300 KB of NFF (more than a pipe holds,
+    // so the write fails whenever the reader closes) into a closed pipe.
     let mut child = Command::new(env!("CARGO_BIN_EXE_morphosys"))
         .current_dir(dir.path())
-        .args(["spd", "balls", "--size", "3"])
+        .args(["spd", "balls", "--size", "4"])
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -336,4 +337,18 @@ fn output_paths_are_checked_before_the_work() {
         assert!(!out.contains("fps") && !out.contains("eye rays"), "{out}");
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
     }
+}
+
+/// `bench` traces into temporary files it deletes: it does not announce
+/// them (issue 17: a dozen "wrote /tmp/.tmpXXX/bench0.vcd" lines).
+#[test]
+fn bench_does_not_announce_its_temporary_waveforms() {
+    let dir = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(dir.path(), &["bench", "--size", "16x16", "--repeat", "1"]);
+    assert!(ok, "{out}{err}");
+    assert!(out.contains("tracing on, 1 thread"), "{out}");
+    assert!(
+        !err.contains("wrote") && !out.contains("wrote"),
+        "{out}{err}"
+    );
 }
