@@ -1122,6 +1122,26 @@ pub fn polygon_tail_two_sided() -> K {
     k
 }
 
+/// The end of a curved body kernel: where F, the streamed object id and
+/// material; for one side of a transmitting body (`back`: the inside run)
+/// also `ram::HIT_BACK_OBJ` (the id on the inside, -1 outside). Clobbers r8.
+fn commit_obj_mat(k: &mut K, back: Option<bool>) {
+    match back {
+        None => {
+            k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
+        }
+        Some(b) => {
+            k.c("mov r8, fb0")
+                .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ));
+            if !b {
+                k.c("movb r8, #-1");
+            }
+            k.c(format!("(f) st r8, [#{}]", ram::HIT_BACK_OBJ));
+        }
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+}
+
 /// Open cylinder body (the caps are [`Inside::Disc`] planar records).
 /// Record (34 words): `B.xyz, e1.xyz, e2.xyz, e1.xyz, e2.xyz, invr, r, sg,
 /// B.xyz, a.xyz, H+2, sg, (e1, e2) x, (e1, e2) y, (e1, e2) z, obj, mat`
@@ -1242,20 +1262,7 @@ fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -
     for (i, x) in [13, 14, 15].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    match back {
-        None => {
-            k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
-        }
-        Some(b) => {
-            k.c("mov r8, fb0")
-                .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ));
-            if !b {
-                k.c("movb r8, #-1");
-            }
-            k.c(format!("(f) st r8, [#{}]", ram::HIT_BACK_OBJ));
-        }
-    }
-    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    commit_obj_mat(&mut k, back);
     k
 }
 
@@ -1460,20 +1467,7 @@ fn cone_sides(ks: u32, ep: u32, nr: u32, back: Option<bool>) -> K {
     for (i, x) in [11, 12, 13].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    match back {
-        None => {
-            k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
-        }
-        Some(b) => {
-            k.c("mov r8, fb0")
-                .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ));
-            if !b {
-                k.c("movb r8, #-1");
-            }
-            k.c(format!("(f) st r8, [#{}]", ram::HIT_BACK_OBJ));
-        }
-    }
-    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    commit_obj_mat(&mut k, back);
     k
 }
 
