@@ -594,52 +594,28 @@ fn plane_hit(k: &mut K, nr: impl Into<Approx>) {
 /// the object with `ram::ORIG_OBJ`; a distance margin would also drop the
 /// hits of rays starting near an edge on the next face).
 fn plane_hit_sides(k: &mut K, nr: impl Into<Approx>, two: bool) {
+    let nr: Approx = nr.into();
+    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .cq("mac r11, r10, r6, >>14");
+    k.c("sub r12, fb0, r1")
+        .c("sub r13, fb0, r2")
+        .c("sub r14, fb0, r3");
+    k.c("mul out, r8, r12")
+        .c("mac out, r9, r13")
+        .cq("mac r15, r10, r14, >>14");
+    k.c("neg r11, r11").c("neg r15, r15");
     if two {
-        return plane_hit_two(k, nr);
+        // the back: den and num change sign, TMP3 = 1
+        k.c("movb r12, #0")
+            .c("cmp.lt r11, #0")
+            .c("(f) movb r12, #1")
+            .c("(f) neg r11, r11")
+            .c("(f) neg r15, r15")
+            .c(format!("st r12, [#{}]", ram::TMP3));
     }
-    let nr: Approx = nr.into();
-    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
-    k.c("mul out, r8, r4")
-        .c("mac out, r9, r5")
-        .cq("mac r11, r10, r6, >>14");
-    k.c("sub r12, fb0, r1")
-        .c("sub r13, fb0, r2")
-        .c("sub r14, fb0, r3");
-    k.c("mul out, r8, r12")
-        .c("mac out, r9, r13")
-        .cq("mac r15, r10, r14, >>14");
-    k.c("neg r11, r11")
-        .c("neg r15, r15")
-        .c("cmp.gt r11, #0")
-        .c("(f) cmp.gt r15, #0")
-        .cq("ldacc r15, <<14")
-        .c("msu out, r7, r11")
-        .c("acch r8")
-        .c("(f) cmp.lt r8, #0");
-    divide(k, 15, 11, 9, [8, 10, 12, 13, 14], nr);
-}
-
-fn plane_hit_two(k: &mut K, nr: impl Into<Approx>) {
-    let nr: Approx = nr.into();
-    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
-    k.c("mul out, r8, r4")
-        .c("mac out, r9, r5")
-        .cq("mac r11, r10, r6, >>14");
-    k.c("sub r12, fb0, r1")
-        .c("sub r13, fb0, r2")
-        .c("sub r14, fb0, r3");
-    k.c("mul out, r8, r12")
-        .c("mac out, r9, r13")
-        .cq("mac r15, r10, r14, >>14");
-    k.c("neg r11, r11")
-        .c("neg r15, r15")
-        .c("movb r12, #0")
-        .c("cmp.lt r11, #0")
-        .c("(f) movb r12, #1")
-        .c("(f) neg r11, r11")
-        .c("(f) neg r15, r15")
-        .c(format!("st r12, [#{}]", ram::TMP3))
-        .c("cmp.gt r11, #0")
+    k.c("cmp.gt r11, #0")
         .c("(f) cmp.gt r15, #0")
         .cq("ldacc r15, <<14")
         .c("msu out, r7, r11")
