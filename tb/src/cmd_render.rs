@@ -36,6 +36,16 @@ pub struct RenderArgs {
     pub newton_steps: u32,
     /// Entries of the reciprocal and reciprocal square root tables.
     pub table_entries: u32,
+    /// Guard bits of the coordinate format (2..=4).
+    pub guard_bits: u32,
+    /// Offset of spawned rays along the normal, in LSBs.
+    pub ray_offset_lsb: i32,
+    /// Stop at once when `json` already holds a complete render made with
+    /// the same `argv`.
+    pub skip_done: bool,
+    /// The command line's arguments (after the program's name), recorded in
+    /// the JSON for `skip_done` and `sweep --merge`.
+    pub argv: Vec<String>,
     /// Profile every chip instance (cycles per kernel and per TinyRISC
     /// label).
     pub profile: bool,
@@ -239,7 +249,35 @@ fn default_out(scene: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}-chip.png"))
 }
 
+/// Whether `path` holds a complete render JSON made with the arguments
+/// `argv`: it parses, records those arguments and has the frame's cycles
+/// (every JSON is written whole or not at all, so a killed render leaves
+/// none).
+pub fn render_json_done(path: &Path, argv: &[String]) -> bool {
+    let Ok(text) = std::fs::read_to_string(path) else {
+        return false;
+    };
+    let Ok(j) = serde_json::from_str::<serde_json::Value>(&text) else {
+        return false;
+    };
+    let same = j["argv"].as_array().is_some_and(|v| {
+        v.iter()
+            .map(|x| x.as_str())
+            .eq(argv.iter().map(|a| Some(a.as_str())))
+    });
+    same && j["cycles"].is_u64()
+}
+
 pub fn command(a: RenderArgs) -> Result<()> {
+    if let (true, Some(j)) = (a.skip_done, &a.json) {
+        if render_json_done(j, &a.argv) {
+            println!(
+                "{}: already rendered with these arguments (--skip-done)",
+                j.display()
+            );
+            return Ok(());
+        }
+    }
     let scene = load_scene(a.scene.as_deref())?;
     // Every output checked before the frame is rendered.
     let out_path = a
@@ -292,7 +330,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
     let nm = firmware::tracer::Numerics {
         newton_steps: a.newton_steps,
         table_entries: a.table_entries,
-        ..Default::default()
+        guard_bits: a.guard_bits,
+        eps_lsb: a.ray_offset_lsb,
     };
     let mut opt = opt;
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
@@ -373,6 +412,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         rep.json["profile"] = profile_json(p);
     }
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
+    rep.json["argv"] = a.argv.clone().into();
     let out = out_path;
     write_atomic(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;

@@ -2,7 +2,7 @@
 //! quality. Renders each scene on the simulated chip under a set of
 //! configurations, one knob varied at a time from the paper's configuration
 //! (256x256, 64 ways, recursion level 2, BSP depth 15, 5 objects per leaf,
-//! the paper's median split; 2 Newton steps, 2 guard bits, 3-LSB ray offset), and writes `results.csv` and the charts:
+//! the paper's median split; 2 Newton steps, 2 guard bits, no ray offset), and writes `results.csv` and the charts:
 //!
 //! * `fig8.{svg,png}`: frames/s at 300 MHz against ways (the paper's Fig. 8,
 //!   with its 13.3 frames/s at 64 ways marked), and `fig8_active.{svg,png}`,
@@ -49,6 +49,10 @@ pub struct SweepArgs {
     /// Run only the issue-model comparison (`--only broadcast`): the
     /// paper's configuration and the packet traversal under both models.
     pub broadcast_only: bool,
+    /// Render nothing: write the plan into this folder (`jobs.txt`, one
+    /// `morphosys render` per distinct render, and `sweep.toml`), for
+    /// GNU parallel or a Slurm job array, then `sweep --merge`.
+    pub plan: Option<PathBuf>,
 }
 
 /// Knob name of the rows of the scene-size sweep.
@@ -313,7 +317,6 @@ struct Row {
     hit_agreement: f64,
     active_rc_fraction: f64,
     objects_tested_per_ray: f64,
-    host_seconds: f64,
     /// Ray-object tests the RCs executed per ray traced, and the share of
     /// cycles the array waited for TinyRISC.
     ray_tests_per_ray: f64,
@@ -354,35 +357,133 @@ fn key(o: &Options, n: &Numerics) -> String {
     )
 }
 
-/// The scenes of the size sweep, generated: (family, size, scene).
-fn family_scenes(a: &SweepArgs) -> Result<Vec<(String, u32, firmware::scene::Scene)>> {
-    let mut v = Vec::new();
-    for f in &a.families {
-        firmware::scene::spd::default_size(f).map_err(|e| anyhow::anyhow!("--families: {e}"))?;
-        for size in 1..=a.max_size {
-            let s = firmware::scene::spd::scene(f, size)
-                .map_err(|e| anyhow::anyhow!("--max-size {}: {}", a.max_size, e.message))?;
-            v.push((f.clone(), size, s));
-        }
-    }
-    Ok(v)
+/// A scene of the sweep: its name in the table (the file as given, or
+/// the generated file's name), its object count, the file a planned render
+/// reads, and for the size sweep its SPD family and size.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+struct SceneRef {
+    name: String,
+    primitives: usize,
+    file: PathBuf,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    family: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    size: Option<u32>,
 }
 
-fn row(
-    scene: &firmware::scene::Scene,
-    knob: &str,
-    value: String,
-    opt: &Options,
-    nm: &Numerics,
-    j: &serde_json::Value,
-) -> Row {
+/// One row of the sweep to measure: a scene under a configuration, and the
+/// render that measures it (configurations equal on a scene, such as the
+/// paper's and `newton_steps=2`, share one).
+struct Point {
+    scene: usize,
+    cfg: Config,
+    job: usize,
+}
+
+/// One distinct render of the sweep: its name (that of its first point;
+/// the plan's `points/NAME.json`) and its first point.
+struct Job {
+    name: String,
+    point: usize,
+}
+
+/// Every point of the sweep in the order of the table (the knob sweep on
+/// each scene, then the size sweep), and the distinct renders they need.
+fn points(scenes: &[SceneRef], cfgs: &[Config], family_size: (u32, u32)) -> (Vec<Point>, Vec<Job>) {
+    let mut pts = Vec::new();
+    for (i, sc) in scenes.iter().enumerate() {
+        if sc.family.is_none() {
+            for c in cfgs {
+                pts.push((i, c.clone()));
+            }
+        }
+    }
+    let nm = Numerics::default();
+    for (i, sc) in scenes.iter().enumerate() {
+        let Some(size) = sc.size.filter(|_| sc.family.is_some()) else {
+            continue;
+        };
+        let (w, h) = family_size;
+        for traversal in Traversal::ALL {
+            let opt = match traversal {
+                Traversal::Paper => paper_config(w, h),
+                Traversal::Packet => packet_config(w, h),
+            };
+            pts.push((
+                i,
+                Config::from(Knob {
+                    knob: SCENE_SIZE,
+                    value: size.to_string(),
+                    opt,
+                    nm,
+                }),
+            ));
+        }
+    }
+    let mut jobs: Vec<Job> = Vec::new();
+    let mut by_key: BTreeMap<String, usize> = BTreeMap::new();
+    let mut names: std::collections::BTreeSet<String> = Default::default();
+    let points = pts
+        .into_iter()
+        .enumerate()
+        .map(|(n, (scene, cfg))| {
+            let k = format!("{scene} {} {}", key(&cfg.opt, &cfg.nm), cfg.timing_name);
+            let job = *by_key.entry(k).or_insert_with(|| {
+                let stem = short(&scenes[scene].name);
+                let what = if cfg.knob == SCENE_SIZE {
+                    cfg.opt.traversal.name().to_string()
+                } else if cfg.knob == cfg.value {
+                    cfg.knob.to_string()
+                } else if matches!(cfg.knob, "broadcast" | "timing") {
+                    // Both traversals under one timing.
+                    format!("{}-{}-{}", cfg.knob, cfg.value, cfg.opt.traversal.name())
+                } else {
+                    format!("{}-{}", cfg.knob, cfg.value)
+                };
+                let base: String = format!("{stem}-{what}")
+                    .chars()
+                    .map(|c| {
+                        if c.is_ascii_alphanumeric() || "._-".contains(c) {
+                            c
+                        } else {
+                            '-'
+                        }
+                    })
+                    .collect();
+                let mut name = base.clone();
+                let mut k = 2;
+                while names.contains(&name) {
+                    name = format!("{base}-{k}");
+                    k += 1;
+                }
+                names.insert(name.clone());
+                jobs.push(Job { name, point: n });
+                jobs.len() - 1
+            });
+            Point { scene, cfg, job }
+        })
+        .collect();
+    (points, jobs)
+}
+
+/// The table row of `p`, from its render's JSON.
+fn point_row(scenes: &[SceneRef], p: &Point, j: &serde_json::Value) -> Row {
+    let sc = &scenes[p.scene];
+    let mut r = row(&sc.name, sc.primitives, &p.cfg, j);
+    r.issue = p.cfg.timing.risc.issue.name().into();
+    r.timing = p.cfg.timing_name.clone();
+    r
+}
+
+fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row {
+    let (opt, nm) = (&c.opt, &c.nm);
     let f = |n: &str| j[n].as_f64().unwrap_or(f64::NAN);
     let s = |n: &str| j[n].as_str().unwrap_or("?").to_string();
     Row {
-        scene: scene.source.clone(),
-        primitives: scene.objects.len(),
-        knob: knob.into(),
-        value,
+        scene: scene.into(),
+        primitives,
+        knob: c.knob.into(),
+        value: c.value.clone(),
         width: opt.width,
         height: opt.height,
         ways: opt.ways,
@@ -402,7 +503,6 @@ fn row(
         hit_agreement: f("hit_agreement"),
         active_rc_fraction: f("active_rc_fraction"),
         objects_tested_per_ray: f("objects_tested_per_ray"),
-        host_seconds: f("host_seconds"),
         ray_tests_per_ray: f("ray_tests_per_ray"),
         array_idle_on_control: f("array_idle_on_control"),
         traversal: opt.traversal.name().into(),
@@ -417,146 +517,460 @@ fn row(
     }
 }
 
-pub fn command(a: SweepArgs) -> Result<()> {
-    let scenes: Vec<Option<PathBuf>> = if !a.knobs {
-        vec![]
-    } else if a.scenes.is_empty() {
-        vec![None]
-    } else {
-        a.scenes.iter().cloned().map(Some).collect()
-    };
-    let families = family_scenes(&a)?;
-    std::fs::create_dir_all(&a.out_dir)
-        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+/// The timing files' names (their stems) and timings.
+fn timing_files(paths: &[PathBuf]) -> Result<Vec<(String, Timing)>> {
     let mut files = Vec::new();
-    for p in &a.timing {
+    for p in paths {
         let name = p.file_stem().map_or_else(
             || p.display().to_string(),
             |s| s.to_string_lossy().into_owned(),
         );
         files.push((name, crate::timing::load(p)?));
     }
-    let mut cfgs = configs(a.size.0, a.size.1, &files);
-    if a.broadcast_only {
+    Ok(files)
+}
+
+/// The configurations asked: every knob (or, with `--only broadcast`, the
+/// issue-model comparison), under the timing files too.
+fn asked_configs(
+    size: (u32, u32),
+    broadcast_only: bool,
+    files: &[(String, Timing)],
+) -> Vec<Config> {
+    let mut cfgs = configs(size.0, size.1, files);
+    if broadcast_only {
         cfgs.retain(|c| matches!(c.knob, "paper" | "traversal" | "broadcast" | "timing"));
     }
+    cfgs
+}
+
+pub fn command(a: SweepArgs) -> Result<()> {
+    let files = timing_files(&a.timing)?;
+    let cfgs = if a.knobs {
+        asked_configs(a.size, a.broadcast_only, &files)
+    } else {
+        vec![]
+    };
+    // The scenes, loaded (or generated) up front: a bad one stops the sweep
+    // before any render.
+    let mut scenes: Vec<(SceneRef, firmware::scene::Scene)> = Vec::new();
+    if a.knobs {
+        let asked: Vec<Option<&Path>> = if a.scenes.is_empty() {
+            vec![None]
+        } else {
+            a.scenes.iter().map(|p| Some(p.as_path())).collect()
+        };
+        for p in asked {
+            let scene = load_scene(p)?;
+            let file = p.map_or_else(crate::cmd_scene::default_scene, Path::to_path_buf);
+            scenes.push((
+                SceneRef {
+                    name: scene.source.clone(),
+                    primitives: scene.objects.len(),
+                    file,
+                    family: None,
+                    size: None,
+                },
+                scene,
+            ));
+        }
+    }
+    for f in &a.families {
+        firmware::scene::spd::default_size(f).map_err(|e| anyhow::anyhow!("--families: {e}"))?;
+        for size in 1..=a.max_size {
+            let s = firmware::scene::spd::scene(f, size)
+                .map_err(|e| anyhow::anyhow!("--max-size {}: {}", a.max_size, e.message))?;
+            scenes.push((
+                SceneRef {
+                    name: s.source.clone(),
+                    primitives: s.objects.len(),
+                    file: PathBuf::from(&s.source),
+                    family: Some(f.clone()),
+                    size: Some(size),
+                },
+                s,
+            ));
+        }
+    }
+    let refs: Vec<SceneRef> = scenes.iter().map(|s| s.0.clone()).collect();
+    let (pts, jobs) = points(&refs, &cfgs, a.family_size);
+    if let Some(dir) = &a.plan {
+        return write_plan(dir, &a, &files, scenes, &pts, &jobs);
+    }
+    std::fs::create_dir_all(&a.out_dir)
+        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+
     let mut rows: Vec<Row> = Vec::new();
     let mut skipped = 0;
-    let bar = indicatif::ProgressBar::new(
-        (scenes.len() * cfgs.len() + families.len() * Traversal::ALL.len()) as u64,
-    );
+    let bar = indicatif::ProgressBar::new(pts.len() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
             .progress_chars("=> "),
     );
-    for s in &scenes {
-        let scene = load_scene(s.as_deref())?;
-        let mut done: BTreeMap<String, Row> = BTreeMap::new();
-        for c in &cfgs {
-            bar.set_message(format!("{} {}={}", scene.source, c.knob, c.value));
-            let k = format!("{} {}", key(&c.opt, &c.nm), c.timing_name);
-            let row = if let Some(r) = done.get(&k) {
-                Row {
-                    knob: c.knob.into(),
-                    value: c.value.clone(),
-                    ..r.clone()
+    // The measured renders by job; a job that failed is None.
+    let mut done: BTreeMap<usize, Option<serde_json::Value>> = BTreeMap::new();
+    // The size sweep: a family's next size is skipped once a render of it
+    // took more than --size-seconds of host time (sizes grow about 8x in
+    // objects).
+    let mut slow: BTreeMap<(String, &str), f64> = BTreeMap::new();
+    for p in &pts {
+        let (sc, scene) = &scenes[p.scene];
+        let c = &p.cfg;
+        bar.inc(1);
+        let j = match done.get(&p.job) {
+            Some(Some(j)) => j.clone(),
+            Some(None) => continue,
+            None => {
+                let traversal = c.opt.traversal.name();
+                if let Some(fam) = sc.family.as_ref().filter(|_| c.knob == SCENE_SIZE) {
+                    if let Some(t) = slow.get(&(fam.clone(), traversal)) {
+                        bar.suspend(|| {
+                            eprintln!(
+                                "skipped {} with the {traversal} traversal: size {} took {t:.0} s (--size-seconds {})",
+                                sc.name,
+                                sc.size.unwrap_or(1) - 1,
+                                a.size_seconds
+                            )
+                        });
+                        skipped += 1;
+                        done.insert(p.job, None);
+                        continue;
+                    }
                 }
-            } else {
+                bar.set_message(format!("{} {}={}", sc.name, c.knob, c.value));
                 let host = crate::render::RenderSettings {
                     timing: c.timing,
                     ..Default::default()
                 };
-                let rep = match crate::cmd_render::render_as(&scene, &c.opt, &c.nm, &host) {
-                    Ok((_, rep)) => rep,
+                match crate::cmd_render::render_as(scene, &c.opt, &c.nm, &host) {
+                    Ok((_, rep)) => {
+                        let t = rep.json["host_seconds"].as_f64().unwrap_or(0.0);
+                        if let Some(fam) = &sc.family {
+                            if t > a.size_seconds {
+                                slow.insert((fam.clone(), traversal), t);
+                            }
+                        }
+                        done.insert(p.job, Some(rep.json.clone()));
+                        rep.json
+                    }
                     Err(e) => {
                         // A configuration the chip cannot run (for example a
                         // BSP too large for the FB) is reported and skipped.
                         bar.suspend(|| {
-                            eprintln!(
-                                "skipped {} with {}={}: {e:#}",
-                                scene.source, c.knob, c.value
-                            )
+                            eprintln!("skipped {} with {}={}: {e:#}", sc.name, c.knob, c.value)
                         });
                         skipped += 1;
-                        bar.inc(1);
+                        done.insert(p.job, None);
                         continue;
                     }
-                };
-                let mut r = row(&scene, c.knob, c.value.clone(), &c.opt, &c.nm, &rep.json);
-                r.issue = c.timing.risc.issue.name().into();
-                r.timing = c.timing_name.clone();
-                done.insert(k, r.clone());
-                r
-            };
-            rows.push(row);
-            bar.inc(1);
-        }
-    }
-    // The scene-size sweep: every family at every size, both traversals
-    // (each with its own defaults). A family's next size is skipped once a
-    // render of it took more than --size-seconds of host time (sizes grow
-    // about 8x in objects).
-    let nm = Numerics::default();
-    let mut slow: BTreeMap<(String, &str), f64> = BTreeMap::new();
-    for (fam, size, scene) in &families {
-        for traversal in Traversal::ALL {
-            bar.set_message(format!("{} traversal={traversal}", scene.source));
-            let (w, h) = a.family_size;
-            let opt = match traversal {
-                Traversal::Paper => paper_config(w, h),
-                Traversal::Packet => packet_config(w, h),
-            };
-            if let Some(t) = slow.get(&(fam.clone(), traversal.name())) {
-                bar.suspend(|| {
-                    eprintln!(
-                        "skipped {} with the {traversal} traversal: size {} took {t:.0} s (--size-seconds {})",
-                        scene.source,
-                        size - 1,
-                        a.size_seconds
-                    )
-                });
-                skipped += 1;
-                bar.inc(1);
-                continue;
-            }
-            match crate::cmd_render::render_with(scene, &opt, &nm, false, None) {
-                Ok((_, rep)) => {
-                    let r = row(scene, SCENE_SIZE, size.to_string(), &opt, &nm, &rep.json);
-                    if r.host_seconds > a.size_seconds {
-                        slow.insert((fam.clone(), traversal.name()), r.host_seconds);
-                    }
-                    rows.push(r);
-                }
-                Err(e) => {
-                    bar.suspend(|| {
-                        eprintln!(
-                            "skipped {} with the {traversal} traversal: {e:#}",
-                            scene.source
-                        )
-                    });
-                    skipped += 1;
                 }
             }
-            bar.inc(1);
-        }
+        };
+        rows.push(point_row(&refs, p, &j));
     }
     bar.finish_and_clear();
     if skipped > 0 {
         eprintln!("{skipped} configurations skipped (see above)");
     }
+    if rows.is_empty() {
+        anyhow::bail!("no configuration of the sweep could be rendered (see above)");
+    }
+    write_results(&rows, &a.out_dir)
+}
 
+/// Write `results.csv` and the charts into `dir`.
+fn write_results(rows: &[Row], dir: &Path) -> Result<()> {
     let mut w = csv::Writer::from_writer(Vec::new());
-    for r in &rows {
+    for r in rows {
         w.serialize(r)?;
     }
-    let csv_path = a.out_dir.join("results.csv");
+    let csv_path = dir.join("results.csv");
     write_atomic(&csv_path, &w.into_inner().context("csv")?)?;
     println!("wrote {}", csv_path.display());
-    for p in charts_for(&rows, &a.out_dir)? {
+    for p in charts_for(rows, dir)? {
         println!("wrote {}", p.display());
     }
     Ok(())
+}
+
+// ---------------------------------------------------------------------------
+// Plans: the sweep as independent jobs, and their merge
+
+/// `sweep.toml`: what a plan asked, enough for `--merge` to rebuild its
+/// points.
+#[derive(serde::Serialize, serde::Deserialize)]
+struct Plan {
+    /// The morphosys that wrote the plan (its jobs run it), and the plan's
+    /// folder when written (its jobs' paths; the folder may move before
+    /// the merge).
+    program: PathBuf,
+    dir: PathBuf,
+    /// Image size of the knob sweep and of the size sweep.
+    size: String,
+    family_size: String,
+    /// The knob sweep (`false`: `--only sizes`) and `--only broadcast`.
+    knobs: bool,
+    broadcast_only: bool,
+    /// Timing files, copied into the plan's folder (paths relative to it).
+    timing: Vec<PathBuf>,
+    /// Every scene, copied or generated into the plan's `scenes/`.
+    scene: Vec<SceneRef>,
+}
+
+const PLAN_FILE: &str = "sweep.toml";
+const JOBS_FILE: &str = "jobs.txt";
+/// The M1 chip's timing (instruction issue), the broadcast knob's.
+const M1_TIMING_FILE: &str = "m1-issue.toml";
+
+/// A word of a shell command line, quoted when it needs to be.
+fn shell_word(w: &str) -> String {
+    if !w.is_empty()
+        && w.chars()
+            .all(|c| c.is_ascii_alphanumeric() || "_./=:,+-@%".contains(c))
+    {
+        w.to_string()
+    } else {
+        format!("'{}'", w.replace('\'', r"'\''"))
+    }
+}
+
+/// The arguments of the `morphosys render` that measures `c` on `scene`,
+/// writing `points/NAME.{png,json}` under `dir`.
+fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> Vec<String> {
+    let (o, n) = (&c.opt, &c.nm);
+    let auto0 = |d: u32| {
+        if d == 0 {
+            "auto".to_string()
+        } else {
+            d.to_string()
+        }
+    };
+    let split = match o.bsp.rule {
+        SplitRule::Median => "median",
+        SplitRule::Sah => "sah",
+        SplitRule::Auto => "auto",
+    };
+    let mut v: Vec<String> = vec!["render".into(), scene.display().to_string()];
+    let mut arg = |k: &str, val: String| {
+        v.push(k.into());
+        v.push(val);
+    };
+    arg("--size", format!("{}x{}", o.width, o.height));
+    arg("--ways", o.ways.to_string());
+    arg("--depth", o.depth.to_string());
+    arg("--traversal", o.traversal.name().into());
+    arg("--split", split.into());
+    arg("--max-depth", auto0(o.bsp.max_depth));
+    arg("--max-leaf", o.bsp.max_leaf.to_string());
+    arg("--collapse", o.collapse.to_string());
+    arg("--layout", o.layout.name().into());
+    arg("--datapath", o.datapath.bits().to_string());
+    arg("--newton-steps", n.newton_steps.to_string());
+    arg("--table-entries", n.table_entries.to_string());
+    arg("--guard-bits", n.guard_bits.to_string());
+    arg("--ray-offset-lsb", n.eps_lsb.to_string());
+    match c.timing_name.as_str() {
+        "default" => {}
+        "M1 issue" => arg("--timing", dir.join(M1_TIMING_FILE).display().to_string()),
+        t => arg(
+            "--timing",
+            dir.join("timing")
+                .join(format!("{t}.toml"))
+                .display()
+                .to_string(),
+        ),
+    }
+    let points = dir.join("points");
+    arg(
+        "--out",
+        points.join(format!("{name}.png")).display().to_string(),
+    );
+    arg(
+        "--json",
+        points.join(format!("{name}.json")).display().to_string(),
+    );
+    v.push("--skip-done".into());
+    v
+}
+
+fn write_plan(
+    dir: &Path,
+    a: &SweepArgs,
+    files: &[(String, Timing)],
+    scenes: Vec<(SceneRef, firmware::scene::Scene)>,
+    pts: &[Point],
+    jobs: &[Job],
+) -> Result<()> {
+    if pts.is_empty() {
+        anyhow::bail!("--plan {}: the sweep asked has no points", dir.display());
+    }
+    for sub in ["points", "scenes", "timing"] {
+        std::fs::create_dir_all(dir.join(sub))
+            .with_context(|| format!("--plan {}: cannot create {sub}/ in it", dir.display()))?;
+    }
+    let dir = &std::fs::canonicalize(dir).with_context(|| format!("--plan {}", dir.display()))?;
+    // The plan's own copies of the scenes and timing files: its jobs give
+    // the same results whatever happens to the originals.
+    let mut refs = Vec::new();
+    for (i, (mut sc, scene)) in scenes.into_iter().enumerate() {
+        let fname = sc
+            .file
+            .file_name()
+            .map_or_else(|| "scene".into(), |f| f.to_string_lossy().into_owned());
+        let to = dir.join("scenes").join(format!("{i:03}-{fname}"));
+        let bytes = match &sc.family {
+            Some(f) => firmware::scene::spd::generate(f, sc.size.unwrap_or(1))
+                .map_err(|e| anyhow::anyhow!(e))?
+                .into_bytes(),
+            None => std::fs::read(&sc.file)
+                .with_context(|| format!("{}: cannot read the scene", sc.file.display()))?,
+        };
+        drop(scene);
+        write_atomic(&to, &bytes)?;
+        sc.file = to;
+        refs.push(sc);
+    }
+    let mut timing = Vec::new();
+    for ((name, _), from) in files.iter().zip(&a.timing) {
+        let rel = Path::new("timing").join(format!("{name}.toml"));
+        let bytes = std::fs::read(from)
+            .with_context(|| format!("{}: cannot read the timing file", from.display()))?;
+        write_atomic(&dir.join(&rel), &bytes)?;
+        timing.push(rel);
+    }
+    if pts.iter().any(|p| p.cfg.timing_name == "M1 issue") {
+        let m1 = pts
+            .iter()
+            .find(|p| p.cfg.timing_name == "M1 issue")
+            .map(|p| p.cfg.timing);
+        let t = crate::timing::to_toml(&m1.unwrap_or_default());
+        write_atomic(&dir.join(M1_TIMING_FILE), t.as_bytes())?;
+    }
+    let program = std::env::current_exe().context("the path of this morphosys")?;
+    let mut text = String::new();
+    for job in jobs {
+        let p = &pts[job.point];
+        let argv = render_argv(dir, &refs[p.scene].file, &p.cfg, &job.name);
+        text.push_str(&shell_word(&program.display().to_string()));
+        for w in &argv {
+            text.push(' ');
+            text.push_str(&shell_word(w));
+        }
+        text.push('\n');
+    }
+    let plan = Plan {
+        program,
+        dir: dir.clone(),
+        size: format!("{}x{}", a.size.0, a.size.1),
+        family_size: format!("{}x{}", a.family_size.0, a.family_size.1),
+        knobs: a.knobs,
+        broadcast_only: a.broadcast_only,
+        timing,
+        scene: refs,
+    };
+    let toml_text = format!(
+        "# A sweep plan written by `morphosys sweep --plan`: what was asked.\n\
+         # Run the jobs ({JOBS_FILE}), then `morphosys sweep --merge {}`.\n{}",
+        dir.display(),
+        toml::to_string(&plan).context("sweep.toml")?
+    );
+    write_atomic(&dir.join(PLAN_FILE), toml_text.as_bytes())?;
+    write_atomic(&dir.join(JOBS_FILE), text.as_bytes())?;
+    println!(
+        "wrote {} ({} renders for {} points) and {}",
+        dir.join(JOBS_FILE).display(),
+        jobs.len(),
+        pts.len(),
+        dir.join(PLAN_FILE).display()
+    );
+    println!(
+        "run them, for example:  parallel --jobs 2 < {}",
+        shell_word(&dir.join(JOBS_FILE).display().to_string())
+    );
+    println!(
+        "then:                   morphosys sweep --merge {}",
+        shell_word(&dir.display().to_string())
+    );
+    Ok(())
+}
+
+/// `sweep --merge DIR`: the table and charts of a plan from its renders'
+/// JSON, into `out_dir`; points whose render is missing, failed or was made
+/// with other arguments are named and left out.
+pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
+    let plan_path = dir.join(PLAN_FILE);
+    let text = std::fs::read_to_string(&plan_path).with_context(|| {
+        format!(
+            "--merge {}: no plan there (cannot read {PLAN_FILE})",
+            dir.display()
+        )
+    })?;
+    let plan: Plan = toml::from_str(&text)
+        .map_err(|e| crate::timing::toml_error(&e, &text, &plan_path.display().to_string()))?;
+    let size = |s: &str| {
+        crate::cmd_scene::parse_size(s)
+            .map_err(|e| anyhow::anyhow!("{}: size {s}: {e}", plan_path.display()))
+    };
+    // The jobs' arguments name the plan's folder as it was when planned.
+    let pdir = &plan.dir;
+    let tfiles: Vec<PathBuf> = plan.timing.iter().map(|t| dir.join(t)).collect();
+    let files = timing_files(&tfiles)?;
+    let cfgs = if plan.knobs {
+        asked_configs(size(&plan.size)?, plan.broadcast_only, &files)
+    } else {
+        vec![]
+    };
+    let (pts, jobs) = points(&plan.scene, &cfgs, size(&plan.family_size)?);
+    let mut measured: Vec<Option<serde_json::Value>> = Vec::new();
+    let mut missing = Vec::new();
+    for job in &jobs {
+        let p = &pts[job.point];
+        let argv = render_argv(pdir, &plan.scene[p.scene].file, &p.cfg, &job.name);
+        let json = dir.join("points").join(format!("{}.json", job.name));
+        if crate::cmd_render::render_json_done(&json, &argv) {
+            let j = std::fs::read_to_string(&json)
+                .ok()
+                .and_then(|t| serde_json::from_str(&t).ok());
+            measured.push(j);
+        } else {
+            missing.push(job.name.clone());
+            measured.push(None);
+        }
+    }
+    let rows: Vec<Row> = pts
+        .iter()
+        .filter_map(|p| {
+            measured[p.job]
+                .as_ref()
+                .map(|j| point_row(&plan.scene, p, j))
+        })
+        .collect();
+    if !missing.is_empty() {
+        eprintln!(
+            "{} of {} renders missing, failed or made with other arguments (no complete {}/points/NAME.json): {}",
+            missing.len(),
+            jobs.len(),
+            dir.display(),
+            missing.join(", ")
+        );
+    }
+    if rows.is_empty() {
+        anyhow::bail!(
+            "--merge {}: no render of the plan is complete",
+            dir.display()
+        );
+    }
+    std::fs::create_dir_all(out_dir)
+        .with_context(|| format!("cannot create {}", out_dir.display()))?;
+    println!(
+        "merged {} of {} points ({} of {} renders)",
+        rows.len(),
+        pts.len(),
+        jobs.len() - missing.len(),
+        jobs.len()
+    );
+    write_results(&rows, out_dir)
 }
 
 fn short(scene: &str) -> String {

@@ -73,9 +73,22 @@ enum Command {
     Sweep {
         /// Scene files (default: scenes/default.toml).
         scenes: Vec<PathBuf>,
-        /// Where results.csv and the charts go.
-        #[arg(long, value_name = "DIR")]
-        out_dir: PathBuf,
+        /// Where results.csv and the charts go (with --merge: default the
+        /// plan's folder).
+        #[arg(long, value_name = "DIR", required_unless_present_any = ["plan", "merge"])]
+        out_dir: Option<PathBuf>,
+        /// Render nothing: write DIR/jobs.txt, one self-contained `morphosys
+        /// render ... --json DIR/points/NAME.json` per distinct render of the
+        /// sweep (for GNU parallel or a Slurm job array; a rerun skips the
+        /// renders already done), and DIR/sweep.toml, what was asked. Every
+        /// size of the size sweep is planned (--size-seconds does not apply).
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["out_dir", "size_seconds", "merge"])]
+        plan: Option<PathBuf>,
+        /// Merge a plan's renders: results.csv and the charts, as the sweep
+        /// run here would write them; missing or failed renders are named
+        /// and left out.
+        #[arg(long, value_name = "DIR", conflicts_with_all = ["scenes", "size", "only", "families", "max_size", "family_size", "size_seconds", "timing"])]
+        merge: Option<PathBuf>,
         /// Image size.
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
@@ -263,6 +276,19 @@ enum Command {
         /// every RC's RAM: 16, 32, 64 or 128.
         #[arg(long, value_name = "N", default_value_t = 128)]
         table_entries: u32,
+        /// Guard bits of the coordinate format above the scene's largest
+        /// object or eye coordinate (2..=4; more: a coarser format).
+        #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=4))]
+        guard_bits: u32,
+        /// Offset of spawned (shadow, reflected, refracted) rays along the
+        /// normal, in LSBs of the coordinate format (0..=64).
+        #[arg(long, value_name = "N", default_value_t = firmware::tracer::kernels::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
+        ray_offset_lsb: i32,
+        /// With --json: when that file already holds a complete render made
+        /// with these same arguments, say so and stop without rendering (a
+        /// rerun of a sweep plan's jobs runs only what is missing).
+        #[arg(long, requires = "json")]
+        skip_done: bool,
         /// Print (and put in the JSON) where the frame's cycles go: per RC kernel while the array works, per TinyRISC
         /// label while it waits (steps every cycle: several times slower).
         #[arg(long)]
@@ -379,8 +405,15 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             timing,
         }),
         Command::Sweep {
+            merge: Some(dir),
+            out_dir,
+            ..
+        } => tb::cmd_sweep::merge(&dir, out_dir.as_deref().unwrap_or(&dir)),
+        Command::Sweep {
             scenes,
             out_dir,
+            plan,
+            merge: None,
             size,
             only,
             families,
@@ -390,7 +423,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             timing,
         } => tb::cmd_sweep::command(tb::cmd_sweep::SweepArgs {
             scenes,
-            out_dir,
+            out_dir: out_dir.unwrap_or_default(),
+            plan,
             size,
             knobs: only.as_deref() != Some("sizes"),
             families: if only.is_some() && only.as_deref() != Some("sizes") {
@@ -489,6 +523,9 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             datapath,
             newton_steps,
             table_entries,
+            guard_bits,
+            ray_offset_lsb,
+            skip_done,
             profile,
             timing,
             firmware,
@@ -511,6 +548,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             datapath,
             newton_steps,
             table_entries,
+            guard_bits,
+            ray_offset_lsb,
+            skip_done,
+            argv: std::env::args().skip(1).collect(),
             profile,
             timing,
             firmware,

@@ -166,18 +166,21 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
     (line, col)
 }
 
+/// A TOML error as one line, `name:line:col: message`.
+pub fn toml_error(e: &toml::de::Error, text: &str, name: &str) -> anyhow::Error {
+    let msg = e.message().trim_end();
+    match e.span() {
+        Some(sp) => {
+            let (l, c) = line_col(text, sp.start);
+            anyhow!("{name}:{l}:{c}: {msg}")
+        }
+        None => anyhow!("{name}: {msg}"),
+    }
+}
+
 /// Parse a timing file's text (`name` for the messages).
 pub fn parse(text: &str, name: &str) -> Result<Timing> {
-    let f: File = toml::from_str(text).map_err(|e| {
-        let msg = e.message().to_string();
-        match e.span() {
-            Some(sp) => {
-                let (l, c) = line_col(text, sp.start);
-                anyhow!("{name}:{l}:{c}: {msg}")
-            }
-            None => anyhow!("{name}: {msg}"),
-        }
-    })?;
+    let f: File = toml::from_str(text).map_err(|e| toml_error(&e, text, name))?;
     // Where a key is written, for the range errors below.
     let at = |table: &str, key: &str| -> String {
         let mut cur = "";

@@ -1,20 +1,9 @@
 //! `morphosys reference`, `compile` and `compare` from the command line.
 
-use std::path::{Path, PathBuf};
+mod common;
+use common::morphosys;
+use std::path::PathBuf;
 use std::process::Command;
-
-fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
 
 fn shared(name: &str) -> String {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))

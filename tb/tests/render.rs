@@ -2,8 +2,9 @@
 //! against the float reference, determinism, the number of ways, and the
 //! `morphosys render` command line.
 
-use std::path::{Path, PathBuf};
-use std::process::Command;
+mod common;
+use common::morphosys;
+use std::path::PathBuf;
 
 use firmware::scene::Scene;
 use firmware::tracer::Options;
@@ -166,19 +167,6 @@ fn bad_options_are_errors_not_panics() {
         let e = tb::render::render_chip(&scene, &o, false, None).unwrap_err();
         assert!(e.to_string().contains("--"), "{e}");
     }
-}
-
-fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
 }
 
 #[test]

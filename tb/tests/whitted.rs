@@ -3,21 +3,9 @@
 //! degenerate polygons are skipped by both renderers alike, and the chip's
 //! ray census agrees with the f64 reference's independent count.
 
+mod common;
+use common::morphosys;
 use std::path::Path;
-use std::process::Command;
-
-fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into(),
-        String::from_utf8_lossy(&out.stderr).into(),
-    )
-}
 
 fn json(path: &Path) -> serde_json::Value {
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()

@@ -2,21 +2,9 @@
 //! firmware with `--firmware`, the chip's timing from a file, the M1 issue
 //! model, and the sweep's timing and broadcast knobs.
 
+mod common;
+use common::morphosys;
 use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn morphosys(dir: &Path, args: &[&str]) -> (bool, String, String) {
-    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .unwrap();
-    (
-        out.status.success(),
-        String::from_utf8_lossy(&out.stdout).into_owned(),
-        String::from_utf8_lossy(&out.stderr).into_owned(),
-    )
-}
 
 fn scene(name: &str) -> String {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");

@@ -1,0 +1,349 @@
+//! Sweeps past one process (issue 16): `sweep --plan` writes one
+//! `morphosys render` per distinct render, GNU parallel runs them, `sweep
+//! --merge` writes the table and charts, byte for byte those of the same
+//! sweep run in one process; reruns skip what is done, and a killed job
+//! leaves nothing that looks complete.
+
+mod common;
+use common::morphosys;
+use std::path::Path;
+use std::process::{Command, Stdio};
+
+/// GNU parallel on `jobs` with 2 job slots: its output, or None where it is
+/// not installed outside CI (CI installs it, `.ci/run`).
+fn parallel(jobs: &Path) -> Option<String> {
+    let run = Command::new("parallel")
+        .args(["--jobs", "2"])
+        .stdin(std::fs::File::open(jobs).unwrap())
+        .output();
+    match run {
+        Ok(out) => {
+            assert!(
+                out.status.success(),
+                "parallel: {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+            Some(String::from_utf8_lossy(&out.stdout).into_owned())
+        }
+        Err(_) if std::env::var_os("CI").is_none() => {
+            eprintln!("GNU parallel not installed (apt-get install parallel); test skipped");
+            None
+        }
+        Err(e) => panic!("GNU parallel must be installed in CI: {e}"),
+    }
+}
+
+#[test]
+fn planned_sweep_on_gnu_parallel_merges_to_the_in_process_sweep() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    // A timing file of our own, so the plan carries one (and its knob).
+    std::fs::write(d.join("slowload.toml"), "[risc]\nload = 4\n").unwrap();
+    let sweep = [
+        "sweep",
+        "--size",
+        "16x16",
+        "--families",
+        "balls,tetra",
+        "--max-size",
+        "1",
+        "--family-size",
+        "16x16",
+        "--timing",
+        "slowload.toml",
+    ];
+    let mut planned = sweep.to_vec();
+    planned.extend(["--plan", "plan"]);
+    let (ok, out, err) = morphosys(d, &planned);
+    assert!(ok, "plan: {err}");
+    assert!(out.contains("jobs.txt"), "{out}");
+    let plan = d.join("plan");
+    let jobs = std::fs::read_to_string(plan.join("jobs.txt")).unwrap();
+    let lines: Vec<&str> = jobs.lines().collect();
+    // Every line a self-contained render writing its own JSON; equal
+    // configurations (the paper's and newton_steps=2, ...) share a line.
+    assert!(lines.len() > 20, "{jobs}");
+    for l in &lines {
+        assert!(l.contains(" render ") && l.contains("/points/") && l.ends_with("--skip-done"));
+    }
+    assert!(jobs.contains("--timing") && jobs.contains("slowload.toml"));
+    let Some(_) = parallel(&plan.join("jobs.txt")) else {
+        return;
+    };
+    let (ok, out, err) = morphosys(d, &["sweep", "--merge", "plan"]);
+    assert!(ok, "merge: {err}");
+    assert!(err.is_empty() || !err.contains("missing"), "{err}");
+    assert!(out.contains("merged"), "{out}");
+
+    // The same sweep in one process: the same table, the same charts.
+    let mut here = sweep.to_vec();
+    here.extend(["--out-dir", "here"]);
+    let (ok, _, err) = morphosys(d, &here);
+    assert!(ok, "sweep: {err}");
+    let csv = std::fs::read(d.join("here/results.csv")).unwrap();
+    assert_eq!(
+        String::from_utf8_lossy(&std::fs::read(plan.join("results.csv")).unwrap()),
+        String::from_utf8_lossy(&csv),
+        "the merged table differs from the in-process sweep's"
+    );
+    assert!(csv.len() > 1000);
+    for chart in [
+        "fig8.svg",
+        "pareto.svg",
+        "scaling.svg",
+        "broadcast.svg",
+        "timing.svg",
+    ] {
+        assert_eq!(
+            std::fs::read(plan.join(chart)).unwrap(),
+            std::fs::read(d.join("here").join(chart)).unwrap(),
+            "{chart}"
+        );
+    }
+
+    // A rerun of the plan renders nothing.
+    let out = parallel(&plan.join("jobs.txt")).unwrap();
+    assert_eq!(
+        out.matches("already rendered with these arguments").count(),
+        lines.len(),
+        "{out}"
+    );
+
+    // A missing render is named; the rest are merged.
+    std::fs::remove_file(plan.join("points/default-ways-8.json")).unwrap();
+    let (ok, out, err) = morphosys(d, &["sweep", "--merge", "plan", "--out-dir", "part"]);
+    assert!(ok, "{err}");
+    assert!(err.contains("default-ways-8"), "{err}");
+    let rows = std::fs::read_to_string(d.join("part/results.csv")).unwrap();
+    assert_eq!(
+        rows.lines().count() + 1,
+        String::from_utf8_lossy(&csv).lines().count()
+    );
+    assert!(!rows.contains(",ways,8,"));
+    assert!(out.contains("merged"), "{out}");
+}
+
+#[test]
+fn killed_render_leaves_no_complete_json_and_merge_names_it() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            "--only",
+            "broadcast",
+            "--size",
+            "1024x1024",
+            "--plan",
+            "plan",
+        ],
+    );
+    assert!(ok, "{err}");
+    let plan = d.join("plan");
+    let jobs = std::fs::read_to_string(plan.join("jobs.txt")).unwrap();
+    let first = jobs.lines().next().unwrap();
+    // Kill the first render a second into its frame.
+    let mut child = Command::new("sh")
+        .args(["-c", &format!("exec {first}")])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_secs(1));
+    assert!(
+        child.try_wait().unwrap().is_none(),
+        "the render ended within a second"
+    );
+    child.kill().unwrap();
+    child.wait().unwrap();
+    // Nothing under points/ parses as a render's report.
+    for e in std::fs::read_dir(plan.join("points")).unwrap() {
+        let p = e.unwrap().path();
+        let text = std::fs::read_to_string(&p).unwrap_or_default();
+        assert!(
+            serde_json::from_str::<serde_json::Value>(&text).is_err(),
+            "{} looks complete",
+            p.display()
+        );
+    }
+    // The merge names every render it lacks and fails: nothing is done.
+    let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan"]);
+    assert!(!ok);
+    assert!(
+        err.contains("default-paper,") || err.contains("default-paper\n"),
+        "{err}"
+    );
+    assert!(err.contains("no render of the plan is complete"), "{err}");
+    assert!(!plan.join("results.csv").exists());
+}
+
+/// A single-node Slurm inside `dir` (docs/cluster/local-slurm.sh), stopped
+/// when dropped.
+struct LocalSlurm {
+    dir: std::path::PathBuf,
+}
+
+impl Drop for LocalSlurm {
+    fn drop(&mut self) {
+        let _ = Command::new("bash")
+            .arg(cluster_script("local-slurm.sh"))
+            .arg("stop")
+            .arg(&self.dir)
+            .output();
+    }
+}
+
+fn cluster_script(name: &str) -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../docs/cluster")
+        .join(name)
+}
+
+/// Whether this machine can run a Slurm of its own: root, and the Debian
+/// packages slurm-wlm and munge (CI has both, `.ci/run`).
+fn slurm_possible() -> bool {
+    let root = Command::new("id")
+        .arg("-u")
+        .output()
+        .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
+    let tools = ["munged", "slurmctld", "slurmd", "sbatch"].iter().all(|t| {
+        Command::new("sh")
+            .args(["-c", &format!("command -v {t}")])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    });
+    match (root && tools, std::env::var_os("CI").is_some()) {
+        (true, _) => true,
+        (false, false) => {
+            eprintln!("not root or no slurm-wlm/munge: the Slurm array test is skipped");
+            false
+        }
+        (false, true) => panic!("CI runs the Slurm test: it needs root, slurm-wlm and munge"),
+    }
+}
+
+#[test]
+fn planned_sweep_on_a_slurm_job_array_merges_to_the_in_process_sweep() {
+    if !slurm_possible() {
+        return;
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sweep = ["sweep", "--only", "broadcast", "--size", "16x16"];
+    let mut planned = sweep.to_vec();
+    planned.extend(["--plan", "plan"]);
+    let (ok, _, err) = morphosys(d, &planned);
+    assert!(ok, "plan: {err}");
+
+    let slurm = LocalSlurm {
+        dir: d.join("slurm"),
+    };
+    let up = Command::new("bash")
+        .arg(cluster_script("local-slurm.sh"))
+        .arg("start")
+        .arg(&slurm.dir)
+        .output()
+        .unwrap();
+    assert!(
+        up.status.success(),
+        "local Slurm: {}{}",
+        String::from_utf8_lossy(&up.stdout),
+        String::from_utf8_lossy(&up.stderr)
+    );
+    let conf = slurm.dir.join("slurm.conf");
+    let submit = Command::new("bash")
+        .arg(cluster_script("submit.sh"))
+        .arg(d.join("plan"))
+        .env("SLURM_CONF", &conf)
+        .output()
+        .unwrap();
+    assert!(
+        submit.status.success(),
+        "submit.sh: {}",
+        String::from_utf8_lossy(&submit.stderr)
+    );
+    // Wait for the array and the merge (a minute at most).
+    let t0 = std::time::Instant::now();
+    loop {
+        let q = Command::new("squeue")
+            .arg("-h")
+            .env("SLURM_CONF", &conf)
+            .output()
+            .unwrap();
+        assert!(q.status.success(), "{}", String::from_utf8_lossy(&q.stderr));
+        if q.stdout.is_empty() {
+            break;
+        }
+        assert!(
+            t0.elapsed().as_secs() < 120,
+            "Slurm jobs still queued: {}",
+            String::from_utf8_lossy(&q.stdout)
+        );
+        std::thread::sleep(std::time::Duration::from_millis(500));
+    }
+    let merged = std::fs::read(d.join("plan/results.csv")).unwrap_or_else(|e| {
+        let logs: Vec<String> = std::fs::read_dir(d.join("plan/slurm"))
+            .map(|r| {
+                r.filter_map(|e| e.ok())
+                    .map(|e| std::fs::read_to_string(e.path()).unwrap_or_default())
+                    .collect()
+            })
+            .unwrap_or_default();
+        panic!(
+            "no merged results.csv ({e}); Slurm logs:\n{}",
+            logs.join("\n")
+        )
+    });
+    let mut here = sweep.to_vec();
+    here.extend(["--out-dir", "here"]);
+    let (ok, _, err) = morphosys(d, &here);
+    assert!(ok, "sweep: {err}");
+    assert_eq!(
+        String::from_utf8_lossy(&merged),
+        String::from_utf8_lossy(&std::fs::read(d.join("here/results.csv")).unwrap())
+    );
+}
+
+#[test]
+fn plan_and_merge_refuse_bad_input_with_one_line() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let run = |args: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+            .current_dir(d)
+            .args(args)
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    // Usage errors: exit 2, naming the arguments.
+    let (code, err) = run(&["sweep", "--plan", "p", "--size-seconds", "5"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("--size-seconds") && err.contains("--plan"),
+        "{err}"
+    );
+    let (code, err) = run(&["sweep", "--merge", "p", "scenes/default.toml"]);
+    assert_eq!(code, Some(2), "{err}");
+    let (code, err) = run(&["sweep"]);
+    assert_eq!(code, Some(2), "{err}");
+    assert!(err.contains("--out-dir"), "{err}");
+    // No plan, or a broken one: exit 1, one line naming the file.
+    let (code, err) = run(&["sweep", "--merge", "nothing"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("nothing") && err.contains("sweep.toml"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    std::fs::create_dir(d.join("bad")).unwrap();
+    std::fs::write(d.join("bad/sweep.toml"), "program = \"x\"\nsize = [\n").unwrap();
+    let (code, err) = run(&["sweep", "--merge", "bad"]);
+    assert_eq!(code, Some(1), "{err}");
+    assert!(err.contains("bad/sweep.toml:2:"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+}
