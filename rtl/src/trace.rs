@@ -120,7 +120,11 @@ enum Phase {
 /// The VCD writer. Attach it to a [`crate::kernel::Sim`].
 pub struct Tracer {
     cfg: TraceConfig,
-    tmp_path: tempfile::TempPath,
+    /// The temporary file renamed onto the waveform's file by `finish`;
+    /// `None` when the waveform goes straight to a device or FIFO.
+    tmp_path: Option<tempfile::TempPath>,
+    /// The regular file the waveform ends up in (a symbolic link followed).
+    target: PathBuf,
     top: String,
     w: vcd::Writer<BufWriter<File>>,
     phase: Phase,
@@ -239,19 +243,32 @@ impl Tracer {
                 std::fs::create_dir_all(dir)?;
             }
         }
-        // Written to a temporary file beside the target and renamed into
-        // place by finish(), so an interrupted run never leaves a truncated
-        // waveform under the requested name.
-        let dir = match cfg.path.parent() {
-            Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-            _ => PathBuf::from("."),
+        // A regular file is written to a temporary file beside it and
+        // renamed into place by finish(), so an interrupted run never leaves
+        // a truncated waveform under the requested name; a symbolic link is
+        // followed (its target replaced, the link kept); a device or FIFO
+        // (`/dev/null`, a named pipe) is written through.
+        let (file, tmp_path, target) = match std::fs::metadata(&cfg.path) {
+            Ok(m) if !m.is_file() && !m.is_dir() => (
+                std::fs::OpenOptions::new().write(true).open(&cfg.path)?,
+                None,
+                cfg.path.clone(),
+            ),
+            _ => {
+                let target = std::fs::canonicalize(&cfg.path).unwrap_or_else(|_| cfg.path.clone());
+                let dir = match target.parent() {
+                    Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                    _ => PathBuf::from("."),
+                };
+                let tmp = tempfile::Builder::new()
+                    .prefix(".morphosys-")
+                    .suffix(".vcd.partial")
+                    .tempfile_in(&dir)?;
+                let (file, tmp_path) = tmp.into_parts();
+                readable(&file)?;
+                (file, Some(tmp_path), target)
+            }
         };
-        let tmp = tempfile::Builder::new()
-            .prefix(".morphosys-")
-            .suffix(".vcd.partial")
-            .tempfile_in(&dir)?;
-        let (file, tmp_path) = tmp.into_parts();
-        readable(&file)?;
         let mut w = vcd::Writer::new(BufWriter::with_capacity(1 << 16, file));
         w.version(concat!("morphosys ", env!("CARGO_PKG_VERSION")))?;
         w.timescale(1, TimescaleUnit::PS)?;
@@ -274,6 +291,7 @@ impl Tracer {
         let mut t = Tracer {
             cfg,
             tmp_path,
+            target,
             top: top_name.to_string(),
             w,
             phase: Phase::Declare,
@@ -397,11 +415,14 @@ impl Tracer {
             self.w.comment(n)?;
         }
         self.w.flush()?;
+        let Some(tmp_path) = self.tmp_path.take() else {
+            // Written through to a device or FIFO: no file to save beside.
+            return Ok(vec![self.cfg.path.clone()]);
+        };
         self.w.writer().get_ref().sync_data()?;
         let gtkw = self.write_gtkw()?;
-        let Tracer { tmp_path, cfg, .. } = self;
-        tmp_path.persist(&cfg.path).map_err(|e| e.error)?;
-        let mut written = vec![cfg.path.clone()];
+        tmp_path.persist(&self.target).map_err(|e| e.error)?;
+        let mut written = vec![self.cfg.path.clone()];
         written.extend(gtkw);
         Ok(written)
     }

@@ -4,17 +4,21 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context as _;
 use firmware::asm;
 
 pub fn command(file: PathBuf, out: Option<PathBuf>) -> anyhow::Result<()> {
+    if let Some(o) = &out {
+        crate::output::Files::new()
+            .input(&file, "FILE")
+            .output(o, "-o")
+            .check()?;
+    }
     let img = asm::assemble_file(&file).map_err(|e| anyhow::anyhow!("{e}"))?;
     match out {
         Some(o) => {
-            std::fs::write(&o, img.to_bytes())
-                .with_context(|| format!("writing {}", o.display()))?;
+            crate::output::write(&o, &img.to_bytes())?;
             let bytes: usize = img.segments.iter().map(|s| s.data.len()).sum();
-            println!(
+            crate::report!(
                 "wrote {} ({} segments, {bytes} bytes, entry 0x{:08x})",
                 o.display(),
                 img.segments.len(),

@@ -23,7 +23,7 @@ use firmware::bsp::BspParams;
 use firmware::tracer::Options;
 use serde_json::json;
 
-use crate::cmd_scene::{load_scene, write_atomic};
+use crate::cmd_scene::{load_scene, write_output};
 
 pub struct BenchArgs {
     pub scene: Option<PathBuf>,
@@ -42,6 +42,17 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 }
 
 pub fn command(a: BenchArgs) -> Result<()> {
+    if let Some(j) = &a.json {
+        crate::output::Files::new()
+            .input(
+                &a.scene
+                    .clone()
+                    .unwrap_or_else(crate::cmd_scene::default_scene),
+                "SCENE",
+            )
+            .output(j, "--json")
+            .check()?;
+    }
     let scene = load_scene(a.scene.as_deref())?;
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     let (width, height) = a.size;
@@ -146,7 +157,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "speedup": speedup,
             "repeat": repeat,
         });
-        write_atomic(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        write_output(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

@@ -10,7 +10,7 @@ use firmware::tracer::Options;
 use serde_json::json;
 
 use crate::cli::TraceWindow;
-use crate::cmd_scene::{load_scene, png_bytes, write_atomic};
+use crate::cmd_scene::{load_scene, png_bytes, write_output};
 use crate::metrics;
 use crate::reference;
 
@@ -271,7 +271,7 @@ pub fn render_json_done(path: &Path, argv: &[String]) -> bool {
 pub fn command(a: RenderArgs) -> Result<()> {
     if let (true, Some(j)) = (a.skip_done, &a.json) {
         if render_json_done(j, &a.argv) {
-            println!(
+            crate::report!(
                 "{}: already rendered with these arguments (--skip-done)",
                 j.display()
             );
@@ -284,16 +284,29 @@ pub fn command(a: RenderArgs) -> Result<()> {
         .out
         .clone()
         .unwrap_or_else(|| default_out(Path::new(&scene.source)));
-    crate::cmd_scene::check_writable(&out_path, "--out")?;
+    let mut files = crate::output::Files::new();
+    files.input(
+        &a.scene
+            .clone()
+            .unwrap_or_else(crate::cmd_scene::default_scene),
+        "SCENE",
+    );
+    for (p, what) in [(&a.firmware, "--firmware"), (&a.timing, "--timing")] {
+        if let Some(p) = p {
+            files.input(p, what);
+        }
+    }
+    files.output(&out_path, "--out");
     for (p, what) in [
         (&a.json, "--json"),
         (&a.vcd, "--vcd"),
         (&a.emit_asm, "--emit-asm"),
     ] {
         if let Some(p) = p {
-            crate::cmd_scene::check_writable(p, what)?;
+            files.output(p, what);
         }
     }
+    files.check()?;
     let (width, height) = a.size.unwrap_or((256, 256));
     if width == 0 || height == 0 || width > 4096 || height > 4096 {
         anyhow::bail!("--size {width}x{height}: each side must be 1..=4096");
@@ -372,7 +385,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         eprintln!("{w}");
     }
     if let Some(p) = &a.emit_asm {
-        write_atomic(p, built.source.as_bytes())?;
+        write_output(p, built.source.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     let trace = a.vcd.map(|p| {
@@ -414,21 +427,22 @@ pub fn command(a: RenderArgs) -> Result<()> {
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     rep.json["argv"] = a.argv.clone().into();
     let out = out_path;
-    write_atomic(&out, &png_bytes(width, height, &chip.rgb8)?)
+    write_output(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;
     eprintln!("wrote {}", out.display());
     let j = &rep.json;
-    println!("scene                    {}", scene.source);
-    println!(
+    crate::report!("scene                    {}", scene.source);
+    crate::report!(
         "size                     {width}x{height}, {} ways, depth {}",
-        opt.ways, opt.depth
+        opt.ways,
+        opt.depth
     );
-    println!(
+    crate::report!(
         "datapath                 {} bits ({datapath_reason}), format {}",
         opt.datapath.bits(),
         j["format"].as_str().unwrap_or("?")
     );
-    println!(
+    crate::report!(
         "node layout              {} ({} FB words of BSP nodes, {} in all{})",
         if opt.traversal == firmware::tracer::Traversal::Packet {
             "packet".to_string()
@@ -443,77 +457,77 @@ pub fn command(a: RenderArgs) -> Result<()> {
             ""
         }
     );
-    println!(
+    crate::report!(
         "bsp                      {} split, depth limit {}: {} nodes, depth {}",
         j["bsp_split"].as_str().unwrap_or("?"),
         j["bsp_depth_limit"],
         j["bsp_nodes"],
         j["bsp_max_depth"]
     );
-    println!("cycles                   {}", j["cycles"]);
-    println!(
+    crate::report!("cycles                   {}", j["cycles"]);
+    crate::report!(
         "fps at 300 MHz           {:.2}",
         j["fps_at_300mhz"].as_f64().unwrap_or(0.0)
     );
     if timing.clock_hz != 300_000_000 {
-        println!(
+        crate::report!(
             "fps at {:<6} MHz        {:.2} (the timing file's clock)",
             timing.clock_hz as f64 / 1e6,
             j["fps_at_clock"].as_f64().unwrap_or(0.0)
         );
     }
-    println!(
+    crate::report!(
         "psnr (dB)                {:.2}",
         j["psnr_db"].as_f64().unwrap_or(0.0)
     );
-    println!(
+    crate::report!(
         "hit agreement            {:.4}",
         j["hit_agreement"].as_f64().unwrap_or(0.0)
     );
-    println!(
+    crate::report!(
         "eye rays misclassified   {:.3}% (hit a different object than the reference's)",
         100.0 * j["eye_misclassified"].as_f64().unwrap_or(0.0)
     );
     let rs = &j["reference_rays"];
-    println!(
+    crate::report!(
         "rays traced on the chip  eye {}, shadow {}, reflect {}, refract {} (reference: {}, {}, {}, {}",
         j["eye_rays"], j["shadow_rays"], j["reflect_rays"], j["refract_rays"],
         rs["eye_rays"], rs["live_shadow_rays"], rs["live_reflect_rays"], rs["live_refract_rays"]
     );
     if rs["reflect_rays"] != rs["live_reflect_rays"] {
-        println!(
+        crate::report!(
             "                         counted as the SPD does, with the zero-weight reflections of Ks = 0 surfaces: {}, {}, {})",
             rs["shadow_rays"], rs["reflect_rays"], rs["refract_rays"]
         );
     } else {
-        println!("                         )");
+        crate::report!("                         )");
     }
-    println!(
+    crate::report!(
         "active RC fraction       {:.3}",
         j["active_rc_fraction"].as_f64().unwrap_or(0.0)
     );
-    println!("dma stall cycles         {}", j["dma_stall_cycles"]);
-    println!(
+    crate::report!("dma stall cycles         {}", j["dma_stall_cycles"]);
+    crate::report!(
         "array idle on control    {:.1}% of the cycles",
         100.0 * j["array_idle_on_control"].as_f64().unwrap_or(0.0)
     );
     if let Some(st) = &chip.firmware.layout.stream {
-        println!(
+        crate::report!(
             "scene streamed           {} KiB in main memory ({} BSP nodes), leaf blocks by DMA into FB bank 1",
             st.image.len().div_ceil(1024),
             st.nodes
         );
     }
-    println!(
+    crate::report!(
         "objects tested per ray   {:.2} broadcast per packet pass, {:.2} tested per ray traced",
         j["objects_tested_per_ray"].as_f64().unwrap_or(0.0),
         j["ray_tests_per_ray"].as_f64().unwrap_or(0.0)
     );
-    println!(
+    crate::report!(
         "host seconds             {:.2}",
         j["host_seconds"].as_f64().unwrap_or(0.0)
     );
-    println!(
+    crate::report!(
         "array cycles / host s    {:.3e}",
         j["array_cycles_per_host_second"].as_f64().unwrap_or(0.0)
     );
@@ -522,7 +536,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(j)?;
-        write_atomic(p, text.as_bytes())?;
+        write_output(p, text.as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

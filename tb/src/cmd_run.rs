@@ -104,6 +104,14 @@ pub fn command(
     datapath: Datapath,
     timing: Option<PathBuf>,
 ) -> anyhow::Result<()> {
+    if let Some(v) = &vcd {
+        let mut files = crate::output::Files::new();
+        files.input(&file, "FILE");
+        if let Some(t) = &timing {
+            files.input(t, "--timing");
+        }
+        files.output(v, "--vcd").check()?;
+    }
     let timing = crate::timing::load_or_default(timing.as_deref())?;
     match datapath {
         Datapath::W16 => command_on::<i16>(file, max_cycles, vcd, window, timing),

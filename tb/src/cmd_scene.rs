@@ -1,7 +1,6 @@
 //! The scene subcommands: `morphosys reference`, `morphosys compile` and
 //! `morphosys compare`.
 
-use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -34,56 +33,15 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(scene)
 }
 
-/// Check before the work that `path` can be written: its folder exists and
-/// takes a new file (a temporary one, removed at once). `what` names the
-/// argument in the error.
+/// [`crate::output::check_writable`].
 pub fn check_writable(path: &Path, what: &str) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    if !dir.is_dir() {
-        anyhow::bail!(
-            "{what} {}: the folder {} does not exist",
-            path.display(),
-            dir.display()
-        );
-    }
-    tempfile::NamedTempFile::new_in(dir)
-        .map(drop)
-        .with_context(|| {
-            format!(
-                "{what} {}: cannot write in {}",
-                path.display(),
-                dir.display()
-            )
-        })
+    crate::output::check_writable(path, what)
 }
 
-/// Write a file atomically: into a temporary file beside it, renamed into
-/// place, so a failed run never leaves half a file.
-pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    tmp.write_all(bytes)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    // A temporary file is created private (0600); the output is an
-    // ordinary file.
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    tmp.persist(path)
-        .map_err(|e| e.error)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(())
+/// Write an output file: atomically for a regular file, through for a
+/// device or FIFO, the target of a symbolic link ([`crate::output::write`]).
+pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
+    crate::output::write(path, bytes)
 }
 
 /// Encode 8-bit RGB as PNG.
@@ -222,11 +180,14 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
         })
     });
     // Every output checked before the image is rendered.
+    let mut files = crate::output::Files::new();
+    files.input(&a.scene.clone().unwrap_or_else(default_scene), "SCENE");
     for (p, what) in [(&out, "--out"), (&a.json, "--json"), (&a.hits, "--hits")] {
         if let Some(p) = p {
-            check_writable(p, what)?;
+            files.output(p, what);
         }
     }
+    files.check()?;
     let t0 = Instant::now();
     let img = render(
         &scene,
@@ -240,7 +201,7 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
     );
     let secs = t0.elapsed().as_secs_f64();
     let s = img.stats;
-    println!(
+    crate::report!(
         "{}: {width}x{height}, depth {max_depth}{}, {:.2} s: {} eye rays ({} hit), {} reflection, {} refraction, {} shadow",
         scene.source,
         if corners { ", rays through pixel corners" } else { "" },
@@ -252,12 +213,12 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
         s.shadow_rays
     );
     if let Some(out) = &out {
-        write_atomic(out, &png_bytes(img.width, img.height, &img.to_rgb8())?)?;
-        println!("wrote {}", out.display());
+        write_output(out, &png_bytes(img.width, img.height, &img.to_rgb8())?)?;
+        crate::report!("wrote {}", out.display());
     }
     if let Some(path) = &a.hits {
-        write_atomic(path, &hits_bytes(&img))?;
-        println!("wrote {}", path.display());
+        write_output(path, &hits_bytes(&img))?;
+        crate::report!("wrote {}", path.display());
     }
     if let Some(path) = &a.json {
         let v = json!({
@@ -274,7 +235,7 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
             "shadow_rays": s.shadow_rays,
             "image": out.as_ref().map(|p| p.display().to_string()),
         });
-        write_atomic(path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        write_output(path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
     }
     Ok(())
 }
@@ -292,6 +253,14 @@ pub struct CompileArgs {
 
 /// `morphosys compile`: the fixed-point scene image and its report.
 pub fn compile_cmd(a: CompileArgs) -> Result<()> {
+    let mut files = crate::output::Files::new();
+    files.input(&a.scene.clone().unwrap_or_else(default_scene), "SCENE");
+    for (p, what) in [(&a.out, "--out"), (&a.json, "--json")] {
+        if let Some(p) = p {
+            files.output(p, what);
+        }
+    }
+    files.check()?;
     let scene = load_scene(a.scene.as_deref())?;
     let opt = CompileOptions {
         bsp: BspParams {
@@ -308,17 +277,17 @@ pub fn compile_cmd(a: CompileArgs) -> Result<()> {
         ..CompileOptions::default()
     };
     let img = compile(&scene, &opt)?;
-    print!("{}", img.report.text());
+    crate::report!("{}", img.report.text().trim_end());
     if let Some(path) = &a.out {
-        write_atomic(path, &img.to_le_bytes())?;
-        println!(
+        write_output(path, &img.to_le_bytes())?;
+        crate::report!(
             "wrote {} ({} words, little-endian)",
             path.display(),
             img.words.len()
         );
     }
     if let Some(path) = &a.json {
-        write_atomic(
+        write_output(
             path,
             (serde_json::to_string_pretty(&img.report)? + "\n").as_bytes(),
         )?;
@@ -334,6 +303,14 @@ pub fn compare(
     hits: Option<(PathBuf, PathBuf)>,
     json_out: Option<PathBuf>,
 ) -> Result<()> {
+    if let Some(j) = &json_out {
+        let mut files = crate::output::Files::new();
+        files.input(a, "A").input(b, "B");
+        if let Some((ha, hb)) = &hits {
+            files.input(ha, "HITS_A").input(hb, "HITS_B");
+        }
+        files.output(j, "--json").check()?;
+    }
     let (wa, ha, pa) = read_png(a)?;
     let (wb, hb, pb) = read_png(b)?;
     if (wa, ha) != (wb, hb) {
@@ -380,7 +357,7 @@ pub fn compare(
             "share_off": off,
             "hit_agreement": agreement,
         });
-        write_atomic(&path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        write_output(&path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
     }
     Ok(())
 }

@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use anyhow::{anyhow, Result};
 use firmware::scene::{spd, PrimType};
 
-use crate::cmd_scene::write_atomic;
+use crate::cmd_scene::write_output;
 
 /// Generate `name` at `size` (default: the SPD program's default size) and
 /// write it to `out`, or to stdout without `out`.
@@ -16,10 +16,13 @@ pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()
         Some(s) => s,
         None => spd::default_size(name).map_err(|e| anyhow!(e))?,
     };
+    if let Some(o) = &out {
+        crate::output::Files::new().output(o, "--out").check()?;
+    }
     let text = spd::generate(name, size).map_err(|e| anyhow!(e))?;
     match out {
         Some(path) => {
-            write_atomic(&path, text.as_bytes())?;
+            write_output(&path, text.as_bytes())?;
             let scene = firmware::scene::nff::parse(&text, &path.display().to_string())?;
             let c = scene.type_counts();
             let parts: Vec<String> = PrimType::ALL
@@ -27,7 +30,7 @@ pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()
                 .filter(|t| c[t.index()] > 0)
                 .map(|t| format!("{} {}", c[t.index()], t.name()))
                 .collect();
-            println!(
+            crate::report!(
                 "{}: {name} size {size}: {} objects ({}), {} lights",
                 path.display(),
                 scene.objects.len(),

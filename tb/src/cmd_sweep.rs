@@ -28,7 +28,7 @@ use rtl::tinyrisc::IssueModel;
 use rtl::Timing;
 
 use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
-use crate::cmd_scene::{load_scene, write_atomic};
+use crate::cmd_scene::{load_scene, write_output};
 
 pub struct SweepArgs {
     pub scenes: Vec<PathBuf>,
@@ -686,7 +686,7 @@ fn write_results(rows: &[Row], dir: &Path) -> Result<()> {
         w.serialize(r)?;
     }
     let csv_path = dir.join("results.csv");
-    write_atomic(&csv_path, &w.into_inner().context("csv")?)?;
+    write_output(&csv_path, &w.into_inner().context("csv")?)?;
     println!("wrote {}", csv_path.display());
     for p in charts_for(rows, dir)? {
         println!("wrote {}", p.display());
@@ -827,7 +827,7 @@ fn write_plan(
                 .with_context(|| format!("{}: cannot read the scene", sc.file.display()))?,
         };
         drop(scene);
-        write_atomic(&to, &bytes)?;
+        write_output(&to, &bytes)?;
         sc.file = to;
         refs.push(sc);
     }
@@ -836,7 +836,7 @@ fn write_plan(
         let rel = Path::new("timing").join(format!("{name}.toml"));
         let bytes = std::fs::read(from)
             .with_context(|| format!("{}: cannot read the timing file", from.display()))?;
-        write_atomic(&dir.join(&rel), &bytes)?;
+        write_output(&dir.join(&rel), &bytes)?;
         timing.push(rel);
     }
     if pts.iter().any(|p| p.cfg.timing_name == "M1 issue") {
@@ -845,7 +845,7 @@ fn write_plan(
             .find(|p| p.cfg.timing_name == "M1 issue")
             .map(|p| p.cfg.timing);
         let t = crate::timing::to_toml(&m1.unwrap_or_default());
-        write_atomic(&dir.join(M1_TIMING_FILE), t.as_bytes())?;
+        write_output(&dir.join(M1_TIMING_FILE), t.as_bytes())?;
     }
     let program = std::env::current_exe().context("the path of this morphosys")?;
     let mut text = String::new();
@@ -875,8 +875,8 @@ fn write_plan(
         dir.display(),
         toml::to_string(&plan).context("sweep.toml")?
     );
-    write_atomic(&dir.join(PLAN_FILE), toml_text.as_bytes())?;
-    write_atomic(&dir.join(JOBS_FILE), text.as_bytes())?;
+    write_output(&dir.join(PLAN_FILE), toml_text.as_bytes())?;
+    write_output(&dir.join(JOBS_FILE), text.as_bytes())?;
     println!(
         "wrote {} ({} renders for {} points) and {}",
         dir.join(JOBS_FILE).display(),

@@ -14,6 +14,7 @@ pub mod cmd_spd;
 pub mod cmd_sweep;
 pub mod fuzz;
 pub mod metrics;
+pub mod output;
 pub mod profile;
 pub mod reference;
 pub mod render;

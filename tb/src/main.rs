@@ -442,7 +442,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             let text = tb::timing::to_toml(&rtl::Timing::default());
             match out {
                 Some(p) => {
-                    tb::cmd_scene::write_atomic(&p, text.as_bytes())?;
+                    tb::output::Files::new().output(&p, "--out").check()?;
+                    tb::cmd_scene::write_output(&p, text.as_bytes())?;
                     eprintln!("wrote {}", p.display());
                     Ok(())
                 }
@@ -578,6 +579,16 @@ fn main() -> ExitCode {
     };
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
+        // A reader that went away (`morphosys spd balls | head`) ends the
+        // command quietly, as it ends `cat` or `rg`.
+        Err(e)
+            if e.chain().any(|c| {
+                c.downcast_ref::<std::io::Error>()
+                    .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+            }) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("morphosys: error: {e:#}");
             ExitCode::FAILURE
@@ -585,9 +596,9 @@ fn main() -> ExitCode {
     }
 }
 
-/// Standard output that cannot be written (a reader that went away, a
-/// full disk) ends the command with one error line and exit code 1, not a
-/// panic: `print!` panics on a write error, and this hook turns that panic
+/// Standard output that cannot be written (a full disk) ends the command
+/// with one error line and exit code 1, and a reader that went away ends it
+/// quietly (exit 0), not a panic: `print!` panics on a write error, and this hook turns that panic
 /// into the message (every other panic keeps the default report).
 fn stdout_errors_are_errors() {
     let default = std::panic::take_hook();
@@ -599,6 +610,10 @@ fn stdout_errors_are_errors() {
             .or_else(|| p.downcast_ref::<&str>().copied())
             .unwrap_or("");
         if let Some(why) = msg.strip_prefix("failed printing to stdout: ") {
+            if why.contains("Broken pipe") {
+                // The reader went away: end quietly, as `cat` does.
+                std::process::exit(0);
+            }
             eprintln!("morphosys: error: writing to standard output: {why}");
             std::process::exit(1);
         }

@@ -216,7 +216,7 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
 /// code 1, never a panic: a reader that goes away (`| head -c 10`) and a
 /// full device (`> /dev/full`).
 #[test]
-fn unwritable_stdout_is_an_error_not_a_panic() {
+fn closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
     use std::process::Stdio;
     let dir = tempfile::tempdir().unwrap();
     // A reader that closes at once: 300 KB of NFF (more than a pipe holds,
@@ -231,11 +231,9 @@ fn unwritable_stdout_is_an_error_not_a_panic() {
     drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    assert_eq!(out.status.code(), Some(1), "{err}");
-    assert!(
-        err.contains("morphosys: error: writing to standard output:") && !err.contains("panicked"),
-        "{err}"
-    );
+    // A reader that went away ends the command quietly (issue 18, item 4).
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(err.is_empty(), "{err}");
     if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
         let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
             .current_dir(dir.path())

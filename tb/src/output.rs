@@ -1,0 +1,323 @@
+//! Output files, the one way every command writes them:
+//!
+//! * a regular file (or a new one) is written to a temporary file beside it
+//!   and renamed into place, so a failed or killed run never leaves half a
+//!   file under the asked name;
+//! * a symbolic link is followed: its target is replaced (atomically, as
+//!   above), the link stays;
+//! * a character device, FIFO or socket (`/dev/null`, `/dev/stdout`, a
+//!   named pipe) is written through, never replaced;
+//! * `-` is standard output.
+//!
+//! [`Files`] checks a command's outputs before any work: each can be
+//! written, none is one of the command's inputs, no two are the same file.
+
+use std::io::Write as _;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use anyhow::{Context as _, Result};
+
+/// Where the bytes for an output path go.
+#[derive(Debug, PartialEq, Eq)]
+enum Target {
+    Stdout,
+    /// A regular file (existing or not), after following symbolic links.
+    File(PathBuf),
+    /// A device, FIFO or socket: opened and written through.
+    Stream(PathBuf),
+}
+
+fn target(path: &Path) -> Result<Target> {
+    if path.as_os_str() == "-" {
+        return Ok(Target::Stdout);
+    }
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_dir() => anyhow::bail!("{} is a folder", path.display()),
+        Ok(m) if m.is_file() => Ok(Target::File(
+            std::fs::canonicalize(path).with_context(|| format!("{}", path.display()))?,
+        )),
+        Ok(_) => Ok(Target::Stream(path.to_path_buf())),
+        Err(_) => {
+            // A dangling symbolic link: the file it names is created.
+            let mut p = path.to_path_buf();
+            for _ in 0..40 {
+                match std::fs::read_link(&p) {
+                    Ok(to) => {
+                        p = match p.parent() {
+                            Some(d) if to.is_relative() => d.join(to),
+                            _ => to,
+                        }
+                    }
+                    Err(_) => return Ok(Target::File(p)),
+                }
+            }
+            anyhow::bail!("{}: too many levels of symbolic links", path.display())
+        }
+    }
+}
+
+/// Set when an output is standard output: reports go to standard error.
+static STDOUT_TAKEN: AtomicBool = AtomicBool::new(false);
+
+/// Whether an output of this command is standard output (`-`), so its
+/// report must go to standard error.
+pub fn stdout_taken() -> bool {
+    STDOUT_TAKEN.load(Ordering::Relaxed)
+}
+
+/// `println!`, or `eprintln!` when standard output carries an output file.
+#[macro_export]
+macro_rules! report {
+    ($($t:tt)*) => {
+        if $crate::output::stdout_taken() {
+            eprintln!($($t)*)
+        } else {
+            println!($($t)*)
+        }
+    };
+}
+
+/// Write `bytes` to `path` by the rules of this module.
+pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    let what = || format!("cannot write {}", path.display());
+    match target(path).with_context(what)? {
+        Target::Stdout => {
+            let mut o = std::io::stdout().lock();
+            o.write_all(bytes)
+                .and_then(|_| o.flush())
+                .with_context(what)
+        }
+        Target::Stream(p) => {
+            let mut f = std::fs::OpenOptions::new()
+                .write(true)
+                .open(&p)
+                .with_context(what)?;
+            f.write_all(bytes)
+                .and_then(|_| f.flush())
+                .with_context(what)
+        }
+        Target::File(p) => {
+            let dir = match p.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            let mut tmp = tempfile::NamedTempFile::new_in(dir).with_context(what)?;
+            tmp.write_all(bytes).with_context(what)?;
+            // A temporary file is created private (0600); the output is an
+            // ordinary file.
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                tmp.as_file()
+                    .set_permissions(std::fs::Permissions::from_mode(0o644))
+                    .with_context(what)?;
+            }
+            tmp.persist(&p).map_err(|e| e.error).with_context(what)?;
+            Ok(())
+        }
+    }
+}
+
+/// Identity of a file for the "same file" checks: device and inode when it
+/// exists, else its absolute path (folder canonicalised).
+#[derive(Debug, PartialEq, Eq)]
+enum Id {
+    Inode(u64, u64),
+    Path(PathBuf),
+    Stdout,
+}
+
+fn id(path: &Path) -> Id {
+    if path.as_os_str() == "-" {
+        return Id::Stdout;
+    }
+    #[cfg(unix)]
+    if let Ok(m) = std::fs::metadata(path) {
+        use std::os::unix::fs::MetadataExt;
+        return Id::Inode(m.dev(), m.ino());
+    }
+    let p = match target(path) {
+        Ok(Target::File(p)) => p,
+        _ => path.to_path_buf(),
+    };
+    let p = std::path::absolute(&p).unwrap_or(p);
+    let p = match (p.parent(), p.file_name()) {
+        (Some(d), Some(f)) => std::fs::canonicalize(d).map_or(p.clone(), |d| d.join(f)),
+        _ => p,
+    };
+    Id::Path(p)
+}
+
+fn is_stream(path: &Path) -> bool {
+    matches!(target(path), Ok(Target::Stream(_)))
+}
+
+/// A command's input and output files, checked together before any work.
+#[derive(Default)]
+pub struct Files {
+    inputs: Vec<(PathBuf, String)>,
+    outputs: Vec<(PathBuf, String)>,
+}
+
+impl Files {
+    pub fn new() -> Files {
+        Files::default()
+    }
+
+    /// An input file (`what` names its argument in messages).
+    pub fn input(&mut self, path: &Path, what: &str) -> &mut Files {
+        self.inputs.push((path.to_path_buf(), what.into()));
+        self
+    }
+
+    /// An output file (`what` names its argument).
+    pub fn output(&mut self, path: &Path, what: &str) -> &mut Files {
+        self.outputs.push((path.to_path_buf(), what.into()));
+        self
+    }
+
+    /// Every output can be written, none is an input, no two are the same
+    /// (two outputs to one device, such as `/dev/null`, are fine; two to
+    /// standard output are not). Marks standard output as taken when an
+    /// output is `-`.
+    pub fn check(&self) -> Result<()> {
+        for (i, (p, what)) in self.outputs.iter().enumerate() {
+            check_writable(p, what)?;
+            let me = id(p);
+            for (q, qwhat) in &self.inputs {
+                if id(q) == me && me != Id::Stdout {
+                    anyhow::bail!(
+                        "{what} {}: that is the input {qwhat} {}; refusing to overwrite it",
+                        p.display(),
+                        q.display()
+                    );
+                }
+            }
+            for (q, qwhat) in &self.outputs[..i] {
+                if id(q) == me && !is_stream(p) {
+                    anyhow::bail!(
+                        "{what} {} and {qwhat} {} are the same file: give each output a path of its own",
+                        p.display(),
+                        q.display()
+                    );
+                }
+            }
+            if me == Id::Stdout {
+                STDOUT_TAKEN.store(true, Ordering::Relaxed);
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Check before the work that `path` can be written: a regular file's
+/// folder exists and takes a new file (a temporary one, removed at once); a
+/// device or FIFO is writable by us. `what` names the argument.
+pub fn check_writable(path: &Path, what: &str) -> Result<()> {
+    match target(path).with_context(|| format!("{what} {}", path.display()))? {
+        Target::Stdout => Ok(()),
+        Target::Stream(p) => {
+            #[cfg(unix)]
+            {
+                use std::os::unix::ffi::OsStrExt;
+                let c = std::ffi::CString::new(p.as_os_str().as_bytes())
+                    .with_context(|| format!("{what} {}", path.display()))?;
+                // SAFETY: access(2) reads a NUL-terminated path and nothing else.
+                if unsafe { libc::access(c.as_ptr(), libc::W_OK) } != 0 {
+                    anyhow::bail!(
+                        "{what} {}: cannot write it: {}",
+                        path.display(),
+                        std::io::Error::last_os_error()
+                    );
+                }
+            }
+            let _ = p;
+            Ok(())
+        }
+        Target::File(p) => {
+            let dir = match p.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d,
+                _ => Path::new("."),
+            };
+            if !dir.is_dir() {
+                anyhow::bail!(
+                    "{what} {}: the folder {} does not exist",
+                    path.display(),
+                    dir.display()
+                );
+            }
+            tempfile::NamedTempFile::new_in(dir)
+                .map(drop)
+                .with_context(|| {
+                    format!(
+                        "{what} {}: cannot write in {}",
+                        path.display(),
+                        dir.display()
+                    )
+                })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn symlinks_are_followed_and_kept() {
+        let d = tempfile::tempdir().unwrap();
+        let real = d.path().join("real.txt");
+        std::fs::write(&real, "old").unwrap();
+        let link = d.path().join("link.txt");
+        std::os::unix::fs::symlink("real.txt", &link).unwrap();
+        write(&link, b"new").unwrap();
+        assert!(std::fs::symlink_metadata(&link)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+        assert_eq!(std::fs::read_to_string(&real).unwrap(), "new");
+        // a dangling link creates its target
+        let dang = d.path().join("dang.txt");
+        std::os::unix::fs::symlink("made.txt", &dang).unwrap();
+        write(&dang, b"x").unwrap();
+        assert_eq!(
+            std::fs::read_to_string(d.path().join("made.txt")).unwrap(),
+            "x"
+        );
+        assert!(std::fs::symlink_metadata(&dang)
+            .unwrap()
+            .file_type()
+            .is_symlink());
+    }
+
+    #[test]
+    fn devices_are_written_through() {
+        let null = Path::new("/dev/null");
+        if !null.exists() {
+            return;
+        }
+        write(null, b"bytes").unwrap();
+        let m = std::fs::metadata(null).unwrap();
+        assert!(!m.is_file(), "/dev/null was replaced by a file");
+        // two outputs to /dev/null are fine, an output over an input is not
+        let d = tempfile::tempdir().unwrap();
+        let input = d.path().join("in.nff");
+        std::fs::write(&input, "x").unwrap();
+        let mut f = Files::new();
+        f.input(&input, "SCENE")
+            .output(null, "--out")
+            .output(null, "--json");
+        f.check().unwrap();
+        let mut f = Files::new();
+        f.input(&input, "SCENE").output(&input, "--out");
+        let e = f.check().unwrap_err().to_string();
+        assert!(e.contains("--out") && e.contains("input SCENE"), "{e}");
+        let out = d.path().join("o.png");
+        let mut f = Files::new();
+        f.output(&out, "--out")
+            .output(&d.path().join(".").join("o.png"), "--json");
+        let e = f.check().unwrap_err().to_string();
+        assert!(e.contains("same file"), "{e}");
+    }
+}

@@ -1,0 +1,184 @@
+//! Output files under hostile or careless use (issue 18, item 1): devices
+//! and FIFOs are written through, never replaced; symbolic links are
+//! followed and kept; standard output is `-`; an output that is an input or
+//! another output is refused before any work.
+
+mod common;
+use common::morphosys;
+
+use std::path::Path;
+
+fn scene() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes/default.toml")
+        .display()
+        .to_string()
+}
+
+#[test]
+fn devices_are_written_through_not_replaced() {
+    let null = Path::new("/dev/null");
+    if !null.exists() {
+        return;
+    }
+    let d = tempfile::tempdir().unwrap();
+    let s = scene();
+    for args in [
+        vec![
+            "render",
+            &s,
+            "--size",
+            "8x8",
+            "--out",
+            "/dev/null",
+            "--json",
+            "/dev/null",
+        ],
+        vec![
+            "reference",
+            &s,
+            "--size",
+            "8x8",
+            "--out",
+            "/dev/null",
+            "--hits",
+            "/dev/null",
+        ],
+        vec!["compile", &s, "--out", "/dev/null"],
+        vec!["spd", "tetra", "--size", "1", "--out", "/dev/null"],
+    ] {
+        let (ok, _, err) = morphosys(d.path(), &args);
+        assert!(ok, "{args:?}: {err}");
+        let m = std::fs::metadata(null).unwrap();
+        assert!(!m.is_file(), "{args:?} replaced /dev/null with a file");
+    }
+    // nothing was left beside the device either
+    assert!(std::fs::read_dir("/dev").unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .starts_with(".tmp")));
+}
+
+#[test]
+fn a_fifo_takes_a_waveform_and_no_partial_file_is_left() {
+    let d = tempfile::tempdir().unwrap();
+    let fifo = d.path().join("wave.vcd");
+    let c = std::ffi::CString::new(fifo.to_str().unwrap()).unwrap();
+    // SAFETY: mkfifo(3) with a NUL-terminated path.
+    assert_eq!(unsafe { libc::mkfifo(c.as_ptr(), 0o644) }, 0);
+    let reader = {
+        let fifo = fifo.clone();
+        std::thread::spawn(move || std::fs::read(fifo).unwrap())
+    };
+    let s = scene();
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &[
+            "render",
+            &s,
+            "--size",
+            "8x8",
+            "--out",
+            "o.png",
+            "--vcd",
+            "wave.vcd",
+            "--trace-cycles",
+            "200",
+        ],
+    );
+    assert!(ok, "{err}");
+    let vcd = reader.join().unwrap();
+    assert!(String::from_utf8_lossy(&vcd).contains("$enddefinitions"));
+    let names: Vec<String> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(names.iter().all(|n| !n.ends_with(".partial")), "{names:?}");
+    assert!(std::fs::symlink_metadata(&fifo)
+        .unwrap()
+        .file_type()
+        .is_fifo());
+}
+
+use std::os::unix::fs::FileTypeExt;
+
+#[test]
+fn symlinks_are_followed_and_stdout_is_a_dash() {
+    let d = tempfile::tempdir().unwrap();
+    std::os::unix::fs::symlink("real.png", d.path().join("link.png")).unwrap();
+    let s = scene();
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &["render", &s, "--size", "8x8", "--out", "link.png"],
+    );
+    assert!(ok, "{err}");
+    let link = d.path().join("link.png");
+    assert!(std::fs::symlink_metadata(&link)
+        .unwrap()
+        .file_type()
+        .is_symlink());
+    let png = std::fs::read(d.path().join("real.png")).unwrap();
+    assert_eq!(&png[1..4], b"PNG");
+
+    // `--out -`: the PNG on standard output, the report on standard error.
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(d.path())
+        .args(["render", &s, "--size", "8x8", "--out", "-"])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    assert_eq!(&out.stdout[1..4], b"PNG");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("psnr"));
+}
+
+#[test]
+fn an_output_over_an_input_or_another_output_is_refused_before_the_work() {
+    let d = tempfile::tempdir().unwrap();
+    let nff = d.path().join("s.nff");
+    let (ok, _, err) = morphosys(d.path(), &["spd", "tetra", "--size", "1", "--out", "s.nff"]);
+    assert!(ok, "{err}");
+    let before = std::fs::read(&nff).unwrap();
+    std::fs::write(d.path().join("d.s"), "halt\n").unwrap();
+    for (args, says) in [
+        (
+            vec!["render", "s.nff", "--size", "8x8", "--out", "s.nff"],
+            "input SCENE",
+        ),
+        (
+            vec!["render", "s.nff", "--size", "8x8", "--out", "./s.nff"],
+            "input SCENE",
+        ),
+        (
+            vec![
+                "render", "s.nff", "--size", "8x8", "--out", "o.png", "--json", "o.png",
+            ],
+            "same file",
+        ),
+        (
+            vec!["reference", "s.nff", "--size", "8x8", "--json", "s.nff"],
+            "input SCENE",
+        ),
+        (vec!["compile", "s.nff", "--out", "s.nff"], "input SCENE"),
+        (vec!["asm", "d.s", "-o", "d.s"], "input FILE"),
+    ] {
+        let (ok, out, err) = morphosys(d.path(), &args);
+        assert!(!ok, "{args:?} succeeded");
+        assert!(err.contains(says), "{args:?}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+        assert!(
+            !out.contains("cycles"),
+            "{args:?} worked before refusing: {out}"
+        );
+    }
+    assert_eq!(
+        std::fs::read(&nff).unwrap(),
+        before,
+        "the scene was overwritten"
+    );
+    assert_eq!(
+        std::fs::read_to_string(d.path().join("d.s")).unwrap(),
+        "halt\n"
+    );
+    assert!(!d.path().join("o.png").exists());
+}
