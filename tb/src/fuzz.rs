@@ -13,7 +13,7 @@
 //! mutation fuzzer of our own on stable Rust.
 
 use std::panic::{self, AssertUnwindSafe};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use firmware::asm::{self, Image};
@@ -114,26 +114,70 @@ const NUMBERS: &[&str] = &[
     "-1e9",
 ];
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+/// The conformance programs, the assembler's and loader's seeds (embedded:
+/// `morphosys fuzz` fuzzes from the same seeds wherever it runs).
+pub const CONFORMANCE: &[(&str, &str)] = &[
+    (
+        "cbcast.s",
+        include_str!("../../firmware/conformance/cbcast.s"),
+    ),
+    ("cbcc.s", include_str!("../../firmware/conformance/cbcc.s")),
+    ("cbcr.s", include_str!("../../firmware/conformance/cbcr.s")),
+    ("dbcb.s", include_str!("../../firmware/conformance/dbcb.s")),
+    ("dct.s", include_str!("../../firmware/conformance/dct.s")),
+    (
+        "double_buffer.s",
+        include_str!("../../firmware/conformance/double_buffer.s"),
+    ),
+    (
+        "ifelse.s",
+        include_str!("../../firmware/conformance/ifelse.s"),
+    ),
+    (
+        "ldctxt.s",
+        include_str!("../../firmware/conformance/ldctxt.s"),
+    ),
+    ("ldfb.s", include_str!("../../firmware/conformance/ldfb.s")),
+    (
+        "lfb_sfb.s",
+        include_str!("../../firmware/conformance/lfb_sfb.s"),
+    ),
+    (
+        "rcrisc.s",
+        include_str!("../../firmware/conformance/rcrisc.s"),
+    ),
+    ("sbcb.s", include_str!("../../firmware/conformance/sbcb.s")),
+    (
+        "status.s",
+        include_str!("../../firmware/conformance/status.s"),
+    ),
+    ("stfb.s", include_str!("../../firmware/conformance/stfb.s")),
+    (
+        "tinyrisc.s",
+        include_str!("../../firmware/conformance/tinyrisc.s"),
+    ),
+    (
+        "transpose.s",
+        include_str!("../../firmware/conformance/transpose.s"),
+    ),
+    ("wfb.s", include_str!("../../firmware/conformance/wfb.s")),
+    ("wide.s", include_str!("../../firmware/conformance/wide.s")),
+];
 
-/// The valid inputs mutations start from.
+/// The valid inputs mutations start from (embedded in the binary).
 pub fn seeds(t: Target) -> Vec<Vec<u8>> {
-    let r = root();
-    let read = |p: &Path| std::fs::read(p).unwrap_or_default();
     match t {
         Target::Nff => {
             let mut v = vec![
-                read(&r.join("scenes/spd/jacks-1.nff")),
-                read(&r.join("scenes/spd/tetra-1.nff")),
+                include_bytes!("../../scenes/spd/jacks-1.nff").to_vec(),
+                include_bytes!("../../scenes/spd/tetra-1.nff").to_vec(),
             ];
-            // The head of balls-4: every entity kind in a few lines.
-            let balls = read(&r.join("scenes/spd/balls-4.nff"));
+            // The head of balls: every entity kind in a few lines.
+            let balls = firmware::scene::spd::generate("balls", 1).unwrap_or_default();
             let head: Vec<u8> = balls
-                .split(|b| *b == b'\n')
+                .lines()
                 .take(60)
-                .flat_map(|l| l.iter().copied().chain(std::iter::once(b'\n')))
+                .flat_map(|l| l.bytes().chain(std::iter::once(b'\n')))
                 .collect();
             v.push(head);
             v.push(
@@ -144,27 +188,16 @@ pub fn seeds(t: Target) -> Vec<Vec<u8>> {
             );
             v
         }
-        Target::Toml => vec![read(&r.join("scenes/default.toml"))],
-        Target::Asm | Target::Image => {
-            let mut v = Vec::new();
-            if let Ok(dir) = std::fs::read_dir(r.join("firmware/conformance")) {
-                let mut paths: Vec<PathBuf> = dir.flatten().map(|e| e.path()).collect();
-                paths.sort();
-                for p in paths {
-                    if p.extension().is_some_and(|e| e == "s") {
-                        let src = read(&p);
-                        if t == Target::Asm {
-                            v.push(src);
-                        } else if let Ok(img) =
-                            asm::assemble(&String::from_utf8_lossy(&src), "seed.s")
-                        {
-                            v.push(img.to_bytes());
-                        }
-                    }
-                }
-            }
-            v
-        }
+        Target::Toml => vec![include_bytes!("../../scenes/default.toml").to_vec()],
+        Target::Asm => CONFORMANCE
+            .iter()
+            .map(|(_, s)| s.as_bytes().to_vec())
+            .collect(),
+        Target::Image => CONFORMANCE
+            .iter()
+            .filter_map(|(name, s)| asm::assemble(s, name).ok())
+            .map(|img| img.to_bytes())
+            .collect(),
     }
 }
 

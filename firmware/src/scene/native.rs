@@ -224,11 +224,33 @@ fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
 
 /// Line and column (1-based) of a byte offset.
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let offset = offset.min(text.len());
-    let before = &text[..offset];
-    let line = before.matches('\n').count() + 1;
-    let col = before.rfind('\n').map_or(offset, |i| offset - i - 1) + 1;
-    (line, col)
+    Lines::of(text).at(offset)
+}
+
+/// Where each line of a text starts: 1-based line and column of any byte
+/// offset in O(log lines), so locating every object of a large scene
+/// stays linear in the file.
+struct Lines {
+    starts: Vec<usize>,
+    len: usize,
+}
+
+impl Lines {
+    fn of(text: &str) -> Lines {
+        let starts = std::iter::once(0)
+            .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+            .collect();
+        Lines {
+            starts,
+            len: text.len(),
+        }
+    }
+
+    fn at(&self, offset: usize) -> (usize, usize) {
+        let offset = offset.min(self.len);
+        let line = self.starts.partition_point(|&s| s <= offset);
+        (line, offset - self.starts[line - 1] + 1)
+    }
 }
 
 /// Parse native TOML text; `file` names it in messages. The result is
@@ -277,8 +299,9 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
             ior: m.ior,
         });
     }
+    let lines = Lines::of(text);
     for o in def.object {
-        let (line, col) = line_col(text, o.span().start);
+        let (line, col) = lines.at(o.span().start);
         let err = |message: String| SceneError {
             file: file.into(),
             line,
@@ -316,6 +339,21 @@ mod tests {
 
     const HEAD: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nup = [0, 1, 0]\nangle = 45\n\
                         [[light]]\nposition = [1, 2, 3]\n[material.m]\ncolor = [1, 1, 1]\n";
+
+    #[test]
+    fn objects_deep_in_a_large_file_are_located() {
+        // 3,000 spheres of 6 lines each after HEAD; the 2,500th is bad.
+        let mut text = String::from(HEAD);
+        for i in 0..3000 {
+            let r = if i == 2499 { "-1" } else { "1" };
+            text.push_str(&format!(
+                "[[object]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [{i}, 0, 0]\nradius = {r}\n\n"
+            ));
+        }
+        let e = parse(&text, "big.toml").unwrap_err();
+        let head_lines = HEAD.lines().count();
+        assert_eq!((e.line, e.col), (head_lines + 2499 * 6 + 1, 1), "{e}");
+    }
 
     #[test]
     fn reads_every_object_type() {
