@@ -446,6 +446,44 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
         .into_iter()
         .filter(|t| !by_type[t.index()].is_empty())
         .collect();
+    // Every count the image holds in a 16-bit field, checked, never wrapped.
+    const FIELD: usize = u16::MAX as usize;
+    for t in &present {
+        let v = &by_type[t.index()];
+        if v.len() > FIELD {
+            return Err(err(
+                scene.objects[v[FIELD]].line,
+                format!(
+                    "the scene has {} {}s; the image counts each type in 16 bits (at most {FIELD}); this is the first one past that",
+                    v.len(),
+                    t.name()
+                ),
+            ));
+        }
+    }
+    for (n, what) in [
+        (scene.lights.len(), "lights"),
+        (scene.materials.len(), "materials"),
+    ] {
+        if n > FIELD {
+            return Err(err(
+                0,
+                format!(
+                    "the scene has {n} {what}; the image counts them in 16 bits (at most {FIELD})"
+                ),
+            ));
+        }
+    }
+    for o in &scene.objects {
+        if let Shape::Polygon { v, .. } = &o.shape {
+            if v.len() > FIELD {
+                return Err(err(
+                    o.line,
+                    format!("a polygon of {} vertices; the image counts them in 16 bits (at most {FIELD})", v.len()),
+                ));
+            }
+        }
+    }
 
     // The BSP, its planes snapped to the format.
     let bounds: Vec<Aabb> = scene.objects.iter().map(|o| o.shape.bounds()).collect();
@@ -496,6 +534,15 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
         .iter()
         .map(|t| by_type[t.index()].len().div_ceil(16))
         .sum();
+    if 4 + bv_per_node > FIELD {
+        return Err(err(
+            0,
+            format!(
+                "a Fig. 5 node of this scene needs {} words (its bit vectors); the image's words-per-node field is 16 bits (at most {FIELD})",
+                4 + bv_per_node
+            ),
+        ));
+    }
     let bv_words = bsp.nodes.len() * (4 + bv_per_node);
     let max_per_type = present
         .iter()
@@ -541,10 +588,11 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
         Layout::BitVectors => 4 + bv_per_node,
         Layout::IndexLists => 8,
     } as u16;
-    w.words[7] = scene.lights.len().min(u16::MAX as usize) as u16;
-    w.words[8] = scene.materials.len().min(u16::MAX as usize) as u16;
+    // (each count checked above)
+    w.words[7] = scene.lights.len() as u16;
+    w.words[8] = scene.materials.len() as u16;
     for t in PrimType::ALL {
-        w.words[9 + t.index()] = by_type[t.index()].len().min(u16::MAX as usize) as u16;
+        w.words[9 + t.index()] = by_type[t.index()].len() as u16;
     }
     // 16..: 32-bit section addresses: camera, lights, materials, objects of
     // each of the 7 types, polygon vertices, nodes, lists.
@@ -664,7 +712,7 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
                 }
                 Shape::Polygon { v, .. } => {
                     w.word(mat);
-                    w.word(v.len().min(u16::MAX as usize) as u16);
+                    w.word(v.len() as u16); // checked above
                     polygon_fixups.push((w.words.len(), polygon_vertices.len()));
                     w.word(0);
                     w.word(0);

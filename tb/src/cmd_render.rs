@@ -308,9 +308,6 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     files.check()?;
     let (width, height) = a.size.unwrap_or((256, 256));
-    if width == 0 || height == 0 || width > 4096 || height > 4096 {
-        anyhow::bail!("--size {width}x{height}: each side must be 1..=4096");
-    }
     let opt = Options {
         width,
         height,

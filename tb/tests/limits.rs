@@ -74,3 +74,89 @@ fn runaway_firmware_stops_at_the_cycle_budget_with_cycle_and_pc() {
     assert_eq!(code, 1, "{err}");
     assert!(err.contains("cycle 5000") && err.contains("pc 0x"), "{err}");
 }
+
+/// One image-size limit everywhere (issue 18, item 8; issue 17, item 2):
+/// `--size` on every command and a scene's own resolution.
+#[test]
+fn every_image_size_has_the_same_limit_and_an_estimate() {
+    let dir = tempfile::tempdir().unwrap();
+    for args in [
+        vec!["render", "--size", "5000x5000"],
+        vec!["bench", "--size", "16384x16384"],
+        vec!["sweep", "--size", "16384x16384", "--out-dir", "x"],
+    ] {
+        let (code, err) = morphosys(&args);
+        assert_eq!(code, 2, "{args:?}: {err}");
+        assert!(
+            err.contains("1..=4096") && err.contains("GB"),
+            "{args:?}: {err}"
+        );
+    }
+    let nff = dir.path().join("big.nff");
+    std::fs::write(
+        &nff,
+        "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 16384 16384\n\
+         b 0 0 0\nl 1 1 1\nf 1 0 0 0.5 0.5 3 0 1\ns 0 0 0 1\n",
+    )
+    .unwrap();
+    let png = dir.path().join("x.png");
+    let (code, err) = morphosys(&[
+        "reference",
+        nff.to_str().unwrap(),
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(
+        err.contains("resolution 16384x16384") && err.contains("--size") && err.contains("11 GB"),
+        "{err}"
+    );
+    assert!(!png.exists());
+    // within the limit from --size, the scene's resolution aside
+    let (code, err) = morphosys(&[
+        "reference",
+        nff.to_str().unwrap(),
+        "--size",
+        "8x8",
+        "--out",
+        png.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 0, "{err}");
+}
+
+/// Every 16-bit count of the scene image is checked, never wrapped (issue
+/// 18, item 4: 70,000 spheres compiled with a count field of 65535).
+#[test]
+fn counts_past_the_image_fields_are_refused_at_the_first_object_past_them() {
+    let dir = tempfile::tempdir().unwrap();
+    let nff = dir.path().join("many.nff");
+    let mut text = String::from(
+        "v\nfrom 0 0 -30\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 64 64\n\
+         b 0 0 0\nl 1 1 -10\nf 1 0 0 0.5 0.5 3 0 1\n",
+    );
+    for i in 0..70_000 {
+        let (x, y, z) = (i % 41, (i / 41) % 41, i / (41 * 41));
+        text.push_str(&format!(
+            "s {} {} {} 0.05\n",
+            x as f64 * 0.5 - 10.0,
+            y as f64 * 0.5 - 10.0,
+            z as f64 * 0.5 - 10.0
+        ));
+    }
+    std::fs::write(&nff, text).unwrap();
+    let img = dir.path().join("many.img");
+    let (code, err) = morphosys(&[
+        "compile",
+        nff.to_str().unwrap(),
+        "--out",
+        img.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1, "{err}");
+    // 10 header lines, then sphere number 65,536 (index 65,535)
+    assert!(
+        err.contains("many.nff:65546:") && err.contains("70000 spheres") && err.contains("65535"),
+        "{err}"
+    );
+    assert!(!img.exists());
+}

@@ -27,7 +27,13 @@ pub struct ExprError {
 pub struct Parser<'t> {
     pub toks: &'t [Token],
     pub pos: usize,
+    /// Unary operators and parentheses open at `pos` (bounded by
+    /// [`MAX_NESTING`], so no expression can overflow the stack).
+    depth: u32,
 }
+
+/// Deepest nesting of parentheses and unary operators in one expression.
+pub const MAX_NESTING: u32 = 256;
 
 fn err(at: Option<usize>, msg: impl Into<String>) -> ExprError {
     ExprError {
@@ -38,7 +44,11 @@ fn err(at: Option<usize>, msg: impl Into<String>) -> ExprError {
 
 impl<'t> Parser<'t> {
     pub fn new(toks: &'t [Token]) -> Self {
-        Parser { toks, pos: 0 }
+        Parser {
+            toks,
+            pos: 0,
+            depth: 0,
+        }
     }
 
     fn peek(&self) -> Option<&Tok> {
@@ -117,6 +127,19 @@ impl<'t> Parser<'t> {
     }
 
     fn unary(&mut self, c: &Ctx) -> Result<Value, ExprError> {
+        if self.depth >= MAX_NESTING {
+            return Err(err(
+                self.here_idx(),
+                format!("expression nested more than {MAX_NESTING} deep (parentheses and unary operators)"),
+            ));
+        }
+        self.depth += 1;
+        let v = self.unary_nested(c);
+        self.depth -= 1;
+        v
+    }
+
+    fn unary_nested(&mut self, c: &Ctx) -> Result<Value, ExprError> {
         match self.peek() {
             Some(Tok::P("-")) => {
                 self.pos += 1;

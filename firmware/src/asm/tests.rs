@@ -403,3 +403,25 @@ fn wide_multiplier_shifts_need_the_32_bit_datapath() {
     assert!(assemble(".datapath 32\n.ctx\nmul r1, r2, r3, >>64\n", "t.s").is_err());
     assert!(assemble(".datapath 24\n", "t.s").is_err());
 }
+
+#[test]
+fn deep_expressions_are_refused_at_their_column_not_overflowing_the_stack() {
+    // Within the limit: evaluated (the independent value: nested negations
+    // of 5 cancel in pairs, parentheses change nothing).
+    let n = expr::MAX_NESTING as usize - 1;
+    let ok = format!("li r1, {}(5)", "-".repeat((n - 1) & !1));
+    assert_eq!(one_text(&ok), one_text("li r1, 5"));
+    // 20,000 parentheses and 50,000 minus signs: one located error each.
+    for text in [
+        format!("li r1, {}1{}", "(".repeat(20_000), ")".repeat(20_000)),
+        format!("li r1, {}1", "-".repeat(50_000)),
+    ] {
+        let e = assemble(&format!(".text\n{text}\n"), "deep.s").unwrap_err();
+        let s = e.to_string();
+        assert!(
+            s.contains("deep.s:2:") && s.contains("nested more than"),
+            "{}",
+            &s[..200.min(s.len())]
+        );
+    }
+}
