@@ -160,3 +160,65 @@ fn counts_past_the_image_fields_are_refused_at_the_first_object_past_them() {
     );
     assert!(!img.exists());
 }
+
+/// Scenes too large are refused while being read, before they can take the
+/// machine's memory (issue 18, item 2: 1.89 M spheres aborted on a failed
+/// 6 GB allocation): under a 2 GB address-space cap, one located line.
+#[test]
+fn huge_scenes_are_refused_while_read_within_bounded_memory() {
+    let dir = tempfile::tempdir().unwrap();
+    let head = "v\nfrom 0 0 -30\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 64 64\n\
+                b 0 0 0\nl 1 1 -10\nf 1 0 0 0.5 0.5 3 0 1\n";
+    let n = firmware::scene::MAX_OBJECTS + 1000;
+    let mut text = String::with_capacity(n * 24);
+    text.push_str(head);
+    for i in 0..n {
+        text.push_str(&format!("s {} {} 0 0.05\n", i % 1000, i / 1000));
+    }
+    let nff = dir.path().join("huge.nff");
+    std::fs::write(&nff, &text).unwrap();
+    let mut toml =
+        String::from("[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nup = [0, 1, 0]\nangle = 45\n");
+    for _ in 0..n {
+        toml.push_str("[[object]]\n");
+    }
+    let tml = dir.path().join("huge.toml");
+    std::fs::write(&tml, &toml).unwrap();
+    let big = dir.path().join("big.nff");
+    std::fs::File::create(&big)
+        .unwrap()
+        .set_len(firmware::scene::MAX_FILE_BYTES + 1)
+        .unwrap();
+    let bin = env!("CARGO_BIN_EXE_morphosys");
+    for (file, says) in [
+        (
+            &nff,
+            format!(
+                "huge.nff:{}:1: more than",
+                firmware::scene::MAX_OBJECTS + 11
+            ),
+        ),
+        (
+            &tml,
+            format!(
+                "huge.toml:{}:1: more than",
+                firmware::scene::MAX_OBJECTS + 6
+            ),
+        ),
+        (&big, "big.nff: the file is 67 MB".to_string()),
+    ] {
+        let out = Command::new("sh")
+            .arg("-c")
+            .arg(format!(
+                "ulimit -v 2000000 && exec {bin} reference {} --out {}",
+                file.display(),
+                dir.path().join("x.png").display()
+            ))
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains(&says), "{says}: {err}");
+        assert_eq!(err.trim().lines().count(), 1, "{err}");
+    }
+}

@@ -674,6 +674,17 @@ pub struct Object {
     pub line: usize,
 }
 
+/// The most objects a scene may hold: far above what the chip's image
+/// takes (65,535 per primitive type) and what renders in reasonable time,
+/// and a bound on the memory a scene file can make us take (about 400
+/// bytes per object while it is read). Checked while parsing, at the first
+/// object past it.
+pub const MAX_OBJECTS: usize = 500_000;
+
+/// The largest scene file read (reading an NFF takes about 7 bytes of
+/// memory per byte of text), checked before reading it.
+pub const MAX_FILE_BYTES: u64 = 64 << 20;
+
 /// A whole scene.
 #[derive(Clone, Debug, PartialEq, Default)]
 pub struct Scene {
@@ -749,6 +760,20 @@ impl Scene {
     /// `.toml` for the native format.
     pub fn load(path: &Path) -> Result<Scene, SceneError> {
         let name = path.display().to_string();
+        if let Ok(m) = std::fs::metadata(path) {
+            if m.is_file() && m.len() > MAX_FILE_BYTES {
+                return Err(SceneError {
+                    file: name,
+                    line: 0,
+                    col: 0,
+                    message: format!(
+                        "the file is {:.0} MB; scene files are read up to {} MB (reading one takes about 7 times its size in memory)",
+                        m.len() as f64 / 1e6,
+                        MAX_FILE_BYTES >> 20
+                    ),
+                });
+            }
+        }
         let text = std::fs::read_to_string(path).map_err(|e| SceneError {
             file: name.clone(),
             line: 0,

@@ -256,6 +256,20 @@ impl Lines {
 /// Parse native TOML text; `file` names it in messages. The result is
 /// validated.
 pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
+    // Objects counted before the document is built (a TOML document takes
+    // several times the memory of its objects).
+    if let Some((at, _)) = text.match_indices("[[object]]").nth(super::MAX_OBJECTS) {
+        let (line, col) = line_col(text, at);
+        return Err(SceneError {
+            file: file.into(),
+            line,
+            col,
+            message: format!(
+                "more than {} objects: scenes are limited to that (this is the first one past it)",
+                super::MAX_OBJECTS
+            ),
+        });
+    }
     let def: File = toml::from_str(text).map_err(|e| {
         let (line, col) = e.span().map_or((0, 0), |s| line_col(text, s.start));
         SceneError {

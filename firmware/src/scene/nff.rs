@@ -154,6 +154,18 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         let (line, col) = (t.line, t.col);
         let kw = t.text.to_string();
         r.pos += 1;
+        if matches!(kw.as_str(), "s" | "c" | "p" | "pp")
+            && scene.objects.len() >= super::MAX_OBJECTS
+        {
+            return Err(r.err_at(
+                line,
+                col,
+                format!(
+                    "more than {} objects: scenes are limited to that (this is the first one past it)",
+                    super::MAX_OBJECTS
+                ),
+            ));
+        }
         let mut add = |scene: &mut Scene, shape: Shape| {
             let m = *material.get_or_insert_with(|| {
                 scene.materials.push(Material::default());
