@@ -81,6 +81,9 @@ pub struct TraceConfig {
     pub max_bytes: u64,
 }
 
+/// The largest waveform written by default (4 GiB).
+pub const MAX_TRACE_BYTES: u64 = 4 << 30;
+
 /// Estimated VCD bytes per traced signal per cycle: about a quarter of the
 /// signals change in a typical cycle of the tracer, at about 8 bytes a
 /// change (measured on `morphosys run` and `render` traces: 1.5 to 2.5).
@@ -95,7 +98,7 @@ impl TraceConfig {
             scope: String::new(),
             clock_hz: 300_000_000,
             budget_cycles: None,
-            max_bytes: 4 << 30,
+            max_bytes: MAX_TRACE_BYTES,
         }
     }
 }
@@ -381,6 +384,10 @@ impl Tracer {
         if let Some(e) = self.err.take() {
             return Err(e);
         }
+        // This cycle's own lines: two timestamps, the clock twice, the
+        // cycle number in binary.
+        let digits = |v: u64| v.checked_ilog10().map_or(1, |d| d + 1) as u64;
+        self.bytes += 2 * (digits(t) + 2) + 6 + (64 - cycle.leading_zeros()).max(1) as u64 + 6;
         if self.bytes > self.cfg.max_bytes {
             // An open-ended trace that outgrew the limit stops here, and says so.
             self.truncated_at = Some(cycle + 1);

@@ -8,7 +8,10 @@ pub struct TraceWindow {
     /// First cycle to trace.
     #[arg(long, value_name = "C", default_value_t = 0)]
     pub trace_from: u64,
-    /// Number of cycles to trace (default: to the end).
+    /// Number of cycles to trace (default: to the end of the run, and for
+    /// `render` the first 100,000 cycles of the first chip instance). A
+    /// window left open stops at 256 MB of waveform, with a warning; one
+    /// asked for is refused up front when its estimate passes 4 GB.
     #[arg(long, value_name = "L")]
     pub trace_cycles: Option<u64>,
     /// Trace only these scopes: comma-separated dotted paths with `*` and
@@ -28,7 +31,31 @@ impl TraceWindow {
         c.first = self.trace_from;
         c.count = self.trace_cycles;
         c.scope = self.trace_scope.clone();
+        if c.count.is_none() {
+            // A run that never halts must not fill the disk at ~6 MB/s.
+            c.max_bytes = OPEN_WINDOW_MAX_BYTES;
+        }
         c
+    }
+}
+
+/// Where a waveform with no `--trace-cycles` stops (with a warning).
+pub const OPEN_WINDOW_MAX_BYTES: u64 = 256 << 20;
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn an_open_window_is_capped_and_an_asked_one_is_not() {
+        let w = super::TraceWindow::default();
+        assert_eq!(w.config("x.vcd".into()).max_bytes, 256 << 20);
+        let w = super::TraceWindow {
+            trace_cycles: Some(10),
+            ..Default::default()
+        };
+        assert_eq!(
+            w.config("x.vcd".into()).max_bytes,
+            rtl::trace::MAX_TRACE_BYTES
+        );
     }
 }
 

@@ -392,6 +392,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         // frame (whose size would be refused anyway).
         if c.count.is_none() {
             c.count = Some(DEFAULT_TRACE_CYCLES);
+            c.max_bytes = rtl::trace::MAX_TRACE_BYTES;
             eprintln!(
                 "tracing cycles {}..{} of the first chip instance (--trace-from / --trace-cycles to change)",
                 c.first,
