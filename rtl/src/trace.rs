@@ -179,6 +179,49 @@ fn readable(f: &File) -> io::Result<()> {
     Ok(())
 }
 
+/// The waveforms being written right now (their temporary files), for a
+/// signal handler to remove: [`partial_files`].
+static PARTIALS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// The temporary files of the waveforms being written now: what an
+/// interrupted run must remove (the `morphosys` command does so on SIGINT,
+/// SIGTERM and SIGHUP).
+pub fn partial_files() -> Vec<PathBuf> {
+    PARTIALS.lock().map(|v| v.clone()).unwrap_or_default()
+}
+
+fn forget_partial(p: &Path) {
+    if let Ok(mut v) = PARTIALS.lock() {
+        v.retain(|q| q != p);
+    }
+}
+
+/// A waveform's temporary file is `.<name>.<pid>.<random>.partial` beside
+/// it. Those of `target` left by a process that no longer runs (killed
+/// outright, with no chance to clean up) are removed.
+fn remove_stale_partials(dir: &Path, name: &str) {
+    let proc_fs = Path::new("/proc/self").exists();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.");
+    for e in entries.flatten() {
+        let f = e.file_name().to_string_lossy().into_owned();
+        let Some(rest) = f
+            .strip_prefix(&prefix)
+            .and_then(|r| r.strip_suffix(".partial"))
+        else {
+            continue;
+        };
+        let Some(pid) = rest.split('.').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if proc_fs && pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
 /// Write a small text file through a temporary file and a rename.
 fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
     let dir = match path.parent() {
@@ -236,6 +279,16 @@ pub fn check_scope_patterns(s: &str) -> Result<(), String> {
     Ok(())
 }
 
+impl Drop for Tracer {
+    fn drop(&mut self) {
+        // Not finished: the temporary file goes (TempPath removes it), and
+        // leaves the list of partial files.
+        if let Some(t) = &self.tmp_path {
+            forget_partial(t);
+        }
+    }
+}
+
 impl Tracer {
     /// Create the VCD file and declare the signals of `top` (named `top_name`).
     pub fn create(cfg: TraceConfig, top_name: &str, top: &dyn Traced) -> io::Result<Tracer> {
@@ -263,11 +316,18 @@ impl Tracer {
                     Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
                     _ => PathBuf::from("."),
                 };
+                let name = target
+                    .file_name()
+                    .map_or_else(|| "waveform".into(), |n| n.to_string_lossy().into_owned());
+                remove_stale_partials(&dir, &name);
                 let tmp = tempfile::Builder::new()
-                    .prefix(".morphosys-")
-                    .suffix(".vcd.partial")
+                    .prefix(&format!(".{name}.{}.", std::process::id()))
+                    .suffix(".partial")
                     .tempfile_in(&dir)?;
                 let (file, tmp_path) = tmp.into_parts();
+                if let Ok(mut v) = PARTIALS.lock() {
+                    v.push(tmp_path.to_path_buf());
+                }
                 readable(&file)?;
                 (file, Some(tmp_path), target)
             }
@@ -428,7 +488,10 @@ impl Tracer {
         };
         self.w.writer().get_ref().sync_data()?;
         let gtkw = self.write_gtkw()?;
-        tmp_path.persist(&self.target).map_err(|e| e.error)?;
+        let partial = tmp_path.to_path_buf();
+        let done = tmp_path.persist(&self.target).map_err(|e| e.error);
+        forget_partial(&partial);
+        done?;
         let mut written = vec![self.cfg.path.clone()];
         written.extend(gtkw);
         Ok(written)

@@ -72,6 +72,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
     let repeat = a.repeat.max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let tmp = tempfile::tempdir().context("cannot create a temporary directory")?;
+    crate::output::register_temporary(tmp.path());
 
     // Each measurement: (chip cycles, best host seconds).
     let measure = |opt: &Options, threads: usize, trace: bool| -> Result<(u64, f64)> {

@@ -597,8 +597,13 @@ pub fn command(a: SweepArgs) -> Result<()> {
     if let Some(dir) = &a.plan {
         return write_plan(dir, &a, &files, scenes, &pts, &jobs);
     }
-    std::fs::create_dir_all(&a.out_dir)
-        .with_context(|| format!("cannot create {}", a.out_dir.display()))?;
+    // Every render's JSON is kept under OUT/points as it finishes: a sweep
+    // that was interrupted resumes where it stopped (the JSON records the
+    // render's arguments, so a changed configuration renders again).
+    let points_dir = a.out_dir.join("points");
+    std::fs::create_dir_all(&points_dir)
+        .with_context(|| format!("cannot create {}", points_dir.display()))?;
+    let mut resumed = 0;
 
     let mut rows: Vec<Row> = Vec::new();
     let mut skipped = 0;
@@ -639,20 +644,41 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     }
                 }
                 bar.set_message(format!("{} {}={}", sc.name, c.knob, c.value));
+                let name = &jobs[p.job].name;
+                let argv = render_argv(&a.out_dir, &sc.file, c, name);
+                let json_path = points_dir.join(format!("{name}.json"));
                 let host = crate::render::RenderSettings {
                     timing: c.timing,
                     ..Default::default()
                 };
-                match crate::cmd_render::render_as(scene, &c.opt, &c.nm, &host) {
-                    Ok((_, rep)) => {
-                        let t = rep.json["host_seconds"].as_f64().unwrap_or(0.0);
+                let measured = if crate::cmd_render::render_json_done(&json_path, &argv) {
+                    resumed += 1;
+                    std::fs::read_to_string(&json_path)
+                        .ok()
+                        .and_then(|t| serde_json::from_str(&t).ok())
+                        .ok_or_else(|| anyhow::anyhow!("{}: unreadable", json_path.display()))
+                } else {
+                    crate::cmd_render::render_as(scene, &c.opt, &c.nm, &host).and_then(
+                        |(_, mut rep)| {
+                            rep.json["argv"] = argv.clone().into();
+                            write_output(
+                                &json_path,
+                                (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
+                            )?;
+                            Ok(rep.json)
+                        },
+                    )
+                };
+                match measured {
+                    Ok(json) => {
+                        let t = json["host_seconds"].as_f64().unwrap_or(0.0);
                         if let Some(fam) = &sc.family {
                             if t > a.size_seconds {
                                 slow.insert((fam.clone(), traversal), t);
                             }
                         }
-                        done.insert(p.job, Some(rep.json.clone()));
-                        rep.json
+                        done.insert(p.job, Some(json.clone()));
+                        json
                     }
                     Err(e) => {
                         // A configuration the chip cannot run (for example a
@@ -670,6 +696,12 @@ pub fn command(a: SweepArgs) -> Result<()> {
         rows.push(point_row(&refs, p, &j));
     }
     bar.finish_and_clear();
+    if resumed > 0 {
+        eprintln!(
+            "{resumed} renders taken from an earlier run ({}/NAME.json, same arguments)",
+            points_dir.display()
+        );
+    }
     if skipped > 0 {
         eprintln!("{skipped} configurations skipped (see above)");
     }

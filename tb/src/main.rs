@@ -573,6 +573,13 @@ fn run(cli: Cli) -> anyhow::Result<()> {
 
 fn main() -> ExitCode {
     stdout_errors_are_errors();
+    // Interrupted (SIGINT, SIGTERM, SIGHUP): no partial waveform, temporary
+    // file or folder is left behind.
+    let _ = ctrlc::set_handler(|| {
+        tb::output::remove_temporaries();
+        eprintln!("morphosys: interrupted; partial and temporary files removed");
+        std::process::exit(130);
+    });
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => return usage_error(e),

@@ -57,6 +57,40 @@ fn target(path: &Path) -> Result<Target> {
     }
 }
 
+/// Temporary files and folders of this process: what an interrupted run
+/// removes ([`remove_temporaries`]).
+static TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Note a temporary file or folder to remove if the run is interrupted.
+pub fn register_temporary(p: &Path) {
+    if let Ok(mut v) = TEMPS.lock() {
+        v.push(p.to_path_buf());
+    }
+}
+
+/// It is gone (renamed into place or removed): forget it.
+pub fn forget_temporary(p: &Path) {
+    if let Ok(mut v) = TEMPS.lock() {
+        v.retain(|q| q != p);
+    }
+}
+
+/// Remove every temporary file and folder of the run and every partial
+/// waveform: called on SIGINT, SIGTERM and SIGHUP before exiting.
+pub fn remove_temporaries() {
+    let mut all = rtl::trace::partial_files();
+    if let Ok(v) = TEMPS.lock() {
+        all.extend(v.iter().cloned());
+    }
+    for p in all {
+        if p.is_dir() {
+            let _ = std::fs::remove_dir_all(&p);
+        } else {
+            let _ = std::fs::remove_file(&p);
+        }
+    }
+}
+
 /// Set when an output is standard output: reports go to standard error.
 static STDOUT_TAKEN: AtomicBool = AtomicBool::new(false);
 
@@ -102,21 +136,29 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
                 Some(d) if !d.as_os_str().is_empty() => d,
                 _ => Path::new("."),
             };
-            let mut tmp = tempfile::NamedTempFile::new_in(dir).with_context(what)?;
-            tmp.write_all(bytes).with_context(what)?;
-            // A temporary file is created private (0600); the output is an
-            // ordinary file.
-            #[cfg(unix)]
-            {
-                use std::os::unix::fs::PermissionsExt;
-                tmp.as_file()
-                    .set_permissions(std::fs::Permissions::from_mode(0o644))
-                    .with_context(what)?;
-            }
-            tmp.persist(&p).map_err(|e| e.error).with_context(what)?;
-            Ok(())
+            let tmp = tempfile::NamedTempFile::new_in(dir).with_context(what)?;
+            let tmp_path = tmp.path().to_path_buf();
+            register_temporary(&tmp_path);
+            let done = finish_file(tmp, bytes, &p).with_context(what);
+            forget_temporary(&tmp_path);
+            done
         }
     }
+}
+
+/// Fill the temporary file and rename it onto `p`.
+fn finish_file(mut tmp: tempfile::NamedTempFile, bytes: &[u8], p: &Path) -> std::io::Result<()> {
+    tmp.write_all(bytes)?;
+    // A temporary file is created private (0600); the output is an
+    // ordinary file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
+    tmp.persist(p).map_err(|e| e.error)?;
+    Ok(())
 }
 
 /// Identity of a file for the "same file" checks: device and inode when it

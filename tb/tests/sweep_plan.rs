@@ -347,3 +347,35 @@ fn plan_and_merge_refuse_bad_input_with_one_line() {
     assert!(err.contains("bad/sweep.toml:2:"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
+
+/// An interrupted in-process sweep resumes (issue 18, item 7): every
+/// render's JSON is kept under OUT/points as it finishes, and a rerun takes
+/// those made with the same arguments instead of rendering them again.
+#[test]
+fn an_in_process_sweep_resumes_from_its_finished_points() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let sweep = [
+        "sweep",
+        "--only",
+        "broadcast",
+        "--size",
+        "16x16",
+        "--out-dir",
+        "out",
+    ];
+    let (ok, _, err) = morphosys(d, &sweep);
+    assert!(ok, "{err}");
+    assert!(!err.contains("taken from an earlier run"), "{err}");
+    let first = std::fs::read(d.join("out/results.csv")).unwrap();
+    let points: Vec<_> = std::fs::read_dir(d.join("out/points")).unwrap().collect();
+    assert_eq!(points.len(), 4);
+    // A point whose JSON was made with other arguments renders again.
+    let p = d.join("out/points/default-paper.json");
+    let text = std::fs::read_to_string(&p).unwrap();
+    std::fs::write(&p, text.replacen("\"--ways\"", "\"--WAYS\"", 1)).unwrap();
+    let (ok, _, err) = morphosys(d, &sweep);
+    assert!(ok, "{err}");
+    assert!(err.contains("3 renders taken from an earlier run"), "{err}");
+    assert_eq!(std::fs::read(d.join("out/results.csv")).unwrap(), first);
+}
