@@ -134,6 +134,9 @@ pub struct Tracer {
     patterns: Vec<Vec<String>>,
     // declaration state
     stack: Vec<String>,
+    /// Every top-level scope declared (matched or not), for the message
+    /// when the scope patterns match no signal.
+    top_scopes: Vec<String>,
     decls: Vec<Decl>,
     // per-call tables, indexed by call order
     scope_on: Vec<bool>,
@@ -360,6 +363,7 @@ impl Tracer {
             phase: Phase::Declare,
             patterns,
             stack: Vec::new(),
+            top_scopes: Vec::new(),
             decls: Vec::new(),
             scope_on: Vec::new(),
             slot: Vec::new(),
@@ -379,6 +383,17 @@ impl Tracer {
         top.trace(&mut t);
         if let Some(e) = t.err.take() {
             return Err(e);
+        }
+        if t.decls.is_empty() && !t.cfg.scope.trim().is_empty() {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "--trace-scope '{}' matches no signal; the top-level scopes are {} (e.g. `--trace-scope {}`)",
+                    t.cfg.scope,
+                    t.top_scopes.join(", "),
+                    t.top_scopes.first().map_or("*", String::as_str)
+                ),
+            ));
         }
         // Refuse up front a trace that would fill the disk.
         let cycles = match (t.cfg.count, t.cfg.budget_cycles) {
@@ -645,6 +660,9 @@ impl Probe for Tracer {
         match self.phase {
             Phase::Declare => {
                 self.stack.push(name.to_string());
+                if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
+                    self.top_scopes.push(self.stack[0].clone());
+                }
                 let on = self.matches_prefix(&self.stack, false);
                 self.scope_on.push(on);
                 if on {

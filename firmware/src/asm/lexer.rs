@@ -144,6 +144,12 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
                 });
                 i += p.chars().count();
             }
+            None if c.is_control() => {
+                return Err(mk(
+                    col,
+                    format!("unexpected control character U+{:04X}", c as u32),
+                ))
+            }
             None => return Err(mk(col, format!("unexpected character `{c}`"))),
         }
     }

@@ -51,7 +51,20 @@ impl fmt::Display for AsmError {
             "{}:{}:{}: error: {}",
             self.file, self.line, self.col, self.message
         )?;
-        writeln!(f, "{:>5} | {}", self.line, self.text)?;
+        // Control characters shown as the replacement character, one
+        // column each, so the caret stays under its column.
+        let shown: String = self
+            .text
+            .chars()
+            .map(|c| {
+                if c.is_control() && c != '\t' {
+                    '\u{FFFD}'
+                } else {
+                    c
+                }
+            })
+            .collect();
+        writeln!(f, "{:>5} | {shown}", self.line)?;
         let pad: String = self
             .text
             .chars()
@@ -89,7 +102,20 @@ const MAX_ERRORS: usize = 50;
 
 /// Assemble a file from disk.
 pub fn assemble_file(path: &std::path::Path) -> Result<Image, String> {
-    let src = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    if Image::is_image(&bytes) {
+        return Err(format!(
+            "{}: this is an assembled image (what `morphosys asm -o` writes), not source; `morphosys run` runs it",
+            path.display()
+        ));
+    }
+    let src = String::from_utf8(bytes).map_err(|e| {
+        format!(
+            "{}: not UTF-8 text (byte {} of the file): not assembly source",
+            path.display(),
+            e.utf8_error().valid_up_to()
+        )
+    })?;
     assemble(&src, &path.display().to_string()).map_err(|e| e.to_string())
 }
 

@@ -22,7 +22,7 @@ use std::path::Path;
 
 /// A 3-vector of `f64`: points, directions and RGB colours.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
-#[serde(from = "[f64; 3]", into = "[f64; 3]")]
+#[serde(try_from = "Vec<f64>", into = "[f64; 3]")]
 pub struct Vec3 {
     pub x: f64,
     pub y: f64,
@@ -32,6 +32,16 @@ pub struct Vec3 {
 impl From<[f64; 3]> for Vec3 {
     fn from(a: [f64; 3]) -> Self {
         Vec3::new(a[0], a[1], a[2])
+    }
+}
+/// A vector read from a scene file: exactly three numbers.
+impl TryFrom<Vec<f64>> for Vec3 {
+    type Error = String;
+    fn try_from(v: Vec<f64>) -> Result<Self, String> {
+        match v[..] {
+            [x, y, z] => Ok(Vec3::new(x, y, z)),
+            _ => Err(format!("expected 3 numbers [x, y, z], found {}", v.len())),
+        }
     }
 }
 impl From<Vec3> for [f64; 3] {
@@ -698,6 +708,17 @@ pub struct Scene {
     /// What the readers skipped or changed, for the user (one entry per
     /// kind, with the count and the first line).
     pub warnings: Vec<Warning>,
+    /// Where the camera, each light and each material were defined (for
+    /// messages; 0 where unknown).
+    pub lines: SourceLines,
+}
+
+/// Lines of a scene file that defined what has no line of its own.
+#[derive(Clone, Debug, PartialEq, Default)]
+pub struct SourceLines {
+    pub camera: usize,
+    pub lights: Vec<usize>,
+    pub materials: Vec<usize>,
 }
 
 /// Something a scene asks for that is not rendered as asked: skipped
@@ -855,32 +876,35 @@ impl Scene {
             message,
         };
         let c = &self.camera;
+        let cl = self.lines.camera;
+        let light_line = |i: usize| self.lines.lights.get(i).copied().unwrap_or(0);
+        let material_line = |i: usize| self.lines.materials.get(i).copied().unwrap_or(0);
         if !(c.from.is_finite()
             && c.at.is_finite()
             && c.up.is_finite()
             && c.angle.is_finite()
             && c.hither.is_finite())
         {
-            return Err(err(0, "camera has a non-finite number".into()));
+            return Err(err(cl, "camera has a non-finite number".into()));
         }
         if (c.at - c.from).length() == 0.0 {
-            return Err(err(0, "camera 'from' and 'at' coincide".into()));
+            return Err(err(cl, "camera 'from' and 'at' coincide".into()));
         }
         if (c.at - c.from).cross(c.up).length() == 0.0 {
             return Err(err(
-                0,
+                cl,
                 "camera 'up' is zero or parallel to the view direction".into(),
             ));
         }
         if !(c.angle > 0.0 && c.angle < 180.0) {
             return Err(err(
-                0,
+                cl,
                 format!("camera angle {} must be in (0, 180) degrees", c.angle),
             ));
         }
         if !(1..=16384).contains(&c.resolution.0) || !(1..=16384).contains(&c.resolution.1) {
             return Err(err(
-                0,
+                cl,
                 format!(
                     "camera resolution {}x{} must be between 1x1 and 16384x16384",
                     c.resolution.0, c.resolution.1
@@ -890,12 +914,13 @@ impl Scene {
         if !self.background.is_finite() {
             return Err(err(0, "background colour has a non-finite number".into()));
         }
-        for l in &self.lights {
+        for (i, l) in self.lights.iter().enumerate() {
             if !l.position.is_finite() || l.color.is_some_and(|c| !c.is_finite()) {
-                return Err(err(0, "light has a non-finite number".into()));
+                return Err(err(light_line(i), "light has a non-finite number".into()));
             }
         }
-        for m in &self.materials {
+        for (i, m) in self.materials.iter().enumerate() {
+            let ml = material_line(i);
             if !(m.color.is_finite()
                 && m.kd.is_finite()
                 && m.ks.is_finite()
@@ -903,11 +928,11 @@ impl Scene {
                 && m.t.is_finite()
                 && m.ior.is_finite())
             {
-                return Err(err(0, "material has a non-finite number".into()));
+                return Err(err(ml, "material has a non-finite number".into()));
             }
             if m.shine < 0.0 {
                 return Err(err(
-                    0,
+                    ml,
                     format!(
                         "material has Phong exponent (shine) {}: it must be >= 0",
                         m.shine
@@ -916,7 +941,7 @@ impl Scene {
             }
             if m.ior <= 0.0 && m.t > 0.0 {
                 return Err(err(
-                    0,
+                    ml,
                     format!(
                         "transmitting material has index of refraction {}: it must be > 0",
                         m.ior

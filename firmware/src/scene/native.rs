@@ -38,11 +38,11 @@ use super::{Camera, Light, Material, Object, Scene, SceneError, Shape, Vec3};
 struct File {
     #[serde(default)]
     background: Option<Vec3>,
-    camera: CameraDef,
+    camera: Spanned<CameraDef>,
     #[serde(default)]
-    light: Vec<LightDef>,
+    light: Vec<Spanned<LightDef>>,
     #[serde(default)]
-    material: BTreeMap<String, MaterialDef>,
+    material: BTreeMap<String, Spanned<MaterialDef>>,
     #[serde(default)]
     object: Vec<Spanned<ObjectDef>>,
 }
@@ -283,7 +283,9 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         source: file.to_string(),
         ..Scene::default()
     };
-    let c = def.camera;
+    let lines = Lines::of(text);
+    scene.lines.camera = lines.at(def.camera.span().start).0;
+    let c = def.camera.into_inner();
     scene.camera = Camera {
         from: c.from,
         at: c.at,
@@ -293,9 +295,15 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         resolution: (c.resolution[0], c.resolution[1]),
     };
     scene.background = def.background.unwrap_or(Vec3::ZERO);
+    scene.lines.lights = def
+        .light
+        .iter()
+        .map(|l| lines.at(l.span().start).0)
+        .collect();
     scene.lights = def
         .light
         .into_iter()
+        .map(|l| l.into_inner())
         .map(|l| Light {
             position: l.position,
             color: l.color,
@@ -304,6 +312,8 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
     let mut names = BTreeMap::new();
     for (name, m) in def.material {
         names.insert(name, scene.materials.len());
+        scene.lines.materials.push(lines.at(m.span().start).0);
+        let m = m.into_inner();
         scene.materials.push(Material {
             color: m.color,
             kd: m.kd,
@@ -313,7 +323,6 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
             ior: m.ior,
         });
     }
-    let lines = Lines::of(text);
     for o in def.object {
         let (line, col) = lines.at(o.span().start);
         let err = |message: String| SceneError {

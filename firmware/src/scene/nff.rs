@@ -169,6 +169,7 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         let mut add = |scene: &mut Scene, shape: Shape| {
             let m = *material.get_or_insert_with(|| {
                 scene.materials.push(Material::default());
+                scene.lines.materials.push(0);
                 scene.materials.len() - 1
             });
             scene.objects.push(Object {
@@ -183,6 +184,7 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                     return Err(r.err_at(line, col, "a second viewpoint 'v': NFF has one".into()));
                 }
                 seen_view = true;
+                scene.lines.camera = line;
                 r.keyword("from")?;
                 let from = r.vec3("'from'")?;
                 r.keyword("at")?;
@@ -232,11 +234,16 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
             "b" => scene.background = r.vec3("background colour")?,
             "l" => {
                 let position = r.vec3("light position")?;
-                // An optional colour: three more numbers on the same line.
-                let same_line =
-                    |r: &Reader, k: usize| r.tokens.get(r.pos + k).is_some_and(|t| t.line == line);
-                let color = if same_line(&r, 0) {
-                    if !(same_line(&r, 1) && same_line(&r, 2)) {
+                // An optional colour: three more numbers on the same line
+                // (a keyword there starts the next entity: a whole scene
+                // may be written on one line).
+                let number = |r: &Reader, k: usize| {
+                    r.tokens
+                        .get(r.pos + k)
+                        .is_some_and(|t| t.line == line && t.text.parse::<f64>().is_ok())
+                };
+                let color = if number(&r, 0) {
+                    if !(number(&r, 1) && number(&r, 2)) {
                         let t = r.peek().map(|t| (t.line, t.col)).unwrap_or((line, 0));
                         return Err(r.err_at(
                             t.0,
@@ -249,6 +256,7 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                     None
                 };
                 scene.lights.push(Light { position, color });
+                scene.lines.lights.push(line);
             }
             "f" => {
                 let color = r.vec3("material colour")?;
@@ -281,6 +289,7 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                     t,
                     ior,
                 });
+                scene.lines.materials.push(line);
                 material = Some(scene.materials.len() - 1);
             }
             "s" => {

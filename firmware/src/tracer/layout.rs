@@ -953,13 +953,21 @@ fn build_as(
     let kd = fit_shift(max_bc, 28 + xb).max(13 + xb);
     let corner_far = a + b * (wd - 1) as f64 + cc * (hd - 1) as f64;
     if a.max_abs() >= 3.9 || corner_far.max_abs() >= 3.9 {
-        return Err(err(
-            0,
-            format!(
-                "camera angle {} too wide for the chip's Q2.13 eye-ray directions",
-                c.angle
-            ),
-        ));
+        return Err(err(0, {
+            let aspect = ax.max(ay);
+            let long = 2.0 * (aspect * half).atan().to_degrees();
+            if aspect > 1.0 {
+                format!(
+                        "a {wd}x{hd} image ({aspect:.1}:1) with the camera angle {} across its shorter side spans {long:.0} degrees across its longer: too wide for the chip's Q2.13 eye-ray directions (at most about 150 degrees); a squarer image or a narrower angle fits",
+                        c.angle
+                    )
+            } else {
+                format!(
+                        "camera angle {} too wide for the chip's Q2.13 eye-ray directions (at most about 150 degrees)",
+                        c.angle
+                    )
+            }
+        }));
     }
     let eye = w.fb.len();
     w.raw(0);

@@ -1,0 +1,191 @@
+//! The smaller findings of the adversarial pass (issue 18, item 12), one
+//! regression test each: every bad input gets one located line and a
+//! non-zero exit, and valid input written oddly is read.
+
+mod common;
+use common::morphosys;
+
+use std::path::Path;
+
+fn default_toml() -> String {
+    std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/default.toml"))
+        .unwrap()
+}
+
+const NFF_HEAD: &str = "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 8 8\n\
+                        b 0 0 0\nl 1 1 1\nf 1 0 0 0.5 0.5 3 0 1\n";
+
+fn fails_with(dir: &Path, args: &[&str], says: &[&str]) {
+    let (ok, _, err) = morphosys(dir, args);
+    assert!(!ok, "{args:?} succeeded");
+    assert_eq!(err.trim().lines().count(), 1, "{args:?}: {err}");
+    for s in says {
+        assert!(err.contains(s), "{args:?}: `{s}` not in: {err}");
+    }
+}
+
+#[test]
+fn toml_vectors_take_exactly_three_numbers() {
+    let d = tempfile::tempdir().unwrap();
+    let text = default_toml();
+    let line = text
+        .lines()
+        .position(|l| l.starts_with("center = "))
+        .unwrap()
+        + 1;
+    let bad = text.replacen(
+        "center = [0.0, 0.0, 1.2]",
+        "center = [0.0, 0.0, 1.2, 5, 6, 7]",
+        1,
+    );
+    assert_ne!(bad, text);
+    std::fs::write(d.path().join("x.toml"), bad).unwrap();
+    fails_with(
+        d.path(),
+        &["reference", "x.toml", "--out", "x.png"],
+        &[&format!("x.toml:{line}:"), "expected 3 numbers", "found 6"],
+    );
+}
+
+#[test]
+fn camera_light_and_material_errors_name_their_line() {
+    let d = tempfile::tempdir().unwrap();
+    let text = default_toml();
+    let cam = text.lines().position(|l| l == "[camera]").unwrap() + 1;
+    std::fs::write(
+        d.path().join("a.toml"),
+        text.replacen("angle = 40.0", "angle = 200.0", 1),
+    )
+    .unwrap();
+    fails_with(
+        d.path(),
+        &["reference", "a.toml", "--out", "x.png"],
+        &[&format!("a.toml:{cam}:"), "angle 200"],
+    );
+    // NFF: the viewpoint's line, and a material's
+    std::fs::write(
+        d.path().join("b.nff"),
+        "b 0 0 0\nv\nfrom 0 0 5\nat 0 0 5\nup 0 1 0\nangle 45\nhither 1\nresolution 8 8\nl 1 1 1\nf 1 0 0 0.5 0.5 3 0 1\ns 0 0 0 1\n",
+    )
+    .unwrap();
+    fails_with(
+        d.path(),
+        &["reference", "b.nff", "--out", "x.png"],
+        &["b.nff:2:", "coincide"],
+    );
+}
+
+#[test]
+fn a_whole_nff_scene_on_one_line_reads_as_the_same_scene() {
+    let d = tempfile::tempdir().unwrap();
+    let text =
+        format!("{NFF_HEAD}l -1 2 3 0.5 0.5 0.5\ns 0 0 0 1\np 3\n-2 -2 -1\n2 -2 -1\n0 2 -1\n");
+    std::fs::write(d.path().join("many.nff"), &text).unwrap();
+    std::fs::write(d.path().join("one.nff"), text.replace('\n', " ")).unwrap();
+    for f in ["many", "one"] {
+        let (ok, _, err) = morphosys(
+            d.path(),
+            &[
+                "reference",
+                &format!("{f}.nff"),
+                "--out",
+                &format!("{f}.png"),
+            ],
+        );
+        assert!(ok, "{f}: {err}");
+    }
+    assert_eq!(
+        std::fs::read(d.path().join("many.png")).unwrap(),
+        std::fs::read(d.path().join("one.png")).unwrap()
+    );
+}
+
+#[test]
+fn a_polygon_starting_with_three_collinear_vertices_is_read() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("p.nff"),
+        format!("{NFF_HEAD}p 4\n0 0 0\n1 0 0\n2 0 0\n0 1 0\n"),
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(d.path(), &["reference", "p.nff", "--out", "p.png"]);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn a_thin_image_is_blamed_on_its_aspect_ratio() {
+    let d = tempfile::tempdir().unwrap();
+    fails_with(
+        d.path(),
+        &["render", "--size", "16x256", "--out", "x.png"],
+        &["16x256", "16.0:1", "shorter side"],
+    );
+}
+
+#[test]
+fn a_trace_scope_matching_nothing_is_refused_with_the_scopes() {
+    let d = tempfile::tempdir().unwrap();
+    let dct = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
+    let dct = dct.to_str().unwrap();
+    fails_with(
+        d.path(),
+        &["run", dct, "--vcd", "w.vcd", "--trace-scope", "nothing"],
+        &["matches no signal", "tinyrisc"],
+    );
+    assert_eq!(
+        std::fs::read_dir(d.path()).unwrap().count(),
+        0,
+        "a file was left"
+    );
+}
+
+#[test]
+fn asm_names_an_image_and_control_characters() {
+    let d = tempfile::tempdir().unwrap();
+    let dct = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
+    let (ok, _, err) = morphosys(d.path(), &["asm", dct.to_str().unwrap(), "-o", "dct.img"]);
+    assert!(ok, "{err}");
+    fails_with(
+        d.path(),
+        &["asm", "dct.img"],
+        &["assembled image", "morphosys run"],
+    );
+    std::fs::write(d.path().join("nul.s"), ".text\nli r1, 1\n\0halt\n").unwrap();
+    let (ok, _, err) = morphosys(d.path(), &["asm", "nul.s"]);
+    assert!(!ok);
+    assert!(
+        err.contains("nul.s:3:1") && err.contains("U+0000") && !err.contains('\0'),
+        "{err:?}"
+    );
+}
+
+#[test]
+fn a_sweep_whose_every_point_fails_is_an_error() {
+    let d = tempfile::tempdir().unwrap();
+    // Too fine for the 16-bit chip: every point of the broadcast sweep fails.
+    std::fs::write(
+        d.path().join("tiny.nff"),
+        "v\nfrom 0 0 -3000\nat 0 0 0\nup 0 1 0\nangle 45\nhither 1\nresolution 8 8\nb 0 0 0\nl 1 1 -100\n\
+         f 1 0 0 0.5 0.5 3 0 1\ns 1000 0 0 1\ns -1000 0 0 0.0001\n",
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &[
+            "sweep",
+            "tiny.nff",
+            "--only",
+            "broadcast",
+            "--size",
+            "8x8",
+            "--out-dir",
+            "out",
+        ],
+    );
+    assert!(!ok, "{err}");
+    assert!(
+        err.contains("no configuration of the sweep could be rendered"),
+        "{err}"
+    );
+    assert!(!d.path().join("out/results.csv").exists());
+}
