@@ -33,14 +33,18 @@ pub fn command(
                 bar.set_position(k);
             }
         });
+        let secs = bar.elapsed().as_secs_f64();
         bar.finish_and_clear();
         println!(
-            "{:>6}: {} inputs, {} accepted, {} rejected with a located error, {} findings; slowest input {:.3} s",
+            "{:>6}: {} inputs ({} structured, largest {} KB), {} accepted, {} rejected with a located error, {} findings; {:.0} inputs/s, slowest input {:.3} s",
             t.name(),
             rep.inputs,
+            rep.structured,
+            rep.largest_input / 1024,
             rep.accepted,
             rep.rejected,
             rep.findings.len(),
+            rep.inputs as f64 / secs.max(1e-9),
             rep.slowest_s
         );
         for (i, f) in rep.findings.iter().enumerate().take(10) {

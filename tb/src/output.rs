@@ -7,7 +7,8 @@
 //!   above), the link stays;
 //! * a character device, FIFO or socket (`/dev/null`, `/dev/stdout`, a
 //!   named pipe) is written through, never replaced;
-//! * `-` is standard output.
+//! * `-` (or `/dev/stdout`) is standard output, and the command's report
+//!   then goes to standard error.
 //!
 //! [`Files`] checks a command's outputs before any work: each can be
 //! written, none is one of the command's inputs, no two are the same file.
@@ -28,9 +29,22 @@ enum Target {
     Stream(PathBuf),
 }
 
+/// `-` and the names of this process's standard output.
+fn is_stdout(path: &Path) -> bool {
+    ["-", "/dev/stdout", "/dev/fd/1", "/proc/self/fd/1"]
+        .iter()
+        .any(|s| path.as_os_str() == *s)
+}
+
 fn target(path: &Path) -> Result<Target> {
-    if path.as_os_str() == "-" {
+    if is_stdout(path) {
         return Ok(Target::Stdout);
+    }
+    // `/dev/stdout`, `/dev/fd/3`, `/proc/self/fd/1`: a descriptor's file,
+    // written through even when it is a regular file (replacing it would
+    // leave the descriptor on the old, unlinked file).
+    if (path.starts_with("/dev") || path.starts_with("/proc")) && path.exists() {
+        return Ok(Target::Stream(path.to_path_buf()));
     }
     match std::fs::metadata(path) {
         Ok(m) if m.is_dir() => anyhow::bail!("{} is a folder", path.display()),
@@ -171,7 +185,7 @@ enum Id {
 }
 
 fn id(path: &Path) -> Id {
-    if path.as_os_str() == "-" {
+    if is_stdout(path) {
         return Id::Stdout;
     }
     #[cfg(unix)]

@@ -130,6 +130,20 @@ fn symlinks_are_followed_and_stdout_is_a_dash() {
     assert!(out.status.success());
     assert_eq!(&out.stdout[1..4], b"PNG");
     assert!(String::from_utf8_lossy(&out.stderr).contains("psnr"));
+
+    // `/dev/stdout` redirected to a regular file: written through the
+    // descriptor, the report on standard error, the file not replaced.
+    let file = d.path().join("so.nff");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(d.path())
+        .args(["spd", "tetra", "--size", "1", "--out", "/dev/stdout"])
+        .stdout(std::fs::File::create(&file).unwrap())
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.starts_with("b ") && text.contains("\nv\n"), "{text}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("tetra size 1"));
 }
 
 #[test]

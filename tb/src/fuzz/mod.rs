@@ -6,11 +6,15 @@
 //! Inputs are mutations of valid seeds (bytes flipped, inserted, deleted;
 //! numbers replaced by NaN, infinities, huge and tiny values; lines
 //! duplicated, dropped, swapped; inputs truncated and spliced) and plain
-//! random bytes, from a fixed seed, so a run is reproducible. Every input
+//! random bytes, and structure-aware inputs ([`structured`]: syntax trees
+//! from the `arbitrary` crate, reaching deep nesting, absurd counts and
+//! files of megabytes), from a fixed seed, so a run is reproducible. Every input
 //! must either be accepted or rejected with an error that names its place;
 //! a panic, or an error without a location, is a finding. `cargo-fuzz`
 //! needs a nightly toolchain this project does not assume, so this is a
 //! mutation fuzzer of our own on stable Rust.
+
+pub mod structured;
 
 use std::panic::{self, AssertUnwindSafe};
 use std::path::PathBuf;
@@ -61,6 +65,10 @@ pub struct Report {
     pub findings: Vec<Finding>,
     /// The slowest input, in seconds (reported, never asserted).
     pub slowest_s: f64,
+    /// Inputs from the structure-aware generator ([`structured`]), and the
+    /// largest input of the run, in bytes.
+    pub structured: u64,
+    pub largest_input: usize,
 }
 
 /// Deterministic generator (xorshift64*).
@@ -119,49 +127,70 @@ const NUMBERS: &[&str] = &[
 pub const CONFORMANCE: &[(&str, &str)] = &[
     (
         "cbcast.s",
-        include_str!("../../firmware/conformance/cbcast.s"),
+        include_str!("../../../firmware/conformance/cbcast.s"),
     ),
-    ("cbcc.s", include_str!("../../firmware/conformance/cbcc.s")),
-    ("cbcr.s", include_str!("../../firmware/conformance/cbcr.s")),
-    ("dbcb.s", include_str!("../../firmware/conformance/dbcb.s")),
-    ("dct.s", include_str!("../../firmware/conformance/dct.s")),
+    (
+        "cbcc.s",
+        include_str!("../../../firmware/conformance/cbcc.s"),
+    ),
+    (
+        "cbcr.s",
+        include_str!("../../../firmware/conformance/cbcr.s"),
+    ),
+    (
+        "dbcb.s",
+        include_str!("../../../firmware/conformance/dbcb.s"),
+    ),
+    ("dct.s", include_str!("../../../firmware/conformance/dct.s")),
     (
         "double_buffer.s",
-        include_str!("../../firmware/conformance/double_buffer.s"),
+        include_str!("../../../firmware/conformance/double_buffer.s"),
     ),
     (
         "ifelse.s",
-        include_str!("../../firmware/conformance/ifelse.s"),
+        include_str!("../../../firmware/conformance/ifelse.s"),
     ),
     (
         "ldctxt.s",
-        include_str!("../../firmware/conformance/ldctxt.s"),
+        include_str!("../../../firmware/conformance/ldctxt.s"),
     ),
-    ("ldfb.s", include_str!("../../firmware/conformance/ldfb.s")),
+    (
+        "ldfb.s",
+        include_str!("../../../firmware/conformance/ldfb.s"),
+    ),
     (
         "lfb_sfb.s",
-        include_str!("../../firmware/conformance/lfb_sfb.s"),
+        include_str!("../../../firmware/conformance/lfb_sfb.s"),
     ),
     (
         "rcrisc.s",
-        include_str!("../../firmware/conformance/rcrisc.s"),
+        include_str!("../../../firmware/conformance/rcrisc.s"),
     ),
-    ("sbcb.s", include_str!("../../firmware/conformance/sbcb.s")),
+    (
+        "sbcb.s",
+        include_str!("../../../firmware/conformance/sbcb.s"),
+    ),
     (
         "status.s",
-        include_str!("../../firmware/conformance/status.s"),
+        include_str!("../../../firmware/conformance/status.s"),
     ),
-    ("stfb.s", include_str!("../../firmware/conformance/stfb.s")),
+    (
+        "stfb.s",
+        include_str!("../../../firmware/conformance/stfb.s"),
+    ),
     (
         "tinyrisc.s",
-        include_str!("../../firmware/conformance/tinyrisc.s"),
+        include_str!("../../../firmware/conformance/tinyrisc.s"),
     ),
     (
         "transpose.s",
-        include_str!("../../firmware/conformance/transpose.s"),
+        include_str!("../../../firmware/conformance/transpose.s"),
     ),
-    ("wfb.s", include_str!("../../firmware/conformance/wfb.s")),
-    ("wide.s", include_str!("../../firmware/conformance/wide.s")),
+    ("wfb.s", include_str!("../../../firmware/conformance/wfb.s")),
+    (
+        "wide.s",
+        include_str!("../../../firmware/conformance/wide.s"),
+    ),
 ];
 
 /// The valid inputs mutations start from (embedded in the binary).
@@ -169,8 +198,8 @@ pub fn seeds(t: Target) -> Vec<Vec<u8>> {
     match t {
         Target::Nff => {
             let mut v = vec![
-                include_bytes!("../../scenes/spd/jacks-1.nff").to_vec(),
-                include_bytes!("../../scenes/spd/tetra-1.nff").to_vec(),
+                include_bytes!("../../../scenes/spd/jacks-1.nff").to_vec(),
+                include_bytes!("../../../scenes/spd/tetra-1.nff").to_vec(),
             ];
             // The head of balls: every entity kind in a few lines.
             let balls = firmware::scene::spd::generate("balls", 1).unwrap_or_default();
@@ -188,7 +217,7 @@ pub fn seeds(t: Target) -> Vec<Vec<u8>> {
             );
             v
         }
-        Target::Toml => vec![include_bytes!("../../scenes/default.toml").to_vec()],
+        Target::Toml => vec![include_bytes!("../../../scenes/default.toml").to_vec()],
         Target::Asm => CONFORMANCE
             .iter()
             .map(|(_, s)| s.as_bytes().to_vec())
@@ -401,9 +430,13 @@ pub fn run(t: Target, count: u64, seed: u64, mut tick: impl FnMut(u64)) -> Repor
     let prev = panic::take_hook();
     panic::set_hook(Box::new(|_| {}));
     for k in 0..count {
-        let input = if seeds.is_empty() || g.below(10) == 0 {
+        let pick = g.below(10);
+        let input = if seeds.is_empty() || pick == 0 {
             let n = g.below(512);
             (0..n).map(|_| g.next() as u8).collect()
+        } else if pick <= 2 {
+            rep.structured += 1;
+            structured::input(t, &mut g)
         } else {
             let a = &seeds[g.below(seeds.len())];
             let b = &seeds[g.below(seeds.len())];
@@ -413,6 +446,7 @@ pub fn run(t: Target, count: u64, seed: u64, mut tick: impl FnMut(u64)) -> Repor
         let r = panic::catch_unwind(AssertUnwindSafe(|| check(t, &input)));
         rep.slowest_s = rep.slowest_s.max(t0.elapsed().as_secs_f64());
         rep.inputs += 1;
+        rep.largest_input = rep.largest_input.max(input.len());
         match r {
             Ok(Ok(true)) => rep.accepted += 1,
             Ok(Ok(false)) => rep.rejected += 1,
