@@ -21,6 +21,8 @@ pub struct RenderArgs {
     pub depth: u32,
     pub out: Option<PathBuf>,
     pub json: Option<PathBuf>,
+    /// The chip's hit map (`compare --hits`).
+    pub hits: Option<PathBuf>,
     pub vcd: Option<PathBuf>,
     pub window: TraceWindow,
     pub emit_asm: Option<PathBuf>,
@@ -299,6 +301,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     files.output(&out_path, "--out");
     for (p, what) in [
         (&a.json, "--json"),
+        (&a.hits, "--hits"),
         (&a.vcd, "--vcd"),
         (&a.emit_asm, "--emit-asm"),
     ] {
@@ -425,6 +428,13 @@ pub fn command(a: RenderArgs) -> Result<()> {
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     rep.json["argv"] = a.argv.clone().into();
     let out = out_path;
+    if let Some(h) = &a.hits {
+        write_output(
+            h,
+            &crate::cmd_scene::hit_map_bytes(width, height, &chip.hits),
+        )?;
+        eprintln!("wrote {}", h.display());
+    }
     write_output(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;
     eprintln!("wrote {}", out.display());

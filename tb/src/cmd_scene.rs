@@ -69,8 +69,14 @@ pub fn read_png(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
 /// Hit map file: `MSHITS1\n<w> <h>\n` then one little-endian u32 per
 /// pixel (object index, 0xFFFFFFFF for none).
 pub fn hits_bytes(img: &Image) -> Vec<u8> {
-    let mut out = format!("MSHITS1\n{} {}\n", img.width, img.height).into_bytes();
-    for h in &img.hits {
+    hit_map_bytes(img.width, img.height, &img.hits)
+}
+
+/// A hit map: `MSHITS1`, the size, then the object hit by each pixel's eye
+/// ray (u32, little-endian, row by row; `u32::MAX` for none).
+pub fn hit_map_bytes(width: u32, height: u32, hits: &[u32]) -> Vec<u8> {
+    let mut out = format!("MSHITS1\n{width} {height}\n").into_bytes();
+    for h in hits {
         out.extend_from_slice(&h.to_le_bytes());
     }
     out
@@ -184,7 +190,7 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
                 })?
             }
         };
-        (w, h, a.depth.unwrap_or(5), false)
+        (w, h, a.depth.unwrap_or(2), false)
     };
     let cap = firmware::tracer::MAX_RAY_DEPTH;
     if max_depth == 0 || max_depth > cap {

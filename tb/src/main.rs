@@ -159,8 +159,9 @@ enum Command {
         /// Image size WIDTHxHEIGHT (default: the scene's resolution).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
         size: Option<(u32, u32)>,
-        /// Maximum ray depth 1..=8; the eye ray is depth 1 (default 5, the
-        /// SPD's; `render` defaults to 2, the paper's).
+        /// Maximum ray depth 1..=8; the eye ray is depth 1 (default 2, the
+        /// paper's recursion level, as `render` and `sweep`, so their images
+        /// compare as they are; `--spd-stats`: 5, the SPD's).
         #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
         depth: Option<u32>,
         /// Write the image here (default: <scene>-reference.png).
@@ -224,6 +225,10 @@ enum Command {
         /// Write the figures as JSON here.
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
+        /// Write the chip's hit map here (the object each pixel's eye ray
+        /// hit), for `compare --hits` against `reference --hits`.
+        #[arg(long, value_name = "PATH")]
+        hits: Option<PathBuf>,
         /// Write the waveform of the first chip instance here.
         #[arg(long, value_name = "PATH")]
         vcd: Option<PathBuf>,
@@ -512,6 +517,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             depth,
             out,
             json,
+            hits,
             vcd,
             window,
             emit_asm,
@@ -537,6 +543,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             depth,
             out,
             json,
+            hits,
             vcd,
             window,
             emit_asm,

@@ -339,3 +339,63 @@ fn bench_does_not_announce_its_temporary_waveforms() {
         "{out}{err}"
     );
 }
+
+/// `render --hits` and `reference --hits` make the hit maps `compare --hits`
+/// reads, and `render` and `reference` share their default depth, so their
+/// default images compare as they are (issue 17, items 1 and 6).
+#[test]
+fn chip_and_reference_hit_maps_and_depths_compare() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes/default.toml")
+        .display()
+        .to_string();
+    for args in [
+        vec![
+            "render",
+            &scene,
+            "--size",
+            "32x32",
+            "--out",
+            "chip.png",
+            "--hits",
+            "chip.hits",
+        ],
+        vec![
+            "reference",
+            &scene,
+            "--size",
+            "32x32",
+            "--out",
+            "ref.png",
+            "--hits",
+            "ref.hits",
+            "--json",
+            "ref.json",
+        ],
+    ] {
+        let (ok, _, err) = morphosys(d.path(), &args);
+        assert!(ok, "{args:?}: {err}");
+    }
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("ref.json")).unwrap()).unwrap();
+    assert_eq!(j["depth"], 2, "reference's default depth is render's");
+    let (ok, out, err) = morphosys(
+        d.path(),
+        &[
+            "compare",
+            "chip.png",
+            "ref.png",
+            "--hits",
+            "chip.hits",
+            "ref.hits",
+        ],
+    );
+    assert!(ok, "{err}");
+    let agree: f64 = out
+        .split("hit agreement ")
+        .nth(1)
+        .and_then(|s| s.trim().trim_end_matches('%').parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(agree > 97.0 && agree <= 100.0, "{out}");
+}
