@@ -84,81 +84,184 @@ pub fn run_image_on<W: Word>(
 }
 
 pub fn print_stats(s: &Stats) {
-    println!("cycles               {}", s.cycles);
-    println!("tinyrisc issued      {}", s.risc_instructions);
-    println!("array busy cycles    {}", s.array_busy_cycles);
-    println!("active RC fraction   {:.3}", s.active_rc_fraction());
-    println!("array stall cycles   {}", s.array_stall_cycles);
-    println!("dma stall cycles     {}", s.dma_stall_cycles);
-    println!(
+    crate::report!("cycles               {}", s.cycles);
+    crate::report!("tinyrisc issued      {}", s.risc_instructions);
+    crate::report!("array busy cycles    {}", s.array_busy_cycles);
+    crate::report!("active RC fraction   {:.3}", s.active_rc_fraction());
+    crate::report!("array stall cycles   {}", s.array_stall_cycles);
+    crate::report!("dma stall cycles     {}", s.dma_stall_cycles);
+    crate::report!(
         "dma busy cycles      {}  ({} transfers, {} words)",
-        s.dma_busy_cycles, s.dma_transfers, s.dma_words
+        s.dma_busy_cycles,
+        s.dma_transfers,
+        s.dma_words
     );
 }
 
-pub fn command(
-    file: PathBuf,
-    max_cycles: u64,
-    vcd: Option<PathBuf>,
-    window: TraceWindow,
-    datapath: Datapath,
-    timing: Option<PathBuf>,
-) -> anyhow::Result<()> {
-    if let Some(v) = &vcd {
-        let mut files = crate::output::Files::new();
-        files.input(&file, "FILE");
-        if let Some(t) = &timing {
-            files.input(t, "--timing");
-        }
-        files.output(v, "--vcd").check()?;
+/// Arguments of `morphosys run`.
+pub struct RunArgs {
+    pub file: PathBuf,
+    pub max_cycles: u64,
+    pub vcd: Option<PathBuf>,
+    pub window: TraceWindow,
+    /// `None`: the source's `.datapath`, else 16.
+    pub datapath: Option<Datapath>,
+    pub timing: Option<PathBuf>,
+    /// (register, value) every one of which must hold after the halt.
+    pub expect: Vec<(u8, u32)>,
+    pub json: Option<PathBuf>,
+}
+
+/// The failure code of the conformance programs: a halt with r1 = 0xBAD
+/// (and r2 = the number of the failed check).
+pub const FAIL_CODE: u32 = 0xBAD;
+
+/// `--expect REG=VALUE`: `r0`..`r15` and a decimal or `0x` hex value.
+pub fn parse_expect(s: &str) -> Result<(u8, u32), String> {
+    let (r, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected REG=VALUE (e.g. r3=38), found '{s}'"))?;
+    let reg = r
+        .trim()
+        .strip_prefix('r')
+        .and_then(|n| n.parse::<u8>().ok())
+        .filter(|n| *n < 16)
+        .ok_or_else(|| format!("'{r}' is not a TinyRISC register (r0..r15)"))?;
+    let v = v.trim();
+    let value = if let Some(h) = v.strip_prefix("0x").or_else(|| v.strip_prefix("0X")) {
+        u32::from_str_radix(h, 16).ok()
+    } else if let Some(n) = v.strip_prefix('-') {
+        n.parse::<u32>().ok().map(|n| n.wrapping_neg())
+    } else {
+        v.parse::<u32>().ok()
     }
-    let timing = crate::timing::load_or_default(timing.as_deref())?;
+    .ok_or_else(|| format!("'{v}' is not a 32-bit value (decimal or 0x hex)"))?;
+    Ok((reg, value))
+}
+
+pub fn command(a: RunArgs) -> anyhow::Result<()> {
+    let mut files = crate::output::Files::new();
+    files.input(&a.file, "FILE");
+    if let Some(t) = &a.timing {
+        files.input(t, "--timing");
+    }
+    for (p, what) in [(&a.vcd, "--vcd"), (&a.json, "--json")] {
+        if let Some(p) = p {
+            files.output(p, what);
+        }
+    }
+    files.check()?;
+    let timing = crate::timing::load_or_default(a.timing.as_deref())?;
+    // The source's `.datapath` unless --datapath says otherwise (and then
+    // they must agree).
+    let source = std::fs::read(&a.file)
+        .ok()
+        .filter(|b| !Image::is_image(b))
+        .and_then(|b| String::from_utf8(b).ok());
+    let declared = source.as_deref().map(crate::render::source_datapath);
+    let datapath = match (a.datapath, declared) {
+        (Some(d), Some(s))
+            if d != s && source.as_deref().is_some_and(|t| t.contains(".datapath")) =>
+        {
+            anyhow::bail!(
+                "{}: the program is for the {}-bit datapath (`.datapath`), --datapath {} asks for {}",
+                a.file.display(),
+                s.bits(),
+                d.bits(),
+                d.bits()
+            )
+        }
+        (Some(d), _) => d,
+        (None, Some(s)) => s,
+        (None, None) => Datapath::W16,
+    };
     match datapath {
-        Datapath::W16 => command_on::<i16>(file, max_cycles, vcd, window, timing),
-        Datapath::W32 => command_on::<i32>(file, max_cycles, vcd, window, timing),
+        Datapath::W16 => command_on::<i16>(&a, datapath, timing),
+        Datapath::W32 => command_on::<i32>(&a, datapath, timing),
     }
 }
 
-fn command_on<W: Word>(
-    file: PathBuf,
-    max_cycles: u64,
-    vcd: Option<PathBuf>,
-    window: TraceWindow,
-    timing: Timing,
-) -> anyhow::Result<()> {
-    let img = load_program(&file)?;
-    let trace = vcd.map(|p| window.config(p));
+fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyhow::Result<()> {
+    let img = load_program(&a.file)?;
+    let trace = a.vcd.clone().map(|p| a.window.config(p));
     let t0 = std::time::Instant::now();
-    let out = run_image_on::<W>(&img, timing, max_cycles, trace)?;
+    let out = run_image_on::<W>(&img, timing, a.max_cycles, trace)?;
     let secs = t0.elapsed().as_secs_f64();
     for f in &out.files {
         eprintln!("wrote {}", f.display());
     }
-    match &out.result {
-        Ok(cycles) => {
-            println!(
-                "halted after {cycles} cycles ({:.3} us at {} MHz)",
-                *cycles as f64 * 1e6 / timing.clock_hz as f64,
-                timing.clock_hz as f64 / 1e6
-            );
-            print_stats(&out.stats());
-            let r = |k| out.reg(k);
-            println!(
-                "r1 {:#010x}  r2 {:#010x}  r3 {:#010x}  r4 {:#010x}",
-                r(1),
-                r(2),
-                r(3),
-                r(4)
-            );
-            if secs > 0.0 {
-                println!(
-                    "host: {:.3} s, {:.1} M cycles/s",
-                    secs,
-                    *cycles as f64 / secs / 1e6
-                );
-            }
-            Ok(())
-        }
-        Err(e) => Err(anyhow!("{e}")),
+    let cycles = match &out.result {
+        Ok(c) => *c,
+        Err(e) => return Err(anyhow!("{e}")),
+    };
+    crate::report!(
+        "halted after {cycles} cycles ({:.3} us at {} MHz), {}-bit datapath",
+        cycles as f64 * 1e6 / timing.clock_hz as f64,
+        timing.clock_hz as f64 / 1e6,
+        datapath.bits()
+    );
+    print_stats(&out.stats());
+    let r = |k| out.reg(k);
+    for row in [[1, 2, 3, 4], [5, 6, 7, 8]] {
+        let cells: Vec<String> = row
+            .iter()
+            .map(|&k| format!("r{k} {:#010x} ({:>10})", r(k), r(k) as i32))
+            .collect();
+        crate::report!("{}", cells.join("  "));
     }
+    if secs > 0.0 {
+        crate::report!(
+            "host: {:.3} s, {:.1} M cycles/s",
+            secs,
+            cycles as f64 / secs / 1e6
+        );
+    }
+    if let Some(p) = &a.json {
+        let s = out.stats();
+        let regs: Vec<serde_json::Value> = (0..16)
+            .map(|k| serde_json::json!({"reg": format!("r{k}"), "value": r(k), "signed": r(k) as i32, "hex": format!("{:#010x}", r(k))}))
+            .collect();
+        let v = serde_json::json!({
+            "program": a.file.display().to_string(),
+            "datapath_bits": datapath.bits(),
+            "cycles": cycles,
+            "registers": regs,
+            "risc_instructions": s.risc_instructions,
+            "array_busy_cycles": s.array_busy_cycles,
+            "active_rc_fraction": s.active_rc_fraction(),
+            "array_stall_cycles": s.array_stall_cycles,
+            "dma_stall_cycles": s.dma_stall_cycles,
+            "dma_busy_cycles": s.dma_busy_cycles,
+            "host_seconds": secs,
+        });
+        crate::output::write(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    // Did the program pass?
+    if a.expect.is_empty() {
+        if r(1) == FAIL_CODE {
+            anyhow::bail!(
+                "{}: the program signalled failure: halted with r1 = 0xBAD (check number r2 = {})",
+                a.file.display(),
+                r(2)
+            );
+        }
+    } else {
+        let wrong: Vec<String> = a
+            .expect
+            .iter()
+            .filter(|(k, v)| r(*k) != *v)
+            .map(|(k, v)| {
+                format!(
+                    "r{k} = {:#x} ({}), expected {v:#x} ({v})",
+                    r(*k),
+                    r(*k) as i32
+                )
+            })
+            .collect();
+        if !wrong.is_empty() {
+            anyhow::bail!("{}: {}", a.file.display(), wrong.join("; "));
+        }
+    }
+    Ok(())
 }

@@ -42,13 +42,24 @@ enum Command {
         vcd: Option<PathBuf>,
         #[command(flatten)]
         window: tb::cli::TraceWindow,
-        /// RC datapath width in bits: 16 (the paper's chip) or 32.
-        #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath, default_value = "16")]
-        datapath: rtl::rc::Datapath,
+        /// RC datapath width in bits: 16 (the paper's chip) or 32 (default:
+        /// the source's `.datapath`, else 16).
+        #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath)]
+        datapath: Option<rtl::rc::Datapath>,
         /// The chip's timing from a TOML file (any subset of the fields
         /// `morphosys timing` prints; the rest keep their defaults).
         #[arg(long, value_name = "FILE.toml")]
         timing: Option<PathBuf>,
+        /// After the halt, TinyRISC register REG must hold VALUE (e.g.
+        /// `r3=38`, `r1=0x1`); repeatable. Any mismatch exits 1. Without
+        /// it, a halt with r1 = 0xBAD (the conformance programs' failure
+        /// code, docs/isa.md) exits 1.
+        #[arg(long, value_name = "REG=VALUE", value_parser = tb::cmd_run::parse_expect)]
+        expect: Vec<(u8, u32)>,
+        /// Write the cycles, the registers (decimal and hex) and the
+        /// statistics as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
     },
     /// Measure the simulator: array cycles per host second with tracing off
     /// and on, and the speed-up on every core.
@@ -395,7 +406,18 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             window,
             datapath,
             timing,
-        } => tb::cmd_run::command(file, max_cycles, vcd, window, datapath, timing),
+            expect,
+            json,
+        } => tb::cmd_run::command(tb::cmd_run::RunArgs {
+            file,
+            max_cycles,
+            vcd,
+            window,
+            datapath,
+            timing,
+            expect,
+            json,
+        }),
         Command::Bench {
             scene,
             size,

@@ -399,3 +399,47 @@ fn chip_and_reference_hit_maps_and_depths_compare() {
         .unwrap_or_else(|| panic!("{out}"));
     assert!(agree > 97.0 && agree <= 100.0, "{out}");
 }
+
+/// `run` honours `.datapath`, fails on the conformance failure code and on
+/// an `--expect`ed register off, and writes the registers as JSON (issue
+/// 17, item 4).
+#[test]
+fn run_reports_pass_and_failure_by_its_exit_status() {
+    let d = tempfile::tempdir().unwrap();
+    let conf = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance");
+    let wide = conf.join("wide.s").display().to_string();
+    let dct = conf.join("dct.s").display().to_string();
+    // wide.s says `.datapath 32`: it passes without --datapath.
+    let (ok, out, err) = morphosys(d.path(), &["run", &wide]);
+    assert!(ok, "{err}");
+    assert!(out.contains("32-bit datapath"), "{out}");
+    // ... and asking for 16 bits contradicts it.
+    let (ok, _, err) = morphosys(d.path(), &["run", &wide, "--datapath", "16"]);
+    assert!(!ok && err.contains(".datapath"), "{err}");
+    // The DCT's own cycle count, checked from outside, and as JSON.
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &[
+            "run", &dct, "--expect", "r1=1", "--expect", "r3=0x26", "--json", "dct.json",
+        ],
+    );
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("dct.json")).unwrap()).unwrap();
+    assert_eq!(j["registers"][3]["value"], 38);
+    assert_eq!(j["registers"][3]["hex"], "0x00000026");
+    let (ok, _, err) = morphosys(d.path(), &["run", &dct, "--expect", "r3=37"]);
+    assert!(
+        !ok && err.contains("r3 = 0x26 (38), expected 0x25 (37)"),
+        "{err}"
+    );
+    // A program that signals failure.
+    std::fs::write(
+        d.path().join("fail.s"),
+        ".text\n li r1, 0xBAD\n li r2, 7\n halt\n",
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(d.path(), &["run", "fail.s"]);
+    assert!(!ok, "exit 0 on a failing program");
+    assert!(err.contains("0xBAD") && err.contains("r2 = 7"), "{err}");
+}
