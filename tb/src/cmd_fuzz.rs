@@ -12,6 +12,12 @@ pub fn command(
     seed: u64,
     save: Option<PathBuf>,
 ) -> anyhow::Result<()> {
+    // The folder for findings is made (or refused) before any input runs.
+    if let Some(dir) = &save {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| anyhow::anyhow!("--save {}: {e}", dir.display()))?;
+        crate::output::check_writable(&dir.join("finding"), "--save")?;
+    }
     let targets = if targets.is_empty() {
         fuzz::ALL.to_vec()
     } else {
