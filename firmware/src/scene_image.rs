@@ -47,6 +47,18 @@ pub const MAX_BSP_DEPTH: u32 = 32;
 /// Compact layout: object index bits of a list entry.
 pub const LIST_INDEX_BITS: u32 = 13;
 
+/// A Fig. 5 membership bit vector: one bit per object of a type (`count`
+/// of them), bit 15 of word 0 the type's first object, set for `members`;
+/// `count.div_ceil(16)` words. Both the compiled scene image and the
+/// tracer's FB image build their node bit vectors with it.
+pub fn membership_words(count: usize, members: impl IntoIterator<Item = usize>) -> Vec<u16> {
+    let mut bits: BitVec<u16, Msb0> = BitVec::repeat(false, count.div_ceil(16) * 16);
+    for k in members {
+        bits.set(k, true);
+    }
+    bits.into_vec()
+}
+
 /// Words of one object record, by type.
 pub fn record_words(t: PrimType) -> usize {
     match t {
@@ -772,15 +784,14 @@ pub fn compile(scene: &Scene, opt: &CompileOptions) -> Result<SceneImage, SceneE
             for n in &bsp.nodes {
                 node_head(&mut w, n);
                 for t in &present {
-                    let mut bits: BitVec<u16, Msb0> =
-                        BitVec::repeat(false, by_type[t.index()].len().div_ceil(16) * 16);
-                    for &i in &n.objects {
-                        let (ot, k) = slot(i);
-                        if ot == *t {
-                            bits.set(k as usize, true);
-                        }
-                    }
-                    w.words.extend_from_slice(bits.as_raw_slice());
+                    let members = n
+                        .objects
+                        .iter()
+                        .map(|&i| slot(i))
+                        .filter(|(ot, _)| ot == t)
+                        .map(|(_, k)| k as usize);
+                    w.words
+                        .extend(membership_words(by_type[t.index()].len(), members));
                 }
             }
             w.addr(A_LISTS, 0);
@@ -999,5 +1010,23 @@ impl Report {
             s += &format!("note: {n}\n");
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod membership_tests {
+    use super::membership_words;
+
+    #[test]
+    fn membership_words_put_the_first_object_in_bit_15_of_word_0() {
+        // Against the shift arithmetic, independently.
+        for count in [1usize, 15, 16, 17, 40] {
+            let members: Vec<usize> = (0..count).filter(|k| k % 3 != 1).collect();
+            let mut want = vec![0u16; count.div_ceil(16)];
+            for &k in &members {
+                want[k / 16] |= 0x8000 >> (k % 16);
+            }
+            assert_eq!(membership_words(count, members), want, "{count} objects");
+        }
     }
 }

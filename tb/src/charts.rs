@@ -115,6 +115,33 @@ fn tick(v: f64) -> String {
     }
 }
 
+/// The ticks of a logarithmic axis over `lo..hi`: powers of two over up
+/// to eight octaves (4, 8, .. 64 ways), 1-2-5 steps over up to three
+/// decades, powers of ten beyond.
+pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+    if !(lo > 0.0 && hi > lo) {
+        return vec![];
+    }
+    let within = |v: f64| v >= lo * (1.0 - 1e-9) && v <= hi * (1.0 + 1e-9);
+    if hi / lo <= 256.0 {
+        let (a, b) = (lo.log2().ceil() as i32, hi.log2().floor() as i32);
+        let v: Vec<f64> = (a..=b).map(|k| 2f64.powi(k)).collect();
+        if v.len() >= 2 {
+            return v;
+        }
+    }
+    let (a, b) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let steps: &[f64] = if hi / lo <= 1000.0 {
+        &[1.0, 2.0, 5.0]
+    } else {
+        &[1.0]
+    };
+    (a..=b)
+        .flat_map(|e| steps.iter().map(move |m| m * 10f64.powi(e)))
+        .filter(|v| within(*v))
+        .collect()
+}
+
 fn range(v: impl Iterator<Item = f64>, log: bool) -> (f64, f64) {
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
     for x in v.filter(|x| x.is_finite()) {
@@ -308,12 +335,13 @@ where
                     .map_err(|e| anyhow!("{e:?}"))?;
                 chart
                     .draw_series(std::iter::once(Text::new(
-                        m.label.clone(),
+                        // beside the marker, not over it
+                        format!("{}   ", m.label),
                         (m.x, m.y),
                         ("sans-serif", 14)
                             .into_font()
                             .color(&RED)
-                            .pos(Pos::new(HPos::Right, VPos::Bottom)),
+                            .pos(Pos::new(HPos::Right, VPos::Center)),
                     )))
                     .map_err(|e| anyhow!("{e:?}"))?;
             }
@@ -332,15 +360,20 @@ where
     } else {
         (y0, y1)
     };
+    // Logarithmic axes tick where the data's scale does ([`log_ticks`]).
+    let (xt, yt) = (log_ticks(x0, x1), log_ticks(y0, y1));
     match (c.log_x, c.log_y) {
         (true, true) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .build_cartesian_2d(
+                (x0..x1).log_scale().with_key_points(xt),
+                (y0..y1).log_scale().with_key_points(yt)
+            )
             .map_err(|e| anyhow!("{e:?}"))?),
         (true, false) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale(), y0..y1)
+            .build_cartesian_2d((x0..x1).log_scale().with_key_points(xt), y0..y1)
             .map_err(|e| anyhow!("{e:?}"))?),
         (false, true) => body!(b
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale())
+            .build_cartesian_2d(x0..x1, (y0..y1).log_scale().with_key_points(yt))
             .map_err(|e| anyhow!("{e:?}"))?),
         (false, false) => body!(b
             .build_cartesian_2d(x0..x1, y0..y1)
@@ -421,6 +454,46 @@ mod tests {
             .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&v| v < 100))
             .count();
         assert!(dark > 200, "title text not rendered ({dark} dark pixels)");
+        // What the chart promises, read back from the SVG (issue 17, item
+        // 7): the x ticks at the measured ways, the hollow marker drawn
+        // hollow and the others filled.
+        // (y position, text) of every text element; the x axis's tick
+        // labels are the ones on the row of the "64".
+        let texts: Vec<(String, String)> = s
+            .split("</text>")
+            .filter_map(|t| {
+                let open = t.rfind("<text")?;
+                let el = &t[open..];
+                let y = el.split(" y=\"").nth(1)?.split('"').next()?.to_string();
+                Some((y, el.rsplit('>').next()?.trim().to_string()))
+            })
+            .collect();
+        let row = &texts.iter().find(|(_, t)| t == "64").expect("a 64 tick").0;
+        let x_ticks: Vec<&str> = texts
+            .iter()
+            .filter(|(y, _)| y == row)
+            .map(|(_, t)| t.as_str())
+            .collect();
+        assert_eq!(x_ticks, ["4", "8", "16", "32", "64"], "{texts:?}");
+        assert_eq!(
+            s.matches("fill=\"none\" stroke=\"#1F77B4\"").count(),
+            1,
+            "one hollow marker"
+        );
+        assert!(
+            s.matches("fill=\"#1F77B4\" stroke=\"none\"").count() >= 4,
+            "filled markers"
+        );
+    }
+
+    #[test]
+    fn log_ticks_follow_the_data() {
+        assert_eq!(log_ticks(3.0, 80.0), vec![4.0, 8.0, 16.0, 32.0, 64.0]);
+        assert_eq!(
+            log_ticks(3.0, 2000.0),
+            vec![5.0, 10.0, 20.0, 50.0, 100.0, 200.0, 500.0, 1000.0, 2000.0]
+        );
+        assert_eq!(log_ticks(50_000.0, 3e9), vec![1e5, 1e6, 1e7, 1e8, 1e9]);
     }
 
     #[test]

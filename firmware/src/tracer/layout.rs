@@ -1595,10 +1595,7 @@ fn build_as(
             });
             match node_layout {
                 NodeLayout::Fig5 => {
-                    let mut words = vec![0u16; ti.bv_words];
-                    for k in ks {
-                        words[k / 16] |= 0x8000 >> (k % 16);
-                    }
+                    let words = crate::scene_image::membership_words(ti.bv_words * 16, ks);
                     for b in words {
                         w.word16(b);
                     }
