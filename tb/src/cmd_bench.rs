@@ -159,7 +159,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "repeat": repeat,
         });
         write_output(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
-        eprintln!("wrote {}", p.display());
+        crate::note!("wrote {}", p.display());
     }
     Ok(())
 }

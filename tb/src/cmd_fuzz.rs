@@ -25,7 +25,7 @@ pub fn command(
     };
     let mut total_findings = 0;
     for t in targets {
-        let bar = indicatif::ProgressBar::new(count);
+        let bar = crate::output::progress_bar(count);
         bar.set_style(
             indicatif::ProgressStyle::with_template(
                 "{prefix:>6} [{bar:40}] {pos}/{len} inputs ({per_sec}, eta {eta})",

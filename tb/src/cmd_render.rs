@@ -386,7 +386,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     if let Some(p) = &a.emit_asm {
         write_output(p, built.source.as_bytes())?;
-        eprintln!("wrote {}", p.display());
+        crate::note!("wrote {}", p.display());
     }
     let trace = a.vcd.map(|p| {
         let mut c = a.window.config(p);
@@ -433,11 +433,11 @@ pub fn command(a: RenderArgs) -> Result<()> {
             h,
             &crate::cmd_scene::hit_map_bytes(width, height, &chip.hits),
         )?;
-        eprintln!("wrote {}", h.display());
+        crate::note!("wrote {}", h.display());
     }
     write_output(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;
-    eprintln!("wrote {}", out.display());
+    crate::note!("wrote {}", out.display());
     let j = &rep.json;
     crate::report!("scene                    {}", scene.source);
     crate::report!(
@@ -545,7 +545,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(j)?;
         write_output(p, text.as_bytes())?;
-        eprintln!("wrote {}", p.display());
+        crate::note!("wrote {}", p.display());
     }
     Ok(())
 }

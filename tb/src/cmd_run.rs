@@ -188,7 +188,7 @@ fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyho
     let out = run_image_on::<W>(&img, timing, a.max_cycles, trace)?;
     let secs = t0.elapsed().as_secs_f64();
     for f in &out.files {
-        eprintln!("wrote {}", f.display());
+        crate::note!("wrote {}", f.display());
     }
     let cycles = match &out.result {
         Ok(c) => *c,
@@ -235,7 +235,7 @@ fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyho
             "host_seconds": secs,
         });
         crate::output::write(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
-        eprintln!("wrote {}", p.display());
+        crate::note!("wrote {}", p.display());
     }
     // Did the program pass?
     if a.expect.is_empty() {

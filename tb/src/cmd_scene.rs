@@ -239,11 +239,11 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
     );
     if let Some(out) = &out {
         write_output(out, &png_bytes(img.width, img.height, &img.to_rgb8())?)?;
-        crate::report!("wrote {}", out.display());
+        crate::note!("wrote {}", out.display());
     }
     if let Some(path) = &a.hits {
         write_output(path, &hits_bytes(&img))?;
-        crate::report!("wrote {}", path.display());
+        crate::note!("wrote {}", path.display());
     }
     if let Some(path) = &a.json {
         let v = json!({

@@ -607,7 +607,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
 
     let mut rows: Vec<Row> = Vec::new();
     let mut skipped = 0;
-    let bar = indicatif::ProgressBar::new(pts.len() as u64);
+    let bar = crate::output::progress_bar(pts.len() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
@@ -719,9 +719,9 @@ fn write_results(rows: &[Row], dir: &Path) -> Result<()> {
     }
     let csv_path = dir.join("results.csv");
     write_output(&csv_path, &w.into_inner().context("csv")?)?;
-    println!("wrote {}", csv_path.display());
+    crate::note!("wrote {}", csv_path.display());
     for p in charts_for(rows, dir)? {
-        println!("wrote {}", p.display());
+        crate::note!("wrote {}", p.display());
     }
     Ok(())
 }

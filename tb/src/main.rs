@@ -18,6 +18,10 @@ use clap::{Parser, Subcommand};
 struct Cli {
     #[command(subcommand)]
     command: Command,
+    /// No progress bars and no "wrote FILE" lines (figures, warnings and
+    /// errors still print).
+    #[arg(long, short, global = true)]
+    quiet: bool,
 }
 
 #[derive(Subcommand)]
@@ -132,6 +136,13 @@ enum Command {
         /// series each in timing.png).
         #[arg(long, value_name = "FILE.toml", num_args = 1..)]
         timing: Vec<PathBuf>,
+    },
+    /// Print a shell completion script: `morphosys completions bash >
+    /// ~/.local/share/bash-completion/completions/morphosys` (zsh: into a
+    /// folder of $fpath as `_morphosys`; fish: ~/.config/fish/completions/).
+    Completions {
+        #[arg(value_enum)]
+        shell: clap_complete::Shell,
     },
     /// Print the chip's default timing as a TOML file, every field with
     /// where its value comes from; edit a copy and pass it with --timing.
@@ -465,13 +476,24 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             size_seconds,
             timing,
         }),
+        Command::Completions { shell } => {
+            use clap::CommandFactory;
+            let mut cmd = Cli::command();
+            let mut text = Vec::new();
+            clap_complete::generate(shell, &mut cmd, "morphosys", &mut text);
+            use std::io::Write;
+            let mut o = std::io::stdout().lock();
+            o.write_all(&text)
+                .and_then(|_| o.flush())
+                .map_err(|e| anyhow::anyhow!("writing the completions to standard output: {e}"))
+        }
         Command::Timing { out } => {
             let text = tb::timing::to_toml(&rtl::Timing::default());
             match out {
                 Some(p) => {
                     tb::output::Files::new().output(&p, "--out").check()?;
                     tb::cmd_scene::write_output(&p, text.as_bytes())?;
-                    eprintln!("wrote {}", p.display());
+                    tb::note!("wrote {}", p.display());
                     Ok(())
                 }
                 None => {
@@ -613,6 +635,7 @@ fn main() -> ExitCode {
         Ok(cli) => cli,
         Err(e) => return usage_error(e),
     };
+    tb::output::set_quiet(cli.quiet);
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that went away (`morphosys spd balls | head`) ends the

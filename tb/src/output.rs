@@ -105,6 +105,37 @@ pub fn remove_temporaries() {
     }
 }
 
+/// `--quiet`: no progress bars and no "wrote FILE" lines (warnings and
+/// errors still print).
+static QUIET: AtomicBool = AtomicBool::new(false);
+
+pub fn set_quiet(q: bool) {
+    QUIET.store(q, Ordering::Relaxed);
+}
+
+pub fn quiet() -> bool {
+    QUIET.load(Ordering::Relaxed)
+}
+
+/// A progress bar of `len` steps, hidden under `--quiet`.
+pub fn progress_bar(len: u64) -> indicatif::ProgressBar {
+    if quiet() {
+        indicatif::ProgressBar::hidden()
+    } else {
+        indicatif::ProgressBar::new(len)
+    }
+}
+
+/// `eprintln!` unless `--quiet`: what a command wrote, and where.
+#[macro_export]
+macro_rules! note {
+    ($($t:tt)*) => {
+        if !$crate::output::quiet() {
+            eprintln!($($t)*)
+        }
+    };
+}
+
 /// Set when an output is standard output: reports go to standard error.
 static STDOUT_TAKEN: AtomicBool = AtomicBool::new(false);
 

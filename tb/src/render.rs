@@ -340,7 +340,7 @@ fn run_group<W: Word>(
     // (Not for `bench`, whose waveforms are temporary.)
     if say_files {
         for f in files {
-            eprintln!("wrote {}", f.display());
+            crate::note!("wrote {}", f.display());
         }
     }
     result.map_err(|e| anyhow!("the tracer firmware stopped: {e}"))?;
@@ -695,7 +695,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     }
     let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
     let bar = if progress && groups.len() > 1 {
-        let b = ProgressBar::new(tiles.len() as u64);
+        let b = crate::output::progress_bar(tiles.len() as u64);
         b.set_style(
             ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} tiles, {eta} left")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),

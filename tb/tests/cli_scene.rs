@@ -443,3 +443,35 @@ fn run_reports_pass_and_failure_by_its_exit_status() {
     assert!(!ok, "exit 0 on a failing program");
     assert!(err.contains("0xBAD") && err.contains("r2 = 7"), "{err}");
 }
+
+/// Shell completions and `--quiet` (issue 17, item 5).
+#[test]
+fn completions_parse_and_quiet_is_quiet() {
+    let d = tempfile::tempdir().unwrap();
+    let (ok, script, err) = morphosys(d.path(), &["completions", "bash"]);
+    assert!(ok, "{err}");
+    assert!(
+        script.contains("render") && script.contains("--traversal"),
+        "no subcommands"
+    );
+    std::fs::write(d.path().join("c.bash"), &script).unwrap();
+    let syntax = Command::new("bash")
+        .arg("-n")
+        .arg(d.path().join("c.bash"))
+        .output();
+    if let Ok(o) = syntax {
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let (ok, out, err) = morphosys(
+        d.path(),
+        &["reference", "--size", "8x8", "--out", "r.png", "--quiet"],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        !err.contains("wrote") && !out.contains("wrote"),
+        "{out}{err}"
+    );
+    assert!(d.path().join("r.png").exists());
+    let (_, _, err) = morphosys(d.path(), &["reference", "--size", "8x8", "--out", "r.png"]);
+    assert!(err.contains("wrote"), "{err}");
+}

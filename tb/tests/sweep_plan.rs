@@ -56,7 +56,10 @@ fn planned_sweep_on_gnu_parallel_merges_to_the_in_process_sweep() {
     planned.extend(["--plan", "plan"]);
     let (ok, out, err) = morphosys(d, &planned);
     assert!(ok, "plan: {err}");
-    assert!(out.contains("jobs.txt"), "{out}");
+    assert!(
+        out.contains("parallel") && err.contains("jobs.txt"),
+        "{out}{err}"
+    );
     let plan = d.join("plan");
     let jobs = std::fs::read_to_string(plan.join("jobs.txt")).unwrap();
     let lines: Vec<&str> = jobs.lines().collect();

@@ -346,7 +346,7 @@ pub fn render(scene: &Scene, opt: &Options) -> Image {
     let (w, h) = (opt.width.max(1), opt.height.max(1));
     let (sw, sh) = if opt.corners { (w + 1, h + 1) } else { (w, h) };
     let bar = if opt.progress && (sw as u64 * sh as u64) >= 1 << 16 {
-        let b = ProgressBar::new(sh as u64);
+        let b = crate::output::progress_bar(sh as u64);
         b.set_style(
             ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} rows, {eta} left")
                 .unwrap_or_else(|_| ProgressStyle::default_bar()),
