@@ -57,7 +57,7 @@ fn planned_sweep_on_gnu_parallel_merges_to_the_in_process_sweep() {
     let (ok, out, err) = morphosys(d, &planned);
     assert!(ok, "plan: {err}");
     assert!(
-        out.contains("parallel") && err.contains("jobs.txt"),
+        out.contains("parallel") && out.contains("jobs.txt"),
         "{out}{err}"
     );
     let plan = d.join("plan");
