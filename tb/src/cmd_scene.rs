@@ -16,17 +16,21 @@ use crate::reference::{render, Image, Options};
 /// The default scene: `scenes/default.toml` under the current directory,
 /// else beside this crate in the source tree.
 pub fn default_scene() -> PathBuf {
-    let local = PathBuf::from("scenes/default.toml");
-    if local.is_file() {
-        return local;
-    }
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../scenes/default.toml")
+    PathBuf::from("scenes/default.toml")
 }
+
+/// The default scene, built into the binary: `morphosys render` works from
+/// any folder (a `scenes/default.toml` in the current folder is used
+/// instead, so an edited copy wins).
+pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
 
 /// Load a scene (or the default one), errors as `file:line:col: ...`.
 pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
-    let path = path.map_or_else(default_scene, Path::to_path_buf);
-    let scene = Scene::load(&path)?;
+    let scene = match path {
+        Some(p) => Scene::load(p)?,
+        None if default_scene().is_file() => Scene::load(&default_scene())?,
+        None => firmware::scene::native::parse(DEFAULT_SCENE, "scenes/default.toml")?,
+    };
     for w in &scene.warnings {
         eprintln!("{w}");
     }

@@ -855,6 +855,10 @@ fn write_plan(
             Some(f) => firmware::scene::spd::generate(f, sc.size.unwrap_or(1))
                 .map_err(|e| anyhow::anyhow!(e))?
                 .into_bytes(),
+            // The default scene, built in when there is no file of it here.
+            None if sc.file == crate::cmd_scene::default_scene() && !sc.file.is_file() => {
+                crate::cmd_scene::DEFAULT_SCENE.as_bytes().to_vec()
+            }
             None => std::fs::read(&sc.file)
                 .with_context(|| format!("{}: cannot read the scene", sc.file.display()))?,
         };

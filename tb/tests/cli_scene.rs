@@ -475,3 +475,16 @@ fn completions_parse_and_quiet_is_quiet() {
     let (_, _, err) = morphosys(d.path(), &["reference", "--size", "8x8", "--out", "r.png"]);
     assert!(err.contains("wrote"), "{err}");
 }
+
+/// The default scene is built into the binary: `render` and `reference`
+/// work from any folder (issue 17, item 5).
+#[test]
+fn the_default_scene_is_built_in() {
+    let d = tempfile::tempdir().unwrap();
+    for cmd in ["render", "reference"] {
+        let (ok, _, err) = morphosys(d.path(), &[cmd, "--size", "8x8"]);
+        assert!(ok, "{cmd}: {err}");
+    }
+    assert!(d.path().join("default-chip.png").exists());
+    assert!(d.path().join("default-reference.png").exists());
+}
