@@ -972,8 +972,12 @@ impl Report {
             self.smallest_feature, self.smallest_feature_lsb, self.smallest_feature_at
         );
         s += &format!(
-            "BSP ({:?}, max depth {}, max {} per leaf): {} nodes, {} leaves ({} empty), depth {}, up to {} objects per leaf, {} leaf references\n",
-            self.bsp_params.rule,
+            "BSP ({} split, max depth {}, max {} per leaf): {} nodes, {} leaves ({} empty), depth {}, up to {} objects per leaf, {} leaf references\n",
+            match self.bsp_params.rule {
+                crate::bsp::SplitRule::Median => "median",
+                crate::bsp::SplitRule::Sah => "SAH",
+                crate::bsp::SplitRule::Auto => "auto",
+            },
             self.bsp_params.max_depth,
             self.bsp_params.max_leaf,
             self.bsp.nodes,
@@ -983,11 +987,18 @@ impl Report {
             self.bsp.max_leaf_objects,
             self.bsp.leaf_references
         );
-        s += &format!("layout: {:?}: {}\n", self.layout, self.layout_reason);
         s += &format!(
-            "footprint: {} words ({} KiB): objects {}, nodes {}; FB holds {} words: {}\n",
+            "layout: {}: {}\n",
+            match self.layout {
+                Layout::BitVectors => "fig5 (bit vectors)",
+                Layout::IndexLists => "compact (index lists)",
+            },
+            self.layout_reason
+        );
+        s += &format!(
+            "footprint: {} words ({:.1} KiB): objects {}, nodes {}; FB holds {} words: {}\n",
             self.total_words,
-            self.total_words * 2 / 1024,
+            self.total_words as f64 * 2.0 / 1024.0,
             self.object_words,
             self.node_words,
             self.fb_words,

@@ -31,11 +31,12 @@ pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()
                 .map(|t| format!("{} {}", c[t.index()], t.name()))
                 .collect();
             crate::report!(
-                "{}: {name} size {size}: {} objects ({}), {} lights",
+                "{}: {name} size {size}: {} objects ({}), {} light{}",
                 path.display(),
                 scene.objects.len(),
                 parts.join(", "),
-                scene.lights.len()
+                scene.lights.len(),
+                if scene.lights.len() == 1 { "" } else { "s" }
             );
         }
         None => print!("{text}"),

@@ -211,20 +211,23 @@ enum Command {
         /// Write the memory image (16-bit little-endian words) here.
         #[arg(long, value_name = "PATH")]
         out: Option<PathBuf>,
-        /// Split by the surface area heuristic instead of the paper's
-        /// spatial median.
-        #[arg(long)]
+        /// BSP split rule: median (the paper's spatial median, axes in turn)
+        /// or sah (surface area heuristic); `--sah` is short for `--split sah`.
+        #[arg(long, value_name = "median|sah", default_value = "median", value_parser = ["median", "sah"])]
+        split: String,
+        #[arg(long, hide = true)]
         sah: bool,
-        /// Maximum BSP depth.
-        #[arg(long, value_name = "N", default_value_t = 15)]
+        /// Maximum BSP depth (1..=32).
+        #[arg(long, value_name = "N", default_value_t = 15, value_parser = clap::value_parser!(u32).range(1..=firmware::scene_image::MAX_BSP_DEPTH as i64))]
         max_depth: u32,
         /// Maximum objects per BSP leaf.
         #[arg(long, value_name = "N", default_value_t = 5)]
         max_leaf: usize,
-        /// Node layout: bit-vectors (Fig. 5) or index-lists (default: the
-        /// smaller).
-        #[arg(long, value_name = "LAYOUT", value_parser = ["bit-vectors", "index-lists"])]
-        layout: Option<String>,
+        /// How BSP nodes name their objects: fig5 (the paper's bit
+        /// vectors) or compact (index lists), as `render --layout`
+        /// (default: the smaller).
+        #[arg(long, value_name = "fig5|compact", value_parser = parse_layout)]
+        layout: Option<firmware::tracer::NodeLayout>,
     },
     /// Render a scene with the paper's BSP ray tracer on the simulated chip;
     /// report frames/s at 300 MHz and the error against the reference.
@@ -535,14 +538,16 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             scene,
             json,
             out,
+            split,
             sah,
             max_depth,
             max_leaf,
             layout,
         } => {
-            let layout = layout.map(|l| match l.as_str() {
-                "index-lists" => firmware::scene_image::Layout::IndexLists,
-                _ => firmware::scene_image::Layout::BitVectors,
+            let sah = sah || split == "sah";
+            let layout = layout.map(|l| match l {
+                firmware::tracer::NodeLayout::Compact => firmware::scene_image::Layout::IndexLists,
+                firmware::tracer::NodeLayout::Fig5 => firmware::scene_image::Layout::BitVectors,
             });
             tb::cmd_scene::compile_cmd(tb::cmd_scene::CompileArgs {
                 scene,

@@ -488,3 +488,35 @@ fn the_default_scene_is_built_in() {
     assert!(d.path().join("default-chip.png").exists());
     assert!(d.path().join("default-reference.png").exists());
 }
+
+/// The same value names for the same concept (issue 17, items 2 and 8):
+/// `compile` takes render's `--layout fig5|compact` and `--split
+/// median|sah`, says so in words, and refuses the old names with the valid
+/// ones.
+#[test]
+fn compile_speaks_renders_names() {
+    let d = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(
+        d.path(),
+        &["compile", "--layout", "compact", "--split", "sah"],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        out.contains("SAH split") && out.contains("compact (index lists)"),
+        "{out}"
+    );
+    assert!(
+        !out.contains("IndexLists") && !out.contains("Sah,") && !out.contains("(0 KiB)"),
+        "{out}"
+    );
+    let (ok, _, err) = morphosys(d.path(), &["compile", "--layout", "bit-vectors"]);
+    assert!(
+        !ok && err.contains("fig5") && err.contains("compact"),
+        "{err}"
+    );
+    let (ok, _, err) = morphosys(d.path(), &["spd", "tetra", "--size", "1", "--out", "t.nff"]);
+    assert!(
+        ok && err.contains("1 light") && !err.contains("1 lights"),
+        "{err}"
+    );
+}
