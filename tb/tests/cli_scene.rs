@@ -514,9 +514,9 @@ fn compile_speaks_renders_names() {
         !ok && err.contains("fig5") && err.contains("compact"),
         "{err}"
     );
-    let (ok, _, err) = morphosys(d.path(), &["spd", "tetra", "--size", "1", "--out", "t.nff"]);
+    let (ok, out, err) = morphosys(d.path(), &["spd", "tetra", "--size", "1", "--out", "t.nff"]);
     assert!(
-        ok && err.contains("1 light") && !err.contains("1 lights"),
-        "{err}"
+        ok && out.contains("1 light") && !out.contains("1 lights"),
+        "{out}{err}"
     );
 }
