@@ -11,7 +11,12 @@ pub fn command(
     count: u64,
     seed: u64,
     save: Option<PathBuf>,
+    json: Option<PathBuf>,
 ) -> anyhow::Result<()> {
+    if let Some(j) = &json {
+        crate::output::Files::new().output(j, "--json").check()?;
+    }
+    let mut figures = Vec::new();
     // The folder for findings is made (or refused) before any input runs.
     if let Some(dir) = &save {
         std::fs::create_dir_all(dir)
@@ -64,6 +69,22 @@ pub fn command(
             }
         }
         total_findings += rep.findings.len();
+        figures.push(serde_json::json!({
+            "target": t.name(),
+            "inputs": rep.inputs,
+            "structured": rep.structured,
+            "largest_input_bytes": rep.largest_input,
+            "accepted": rep.accepted,
+            "rejected": rep.rejected,
+            "findings": rep.findings.iter().map(|f| f.what.clone()).collect::<Vec<_>>(),
+            "inputs_per_second": rep.inputs as f64 / secs.max(1e-9),
+            "slowest_input_seconds": rep.slowest_s,
+        }));
+    }
+    if let Some(j) = &json {
+        let v = serde_json::json!({"seed": seed, "count": count, "targets": figures});
+        crate::output::write(j, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        crate::note!("wrote {}", j.display());
     }
     if total_findings > 0 {
         bail!("{total_findings} findings");

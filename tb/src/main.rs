@@ -166,6 +166,10 @@ enum Command {
         /// Save the inputs of findings under DIR/<target>/.
         #[arg(long, value_name = "DIR")]
         save: Option<PathBuf>,
+        /// Write the figures per target (inputs, accepted, rejected,
+        /// findings, inputs per second, slowest input) as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
     },
     /// Run a testbench: drive a block of the chip, check it against a
     /// reference model, write its waveform.
@@ -374,6 +378,10 @@ enum Bench {
         vcd: Option<PathBuf>,
         #[command(flatten)]
         window: tb::cli::TraceWindow,
+        /// Write the result (cycles, contexts, values checked, mismatches)
+        /// as JSON here.
+        #[arg(long, value_name = "PATH")]
+        json: Option<PathBuf>,
     },
 }
 
@@ -513,9 +521,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             count,
             seed,
             save,
-        } => tb::cmd_fuzz::command(targets, count, seed, save),
+            json,
+        } => tb::cmd_fuzz::command(targets, count, seed, save, json),
         Command::Tb { bench } => match bench {
-            Bench::Rc { vcd, window } => tb::testbench::rc::command(vcd, window),
+            Bench::Rc { vcd, window, json } => tb::testbench::rc::command(vcd, window, json),
         },
         Command::Reference {
             scene,

@@ -520,3 +520,31 @@ fn compile_speaks_renders_names() {
         "{out}{err}"
     );
 }
+
+/// JSON from every command that measures (issue 17, item 5): `tb rc` and
+/// `fuzz` too.
+#[test]
+fn testbench_and_fuzz_write_json() {
+    let d = tempfile::tempdir().unwrap();
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &[
+            "tb", "rc", "--vcd", "rc.vcd", "--json", "rc.json", "--quiet",
+        ],
+    );
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("rc.json")).unwrap()).unwrap();
+    assert_eq!(j["pass"], true);
+    assert!(j["values_checked"].as_u64().unwrap() > 1000, "{j}");
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &["fuzz", "asm", "--count", "50", "--json", "f.json"],
+    );
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(d.path().join("f.json")).unwrap()).unwrap();
+    assert_eq!(j["targets"][0]["target"], "asm");
+    assert_eq!(j["targets"][0]["inputs"], 50);
+    assert!(j["targets"][0]["findings"].as_array().unwrap().is_empty());
+}

@@ -349,8 +349,22 @@ pub fn run(trace: Option<TraceConfig>) -> anyhow::Result<Report> {
 }
 
 /// `morphosys tb rc`.
-pub fn command(vcd: Option<PathBuf>, window: crate::cli::TraceWindow) -> anyhow::Result<()> {
+pub fn command(
+    vcd: Option<PathBuf>,
+    window: crate::cli::TraceWindow,
+    json: Option<PathBuf>,
+) -> anyhow::Result<()> {
     let path = vcd.unwrap_or_else(|| PathBuf::from("waves/rc.vcd"));
+    // The waveform's folder is made (waves/ by default), as the tracer would.
+    if let Some(d) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(d).with_context(|| format!("--vcd {}", path.display()))?;
+    }
+    let mut files = crate::output::Files::new();
+    files.output(&path, "--vcd");
+    if let Some(j) = &json {
+        files.output(j, "--json");
+    }
+    files.check()?;
     let mut cfg = window.config(path);
     cfg.budget_cycles = Some(stimulus().len() as u64);
     let r = run(Some(cfg))?;
@@ -359,7 +373,7 @@ pub fn command(vcd: Option<PathBuf>, window: crate::cli::TraceWindow) -> anyhow:
         r.cycles, r.executed, r.checks
     );
     for f in &r.files {
-        println!("  wrote {}", f.display());
+        crate::note!("  wrote {}", f.display());
     }
     if let Some(v) = r
         .files
@@ -367,6 +381,19 @@ pub fn command(vcd: Option<PathBuf>, window: crate::cli::TraceWindow) -> anyhow:
         .find(|f| f.extension().is_some_and(|e| e == "gtkw"))
     {
         println!("  view:  gtkwave {}", v.display());
+    }
+    if let Some(j) = &json {
+        let v = serde_json::json!({
+            "testbench": "rc",
+            "cycles": r.cycles,
+            "contexts_executed": r.executed,
+            "values_checked": r.checks,
+            "mismatches": r.mismatches,
+            "pass": r.mismatches.is_empty(),
+            "files": r.files.iter().map(|f| f.display().to_string()).collect::<Vec<_>>(),
+        });
+        crate::output::write(j, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        crate::note!("  wrote {}", j.display());
     }
     if !r.mismatches.is_empty() {
         for m in &r.mismatches {
