@@ -220,6 +220,7 @@ pub fn render_built(
         "datapath_bits": opt.datapath.bits(),
         "format": chip.firmware.format(),
         "compiler_format": r.format,
+        "format_note": "format: the tracer's, the finest in which every object and the eye fit with the guard bits (lights are scaled apart, never coarser than compiler_format); compiler_format: the scene image's (morphosys compile), which also spans the lights and the camera's target",
         "bsp_nodes": r.bsp.nodes,
         "bsp_split": chip.firmware.bsp.rule,
         "bsp_depth_limit": chip.firmware.bsp.max_depth,
