@@ -126,6 +126,18 @@ pub fn command(a: BenchArgs) -> Result<()> {
     let off = cycles as f64 / one;
     let on = traced_cycles as f64 / traced;
     let speedup = big_one / all;
+    // What the figures were measured on: the fastest of `repeat` runs each.
+    let cpu = std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let traced_slowdown = traced / untraced_small;
+    println!("host                           {cpu}, {cores} threads; each figure the fastest of {repeat} runs");
     println!(
         "workload                       {} at {width}x{height}, 64 ways: {cycles} chip cycles",
         scene.source
@@ -135,7 +147,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
         off / 1e6
     );
     println!(
-        "tracing on, 1 thread           {:.2} M array cycles per host second at 64x32 ({traced:.3} s against {untraced_small:.3} s untraced; VCD of tinyrisc, broadcast, rc_r0_c0)",
+        "tracing on, 1 thread           {:.2} M array cycles per host second at 64x32 ({traced:.3} s against {untraced_small:.3} s untraced, {traced_slowdown:.1}x; VCD of tinyrisc, broadcast, rc_r0_c0)",
         on / 1e6
     );
     println!(
@@ -157,6 +169,9 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "threads": cores,
             "speedup": speedup,
             "repeat": repeat,
+            "statistic": format!("fastest of {repeat} runs"),
+            "host_cpu": cpu,
+            "traced_slowdown": traced_slowdown,
         });
         write_output(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
         crate::note!("wrote {}", p.display());

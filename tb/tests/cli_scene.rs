@@ -338,6 +338,21 @@ fn bench_does_not_announce_its_temporary_waveforms() {
         !err.contains("wrote") && !out.contains("wrote"),
         "{out}{err}"
     );
+    // Honest figures (issue 15, items 2 and 6): the host, the statistic
+    // and the traced slowdown.
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "bench", "--size", "16x16", "--repeat", "2", "--json", "b.json", "-q",
+        ],
+    );
+    assert!(ok, "{out}{err}");
+    assert!(out.contains("fastest of 2 runs"), "{out}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b.json")).unwrap()).unwrap();
+    assert_eq!(j["repeat"], 2);
+    assert!(!j["host_cpu"].as_str().unwrap().is_empty());
+    assert!(j["traced_slowdown"].as_f64().unwrap() > 1.0, "{j}");
 }
 
 /// `render --hits` and `reference --hits` make the hit maps `compare --hits`
