@@ -76,6 +76,16 @@ impl Count {
     }
 }
 
+/// Write an entity `n.times()` over, the input kept under 4 MB.
+fn repeat(n: &Count, out: &mut String, mut write: impl FnMut(&mut String)) {
+    for _ in 0..n.times() {
+        if out.len() > 4 << 20 {
+            break;
+        }
+        write(out);
+    }
+}
+
 fn nums(v: &[Num]) -> String {
     v.iter().map(Num::text).collect::<Vec<_>>().join(" ")
 }
@@ -133,14 +143,7 @@ impl NffItem {
             }
             NffItem::Material(v) => out.push_str(&format!("f {}\n", nums(v))),
             NffItem::Background(v) => out.push_str(&format!("b {}\n", nums(v))),
-            NffItem::Repeat(n, item) => {
-                for _ in 0..n.times() {
-                    if out.len() > 4 << 20 {
-                        break;
-                    }
-                    item.write(out);
-                }
-            }
+            NffItem::Repeat(n, item) => repeat(n, out, |out| item.write(out)),
         }
     }
 }
@@ -232,14 +235,7 @@ impl TomlItem {
             TomlItem::Light { position } => {
                 out.push_str(&format!("[[light]]\nposition = {}\n", array(position)))
             }
-            TomlItem::Repeat(n, item) => {
-                for _ in 0..n.times() {
-                    if out.len() > 4 << 20 {
-                        break;
-                    }
-                    item.write(out);
-                }
-            }
+            TomlItem::Repeat(n, item) => repeat(n, out, |out| item.write(out)),
         }
     }
 }
@@ -376,14 +372,7 @@ impl AsmLine {
                 out.push('\n');
             }
             AsmLine::Space(n) => out.push_str(&format!(".data\n.space {}\n", n.text())),
-            AsmLine::Repeat(n, line) => {
-                for _ in 0..n.times() {
-                    if out.len() > 4 << 20 {
-                        break;
-                    }
-                    line.write(out);
-                }
-            }
+            AsmLine::Repeat(n, line) => repeat(n, out, |out| line.write(out)),
         }
     }
 }
