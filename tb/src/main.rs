@@ -74,7 +74,7 @@ enum Command {
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "128x128")]
         size: (u32, u32),
         /// Runs per configuration; the fastest counts.
-        #[arg(long, value_name = "N", default_value_t = 3)]
+        #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
         repeat: u32,
         /// Write the figures as JSON here.
         #[arg(long, value_name = "PATH")]
@@ -117,7 +117,8 @@ enum Command {
             long,
             value_name = "NAMES",
             value_delimiter = ',',
-            default_value = "balls,tetra,rings,gears,lattice"
+            default_value = "balls,tetra,rings,gears,lattice",
+            value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names())
         )]
         families: Vec<String>,
         /// Largest SPD size factor of the size sweep.
@@ -158,7 +159,7 @@ enum Command {
         #[arg(value_enum)]
         targets: Vec<tb::fuzz::Target>,
         /// Inputs per target.
-        #[arg(long, value_name = "N", default_value_t = 100_000)]
+        #[arg(long, value_name = "N", default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..))]
         count: u64,
         /// Random seed (runs are reproducible).
         #[arg(long, value_name = "S", default_value_t = 1)]
@@ -225,7 +226,7 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = 15, value_parser = clap::value_parser!(u32).range(1..=firmware::scene_image::MAX_BSP_DEPTH as i64))]
         max_depth: u32,
         /// Maximum objects per BSP leaf.
-        #[arg(long, value_name = "N", default_value_t = 5)]
+        #[arg(long, value_name = "N", default_value_t = 5, value_parser = parse_at_least_one)]
         max_leaf: usize,
         /// How BSP nodes name their objects: fig5 (the paper's bit
         /// vectors) or compact (index lists), as `render --layout`
@@ -272,7 +273,7 @@ enum Command {
         #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_depth)]
         max_depth: u32,
         /// Maximum objects per BSP leaf.
-        #[arg(long, value_name = "N", default_value_t = 5)]
+        #[arg(long, value_name = "N", default_value_t = 5, value_parser = parse_at_least_one)]
         max_leaf: usize,
         /// BSP split rule: median (the paper's spatial median, axes in turn),
         /// sah (surface area heuristic) or auto (median for the paper's
@@ -308,7 +309,7 @@ enum Command {
         newton_steps: u32,
         /// Entries of the reciprocal and reciprocal square-root tables in
         /// every RC's RAM: 16, 32, 64 or 128.
-        #[arg(long, value_name = "N", default_value_t = 128)]
+        #[arg(long, value_name = "N", default_value_t = 128, value_parser = parse_table_entries)]
         table_entries: u32,
         /// Guard bits of the coordinate format above the scene's largest
         /// object or eye coordinate (2..=4; more: a coarser format).
@@ -383,6 +384,26 @@ enum Bench {
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
     },
+}
+
+/// `--table-entries`: the table sizes that fit a 128-word slot of an RC's RAM.
+fn parse_table_entries(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if firmware::tracer::kernels::TABLE_SIZES.contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM), found '{s}'"
+        )),
+    }
+}
+
+/// A count of at least one.
+fn parse_at_least_one(s: &str) -> Result<usize, String> {
+    match s.parse::<usize>() {
+        Ok(n) if n >= 1 => Ok(n),
+        _ => Err(format!(
+            "expected a whole number of at least 1, found '{s}'"
+        )),
+    }
 }
 
 fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {

@@ -281,6 +281,30 @@ fn usage_errors_name_the_argument_and_exit_2() {
             &["reference", "--depth", "9"][..],
             "'--depth <N>': 9 is not in 1..=8",
         ),
+        (
+            &["render", "--table-entries", "5"][..],
+            "'--table-entries <N>': expected 16, 32, 64 or 128",
+        ),
+        (
+            &["render", "--max-leaf", "0"][..],
+            "'--max-leaf <N>': expected a whole number of at least 1",
+        ),
+        (
+            &["compile", "--max-leaf", "0"][..],
+            "'--max-leaf <N>': expected a whole number of at least 1",
+        ),
+        (
+            &["sweep", "--families", "nope", "--out-dir", "x"][..],
+            "'--families <NAMES>'",
+        ),
+        (
+            &["bench", "--repeat", "0"][..],
+            "'--repeat <N>': 0 is not in 1..",
+        ),
+        (
+            &["fuzz", "--count", "0"][..],
+            "'--count <N>': 0 is not in 1..",
+        ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
             .current_dir(dir.path())
