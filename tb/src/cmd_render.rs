@@ -252,28 +252,24 @@ fn default_out(scene: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}-chip.png"))
 }
 
-/// Whether `path` holds a complete render JSON made with the arguments
+/// The render JSON in `path` if it is complete and made with the arguments
 /// `argv`: it parses, records those arguments and has the frame's cycles
 /// (every JSON is written whole or not at all, so a killed render leaves
 /// none).
-pub fn render_json_done(path: &Path, argv: &[String]) -> bool {
-    let Ok(text) = std::fs::read_to_string(path) else {
-        return false;
-    };
-    let Ok(j) = serde_json::from_str::<serde_json::Value>(&text) else {
-        return false;
-    };
+pub fn done_render(path: &Path, argv: &[String]) -> Option<serde_json::Value> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let j = serde_json::from_str::<serde_json::Value>(&text).ok()?;
     let same = j["argv"].as_array().is_some_and(|v| {
         v.iter()
             .map(|x| x.as_str())
             .eq(argv.iter().map(|a| Some(a.as_str())))
     });
-    same && j["cycles"].is_u64()
+    (same && j["cycles"].is_u64()).then_some(j)
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {
     if let (true, Some(j)) = (a.skip_done, &a.json) {
-        if render_json_done(j, &a.argv) {
+        if done_render(j, &a.argv).is_some() {
             crate::report!(
                 "{}: already rendered with these arguments (--skip-done)",
                 j.display()

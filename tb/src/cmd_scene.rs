@@ -37,11 +37,6 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(scene)
 }
 
-/// [`crate::output::check_writable`].
-pub fn check_writable(path: &Path, what: &str) -> Result<()> {
-    crate::output::check_writable(path, what)
-}
-
 /// Write an output file: atomically for a regular file, through for a
 /// device or FIFO, the target of a symbolic link ([`crate::output::write`]).
 pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {

@@ -651,12 +651,9 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     timing: c.timing,
                     ..Default::default()
                 };
-                let measured = if crate::cmd_render::render_json_done(&json_path, &argv) {
+                let measured = if let Some(j) = crate::cmd_render::done_render(&json_path, &argv) {
                     resumed += 1;
-                    std::fs::read_to_string(&json_path)
-                        .ok()
-                        .and_then(|t| serde_json::from_str(&t).ok())
-                        .ok_or_else(|| anyhow::anyhow!("{}: unreadable", json_path.display()))
+                    Ok(j)
                 } else {
                     crate::cmd_render::render_as(scene, &c.opt, &c.nm, &host).and_then(
                         |(_, mut rep)| {
@@ -964,15 +961,11 @@ pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
         let p = &pts[job.point];
         let argv = render_argv(pdir, &plan.scene[p.scene].file, &p.cfg, &job.name);
         let json = dir.join("points").join(format!("{}.json", job.name));
-        if crate::cmd_render::render_json_done(&json, &argv) {
-            let j = std::fs::read_to_string(&json)
-                .ok()
-                .and_then(|t| serde_json::from_str(&t).ok());
-            measured.push(j);
-        } else {
+        let j = crate::cmd_render::done_render(&json, &argv);
+        if j.is_none() {
             missing.push(job.name.clone());
-            measured.push(None);
         }
+        measured.push(j);
     }
     let rows: Vec<Row> = pts
         .iter()
