@@ -960,8 +960,12 @@ impl Report {
             types.join(", ")
         );
         s += &format!(
-            "format: {} (LSB {}, {} guard bit(s); coordinates up to {})\n",
-            self.format, self.lsb, self.guard_bits, self.max_abs_coordinate
+            "format: {} (LSB {}, {} guard bit{}; coordinates up to {})\n",
+            self.format,
+            self.lsb,
+            self.guard_bits,
+            if self.guard_bits == 1 { "" } else { "s" },
+            self.max_abs_coordinate
         );
         s += &format!(
             "largest quantization error: {:.3e} ({:.3} LSB)\n",

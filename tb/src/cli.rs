@@ -6,17 +6,17 @@ use clap::Args;
 #[derive(Args, Clone, Debug, Default)]
 pub struct TraceWindow {
     /// First cycle to trace.
-    #[arg(long, value_name = "C", default_value_t = 0)]
+    #[arg(long, value_name = "CYCLE", default_value_t = 0)]
     pub trace_from: u64,
     /// Number of cycles to trace (default: to the end of the run, and for
     /// `render` the first 100,000 cycles of the first chip instance). A
     /// window left open stops at 256 MB of waveform, with a warning; one
     /// asked for is refused up front when its estimate passes 4 GB.
-    #[arg(long, value_name = "L")]
+    #[arg(long, value_name = "CYCLES", value_parser = parse_count::<u64>)]
     pub trace_cycles: Option<u64>,
     /// Trace only these scopes: comma-separated dotted paths with `*` and
     /// `?` globs, e.g. `rc.alu,rc.flags` or `array.rc_r*_c0`.
-    #[arg(long, value_name = "S", default_value = "", value_parser = parse_scope)]
+    #[arg(long, value_name = "SCOPE", default_value = "", value_parser = parse_scope)]
     pub trace_scope: String,
 }
 
@@ -99,3 +99,43 @@ pub fn parse_datapath_choice(s: &str) -> Result<DatapathChoice, String> {
         .map(DatapathChoice::Fixed)
         .map_err(|e| e.replace("a datapath width: 16", "a datapath width: auto, 16"))
 }
+
+/// A count of at least one (`--count`, `--repeat`, `--max-size`,
+/// `--trace-cycles`): clap's value error names the argument.
+pub fn parse_count<T>(s: &str) -> Result<T, String>
+where
+    T: std::str::FromStr + PartialOrd + From<u8>,
+{
+    match s.parse::<T>() {
+        Ok(n) if n >= T::from(1) => Ok(n),
+        _ => Err(format!(
+            "expected a whole number of at least 1, found '{s}'"
+        )),
+    }
+}
+
+/// A number of seconds above zero.
+pub fn parse_seconds(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
+        _ => Err(format!("expected a number of seconds above 0, found '{s}'")),
+    }
+}
+
+/// A bad argument found after parsing (one whose limits depend on another
+/// argument, such as `spd NAME --size N`): like clap's own, one line and
+/// exit code 2.
+#[derive(Debug)]
+pub struct UsageError {
+    /// The subcommand whose `--help` the message points to.
+    pub command: &'static str,
+    pub message: String,
+}
+
+impl std::fmt::Display for UsageError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}", self.message)
+    }
+}
+
+impl std::error::Error for UsageError {}

@@ -494,18 +494,18 @@ pub fn command(a: RenderArgs) -> Result<()> {
         100.0 * j["eye_misclassified"].as_f64().unwrap_or(0.0)
     );
     let rs = &j["reference_rays"];
+    let spd_count = rs["reflect_rays"] != rs["live_reflect_rays"];
     crate::report!(
-        "rays traced on the chip  eye {}, shadow {}, reflect {}, refract {} (reference: {}, {}, {}, {}",
+        "rays traced on the chip  eye {}, shadow {}, reflect {}, refract {} (reference: {}, {}, {}, {}{}",
         j["eye_rays"], j["shadow_rays"], j["reflect_rays"], j["refract_rays"],
-        rs["eye_rays"], rs["live_shadow_rays"], rs["live_reflect_rays"], rs["live_refract_rays"]
+        rs["eye_rays"], rs["live_shadow_rays"], rs["live_reflect_rays"], rs["live_refract_rays"],
+        if spd_count { ";" } else { ")" }
     );
-    if rs["reflect_rays"] != rs["live_reflect_rays"] {
+    if spd_count {
         crate::report!(
             "                         counted as the SPD does, with the zero-weight reflections of Ks = 0 surfaces: {}, {}, {})",
             rs["shadow_rays"], rs["reflect_rays"], rs["refract_rays"]
         );
-    } else {
-        crate::report!("                         )");
     }
     crate::report!(
         "active RC fraction       {:.3}",

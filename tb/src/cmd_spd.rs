@@ -16,6 +16,14 @@ pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()
         Some(s) => s,
         None => spd::default_size(name).map_err(|e| anyhow!(e))?,
     };
+    // The size's limits depend on the generator: a usage error (exit 2).
+    if let Err(message) = spd::check_size(name, size) {
+        return Err(crate::cli::UsageError {
+            command: "spd",
+            message: format!("invalid value '{size}' for '--size <N>': {message}"),
+        }
+        .into());
+    }
     if let Some(o) = &out {
         crate::output::Files::new().output(o, "--out").check()?;
     }

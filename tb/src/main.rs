@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand};
+use clap::{CommandFactory, Parser, Subcommand};
 
 #[derive(Parser)]
 #[command(
@@ -31,7 +31,7 @@ enum Command {
     Asm {
         file: PathBuf,
         /// Write the assembled image here.
-        #[arg(short, long, value_name = "OUT")]
+        #[arg(short, long, value_name = "FILE.img")]
         out: Option<PathBuf>,
     },
     /// Run a program (assembly source or image) on the chip to its halt and
@@ -74,7 +74,7 @@ enum Command {
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "128x128")]
         size: (u32, u32),
         /// Runs per configuration; the fastest counts.
-        #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u32).range(1..))]
+        #[arg(long, value_name = "N", default_value_t = 3, value_parser = tb::cli::parse_count::<u32>)]
         repeat: u32,
         /// Write the figures as JSON here.
         #[arg(long, value_name = "PATH")]
@@ -97,12 +97,12 @@ enum Command {
         /// sweep (for GNU parallel or a Slurm job array; a rerun skips the
         /// renders already done), and DIR/sweep.toml, what was asked. Every
         /// size of the size sweep is planned (--size-seconds does not apply).
-        #[arg(long, value_name = "DIR", conflicts_with_all = ["out_dir", "size_seconds", "merge"])]
+        #[arg(long, value_name = "PLAN", conflicts_with_all = ["out_dir", "size_seconds", "merge"])]
         plan: Option<PathBuf>,
         /// Merge a plan's renders: results.csv and the charts, as the sweep
         /// run here would write them; missing or failed renders are named
         /// and left out.
-        #[arg(long, value_name = "DIR", conflicts_with_all = ["scenes", "size", "only", "families", "max_size", "family_size", "size_seconds", "timing"])]
+        #[arg(long, value_name = "PLAN", conflicts_with_all = ["scenes", "size", "only", "families", "max_size", "family_size", "size_seconds", "timing"])]
         merge: Option<PathBuf>,
         /// Image size.
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
@@ -110,7 +110,7 @@ enum Command {
         /// Run only one part: `knobs` (every knob on SCENES), `sizes` (the
         /// SPD families at sizes 1..=--max-size, both traversals) or
         /// `broadcast` (both traversals on SCENES under both issue models).
-        #[arg(long, value_name = "PART", value_parser = ["knobs", "sizes", "broadcast"])]
+        #[arg(long, value_name = "knobs|sizes|broadcast", value_parser = ["knobs", "sizes", "broadcast"])]
         only: Option<String>,
         /// SPD generators of the size sweep, comma-separated.
         #[arg(
@@ -122,7 +122,7 @@ enum Command {
         )]
         families: Vec<String>,
         /// Largest SPD size factor of the size sweep.
-        #[arg(long, value_name = "N", default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..))]
+        #[arg(long, value_name = "N", default_value_t = 4, value_parser = tb::cli::parse_count::<u32>)]
         max_size: u32,
         /// Image size of the size sweep (streamed scenes of thousands of
         /// objects take minutes of host time at 256x256).
@@ -130,7 +130,7 @@ enum Command {
         family_size: (u32, u32),
         /// Skip a family's larger sizes (with a traversal) once one of its
         /// renders took longer than this many host seconds.
-        #[arg(long, value_name = "S", default_value_t = 60.0)]
+        #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = tb::cli::parse_seconds)]
         size_seconds: f64,
         /// Timing files: the paper's configuration and the packet
         /// traversal on each scene under each (the `timing` knob, one
@@ -159,10 +159,10 @@ enum Command {
         #[arg(value_enum)]
         targets: Vec<tb::fuzz::Target>,
         /// Inputs per target.
-        #[arg(long, value_name = "N", default_value_t = 100_000, value_parser = clap::value_parser!(u64).range(1..))]
+        #[arg(long, value_name = "N", default_value_t = 100_000, value_parser = tb::cli::parse_count::<u64>)]
         count: u64,
         /// Random seed (runs are reproducible).
-        #[arg(long, value_name = "S", default_value_t = 1)]
+        #[arg(long, value_name = "N", default_value_t = 1)]
         seed: u64,
         /// Save the inputs of findings under DIR/<target>/.
         #[arg(long, value_name = "DIR")]
@@ -214,7 +214,7 @@ enum Command {
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
         /// Write the memory image (16-bit little-endian words) here.
-        #[arg(long, value_name = "PATH")]
+        #[arg(long, value_name = "FILE.img")]
         out: Option<PathBuf>,
         /// BSP split rule: median (the paper's spatial median, axes in turn)
         /// or sah (surface area heuristic); `--sah` is short for `--split sah`.
@@ -226,7 +226,7 @@ enum Command {
         #[arg(long, value_name = "N", default_value_t = 15, value_parser = clap::value_parser!(u32).range(1..=firmware::scene_image::MAX_BSP_DEPTH as i64))]
         max_depth: u32,
         /// Maximum objects per BSP leaf.
-        #[arg(long, value_name = "N", default_value_t = 5, value_parser = parse_at_least_one)]
+        #[arg(long, value_name = "N", default_value_t = 5, value_parser = tb::cli::parse_count::<usize>)]
         max_leaf: usize,
         /// How BSP nodes name their objects: fig5 (the paper's bit
         /// vectors) or compact (index lists), as `render --layout`
@@ -273,7 +273,7 @@ enum Command {
         #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = parse_depth)]
         max_depth: u32,
         /// Maximum objects per BSP leaf.
-        #[arg(long, value_name = "N", default_value_t = 5, value_parser = parse_at_least_one)]
+        #[arg(long, value_name = "N", default_value_t = 5, value_parser = tb::cli::parse_count::<usize>)]
         max_leaf: usize,
         /// BSP split rule: median (the paper's spatial median, axes in turn),
         /// sah (surface area heuristic) or auto (median for the paper's
@@ -288,7 +288,7 @@ enum Command {
         /// BSP traversal: paper (the paper's: where the rays disagree, test
         /// every object under the node) or packet (per-ray intervals; a
         /// child is visited only by the rays that reach it).
-        #[arg(long, value_name = "paper|packet", default_value = "packet", value_parser = parse_traversal)]
+        #[arg(long, value_name = "packet|paper", default_value = "packet", value_parser = parse_traversal)]
         traversal: firmware::tracer::Traversal,
         /// Packet traversal: which BSP subtrees to walk as one leaf of all
         /// their objects: auto (where that costs less than walking them, by
@@ -360,7 +360,7 @@ enum Command {
         #[arg(value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names()))]
         name: String,
         /// SPD size factor (default: the SPD program's default).
-        #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..))]
+        #[arg(long, value_name = "N", value_parser = tb::cli::parse_count::<u32>)]
         size: Option<u32>,
         /// Write the NFF here (default: stdout).
         #[arg(long, value_name = "FILE.nff")]
@@ -392,16 +392,6 @@ fn parse_table_entries(s: &str) -> Result<u32, String> {
         Ok(n) if firmware::tracer::kernels::TABLE_SIZES.contains(&n) => Ok(n),
         _ => Err(format!(
             "expected 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM), found '{s}'"
-        )),
-    }
-}
-
-/// A count of at least one.
-fn parse_at_least_one(s: &str) -> Result<usize, String> {
-    match s.parse::<usize>() {
-        Ok(n) if n >= 1 => Ok(n),
-        _ => Err(format!(
-            "expected a whole number of at least 1, found '{s}'"
         )),
     }
 }
@@ -683,10 +673,19 @@ fn main() -> ExitCode {
         {
             ExitCode::SUCCESS
         }
-        Err(e) => {
-            eprintln!("morphosys: error: {e:#}");
-            ExitCode::FAILURE
-        }
+        Err(e) => match e.downcast_ref::<tb::cli::UsageError>() {
+            Some(u) => {
+                eprintln!(
+                    "morphosys: error: {} (see `morphosys {} --help`)",
+                    u.message, u.command
+                );
+                ExitCode::from(2)
+            }
+            None => {
+                eprintln!("morphosys: error: {e:#}");
+                ExitCode::FAILURE
+            }
+        },
     }
 }
 
@@ -751,6 +750,14 @@ fn usage_error(e: clap::Error) -> ExitCode {
         .find_map(|l| l.trim().strip_prefix("tip: "))
         .map(|t| format!("; {t}"))
         .unwrap_or_default();
-    eprintln!("morphosys: error: {first}{tip} (see `morphosys --help`)");
+    // Point to the help of the subcommand at fault, where there is one.
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let command = Cli::command();
+    let sub = args
+        .iter()
+        .find(|a| command.find_subcommand(a.as_str()).is_some())
+        .map(|a| format!("{a} "))
+        .unwrap_or_default();
+    eprintln!("morphosys: error: {first}{tip} (see `morphosys {sub}--help`)");
     ExitCode::from(2)
 }

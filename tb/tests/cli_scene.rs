@@ -299,11 +299,23 @@ fn usage_errors_name_the_argument_and_exit_2() {
         ),
         (
             &["bench", "--repeat", "0"][..],
-            "'--repeat <N>': 0 is not in 1..",
+            "'--repeat <N>': expected a whole number of at least 1",
         ),
         (
             &["fuzz", "--count", "0"][..],
-            "'--count <N>': 0 is not in 1..",
+            "'--count <N>': expected a whole number of at least 1",
+        ),
+        (
+            &["spd", "balls", "--size", "99"][..],
+            "'--size <N>': size 99 for balls: expected 1 to 6",
+        ),
+        (
+            &["render", "--vcd", "x.vcd", "--trace-cycles", "0"][..],
+            "'--trace-cycles <CYCLES>': expected a whole number of at least 1",
+        ),
+        (
+            &["sweep", "--out-dir", "x", "--size-seconds=-1"][..],
+            "'--size-seconds <SECONDS>': expected a number of seconds above 0",
         ),
     ] {
         let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
@@ -315,6 +327,11 @@ fn usage_errors_name_the_argument_and_exit_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(want), "{args:?}: {err}");
         assert_eq!(err.lines().count(), 1, "{args:?}: {err}");
+        // The hint points to the help of the subcommand at fault.
+        assert!(
+            err.contains(&format!("(see `morphosys {} --help`)", args[0])),
+            "{args:?}: {err}"
+        );
     }
 }
 

@@ -121,6 +121,18 @@ pub fn default_size(name: &str) -> Result<u32, String> {
     Ok(find(name)?.default_size)
 }
 
+/// Whether `size` is a size factor `name` takes.
+pub fn check_size(name: &str, size: u32) -> Result<(), String> {
+    let g = find(name)?;
+    if size < 1 || size > g.max_size {
+        return Err(format!(
+            "size {size} for {name}: expected 1 to {} (the SPD default is {})",
+            g.max_size, g.default_size
+        ));
+    }
+    Ok(())
+}
+
 /// The NFF text the SPD program `name` prints at size factor `size`.
 pub fn generate(name: &str, size: u32) -> Result<String, String> {
     let g = find(name)?;
