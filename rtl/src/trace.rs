@@ -1,5 +1,7 @@
-//! Waveform tracing: VCD through the `vcd` crate, plus a GTKWave save file
-//! and translate-filter files beside it.
+//! Waveform tracing: VCD through the `vcd` crate, or FST (GTKWave's and
+//! Surfer's compressed format; a path ending in `.fst`) through the
+//! `fst-writer` crate, plus a GTKWave save file and translate-filter files
+//! beside it.
 //!
 //! Modules describe their signals through one function, [`Traced::trace`],
 //! which both declares them (once, when a tracer is attached) and reports
@@ -81,6 +83,16 @@ pub struct TraceConfig {
     pub max_bytes: u64,
 }
 
+/// Whether a waveform path asks for FST (`.fst`) rather than VCD.
+pub fn is_fst(path: &Path) -> bool {
+    path.extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("fst"))
+}
+
+/// Value changes an FST writer holds in memory before it writes them out
+/// as one compressed section.
+const FST_SECTION_BYTES: usize = 64 << 20;
+
 /// The largest waveform written by default (4 GiB).
 pub const MAX_TRACE_BYTES: u64 = 4 << 30;
 
@@ -103,9 +115,116 @@ impl TraceConfig {
     }
 }
 
+/// Where value changes go: a VCD text stream, or an FST file (header
+/// while declaring, body while sampling).
+enum Sink {
+    Vcd(vcd::Writer<BufWriter<File>>),
+    FstHeader(fst_writer::FstHeaderWriter<BufWriter<File>>),
+    FstBody(fst_writer::FstBodyWriter<BufWriter<File>>),
+    /// Between the two FST phases, or after finishing.
+    Gone,
+}
+
+/// One signal's handle in the file.
+#[derive(Clone, Copy)]
+enum SigId {
+    Vcd(IdCode),
+    Fst(fst_writer::FstSignalId),
+}
+
+fn fst_err(e: fst_writer::FstWriteError) -> io::Error {
+    match e {
+        fst_writer::FstWriteError::Io(e) => e,
+        e => io::Error::other(e.to_string()),
+    }
+}
+
+impl Sink {
+    fn add_module(&mut self, name: &str) -> io::Result<()> {
+        match self {
+            Sink::Vcd(w) => w.add_module(name),
+            Sink::FstHeader(h) => h
+                .scope(name, "", fst_writer::FstScopeType::Module)
+                .map_err(fst_err),
+            _ => Ok(()),
+        }
+    }
+
+    fn upscope(&mut self) -> io::Result<()> {
+        match self {
+            Sink::Vcd(w) => w.upscope(),
+            Sink::FstHeader(h) => h.up_scope().map_err(fst_err),
+            _ => Ok(()),
+        }
+    }
+
+    fn add_wire(&mut self, width: u32, name: &str) -> io::Result<SigId> {
+        match self {
+            Sink::Vcd(w) => w.add_wire(width, name).map(SigId::Vcd),
+            Sink::FstHeader(h) => h
+                .var(
+                    name,
+                    fst_writer::FstSignalType::bit_vec(width),
+                    fst_writer::FstVarType::Wire,
+                    fst_writer::FstVarDirection::Implicit,
+                    None,
+                )
+                .map(SigId::Fst)
+                .map_err(fst_err),
+            _ => Err(io::Error::other("waveform declared after its header")),
+        }
+    }
+
+    /// End of the declarations.
+    fn end_definitions(&mut self) -> io::Result<()> {
+        match std::mem::replace(self, Sink::Gone) {
+            Sink::Vcd(mut w) => {
+                w.enddefinitions()?;
+                *self = Sink::Vcd(w);
+            }
+            Sink::FstHeader(h) => *self = Sink::FstBody(h.finish().map_err(fst_err)?),
+            other => *self = other,
+        }
+        Ok(())
+    }
+
+    fn timestamp(&mut self, t: u64) -> io::Result<()> {
+        match self {
+            Sink::Vcd(w) => w.timestamp(t),
+            Sink::FstBody(b) => b.time_change(t).map_err(fst_err),
+            _ => Ok(()),
+        }
+    }
+
+    /// A new value of a `width`-bit signal.
+    fn change(&mut self, id: SigId, width: u32, v: u64) -> io::Result<()> {
+        match (self, id) {
+            (Sink::Vcd(w), SigId::Vcd(id)) => {
+                let wr = w.writer();
+                if width == 1 {
+                    writeln!(wr, "{v}{id}")
+                } else {
+                    writeln!(wr, "b{v:b} {id}")
+                }
+            }
+            (Sink::FstBody(b), SigId::Fst(id)) => {
+                let mut bits = [b'0'; 64];
+                let w = width as usize;
+                for (k, bit) in bits[..w].iter_mut().enumerate() {
+                    if v >> (w - 1 - k) & 1 == 1 {
+                        *bit = b'1';
+                    }
+                }
+                b.signal_change(id, &bits[..w]).map_err(fst_err)
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
 #[derive(Clone, Copy)]
 struct SigInfo {
-    id: IdCode,
+    id: SigId,
     width: u32,
     display: Display,
 }
@@ -129,7 +248,7 @@ pub struct Tracer {
     /// The regular file the waveform ends up in (a symbolic link followed).
     target: PathBuf,
     top: String,
-    w: vcd::Writer<BufWriter<File>>,
+    w: Sink,
     phase: Phase,
     patterns: Vec<Vec<String>>,
     // declaration state
@@ -146,8 +265,8 @@ pub struct Tracer {
     slot_i: usize,
     last: Vec<Option<u64>>,
     seen: Vec<BTreeSet<u64>>,
-    clk: IdCode,
-    cycle_id: IdCode,
+    clk: SigId,
+    cycle_id: SigId,
     sampled: u64,
     last_cycle: Option<u64>,
     note: Option<String>,
@@ -307,6 +426,17 @@ impl Tracer {
         // a truncated waveform under the requested name; a symbolic link is
         // followed (its target replaced, the link kept); a device or FIFO
         // (`/dev/null`, a named pipe) is written through.
+        let through = matches!(std::fs::metadata(&cfg.path), Ok(m) if !m.is_file() && !m.is_dir());
+        if through && is_fst(&cfg.path) {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "{}: an FST waveform needs a regular file (it is written out of order); \
+                     give a path ending in .vcd to write through a device or pipe",
+                    cfg.path.display()
+                ),
+            ));
+        }
         let (file, tmp_path, target) = match std::fs::metadata(&cfg.path) {
             Ok(m) if !m.is_file() && !m.is_dir() => (
                 std::fs::OpenOptions::new().write(true).open(&cfg.path)?,
@@ -335,9 +465,25 @@ impl Tracer {
                 (file, Some(tmp_path), target)
             }
         };
-        let mut w = vcd::Writer::new(BufWriter::with_capacity(1 << 16, file));
-        w.version(concat!("morphosys ", env!("CARGO_PKG_VERSION")))?;
-        w.timescale(1, TimescaleUnit::PS)?;
+        let out = BufWriter::with_capacity(1 << 16, file);
+        let version = concat!("morphosys ", env!("CARGO_PKG_VERSION"));
+        let mut w = if is_fst(&cfg.path) {
+            let info = fst_writer::FstInfo {
+                // FST files start at 0 (the writer's first frame): signals
+                // are undefined (x) up to the window, as in the VCD.
+                start_time: 0,
+                timescale_exponent: -12,
+                version: version.to_string(),
+                date: String::new(),
+                file_type: fst_writer::FstFileType::Verilog,
+            };
+            Sink::FstHeader(fst_writer::FstHeaderWriter::new(out, &info).map_err(fst_err)?)
+        } else {
+            let mut w = vcd::Writer::new(out);
+            w.version(version)?;
+            w.timescale(1, TimescaleUnit::PS)?;
+            Sink::Vcd(w)
+        };
         w.add_module(top_name)?;
         let clk = w.add_wire(1, "clk")?;
         let cycle_id = w.add_wire(64, "cycle")?;
@@ -418,7 +564,7 @@ impl Tracer {
             }
         }
         t.w.upscope()?;
-        t.w.enddefinitions()?;
+        t.w.end_definitions()?;
         t.last = vec![None; t.decls.len()];
         t.seen = vec![BTreeSet::new(); t.decls.len()];
         t.phase = Phase::Sample;
@@ -450,9 +596,8 @@ impl Tracer {
         let t = self.time(cycle);
         let half = (self.time(cycle + 1) - t) / 2;
         self.w.timestamp(t)?;
-        self.w.change_scalar(self.clk, vcd::Value::V1)?;
-        let wr = self.w.writer();
-        writeln!(wr, "b{:b} {}", cycle, self.cycle_id)?;
+        self.w.change(self.clk, 1, 1)?;
+        self.w.change(self.cycle_id, 64, cycle)?;
         self.scope_i = 0;
         self.slot_i = 0;
         top.trace(self);
@@ -476,7 +621,14 @@ impl Tracer {
             self.note.get_or_insert(msg);
         }
         self.w.timestamp(t + half)?;
-        self.w.change_scalar(self.clk, vcd::Value::V0)?;
+        self.w.change(self.clk, 1, 0)?;
+        // The FST writer holds value changes in memory until a flush, which
+        // writes one compressed section: bound that memory.
+        if let Sink::FstBody(b) = &mut self.w {
+            if b.size() > FST_SECTION_BYTES {
+                b.flush().map_err(fst_err)?;
+            }
+        }
         self.sampled += 1;
         self.last_cycle = Some(cycle);
         Ok(())
@@ -493,15 +645,29 @@ impl Tracer {
         let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
         let t = self.time(end);
         self.w.timestamp(t)?;
-        if let Some(n) = &self.note {
-            self.w.comment(n)?;
-        }
-        self.w.flush()?;
-        let Some(tmp_path) = self.tmp_path.take() else {
-            // Written through to a device or FIFO: no file to save beside.
-            return Ok(vec![self.cfg.path.clone()]);
+        let file = match std::mem::replace(&mut self.w, Sink::Gone) {
+            Sink::Vcd(mut w) => {
+                if let Some(n) = &self.note {
+                    w.comment(n)?;
+                }
+                w.flush()?;
+                let Some(tmp_path) = self.tmp_path.take() else {
+                    // Written through to a device or FIFO: no file to save beside.
+                    return Ok(vec![self.cfg.path.clone()]);
+                };
+                self.tmp_path = Some(tmp_path);
+                w.writer().get_ref().try_clone()?
+            }
+            Sink::FstBody(b) => {
+                // FST has no comments: the note went to standard error.
+                let mut out = b.finish().map_err(fst_err)?;
+                out.flush()?;
+                out.get_ref().try_clone()?
+            }
+            _ => return Err(io::Error::other("waveform finished twice")),
         };
-        self.w.writer().get_ref().sync_data()?;
+        file.sync_data()?;
+        let tmp_path = self.tmp_path.take().expect("a regular file");
         let gtkw = self.write_gtkw()?;
         let partial = tmp_path.to_path_buf();
         let done = tmp_path.persist(&self.target).map_err(|e| e.error);
@@ -701,7 +867,7 @@ impl Probe for Tracer {
                         Ok(id) => id,
                         Err(e) => {
                             self.err.get_or_insert(e);
-                            vcd::IdCode::FIRST
+                            SigId::Vcd(vcd::IdCode::FIRST)
                         }
                     };
                     self.slot.push(Some(self.decls.len() as u32));
@@ -730,13 +896,7 @@ impl Probe for Tracer {
                             self.seen[i].insert(v);
                         }
                         self.bytes += info.width as u64 + 6;
-                        let wr = self.w.writer();
-                        let r = if info.width == 1 {
-                            writeln!(wr, "{}{}", v, info.id)
-                        } else {
-                            writeln!(wr, "b{:b} {}", v, info.id)
-                        };
-                        if let Err(e) = r {
+                        if let Err(e) = self.w.change(info.id, info.width, v) {
                             self.err.get_or_insert(e);
                         }
                     }

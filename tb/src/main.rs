@@ -41,14 +41,15 @@ enum Command {
         /// Stop with an error after this many cycles.
         #[arg(long, value_name = "N", default_value_t = 100_000_000)]
         max_cycles: u64,
-        /// Write the waveform here (GTKWave save file and filters beside it).
+        /// Write the waveform here: VCD, or FST where the path ends in `.fst`
+        /// (GTKWave save file and filters beside it).
         #[arg(long, value_name = "PATH")]
         vcd: Option<PathBuf>,
         #[command(flatten)]
         window: tb::cli::TraceWindow,
         /// RC datapath width in bits: 16 (the paper's chip) or 32 (default:
         /// the source's `.datapath`, else 16).
-        #[arg(long, value_name = "BITS", value_parser = tb::cli::parse_datapath)]
+        #[arg(long, value_name = "16|32", value_parser = tb::cli::parse_datapath)]
         datapath: Option<rtl::rc::Datapath>,
         /// The chip's timing from a TOML file (any subset of the fields
         /// `morphosys timing` prints; the rest keep their defaults).
@@ -259,13 +260,15 @@ enum Command {
         /// hit), for `compare --hits` against `reference --hits`.
         #[arg(long, value_name = "PATH")]
         hits: Option<PathBuf>,
-        /// Write the waveform of the first chip instance here.
+        /// Write the waveform of the first chip instance here: VCD, or FST
+        /// where the path ends in `.fst` (GTKWave save file and filters
+        /// beside it).
         #[arg(long, value_name = "PATH")]
         vcd: Option<PathBuf>,
         #[command(flatten)]
         window: tb::cli::TraceWindow,
         /// Write the generated firmware (assembly source) here.
-        #[arg(long, value_name = "PATH")]
+        #[arg(long, value_name = "FILE.s")]
         emit_asm: Option<PathBuf>,
         /// Maximum BSP depth: a number (1..=32) or auto (the paper's 15 for
         /// the paper's traversal; for the packet traversal 15 for a median
@@ -373,8 +376,9 @@ enum Bench {
     /// One Reconfigurable Cell: every ALU, shifter, multiplier, register-file
     /// and RAM operation, checked against an independent reference model.
     Rc {
-        /// Write the waveform here (a GTKWave `.gtkw` save file and the
-        /// translate filters go beside it).
+        /// Write the waveform here: VCD, or FST where the path ends in
+        /// `.fst` (a GTKWave `.gtkw` save file and the translate filters go
+        /// beside it).
         #[arg(long, value_name = "PATH")]
         vcd: Option<PathBuf>,
         #[command(flatten)]

@@ -1,0 +1,163 @@
+//! FST waveforms (issue 15, item 3): a `--vcd` path ending in `.fst` writes
+//! FST (GTKWave's and Surfer's compressed format) through the `fst-writer`
+//! crate. Each test writes the same window as VCD and as FST and reads both
+//! back with the `wellen` crate (the reader Surfer uses): the same signals
+//! under the same names, changing at the same times to the same values.
+//! Where GTKWave's `fst2vcd` is installed (CI installs it), it must convert
+//! the FST too, to a VCD that reads back the same.
+
+mod common;
+use common::morphosys;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Every signal of a waveform: full name -> its changes (time, bits).
+type Changes = BTreeMap<String, Vec<(u64, String)>>;
+
+fn read_back(path: &Path) -> Changes {
+    let mut w = wellen::simple::read(path)
+        .unwrap_or_else(|e| panic!("{} does not read back: {e:?}", path.display()));
+    let h = w.hierarchy();
+    let vars: Vec<(String, wellen::SignalRef)> = h
+        .all_vars()
+        .map(|v| (h[v].full_name(h), h[v].signal_ref()))
+        .collect();
+    let refs: Vec<wellen::SignalRef> = vars.iter().map(|(_, r)| *r).collect();
+    w.load_signals(&refs);
+    let times = w.time_table().to_vec();
+    let mut out = Changes::new();
+    for (name, r) in vars {
+        let signal = w.get_signal(r).expect("loaded");
+        // Undefined (x) before the first value: FST says so explicitly
+        // from time 0 (its first frame) where a VCD that starts later
+        // says nothing; both mean the same.
+        let changes: Vec<(u64, String)> = signal
+            .iter_changes()
+            .skip_while(|(_, v)| v.to_bit_string().is_some_and(|b| b.contains('x')))
+            .map(|(t, v)| {
+                // Leading zeros are not part of a value (VCD drops them).
+                let bits = v.to_bit_string().expect("a bit vector");
+                let bits = bits.trim_start_matches('0');
+                (
+                    times[t as usize],
+                    if bits.is_empty() { "0" } else { bits }.to_string(),
+                )
+            })
+            .collect();
+        assert!(out.insert(name.clone(), changes).is_none(), "{name} twice");
+    }
+    out
+}
+
+fn assert_same(vcd: &Changes, fst: &Changes, what: &str) {
+    assert_eq!(
+        vcd.keys().collect::<Vec<_>>(),
+        fst.keys().collect::<Vec<_>>(),
+        "{what}: the signals differ"
+    );
+    let mut changes = 0;
+    for (name, a) in vcd {
+        let b = &fst[name];
+        assert_eq!(a, b, "{what}: {name} differs");
+        changes += a.len();
+    }
+    assert!(vcd.len() > 10 && changes > 100, "{what}: too little traced");
+}
+
+/// fst2vcd (GTKWave's) converts our FST, and its VCD reads back the same.
+fn check_with_fst2vcd(fst: &Path, want: &Changes) {
+    let run = std::process::Command::new("fst2vcd").arg(fst).output();
+    match run {
+        Ok(out) => {
+            assert!(
+                out.status.success(),
+                "fst2vcd {}: {}",
+                fst.display(),
+                String::from_utf8_lossy(&out.stderr)
+            );
+            let back = fst.with_extension("fst2vcd.vcd");
+            std::fs::write(&back, &out.stdout).unwrap();
+            assert_same(want, &read_back(&back), "fst2vcd's VCD");
+        }
+        Err(_) if std::env::var_os("CI").is_none() => {
+            eprintln!("fst2vcd (Debian package gtkwave) not installed; that check skipped");
+        }
+        Err(e) => panic!("fst2vcd must be installed in CI: {e}"),
+    }
+}
+
+#[test]
+fn a_program_traced_as_fst_reads_back_as_its_vcd() {
+    let dir = tempfile::tempdir().unwrap();
+    let program = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
+    let program = program.to_str().unwrap();
+    for name in ["dct.vcd", "dct.fst"] {
+        let (ok, _, err) = morphosys(dir.path(), &["run", program, "--vcd", name]);
+        assert!(ok, "{name}: {err}");
+    }
+    let vcd = read_back(&dir.path().join("dct.vcd"));
+    let fst = read_back(&dir.path().join("dct.fst"));
+    assert_same(&vcd, &fst, "run dct.s");
+    // The GTKWave save file names the FST.
+    let gtkw = std::fs::read_to_string(dir.path().join("dct.gtkw")).unwrap();
+    assert!(gtkw.contains("dct.fst"), "{gtkw}");
+    check_with_fst2vcd(&dir.path().join("dct.fst"), &vcd);
+}
+
+#[test]
+fn a_render_window_traced_as_fst_reads_back_as_its_vcd_and_is_smaller() {
+    let dir = tempfile::tempdir().unwrap();
+    for name in ["r.vcd", "r.fst"] {
+        let (ok, _, err) = morphosys(
+            dir.path(),
+            &[
+                "render",
+                "--size",
+                "16x16",
+                "--vcd",
+                name,
+                "--trace-from",
+                "2000",
+                "--trace-cycles",
+                "3000",
+            ],
+        );
+        assert!(ok, "{name}: {err}");
+    }
+    let vcd_path = dir.path().join("r.vcd");
+    let fst_path = dir.path().join("r.fst");
+    let vcd = read_back(&vcd_path);
+    let fst = read_back(&fst_path);
+    assert_same(&vcd, &fst, "render window");
+    let (a, b) = (
+        std::fs::metadata(&vcd_path).unwrap().len(),
+        std::fs::metadata(&fst_path).unwrap().len(),
+    );
+    assert!(
+        b * 4 < a,
+        "FST {b} bytes is not much smaller than VCD {a} bytes"
+    );
+    check_with_fst2vcd(&fst_path, &vcd);
+}
+
+#[test]
+fn an_fst_waveform_into_a_pipe_is_refused_before_the_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("w.fst");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable; test skipped");
+        return;
+    }
+    let program = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &["run", program.to_str().unwrap(), "--vcd", "w.fst"],
+    );
+    assert!(!ok);
+    assert!(
+        err.contains("an FST waveform needs a regular file"),
+        "{err}"
+    );
+    assert_eq!(err.lines().count(), 1, "{err}");
+}
