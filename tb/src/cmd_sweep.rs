@@ -1136,8 +1136,15 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             log_y: false,
         },
     )?);
-    if sizes.is_empty() {
-        // No size sweep: the scenes of the knob sweep, paper configuration.
+    let knob_scenes = rows
+        .iter()
+        .filter(|r| r.knob == "paper")
+        .map(|r| r.scene.as_str())
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    if sizes.is_empty() && knob_scenes >= 2 {
+        // No size sweep: the scenes of the knob sweep, paper configuration
+        // (a line needs two scenes at least; one is no chart).
         let scaling = vec![Series {
             name: "paper configuration".into(),
             points: rows

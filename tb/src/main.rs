@@ -71,7 +71,7 @@ enum Command {
     Bench {
         /// Scene file (.nff or .toml); default scenes/default.toml.
         scene: Option<PathBuf>,
-        /// Image size of the throughput workload.
+        /// Image size of the throughput workload (each side 1..=4096).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "128x128")]
         size: (u32, u32),
         /// Runs per configuration; the fastest counts.
@@ -105,7 +105,7 @@ enum Command {
         /// and left out.
         #[arg(long, value_name = "PLAN", conflicts_with_all = ["scenes", "size", "only", "families", "max_size", "family_size", "size_seconds", "timing"])]
         merge: Option<PathBuf>,
-        /// Image size.
+        /// Image size (each side 1..=4096).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size, default_value = "256x256")]
         size: (u32, u32),
         /// Run only one part: `knobs` (every knob on SCENES), `sizes` (the
@@ -184,7 +184,7 @@ enum Command {
     Reference {
         /// Scene file (.nff or .toml); default scenes/default.toml.
         scene: Option<PathBuf>,
-        /// Image size WIDTHxHEIGHT (default: the scene's resolution).
+        /// Image size WIDTHxHEIGHT, each side 1..=4096 (default: the scene's resolution).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
         size: Option<(u32, u32)>,
         /// Maximum ray depth 1..=8; the eye ray is depth 1 (default 2, the
@@ -240,7 +240,7 @@ enum Command {
     Render {
         /// Scene file (.nff or .toml); default scenes/default.toml.
         scene: Option<PathBuf>,
-        /// Image size WIDTHxHEIGHT (default 256x256).
+        /// Image size WIDTHxHEIGHT, each side 1..=4096 (default 256x256).
         #[arg(long, value_name = "WxH", value_parser = tb::cmd_scene::parse_size)]
         size: Option<(u32, u32)>,
         /// Rays traced in parallel: 4, 8, 16, 32 or 64.

@@ -222,3 +222,48 @@ fn the_sweep_charts_the_issue_models_and_timing_files() {
     assert!(d.join("sw/broadcast.png").is_file());
     assert!(d.join("sw/timing.png").is_file());
 }
+
+/// A knob sweep of one scene draws no one-point scaling chart (issue 17:
+/// `sweep --only knobs` wrote a `scaling.png` of a single point); with two
+/// scenes it draws one with both.
+#[test]
+fn a_one_scene_knob_sweep_writes_no_scaling_chart() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene("tetra-1.nff");
+    let (ok, out, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            &s,
+            "--only",
+            "knobs",
+            "--size",
+            "8x8",
+            "--out-dir",
+            "one",
+        ],
+    );
+    assert!(ok, "{out}\n{err}");
+    assert!(d.join("one/fig8.svg").is_file());
+    assert!(!d.join("one/scaling.svg").exists());
+    assert!(!d.join("one/scaling.png").exists());
+    let t = scene("jacks-1.nff");
+    let (ok, out, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            &s,
+            &t,
+            "--only",
+            "knobs",
+            "--size",
+            "8x8",
+            "--out-dir",
+            "two",
+        ],
+    );
+    assert!(ok, "{out}\n{err}");
+    let svg = std::fs::read_to_string(d.join("two/scaling.svg")).unwrap();
+    assert!(svg.contains("paper configuration"), "{svg}");
+}
