@@ -18,5 +18,6 @@ pub mod output;
 pub mod profile;
 pub mod reference;
 pub mod render;
+pub mod surfer;
 pub mod testbench;
 pub mod timing;
