@@ -758,17 +758,16 @@ impl Tracer {
             }
             g
         };
-        // Groups open unless the trace is large (GTKWave 3.3 then shows a
-        // closed group as an empty pair of braces until it is opened).
-        let closed = self.decls.len() > 300;
+        // Groups open, whatever the size: GTKWave 3.3 shows a group saved
+        // closed as an empty pair of braces (`tinyrisc {` / `} tinyrisc`)
+        // until it is opened, which reads as an empty trace.
         for (scope, sigs) in &groups {
             let label = if scope.is_empty() {
                 self.top.clone()
             } else {
                 scope.clone()
             };
-            let begin = 0x800200 | if closed { 0x400000 } else { 0 };
-            s.push_str(&format!("@{begin:x}\n-{label}\n"));
+            s.push_str(&format!("@{:x}\n-{label}\n", 0x800200));
             for &i in sigs {
                 let d = &self.decls[i];
                 let name = format!("{}.{}", self.top, d.path.join("."));

@@ -15,12 +15,26 @@ pub struct TraceWindow {
     #[arg(long, value_name = "CYCLES", value_parser = parse_count::<u64>)]
     pub trace_cycles: Option<u64>,
     /// Trace only these scopes: comma-separated dotted paths with `*` and
-    /// `?` globs, e.g. `rc.alu,rc.flags` or `array.rc_r*_c0`.
-    #[arg(long, value_name = "SCOPE", default_value = "", value_parser = parse_scope)]
-    pub trace_scope: String,
+    /// `?` globs, e.g. `rc.alu,rc.flags` or `array.rc_r*_c0`; `all` for
+    /// every signal. Default: every signal, except for `render`: what an
+    /// architect looks at first (TinyRISC pc, instruction and state, the
+    /// broadcast unit, DMA, the array's context, awake and flag masks, and
+    /// RC (0,0)), see `RENDER_SCOPE`.
+    #[arg(long, value_name = "SCOPE", value_parser = parse_scope)]
+    pub trace_scope: Option<String>,
 }
 
+/// The signals a render's waveform records unless `--trace-scope` says
+/// otherwise: the control path and one RC, 52 signals of the 1,842
+/// (`--trace-scope all` records every one).
+pub const RENDER_SCOPE: &str = "tinyrisc.pc,tinyrisc.ir,tinyrisc.state,broadcast,dma,\
+array.active,array.mode,array.active_rcs,array.ctx,array.op,array.awake,array.flag_f,\
+array.fb0,array.fb1,array.rc_r0_c0";
+
 fn parse_scope(s: &str) -> Result<String, String> {
+    if s.trim() == "all" {
+        return Ok(String::new());
+    }
     rtl::trace::check_scope_patterns(s)?;
     Ok(s.to_string())
 }
@@ -30,7 +44,7 @@ impl TraceWindow {
         let mut c = rtl::trace::TraceConfig::new(path);
         c.first = self.trace_from;
         c.count = self.trace_cycles;
-        c.scope = self.trace_scope.clone();
+        c.scope = self.trace_scope.clone().unwrap_or_default();
         if c.count.is_none() {
             // A run that never halts must not fill the disk at ~6 MB/s.
             c.max_bytes = OPEN_WINDOW_MAX_BYTES;

@@ -387,6 +387,9 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     let trace = a.vcd.map(|p| {
         let mut c = a.window.config(p);
+        if a.window.trace_scope.is_none() {
+            c.scope = crate::cli::RENDER_SCOPE.to_string();
+        }
         // A frame runs for millions of cycles: without --trace-cycles the
         // waveform covers a window of the first chip instance, not the whole
         // frame (whose size would be refused anyway).

@@ -73,14 +73,6 @@ const SPECIAL: &[(&str, &str, Special)] = &[
     ),
     (
         "README.md",
-        "morphosys render --size 64x64 --vcd w.vcd",
-        Special::RunAs(
-            "morphosys render --size 64x64 --vcd w.vcd --trace-cycles 5000",
-            "the measured window is a 243 MB file; the same command over 5,000 cycles",
-        ),
-    ),
-    (
-        "README.md",
         "cargo bench -p morphosys-tb",
         Special::Skip("a benchmark: speed is measured, never run as a test"),
     ),

@@ -161,3 +161,60 @@ fn an_fst_waveform_into_a_pipe_is_refused_before_the_run() {
     );
     assert_eq!(err.lines().count(), 1, "{err}");
 }
+
+/// A render's waveform reads well by default (issue 15, item 5): the
+/// control path, the array's masks and one RC, every group open in the
+/// save file; `--trace-scope all` records every signal.
+#[test]
+fn a_render_traces_what_an_architect_looks_at_first() {
+    let dir = tempfile::tempdir().unwrap();
+    let render = |name: &str, extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            "--size",
+            "16x16",
+            "--vcd",
+            name,
+            "--trace-cycles",
+            "500",
+        ];
+        args.extend(extra);
+        let (ok, _, err) = morphosys(dir.path(), &args);
+        assert!(ok, "{err}");
+        read_back(&dir.path().join(name))
+    };
+    let default = render("d.vcd", &[]);
+    for want in [
+        "morphosys.tinyrisc.pc",
+        "morphosys.tinyrisc.ir",
+        "morphosys.tinyrisc.state",
+        "morphosys.broadcast.run_ctx",
+        "morphosys.dma.remaining",
+        "morphosys.array.ctx",
+        "morphosys.array.awake",
+        "morphosys.array.flag_f",
+        "morphosys.array.rc_r0_c0.regfile.r1",
+        "morphosys.array.rc_r0_c0.flags.f",
+    ] {
+        assert!(
+            default.contains_key(want),
+            "{want} not traced: {:?}",
+            default.keys()
+        );
+    }
+    assert!(default.len() < 100, "{} signals by default", default.len());
+    assert!(!default.keys().any(|k| k.contains("rc_r0_c1")));
+    // All 64 RCs awake at the start of a frame: the mask is all ones.
+    let awake = &default["morphosys.array.awake"];
+    assert_eq!(awake[0].1, "1".repeat(64), "{awake:?}");
+    let gtkw = std::fs::read_to_string(dir.path().join("d.gtkw")).unwrap();
+    assert!(gtkw.contains("@800200\n-tinyrisc"), "{gtkw}");
+    let all = render("a.vcd", &["--trace-scope", "all"]);
+    assert!(
+        all.len() > 1800,
+        "{} signals with --trace-scope all",
+        all.len()
+    );
+    let gtkw = std::fs::read_to_string(dir.path().join("a.gtkw")).unwrap();
+    assert!(!gtkw.contains("@c00200"), "a group saved closed");
+}

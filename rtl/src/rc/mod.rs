@@ -461,6 +461,15 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
         );
         p.signal("op", 6, Display::Translate(&OP_FILTER), c.op as u64);
         let en = self.enabled();
+        // The array at a glance: which RCs are awake, which have F set
+        // (bit i: RC i, row-major).
+        p.signal(
+            "awake",
+            N as u32,
+            Display::Hex,
+            !self.flags.sleep & Self::FULL,
+        );
+        p.signal("flag_f", N as u32, Display::Hex, self.flags.f & Self::FULL);
         let bits = W::BITS;
         let mask = |b: u32| if b >= 64 { u64::MAX } else { (1u64 << b) - 1 };
         let sig = |x: W| x.to_i64() as u64 & mask(bits);
