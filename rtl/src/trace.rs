@@ -27,7 +27,7 @@ use std::fs::File;
 use std::io::{self, BufWriter, Write};
 use std::path::{Path, PathBuf};
 
-use vcd::{IdCode, TimescaleUnit};
+use vcd::TimescaleUnit;
 
 /// How GTKWave should show a signal.
 #[derive(Clone, Copy)]
@@ -83,6 +83,24 @@ pub struct TraceConfig {
     pub max_bytes: u64,
 }
 
+/// `v` in decimal into `out`; returns the number of digits.
+fn decimal(mut v: u64, out: &mut [u8]) -> usize {
+    let mut tmp = [0u8; 20];
+    let mut n = 0;
+    loop {
+        tmp[n] = b'0' + (v % 10) as u8;
+        n += 1;
+        v /= 10;
+        if v == 0 {
+            break;
+        }
+    }
+    for k in 0..n {
+        out[k] = tmp[n - 1 - k];
+    }
+    n
+}
+
 /// Whether a waveform path asks for FST (`.fst`) rather than VCD.
 pub fn is_fst(path: &Path) -> bool {
     path.extension()
@@ -118,7 +136,10 @@ impl TraceConfig {
 /// Where value changes go: a VCD text stream, or an FST file (header
 /// while declaring, body while sampling).
 enum Sink {
-    Vcd(vcd::Writer<BufWriter<File>>),
+    /// The `vcd` crate writes the header; value changes and timestamps are
+    /// written as bytes here (`core::fmt` cost more than the simulation).
+    /// `ids`: each signal's identifier code, as text.
+    Vcd(vcd::Writer<BufWriter<File>>, Vec<Box<[u8]>>),
     FstHeader(fst_writer::FstHeaderWriter<BufWriter<File>>),
     FstBody(fst_writer::FstBodyWriter<BufWriter<File>>),
     /// Between the two FST phases, or after finishing.
@@ -128,7 +149,8 @@ enum Sink {
 /// One signal's handle in the file.
 #[derive(Clone, Copy)]
 enum SigId {
-    Vcd(IdCode),
+    /// Index into the VCD sink's identifier texts.
+    Vcd(u32),
     Fst(fst_writer::FstSignalId),
 }
 
@@ -142,7 +164,7 @@ fn fst_err(e: fst_writer::FstWriteError) -> io::Error {
 impl Sink {
     fn add_module(&mut self, name: &str) -> io::Result<()> {
         match self {
-            Sink::Vcd(w) => w.add_module(name),
+            Sink::Vcd(w, _) => w.add_module(name),
             Sink::FstHeader(h) => h
                 .scope(name, "", fst_writer::FstScopeType::Module)
                 .map_err(fst_err),
@@ -152,7 +174,7 @@ impl Sink {
 
     fn upscope(&mut self) -> io::Result<()> {
         match self {
-            Sink::Vcd(w) => w.upscope(),
+            Sink::Vcd(w, _) => w.upscope(),
             Sink::FstHeader(h) => h.up_scope().map_err(fst_err),
             _ => Ok(()),
         }
@@ -160,7 +182,11 @@ impl Sink {
 
     fn add_wire(&mut self, width: u32, name: &str) -> io::Result<SigId> {
         match self {
-            Sink::Vcd(w) => w.add_wire(width, name).map(SigId::Vcd),
+            Sink::Vcd(w, ids) => {
+                let id = w.add_wire(width, name)?;
+                ids.push(id.to_string().into_bytes().into_boxed_slice());
+                Ok(SigId::Vcd(ids.len() as u32 - 1))
+            }
             Sink::FstHeader(h) => h
                 .var(
                     name,
@@ -178,9 +204,9 @@ impl Sink {
     /// End of the declarations.
     fn end_definitions(&mut self) -> io::Result<()> {
         match std::mem::replace(self, Sink::Gone) {
-            Sink::Vcd(mut w) => {
+            Sink::Vcd(mut w, ids) => {
                 w.enddefinitions()?;
-                *self = Sink::Vcd(w);
+                *self = Sink::Vcd(w, ids);
             }
             Sink::FstHeader(h) => *self = Sink::FstBody(h.finish().map_err(fst_err)?),
             other => *self = other,
@@ -190,7 +216,13 @@ impl Sink {
 
     fn timestamp(&mut self, t: u64) -> io::Result<()> {
         match self {
-            Sink::Vcd(w) => w.timestamp(t),
+            Sink::Vcd(w, _) => {
+                let mut buf = [0u8; 24];
+                buf[0] = b'#';
+                let n = 1 + decimal(t, &mut buf[1..]);
+                buf[n] = b'\n';
+                w.writer().write_all(&buf[..=n])
+            }
             Sink::FstBody(b) => b.time_change(t).map_err(fst_err),
             _ => Ok(()),
         }
@@ -199,13 +231,29 @@ impl Sink {
     /// A new value of a `width`-bit signal.
     fn change(&mut self, id: SigId, width: u32, v: u64) -> io::Result<()> {
         match (self, id) {
-            (Sink::Vcd(w), SigId::Vcd(id)) => {
-                let wr = w.writer();
+            (Sink::Vcd(w, ids), SigId::Vcd(id)) => {
+                // `0!` for one bit, `b1011 !` for a vector (no leading zeros).
+                let id = &ids[id as usize];
+                let mut buf = [0u8; 128];
+                let mut n = 0;
                 if width == 1 {
-                    writeln!(wr, "{v}{id}")
+                    buf[0] = b'0' + (v & 1) as u8;
+                    n = 1;
                 } else {
-                    writeln!(wr, "b{v:b} {id}")
+                    buf[0] = b'b';
+                    n += 1;
+                    let top = 63 - (v | 1).leading_zeros();
+                    for k in (0..=top).rev() {
+                        buf[n] = b'0' + (v >> k & 1) as u8;
+                        n += 1;
+                    }
+                    buf[n] = b' ';
+                    n += 1;
                 }
+                buf[n..n + id.len()].copy_from_slice(id);
+                n += id.len();
+                buf[n] = b'\n';
+                w.writer().write_all(&buf[..=n])
             }
             (Sink::FstBody(b), SigId::Fst(id)) => {
                 let mut bits = [b'0'; 64];
@@ -482,7 +530,7 @@ impl Tracer {
             let mut w = vcd::Writer::new(out);
             w.version(version)?;
             w.timescale(1, TimescaleUnit::PS)?;
-            Sink::Vcd(w)
+            Sink::Vcd(w, Vec::new())
         };
         w.add_module(top_name)?;
         let clk = w.add_wire(1, "clk")?;
@@ -646,7 +694,7 @@ impl Tracer {
         let t = self.time(end);
         self.w.timestamp(t)?;
         let file = match std::mem::replace(&mut self.w, Sink::Gone) {
-            Sink::Vcd(mut w) => {
+            Sink::Vcd(mut w, _) => {
                 if let Some(n) = &self.note {
                     w.comment(n)?;
                 }
@@ -866,7 +914,7 @@ impl Probe for Tracer {
                         Ok(id) => id,
                         Err(e) => {
                             self.err.get_or_insert(e);
-                            SigId::Vcd(vcd::IdCode::FIRST)
+                            SigId::Vcd(0)
                         }
                     };
                     self.slot.push(Some(self.decls.len() as u32));
