@@ -53,6 +53,19 @@ pub trait Probe {
     /// caller then skips its contents and does not call [`Probe::end`].
     fn scope(&mut self, name: fmt::Arguments<'_>) -> bool;
     fn end(&mut self);
+    /// Which of `n` sibling scopes, named `name(i)`, may hold traced
+    /// signals (bit i). The caller then enters only those, so a probe
+    /// that traces one RC of 64 is asked about 64 scopes once, not 64
+    /// times a cycle. The answer must not change between calls in the
+    /// same order (it is computed once, while declaring).
+    fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
+        let _ = name;
+        if n >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << n) - 1
+        }
+    }
     /// A signal of `width` bits (1..=64) with its current value (only the
     /// low `width` bits are used).
     fn signal(&mut self, name: &str, width: u32, display: Display, value: u64);
@@ -307,6 +320,9 @@ pub struct Tracer {
     decls: Vec<Decl>,
     // per-call tables, indexed by call order
     scope_on: Vec<bool>,
+    /// Answers of [`Probe::open_scopes`], in call order.
+    open_masks: Vec<u64>,
+    open_i: usize,
     slot: Vec<Option<u32>>,
     // sampling state
     scope_i: usize,
@@ -560,6 +576,8 @@ impl Tracer {
             top_scopes: Vec::new(),
             decls: Vec::new(),
             scope_on: Vec::new(),
+            open_masks: Vec::new(),
+            open_i: 0,
             slot: Vec::new(),
             scope_i: 0,
             slot_i: 0,
@@ -648,6 +666,7 @@ impl Tracer {
         self.w.change(self.cycle_id, 64, cycle)?;
         self.scope_i = 0;
         self.slot_i = 0;
+        self.open_i = 0;
         top.trace(self);
         if let Some(e) = self.err.take() {
             return Err(e);
@@ -869,6 +888,31 @@ impl Tracer {
 }
 
 impl Probe for Tracer {
+    fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
+        match self.phase {
+            Phase::Declare => {
+                let mut mask = 0u64;
+                for i in 0..n.min(64) {
+                    let mut path = self.stack.clone();
+                    path.push(name(i));
+                    if path.len() == 1 && !self.top_scopes.contains(&path[0]) {
+                        self.top_scopes.push(path[0].clone());
+                    }
+                    if self.matches_prefix(&path, false) {
+                        mask |= 1 << i;
+                    }
+                }
+                self.open_masks.push(mask);
+                mask
+            }
+            Phase::Sample => {
+                let m = self.open_masks[self.open_i];
+                self.open_i += 1;
+                m
+            }
+        }
+    }
+
     fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
         match self.phase {
             Phase::Declare => {
@@ -904,51 +948,63 @@ impl Probe for Tracer {
         }
     }
 
+    #[inline]
     fn signal(&mut self, name: &str, width: u32, display: Display, value: u64) {
-        match self.phase {
-            Phase::Declare => {
-                let mut path = self.stack.clone();
-                path.push(name.to_string());
-                if self.matches_prefix(&path, true) {
-                    let id = match self.w.add_wire(width, name) {
-                        Ok(id) => id,
-                        Err(e) => {
-                            self.err.get_or_insert(e);
-                            SigId::Vcd(0)
-                        }
-                    };
-                    self.slot.push(Some(self.decls.len() as u32));
-                    self.decls.push(Decl {
-                        path,
-                        info: SigInfo { id, width, display },
-                    });
-                } else {
-                    self.slot.push(None);
-                }
+        if let Phase::Declare = self.phase {
+            return self.declare_signal(name, width, display);
+        }
+        // The sampled cycle: most signals are not traced or did not change.
+        let s = self.slot[self.slot_i];
+        self.slot_i += 1;
+        if let Some(i) = s {
+            let i = i as usize;
+            let v = if width >= 64 {
+                value
+            } else {
+                value & ((1u64 << width) - 1)
+            };
+            if self.last[i] != Some(v) {
+                self.record_change(i, v);
             }
-            Phase::Sample => {
-                let s = self.slot[self.slot_i];
-                self.slot_i += 1;
-                if let Some(i) = s {
-                    let i = i as usize;
-                    let info = self.decls[i].info;
-                    let v = if width >= 64 {
-                        value
-                    } else {
-                        value & ((1u64 << width) - 1)
-                    };
-                    if self.last[i] != Some(v) {
-                        self.last[i] = Some(v);
-                        if let Display::Translate(_) = info.display {
-                            self.seen[i].insert(v);
-                        }
-                        self.bytes += info.width as u64 + 6;
-                        if let Err(e) = self.w.change(info.id, info.width, v) {
-                            self.err.get_or_insert(e);
-                        }
-                    }
+        }
+    }
+}
+
+impl Tracer {
+    #[cold]
+    #[inline(never)]
+    fn declare_signal(&mut self, name: &str, width: u32, display: Display) {
+        let mut path = self.stack.clone();
+        path.push(name.to_string());
+        if self.matches_prefix(&path, true) {
+            let id = match self.w.add_wire(width, name) {
+                Ok(id) => id,
+                Err(e) => {
+                    self.err.get_or_insert(e);
+                    SigId::Vcd(0)
                 }
-            }
+            };
+            self.slot.push(Some(self.decls.len() as u32));
+            self.decls.push(Decl {
+                path,
+                info: SigInfo { id, width, display },
+            });
+        } else {
+            self.slot.push(None);
+        }
+    }
+
+    /// Signal `i` changed to `v`: write it.
+    #[inline(never)]
+    fn record_change(&mut self, i: usize, v: u64) {
+        let info = self.decls[i].info;
+        self.last[i] = Some(v);
+        if let Display::Translate(_) = info.display {
+            self.seen[i].insert(v);
+        }
+        self.bytes += info.width as u64 + 6;
+        if let Err(e) = self.w.change(info.id, info.width, v) {
+            self.err.get_or_insert(e);
         }
     }
 }

@@ -473,7 +473,17 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
         let bits = W::BITS;
         let mask = |b: u32| if b >= 64 { u64::MAX } else { (1u64 << b) - 1 };
         let sig = |x: W| x.to_i64() as u64 & mask(bits);
+        // Ask once which lanes' scopes are traced, then enter only those.
+        let names = self.names;
+        let lane_name = move |i: usize| match names {
+            LaneNames::Single => "rc".to_string(),
+            LaneNames::Grid => format!("rc_r{}_c{}", i / 8, i % 8),
+        };
+        let wanted = p.open_scopes(N, &mut |i| lane_name(i));
         for i in 0..N {
+            if wanted >> i & 1 == 0 {
+                continue;
+            }
             let open = match self.names {
                 LaneNames::Single => p.scope(format_args!("rc")),
                 LaneNames::Grid => p.scope(format_args!("rc_r{}_c{}", i / 8, i % 8)),
