@@ -220,24 +220,52 @@ impl<W: Word> Clocked for Array<W> {
 
 impl<W: Word> Traced for Array<W> {
     fn trace(&self, p: &mut dyn Probe) {
-        p.signal("active", 1, Display::Bin, self.active as u64);
-        p.signal("mode", 2, Display::Hex, self.mode as u64);
-        p.signal("active_rcs", 7, Display::Hex, self.active_now as u64);
+        // Asked once which of these are traced: a trace of one RC computes
+        // none of them.
+        const NAMES: [&str; 13] = [
+            "active",
+            "mode",
+            "active_rcs",
+            "ctx_g0",
+            "ctx_g1",
+            "ctx_g2",
+            "ctx_g3",
+            "ctx_g4",
+            "ctx_g5",
+            "ctx_g6",
+            "ctx_g7",
+            "fb0",
+            "fb1",
+        ];
+        let on = p.traced_signals(&NAMES);
+        if on & 1 != 0 {
+            p.signal("active", 1, Display::Bin, self.active as u64);
+        }
+        if on & 2 != 0 {
+            p.signal("mode", 2, Display::Hex, self.mode as u64);
+        }
+        if on & 4 != 0 {
+            p.signal("active_rcs", 7, Display::Hex, self.active_now as u64);
+        }
         for (g, w) in self.words.iter().enumerate() {
-            let name = [
-                "ctx_g0", "ctx_g1", "ctx_g2", "ctx_g3", "ctx_g4", "ctx_g5", "ctx_g6", "ctx_g7",
-            ][g];
+            if on >> (3 + g) & 1 == 0 {
+                continue;
+            }
             let v = if self.active && (g == 0 || self.mode != Mode::Simd) {
                 *w
             } else {
                 Context::NOP.encode()
             };
-            p.signal(name, 32, Display::Translate(&CTX_FILTER), v as u64);
+            p.signal(NAMES[3 + g], 32, Display::Translate(&CTX_FILTER), v as u64);
         }
         let bits = W::BITS;
         let m = u64::MAX >> (64 - bits);
-        p.signal("fb0", bits, Display::Signed, self.fb[0].to_i64() as u64 & m);
-        p.signal("fb1", bits, Display::Signed, self.fb[1].to_i64() as u64 & m);
+        if on >> 11 & 1 != 0 {
+            p.signal("fb0", bits, Display::Signed, self.fb[0].to_i64() as u64 & m);
+        }
+        if on >> 12 & 1 != 0 {
+            p.signal("fb1", bits, Display::Signed, self.fb[1].to_i64() as u64 & m);
+        }
         self.rc.trace(p);
     }
 }

@@ -69,6 +69,24 @@ pub trait Probe {
     /// A signal of `width` bits (1..=64) with its current value (only the
     /// low `width` bits are used).
     fn signal(&mut self, name: &str, width: u32, display: Display, value: u64);
+    /// Several signals of one width and display in one call (a register
+    /// file): the same as calling [`Probe::signal`] for each in turn.
+    fn signal_row(&mut self, names: &[&str], width: u32, display: Display, values: &[u64]) {
+        for (n, &v) in names.iter().zip(values) {
+            self.signal(n, width, display, v);
+        }
+    }
+    /// Which of the signals `names` of the current scope are traced (bit
+    /// i); the caller then reports only those, and need not compute the
+    /// others' values. Like [`Probe::open_scopes`], computed once while
+    /// declaring.
+    fn traced_signals(&mut self, names: &[&str]) -> u64 {
+        if names.len() >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << names.len()) - 1
+        }
+    }
 }
 
 /// A module that has signals.
@@ -888,6 +906,52 @@ impl Tracer {
 }
 
 impl Probe for Tracer {
+    fn signal_row(&mut self, names: &[&str], width: u32, display: Display, values: &[u64]) {
+        if let Phase::Declare = self.phase {
+            for n in names {
+                self.declare_signal(n, width, display);
+            }
+            return;
+        }
+        let mask = if width >= 64 {
+            u64::MAX
+        } else {
+            (1u64 << width) - 1
+        };
+        for &value in &values[..names.len()] {
+            let s = self.slot[self.slot_i];
+            self.slot_i += 1;
+            if let Some(i) = s {
+                let (i, v) = (i as usize, value & mask);
+                if self.last[i] != Some(v) {
+                    self.record_change(i, v);
+                }
+            }
+        }
+    }
+
+    fn traced_signals(&mut self, names: &[&str]) -> u64 {
+        match self.phase {
+            Phase::Declare => {
+                let mut mask = 0u64;
+                for (i, n) in names.iter().enumerate().take(64) {
+                    let mut path = self.stack.clone();
+                    path.push(n.to_string());
+                    if self.matches_prefix(&path, true) {
+                        mask |= 1 << i;
+                    }
+                }
+                self.open_masks.push(mask);
+                mask
+            }
+            Phase::Sample => {
+                let m = self.open_masks[self.open_i];
+                self.open_i += 1;
+                m
+            }
+        }
+    }
+
     fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
         match self.phase {
             Phase::Declare => {

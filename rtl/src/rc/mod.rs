@@ -517,9 +517,8 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
                 p.end();
             }
             if p.scope(format_args!("regfile")) {
-                for (k, name) in REG_NAMES.iter().enumerate() {
-                    p.signal(name, bits, Display::Signed, sig(self.regs.r[k][i]));
-                }
+                let values: [u64; 16] = std::array::from_fn(|k| sig(self.regs.r[k][i]));
+                p.signal_row(&REG_NAMES, bits, Display::Signed, &values);
                 p.end();
             }
             if p.scope(format_args!("ram")) {

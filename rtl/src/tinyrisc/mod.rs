@@ -236,9 +236,8 @@ impl Traced for TinyRisc {
             self.state as u64,
         );
         if p.scope(format_args!("regs")) {
-            for (k, n) in REG_NAMES.iter().enumerate() {
-                p.signal(n, 32, Display::Hex, self.regs.read(k as u8) as u64);
-            }
+            let values: [u64; 16] = std::array::from_fn(|k| self.regs.read(k as u8) as u64);
+            p.signal_row(&REG_NAMES, 32, Display::Hex, &values);
             p.end();
         }
     }
