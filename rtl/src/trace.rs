@@ -173,9 +173,30 @@ enum Sink {
     Vcd(vcd::Writer<BufWriter<File>>, Vec<Box<[u8]>>),
     FstHeader(fst_writer::FstHeaderWriter<BufWriter<File>>),
     FstBody(fst_writer::FstBodyWriter<BufWriter<File>>),
+    /// While sampling: value changes go in batches to a thread that
+    /// writes them into the sink it owns (the simulation does not wait for
+    /// the formatting); [`Sink::join`] gets the sink back.
+    Threaded {
+        batch: Vec<Msg>,
+        tx: std::sync::mpsc::SyncSender<Vec<Msg>>,
+        worker: std::thread::JoinHandle<(Sink, io::Result<()>)>,
+    },
     /// Between the two FST phases, or after finishing.
     Gone,
 }
+
+/// What the sampling thread hands the writing thread.
+#[derive(Clone, Copy)]
+enum Msg {
+    Time(u64),
+    Change(SigId, u32, u64),
+}
+
+/// Value changes per batch handed to the writing thread (24 bytes each);
+/// at most [`QUEUED_BATCHES`] wait, so memory stays bounded when the disk
+/// is slower than the simulation.
+const BATCH: usize = 4096;
+const QUEUED_BATCHES: usize = 4;
 
 /// One signal's handle in the file.
 #[derive(Clone, Copy)]
@@ -245,8 +266,85 @@ impl Sink {
         Ok(())
     }
 
+    /// Hand the sink to a writing thread (see [`Sink::Threaded`]).
+    fn threaded(self) -> io::Result<Sink> {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Msg>>(QUEUED_BATCHES);
+        let worker = std::thread::Builder::new()
+            .name("waveform writer".into())
+            .spawn(move || {
+                let mut sink = self;
+                let mut res = Ok(());
+                for batch in rx {
+                    if res.is_err() {
+                        continue; // keep draining: the sender must not block
+                    }
+                    for &m in &batch {
+                        let r = match m {
+                            Msg::Time(t) => sink.timestamp(t),
+                            Msg::Change(id, w, v) => sink.change(id, w, v),
+                        };
+                        if let Err(e) = r {
+                            res = Err(e);
+                            break;
+                        }
+                    }
+                    // The FST writer holds value changes in memory until a
+                    // flush, which writes one compressed section: bound that
+                    // memory.
+                    if let Sink::FstBody(b) = &mut sink {
+                        if b.size() > FST_SECTION_BYTES {
+                            if let Err(e) = b.flush().map_err(fst_err) {
+                                res = Err(e);
+                            }
+                        }
+                    }
+                }
+                (sink, res)
+            })?;
+        Ok(Sink::Threaded {
+            batch: Vec::with_capacity(BATCH),
+            tx,
+            worker,
+        })
+    }
+
+    /// The sink back from its writing thread, every change written.
+    fn join(self) -> io::Result<Sink> {
+        match self {
+            Sink::Threaded {
+                batch, tx, worker, ..
+            } => {
+                let sent = tx.send(batch);
+                drop(tx);
+                let (sink, res) = worker
+                    .join()
+                    .map_err(|_| io::Error::other("the waveform writer panicked"))?;
+                res?;
+                sent.map_err(|_| io::Error::other("the waveform writer stopped"))?;
+                Ok(sink)
+            }
+            other => Ok(other),
+        }
+    }
+
+    #[inline]
+    fn queue(
+        batch: &mut Vec<Msg>,
+        tx: &std::sync::mpsc::SyncSender<Vec<Msg>>,
+        m: Msg,
+    ) -> io::Result<()> {
+        batch.push(m);
+        if batch.len() >= BATCH {
+            let full = std::mem::replace(batch, Vec::with_capacity(BATCH));
+            tx.send(full)
+                .map_err(|_| io::Error::other("the waveform writer stopped"))?;
+        }
+        Ok(())
+    }
+
     fn timestamp(&mut self, t: u64) -> io::Result<()> {
         match self {
+            Sink::Threaded { batch, tx, .. } => Sink::queue(batch, tx, Msg::Time(t)),
             Sink::Vcd(w, _) => {
                 let mut buf = [0u8; 24];
                 buf[0] = b'#';
@@ -262,6 +360,9 @@ impl Sink {
     /// A new value of a `width`-bit signal.
     fn change(&mut self, id: SigId, width: u32, v: u64) -> io::Result<()> {
         match (self, id) {
+            (Sink::Threaded { batch, tx, .. }, id) => {
+                Sink::queue(batch, tx, Msg::Change(id, width, v))
+            }
             (Sink::Vcd(w, ids), SigId::Vcd(id)) => {
                 // `0!` for one bit, `b1011 !` for a vector (no leading zeros).
                 let id = &ids[id as usize];
@@ -649,6 +750,7 @@ impl Tracer {
         }
         t.w.upscope()?;
         t.w.end_definitions()?;
+        t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded()?;
         t.last = vec![None; t.decls.len()];
         t.seen = vec![BTreeSet::new(); t.decls.len()];
         t.phase = Phase::Sample;
@@ -707,13 +809,6 @@ impl Tracer {
         }
         self.w.timestamp(t + half)?;
         self.w.change(self.clk, 1, 0)?;
-        // The FST writer holds value changes in memory until a flush, which
-        // writes one compressed section: bound that memory.
-        if let Sink::FstBody(b) = &mut self.w {
-            if b.size() > FST_SECTION_BYTES {
-                b.flush().map_err(fst_err)?;
-            }
-        }
         self.sampled += 1;
         self.last_cycle = Some(cycle);
         Ok(())
@@ -729,6 +824,7 @@ impl Tracer {
     pub fn finish(mut self) -> io::Result<Vec<PathBuf>> {
         let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
         let t = self.time(end);
+        self.w = std::mem::replace(&mut self.w, Sink::Gone).join()?;
         self.w.timestamp(t)?;
         let file = match std::mem::replace(&mut self.w, Sink::Gone) {
             Sink::Vcd(mut w, _) => {
