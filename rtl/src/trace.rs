@@ -13,7 +13,12 @@
 //! * A scope filter (`--trace-scope`) keeps only the signals whose path
 //!   matches one of its patterns; a module skips a whole scope that nothing
 //!   under it can match.
-//! * A value is written only when it changed; the file is buffered.
+//! * A value is written only when it changed; the changes are formatted
+//!   and written by a second thread (`waveform writer`), fed in batches,
+//!   so the simulation does not wait for the formatting.
+//! * A module asks once which of its scopes ([`Probe::open_scopes`]) and
+//!   signals ([`Probe::traced_signals`]) are traced, and reports only
+//!   those; a register file is one call ([`Probe::signal_row`]).
 //! * Names are GTKWave- and Surfer-safe: letters, digits and `_`, scopes for
 //!   hierarchy, never `name[3]` indices (`rc_r3_c4`, `r12`).
 //!
