@@ -135,6 +135,14 @@ const SPECIAL: &[(&str, &str, Special)] = &[
         Special::Skip("the command running this test (.ci/run runs it)"),
     ),
     (
+        "docs/performance.md",
+        "morphosys bench --repeat 7 --json docs/results/bench.json",
+        Special::RunAs(
+            "morphosys bench --repeat 1 --json bench.json",
+            "a measurement, not a check: run once, into the scratch folder rather than over the committed results",
+        ),
+    ),
+    (
         "docs/cluster.md",
         "apt-get install parallel",
         Special::Skip("installs a Debian package; .ci/run installs it"),
@@ -643,6 +651,7 @@ const DOCUMENTS: &[&str] = &[
     "docs/scenes.md",
     "docs/tracer.md",
     "docs/cluster.md",
+    "docs/performance.md",
 ];
 
 #[test]
@@ -668,6 +677,11 @@ fn tracer_commands_run_as_written() {
 #[test]
 fn cluster_commands_run_as_written() {
     check_document("docs/cluster.md");
+}
+
+#[test]
+fn performance_commands_run_as_written() {
+    check_document("docs/performance.md");
 }
 
 /// Every document is checked, and every exception still names a command a
