@@ -195,6 +195,14 @@ enum Sink {
 enum Msg {
     Time(u64),
     Change(SigId, u32, u64),
+    /// The rising edge of a cycle at time `t`: the timestamp, `clk` 1 and
+    /// the `cycle` counter (one message where three were).
+    Rise {
+        t: u64,
+        cycle: u64,
+    },
+    /// The falling edge at time `t`: the timestamp and `clk` 0.
+    Fall(u64),
 }
 
 /// Value changes per batch handed to the writing thread (24 bytes each);
@@ -272,7 +280,8 @@ impl Sink {
     }
 
     /// Hand the sink to a writing thread (see [`Sink::Threaded`]).
-    fn threaded(self) -> io::Result<Sink> {
+    /// `clk` and `cycle`: the signals [`Msg::Rise`] and [`Msg::Fall`] set.
+    fn threaded(self, clk: SigId, cycle_id: SigId) -> io::Result<Sink> {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Msg>>(QUEUED_BATCHES);
         let worker = std::thread::Builder::new()
             .name("waveform writer".into())
@@ -287,6 +296,11 @@ impl Sink {
                         let r = match m {
                             Msg::Time(t) => sink.timestamp(t),
                             Msg::Change(id, w, v) => sink.change(id, w, v),
+                            Msg::Rise { t, cycle } => sink
+                                .timestamp(t)
+                                .and_then(|_| sink.change(clk, 1, 1))
+                                .and_then(|_| sink.change(cycle_id, 64, cycle)),
+                            Msg::Fall(t) => sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0)),
                         };
                         if let Err(e) = r {
                             res = Err(e);
@@ -345,6 +359,14 @@ impl Sink {
                 .map_err(|_| io::Error::other("the waveform writer stopped"))?;
         }
         Ok(())
+    }
+
+    /// A clock edge ([`Msg::Rise`], [`Msg::Fall`]), for the writing thread.
+    fn edge(&mut self, m: Msg) -> io::Result<()> {
+        match self {
+            Sink::Threaded { batch, tx, .. } => Sink::queue(batch, tx, m),
+            _ => Err(io::Error::other("a clock edge outside sampling")),
+        }
     }
 
     fn timestamp(&mut self, t: u64) -> io::Result<()> {
@@ -755,7 +777,7 @@ impl Tracer {
         }
         t.w.upscope()?;
         t.w.end_definitions()?;
-        t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded()?;
+        t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded(t.clk, t.cycle_id)?;
         t.last = vec![None; t.decls.len()];
         t.seen = vec![BTreeSet::new(); t.decls.len()];
         t.phase = Phase::Sample;
@@ -786,9 +808,7 @@ impl Tracer {
         }
         let t = self.time(cycle);
         let half = (self.time(cycle + 1) - t) / 2;
-        self.w.timestamp(t)?;
-        self.w.change(self.clk, 1, 1)?;
-        self.w.change(self.cycle_id, 64, cycle)?;
+        self.w.edge(Msg::Rise { t, cycle })?;
         self.scope_i = 0;
         self.slot_i = 0;
         self.open_i = 0;
@@ -812,8 +832,7 @@ impl Tracer {
             eprintln!("morphosys: warning: {msg}");
             self.note.get_or_insert(msg);
         }
-        self.w.timestamp(t + half)?;
-        self.w.change(self.clk, 1, 0)?;
+        self.w.edge(Msg::Fall(t + half))?;
         self.sampled += 1;
         self.last_cycle = Some(cycle);
         Ok(())
