@@ -117,6 +117,9 @@ pub struct TraceConfig {
     /// Refuse, before writing anything, a trace whose estimated size
     /// exceeds this (default 4 GiB).
     pub max_bytes: u64,
+    /// FST only: bytes of value changes held in memory before they are
+    /// compressed into the file as one section ([`FST_SECTION_BYTES`]).
+    pub fst_section_bytes: usize,
 }
 
 /// `v` in decimal into `out`; returns the number of digits.
@@ -144,8 +147,9 @@ pub fn is_fst(path: &Path) -> bool {
 }
 
 /// Value changes an FST writer holds in memory before it writes them out
-/// as one compressed section.
-const FST_SECTION_BYTES: usize = 64 << 20;
+/// as one compressed section (the default of
+/// [`TraceConfig::fst_section_bytes`]).
+pub const FST_SECTION_BYTES: usize = 64 << 20;
 
 /// The largest waveform written by default (4 GiB).
 pub const MAX_TRACE_BYTES: u64 = 4 << 30;
@@ -165,6 +169,7 @@ impl TraceConfig {
             clock_hz: 300_000_000,
             budget_cycles: None,
             max_bytes: MAX_TRACE_BYTES,
+            fst_section_bytes: FST_SECTION_BYTES,
         }
     }
 }
@@ -281,13 +286,17 @@ impl Sink {
 
     /// Hand the sink to a writing thread (see [`Sink::Threaded`]).
     /// `clk` and `cycle`: the signals [`Msg::Rise`] and [`Msg::Fall`] set.
-    fn threaded(self, clk: SigId, cycle_id: SigId) -> io::Result<Sink> {
+    /// `section_bytes`: see [`TraceConfig::fst_section_bytes`].
+    fn threaded(self, clk: SigId, cycle_id: SigId, section_bytes: usize) -> io::Result<Sink> {
         let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Msg>>(QUEUED_BATCHES);
         let worker = std::thread::Builder::new()
             .name("waveform writer".into())
             .spawn(move || {
                 let mut sink = self;
                 let mut res = Ok(());
+                // A section can end only after a time step of its own (the
+                // FST writer cannot start one at the time it ended at).
+                let mut stepped = false;
                 for batch in rx {
                     if res.is_err() {
                         continue; // keep draining: the sender must not block
@@ -296,25 +305,25 @@ impl Sink {
                         let r = match m {
                             Msg::Time(t) => sink.timestamp(t),
                             Msg::Change(id, w, v) => sink.change(id, w, v),
-                            Msg::Rise { t, cycle } => sink
-                                .timestamp(t)
-                                .and_then(|_| sink.change(clk, 1, 1))
-                                .and_then(|_| sink.change(cycle_id, 64, cycle)),
-                            Msg::Fall(t) => sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0)),
+                            Msg::Rise { t, cycle } => {
+                                if std::mem::take(&mut stepped) {
+                                    if let Err(e) = sink.fst_section(section_bytes) {
+                                        res = Err(e);
+                                        break;
+                                    }
+                                }
+                                sink.timestamp(t)
+                                    .and_then(|_| sink.change(clk, 1, 1))
+                                    .and_then(|_| sink.change(cycle_id, 64, cycle))
+                            }
+                            Msg::Fall(t) => {
+                                stepped = true;
+                                sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0))
+                            }
                         };
                         if let Err(e) = r {
                             res = Err(e);
                             break;
-                        }
-                    }
-                    // The FST writer holds value changes in memory until a
-                    // flush, which writes one compressed section: bound that
-                    // memory.
-                    if let Sink::FstBody(b) = &mut sink {
-                        if b.size() > FST_SECTION_BYTES {
-                            if let Err(e) = b.flush().map_err(fst_err) {
-                                res = Err(e);
-                            }
                         }
                     }
                 }
@@ -357,6 +366,19 @@ impl Sink {
             let full = std::mem::replace(batch, Vec::with_capacity(BATCH));
             tx.send(full)
                 .map_err(|_| io::Error::other("the waveform writer stopped"))?;
+        }
+        Ok(())
+    }
+
+    /// The FST writer holds value changes in memory until a flush, which
+    /// writes them as one compressed section; it can flush only right
+    /// before a new time step, so this is called at each rising edge, and
+    /// flushes once more than `limit` bytes wait.
+    fn fst_section(&mut self, limit: usize) -> io::Result<()> {
+        if let Sink::FstBody(b) = self {
+            if b.size() > limit {
+                b.flush().map_err(fst_err)?;
+            }
         }
         Ok(())
     }
@@ -777,7 +799,11 @@ impl Tracer {
         }
         t.w.upscope()?;
         t.w.end_definitions()?;
-        t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded(t.clk, t.cycle_id)?;
+        t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded(
+            t.clk,
+            t.cycle_id,
+            t.cfg.fst_section_bytes,
+        )?;
         t.last = vec![None; t.decls.len()];
         t.seen = vec![BTreeSet::new(); t.decls.len()];
         t.phase = Phase::Sample;
