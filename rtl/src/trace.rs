@@ -1077,50 +1077,11 @@ impl Probe for Tracer {
     }
 
     fn traced_signals(&mut self, names: &[&str]) -> u64 {
-        match self.phase {
-            Phase::Declare => {
-                let mut mask = 0u64;
-                for (i, n) in names.iter().enumerate().take(64) {
-                    let mut path = self.stack.clone();
-                    path.push(n.to_string());
-                    if self.matches_prefix(&path, true) {
-                        mask |= 1 << i;
-                    }
-                }
-                self.open_masks.push(mask);
-                mask
-            }
-            Phase::Sample => {
-                let m = self.open_masks[self.open_i];
-                self.open_i += 1;
-                m
-            }
-        }
+        self.mask_of(names.len(), &mut |i| names[i].to_string(), true)
     }
 
     fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
-        match self.phase {
-            Phase::Declare => {
-                let mut mask = 0u64;
-                for i in 0..n.min(64) {
-                    let mut path = self.stack.clone();
-                    path.push(name(i));
-                    if path.len() == 1 && !self.top_scopes.contains(&path[0]) {
-                        self.top_scopes.push(path[0].clone());
-                    }
-                    if self.matches_prefix(&path, false) {
-                        mask |= 1 << i;
-                    }
-                }
-                self.open_masks.push(mask);
-                mask
-            }
-            Phase::Sample => {
-                let m = self.open_masks[self.open_i];
-                self.open_i += 1;
-                m
-            }
-        }
+        self.mask_of(n, name, false)
     }
 
     fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
@@ -1181,6 +1142,30 @@ impl Probe for Tracer {
 }
 
 impl Tracer {
+    /// Which of `n` names under the current scope the patterns take in
+    /// (`complete`: as signals, else as scopes that may hold some):
+    /// computed while declaring, replayed in the same order while sampling.
+    fn mask_of(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String, complete: bool) -> u64 {
+        if let Phase::Sample = self.phase {
+            let m = self.open_masks[self.open_i];
+            self.open_i += 1;
+            return m;
+        }
+        let mut mask = 0u64;
+        for i in 0..n.min(64) {
+            let mut path = self.stack.clone();
+            path.push(name(i));
+            if path.len() == 1 && !self.top_scopes.contains(&path[0]) {
+                self.top_scopes.push(path[0].clone());
+            }
+            if self.matches_prefix(&path, complete) {
+                mask |= 1 << i;
+            }
+        }
+        self.open_masks.push(mask);
+        mask
+    }
+
     #[cold]
     #[inline(never)]
     fn declare_signal(&mut self, name: &str, width: u32, display: Display) {
