@@ -198,7 +198,6 @@ enum Sink {
 /// What the sampling thread hands the writing thread.
 #[derive(Clone, Copy)]
 enum Msg {
-    Time(u64),
     Change(SigId, u32, u64),
     /// The rising edge of a cycle at time `t`: the timestamp, `clk` 1 and
     /// the `cycle` counter (one message where three were).
@@ -303,7 +302,6 @@ impl Sink {
                     }
                     for &m in &batch {
                         let r = match m {
-                            Msg::Time(t) => sink.timestamp(t),
                             Msg::Change(id, w, v) => sink.change(id, w, v),
                             Msg::Rise { t, cycle } => {
                                 if std::mem::take(&mut stepped) {
@@ -393,7 +391,8 @@ impl Sink {
 
     fn timestamp(&mut self, t: u64) -> io::Result<()> {
         match self {
-            Sink::Threaded { batch, tx, .. } => Sink::queue(batch, tx, Msg::Time(t)),
+            // While sampling, time moves only with the clock edges.
+            Sink::Threaded { .. } => Err(io::Error::other("a timestamp outside the clock edges")),
             Sink::Vcd(w, _) => {
                 let mut buf = [0u8; 24];
                 buf[0] = b'#';
