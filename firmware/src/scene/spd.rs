@@ -135,13 +135,8 @@ pub fn check_size(name: &str, size: u32) -> Result<(), String> {
 
 /// The NFF text the SPD program `name` prints at size factor `size`.
 pub fn generate(name: &str, size: u32) -> Result<String, String> {
+    check_size(name, size)?;
     let g = find(name)?;
-    if size < 1 || size > g.max_size {
-        return Err(format!(
-            "size {size} for {name}: expected 1 to {} (the SPD default is {})",
-            g.max_size, g.default_size
-        ));
-    }
     let mut lib = Lib::new();
     (g.run)(&mut lib, size);
     Ok(lib.out)
