@@ -38,6 +38,16 @@ pub enum LaneNames {
     Grid,
 }
 
+impl LaneNames {
+    /// The scope name of lane `i` (in waveforms and fault messages).
+    pub fn name(self, i: usize) -> String {
+        match self {
+            LaneNames::Single => "rc".to_string(),
+            LaneNames::Grid => format!("rc_r{}_c{}", i / 8, i % 8),
+        }
+    }
+}
+
 /// Which pending updates the clock edge applies.
 #[derive(Clone, Copy, Default)]
 struct Pending {
@@ -176,11 +186,10 @@ impl<const N: usize, W: Word> RcArray<N, W> {
     }
 
     fn lane_fault(&self, lane: usize, msg: String) -> Fault {
-        let who = match self.names {
-            LaneNames::Single => "rc".to_string(),
-            LaneNames::Grid => format!("rc_r{}_c{}", lane / 8, lane % 8),
-        };
-        Fault::new(who, format!("{msg} (context `{}`)", self.ctx))
+        Fault::new(
+            self.names.name(lane),
+            format!("{msg} (context `{}`)", self.ctx),
+        )
     }
 }
 
@@ -475,11 +484,7 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
         let sig = |x: W| x.to_i64() as u64 & mask(bits);
         // Ask once which lanes' scopes are traced, then enter only those.
         let names = self.names;
-        let lane_name = move |i: usize| match names {
-            LaneNames::Single => "rc".to_string(),
-            LaneNames::Grid => format!("rc_r{}_c{}", i / 8, i % 8),
-        };
-        let wanted = p.open_scopes(N, &mut |i| lane_name(i));
+        let wanted = p.open_scopes(N, &mut |i| names.name(i));
         for i in 0..N {
             if wanted >> i & 1 == 0 {
                 continue;
