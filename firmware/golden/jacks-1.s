@@ -2,14 +2,14 @@
 ; 256x256, 64 ways (8x8 tiles), depth 2, 16-bit datapath, scene format Q6.9
 ; packet traversal, BSP sah split to depth 15, at most 5 objects per leaf, collapse auto
         .datapath 16
-; FB image (620 words) at 0x40000, tile list at 0x60000: loaded by the host.
+; FB image (626 words) at 0x40000, tile list at 0x60000: loaded by the host.
 CTXBASE = 0x20000
 FBIMG = 0x40000
-FBWORDS = 620
+FBWORDS = 626
 TILELIST = 0x60000
 FB_EYE = 258
 FB_POST = 272
-ROOT = 568
+ROOT = 574
 MAILBOX = 1048576
 NOBJ = 9
 
@@ -367,10 +367,10 @@ pcylinder_go:  addi r13, r13, 1
         lfb r3, 0(r7)
         beqz r3, pcylinder_nocap
         li r1, (k_disc - CTXBASE) / 4
-        addi r2, r7, 35
+        addi r2, r7, 37
         sbcb r1, r2, (k_disc_end - k_disc) / 4
         li r1, (k_disc - CTXBASE) / 4
-        addi r2, r7, 55
+        addi r2, r7, 57
         sbcb r1, r2, (k_disc_end - k_disc) / 4
 pcylinder_nocap:
 pcylinder_next:
@@ -1459,6 +1459,15 @@ k_sphere:
         msu r9, r11, r5, >>10
         ldacc r10, <<14
         msu r10, r11, r6, >>10
+        mul out, r8, r4
+        mac out, r9, r5
+        mac r12, r10, r6, >>14
+        ldacc r8, <<14
+        msu r8, r12, r4, >>14
+        ldacc r9, <<14
+        msu r9, r12, r5, >>14
+        ldacc r10, <<14
+        msu r10, r12, r6, >>14
         mov r12, fb0
         mov r13, fb0
         mul r8, r8, r13, >>11
@@ -1532,9 +1541,19 @@ k_cyl:
         mul out, fb0, r8
         mac out, fb0, r9
         mac r11, fb0, r10, >>14
+        accl r14
+        sll r15, r11, #14
+        sub r14, r14, r15
+        add r14, fb0, r14
+        st r14, [#291]
         mul out, fb0, r8
         mac out, fb0, r9
         mac r12, fb0, r10, >>14
+        accl r15
+        sll r13, r12, #14
+        sub r15, r15, r13
+        add r15, fb0, r15
+        st r15, [#292]
         st r11, [#286]
         st r12, [#287]
         mul out, fb0, r4
@@ -1587,10 +1606,20 @@ k_cyl:
         ld r12, [r0 + #287]
         mul out, r11, r8
         mac r13, r12, r9, >>14
+        ld r14, [r0 + #291]
+        ld r15, [r0 + #292]
         ldacc r11, <<14
+        mac out, r14, #1
         msu r11, r13, r8, >>10
         ldacc r12, <<14
+        mac out, r15, #1
         msu r12, r13, r9, >>10
+        mul out, r11, r8
+        mac r14, r12, r9, >>14
+        ldacc r11, <<14
+        msu r11, r14, r8, >>14
+        ldacc r12, <<14
+        msu r12, r14, r9, >>14
         mov r14, fb0
         mul r11, r11, r14, >>10
         mul r12, r12, r14, >>10
@@ -1629,7 +1658,7 @@ k_cyl:
         sra r8, r8, r9
         st r8, [#290]
         mov r9, fb0
-        mul r9, r9, r8, >>14
+        mul r9, r9, r8, >>18
         mov r11, fb0
         mul r9, r9, r11, >>14
         sub r9, r13, r9

@@ -157,6 +157,17 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
             });
         }
     }
+    // The kernels as first written (`--normals coarse`): the paper
+    // configuration's point before the fine normals, beside it.
+    v.push(Knob {
+        knob: "normals",
+        value: "coarse".into(),
+        opt: base,
+        nm: Numerics {
+            fine_normals: false,
+            ..nm
+        },
+    });
     for eps_lsb in [1, 3, 8] {
         v.push(Knob {
             knob: "ray_offset_lsb",
@@ -308,6 +319,8 @@ struct Row {
     table_entries: u32,
     guard_bits: u32,
     ray_offset_lsb: i32,
+    /// `fine` or `coarse` (`render --normals`).
+    normals: String,
     /// RC datapath width: 16 (the paper's chip) or 32.
     datapath_bits: u32,
     format: String,
@@ -495,6 +508,7 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
         table_entries: nm.table_entries,
         guard_bits: nm.guard_bits,
         ray_offset_lsb: nm.eps_lsb,
+        normals: if nm.fine_normals { "fine" } else { "coarse" }.into(),
         datapath_bits: opt.datapath.bits(),
         format: s("format"),
         cycles: j["cycles"].as_u64().unwrap_or(0),
@@ -799,6 +813,10 @@ fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> Vec<String> 
     arg("--table-entries", n.table_entries.to_string());
     arg("--guard-bits", n.guard_bits.to_string());
     arg("--ray-offset-lsb", n.eps_lsb.to_string());
+    arg(
+        "--normals",
+        if n.fine_normals { "fine" } else { "coarse" }.into(),
+    );
     match c.timing_name.as_str() {
         "default" => {}
         "M1 issue" => arg("--timing", dir.join(M1_TIMING_FILE).display().to_string()),
@@ -1111,7 +1129,18 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             .collect(),
         style: Default::default(),
     });
-    let pareto: Vec<Series> = pareto.into_iter().chain(tables).collect();
+    // Coarse normals, then the paper configuration's fine ones: the same
+    // kernels' cost and gain.
+    let normals = scenes.iter().map(|s| Series {
+        name: format!("{} normals coarse, fine", short(s)),
+        points: ["normals", "paper"]
+            .iter()
+            .filter_map(|k| rows.iter().find(|r| r.scene == *s && r.knob == *k))
+            .map(|r| (r.fps_at_300mhz, r.psnr_db))
+            .collect(),
+        style: Default::default(),
+    });
+    let pareto: Vec<Series> = pareto.into_iter().chain(tables).chain(normals).collect();
     let paper: Vec<Mark> = rows
         .iter()
         .filter(|r| r.knob == "paper")

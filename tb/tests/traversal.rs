@@ -5,9 +5,9 @@
 use std::path::PathBuf;
 
 use firmware::scene::Scene;
-use firmware::tracer::{Options, Traversal};
+use firmware::tracer::{Numerics, Options, Traversal};
 use tb::reference::{self, shapes, NO_HIT};
-use tb::render::render_chip;
+use tb::render::{render_chip, render_chip_with};
 
 fn scene_path(name: &str) -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -36,15 +36,27 @@ fn opts(w: u32, h: u32, traversal: Traversal) -> Options {
 }
 
 /// The cycle counts published before the packet traversal existed
-/// (README, docs/tracer.md): the paper's traversal must keep them.
+/// (README, docs/tracer.md): the paper's traversal must keep them, with
+/// the kernels as they were then (`--normals coarse`).
 #[test]
 fn paper_traversal_keeps_its_cycle_counts() {
+    let coarse = Numerics {
+        fine_normals: false,
+        ..Numerics::default()
+    };
     for (name, cycles) in [
         ("jacks-1.nff", 3_036_704u64),
         ("tetra-1.nff", 1_234_920),
         ("default.toml", 8_529_730),
     ] {
-        let r = render_chip(&load(name), &opts(256, 256, Traversal::Paper), false, None).unwrap();
+        let r = render_chip_with(
+            &load(name),
+            &opts(256, 256, Traversal::Paper),
+            &coarse,
+            false,
+            None,
+        )
+        .unwrap();
         assert_eq!(r.cycles, cycles, "{name}");
     }
 }

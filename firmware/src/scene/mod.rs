@@ -356,6 +356,26 @@ impl Shape {
         }
     }
 
+    /// The shape moved by `d` (directions, radii and normals unchanged).
+    pub fn translated(&self, d: Vec3) -> Shape {
+        let mut s = self.clone();
+        match &mut s {
+            Shape::Sphere { center, .. } => *center = *center + d,
+            Shape::Cone { base, apex, .. } => {
+                *base = *base + d;
+                *apex = *apex + d;
+            }
+            Shape::Box { min, max } => {
+                *min = *min + d;
+                *max = *max + d;
+            }
+            Shape::Rectangle { corner, .. } => *corner = *corner + d,
+            Shape::Triangle { v, .. } => v.iter_mut().for_each(|p| *p = *p + d),
+            Shape::Polygon { v, .. } => v.iter_mut().for_each(|p| *p = *p + d),
+        }
+        s
+    }
+
     /// A bounding box of the shape (conservative for cones).
     pub fn bounds(&self) -> Aabb {
         match self {
@@ -962,6 +982,21 @@ impl Scene {
             }
         }
         Ok(())
+    }
+
+    /// The scene moved by `d`: objects, eye, look-at point and lights (the
+    /// image is the same).
+    pub fn translated(&self, d: Vec3) -> Scene {
+        let mut s = self.clone();
+        for o in &mut s.objects {
+            o.shape = o.shape.translated(d);
+        }
+        s.camera.from = s.camera.from + d;
+        s.camera.at = s.camera.at + d;
+        for l in &mut s.lights {
+            l.position = l.position + d;
+        }
+        s
     }
 
     /// Bounds of all objects.

@@ -159,17 +159,32 @@ pub fn program(
     if has(ChipType::Sphere) {
         objk.push((
             "k_sphere",
-            k::sphere_with(lay.ks_sphere, lay.ep_sphere, nm.approx(), lay.sphere_fine),
+            k::sphere_with(
+                lay.ks_sphere,
+                lay.ep_sphere,
+                nm.approx(),
+                lay.sphere_fine,
+                lay.fine_normals,
+            ),
         ));
     }
     if has(ChipType::GlassSphere) {
         objk.push((
             "k_gsphere",
-            k::sphere_two_sided(lay.ks_sphere, lay.ep_sphere, nm.approx(), lay.sphere_fine),
+            k::sphere_two_sided(
+                lay.ks_sphere,
+                lay.ep_sphere,
+                nm.approx(),
+                lay.sphere_fine,
+                lay.fine_normals,
+            ),
         ));
     }
     if has(ChipType::Cylinder) {
-        objk.push(("k_cyl", k::cylinder(lay.ks_cyl, lay.ep_cyl, nm.approx())));
+        objk.push((
+            "k_cyl",
+            k::cylinder(lay.ks_cyl, lay.ep_cyl, nm.approx(), lay.fine_normals),
+        ));
         objk.push(("k_disc", k::planar(Inside::Disc, lay.kt_disc, nm.approx())));
     }
     if has(ChipType::Cone) {
@@ -220,11 +235,11 @@ pub fn program(
     if has(ChipType::GlassCylinder) {
         objk.push((
             "k_gcylf",
-            k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), false),
+            k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), false, lay.fine_normals),
         ));
         objk.push((
             "k_gcylb",
-            k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), true),
+            k::cylinder_side(lay.ks_cyl, lay.ep_cyl, nm.approx(), true, lay.fine_normals),
         ));
     }
     if has(ChipType::GlassCone) {
@@ -629,7 +644,7 @@ test_objects:\n        lw r13, PASS(r0)",
             nw = t.bv_words
         );
             }
-            broadcast_object(w, t.ty, n);
+            broadcast_object(w, t.ty, n, lay.fine_normals);
             if compact {
                 let _ = writeln!(
                     w,
@@ -852,7 +867,7 @@ pt_load: dwait\n        li r7, SBANK\n        lw r6, 8(r5)"
                 cnt = 28 + 4 * j
             );
             check(w, &n);
-            broadcast_object(w, t.ty, &n);
+            broadcast_object(w, t.ty, &n, lay.fine_normals);
             let _ = writeln!(
                 w,
                 "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
@@ -878,7 +893,7 @@ leaf_go: li r12, MAILBOX\n        addi r6, r5, {head}",
 {n}_loop:\n        lfb r7, 0(r6)\n        lfb r8, 1(r6)\n        addi r6, r6, 2\n        blt r8, r0, {n}_go\n        slli r8, r8, 4\n        add r8, r8, r12"
             );
             check(w, &n);
-            broadcast_object(w, t.ty, &n);
+            broadcast_object(w, t.ty, &n, lay.fine_normals);
             let _ = writeln!(
                 w,
                 "{n}_next:\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:"
@@ -1001,7 +1016,7 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
         lw r1, TESTS(r0)\n        addi r1, r1, 1\n        sw r1, TESTS(r0)",
             cnt = 28 + 4 * j
         );
-        broadcast_object(w, t.ty, n.as_str());
+        broadcast_object(w, t.ty, n.as_str(), lay.fine_normals);
         let _ = writeln!(
             w,
             "{n}_next:\n        addi r7, r7, {size}\n        addi r9, r9, -1\n        bnez r9, {n}_loop\n{n}_end:",
@@ -1015,9 +1030,9 @@ to_have: lw r6, 24(r5)\n        lw r13, PASS(r0)\n        li r7, SBANK + {head}"
 /// whose FB record starts at the address in `r7`, by the kernels of its
 /// type (labels prefixed `n`; clobbers r1..r3). Shared by the resident
 /// Fig. 6 / compact loops and the streamed leaf loop.
-fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
+fn broadcast_object(w: &mut String, ty: ChipType, n: &str, fine_normals: bool) {
     use super::layout::{
-        CONE_BODY_WORDS, CYL_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
+        cyl_body_words, CONE_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
     };
     let one = |w: &mut String, k: &str| {
         let _ = writeln!(
@@ -1053,7 +1068,7 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::Triangle => one(w, "k_tri"),
         ChipType::SmoothTriangle => one(w, "k_tris"),
         ChipType::Box => one(w, "k_box"),
-        ChipType::Cylinder => capped(w, "k_cyl", CYL_BODY_WORDS),
+        ChipType::Cylinder => capped(w, "k_cyl", cyl_body_words(fine_normals)),
         ChipType::Cone => capped(w, "k_cone", CONE_BODY_WORDS),
         ChipType::GlassRectangle => one(w, "k_grect"),
         ChipType::GlassTriangle => one(w, "k_gtri"),
@@ -1062,7 +1077,7 @@ fn broadcast_object(w: &mut String, ty: ChipType, n: &str) {
         ChipType::GlassCylinder | ChipType::GlassCone => {
             // Both bodies, then the caps as two-sided discs where set.
             let (front, back, body) = if ty == ChipType::GlassCylinder {
-                ("k_gcylf", "k_gcylb", CYL_BODY_WORDS)
+                ("k_gcylf", "k_gcylb", cyl_body_words(fine_normals))
             } else {
                 ("k_gconef", "k_gconeb", CONE_BODY_WORDS)
             };

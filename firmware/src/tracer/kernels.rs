@@ -91,6 +91,10 @@ pub mod ram {
     pub const TMP2: u32 = 288;
     pub const TMP3: u32 = 289;
     pub const TMP4: u32 = 290;
+    /// Two more temporaries of one kernel (the cylinder's), sharing the
+    /// cone kernel's words.
+    pub const TMP5: u32 = CONE_TMP;
+    pub const TMP6: u32 = CONE_TMP + 1;
     /// The cone kernel's frame values and zoom (8 words, temporaries of
     /// that kernel).
     pub const CONE_TMP: u32 = 291;
@@ -439,7 +443,7 @@ fn commit_streamed_normal(k: &mut K, t: u8) {
 /// `n = -(sg p / r + sqrt(s) d)`.
 pub fn sphere(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
     let nr: Approx = nr.into();
-    sphere_with(ks, ep, nr, false)
+    sphere_with(ks, ep, nr, false, true)
 }
 
 /// [`sphere`], with `fine`: spheres a few LSB across, whose rounded centre
@@ -450,8 +454,12 @@ pub fn sphere(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
 /// formed in the accumulator from the unrounded centre and the unrounded
 /// `b` (its remainder below 1 LSB, read back with `accl`, is subtracted
 /// along `d` as well): `p = (c - o) + cl - b d` to 2^-ep LSB.
-pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
-    sphere_sides(ks, ep, nr, fine, false)
+///
+/// `perp` ([`super::Numerics::fine_normals`]): `p` is made perpendicular
+/// to `d` instead ([`perpendicular_to_d`], which also takes out what `b`'s
+/// rounding left along `d`, so the fine record needs no remainder of `b`).
+pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, perp: bool) -> K {
+    sphere_sides(ks, ep, nr, fine, perp, false)
 }
 
 /// A ray starting on a transmitting sphere ignores its roots closer than
@@ -467,11 +475,30 @@ pub const SELF_LSB: i32 = 8;
 /// more than [`SELF_LSB`]) the far root, with the normal turned to the
 /// ray; a hit on the far side records the object in `ram::HIT_BACK_OBJ`.
 /// The record is the sphere's ([`sphere_with`]).
-pub fn sphere_two_sided(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
-    sphere_sides(ks, ep, nr, fine, true)
+pub fn sphere_two_sided(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, perp: bool) -> K {
+    sphere_sides(ks, ep, nr, fine, perp, true)
 }
 
-fn sphere_sides(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, two: bool) -> K {
+/// Remove from the vector in `p` its component along the ray direction
+/// (r4..r6): `p -= (p.d) d`, with `t` a temporary. The perpendicular
+/// vector `(c - o) - b d` of the sphere and cylinder tests is
+/// perpendicular to `d` only in exact arithmetic: `b` is rounded to an
+/// LSB and the Q1.14 direction is not quite unit (`|d|^2 - 1` of a few
+/// 2^-14), and the distance `b` multiplies that. Far from the eye (`b`
+/// thousands of LSB) the leftover along `d` reaches an LSB or more, and
+/// divided by a radius of a few dozen LSB it tilts the normal by a
+/// hundredth of a radian, which a Phong highlight or a reflection shows.
+fn perpendicular_to_d(k: &mut K, p: [u8; 3], t: u8) {
+    k.c(format!("mul out, r{}, r4", p[0]))
+        .c(format!("mac out, r{}, r5", p[1]))
+        .cq(format!("mac r{t}, r{}, r6, >>14", p[2]));
+    for (x, d) in p.into_iter().zip([4, 5, 6]) {
+        k.cq(format!("ldacc r{x}, <<14"))
+            .cq(format!("msu r{x}, r{t}, r{d}, >>14"));
+    }
+}
+
+fn sphere_sides(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, perp: bool, two: bool) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("sphere: oc = c - o");
@@ -481,7 +508,7 @@ fn sphere_sides(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, two: bool) 
     k.c("mul out, r8, r4")
         .c("mac out, r9, r5")
         .cq("mac r11, r10, r6, >>14"); // b
-    if fine {
+    if fine && !perp {
         // b's remainder: the accumulator minus round(b) 2^14, below 2^13
         // in magnitude, so its low half is exact (the wrap is intended).
         k.c("accl r12")
@@ -489,15 +516,21 @@ fn sphere_sides(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, two: bool) 
             .c("sub r12, r12, r14");
     }
     for (x, d) in [(8, 4), (9, 5), (10, 6)] {
-        if fine {
+        if fine && !perp {
             k.cq(format!("mul r13, r12, r{d}, >>14"))
                 .cq(format!("ldacc r{x}, <<14"))
                 .c("mac out, fb0, #1")
                 .c("msu out, r13, #1");
         } else {
             k.cq(format!("ldacc r{x}, <<14"));
+            if fine {
+                k.c("mac out, fb0, #1");
+            }
         }
         k.c(format!("msu r{x}, r11, r{d}, >>{}", q(14) - ep));
+    }
+    if perp {
+        perpendicular_to_d(&mut k, [8, 9, 10], 12);
     }
     let er = if fine { ep } else { 0 };
     k.c("mov r12, fb0").c("mov r13, fb0"); // r, invr
@@ -1119,18 +1152,28 @@ fn commit_obj_mat(k: &mut K, back: Option<bool>) {
 }
 
 /// Open cylinder body (the caps are [`Inside::Disc`] planar records).
-/// Record (34 words): `B.xyz, e1.xyz, e2.xyz, e1.xyz, e2.xyz, invr, r, sg,
-/// B.xyz, a.xyz, H+2, sg, (e1, e2) x, (e1, e2) y, (e1, e2) z, obj, mat`
-/// (e1, e2, a an orthonormal frame, a along the axis, B the base centre, H
-/// the height, scene units). The perpendicular vector keeps `ep` extra
-/// fraction bits, as the sphere's, and the normal follows from it without
-/// the hit point.
+/// Record (36 words): `B.xyz, e1.xyz, b1, e2.xyz, b2, e1.xyz, e2.xyz, invr,
+/// r, sg, B.xyz, a.xyz, H+2, sg, (e1, e2) x, (e1, e2) y, (e1, e2) z, obj,
+/// mat` (e1, e2, a an orthonormal frame, a along the axis, B the base
+/// centre rounded to the LSB and `b1`, `b2` what the rounding left of it
+/// along e1 and e2 in 2^-14 LSB, H the height, scene units; `r` with `ep`
+/// extra fraction bits, `invr = 2^(14+ks) / r` of the unrounded radius).
+/// The perpendicular vector keeps `ep` extra fraction bits, as the
+/// sphere's, formed from the unrounded `(B - o).e1`, `(B - o).e2` (the
+/// rounding remainders of the projections and of B added back in the
+/// accumulator) and made perpendicular to the 2D direction; the normal
+/// follows from it without the hit point.
 ///
 /// In the plane across the axis the ray is a 2D ray: its direction
 /// `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D problem is the
 /// sphere's perpendicular method, and `t = tau / |d2|` by [`divide`].
-pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
-    cylinder_sides(ks, ep, nr, None)
+///
+/// Without `fine` ([`super::Numerics::fine_normals`] off) the record has
+/// no `b1`, `b2` (34 words), `r` is rounded to the LSB and `invr` is of
+/// that, and the perpendicular vector is formed from the rounded
+/// projections and left as it comes.
+pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool) -> K {
+    cylinder_sides(ks, ep, nr, None, fine)
 }
 
 /// The body of a transmitting cylinder, one side per run: its record holds
@@ -1139,23 +1182,33 @@ pub fn cylinder(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
 /// run this is (recorded in `ram::HIT_BACK_OBJ`). Both accept a root only
 /// more than [`SELF_LSB`] ahead along the ray (a ray starting on the
 /// surface, however rounded, does not hit it there again).
-pub fn cylinder_side(ks: u32, ep: u32, nr: impl Into<Approx>, back: bool) -> K {
-    cylinder_sides(ks, ep, nr, Some(back))
+pub fn cylinder_side(ks: u32, ep: u32, nr: impl Into<Approx>, back: bool, fine: bool) -> K {
+    cylinder_sides(ks, ep, nr, Some(back), fine)
 }
 
-fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -> K {
+fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>, fine: bool) -> K {
     let nr: Approx = nr.into();
     let mut k = K::default();
     k.comment("cylinder: oc = B - o, projected on e1, e2");
     k.c("sub r8, fb0, r1")
         .c("sub r9, fb0, r2")
         .c("sub r10, fb0, r3");
-    k.c("mul out, fb0, r8")
-        .c("mac out, fb0, r9")
-        .cq("mac r11, fb0, r10, >>14");
-    k.c("mul out, fb0, r8")
-        .c("mac out, fb0, r9")
-        .cq("mac r12, fb0, r10, >>14");
+    // oc2 = (oc.e1, oc.e2) rounded to LSB, and what the rounding left (in
+    // 2^-14 LSB, the accumulator's low half minus the rounded value's, exact
+    // below 2^13): added back when the perpendicular vector is formed, whose
+    // half-LSB error over a radius of a few dozen LSB would tilt the normal.
+    for (x, rem, t, at) in [(11, 14, 15, ram::TMP5), (12, 15, 13, ram::TMP6)] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r9")
+            .cq(format!("mac r{x}, fb0, r10, >>14"));
+        if fine {
+            k.c(format!("accl r{rem}"))
+                .cq(format!("sll r{t}, r{x}, #14"))
+                .c(format!("sub r{rem}, r{rem}, r{t}"))
+                .c(format!("add r{rem}, fb0, r{rem}"))
+                .c(format!("st r{rem}, [#{at}]"));
+        }
+    }
     k.c(format!("st r11, [#{}]", ram::TMP0))
         .c(format!("st r12, [#{}]", ram::TMP1));
     k.c("mul out, fb0, r4")
@@ -1172,10 +1225,25 @@ fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -
     k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
         .c(format!("ld r12, [r0 + #{}]", ram::TMP1));
     k.cq("mul out, r11, r8").cq("mac r13, r12, r9, >>14"); // b
-    k.cq("ldacc r11, <<14")
-        .c(format!("msu r11, r13, r8, >>{}", q(14) - ep));
-    k.cq("ldacc r12, <<14")
-        .c(format!("msu r12, r13, r9, >>{}", q(14) - ep));
+    if fine {
+        k.c(format!("ld r14, [r0 + #{}]", ram::TMP5))
+            .c(format!("ld r15, [r0 + #{}]", ram::TMP6));
+    }
+    for (x, rem, d) in [(11, 14, 8), (12, 15, 9)] {
+        k.cq(format!("ldacc r{x}, <<14"));
+        if fine {
+            k.c(format!("mac out, r{rem}, #1"));
+        }
+        k.c(format!("msu r{x}, r13, r{d}, >>{}", q(14) - ep));
+    }
+    if fine {
+        // p2 perpendicular to d2n (see `perpendicular_to_d`)
+        k.c("mul out, r11, r8").cq("mac r14, r12, r9, >>14");
+        for (x, d) in [(11, 8), (12, 9)] {
+            k.cq(format!("ldacc r{x}, <<14"))
+                .cq(format!("msu r{x}, r14, r{d}, >>14"));
+        }
+    }
     k.c("mov r14, fb0")
         .c(format!("mul r11, r11, r14, >>{}", ks + ep))
         .c(format!("mul r12, r12, r14, >>{}", ks + ep))
@@ -1189,8 +1257,9 @@ fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -
         .c("(f) cmp.gt r10, #0");
     sqrt_q14(&mut k, 15, 8, [9, 11, 12, 14], nr);
     k.c(format!("st r8, [#{}]", ram::TMP4));
+    let er = if fine { ep } else { 0 };
     k.c("mov r9, fb0")
-        .cq("mul r9, r9, r8, >>14") // h
+        .c(format!("mul r9, r9, r8, >>{}", q(14) + er)) // h
         .c("mov r11, fb0")
         .cq("mul r9, r9, r11, >>14")
         .c("sub r9, r13, r9") // tau
@@ -2225,17 +2294,23 @@ pub fn pk_init_ram(k: &mut K) {
 mod tests {
     use super::*;
     use crate::tracer::layout::{
-        CONE_BODY_WORDS, CYL_BODY_WORDS, PLANAR_WORDS, SPHERE_FINE_WORDS, SPHERE_WORDS,
+        CONE_BODY_WORDS, CYL_BODY_WORDS, CYL_BODY_WORDS_COARSE, PLANAR_WORDS, SPHERE_FINE_WORDS,
+        SPHERE_WORDS,
     };
 
     #[test]
     fn every_kernel_reads_exactly_its_record() {
         assert_eq!(sphere(8, 2, 2).fb_reads, SPHERE_WORDS);
-        assert_eq!(sphere_with(8, 2, 2, true).fb_reads, SPHERE_FINE_WORDS);
+        assert_eq!(sphere_with(8, 2, 2, true, true).fb_reads, SPHERE_FINE_WORDS);
+        assert_eq!(
+            sphere_with(8, 2, 2, true, false).fb_reads,
+            SPHERE_FINE_WORDS
+        );
         for i in [Inside::Triangle, Inside::Rectangle, Inside::Disc] {
             assert_eq!(planar(i, 9, 2).fb_reads, PLANAR_WORDS);
         }
-        assert_eq!(cylinder(8, 2, 2).fb_reads, CYL_BODY_WORDS);
+        assert_eq!(cylinder(8, 2, 2, true).fb_reads, CYL_BODY_WORDS);
+        assert_eq!(cylinder(8, 2, 2, false).fb_reads, CYL_BODY_WORDS_COARSE);
         assert_eq!(cone(8, 2, 2).fb_reads, CONE_BODY_WORDS);
         assert_eq!(polygon_head(2).fb_reads, 15);
         assert_eq!(aabox(2).fb_reads, crate::tracer::layout::BOX_WORDS);

@@ -185,9 +185,23 @@ pub const PLANAR_WORDS: usize = 20;
 /// Smooth triangle: the planar record with the vertex normals (per axis
 /// `n0, n1, n2`, Q1.14) before the face normal at its end.
 pub const SMOOTH_WORDS: usize = PLANAR_WORDS + 9;
-pub const CYL_BODY_WORDS: usize = 34;
+pub const CYL_BODY_WORDS: usize = 36;
+/// The cylinder body without the base's remainders (fine normals off).
+pub const CYL_BODY_WORDS_COARSE: usize = 34;
+
+/// Words of a cylinder body ([`super::kernels::cylinder`]).
+pub const fn cyl_body_words(fine_normals: bool) -> usize {
+    if fine_normals {
+        CYL_BODY_WORDS
+    } else {
+        CYL_BODY_WORDS_COARSE
+    }
+}
+
 /// Cylinder group: caps flag, body, base cap, apex cap.
-pub const CYL_WORDS: usize = 1 + CYL_BODY_WORDS + 2 * PLANAR_WORDS;
+pub const fn cyl_words(fine_normals: bool) -> usize {
+    1 + cyl_body_words(fine_normals) + 2 * PLANAR_WORDS
+}
 pub const CONE_BODY_WORDS: usize = 40;
 /// Cone group: caps flag, body, base cap, apex cap (as the cylinder's).
 pub const CONE_WORDS: usize = 1 + CONE_BODY_WORDS + 2 * PLANAR_WORDS;
@@ -271,6 +285,9 @@ pub struct Layout {
     /// Sphere records carry the centre's rounding remainder and the radius
     /// with `ep_sphere` extra bits ([`SPHERE_FINE_BELOW_LSB`]).
     pub sphere_fine: bool,
+    /// [`super::Numerics::fine_normals`]: the sphere and cylinder kernels
+    /// and the cylinder record.
+    pub fine_normals: bool,
     /// The same for the cylinder kernel.
     pub ep_cyl: u32,
     /// Scale shift of the cone kernel's `invS` and extra fraction bits of
@@ -712,10 +729,11 @@ pub fn build(
     image: &SceneImage,
     opt: &Options,
     guard_bits: u32,
+    fine_normals: bool,
     force_stream: bool,
 ) -> Result<Layout, String> {
     if !force_stream {
-        let lay = build_as(scene, image, opt, guard_bits, false, false)?;
+        let lay = build_as(scene, image, opt, guard_bits, fine_normals, false, false)?;
         if lay.stream.is_none() {
             return Ok(lay);
         }
@@ -724,7 +742,15 @@ pub fn build(
     // small: it is laid out again in the finest format with one guard bit
     // (differences of two points of the scene still fit), the compiler's
     // rule, and sphere records carry the unrounded radius's reciprocal.
-    build_as(scene, image, opt, guard_bits.min(1), true, true)
+    build_as(
+        scene,
+        image,
+        opt,
+        guard_bits.min(1),
+        fine_normals,
+        true,
+        true,
+    )
 }
 
 /// Lay out the scene for the packet traversal. `fine`: the format of the
@@ -739,11 +765,12 @@ pub fn build_packet(
     image: &SceneImage,
     opt: &Options,
     guard_bits: u32,
+    fine_normals: bool,
     force_stream: bool,
     fine: bool,
 ) -> Result<Layout, String> {
     let g = if fine { guard_bits.min(1) } else { guard_bits };
-    build_as(scene, image, opt, g, fine, force_stream)
+    build_as(scene, image, opt, g, fine_normals, fine, force_stream)
 }
 
 fn build_as(
@@ -751,6 +778,7 @@ fn build_as(
     image: &SceneImage,
     opt: &Options,
     guard_bits: u32,
+    fine_normals: bool,
     fine: bool,
     streamed: bool,
 ) -> Result<Layout, String> {
@@ -1097,8 +1125,8 @@ fn build_as(
         let size = match t {
             ChipType::Sphere | ChipType::GlassSphere if sphere_fine => SPHERE_FINE_WORDS,
             ChipType::Sphere | ChipType::GlassSphere => SPHERE_WORDS,
-            ChipType::Cylinder => CYL_WORDS,
-            ChipType::GlassCylinder => CYL_WORDS + CYL_BODY_WORDS,
+            ChipType::Cylinder => cyl_words(fine_normals),
+            ChipType::GlassCylinder => cyl_words(fine_normals) + cyl_body_words(fine_normals),
             ChipType::GlassCone => CONE_WORDS + CONE_BODY_WORDS,
             ChipType::Cone => CONE_WORDS,
             ChipType::Box => BOX_WORDS,
@@ -1228,8 +1256,16 @@ fn build_as(
                     let av = axis * (1.0 / h);
                     let e1 = perpendicular(av);
                     let e2 = av.cross(e1);
-                    let rq = (base_radius.abs() * s).round().max(1.0);
-                    let invr = ((14 + xb + ks_cyl) as f64).exp2() / rq;
+                    let rs = base_radius.abs() * s;
+                    // Fine normals: the radius with `ep` extra bits and its
+                    // reciprocal unrounded; otherwise both of the rounded
+                    // radius.
+                    let rq = rs.round().max(1.0);
+                    let invr =
+                        ((14 + xb + ks_cyl) as f64).exp2() / if fine_normals { rs } else { rq };
+                    // The base's rounding remainder along e1 and e2.
+                    let bq = Vec3::from(base.to_array().map(|x| w.sat(x * s) as f64));
+                    let brem = *base * s - bq;
                     let sg = if *inside { -1.0 } else { 1.0 };
                     w.raw(*caps as i64);
                     // A transmitting cylinder: the body twice, the second
@@ -1243,11 +1279,21 @@ fn build_as(
                         let sg = sg * side;
                         w.point(*base);
                         w.unit(e1);
+                        if fine_normals {
+                            w.push(brem.dot(e1) * w.one());
+                        }
                         w.unit(e2);
+                        if fine_normals {
+                            w.push(brem.dot(e2) * w.one());
+                        }
                         w.unit(e1);
                         w.unit(e2);
                         w.push(invr);
-                        w.push(rq);
+                        if fine_normals {
+                            w.push(rs * (ep_cyl as f64).exp2());
+                        } else {
+                            w.push(rq);
+                        }
                         w.push(sg * w.one());
                         w.point(*base);
                         w.unit(av);
@@ -1378,6 +1424,7 @@ fn build_as(
         ks_cyl,
         ep_sphere,
         sphere_fine,
+        fine_normals,
         ep_cyl,
         ks_cone,
         ep_cone,
@@ -1398,6 +1445,7 @@ fn build_as(
                 ep_cyl,
                 ks_cone,
                 ep_cone,
+                fine_normals,
             )
         } else {
             Vec::new()
@@ -1648,6 +1696,7 @@ struct Finish {
     ks_cyl: u32,
     ep_sphere: u32,
     sphere_fine: bool,
+    fine_normals: bool,
     ep_cyl: u32,
     ks_cone: u32,
     ep_cone: u32,
@@ -1704,6 +1753,7 @@ impl Finish {
             ks_cyl: self.ks_cyl,
             ep_sphere: self.ep_sphere,
             sphere_fine: self.sphere_fine,
+            fine_normals: self.fine_normals,
             ep_cyl: self.ep_cyl,
             ks_cone: self.ks_cone,
             ep_cone: self.ep_cone,
@@ -1734,12 +1784,13 @@ fn object_costs(
     ep_cyl: u32,
     ks_cone: u32,
     ep_cone: u32,
+    fine_normals: bool,
 ) -> Vec<f64> {
     use super::kernels as k;
     let nr = 2u32;
-    let sphere = k::sphere_with(ks_sphere, ep_sphere, nr, fine).len();
+    let sphere = k::sphere_with(ks_sphere, ep_sphere, nr, fine, fine_normals).len();
     let disc = k::planar(Inside::Disc, 8, nr).len();
-    let cyl = k::cylinder(ks_cyl, ep_cyl, nr).len();
+    let cyl = k::cylinder(ks_cyl, ep_cyl, nr, fine_normals).len();
     let cone = k::cone(ks_cone, ep_cone, nr).len();
     let boxk = k::aabox(nr).len();
     let planar = k::planar(Inside::Triangle, 8, nr).len();
