@@ -1165,6 +1165,42 @@ fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             log_y: false,
         },
     )?);
+    // Coarse against fine normals: PSNR against cycles per scene, the
+    // arrow's tail the kernels as first written.
+    let normals: Vec<Series> = scenes
+        .iter()
+        .filter_map(|s| {
+            let pick = |k: &str| rows.iter().find(|r| r.scene == *s && r.knob == k);
+            let (coarse, fine) = (pick("normals")?, pick("paper")?);
+            Some(Series {
+                name: format!("{} ({}-bit)", short(s), fine.datapath_bits),
+                points: [coarse, fine]
+                    .iter()
+                    .map(|r| (r.cycles as f64, r.psnr_db))
+                    .collect(),
+                style: SeriesStyle::default(),
+            })
+        })
+        .collect();
+    if !normals.is_empty() {
+        out.extend(charts::write(
+            &dir.join("normals"),
+            &Chart {
+                title: format!(
+                    "Normals: each line from coarse to fine, paper configuration ({}x{})",
+                    size.0, size.1
+                ),
+                x_label: "chip cycles per frame".into(),
+                y_label: "PSNR against the f64 reference (dB)".into(),
+                series: normals,
+                marks: vec![],
+                lines: true,
+                log_x: true,
+                pareto: false,
+                log_y: false,
+            },
+        )?);
+    }
     let knob_scenes = rows
         .iter()
         .filter(|r| r.knob == "paper")

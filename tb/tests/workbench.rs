@@ -266,4 +266,23 @@ fn a_one_scene_knob_sweep_writes_no_scaling_chart() {
     assert!(ok, "{out}\n{err}");
     let svg = std::fs::read_to_string(d.join("two/scaling.svg")).unwrap();
     assert!(svg.contains("paper configuration"), "{svg}");
+    // Coarse beside fine normals: a row of its own, and a chart of the
+    // pairs. jacks-1's spheres and cylinders take the fine kernels' extra
+    // contexts (tetra-1 has neither: the same kernels).
+    let svg = std::fs::read_to_string(d.join("two/normals.svg")).unwrap();
+    assert!(svg.contains("jacks-1") && svg.contains("tetra-1"), "{svg}");
+    let csv = std::fs::read_to_string(d.join("two/results.csv")).unwrap();
+    let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| head.iter().position(|h| *h == name).unwrap();
+    let cycles = |knob: &str, normals: &str| -> u64 {
+        csv.lines()
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .find(|f| {
+                f[0].contains("jacks-1") && f[col("knob")] == knob && f[col("normals")] == normals
+            })
+            .unwrap_or_else(|| panic!("no jacks-1 row {knob}, {normals}:\n{csv}"))[col("cycles")]
+        .parse()
+        .unwrap()
+    };
+    assert!(cycles("normals", "coarse") < cycles("paper", "fine"));
 }
