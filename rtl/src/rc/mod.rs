@@ -22,7 +22,7 @@ use std::fmt;
 
 use crate::kernel::{Clocked, Fault};
 use crate::trace::{Display, Filter, Probe, Traced};
-use context::{ASrc, BSrc, Context, Guard, Op};
+use context::{ASrc, BSrc, Cond, Context, Guard, Op};
 use flags::Flags;
 use lanes::{full, select, select_word, Mask};
 use ram::Ram;
@@ -231,6 +231,60 @@ fn sat<W: Word, const N: usize>(res: &mut [W; N], f: impl Fn(usize) -> (W, bool)
     lanes::pack_bools(&v)
 }
 
+/// The multiplier's output stage over every lane: the accumulator shifted
+/// right by `sh` (rounded unless `trunc`) and saturated to the word;
+/// returns the saturated lanes. The rounding choice is made once, outside
+/// the lane loop (`sh = 0` has no rounding bit either way).
+#[inline(always)]
+fn scale_lanes<W: Word, const N: usize>(
+    acc: &[W::Acc; N],
+    sh: u32,
+    trunc: bool,
+    res: &mut [W; N],
+) -> Mask {
+    if trunc || sh & (2 * W::BITS - 1) == 0 {
+        sat(res, |i| W::scale(acc[i], sh, true))
+    } else {
+        sat(res, |i| W::scale(acc[i], sh, false))
+    }
+}
+
+/// The flag F of every lane for `cmp` (before the merge with the executing
+/// lanes): the condition chosen once, each arm a loop over the lanes (the
+/// condition inside the loop kept it from vectorising).
+#[inline(always)]
+fn cmp_mask<W: Word, const N: usize>(
+    cond: Cond,
+    a: &[W; N],
+    b: &[W; N],
+    cf: Mask,
+    vf: Mask,
+) -> Mask {
+    macro_rules! by {
+        ($k:expr) => {
+            lanes::pack::<N>(|i| W::cond($k, a[i], b[i], false, false))
+        };
+    }
+    match cond {
+        Cond::Eq => by!(Cond::Eq),
+        Cond::Ne => by!(Cond::Ne),
+        Cond::Lt => by!(Cond::Lt),
+        Cond::Ge => by!(Cond::Ge),
+        Cond::Le => by!(Cond::Le),
+        Cond::Gt => by!(Cond::Gt),
+        Cond::Ltu => by!(Cond::Ltu),
+        Cond::Geu => by!(Cond::Geu),
+        Cond::Leu => by!(Cond::Leu),
+        Cond::Gtu => by!(Cond::Gtu),
+        Cond::Bit => by!(Cond::Bit),
+        Cond::Nbit => by!(Cond::Nbit),
+        Cond::Cs => cf & full(N),
+        Cond::Vs => vf & full(N),
+        Cond::True => full(N),
+        Cond::False => 0,
+    }
+}
+
 impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
     fn eval(&mut self) -> Result<(), Fault> {
         let c = self.ctx;
@@ -320,10 +374,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
             }
             Op::Cmp => {
-                let (cf, vf, cond) = (self.flags.c, self.flags.v, c.cond());
-                self.d_f = lanes::pack::<N>(|i| {
-                    W::cond(cond, a[i], b[i], cf >> i & 1 != 0, vf >> i & 1 != 0)
-                });
+                self.d_f = cmp_mask(c.cond(), a, b, self.flags.c, self.flags.v);
                 self.pend.f = true;
             }
             Op::Sll => map!(res, |i| W::sll(a[i], W::amount(b[i]))),
@@ -348,18 +399,28 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                     }
                     _ => unreachable!(),
                 }
-                for i in 0..N {
-                    let (r, s2) = W::scale(acc_d[i], sh, trunc);
-                    res[i] = r;
-                    s[i] |= s2;
+                // The rounding choice once, outside the lane loop (`sh = 0`
+                // has no rounding bit either way).
+                macro_rules! scale {
+                    ($trunc:expr) => {
+                        for i in 0..N {
+                            let (r, s2) = W::scale(acc_d[i], sh, $trunc);
+                            res[i] = r;
+                            s[i] |= s2;
+                        }
+                    };
+                }
+                if trunc || sh & (2 * W::BITS - 1) == 0 {
+                    scale!(true)
+                } else {
+                    scale!(false)
                 }
                 (self.d_v, self.d_c) = (lanes::pack_bools(&s), 0);
                 self.pend.cv = true;
                 self.pend.acc = true;
             }
             Op::Acc => {
-                let acc = &self.acc;
-                self.d_v = sat(res, |i| W::scale(acc[i], sh, trunc));
+                self.d_v = scale_lanes(&self.acc, sh, trunc, res);
                 (self.d_c, self.pend.cv) = (0, true);
             }
             Op::Acch => map!(res, |i| W::acch(self.acc[i])),

@@ -68,12 +68,18 @@ macro_rules! multiplier_unit {
 }
 
 /// 32-bit accumulator: the exact sum in 64 bits, clamped (vectorises).
+/// `acc +- p` saturated to 32 bits. In 32-bit arithmetic: a 16x16 product
+/// is at most 2^30 in magnitude, so `-p` fits, and an overflow's true sum
+/// lies beyond the limit on `acc`'s side (same as the 64-bit sum clamped,
+/// which the property tests check; without 64-bit lanes it vectorises
+/// twice as wide).
 #[inline(always)]
 fn accumulate32(acc: i32, p: i32, sub: bool) -> (i32, bool) {
-    let p = if sub { -(p as i64) } else { p as i64 };
-    let w = acc as i64 + p;
-    let r = w.clamp(i32::MIN as i64, i32::MAX as i64);
-    (r as i32, r != w)
+    let q = if sub { p.wrapping_neg() } else { p };
+    let r = acc.wrapping_add(q);
+    // Overflow: both addends of one sign, the sum of the other.
+    let o = ((acc ^ r) & (q ^ r)) < 0;
+    ((if o { (acc >> 31) ^ i32::MAX } else { r }), o)
 }
 
 /// 64-bit accumulator: a wrapping sum and its overflow flag (i128 sums do
