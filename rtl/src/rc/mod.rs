@@ -79,8 +79,10 @@ pub struct RcArray<const N: usize, W: Word = i16> {
     res: [W; N],
     acc_d: [W::Acc; N],
     addr: [u16; N],
-    /// The RAM access of this cycle has one address in every lane.
+    /// The RAM access of this cycle has one address in every lane,
+    /// `addr0` (`addr` is then not written).
     uniform: bool,
+    addr0: u16,
     d_c: Mask,
     d_v: Mask,
     d_f: Mask,
@@ -127,6 +129,7 @@ impl<const N: usize, W: Word> RcArray<N, W> {
             acc_d: [W::Acc::default(); N],
             addr: [0; N],
             uniform: false,
+            addr0: 0,
             d_c: 0,
             d_v: 0,
             d_f: 0,
@@ -182,6 +185,16 @@ impl<const N: usize, W: Word> RcArray<N, W> {
         match self.ctx.b {
             BSrc::Reg(r) => self.regs.read(r)[i],
             BSrc::Imm(v) => W::imm(v),
+        }
+    }
+
+    /// The RAM address of lane `i` in the cycle just evaluated (a `ld` or
+    /// `st`).
+    pub fn ram_addr(&self, i: usize) -> u16 {
+        if self.uniform {
+            self.addr0
+        } else {
+            self.addr[i]
         }
     }
 
@@ -440,28 +453,44 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 } else {
                     map!(addr, |i| W::addr(a[i], b[i]));
                 }
-                let mut bad = [false; N];
-                for i in 0..N {
-                    bad[i] = !Ram::<N, W>::valid(addr[i]);
-                }
-                let bad = lanes::pack_bools(&bad) & en;
-                if bad != 0 {
-                    let i = bad.trailing_zeros() as usize;
-                    let msg = format!("RAM address {} outside 0..=511", addr[i]);
-                    return Err(self.lane_fault(i, msg));
-                }
                 // One address in every lane (constants, the stack, the hit
-                // record): a whole RAM row; otherwise one word per lane.
-                let a0 = addr[0];
-                self.uniform = addr.iter().all(|&x| x == a0);
-                for i in 0..N {
-                    self.addr[i] = addr[i].clamp(0, 511) as u16;
+                // record): a whole RAM row, one address to check and keep;
+                // otherwise one word per lane.
+                // (lane 0's address from its operands, not read back from
+                // `addr`: a scalar load of a vector just stored stalls)
+                let a0 = if store {
+                    W::addr1(b[0])
+                } else {
+                    W::addr(a[0], b[0])
+                };
+                self.uniform = addr.iter().fold(true, |u, &x| u & (x == a0));
+                if self.uniform {
+                    if !Ram::<N, W>::valid(a0) {
+                        let i = en.trailing_zeros() as usize;
+                        let msg = format!("RAM address {a0} outside 0..=511");
+                        return Err(self.lane_fault(i, msg));
+                    }
+                    self.addr0 = a0 as u16;
+                } else {
+                    let mut bad = [false; N];
+                    for i in 0..N {
+                        bad[i] = !Ram::<N, W>::valid(addr[i]);
+                    }
+                    let bad = lanes::pack_bools(&bad) & en;
+                    if bad != 0 {
+                        let i = bad.trailing_zeros() as usize;
+                        let msg = format!("RAM address {} outside 0..=511", addr[i]);
+                        return Err(self.lane_fault(i, msg));
+                    }
+                    for i in 0..N {
+                        self.addr[i] = addr[i].clamp(0, 511) as u16;
+                    }
                 }
                 if store {
                     // A store has no result: `res` carries its data to the edge.
                     *res = *a;
                 } else if self.uniform {
-                    *res = *self.ram.row(self.addr[0] as usize);
+                    *res = *self.ram.row(self.addr0 as usize);
                 } else {
                     for i in 0..N {
                         res[i] = self.ram.read(i, self.addr[i] as usize);
@@ -498,7 +527,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
         }
         if p.store {
             if self.uniform {
-                select_word(self.ram.row_mut(self.addr[0] as usize), en, &self.res);
+                select_word(self.ram.row_mut(self.addr0 as usize), en, &self.res);
             } else {
                 for i in 0..N {
                     if en >> i & 1 != 0 {
@@ -593,7 +622,7 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
                     "addr",
                     9,
                     Display::Hex,
-                    if mem { self.addr[i] as u64 } else { 0 },
+                    if mem { self.ram_addr(i) as u64 } else { 0 },
                 );
                 p.signal("we", 1, Display::Bin, (mem && c.op == Op::St) as u64);
                 p.end();
