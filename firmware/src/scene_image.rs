@@ -295,6 +295,16 @@ fn coordinates(s: &Shape) -> Vec<f64> {
     out
 }
 
+/// The fraction bits of the format [`compile`] fits to `scene` with
+/// `guard_bits`, if it can represent the scene (no BSP built).
+pub fn fitted_frac(scene: &Scene, guard_bits: u32) -> Option<u32> {
+    let opt = CompileOptions {
+        guard_bits,
+        ..CompileOptions::default()
+    };
+    fit(scene, &opt).ok().map(|(q, _)| q.frac)
+}
+
 /// Fit the format, or say why the scene cannot be represented.
 fn fit(scene: &Scene, opt: &CompileOptions) -> Result<(QFormat, f64), SceneError> {
     let err = |line: usize, message: String| SceneError {

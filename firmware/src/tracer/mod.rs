@@ -404,7 +404,6 @@ fn build_as(
     nm: &Numerics,
     force_stream: bool,
 ) -> Result<Firmware, String> {
-    let fw = build_any_bsp(scene, opt, nm, force_stream)?;
     let curved = scene.objects.iter().any(|o| {
         matches!(
             o.shape,
@@ -412,12 +411,30 @@ fn build_as(
         )
     });
     if !nm.fine_normals || !curved {
-        return Ok(fw);
+        return build_any_bsp(scene, opt, nm, force_stream);
     }
-    let lsb = (-(fw.frac as f64)).exp2();
-    let eye = scene.camera.from;
-    let snap = |x: f64| (x / lsb).round() * lsb - x;
-    let d = crate::scene::Vec3::new(snap(eye.x), snap(eye.y), snap(eye.z));
+    // The move that puts the eye on the grid of `frac`.
+    let to_grid = |frac: u32| {
+        let lsb = (-(frac as f64)).exp2();
+        let eye = scene.camera.from;
+        let snap = |x: f64| (x / lsb).round() * lsb - x;
+        crate::scene::Vec3::new(snap(eye.x), snap(eye.y), snap(eye.z))
+    };
+    // Built once where the format is foreseen (a resident layout's: the
+    // compiler's fit refined by the layout's), else built, moved and
+    // built again.
+    let foreseen = crate::scene_image::fitted_frac(scene, nm.guard_bits)
+        .map(|c| layout::fit_frac(scene, c, nm.guard_bits) + opt.datapath.bits() - 16);
+    if let Some(frac) = foreseen {
+        let d = to_grid(frac);
+        if let Ok(fw) = build_any_bsp(&scene.translated(d), opt, nm, force_stream) {
+            if fw.frac == frac {
+                return Ok(fw);
+            }
+        }
+    }
+    let fw = build_any_bsp(scene, opt, nm, force_stream)?;
+    let d = to_grid(fw.frac);
     if d == crate::scene::Vec3::ZERO {
         return Ok(fw);
     }
