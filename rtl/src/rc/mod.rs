@@ -440,8 +440,17 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             Op::Accl => map!(res, |i| W::accl(self.acc[i])),
             Op::Ldacc => {
                 let acc_d = &mut self.acc_d;
-                for i in 0..N {
-                    acc_d[i] = W::ldacc(a[i], sh);
+                // The shift the tracer uses (a Q.14 or Q.30 product's
+                // scale) cannot saturate: no clamp in a wider type.
+                let sh = sh & (2 * W::BITS - 1);
+                if sh < W::BITS {
+                    for i in 0..N {
+                        acc_d[i] = W::ldacc_narrow(a[i], sh);
+                    }
+                } else {
+                    for i in 0..N {
+                        acc_d[i] = W::ldacc(a[i], sh);
+                    }
                 }
                 self.pend.acc = true;
             }

@@ -52,6 +52,14 @@ macro_rules! multiplier_unit {
                 ((a as $w) << (sh & $smask)).clamp(<$acc>::MIN as $w, <$acc>::MAX as $w) as $acc
             }
 
+            /// [`load`] for `sh` below the word's width: `A 2^sh` always
+            /// fits the accumulator (at most 2^(2 bits - 2) in magnitude),
+            /// so no clamp and no wider type.
+            #[inline(always)]
+            pub fn load_narrow(a: $t, sh: u32) -> $acc {
+                (a as $acc) << sh
+            }
+
             /// `acch`: the accumulator's upper word.
             #[inline(always)]
             pub fn high(acc: $acc) -> $t {

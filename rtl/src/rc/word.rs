@@ -109,6 +109,8 @@ pub trait Word:
     fn accumulate(acc: Self::Acc, p: Self::Acc, sub: bool) -> (Self::Acc, bool);
     fn scale(acc: Self::Acc, sh: u32, trunc: bool) -> (Self, bool);
     fn ldacc(a: Self, sh: u32) -> Self::Acc;
+    /// `ldacc` for `sh < BITS` (no saturation possible).
+    fn ldacc_narrow(a: Self, sh: u32) -> Self::Acc;
     fn acch(acc: Self::Acc) -> Self;
     fn accl(acc: Self::Acc) -> Self;
 
@@ -235,6 +237,10 @@ macro_rules! impl_word {
             #[inline(always)]
             fn ldacc(a: Self, sh: u32) -> $acc {
                 multiplier::$m::load(a, sh)
+            }
+            #[inline(always)]
+            fn ldacc_narrow(a: Self, sh: u32) -> $acc {
+                multiplier::$m::load_narrow(a, sh)
             }
             #[inline(always)]
             fn acch(acc: $acc) -> Self {
