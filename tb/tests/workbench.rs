@@ -96,6 +96,24 @@ fn an_emitted_firmware_renders_the_same_and_an_edited_one_differs() {
         !ok && err.contains("fw.s:2: the firmware was generated for `32x32"),
         "{err}"
     );
+    // The fine normals' records and kernels are not the coarse ones'.
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "render",
+            &s,
+            "--size",
+            "32x32",
+            "--normals",
+            "coarse",
+            "--firmware",
+            "fw.s",
+        ],
+    );
+    assert!(
+        !ok && err.contains("fine normals`; these options give") && err.contains("coarse normals`"),
+        "{err}"
+    );
     // A fault stops with the cycle and the PC, and no image is written.
     let fault = fw.replacen("ld r13, [r13 + #0]", "ld r13, [r13 + #600]", 1);
     std::fs::write(d.join("fault.s"), fault).unwrap();

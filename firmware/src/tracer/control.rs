@@ -284,7 +284,7 @@ pub fn program(
     );
     let _ = writeln!(
         w,
-        "; {}x{}, {} ways ({}x{} tiles), depth {}, {} datapath, scene format Q{}.{}",
+        "; {}x{}, {} ways ({}x{} tiles), depth {}, {} datapath, scene format Q{}.{}, {} normals",
         opt.width,
         opt.height,
         opt.ways,
@@ -293,7 +293,8 @@ pub fn program(
         opt.depth,
         opt.datapath,
         opt.datapath.bits() - 1 - lay.frac,
-        lay.frac
+        lay.frac,
+        if lay.fine_normals { "fine" } else { "coarse" }
     );
     let _ = writeln!(
         w,
