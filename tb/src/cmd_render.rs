@@ -42,8 +42,8 @@ pub struct RenderArgs {
     pub guard_bits: u32,
     /// Offset of spawned rays along the normal, in LSBs.
     pub ray_offset_lsb: i32,
-    /// `--normals fine` ([`firmware::tracer::Numerics::fine_normals`]).
-    pub fine_normals: bool,
+    /// `--normals` ([`firmware::tracer::Normals`]).
+    pub normals: firmware::tracer::Normals,
     /// Stop at once when `json` already holds a complete render made with
     /// the same `argv`.
     pub skip_done: bool,
@@ -195,7 +195,7 @@ pub fn render_built(
         "depth": opt.depth,
         "newton_steps": nm.newton_steps,
         "table_entries": nm.table_entries,
-        "normals": if nm.fine_normals { "fine" } else { "coarse" },
+        "normals": if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
         "psnr_db": if psnr.is_finite() { psnr } else { 99.0 },
         "hit_agreement": agree,
         "eye_misclassified": 1.0 - agree,
@@ -345,7 +345,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         table_entries: a.table_entries,
         guard_bits: a.guard_bits,
         eps_lsb: a.ray_offset_lsb,
-        fine_normals: a.fine_normals,
+        normals: a.normals,
     };
     let mut opt = opt;
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;

@@ -164,7 +164,7 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
         value: "coarse".into(),
         opt: base,
         nm: Numerics {
-            fine_normals: false,
+            normals: firmware::tracer::Normals::Coarse,
             ..nm
         },
     });
@@ -508,7 +508,12 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
         table_entries: nm.table_entries,
         guard_bits: nm.guard_bits,
         ray_offset_lsb: nm.eps_lsb,
-        normals: if nm.fine_normals { "fine" } else { "coarse" }.into(),
+        normals: if nm.normals.fine_on(opt.datapath) {
+            "fine"
+        } else {
+            "coarse"
+        }
+        .into(),
         datapath_bits: opt.datapath.bits(),
         format: s("format"),
         cycles: j["cycles"].as_u64().unwrap_or(0),
@@ -813,10 +818,7 @@ fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> Vec<String> 
     arg("--table-entries", n.table_entries.to_string());
     arg("--guard-bits", n.guard_bits.to_string());
     arg("--ray-offset-lsb", n.eps_lsb.to_string());
-    arg(
-        "--normals",
-        if n.fine_normals { "fine" } else { "coarse" }.into(),
-    );
+    arg("--normals", n.normals.name().into());
     match c.timing_name.as_str() {
         "default" => {}
         "M1 issue" => arg("--timing", dir.join(M1_TIMING_FILE).display().to_string()),

@@ -326,10 +326,11 @@ enum Command {
         /// coordinate format's grid with the whole scene, and the
         /// perpendicular vector formed from unrounded centres and axes and
         /// kept perpendicular to the ray: 9 more cycles per sphere test, 19
-        /// per cylinder test) or coarse (the kernels as first written, with
-        /// which the comparison with the paper was made)
-        #[arg(long, value_name = "fine|coarse", default_value = "fine", value_parser = ["fine", "coarse"])]
-        normals: String,
+        /// per cylinder test), coarse (the kernels as first written, with
+        /// which the comparison with the paper was made) or auto (fine on
+        /// the 16-bit chip, coarse on the 32-bit one)
+        #[arg(long, value_name = "auto|fine|coarse", default_value = "auto", value_parser = parse_normals)]
+        normals: firmware::tracer::Normals,
         /// With --json: when that file already holds a complete render made
         /// with these same arguments, say so and stop without rendering (a
         /// rerun of a sweep plan's jobs runs only what is missing).
@@ -406,6 +407,10 @@ fn parse_table_entries(s: &str) -> Result<u32, String> {
             "expected 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM), found '{s}'"
         )),
     }
+}
+
+fn parse_normals(s: &str) -> Result<firmware::tracer::Normals, String> {
+    s.parse()
 }
 
 fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
@@ -640,7 +645,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             table_entries,
             guard_bits,
             ray_offset_lsb,
-            fine_normals: normals == "fine",
+            normals,
             skip_done,
             argv: std::env::args().skip(1).collect(),
             profile,

@@ -64,7 +64,11 @@ fn run_in<W: Word>(
         ..Options::default()
     };
     let nm = tracer::Numerics {
-        fine_normals: FINE_NORMALS.with(|f| f.get()),
+        normals: if FINE_NORMALS.with(|f| f.get()) {
+            tracer::Normals::Fine
+        } else {
+            tracer::Normals::Coarse
+        },
         ..tracer::Numerics::default()
     };
     let fw = tracer::build_with(&scene, &opt, &nm).unwrap();

@@ -41,7 +41,7 @@ fn opts(w: u32, h: u32, traversal: Traversal) -> Options {
 #[test]
 fn paper_traversal_keeps_its_cycle_counts() {
     let coarse = Numerics {
-        fine_normals: false,
+        normals: firmware::tracer::Normals::Coarse,
         ..Numerics::default()
     };
     for (name, cycles) in [

@@ -219,14 +219,58 @@ pub struct Numerics {
     /// Entries of the reciprocal and reciprocal square root tables in every
     /// RC's RAM: 16, 32, 64 or 128 ([`kernels::TABLE_SIZES`]).
     pub table_entries: u32,
-    /// Fine normals: the eye on the coordinate format's grid (the scene
-    /// moved by less than an LSB), and the sphere and cylinder tests'
-    /// perpendicular vector formed from unrounded quantities and made
-    /// perpendicular to the ray ([`kernels::sphere_with`],
-    /// [`kernels::cylinder`]): 9 more cycles per sphere test, 19 per
-    /// cylinder test. Off: the kernels as first written (the cycle counts
-    /// the comparison with the paper was made with).
-    pub fine_normals: bool,
+    /// Fine or coarse normals ([`Normals`]).
+    pub normals: Normals,
+}
+
+/// Normals of spheres and cylinders. Fine: the eye on the coordinate
+/// format's grid (the scene moved by less than an LSB), and the sphere
+/// and cylinder tests' perpendicular vector formed from unrounded
+/// quantities and made perpendicular to the ray
+/// ([`kernels::sphere_with`], [`kernels::cylinder`]): 9 more cycles per
+/// sphere test, 19 per cylinder test. Coarse: the kernels as first
+/// written (the cycle counts the comparison with the paper was made
+/// with). Auto: fine on the 16-bit chip, whose accuracy they decide
+/// (jacks-2: 29.5 to 33.2 dB), coarse on the 32-bit chip, whose 16 more
+/// fraction bits leave nothing to gain that shows (jacks-2: 56.0 dB
+/// coarse, 66.6 fine, for 5% of the frame rate).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Normals {
+    #[default]
+    Auto,
+    Fine,
+    Coarse,
+}
+
+impl Normals {
+    /// Fine normals on `datapath`?
+    pub fn fine_on(self, datapath: rtl::rc::Datapath) -> bool {
+        match self {
+            Normals::Auto => datapath == rtl::rc::Datapath::W16,
+            Normals::Fine => true,
+            Normals::Coarse => false,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Normals::Auto => "auto",
+            Normals::Fine => "fine",
+            Normals::Coarse => "coarse",
+        }
+    }
+}
+
+impl std::str::FromStr for Normals {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Normals, String> {
+        match s {
+            "auto" => Ok(Normals::Auto),
+            "fine" => Ok(Normals::Fine),
+            "coarse" => Ok(Normals::Coarse),
+            _ => Err(format!("expected auto, fine or coarse, found '{s}'")),
+        }
+    }
 }
 
 impl Numerics {
@@ -246,7 +290,7 @@ impl Default for Numerics {
             guard_bits: 2,
             eps_lsb: kernels::EPS_LSB,
             table_entries: kernels::TABLE_ENTRIES,
-            fine_normals: true,
+            normals: Normals::Auto,
         }
     }
 }
@@ -410,7 +454,7 @@ fn build_as(
             crate::scene::Shape::Sphere { .. } | crate::scene::Shape::Cone { .. }
         )
     });
-    if !nm.fine_normals || !curved {
+    if !nm.normals.fine_on(opt.datapath) || !curved {
         return build_any_bsp(scene, opt, nm, force_stream);
     }
     // The move that puts the eye on the grid of `frac`.
@@ -509,7 +553,7 @@ fn build_one(
             &image,
             opt,
             nm.guard_bits,
-            nm.fine_normals,
+            nm.normals.fine_on(opt.datapath),
             force_stream,
         )?,
         Traversal::Packet => {
@@ -542,7 +586,7 @@ fn build_one(
                         &pi,
                         &paper_opt,
                         nm.guard_bits,
-                        nm.fine_normals,
+                        nm.normals.fine_on(opt.datapath),
                         false,
                     )
                     .map_or(true, |l| l.stream.is_some()),
@@ -554,7 +598,7 @@ fn build_one(
                 &image,
                 opt,
                 nm.guard_bits,
-                nm.fine_normals,
+                nm.normals.fine_on(opt.datapath),
                 force_stream,
                 fine,
             )?
