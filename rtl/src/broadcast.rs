@@ -181,12 +181,20 @@ impl Broadcast {
         if simd {
             // the hot path: one context
             let c = get(addr)?;
-            let mut fbd = [W::ZERO; 2];
             self.d_ptr = cur.ptr;
-            if c.asrc == ASrc::Fb {
+            // Built whole from the datum (a store into one half of the pair
+            // read back at once as the whole pair stalls the forwarding).
+            let fbd = if c.asrc == ASrc::Fb {
                 let s = (c.ra & 1) as usize;
-                fbd[s] = self.stream(s, &run, addr, fbm, dma_fb_banks)?;
-            }
+                let v = self.stream(s, &run, addr, fbm, dma_fb_banks)?;
+                if s == 0 {
+                    [v, W::ZERO]
+                } else {
+                    [W::ZERO, v]
+                }
+            } else {
+                [W::ZERO; 2]
+            };
             self.word = cm.word(addr);
             array.drive_simd(self.word, c, fbd);
             return Ok(());
