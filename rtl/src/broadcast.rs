@@ -156,9 +156,13 @@ impl Broadcast {
             array.idle();
             return Ok(());
         };
+        // The fields the cycle needs first, read from the unit itself
+        // rather than from the copy of the run (a narrow load from a wide
+        // store just made stalls the forwarding).
+        let (mode, first, k) = (cur.run.mode, cur.run.ctx, cur.k);
         let run = cur.run;
-        let simd = run.mode == Mode::Simd;
-        let addr = run.ctx + if simd { cur.k } else { cur.k * 8 };
+        let simd = mode == Mode::Simd;
+        let addr = first + if simd { k } else { k * 8 };
         if dma_ctx_banks >> context_memory::bank(addr) & 1 != 0 {
             return Err(Self::fault(
                 &run,
