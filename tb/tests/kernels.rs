@@ -422,7 +422,7 @@ struct Errors {
 }
 
 thread_local! {
-    /// [`tracer::Numerics::fine_normals`] of the firmware [`run_in`] builds
+    /// Fine (else coarse) [`tracer::Normals`] of the firmware [`run_in`] builds
     /// (each test runs on a thread of its own).
     static FINE_NORMALS: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
 }

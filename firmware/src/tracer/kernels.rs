@@ -455,8 +455,8 @@ pub fn sphere(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
 /// `b` (its remainder below 1 LSB, read back with `accl`, is subtracted
 /// along `d` as well): `p = (c - o) + cl - b d` to 2^-ep LSB.
 ///
-/// `perp` ([`super::Numerics::fine_normals`]): `p` is made perpendicular
-/// to `d` instead ([`perpendicular_to_d`], which also takes out what `b`'s
+/// `perp` (fine normals, [`super::Normals`]): `p` is made perpendicular
+/// to `d` instead ([`perpendicular_to`], which also takes out what `b`'s
 /// rounding left along `d`, so the fine record needs no remainder of `b`).
 pub fn sphere_with(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, perp: bool) -> K {
     sphere_sides(ks, ep, nr, fine, perp, false)
@@ -479,8 +479,9 @@ pub fn sphere_two_sided(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, per
     sphere_sides(ks, ep, nr, fine, perp, true)
 }
 
-/// Remove from the vector in `p` its component along the ray direction
-/// (r4..r6): `p -= (p.d) d`, with `t` a temporary. The perpendicular
+/// Remove from the vector in registers `p` its component along the unit
+/// vector in registers `d` (the ray direction r4..r6, or the cylinder's 2D
+/// direction): `p -= (p.d) d`, with `t` a temporary. The perpendicular
 /// vector `(c - o) - b d` of the sphere and cylinder tests is
 /// perpendicular to `d` only in exact arithmetic: `b` is rounded to an
 /// LSB and the Q1.14 direction is not quite unit (`|d|^2 - 1` of a few
@@ -488,13 +489,18 @@ pub fn sphere_two_sided(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, per
 /// thousands of LSB) the leftover along `d` reaches an LSB or more, and
 /// divided by a radius of a few dozen LSB it tilts the normal by a
 /// hundredth of a radian, which a Phong highlight or a reflection shows.
-fn perpendicular_to_d(k: &mut K, p: [u8; 3], t: u8) {
-    k.c(format!("mul out, r{}, r4", p[0]))
-        .c(format!("mac out, r{}, r5", p[1]))
-        .cq(format!("mac r{t}, r{}, r6, >>14", p[2]));
-    for (x, d) in p.into_iter().zip([4, 5, 6]) {
+fn perpendicular_to(k: &mut K, p: &[u8], d: &[u8], t: u8) {
+    let n = p.len();
+    for (i, (x, e)) in p.iter().zip(d).enumerate() {
+        match i {
+            0 => k.c(format!("mul out, r{x}, r{e}")),
+            _ if i + 1 < n => k.c(format!("mac out, r{x}, r{e}")),
+            _ => k.cq(format!("mac r{t}, r{x}, r{e}, >>14")),
+        };
+    }
+    for (x, e) in p.iter().zip(d) {
         k.cq(format!("ldacc r{x}, <<14"))
-            .cq(format!("msu r{x}, r{t}, r{d}, >>14"));
+            .cq(format!("msu r{x}, r{t}, r{e}, >>14"));
     }
 }
 
@@ -530,7 +536,7 @@ fn sphere_sides(ks: u32, ep: u32, nr: impl Into<Approx>, fine: bool, perp: bool,
         k.c(format!("msu r{x}, r11, r{d}, >>{}", q(14) - ep));
     }
     if perp {
-        perpendicular_to_d(&mut k, [8, 9, 10], 12);
+        perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
     }
     let er = if fine { ep } else { 0 };
     k.c("mov r12, fb0").c("mov r13, fb0"); // r, invr
@@ -1168,7 +1174,7 @@ fn commit_obj_mat(k: &mut K, back: Option<bool>) {
 /// `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D problem is the
 /// sphere's perpendicular method, and `t = tau / |d2|` by [`divide`].
 ///
-/// Without `fine` ([`super::Numerics::fine_normals`] off) the record has
+/// Without `fine` (coarse normals, [`super::Normals`]) the record has
 /// no `b1`, `b2` (34 words), `r` is rounded to the LSB and `invr` is of
 /// that, and the perpendicular vector is formed from the rounded
 /// projections and left as it comes.
@@ -1237,12 +1243,8 @@ fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>, f
         k.c(format!("msu r{x}, r13, r{d}, >>{}", q(14) - ep));
     }
     if fine {
-        // p2 perpendicular to d2n (see `perpendicular_to_d`)
-        k.c("mul out, r11, r8").cq("mac r14, r12, r9, >>14");
-        for (x, d) in [(11, 8), (12, 9)] {
-            k.cq(format!("ldacc r{x}, <<14"))
-                .cq(format!("msu r{x}, r14, r{d}, >>14"));
-        }
+        // p2 perpendicular to the 2D direction d2n
+        perpendicular_to(&mut k, &[11, 12], &[8, 9], 14);
     }
     k.c("mov r14, fb0")
         .c(format!("mul r11, r11, r14, >>{}", ks + ep))

@@ -285,8 +285,8 @@ pub struct Layout {
     /// Sphere records carry the centre's rounding remainder and the radius
     /// with `ep_sphere` extra bits ([`SPHERE_FINE_BELOW_LSB`]).
     pub sphere_fine: bool,
-    /// [`super::Numerics::fine_normals`]: the sphere and cylinder kernels
-    /// and the cylinder record.
+    /// Fine normals ([`super::Normals`], resolved for the datapath): the
+    /// sphere and cylinder kernels and the cylinder record.
     pub fine_normals: bool,
     /// The same for the cylinder kernel.
     pub ep_cyl: u32,

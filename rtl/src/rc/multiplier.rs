@@ -75,8 +75,7 @@ macro_rules! multiplier_unit {
     };
 }
 
-/// 32-bit accumulator: the exact sum in 64 bits, clamped (vectorises).
-/// `acc +- p` saturated to 32 bits. In 32-bit arithmetic: a 16x16 product
+/// 32-bit accumulator: `acc +- p` saturated to 32 bits. In 32-bit arithmetic: a 16x16 product
 /// is at most 2^30 in magnitude, so `-p` fits, and an overflow's true sum
 /// lies beyond the limit on `acc`'s side (same as the 64-bit sum clamped,
 /// which the property tests check; without 64-bit lanes it vectorises
