@@ -122,24 +122,6 @@ pub struct TraceConfig {
     pub fst_section_bytes: usize,
 }
 
-/// `v` in decimal into `out`; returns the number of digits.
-fn decimal(mut v: u64, out: &mut [u8]) -> usize {
-    let mut tmp = [0u8; 20];
-    let mut n = 0;
-    loop {
-        tmp[n] = b'0' + (v % 10) as u8;
-        n += 1;
-        v /= 10;
-        if v == 0 {
-            break;
-        }
-    }
-    for k in 0..n {
-        out[k] = tmp[n - 1 - k];
-    }
-    n
-}
-
 /// Whether a waveform path asks for FST (`.fst`) rather than VCD.
 pub fn is_fst(path: &Path) -> bool {
     path.extension()
@@ -177,48 +159,57 @@ impl TraceConfig {
 /// Where value changes go: a VCD text stream, or an FST file (header
 /// while declaring, body while sampling).
 enum Sink {
-    /// The `vcd` crate writes the header; value changes and timestamps are
-    /// written as bytes here (`core::fmt` cost more than the simulation).
-    /// `ids`: each signal's identifier code, as text.
-    Vcd(vcd::Writer<BufWriter<File>>, Vec<Box<[u8]>>),
+    /// The `vcd` crate writes the header; timestamps and value changes are
+    /// formatted as bytes by [`VcdBody`] (`core::fmt` cost more than the
+    /// simulation).
+    Vcd(vcd::Writer<BufWriter<File>>, VcdBody),
     FstHeader(fst_writer::FstHeaderWriter<BufWriter<File>>),
     FstBody(fst_writer::FstBodyWriter<BufWriter<File>>),
     /// While sampling: value changes go in batches to a thread that
     /// writes them into the sink it owns (the simulation does not wait for
     /// the formatting); [`Sink::join`] gets the sink back.
     Threaded {
-        batch: Vec<Msg>,
-        tx: std::sync::mpsc::SyncSender<Vec<Msg>>,
-        worker: std::thread::JoinHandle<(Sink, io::Result<()>)>,
+        batch: Vec<u64>,
+        tx: std::sync::mpsc::SyncSender<Vec<u64>>,
+        /// Emptied batches coming back from the writing thread.
+        spare: std::sync::mpsc::Receiver<Vec<u64>>,
+        worker: std::thread::JoinHandle<Written>,
     },
     /// Between the two FST phases, or after finishing.
     Gone,
 }
 
-/// What the sampling thread hands the writing thread.
-#[derive(Clone, Copy)]
-enum Msg {
-    Change(SigId, u32, u64),
-    /// The rising edge of a cycle at time `t`: the timestamp, `clk` 1 and
-    /// the `cycle` counter (one message where three were).
-    Rise {
-        t: u64,
-        cycle: u64,
-    },
-    /// The falling edge at time `t`: the timestamp and `clk` 0.
-    Fall(u64),
-}
+/// What the writing thread hands back: the sink, how writing went, and
+/// per traced signal the values it took if it has a translate filter.
+type Written = (Sink, io::Result<()>, Vec<BTreeSet<u64>>);
 
-/// Value changes per batch handed to the writing thread (24 bytes each);
+/// What the sampling thread hands the writing thread, packed in 64-bit
+/// words (the messages are most of the traffic between the two cores):
+///
+/// * a change of traced signal `i` (in declaration order) to `v`: one word
+///   `i << 48 | v` when `i` < [`MSG_CYCLE`] and `v` < 2^48;
+/// * a sampled cycle `c` begins, `MSG_CYCLE << 48 | c`: the falling edge
+///   of the cycle sampled before it, if any (its timestamp and `clk` 0),
+///   then this cycle's rising edge (its timestamp, `clk` 1 and the `cycle`
+///   counter); the writing thread computes the times;
+/// * anything larger: `MSG_LONG << 48 | i` (`i` = [`LONG_CYCLE`] for a
+///   cycle) and the value in the next word.
+const MSG_CYCLE: u64 = 0xFFFE;
+const MSG_LONG: u64 = 0xFFFF;
+const LONG_CYCLE: u64 = (1 << 48) - 1;
+const MSG_VALUE: u64 = (1 << 48) - 1;
+
+/// Words per batch handed to the writing thread (128 KB: a batch stays in
+/// the cores' second-level caches);
 /// at most [`QUEUED_BATCHES`] wait, so memory stays bounded when the disk
 /// is slower than the simulation.
-const BATCH: usize = 4096;
-const QUEUED_BATCHES: usize = 4;
+const BATCH: usize = 1 << 14;
+const QUEUED_BATCHES: usize = 8;
 
 /// One signal's handle in the file.
 #[derive(Clone, Copy)]
 enum SigId {
-    /// Index into the VCD sink's identifier texts.
+    /// Index into the VCD body's identifier codes.
     Vcd(u32),
     Fst(fst_writer::FstSignalId),
 }
@@ -227,6 +218,164 @@ fn fst_err(e: fst_writer::FstWriteError) -> io::Error {
     match e {
         fst_writer::FstWriteError::Io(e) => e,
         e => io::Error::other(e.to_string()),
+    }
+}
+
+/// The times of clock edges in picoseconds: the rising edge of cycle `c`
+/// at `c * 1e12 / hz` rounded down. Consecutive cycles (the common case)
+/// step by the period's quotient and remainder instead of dividing.
+struct Clock {
+    hz: u64,
+    /// `1e12 / hz` and `1e12 % hz`.
+    q: u64,
+    r: u64,
+    /// The last cycle asked for, its time and `c * 1e12 % hz`.
+    c: u64,
+    t: u64,
+    rem: u64,
+}
+
+impl Clock {
+    fn new(hz: u64) -> Clock {
+        let hz = hz.max(1);
+        Clock {
+            hz,
+            q: 1_000_000_000_000 / hz,
+            r: 1_000_000_000_000 % hz,
+            c: 0,
+            t: 0,
+            rem: 0,
+        }
+    }
+
+    /// The time of cycle `c`'s rising edge.
+    #[inline]
+    fn time(&mut self, c: u64) -> u64 {
+        if c == self.c.wrapping_add(1) {
+            self.c = c;
+            self.t += self.q;
+            self.rem += self.r;
+            if self.rem >= self.hz {
+                self.rem -= self.hz;
+                self.t += 1;
+            }
+        } else if c != self.c {
+            let ps = c as u128 * 1_000_000_000_000u128;
+            self.c = c;
+            self.t = (ps / self.hz as u128) as u64;
+            self.rem = (ps % self.hz as u128) as u64;
+        }
+        self.t
+    }
+
+    /// The rising and falling edges of cycle `c` (the fall half a period,
+    /// rounded down, after the rise).
+    #[inline]
+    fn edges(&mut self, c: u64) -> (u64, u64) {
+        let t = self.time(c);
+        let next = self.time(c + 1);
+        (t, t + (next - t) / 2)
+    }
+}
+
+/// `"0"`..`"1"` for each of the 8 bits of a byte, most significant first.
+static BIN8: [[u8; 8]; 256] = {
+    let mut t = [[0u8; 8]; 256];
+    let mut b = 0;
+    while b < 256 {
+        let mut k = 0;
+        while k < 8 {
+            t[b][k] = b'0' + ((b >> (7 - k)) & 1) as u8;
+            k += 1;
+        }
+        b += 1;
+    }
+    t
+};
+
+/// Bytes of VCD body gathered before they are handed to the file.
+const VCD_CHUNK: usize = 1 << 16;
+/// Room after the chunk for the longest line (a 64-bit value, its code).
+const VCD_SLACK: usize = 128;
+
+/// The body of a VCD file: timestamps and value changes, formatted into a
+/// buffer of its own and written to the file [`VCD_CHUNK`] bytes at a time.
+struct VcdBody {
+    /// Each signal's identifier code, padded, and its length.
+    ids: Vec<([u8; 16], u8)>,
+    buf: Box<[u8]>,
+    len: usize,
+}
+
+impl VcdBody {
+    fn new() -> VcdBody {
+        VcdBody {
+            ids: Vec::new(),
+            buf: vec![0; VCD_CHUNK + VCD_SLACK].into_boxed_slice(),
+            len: 0,
+        }
+    }
+
+    fn add_id(&mut self, code: &str) -> io::Result<u32> {
+        let b = code.as_bytes();
+        if b.len() > 16 {
+            return Err(io::Error::other("VCD identifier code longer than 16 bytes"));
+        }
+        let mut id = [0u8; 16];
+        id[..b.len()].copy_from_slice(b);
+        self.ids.push((id, b.len() as u8));
+        Ok(self.ids.len() as u32 - 1)
+    }
+
+    /// `#t`.
+    #[inline]
+    fn timestamp(&mut self, t: u64) {
+        let mut digits = itoa::Buffer::new();
+        let d = digits.format(t).as_bytes();
+        let dst = &mut self.buf[self.len..self.len + VCD_SLACK];
+        dst[0] = b'#';
+        dst[1..1 + d.len()].copy_from_slice(d);
+        dst[1 + d.len()] = b'\n';
+        self.len += d.len() + 2;
+    }
+
+    /// `0!` for one bit, `b1011 !` for a vector (no leading zeros).
+    #[inline]
+    fn change(&mut self, id: u32, width: u32, v: u64) {
+        let (code, n) = self.ids[id as usize];
+        let dst = &mut self.buf[self.len..self.len + VCD_SLACK];
+        let mut k;
+        if width == 1 {
+            dst[0] = b'0' + (v & 1) as u8;
+            k = 1;
+        } else {
+            dst[0] = b'b';
+            // All 64 digits, then the significant ones moved into place
+            // with one fixed-size copy.
+            let bits = 64 - (v | 1).leading_zeros() as usize;
+            let mut all = [b'0'; 128];
+            for (byte, out) in all[..64].chunks_exact_mut(8).enumerate() {
+                out.copy_from_slice(&BIN8[(v >> (56 - 8 * byte)) as u8 as usize]);
+            }
+            dst[1..65].copy_from_slice(&all[64 - bits..128 - bits]);
+            dst[1 + bits] = b' ';
+            k = bits + 2;
+        }
+        dst[k..k + 16].copy_from_slice(&code);
+        k += n as usize;
+        dst[k] = b'\n';
+        self.len += k + 1;
+    }
+
+    /// Hand the gathered bytes to the file once a chunk is full (`all`:
+    /// whatever is gathered).
+    #[inline]
+    fn flush(&mut self, out: &mut BufWriter<File>, all: bool) -> io::Result<()> {
+        if self.len >= VCD_CHUNK || (all && self.len > 0) {
+            let n = std::mem::take(&mut self.len);
+            out.write_all(&self.buf[..n])?;
+        }
+        Ok(())
     }
 }
 
@@ -251,10 +400,9 @@ impl Sink {
 
     fn add_wire(&mut self, width: u32, name: &str) -> io::Result<SigId> {
         match self {
-            Sink::Vcd(w, ids) => {
+            Sink::Vcd(w, body) => {
                 let id = w.add_wire(width, name)?;
-                ids.push(id.to_string().into_bytes().into_boxed_slice());
-                Ok(SigId::Vcd(ids.len() as u32 - 1))
+                body.add_id(&id.to_string()).map(SigId::Vcd)
             }
             Sink::FstHeader(h) => h
                 .var(
@@ -273,9 +421,9 @@ impl Sink {
     /// End of the declarations.
     fn end_definitions(&mut self) -> io::Result<()> {
         match std::mem::replace(self, Sink::Gone) {
-            Sink::Vcd(mut w, ids) => {
+            Sink::Vcd(mut w, body) => {
                 w.enddefinitions()?;
-                *self = Sink::Vcd(w, ids);
+                *self = Sink::Vcd(w, body);
             }
             Sink::FstHeader(h) => *self = Sink::FstBody(h.finish().map_err(fst_err)?),
             other => *self = other,
@@ -284,88 +432,147 @@ impl Sink {
     }
 
     /// Hand the sink to a writing thread (see [`Sink::Threaded`]).
-    /// `clk` and `cycle`: the signals [`Msg::Rise`] and [`Msg::Fall`] set.
+    /// `sigs`: each traced signal's handle, width and whether its values
+    /// are kept for a translate filter; `clk` and `cycle`: the signals a
+    /// cycle's edges set; `clock_hz`: the clock the times are in;
     /// `section_bytes`: see [`TraceConfig::fst_section_bytes`].
-    fn threaded(self, clk: SigId, cycle_id: SigId, section_bytes: usize) -> io::Result<Sink> {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<Msg>>(QUEUED_BATCHES);
+    fn threaded(
+        self,
+        sigs: Vec<(SigId, u32, bool)>,
+        clk: SigId,
+        cycle_id: SigId,
+        clock_hz: u64,
+        section_bytes: usize,
+    ) -> io::Result<Sink> {
+        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<u64>>(QUEUED_BATCHES);
+        let (back, spare) = std::sync::mpsc::sync_channel::<Vec<u64>>(QUEUED_BATCHES + 2);
         let worker = std::thread::Builder::new()
             .name("waveform writer".into())
             .spawn(move || {
                 let mut sink = self;
                 let mut res = Ok(());
+                let mut seen = vec![BTreeSet::new(); sigs.len()];
+                let mut clock = Clock::new(clock_hz);
+                // The falling edge of the last cycle begun, written when
+                // the next one begins or the trace ends.
+                let mut fall: Option<u64> = None;
                 // A section can end only after a time step of its own (the
                 // FST writer cannot start one at the time it ended at).
                 let mut stepped = false;
-                for batch in rx {
+                let mut cycle = |sink: &mut Sink, c: u64| -> io::Result<()> {
+                    if let Some(t) = fall.take() {
+                        sink.timestamp(t)?;
+                        sink.change(clk, 1, 0)?;
+                        stepped = true;
+                    }
+                    if std::mem::take(&mut stepped) {
+                        sink.fst_section(section_bytes)?;
+                    }
+                    let (rise, f) = clock.edges(c);
+                    fall = Some(f);
+                    sink.timestamp(rise)?;
+                    sink.change(clk, 1, 1)?;
+                    sink.change(cycle_id, 64, c)
+                };
+                for mut batch in rx {
                     if res.is_err() {
                         continue; // keep draining: the sender must not block
                     }
-                    for &m in &batch {
-                        let r = match m {
-                            Msg::Change(id, w, v) => sink.change(id, w, v),
-                            Msg::Rise { t, cycle } => {
-                                if std::mem::take(&mut stepped) {
-                                    if let Err(e) = sink.fst_section(section_bytes) {
-                                        res = Err(e);
-                                        break;
-                                    }
+                    let mut k = 0;
+                    while k < batch.len() {
+                        let m = batch[k];
+                        k += 1;
+                        let (tag, low) = (m >> 48, m & MSG_VALUE);
+                        let (i, v) = match tag {
+                            MSG_CYCLE => (None, low),
+                            MSG_LONG => {
+                                let v = batch.get(k).copied().unwrap_or(0);
+                                k += 1;
+                                ((low != LONG_CYCLE).then_some(low as usize), v)
+                            }
+                            _ => (Some(tag as usize), low),
+                        };
+                        let r = match i {
+                            Some(i) => {
+                                let (id, w, filtered) = sigs[i];
+                                if filtered {
+                                    seen[i].insert(v);
                                 }
-                                sink.timestamp(t)
-                                    .and_then(|_| sink.change(clk, 1, 1))
-                                    .and_then(|_| sink.change(cycle_id, 64, cycle))
+                                sink.change(id, w, v)
                             }
-                            Msg::Fall(t) => {
-                                stepped = true;
-                                sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0))
-                            }
+                            None => cycle(&mut sink, v),
                         };
                         if let Err(e) = r {
                             res = Err(e);
                             break;
                         }
                     }
+                    batch.clear();
+                    let _ = back.try_send(batch);
                 }
-                (sink, res)
+                if res.is_ok() {
+                    if let Some(t) = fall {
+                        res = sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0));
+                    }
+                }
+                (sink, res, seen)
             })?;
         Ok(Sink::Threaded {
             batch: Vec::with_capacity(BATCH),
             tx,
+            spare,
             worker,
         })
     }
 
-    /// The sink back from its writing thread, every change written.
-    fn join(self) -> io::Result<Sink> {
+    /// The sink back from its writing thread, every change written, and
+    /// the values of the signals with translate filters.
+    fn join(self) -> io::Result<(Sink, Vec<BTreeSet<u64>>)> {
         match self {
             Sink::Threaded {
                 batch, tx, worker, ..
             } => {
                 let sent = tx.send(batch);
                 drop(tx);
-                let (sink, res) = worker
+                let (sink, res, seen) = worker
                     .join()
                     .map_err(|_| io::Error::other("the waveform writer panicked"))?;
                 res?;
                 sent.map_err(|_| io::Error::other("the waveform writer stopped"))?;
-                Ok(sink)
+                Ok((sink, seen))
             }
-            other => Ok(other),
+            other => Ok((other, Vec::new())),
         }
     }
 
+    /// Queue a message for the writing thread: a change of signal `i` to
+    /// `v`, or (`i` = `None`) the start of cycle `v`.
     #[inline]
-    fn queue(
-        batch: &mut Vec<Msg>,
-        tx: &std::sync::mpsc::SyncSender<Vec<Msg>>,
-        m: Msg,
-    ) -> io::Result<()> {
-        batch.push(m);
-        if batch.len() >= BATCH {
-            let full = std::mem::replace(batch, Vec::with_capacity(BATCH));
-            tx.send(full)
-                .map_err(|_| io::Error::other("the waveform writer stopped"))?;
+    fn send(&mut self, i: Option<u32>, v: u64) -> io::Result<()> {
+        match self {
+            Sink::Threaded {
+                batch, tx, spare, ..
+            } => {
+                let tag = i.map_or(MSG_CYCLE, u64::from);
+                let short = v <= MSG_VALUE && (tag < MSG_CYCLE || i.is_none());
+                if short {
+                    batch.push(tag << 48 | v);
+                } else {
+                    batch.push(MSG_LONG << 48 | i.map_or(LONG_CYCLE, u64::from));
+                    batch.push(v);
+                }
+                if batch.len() >= BATCH {
+                    let next = spare
+                        .try_recv()
+                        .unwrap_or_else(|_| Vec::with_capacity(BATCH));
+                    let full = std::mem::replace(batch, next);
+                    tx.send(full)
+                        .map_err(|_| io::Error::other("the waveform writer stopped"))?;
+                }
+                Ok(())
+            }
+            _ => Err(io::Error::other("a value change outside sampling")),
         }
-        Ok(())
     }
 
     /// The FST writer holds value changes in memory until a flush, which
@@ -381,59 +588,26 @@ impl Sink {
         Ok(())
     }
 
-    /// A clock edge ([`Msg::Rise`], [`Msg::Fall`]), for the writing thread.
-    fn edge(&mut self, m: Msg) -> io::Result<()> {
-        match self {
-            Sink::Threaded { batch, tx, .. } => Sink::queue(batch, tx, m),
-            _ => Err(io::Error::other("a clock edge outside sampling")),
-        }
-    }
-
     fn timestamp(&mut self, t: u64) -> io::Result<()> {
         match self {
-            // While sampling, time moves only with the clock edges.
-            Sink::Threaded { .. } => Err(io::Error::other("a timestamp outside the clock edges")),
-            Sink::Vcd(w, _) => {
-                let mut buf = [0u8; 24];
-                buf[0] = b'#';
-                let n = 1 + decimal(t, &mut buf[1..]);
-                buf[n] = b'\n';
-                w.writer().write_all(&buf[..=n])
+            Sink::Vcd(w, body) => {
+                body.timestamp(t);
+                body.flush(w.writer(), false)
             }
             Sink::FstBody(b) => b.time_change(t).map_err(fst_err),
+            // While sampling, time moves only with the clock edges.
+            Sink::Threaded { .. } => Err(io::Error::other("a timestamp outside the clock edges")),
             _ => Ok(()),
         }
     }
 
     /// A new value of a `width`-bit signal.
+    #[inline]
     fn change(&mut self, id: SigId, width: u32, v: u64) -> io::Result<()> {
         match (self, id) {
-            (Sink::Threaded { batch, tx, .. }, id) => {
-                Sink::queue(batch, tx, Msg::Change(id, width, v))
-            }
-            (Sink::Vcd(w, ids), SigId::Vcd(id)) => {
-                // `0!` for one bit, `b1011 !` for a vector (no leading zeros).
-                let id = &ids[id as usize];
-                let mut buf = [0u8; 128];
-                let mut n = 0;
-                if width == 1 {
-                    buf[0] = b'0' + (v & 1) as u8;
-                    n = 1;
-                } else {
-                    buf[0] = b'b';
-                    n += 1;
-                    let top = 63 - (v | 1).leading_zeros();
-                    for k in (0..=top).rev() {
-                        buf[n] = b'0' + (v >> k & 1) as u8;
-                        n += 1;
-                    }
-                    buf[n] = b' ';
-                    n += 1;
-                }
-                buf[n..n + id.len()].copy_from_slice(id);
-                n += id.len();
-                buf[n] = b'\n';
-                w.writer().write_all(&buf[..=n])
+            (Sink::Vcd(w, body), SigId::Vcd(id)) => {
+                body.change(id, width, v);
+                body.flush(w.writer(), false)
             }
             (Sink::FstBody(b), SigId::Fst(id)) => {
                 let mut bits = [b'0'; 64];
@@ -449,6 +623,9 @@ impl Sink {
         }
     }
 }
+
+/// [`Tracer::slot_decl`] of a signal call that is not traced.
+const NOT_TRACED: u32 = u32::MAX;
 
 #[derive(Clone, Copy)]
 struct SigInfo {
@@ -490,11 +667,23 @@ pub struct Tracer {
     /// Answers of [`Probe::open_scopes`], in call order.
     open_masks: Vec<u64>,
     open_i: usize,
-    slot: Vec<Option<u32>>,
+    /// Per signal call (in call order, traced or not; padded to a multiple
+    /// of 8 with untraced slots): the mask of its width (0 when it is not
+    /// traced, so it never changes) and the value reported this cycle.
+    mask: Vec<u64>,
+    cur: Vec<u64>,
+    /// Signal calls in a sampled cycle (the unpadded length of `cur`).
+    calls: usize,
+    /// Per signal call: the index of its declaration, [`NOT_TRACED`] if none.
+    slot_decl: Vec<u32>,
     // sampling state
     scope_i: usize,
     slot_i: usize,
-    last: Vec<Option<u64>>,
+    /// Per signal call: the value last written.
+    last: Vec<u64>,
+    /// Before the first sampled cycle: every traced signal is written.
+    first_sample: bool,
+    clock: Clock,
     seen: Vec<BTreeSet<u64>>,
     clk: SigId,
     cycle_id: SigId,
@@ -713,7 +902,7 @@ impl Tracer {
             let mut w = vcd::Writer::new(out);
             w.version(version)?;
             w.timescale(1, TimescaleUnit::PS)?;
-            Sink::Vcd(w, Vec::new())
+            Sink::Vcd(w, VcdBody::new())
         };
         w.add_module(top_name)?;
         let clk = w.add_wire(1, "clk")?;
@@ -745,10 +934,15 @@ impl Tracer {
             scope_on: Vec::new(),
             open_masks: Vec::new(),
             open_i: 0,
-            slot: Vec::new(),
+            mask: Vec::new(),
+            cur: Vec::new(),
+            calls: 0,
+            slot_decl: Vec::new(),
             scope_i: 0,
             slot_i: 0,
             last: Vec::new(),
+            first_sample: true,
+            clock: Clock::new(1),
             seen: Vec::new(),
             clk,
             cycle_id,
@@ -798,13 +992,28 @@ impl Tracer {
         }
         t.w.upscope()?;
         t.w.end_definitions()?;
+        let sigs = t
+            .decls
+            .iter()
+            .map(|d| {
+                let filtered = matches!(d.info.display, Display::Translate(_));
+                (d.info.id, d.info.width, filtered)
+            })
+            .collect();
         t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded(
+            sigs,
             t.clk,
             t.cycle_id,
+            t.cfg.clock_hz,
             t.cfg.fst_section_bytes,
         )?;
-        t.last = vec![None; t.decls.len()];
-        t.seen = vec![BTreeSet::new(); t.decls.len()];
+        t.clock = Clock::new(t.cfg.clock_hz);
+        t.calls = t.mask.len();
+        let padded = t.calls.next_multiple_of(8);
+        t.mask.resize(padded, 0);
+        t.slot_decl.resize(padded, NOT_TRACED);
+        t.cur = vec![0; padded];
+        t.last = vec![0; padded];
         t.phase = Phase::Sample;
         Ok(t)
     }
@@ -831,13 +1040,19 @@ impl Tracer {
         if !self.in_window(cycle) {
             return Ok(());
         }
-        let t = self.time(cycle);
-        let half = (self.time(cycle + 1) - t) / 2;
-        self.w.edge(Msg::Rise { t, cycle })?;
+        let t = self.clock.time(cycle);
+        self.w.send(None, cycle)?;
         self.scope_i = 0;
         self.slot_i = 0;
         self.open_i = 0;
         top.trace(self);
+        if self.slot_i != self.calls {
+            return Err(io::Error::other(format!(
+                "a module reported {} signals where it declared {}",
+                self.slot_i, self.calls
+            )));
+        }
+        self.write_changes();
         if let Some(e) = self.err.take() {
             return Err(e);
         }
@@ -857,7 +1072,6 @@ impl Tracer {
             eprintln!("morphosys: warning: {msg}");
             self.note.get_or_insert(msg);
         }
-        self.w.edge(Msg::Fall(t + half))?;
         self.sampled += 1;
         self.last_cycle = Some(cycle);
         Ok(())
@@ -873,10 +1087,16 @@ impl Tracer {
     pub fn finish(mut self) -> io::Result<Vec<PathBuf>> {
         let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
         let t = self.time(end);
-        self.w = std::mem::replace(&mut self.w, Sink::Gone).join()?;
+        let (w, seen) = std::mem::replace(&mut self.w, Sink::Gone).join()?;
+        self.w = w;
+        self.seen = seen;
         self.w.timestamp(t)?;
-        let file = match std::mem::replace(&mut self.w, Sink::Gone) {
-            Sink::Vcd(mut w, _) => {
+        // Not synced to the disk: the rename below keeps an interrupted
+        // run from leaving a partial file under the waveform's name; an
+        // fsync of a 30 MB trace took longer than simulating it.
+        match std::mem::replace(&mut self.w, Sink::Gone) {
+            Sink::Vcd(mut w, mut body) => {
+                body.flush(w.writer(), true)?;
                 if let Some(n) = &self.note {
                     w.comment(n)?;
                 }
@@ -886,17 +1106,13 @@ impl Tracer {
                     return Ok(vec![self.cfg.path.clone()]);
                 };
                 self.tmp_path = Some(tmp_path);
-                w.writer().get_ref().try_clone()?
             }
             Sink::FstBody(b) => {
                 // FST has no comments: the note went to standard error.
-                let mut out = b.finish().map_err(fst_err)?;
-                out.flush()?;
-                out.get_ref().try_clone()?
+                b.finish().map_err(fst_err)?.flush()?;
             }
             _ => return Err(io::Error::other("waveform finished twice")),
         };
-        file.sync_data()?;
         let tmp_path = self.tmp_path.take().expect("a regular file");
         let gtkw = self.write_gtkw()?;
         let partial = tmp_path.to_path_buf();
@@ -1058,19 +1274,12 @@ impl Probe for Tracer {
             }
             return;
         }
-        let mask = if width >= 64 {
-            u64::MAX
-        } else {
-            (1u64 << width) - 1
-        };
-        for &value in &values[..names.len()] {
-            let s = self.slot[self.slot_i];
-            self.slot_i += 1;
-            if let Some(i) = s {
-                let (i, v) = (i as usize, value & mask);
-                if self.last[i] != Some(v) {
-                    self.record_change(i, v);
-                }
+        let i = self.slot_i;
+        let n = names.len();
+        self.slot_i += n;
+        if let (Some(cur), Some(mask)) = (self.cur.get_mut(i..i + n), self.mask.get(i..i + n)) {
+            for ((c, &m), &v) in cur.iter_mut().zip(mask).zip(values) {
+                *c = v & m;
             }
         }
     }
@@ -1123,19 +1332,13 @@ impl Probe for Tracer {
         if let Phase::Declare = self.phase {
             return self.declare_signal(name, width, display);
         }
-        // The sampled cycle: most signals are not traced or did not change.
-        let s = self.slot[self.slot_i];
+        // The sampled cycle: keep the value (masked to its width, to 0
+        // when not traced); the changes are found once the cycle's walk
+        // is over ([`Tracer::write_changes`]).
+        let i = self.slot_i;
         self.slot_i += 1;
-        if let Some(i) = s {
-            let i = i as usize;
-            let v = if width >= 64 {
-                value
-            } else {
-                value & ((1u64 << width) - 1)
-            };
-            if self.last[i] != Some(v) {
-                self.record_change(i, v);
-            }
+        if let (Some(c), Some(&m)) = (self.cur.get_mut(i), self.mask.get(i)) {
+            *c = value & m;
         }
     }
 }
@@ -1178,26 +1381,54 @@ impl Tracer {
                     SigId::Vcd(0)
                 }
             };
-            self.slot.push(Some(self.decls.len() as u32));
+            self.mask.push(u64::MAX >> (64 - width.clamp(1, 64)));
+            self.slot_decl.push(self.decls.len() as u32);
             self.decls.push(Decl {
                 path,
                 info: SigInfo { id, width, display },
             });
         } else {
-            self.slot.push(None);
+            self.mask.push(0);
+            self.slot_decl.push(NOT_TRACED);
         }
     }
 
-    /// Signal `i` changed to `v`: write it.
-    #[inline(never)]
-    fn record_change(&mut self, i: usize, v: u64) {
-        let info = self.decls[i].info;
-        self.last[i] = Some(v);
-        if let Display::Translate(_) = info.display {
-            self.seen[i].insert(v);
+    /// Compare the values the cycle's walk reported with the last ones
+    /// written, and write those that changed (all traced ones the first
+    /// time).
+    #[inline]
+    fn write_changes(&mut self) {
+        if std::mem::take(&mut self.first_sample) {
+            for i in 0..self.cur.len() {
+                if self.slot_decl[i] != NOT_TRACED {
+                    self.record_change(i, self.cur[i]);
+                }
+            }
+            return;
         }
-        self.bytes += info.width as u64 + 6;
-        if let Err(e) = self.w.change(info.id, info.width, v) {
+        // Eight at a time (a few vector instructions): most cycles change
+        // a few of the signals.
+        for base in (0..self.cur.len()).step_by(8) {
+            let (cur, last) = (&self.cur[base..base + 8], &self.last[base..base + 8]);
+            if cur.iter().zip(last).fold(0, |d, (c, l)| d | (c ^ l)) != 0 {
+                for i in base..base + 8 {
+                    let v = self.cur[i];
+                    if v != self.last[i] {
+                        self.record_change(i, v);
+                    }
+                }
+            }
+        }
+    }
+
+    /// The signal of call `slot` changed to `v`: write it.
+    #[inline]
+    fn record_change(&mut self, slot: usize, v: u64) {
+        self.last[slot] = v;
+        let d = self.slot_decl[slot];
+        // A change costs about its width in digits and 6 bytes more.
+        self.bytes += (self.mask[slot].count_ones() + 6) as u64;
+        if let Err(e) = self.w.send(Some(d), v) {
             self.err.get_or_insert(e);
         }
     }
