@@ -28,7 +28,7 @@ use crate::memory::MainMemory;
 use crate::rc::context::Context;
 use crate::rc::{Datapath, Word};
 use crate::tinyrisc::{decode, Command, Machine, RiscTiming, TinyRisc};
-use crate::trace::{Display, Probe, Traced};
+use crate::trace::{Display, Field, Probe, Traced};
 
 /// Every cycle parameter of the chip.
 ///
@@ -446,12 +446,26 @@ impl<W: Word> Traced for Chip<W> {
                 Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
                 None => (0, 0, 0, [0, 0]),
             };
-            p.signal("busy", 1, Display::Bin, busy);
-            p.signal("queued", 1, Display::Bin, !self.bcast.can_issue() as u64);
-            p.signal("run_ctx", 13, Display::Hex, ctx);
-            p.signal("step", 14, Display::Hex, k);
-            p.signal("fb0_ptr", 16, Display::Hex, ptr[0] as u64);
-            p.signal("fb1_ptr", 16, Display::Hex, ptr[1] as u64);
+            p.block(
+                &|| {
+                    vec![
+                        Field::new("", "busy", 1, Display::Bin),
+                        Field::new("", "queued", 1, Display::Bin),
+                        Field::new("", "run_ctx", 13, Display::Hex),
+                        Field::new("", "step", 14, Display::Hex),
+                        Field::new("", "fb0_ptr", 16, Display::Hex),
+                        Field::new("", "fb1_ptr", 16, Display::Hex),
+                    ]
+                },
+                &[
+                    busy,
+                    !self.bcast.can_issue() as u64,
+                    ctx,
+                    k,
+                    ptr[0] as u64,
+                    ptr[1] as u64,
+                ],
+            );
             p.end();
         }
         if p.scope(format_args!("dma")) {
@@ -459,21 +473,25 @@ impl<W: Word> Traced for Chip<W> {
                 Some((r, _)) => (r.kind as u64, r.mem as u64, r.local as u64),
                 None => (0, 0, 0),
             };
-            p.signal("kind", 2, Display::Hex, kind);
-            p.signal("mem", 32, Display::Hex, mem);
-            p.signal("local", 16, Display::Hex, local);
-            p.signal("remaining", 16, Display::Hex, self.dma.remaining() as u64);
-            p.signal(
-                "fb_banks",
-                4,
-                Display::Bin,
-                self.dma.owned_fb_banks() as u64,
-            );
-            p.signal(
-                "ctx_banks",
-                2,
-                Display::Bin,
-                self.dma.owned_ctx_banks() as u64,
+            p.block(
+                &|| {
+                    vec![
+                        Field::new("", "kind", 2, Display::Hex),
+                        Field::new("", "mem", 32, Display::Hex),
+                        Field::new("", "local", 16, Display::Hex),
+                        Field::new("", "remaining", 16, Display::Hex),
+                        Field::new("", "fb_banks", 4, Display::Bin),
+                        Field::new("", "ctx_banks", 2, Display::Bin),
+                    ]
+                },
+                &[
+                    kind,
+                    mem,
+                    local,
+                    self.dma.remaining() as u64,
+                    self.dma.owned_fb_banks() as u64,
+                    self.dma.owned_ctx_banks() as u64,
+                ],
             );
             p.end();
         }

@@ -92,6 +92,57 @@ pub trait Probe {
             (1u64 << names.len()) - 1
         }
     }
+    /// A module's signals in one call: `fields()` describes them (called
+    /// only while declaring) and `values[k]` is field k's value. The same
+    /// as, for each run of consecutive fields with the same
+    /// [`Field::scope`], entering that scope (none for `""`), calling
+    /// [`Probe::signal`] for each field and leaving it; but one call a
+    /// cycle instead of one per signal and scope.
+    fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
+        let fields = fields();
+        let mut k = 0;
+        while k < fields.len() {
+            let scope = fields[k].scope;
+            let end = k + fields[k..].iter().take_while(|f| f.scope == scope).count();
+            let open = scope.is_empty() || self.scope(format_args!("{scope}"));
+            if open {
+                for (f, &v) in fields[k..end].iter().zip(&values[k..end]) {
+                    self.signal(f.name, f.width, f.display, v);
+                }
+                if !scope.is_empty() {
+                    self.end();
+                }
+            }
+            k = end;
+        }
+    }
+}
+
+/// One signal of a [`Probe::block`].
+#[derive(Clone, Copy)]
+pub struct Field {
+    /// The scope it sits in, under the scope the block is reported in
+    /// (`""`: that scope itself).
+    pub scope: &'static str,
+    pub name: &'static str,
+    pub width: u32,
+    pub display: Display,
+}
+
+impl Field {
+    pub const fn new(
+        scope: &'static str,
+        name: &'static str,
+        width: u32,
+        display: Display,
+    ) -> Field {
+        Field {
+            scope,
+            name,
+            width,
+            display,
+        }
+    }
 }
 
 /// A module that has signals.
@@ -624,6 +675,14 @@ impl Sink {
     }
 }
 
+/// A signal call's mask (of its width; 0 when not traced) and the value
+/// last written ([`Tracer::slots`]).
+#[derive(Clone, Copy)]
+struct Slot {
+    mask: u64,
+    last: u64,
+}
+
 /// [`Tracer::slot_decl`] of a signal call that is not traced.
 const NOT_TRACED: u32 = u32::MAX;
 
@@ -667,21 +726,22 @@ pub struct Tracer {
     /// Answers of [`Probe::open_scopes`], in call order.
     open_masks: Vec<u64>,
     open_i: usize,
-    /// Per signal call (in call order, traced or not; padded to a multiple
-    /// of 8 with untraced slots): the mask of its width (0 when it is not
-    /// traced, so it never changes) and the value reported this cycle.
-    mask: Vec<u64>,
-    cur: Vec<u64>,
-    /// Signal calls in a sampled cycle (the unpadded length of `cur`).
-    calls: usize,
+    /// Per signal call (in call order, traced or not): the mask of its
+    /// width (0 when it is not traced, so it never changes) and the value
+    /// last written.
+    slots: Vec<Slot>,
+    /// The calls whose value changed this cycle, with the new value: one
+    /// store per call and a count that moves on when the value differs
+    /// (no branch, and no wide load of what narrow stores just wrote).
+    changed: Vec<(u32, u64)>,
+    n_changed: usize,
     /// Per signal call: the index of its declaration, [`NOT_TRACED`] if none.
     slot_decl: Vec<u32>,
     // sampling state
     scope_i: usize,
     slot_i: usize,
-    /// Per signal call: the value last written.
-    last: Vec<u64>,
-    /// Before the first sampled cycle: every traced signal is written.
+    /// In the first sampled cycle every call counts as a change (and the
+    /// traced ones are written).
     first_sample: bool,
     clock: Clock,
     seen: Vec<BTreeSet<u64>>,
@@ -934,13 +994,12 @@ impl Tracer {
             scope_on: Vec::new(),
             open_masks: Vec::new(),
             open_i: 0,
-            mask: Vec::new(),
-            cur: Vec::new(),
-            calls: 0,
+            slots: Vec::new(),
+            changed: Vec::new(),
+            n_changed: 0,
             slot_decl: Vec::new(),
             scope_i: 0,
             slot_i: 0,
-            last: Vec::new(),
             first_sample: true,
             clock: Clock::new(1),
             seen: Vec::new(),
@@ -1008,12 +1067,7 @@ impl Tracer {
             t.cfg.fst_section_bytes,
         )?;
         t.clock = Clock::new(t.cfg.clock_hz);
-        t.calls = t.mask.len();
-        let padded = t.calls.next_multiple_of(8);
-        t.mask.resize(padded, 0);
-        t.slot_decl.resize(padded, NOT_TRACED);
-        t.cur = vec![0; padded];
-        t.last = vec![0; padded];
+        t.changed = vec![(0, 0); t.slots.len() + 1];
         t.phase = Phase::Sample;
         Ok(t)
     }
@@ -1045,11 +1099,13 @@ impl Tracer {
         self.scope_i = 0;
         self.slot_i = 0;
         self.open_i = 0;
+        self.n_changed = 0;
         top.trace(self);
-        if self.slot_i != self.calls {
+        if self.slot_i != self.slots.len() {
             return Err(io::Error::other(format!(
                 "a module reported {} signals where it declared {}",
-                self.slot_i, self.calls
+                self.slot_i,
+                self.slots.len()
             )));
         }
         self.write_changes();
@@ -1267,6 +1323,55 @@ impl Tracer {
 }
 
 impl Probe for Tracer {
+    fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
+        if let Phase::Sample = self.phase {
+            return self.sample_calls(values);
+        }
+        // Declaring: the scopes and signals `Probe::block` describes, with
+        // a slot for every field (those of scopes left out untraced), as
+        // the sampled cycles report every value.
+        let fields = fields();
+        let mut k = 0;
+        while k < fields.len() {
+            let scope = fields[k].scope;
+            let end = k + fields[k..].iter().take_while(|f| f.scope == scope).count();
+            let open = scope.is_empty() || {
+                self.stack.push(scope.to_string());
+                if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
+                    self.top_scopes.push(self.stack[0].clone());
+                }
+                let on = self.matches_prefix(&self.stack, false);
+                if on {
+                    if let Err(e) = self.w.add_module(scope) {
+                        self.err.get_or_insert(e);
+                    }
+                } else {
+                    self.stack.pop();
+                }
+                on
+            };
+            for f in &fields[k..end] {
+                if open {
+                    self.declare_signal(f.name, f.width, f.display);
+                } else {
+                    self.slots.push(Slot { mask: 0, last: 0 });
+                    self.slot_decl.push(NOT_TRACED);
+                }
+            }
+            if open && !scope.is_empty() {
+                self.end();
+            }
+            k = end;
+        }
+        if values.len() != fields.len() {
+            self.err.get_or_insert(io::Error::other(format!(
+                "a block of {} signals reported {} values",
+                fields.len(),
+                values.len()
+            )));
+        }
+    }
+
     fn signal_row(&mut self, names: &[&str], width: u32, display: Display, values: &[u64]) {
         if let Phase::Declare = self.phase {
             for n in names {
@@ -1274,14 +1379,7 @@ impl Probe for Tracer {
             }
             return;
         }
-        let i = self.slot_i;
-        let n = names.len();
-        self.slot_i += n;
-        if let (Some(cur), Some(mask)) = (self.cur.get_mut(i..i + n), self.mask.get(i..i + n)) {
-            for ((c, &m), &v) in cur.iter_mut().zip(mask).zip(values) {
-                *c = v & m;
-            }
-        }
+        self.sample_calls(&values[..names.len()]);
     }
 
     fn traced_signals(&mut self, names: &[&str]) -> u64 {
@@ -1332,14 +1430,7 @@ impl Probe for Tracer {
         if let Phase::Declare = self.phase {
             return self.declare_signal(name, width, display);
         }
-        // The sampled cycle: keep the value (masked to its width, to 0
-        // when not traced); the changes are found once the cycle's walk
-        // is over ([`Tracer::write_changes`]).
-        let i = self.slot_i;
-        self.slot_i += 1;
-        if let (Some(c), Some(&m)) = (self.cur.get_mut(i), self.mask.get(i)) {
-            *c = value & m;
-        }
+        self.sample_calls(&[value]);
     }
 }
 
@@ -1381,42 +1472,53 @@ impl Tracer {
                     SigId::Vcd(0)
                 }
             };
-            self.mask.push(u64::MAX >> (64 - width.clamp(1, 64)));
+            self.slots.push(Slot {
+                mask: u64::MAX >> (64 - width.clamp(1, 64)),
+                last: 0,
+            });
             self.slot_decl.push(self.decls.len() as u32);
             self.decls.push(Decl {
                 path,
                 info: SigInfo { id, width, display },
             });
         } else {
-            self.mask.push(0);
+            self.slots.push(Slot { mask: 0, last: 0 });
             self.slot_decl.push(NOT_TRACED);
         }
     }
 
-    /// Compare the values the cycle's walk reported with the last ones
-    /// written, and write those that changed (all traced ones the first
-    /// time).
+    /// The sampled cycle's next signal calls reported `values`: each kept
+    /// in [`Tracer::changed`] if it differs from the last value written
+    /// (masked to its width, to 0 when not traced). The counters live in
+    /// locals through the loop (stored back to `self` each time, they made
+    /// a chain of store-to-load forwards).
     #[inline]
-    fn write_changes(&mut self) {
-        if std::mem::take(&mut self.first_sample) {
-            for i in 0..self.cur.len() {
-                if self.slot_decl[i] != NOT_TRACED {
-                    self.record_change(i, self.cur[i]);
-                }
-            }
-            return;
+    fn sample_calls(&mut self, values: &[u64]) {
+        let start = self.slot_i;
+        self.slot_i += values.len();
+        let Some(slots) = self.slots.get(start..start + values.len()) else {
+            return; // more calls than declared: reported after the walk
+        };
+        let first = self.first_sample;
+        let changed = &mut self.changed[..];
+        let mut n = self.n_changed;
+        for (k, (s, &value)) in slots.iter().zip(values).enumerate() {
+            let v = value & s.mask;
+            // `n` <= the calls so far < `changed.len()`.
+            changed[n] = ((start + k) as u32, v);
+            n += (v != s.last || first) as usize;
         }
-        // Eight at a time (a few vector instructions): most cycles change
-        // a few of the signals.
-        for base in (0..self.cur.len()).step_by(8) {
-            let (cur, last) = (&self.cur[base..base + 8], &self.last[base..base + 8]);
-            if cur.iter().zip(last).fold(0, |d, (c, l)| d | (c ^ l)) != 0 {
-                for i in base..base + 8 {
-                    let v = self.cur[i];
-                    if v != self.last[i] {
-                        self.record_change(i, v);
-                    }
-                }
+        self.n_changed = n;
+    }
+
+    /// Write the values that changed in the cycle's walk (all traced ones
+    /// the first time).
+    fn write_changes(&mut self) {
+        let first = std::mem::take(&mut self.first_sample);
+        for k in 0..self.n_changed {
+            let (i, v) = self.changed[k];
+            if !first || self.slot_decl[i as usize] != NOT_TRACED {
+                self.record_change(i as usize, v);
             }
         }
     }
@@ -1424,10 +1526,10 @@ impl Tracer {
     /// The signal of call `slot` changed to `v`: write it.
     #[inline]
     fn record_change(&mut self, slot: usize, v: u64) {
-        self.last[slot] = v;
+        self.slots[slot].last = v;
         let d = self.slot_decl[slot];
         // A change costs about its width in digits and 6 bytes more.
-        self.bytes += (self.mask[slot].count_ones() + 6) as u64;
+        self.bytes += (self.slots[slot].mask.count_ones() + 6) as u64;
         if let Err(e) = self.w.send(Some(d), v) {
             self.err.get_or_insert(e);
         }

@@ -21,7 +21,7 @@ pub mod word;
 use std::fmt;
 
 use crate::kernel::{Clocked, Fault};
-use crate::trace::{Display, Filter, Probe, Traced};
+use crate::trace::{Display, Field, Filter, Probe, Traced};
 use context::{ASrc, BSrc, Cond, Context, Guard, Op};
 use flags::Flags;
 use lanes::{full, select, select_word, Mask};
@@ -561,23 +561,25 @@ const REG_NAMES: [&str; 16] = [
 impl<const N: usize, W: Word> Traced for RcArray<N, W> {
     fn trace(&self, p: &mut dyn Probe) {
         let c = &self.ctx;
-        p.signal(
-            "ctx",
-            32,
-            Display::Translate(&CTX_FILTER),
-            self.ctx_word as u64,
-        );
-        p.signal("op", 6, Display::Translate(&OP_FILTER), c.op as u64);
         let en = self.enabled();
-        // The array at a glance: which RCs are awake, which have F set
-        // (bit i: RC i, row-major).
-        p.signal(
-            "awake",
-            N as u32,
-            Display::Hex,
-            !self.flags.sleep & Self::FULL,
+        // The array at a glance: its context, and which RCs are awake and
+        // which have F set (bit i: RC i, row-major).
+        p.block(
+            &|| {
+                vec![
+                    Field::new("", "ctx", 32, Display::Translate(&CTX_FILTER)),
+                    Field::new("", "op", 6, Display::Translate(&OP_FILTER)),
+                    Field::new("", "awake", N as u32, Display::Hex),
+                    Field::new("", "flag_f", N as u32, Display::Hex),
+                ]
+            },
+            &[
+                self.ctx_word as u64,
+                c.op as u64,
+                !self.flags.sleep & Self::FULL,
+                self.flags.f & Self::FULL,
+            ],
         );
-        p.signal("flag_f", N as u32, Display::Hex, self.flags.f & Self::FULL);
         let bits = W::BITS;
         let mask = |b: u32| if b >= 64 { u64::MAX } else { (1u64 << b) - 1 };
         let sig = |x: W| x.to_i64() as u64 & mask(bits);
@@ -595,47 +597,46 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
             if !open {
                 continue;
             }
+            // One block per RC: out, alu, mul, flags, regfile, ram.
             let bit = |m: Mask| m >> i & 1;
-            p.signal("out", bits, Display::Signed, sig(self.out[i]));
-            if p.scope(format_args!("alu")) {
-                p.signal("a", bits, Display::Signed, sig(self.operand_a(i)));
-                p.signal("b", bits, Display::Signed, sig(self.operand_b(i)));
-                p.signal("result", bits, Display::Signed, sig(self.res[i]));
-                p.signal("en", 1, Display::Bin, bit(en));
-                p.end();
+            let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
+            let mut v = [0u64; 28];
+            v[0] = sig(self.out[i]);
+            v[1] = sig(self.operand_a(i));
+            v[2] = sig(self.operand_b(i));
+            v[3] = sig(self.res[i]);
+            v[4] = bit(en);
+            v[5] = W::acc_i128(self.acc[i]) as u64 & mask(2 * bits);
+            v[6] = bit(self.flags.f);
+            v[7] = bit(self.flags.c);
+            v[8] = bit(self.flags.v);
+            v[9] = bit(self.flags.sleep);
+            for (k, r) in v[10..26].iter_mut().enumerate() {
+                *r = sig(self.regs.r[k][i]);
             }
-            if p.scope(format_args!("mul")) {
-                p.signal(
-                    "acc",
-                    2 * bits,
-                    Display::Signed,
-                    W::acc_i128(self.acc[i]) as u64 & mask(2 * bits),
-                );
-                p.end();
-            }
-            if p.scope(format_args!("flags")) {
-                p.signal("f", 1, Display::Bin, bit(self.flags.f));
-                p.signal("c", 1, Display::Bin, bit(self.flags.c));
-                p.signal("v", 1, Display::Bin, bit(self.flags.v));
-                p.signal("sleep", 1, Display::Bin, bit(self.flags.sleep));
-                p.end();
-            }
-            if p.scope(format_args!("regfile")) {
-                let values: [u64; 16] = std::array::from_fn(|k| sig(self.regs.r[k][i]));
-                p.signal_row(&REG_NAMES, bits, Display::Signed, &values);
-                p.end();
-            }
-            if p.scope(format_args!("ram")) {
-                let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
-                p.signal(
-                    "addr",
-                    9,
-                    Display::Hex,
-                    if mem { self.ram_addr(i) as u64 } else { 0 },
-                );
-                p.signal("we", 1, Display::Bin, (mem && c.op == Op::St) as u64);
-                p.end();
-            }
+            v[26] = if mem { self.ram_addr(i) as u64 } else { 0 };
+            v[27] = (mem && c.op == Op::St) as u64;
+            p.block(
+                &|| {
+                    let mut f = vec![
+                        Field::new("", "out", bits, Display::Signed),
+                        Field::new("alu", "a", bits, Display::Signed),
+                        Field::new("alu", "b", bits, Display::Signed),
+                        Field::new("alu", "result", bits, Display::Signed),
+                        Field::new("alu", "en", 1, Display::Bin),
+                        Field::new("mul", "acc", 2 * bits, Display::Signed),
+                        Field::new("flags", "f", 1, Display::Bin),
+                        Field::new("flags", "c", 1, Display::Bin),
+                        Field::new("flags", "v", 1, Display::Bin),
+                        Field::new("flags", "sleep", 1, Display::Bin),
+                    ];
+                    f.extend(REG_NAMES.map(|r| Field::new("regfile", r, bits, Display::Signed)));
+                    f.push(Field::new("ram", "addr", 9, Display::Hex));
+                    f.push(Field::new("ram", "we", 1, Display::Bin));
+                    f
+                },
+                &v,
+            );
             p.end();
         }
     }

@@ -19,7 +19,7 @@ pub use decode::{Instr, Opcode, INSTR_FILTER};
 pub use execute::{Command, Machine};
 pub use register_file::RegisterFile;
 
-use crate::trace::{Display, Probe, Traced};
+use crate::trace::{Display, Field, Probe, Traced};
 
 /// Cycle cost of each instruction class (see `docs/isa.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -227,18 +227,25 @@ pub static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
 
 impl Traced for TinyRisc {
     fn trace(&self, p: &mut dyn Probe) {
-        p.signal("pc", 32, Display::Hex, self.pc as u64);
-        p.signal("ir", 32, Display::Translate(&INSTR_FILTER), self.ir as u64);
-        p.signal(
-            "state",
-            3,
-            Display::Translate(&STATE_FILTER),
-            self.state as u64,
-        );
-        if p.scope(format_args!("regs")) {
-            let values: [u64; 16] = std::array::from_fn(|k| self.regs.read(k as u8) as u64);
-            p.signal_row(&REG_NAMES, 32, Display::Hex, &values);
-            p.end();
+        // One block: pc, ir, state, then the register file in `regs`.
+        let mut values = [0u64; 19];
+        values[0] = self.pc as u64;
+        values[1] = self.ir as u64;
+        values[2] = self.state as u64;
+        for (k, v) in values[3..].iter_mut().enumerate() {
+            *v = self.regs.read(k as u8) as u64;
         }
+        p.block(
+            &|| {
+                let mut f = vec![
+                    Field::new("", "pc", 32, Display::Hex),
+                    Field::new("", "ir", 32, Display::Translate(&INSTR_FILTER)),
+                    Field::new("", "state", 3, Display::Translate(&STATE_FILTER)),
+                ];
+                f.extend(REG_NAMES.map(|r| Field::new("regs", r, 32, Display::Hex)));
+                f
+            },
+            &values,
+        );
     }
 }
