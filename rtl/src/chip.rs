@@ -313,6 +313,18 @@ impl<W: Word> Chip<W> {
     /// instruction word changed (a DMA store into the program), or after
     /// `limit` cycles. Returns the cycles run.
     pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        self.run_stalled_sampled(limit, |_| true)
+    }
+
+    /// [`Chip::run_stalled`], calling `sample` between each cycle's
+    /// evaluation and its commit (a waveform samples the cycle; `false`
+    /// stops before the commit).
+    #[inline]
+    pub fn run_stalled_sampled(
+        &mut self,
+        limit: u64,
+        mut sample: impl FnMut(&Self) -> bool,
+    ) -> (u64, Result<(), Fault>) {
         use crate::tinyrisc::{State, Wait};
         let mut n = 0;
         while n < limit
@@ -336,6 +348,9 @@ impl<W: Word> Chip<W> {
             }
             if let Err(f) = self.array.eval() {
                 return (n, Err(self.locate(f)));
+            }
+            if !sample(self) {
+                break;
             }
             // TinyRISC's stalled eval left no command and no write-back.
             self.commit();
@@ -570,15 +585,14 @@ fn run_loop<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, Run
                 text,
             });
         }
-        if !sim.tracing() {
-            let limit = max_cycles - sim.cycle();
-            if sim
-                .fast_forward(|c| c.run_stalled(limit))
-                .map_err(RunError::Step)?
-                > 0
-            {
-                continue;
-            }
+        let limit = max_cycles - sim.cycle();
+        let stalled = if sim.tracing() {
+            sim.fast_forward_sampled(|c, sample| c.run_stalled_sampled(limit, sample))
+        } else {
+            sim.fast_forward(|c| c.run_stalled(limit))
+        };
+        if stalled.map_err(RunError::Step)? > 0 {
+            continue;
         }
         sim.step().map_err(RunError::Step)?;
     }

@@ -142,6 +142,51 @@ impl<T: Clocked + Traced> Sim<T> {
         }
     }
 
+    /// [`Sim::fast_forward`] that also works with a waveform: `f` gets the
+    /// top module and a function to call with it between the evaluation
+    /// and the commit of every cycle it simulates (the waveform samples
+    /// the cycle there; `false`: writing it failed, stop before the
+    /// commit).
+    pub fn fast_forward_sampled(
+        &mut self,
+        f: impl FnOnce(&mut T, &mut dyn FnMut(&T) -> bool) -> (u64, Result<(), Fault>),
+    ) -> Result<u64, StepError> {
+        let mut cycle = self.cycle;
+        let mut err = None;
+        let (n, r) = match &mut self.tracer {
+            None => f(&mut self.top, &mut |_| true),
+            Some(t) => f(&mut self.top, &mut |top: &T| match t.sample(cycle, top) {
+                Ok(()) => {
+                    cycle += 1;
+                    true
+                }
+                Err(e) => {
+                    err = Some(e);
+                    false
+                }
+            }),
+        };
+        self.cycle += n;
+        if let Some(e) = err {
+            return Err(StepError::Trace(e));
+        }
+        match r {
+            Ok(()) => Ok(n),
+            Err(fault) => {
+                if let Some(t) = &mut self.tracer {
+                    t.note(&format!(
+                        "stopped by a fault at cycle {}: {fault}",
+                        self.cycle
+                    ));
+                }
+                Err(StepError::Fault {
+                    cycle: self.cycle,
+                    fault,
+                })
+            }
+        }
+    }
+
     /// Close the waveform, if any; returns the files written.
     pub fn finish_trace(&mut self) -> io::Result<Vec<std::path::PathBuf>> {
         match self.tracer.take() {

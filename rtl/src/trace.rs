@@ -116,6 +116,23 @@ pub trait Probe {
             k = end;
         }
     }
+    /// [`Probe::block`] for signals that change only when `version` does
+    /// (a register file and its count of writes): `fill` writes their
+    /// values into the slice it is given. A probe that remembers the
+    /// version it saw at this call may skip the block while it is the
+    /// same, without asking for the values.
+    fn block_versioned(
+        &mut self,
+        version: u64,
+        fields: &dyn Fn() -> Vec<Field>,
+        fill: &mut dyn FnMut(&mut [u64]),
+    ) {
+        let _ = version;
+        let f = fields();
+        let mut values = vec![0; f.len()];
+        fill(&mut values);
+        self.block(&|| f.clone(), &values);
+    }
 }
 
 /// One signal of a [`Probe::block`].
@@ -726,6 +743,11 @@ pub struct Tracer {
     /// Answers of [`Probe::open_scopes`], in call order.
     open_masks: Vec<u64>,
     open_i: usize,
+    /// Per [`Probe::block_versioned`] call: the version last sampled and
+    /// the block's size; a buffer for its values.
+    versions: Vec<(u64, usize)>,
+    version_i: usize,
+    scratch: Vec<u64>,
     /// Per signal call (in call order, traced or not): the mask of its
     /// width (0 when it is not traced, so it never changes) and the value
     /// last written.
@@ -994,6 +1016,9 @@ impl Tracer {
             scope_on: Vec::new(),
             open_masks: Vec::new(),
             open_i: 0,
+            versions: Vec::new(),
+            version_i: 0,
+            scratch: Vec::new(),
             slots: Vec::new(),
             changed: Vec::new(),
             n_changed: 0,
@@ -1099,6 +1124,7 @@ impl Tracer {
         self.scope_i = 0;
         self.slot_i = 0;
         self.open_i = 0;
+        self.version_i = 0;
         self.n_changed = 0;
         top.trace(self);
         if self.slot_i != self.slots.len() {
@@ -1323,6 +1349,37 @@ impl Tracer {
 }
 
 impl Probe for Tracer {
+    fn block_versioned(
+        &mut self,
+        version: u64,
+        fields: &dyn Fn() -> Vec<Field>,
+        fill: &mut dyn FnMut(&mut [u64]),
+    ) {
+        if let Phase::Declare = self.phase {
+            let n = fields().len();
+            self.versions.push((version, n));
+            self.scratch.resize(self.scratch.len().max(n), 0);
+            return self.block(fields, &vec![0; n]);
+        }
+        let Some(&(last, n)) = self.versions.get(self.version_i) else {
+            self.err.get_or_insert(io::Error::other(
+                "a module reported a block of signals it did not declare",
+            ));
+            return;
+        };
+        self.versions[self.version_i].0 = version;
+        self.version_i += 1;
+        if version == last && !self.first_sample {
+            // Unchanged: the values last written still hold.
+            self.slot_i += n;
+            return;
+        }
+        let mut values = std::mem::take(&mut self.scratch);
+        fill(&mut values[..n]);
+        self.sample_calls(&values[..n]);
+        self.scratch = values;
+    }
+
     fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
         if let Phase::Sample = self.phase {
             return self.sample_calls(values);

@@ -218,3 +218,45 @@ fn the_stall_fast_path_is_cycle_exact() {
     // The comparison means something only where the fast path ran.
     assert!(stalled >= 10, "only {stalled} programs stall");
 }
+
+/// With a waveform, the stalled cycles go through the same fast path
+/// (`Chip::run_stalled_sampled`), sampled cycle by cycle. Every program's
+/// full waveform (`--trace-scope all`), run that way, must be byte for byte
+/// the waveform of plain stepping through `Sim::step`.
+#[test]
+fn the_stall_fast_path_traces_the_same_waveform() {
+    let tmp = tempfile::tempdir().unwrap();
+    let mut stalled = 0;
+    for name in LISTED.iter().chain(REPORTED) {
+        let img = load_program(&dir().join(name)).unwrap();
+        let fast_vcd = tmp.path().join("fast.vcd");
+        let fast = run_image(
+            &img,
+            Timing::default(),
+            2_000_000,
+            Some(rtl::trace::TraceConfig::new(&fast_vcd)),
+        )
+        .unwrap();
+        assert!(fast.result.is_ok(), "{name}");
+        if fast.stats().array_stall_cycles + fast.stats().dma_stall_cycles > 0 {
+            stalled += 1;
+        }
+        let slow_vcd = tmp.path().join("slow.vcd");
+        let mut chip = rtl::Chip::new(Timing::default(), tb::cmd_run::DEFAULT_MEMORY);
+        img.load(&mut chip).unwrap();
+        let mut slow = rtl::Sim::new(chip);
+        slow.trace(rtl::trace::TraceConfig::new(&slow_vcd), "morphosys")
+            .unwrap();
+        while !slow.top.halted() {
+            slow.step().unwrap();
+        }
+        slow.finish_trace().unwrap();
+        let (f, s) = (
+            std::fs::read(&fast_vcd).unwrap(),
+            std::fs::read(&slow_vcd).unwrap(),
+        );
+        assert!(f.len() > 1000, "{name}: a waveform of {} bytes", f.len());
+        assert!(f == s, "{name}: the waveforms differ");
+    }
+    assert!(stalled >= 10, "only {stalled} programs stall");
+}

@@ -585,10 +585,13 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
         let sig = |x: W| x.to_i64() as u64 & mask(bits);
         // Ask once which lanes' scopes are traced, then enter only those.
         let names = self.names;
-        let wanted = p.open_scopes(N, &mut |i| names.name(i));
-        for i in 0..N {
-            if wanted >> i & 1 == 0 {
-                continue;
+        let mut wanted = p.open_scopes(N, &mut |i| names.name(i));
+        // The set bits only (a trace of one RC does not test 64 bits).
+        while wanted != 0 {
+            let i = wanted.trailing_zeros() as usize;
+            wanted &= wanted - 1;
+            if i >= N {
+                break;
             }
             let open = match self.names {
                 LaneNames::Single => p.scope(format_args!("rc")),
@@ -597,28 +600,12 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
             if !open {
                 continue;
             }
-            // One block per RC: out, alu, mul, flags, regfile, ram.
+            // Three blocks per RC: out, alu, mul and flags; the register
+            // file (skipped by a waveform while it takes no write); ram.
             let bit = |m: Mask| m >> i & 1;
-            let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
-            let mut v = [0u64; 28];
-            v[0] = sig(self.out[i]);
-            v[1] = sig(self.operand_a(i));
-            v[2] = sig(self.operand_b(i));
-            v[3] = sig(self.res[i]);
-            v[4] = bit(en);
-            v[5] = W::acc_i128(self.acc[i]) as u64 & mask(2 * bits);
-            v[6] = bit(self.flags.f);
-            v[7] = bit(self.flags.c);
-            v[8] = bit(self.flags.v);
-            v[9] = bit(self.flags.sleep);
-            for (k, r) in v[10..26].iter_mut().enumerate() {
-                *r = sig(self.regs.r[k][i]);
-            }
-            v[26] = if mem { self.ram_addr(i) as u64 } else { 0 };
-            v[27] = (mem && c.op == Op::St) as u64;
             p.block(
                 &|| {
-                    let mut f = vec![
+                    vec![
                         Field::new("", "out", bits, Display::Signed),
                         Field::new("alu", "a", bits, Display::Signed),
                         Field::new("alu", "b", bits, Display::Signed),
@@ -629,13 +616,46 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
                         Field::new("flags", "c", 1, Display::Bin),
                         Field::new("flags", "v", 1, Display::Bin),
                         Field::new("flags", "sleep", 1, Display::Bin),
-                    ];
-                    f.extend(REG_NAMES.map(|r| Field::new("regfile", r, bits, Display::Signed)));
-                    f.push(Field::new("ram", "addr", 9, Display::Hex));
-                    f.push(Field::new("ram", "we", 1, Display::Bin));
-                    f
+                    ]
                 },
-                &v,
+                &[
+                    sig(self.out[i]),
+                    sig(self.operand_a(i)),
+                    sig(self.operand_b(i)),
+                    sig(self.res[i]),
+                    bit(en),
+                    W::acc_i128(self.acc[i]) as u64 & mask(2 * bits),
+                    bit(self.flags.f),
+                    bit(self.flags.c),
+                    bit(self.flags.v),
+                    bit(self.flags.sleep),
+                ],
+            );
+            p.block_versioned(
+                self.regs.writes(),
+                &|| {
+                    REG_NAMES
+                        .map(|r| Field::new("regfile", r, bits, Display::Signed))
+                        .to_vec()
+                },
+                &mut |v| {
+                    for (k, r) in v.iter_mut().enumerate() {
+                        *r = sig(self.regs.r[k][i]);
+                    }
+                },
+            );
+            let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
+            p.block(
+                &|| {
+                    vec![
+                        Field::new("ram", "addr", 9, Display::Hex),
+                        Field::new("ram", "we", 1, Display::Bin),
+                    ]
+                },
+                &[
+                    if mem { self.ram_addr(i) as u64 } else { 0 },
+                    (mem && c.op == Op::St) as u64,
+                ],
             );
             p.end();
         }

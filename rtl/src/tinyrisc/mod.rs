@@ -227,25 +227,29 @@ pub static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
 
 impl Traced for TinyRisc {
     fn trace(&self, p: &mut dyn Probe) {
-        // One block: pc, ir, state, then the register file in `regs`.
-        let mut values = [0u64; 19];
-        values[0] = self.pc as u64;
-        values[1] = self.ir as u64;
-        values[2] = self.state as u64;
-        for (k, v) in values[3..].iter_mut().enumerate() {
-            *v = self.regs.read(k as u8) as u64;
-        }
         p.block(
             &|| {
-                let mut f = vec![
+                vec![
                     Field::new("", "pc", 32, Display::Hex),
                     Field::new("", "ir", 32, Display::Translate(&INSTR_FILTER)),
                     Field::new("", "state", 3, Display::Translate(&STATE_FILTER)),
-                ];
-                f.extend(REG_NAMES.map(|r| Field::new("regs", r, 32, Display::Hex)));
-                f
+                ]
             },
-            &values,
+            &[self.pc as u64, self.ir as u64, self.state as u64],
+        );
+        // The register file, skipped by the waveform while it takes no write.
+        p.block_versioned(
+            self.regs.writes(),
+            &|| {
+                REG_NAMES
+                    .map(|r| Field::new("regs", r, 32, Display::Hex))
+                    .to_vec()
+            },
+            &mut |v| {
+                for (k, v) in v.iter_mut().enumerate() {
+                    *v = self.regs.read(k as u8) as u64;
+                }
+            },
         );
     }
 }
