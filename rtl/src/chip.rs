@@ -452,11 +452,15 @@ impl<W: Word> Clocked for Chip<W> {
 
 impl<W: Word> Traced for Chip<W> {
     fn trace(&self, p: &mut dyn Probe) {
-        if p.scope(format_args!("tinyrisc")) {
+        // Asked once which of the four are traced; the others are not
+        // entered at all.
+        const SCOPES: [&str; 4] = ["tinyrisc", "broadcast", "dma", "array"];
+        let on = p.open_scopes(4, &mut |i| SCOPES[i].to_string());
+        if on & 1 != 0 && p.scope(format_args!("tinyrisc")) {
             self.risc.trace(p);
             p.end();
         }
-        if p.scope(format_args!("broadcast")) {
+        if on & 2 != 0 && p.scope(format_args!("broadcast")) {
             let (busy, ctx, k, ptr) = match self.bcast.current() {
                 Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
                 None => (0, 0, 0, [0, 0]),
@@ -483,7 +487,7 @@ impl<W: Word> Traced for Chip<W> {
             );
             p.end();
         }
-        if p.scope(format_args!("dma")) {
+        if on & 4 != 0 && p.scope(format_args!("dma")) {
             let (kind, mem, local) = match self.dma.current() {
                 Some((r, _)) => (r.kind as u64, r.mem as u64, r.local as u64),
                 None => (0, 0, 0),
@@ -510,7 +514,7 @@ impl<W: Word> Traced for Chip<W> {
             );
             p.end();
         }
-        if p.scope(format_args!("array")) {
+        if on & 8 != 0 && p.scope(format_args!("array")) {
             self.array.trace(p);
             p.end();
         }

@@ -766,6 +766,10 @@ pub struct Tracer {
     /// traced ones are written).
     first_sample: bool,
     clock: Clock,
+    /// The digits of the times written, and the time that takes one more
+    /// (the times only grow).
+    digits: u64,
+    digits_below: u64,
     seen: Vec<BTreeSet<u64>>,
     clk: SigId,
     cycle_id: SigId,
@@ -1027,6 +1031,8 @@ impl Tracer {
             slot_i: 0,
             first_sample: true,
             clock: Clock::new(1),
+            digits: 1,
+            digits_below: 10,
             seen: Vec::new(),
             clk,
             cycle_id,
@@ -1140,8 +1146,11 @@ impl Tracer {
         }
         // This cycle's own lines: two timestamps, the clock twice, the
         // cycle number in binary.
-        let digits = |v: u64| v.checked_ilog10().map_or(1, |d| d + 1) as u64;
-        self.bytes += 2 * (digits(t) + 2) + 6 + (64 - cycle.leading_zeros()).max(1) as u64 + 6;
+        while t >= self.digits_below {
+            self.digits += 1;
+            self.digits_below = self.digits_below.saturating_mul(10);
+        }
+        self.bytes += 2 * (self.digits + 2) + 6 + (64 - cycle.leading_zeros()).max(1) as u64 + 6;
         if self.bytes > self.cfg.max_bytes {
             // An open-ended trace that outgrew the limit stops here, and says so.
             self.truncated_at = Some(cycle + 1);
