@@ -177,7 +177,7 @@ fn dma_conflict(dma: &Dma, bank: usize, what: &str) -> Fault {
 }
 
 impl<W: Word> Machine for View<'_, W> {
-    #[inline]
+    #[inline(always)]
     fn fetch(&self, pc: u32) -> Result<u32, Fault> {
         self.mem
             .check(pc, 4)
@@ -319,7 +319,6 @@ impl<W: Word> Chip<W> {
     /// [`Chip::run_stalled`], calling `sample` between each cycle's
     /// evaluation and its commit (a waveform samples the cycle; `false`
     /// stops before the commit).
-    #[inline]
     pub fn run_stalled_sampled(
         &mut self,
         limit: u64,
@@ -390,7 +389,7 @@ impl<W: Word> Chip<W> {
 }
 
 impl<W: Word> Clocked for Chip<W> {
-    #[inline]
+    #[inline(always)]
     fn eval(&mut self) -> Result<(), Fault> {
         let view = View {
             array: &self.array,
@@ -575,32 +574,60 @@ pub fn run_to_halt32(sim: &mut Sim<Chip<i32>>, max_cycles: u64) -> Result<u64, R
 }
 
 fn run_loop<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
+    if sim.tracing() {
+        return run_loop_traced(sim, max_cycles);
+    }
     while !sim.top.halted() {
         if sim.cycle() >= max_cycles {
-            let pc = sim.top.risc.pc;
-            let text = if sim.top.mem.check(pc, 4).is_ok() {
-                decode::disassemble(sim.top.mem.read(pc, 4))
-            } else {
-                "?".into()
-            };
-            return Err(RunError::MaxCycles {
-                cycles: sim.cycle(),
-                pc,
-                text,
-            });
+            return Err(no_halt(sim));
         }
         let limit = max_cycles - sim.cycle();
-        let stalled = if sim.tracing() {
-            sim.fast_forward_sampled(|c, sample| c.run_stalled_sampled(limit, sample))
-        } else {
-            sim.fast_forward(|c| c.run_stalled(limit))
-        };
-        if stalled.map_err(RunError::Step)? > 0 {
+        if sim
+            .fast_forward(|c| c.run_stalled(limit))
+            .map_err(RunError::Step)?
+            > 0
+        {
             continue;
         }
         sim.step().map_err(RunError::Step)?;
     }
     Ok(sim.cycle())
+}
+
+/// [`run_loop`] with a waveform: a loop of its own, so that the untraced
+/// loop's code is what it was before tracing could take the fast path.
+#[inline(never)]
+fn run_loop_traced<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
+    while !sim.top.halted() {
+        if sim.cycle() >= max_cycles {
+            return Err(no_halt(sim));
+        }
+        let limit = max_cycles - sim.cycle();
+        if sim
+            .fast_forward_sampled(|c, sample| c.run_stalled_sampled(limit, sample))
+            .map_err(RunError::Step)?
+            > 0
+        {
+            continue;
+        }
+        sim.step().map_err(RunError::Step)?;
+    }
+    Ok(sim.cycle())
+}
+
+#[cold]
+fn no_halt<W: Word>(sim: &Sim<Chip<W>>) -> RunError {
+    let pc = sim.top.risc.pc;
+    let text = if sim.top.mem.check(pc, 4).is_ok() {
+        decode::disassemble(sim.top.mem.read(pc, 4))
+    } else {
+        "?".into()
+    };
+    RunError::MaxCycles {
+        cycles: sim.cycle(),
+        pc,
+        text,
+    }
 }
 
 // Keep the decoded-context type in the public surface of the chip module.

@@ -96,7 +96,7 @@ impl<T: Clocked + Traced> Sim<T> {
     }
 
     /// One clock cycle.
-    #[inline]
+    #[inline(always)]
     pub fn step(&mut self) -> Result<(), StepError> {
         if let Err(fault) = self.top.eval() {
             if let Some(t) = &mut self.tracer {

@@ -1120,7 +1120,9 @@ impl Tracer {
         ((cycle as u128 * 1_000_000_000_000u128) / self.cfg.clock_hz as u128) as u64
     }
 
-    /// Record the values of `top` during `cycle`.
+    /// Record the values of `top` during `cycle`. Out of line: the
+    /// untraced cycle loop keeps only the test for a tracer.
+    #[inline(never)]
     pub fn sample(&mut self, cycle: u64, top: &dyn Traced) -> io::Result<()> {
         if !self.in_window(cycle) {
             return Ok(());

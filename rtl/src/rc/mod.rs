@@ -600,12 +600,26 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
             if !open {
                 continue;
             }
-            // Three blocks per RC: out, alu, mul and flags; the register
-            // file (skipped by a waveform while it takes no write); ram.
+            // Two blocks per RC: out, alu, mul, flags and the register
+            // file; ram.
             let bit = |m: Mask| m >> i & 1;
+            let mut v = [0u64; 26];
+            v[0] = sig(self.out[i]);
+            v[1] = sig(self.operand_a(i));
+            v[2] = sig(self.operand_b(i));
+            v[3] = sig(self.res[i]);
+            v[4] = bit(en);
+            v[5] = W::acc_i128(self.acc[i]) as u64 & mask(2 * bits);
+            v[6] = bit(self.flags.f);
+            v[7] = bit(self.flags.c);
+            v[8] = bit(self.flags.v);
+            v[9] = bit(self.flags.sleep);
+            for (k, r) in v[10..].iter_mut().enumerate() {
+                *r = sig(self.regs.r[k][i]);
+            }
             p.block(
                 &|| {
-                    vec![
+                    let mut f = vec![
                         Field::new("", "out", bits, Display::Signed),
                         Field::new("alu", "a", bits, Display::Signed),
                         Field::new("alu", "b", bits, Display::Signed),
@@ -616,33 +630,11 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
                         Field::new("flags", "c", 1, Display::Bin),
                         Field::new("flags", "v", 1, Display::Bin),
                         Field::new("flags", "sleep", 1, Display::Bin),
-                    ]
+                    ];
+                    f.extend(REG_NAMES.map(|r| Field::new("regfile", r, bits, Display::Signed)));
+                    f
                 },
-                &[
-                    sig(self.out[i]),
-                    sig(self.operand_a(i)),
-                    sig(self.operand_b(i)),
-                    sig(self.res[i]),
-                    bit(en),
-                    W::acc_i128(self.acc[i]) as u64 & mask(2 * bits),
-                    bit(self.flags.f),
-                    bit(self.flags.c),
-                    bit(self.flags.v),
-                    bit(self.flags.sleep),
-                ],
-            );
-            p.block_versioned(
-                self.regs.writes(),
-                &|| {
-                    REG_NAMES
-                        .map(|r| Field::new("regfile", r, bits, Display::Signed))
-                        .to_vec()
-                },
-                &mut |v| {
-                    for (k, r) in v.iter_mut().enumerate() {
-                        *r = sig(self.regs.r[k][i]);
-                    }
-                },
+                &v,
             );
             let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
             p.block(

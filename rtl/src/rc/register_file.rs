@@ -12,16 +12,12 @@ pub const REGS: usize = 16;
 
 pub struct RegisterFile<const N: usize, W: Word = i16> {
     pub(crate) r: [[W; N]; REGS],
-    /// Writes so far, of any lane (a waveform skips the registers while it
-    /// holds).
-    writes: u64,
 }
 
 impl<const N: usize, W: Word> Default for RegisterFile<N, W> {
     fn default() -> Self {
         RegisterFile {
             r: [[W::ZERO; N]; REGS],
-            writes: 0,
         }
     }
 }
@@ -37,19 +33,11 @@ impl<const N: usize, W: Word> RegisterFile<N, W> {
     #[inline(always)]
     pub fn write(&mut self, k: u8, mask: Mask, data: &[W; N]) {
         select_word(&mut self.r[k as usize & 15], mask, data);
-        self.writes += 1;
-    }
-
-    /// How many writes the registers have taken: the same number, the
-    /// same values.
-    pub fn writes(&self) -> u64 {
-        self.writes
     }
 
     /// Set a register of one lane directly (testbench and loader access, not
     /// a datapath port).
     pub fn poke(&mut self, lane: usize, k: u8, v: W) {
         self.r[k as usize & 15][lane] = v;
-        self.writes += 1;
     }
 }

@@ -79,6 +79,7 @@ fn fb_addr(v: i64, what: &str) -> Result<u16, Fault> {
 impl TinyRisc {
     /// Execute the instruction at `pc` (when not busy, stalled or halted):
     /// computes the next state and the command.
+    #[inline(always)]
     pub fn eval<M: Machine>(&mut self, m: &M) -> Result<(), Fault> {
         self.cmd = Command::None;
         self.d_reg = None;

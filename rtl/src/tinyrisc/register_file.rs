@@ -1,20 +1,10 @@
 //! TinyRISC register file: 16 x 32-bit, `r0` reads as zero, `r15` is the
 //! link register of `jal`.
 
-#[derive(Clone, Copy, Debug, Default)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RegisterFile {
     r: [u32; 16],
-    /// Writes so far (a waveform skips the registers while it holds).
-    writes: u64,
 }
-
-impl PartialEq for RegisterFile {
-    fn eq(&self, other: &Self) -> bool {
-        self.r == other.r
-    }
-}
-
-impl Eq for RegisterFile {}
 
 impl RegisterFile {
     #[inline(always)]
@@ -27,14 +17,7 @@ impl RegisterFile {
     pub fn write(&mut self, k: u8, v: u32) {
         if k & 15 != 0 {
             self.r[k as usize & 15] = v;
-            self.writes += 1;
         }
-    }
-
-    /// How many writes the registers have taken: the same number, the
-    /// same values.
-    pub fn writes(&self) -> u64 {
-        self.writes
     }
 
     pub fn all(&self) -> &[u32; 16] {
