@@ -418,14 +418,17 @@ impl VcdBody {
             k = 1;
         } else {
             dst[0] = b'b';
-            // All 64 digits, then the significant ones moved into place
-            // with one fixed-size copy.
+            // The digits of the significant bytes, most significant first,
+            // then the significant digits moved into place with one
+            // fixed-size copy.
             let bits = 64 - (v | 1).leading_zeros() as usize;
-            let mut all = [b'0'; 128];
-            for (byte, out) in all[..64].chunks_exact_mut(8).enumerate() {
-                out.copy_from_slice(&BIN8[(v >> (56 - 8 * byte)) as u8 as usize]);
+            let bytes = bits.div_ceil(8);
+            let mut all = [b'0'; 72];
+            for (byte, out) in all[..8 * bytes].chunks_exact_mut(8).enumerate() {
+                out.copy_from_slice(&BIN8[(v >> (8 * (bytes - 1 - byte))) as u8 as usize]);
             }
-            dst[1..65].copy_from_slice(&all[64 - bits..128 - bits]);
+            let from = 8 * bytes - bits;
+            dst[1..65].copy_from_slice(&all[from..from + 64]);
             dst[1 + bits] = b' ';
             k = bits + 2;
         }
@@ -519,7 +522,10 @@ impl Sink {
             .spawn(move || {
                 let mut sink = self;
                 let mut res = Ok(());
-                let mut seen = vec![BTreeSet::new(); sigs.len()];
+                // Values of the filtered signals, deduplicated whenever a
+                // list doubles (a set insertion per change cost more).
+                let mut seen: Vec<Vec<u64>> = vec![Vec::new(); sigs.len()];
+                let mut seen_cap = vec![1024usize; sigs.len()];
                 let mut clock = Clock::new(clock_hz);
                 // The falling edge of the last cycle begun, written when
                 // the next one begins or the trace ends.
@@ -564,7 +570,12 @@ impl Sink {
                             Some(i) => {
                                 let (id, w, filtered) = sigs[i];
                                 if filtered {
-                                    seen[i].insert(v);
+                                    seen[i].push(v);
+                                    if seen[i].len() >= seen_cap[i] {
+                                        seen[i].sort_unstable();
+                                        seen[i].dedup();
+                                        seen_cap[i] = (2 * seen[i].len()).max(1024);
+                                    }
                                 }
                                 sink.change(id, w, v)
                             }
@@ -583,6 +594,7 @@ impl Sink {
                         res = sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0));
                     }
                 }
+                let seen = seen.into_iter().map(BTreeSet::from_iter).collect();
                 (sink, res, seen)
             })?;
         Ok(Sink::Threaded {
