@@ -312,6 +312,7 @@ impl<W: Word> Chip<W> {
     /// stall counters included); stops when the wait is over, the
     /// instruction word changed (a DMA store into the program), or after
     /// `limit` cycles. Returns the cycles run.
+    #[inline]
     pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
         self.run_stalled_sampled(limit, |_| true)
     }
@@ -319,6 +320,7 @@ impl<W: Word> Chip<W> {
     /// [`Chip::run_stalled`], calling `sample` between each cycle's
     /// evaluation and its commit (a waveform samples the cycle; `false`
     /// stops before the commit).
+    #[inline(always)]
     pub fn run_stalled_sampled(
         &mut self,
         limit: u64,

@@ -126,6 +126,7 @@ impl<T: Clocked + Traced> Sim<T> {
     /// Advance by a fast path of the top module that simulates whole
     /// cycles itself (`f` returns the cycles it completed and how it ended).
     /// Only without a waveform: the fast path samples nothing.
+    #[inline(always)]
     pub fn fast_forward(
         &mut self,
         f: impl FnOnce(&mut T) -> (u64, Result<(), Fault>),
