@@ -1618,7 +1618,103 @@ impl Tracer {
 
 #[cfg(test)]
 mod tests {
-    use super::glob;
+    use super::*;
+    use crate::kernel::{Clocked, Fault, Sim};
+
+    /// A counter reporting the same signals through blocks (and a
+    /// versioned block) or through one call per scope and signal.
+    struct Demo {
+        t: u64,
+        by_block: bool,
+    }
+
+    impl Clocked for Demo {
+        fn eval(&mut self) -> Result<(), Fault> {
+            Ok(())
+        }
+        fn commit(&mut self) {
+            self.t += 1;
+        }
+    }
+
+    impl Traced for Demo {
+        fn trace(&self, p: &mut dyn Probe) {
+            let t = self.t;
+            let (a, b, c, d) = (t, t / 3, (t * 7) as i16 as u64, t % 2);
+            let (r0, r1) = (t / 5, t / 5 * 3);
+            if self.by_block {
+                p.block(
+                    &|| {
+                        vec![
+                            Field::new("", "a", 8, Display::Hex),
+                            Field::new("x", "b", 4, Display::Hex),
+                            Field::new("x", "c", 16, Display::Signed),
+                            Field::new("y", "d", 1, Display::Bin),
+                        ]
+                    },
+                    &[a, b, c, d],
+                );
+                p.block_versioned(
+                    t / 5,
+                    &|| {
+                        vec![
+                            Field::new("regs", "r0", 8, Display::Hex),
+                            Field::new("regs", "r1", 8, Display::Hex),
+                        ]
+                    },
+                    &mut |v| {
+                        v[0] = r0;
+                        v[1] = r1;
+                    },
+                );
+            } else {
+                p.signal("a", 8, Display::Hex, a);
+                if p.scope(format_args!("x")) {
+                    p.signal("b", 4, Display::Hex, b);
+                    p.signal("c", 16, Display::Signed, c);
+                    p.end();
+                }
+                if p.scope(format_args!("y")) {
+                    p.signal("d", 1, Display::Bin, d);
+                    p.end();
+                }
+                if p.scope(format_args!("regs")) {
+                    p.signal_row(&["r0", "r1"], 8, Display::Hex, &[r0, r1]);
+                    p.end();
+                }
+            }
+        }
+    }
+
+    fn waveform(dir: &Path, by_block: bool, scope: &str, first: u64) -> Vec<u8> {
+        let path = dir.join(format!("{by_block}.vcd"));
+        let mut cfg = TraceConfig::new(&path);
+        cfg.scope = scope.into();
+        cfg.first = first;
+        let mut sim = Sim::new(Demo { t: 0, by_block });
+        sim.trace(cfg, "demo").unwrap();
+        for _ in 0..600 {
+            sim.step().unwrap();
+        }
+        sim.finish_trace().unwrap();
+        std::fs::read(&path).unwrap()
+    }
+
+    /// Blocks and versioned blocks write the waveform that one call per
+    /// scope and signal writes, whatever the scope filter and window.
+    #[test]
+    fn blocks_write_what_single_calls_write() {
+        let dir = tempfile::tempdir().unwrap();
+        for (scope, first) in [("", 0), ("x,regs", 0), ("y", 7), ("regs.r1,a", 13)] {
+            let calls = waveform(dir.path(), false, scope, first);
+            let blocks = waveform(dir.path(), true, scope, first);
+            assert!(calls.len() > 2000, "{scope}: {} bytes", calls.len());
+            assert!(
+                calls == blocks,
+                "{scope} from {first}: the waveforms differ"
+            );
+        }
+    }
 
     #[test]
     fn glob_matches_like_a_shell() {
