@@ -300,7 +300,10 @@ fn cmp_mask<W: Word, const N: usize>(
 
 impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
     fn eval(&mut self) -> Result<(), Fault> {
-        let c = self.ctx;
+        // The fields one at a time (a copy of the whole context was one
+        // wide load reaching past it into `lane_enable`, both just stored
+        // by the array: the load could not be forwarded and stalled).
+        let c = &self.ctx;
         let en = self.enabled();
         self.en = en;
         self.pend = Pending {
