@@ -39,12 +39,22 @@ fn main() {
                 ..Context::rrr(Op::Min, 1, 1, 2)
             },
         ),
+        (
+            "mac(f)",
+            Context {
+                shift: 8,
+                guard: Guard::IfF,
+                ..Context::rrr(Op::Mac, 1, 1, 2)
+            },
+        ),
         ("sra", Context::rri(Op::Sra, 1, 1, 2)),
         ("ld", Context::rri(Op::Ld, 1, 0, 2)),
     ] {
         if only.as_deref().is_some_and(|o| o != name) {
             continue;
         }
+        // The guarded cases run in every other lane (F set in the odd ones).
+        rc.flags.f = 0xAAAA_AAAA_AAAA_AAAA;
         let n = 5_000_000u64;
         let w = c.encode();
         let t = std::time::Instant::now();

@@ -128,6 +128,30 @@ mod tests {
             for i in 0..64 {
                 assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
             }
+            // The accumulators of both datapaths (i32 and i64 lanes).
+            let mut d = [7i32; 64];
+            <i16 as Word>::select_acc(&mut d, x, &src);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
+            let mut d = [-7i64; 64];
+            let src64: [i64; 64] = std::array::from_fn(|i| (i as i64 - 30) << 40);
+            <i32 as Word>::select_acc(&mut d, x, &src64);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src64[i] } else { -7 });
+            }
+            let mut d = [7i32; 12];
+            <i16 as Word>::select_acc(&mut d, x, &b12.map(|b| b as i32 - 5));
+            for i in 0..12 {
+                assert_eq!(
+                    d[i],
+                    if x >> i & 1 == 1 {
+                        b12[i] as i32 - 5
+                    } else {
+                        7
+                    }
+                );
+            }
         }
     }
 }

@@ -24,7 +24,7 @@ use crate::kernel::{Clocked, Fault};
 use crate::trace::{Display, Field, Filter, Probe, Traced};
 use context::{ASrc, BSrc, Cond, Context, Guard, Op};
 use flags::Flags;
-use lanes::{full, select, select_word, Mask};
+use lanes::{full, select_word, Mask};
 use ram::Ram;
 use register_file::RegisterFile;
 pub use word::{Datapath, Word};
@@ -535,7 +535,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             self.flags.f = Flags::merge(self.flags.f, en, self.d_f);
         }
         if p.acc {
-            select(&mut self.acc, en, &self.acc_d);
+            W::select_acc(&mut self.acc, en, &self.acc_d);
         }
         if p.store {
             if self.uniform {
