@@ -32,24 +32,23 @@ fn main() {
                 ..Context::rrr(Op::Cmp, 0, 1, 2)
             },
         ),
-        (
-            "min(f)",
-            Context {
-                guard: Guard::IfF,
-                ..Context::rrr(Op::Min, 1, 1, 2)
-            },
-        ),
-        (
-            "mac(f)",
-            Context {
-                shift: 8,
-                guard: Guard::IfF,
-                ..Context::rrr(Op::Mac, 1, 1, 2)
-            },
-        ),
+        ("min", Context::rrr(Op::Min, 1, 1, 2)),
         ("sra", Context::rri(Op::Sra, 1, 1, 2)),
         ("ld", Context::rri(Op::Ld, 1, 0, 2)),
-    ] {
+        ("st", Context::rri(Op::St, 0, 1, 2)),
+        ("sub", Context::rrr(Op::Sub, 1, 1, 2)),
+        ("ldacc", Context::rri(Op::Ldacc, 0, 1, 14)),
+    ]
+    .into_iter()
+    .flat_map(|(name, c)| {
+        // Each also guarded by F, set in every other lane: the partial
+        // masks of the tracer's sleeping rays.
+        let guarded = Context {
+            guard: Guard::IfF,
+            ..c
+        };
+        [(name.to_string(), c), (format!("{name}(f)"), guarded)]
+    }) {
         if only.as_deref().is_some_and(|o| o != name) {
             continue;
         }

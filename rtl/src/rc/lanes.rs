@@ -40,13 +40,27 @@ pub fn select_word<W: Word, const N: usize>(dst: &mut [W; N], mask: Mask, src: &
         if !N.is_multiple_of(8) {
             return select(dst, mask, src);
         }
-        let mut m = [W::ZERO; N];
-        for c in 0..N / 8 {
-            m[c * 8..c * 8 + 8].copy_from_slice(W::expand8((mask >> (c * 8)) as usize & 255));
-        }
-        for i in 0..N {
-            dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
-        }
+        blend(dst, &expand(mask), src);
+    }
+}
+
+/// The 0 / -1 lanes of `mask` (`N` a multiple of 8), by table
+/// ([`Word::expand8`]), for [`blend`]: one expansion serves every array
+/// a commit writes under the same mask.
+#[inline(always)]
+pub fn expand<W: Word, const N: usize>(mask: Mask) -> [W; N] {
+    let mut m = [W::ZERO; N];
+    for c in 0..N / 8 {
+        m[c * 8..c * 8 + 8].copy_from_slice(W::expand8((mask >> (c * 8)) as usize & 255));
+    }
+    m
+}
+
+/// `dst[i] = src[i]` where `m[i]` is -1 (bit operations: vectorises).
+#[inline(always)]
+pub fn blend<W: Word, const N: usize>(dst: &mut [W; N], m: &[W; N], src: &[W; N]) {
+    for i in 0..N {
+        dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
     }
 }
 

@@ -24,7 +24,7 @@ use crate::kernel::{Clocked, Fault};
 use crate::trace::{Display, Field, Filter, Probe, Traced};
 use context::{ASrc, BSrc, Cond, Context, Guard, Op};
 use flags::Flags;
-use lanes::{full, select_word, Mask};
+use lanes::{blend, expand, full, select_word, Mask};
 use ram::Ram;
 use register_file::RegisterFile;
 pub use word::{Datapath, Word};
@@ -522,9 +522,18 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
         let c = self.ctx;
         let p = self.pend;
         if p.result {
-            select_word(&mut self.out, en, &self.res);
-            if c.we {
-                self.regs.write(c.rd, en, &self.res);
+            if en == Self::FULL || !N.is_multiple_of(8) {
+                select_word(&mut self.out, en, &self.res);
+                if c.we {
+                    self.regs.write(c.rd, en, &self.res);
+                }
+            } else {
+                // Some lanes: the mask expanded once for both writes.
+                let m = expand::<W, N>(en);
+                blend(&mut self.out, &m, &self.res);
+                if c.we {
+                    self.regs.write_lanes(c.rd, &m, &self.res);
+                }
             }
         }
         if p.cv {

@@ -5,7 +5,7 @@
 //! during the cycle; the write lands at the clock edge
 //! ([`RegisterFile::write`] is only called from the array's commit).
 
-use super::lanes::{select_word, Mask};
+use super::lanes::{blend, select_word, Mask};
 use super::word::Word;
 
 pub const REGS: usize = 16;
@@ -33,6 +33,13 @@ impl<const N: usize, W: Word> RegisterFile<N, W> {
     #[inline(always)]
     pub fn write(&mut self, k: u8, mask: Mask, data: &[W; N]) {
         select_word(&mut self.r[k as usize & 15], mask, data);
+    }
+
+    /// [`RegisterFile::write`] with the mask already expanded to 0 / -1
+    /// lanes ([`super::lanes::expand`]).
+    #[inline(always)]
+    pub fn write_lanes(&mut self, k: u8, m: &[W; N], data: &[W; N]) {
+        blend(&mut self.r[k as usize & 15], m, data);
     }
 
     /// Set a register of one lane directly (testbench and loader access, not
