@@ -100,20 +100,16 @@ pub trait Probe {
     /// cycle instead of one per signal and scope.
     fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
         let fields = fields();
-        let mut k = 0;
-        while k < fields.len() {
-            let scope = fields[k].scope;
-            let end = k + fields[k..].iter().take_while(|f| f.scope == scope).count();
+        for (scope, run) in scope_runs(&fields) {
             let open = scope.is_empty() || self.scope(format_args!("{scope}"));
             if open {
-                for (f, &v) in fields[k..end].iter().zip(&values[k..end]) {
+                for (f, &v) in fields[run.clone()].iter().zip(&values[run]) {
                     self.signal(f.name, f.width, f.display, v);
                 }
                 if !scope.is_empty() {
                     self.end();
                 }
             }
-            k = end;
         }
     }
     /// [`Probe::block`] for signals that change only when `version` does
@@ -133,6 +129,18 @@ pub trait Probe {
         fill(&mut values);
         self.block(&|| f.clone(), &values);
     }
+}
+
+/// The runs of consecutive fields in one scope: each scope and its range.
+fn scope_runs(fields: &[Field]) -> Vec<(&'static str, std::ops::Range<usize>)> {
+    let mut runs: Vec<(&'static str, std::ops::Range<usize>)> = Vec::new();
+    for (k, f) in fields.iter().enumerate() {
+        match runs.last_mut() {
+            Some((scope, run)) if *scope == f.scope => run.end = k + 1,
+            _ => runs.push((f.scope, k..k + 1)),
+        }
+    }
+    runs
 }
 
 /// One signal of a [`Probe::block`].
@@ -1411,10 +1419,7 @@ impl Probe for Tracer {
         // a slot for every field (those of scopes left out untraced), as
         // the sampled cycles report every value.
         let fields = fields();
-        let mut k = 0;
-        while k < fields.len() {
-            let scope = fields[k].scope;
-            let end = k + fields[k..].iter().take_while(|f| f.scope == scope).count();
+        for (scope, run) in scope_runs(&fields) {
             let open = scope.is_empty() || {
                 self.stack.push(scope.to_string());
                 if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
@@ -1430,7 +1435,7 @@ impl Probe for Tracer {
                 }
                 on
             };
-            for f in &fields[k..end] {
+            for f in &fields[run] {
                 if open {
                     self.declare_signal(f.name, f.width, f.display);
                 } else {
@@ -1441,7 +1446,6 @@ impl Probe for Tracer {
             if open && !scope.is_empty() {
                 self.end();
             }
-            k = end;
         }
         if values.len() != fields.len() {
             self.err.get_or_insert(io::Error::other(format!(
