@@ -400,36 +400,40 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 let acc = &self.acc;
                 let acc_d = &mut self.acc_d;
                 let mut s = [false; N];
-                match c.op {
-                    Op::Mul => {
-                        for i in 0..N {
-                            acc_d[i] = W::product(a[i], b[i]);
-                        }
-                    }
-                    Op::Mac | Op::Msu => {
-                        let sub = c.op == Op::Msu;
-                        for i in 0..N {
-                            let p = W::product(a[i], b[i]);
-                            (acc_d[i], s[i]) = W::accumulate(acc[i], p, sub);
-                        }
-                    }
-                    _ => unreachable!(),
-                }
-                // The rounding choice once, outside the lane loop (`sh = 0`
-                // has no rounding bit either way).
-                macro_rules! scale {
+                // One loop per operation and rounding choice (chosen once,
+                // outside the lanes; `sh = 0` has no rounding bit either
+                // way): the product is scaled while it is in a register,
+                // not stored and loaded back.
+                macro_rules! lanes {
                     ($trunc:expr) => {
-                        for i in 0..N {
-                            let (r, s2) = W::scale(acc_d[i], sh, $trunc);
-                            res[i] = r;
-                            s[i] |= s2;
+                        match c.op {
+                            Op::Mul => {
+                                for i in 0..N {
+                                    let p = W::product(a[i], b[i]);
+                                    acc_d[i] = p;
+                                    let (r, s2) = W::scale(p, sh, $trunc);
+                                    res[i] = r;
+                                    s[i] = s2;
+                                }
+                            }
+                            _ => {
+                                let sub = c.op == Op::Msu;
+                                for i in 0..N {
+                                    let p = W::product(a[i], b[i]);
+                                    let (n, s1) = W::accumulate(acc[i], p, sub);
+                                    acc_d[i] = n;
+                                    let (r, s2) = W::scale(n, sh, $trunc);
+                                    res[i] = r;
+                                    s[i] = s1 | s2;
+                                }
+                            }
                         }
                     };
                 }
                 if trunc || sh & (2 * W::BITS - 1) == 0 {
-                    scale!(true)
+                    lanes!(true)
                 } else {
-                    scale!(false)
+                    lanes!(false)
                 }
                 (self.d_v, self.d_c) = (lanes::pack_bools(&s), 0);
                 self.pend.cv = true;
