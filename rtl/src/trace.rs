@@ -18,7 +18,12 @@
 //!   so the simulation does not wait for the formatting.
 //! * A module asks once which of its scopes ([`Probe::open_scopes`]) and
 //!   signals ([`Probe::traced_signals`]) are traced, and reports only
-//!   those; a register file is one call ([`Probe::signal_row`]).
+//!   those; a module's signals are one call ([`Probe::block`]), and a
+//!   register file that changes only when its version does is skipped
+//!   while the version holds ([`Probe::block_versioned`]).
+//! * The values a cycle reports are compared with the last ones written
+//!   after the cycle's walk; the changes go to the writing thread packed
+//!   in 64-bit words, and it computes the clock edges' times.
 //! * Names are GTKWave- and Surfer-safe: letters, digits and `_`, scopes for
 //!   hierarchy, never `name[3]` indices (`rc_r3_c4`, `r12`).
 //!
@@ -1137,7 +1142,7 @@ impl Tracer {
     }
 
     fn time(&self, cycle: u64) -> u64 {
-        ((cycle as u128 * 1_000_000_000_000u128) / self.cfg.clock_hz as u128) as u64
+        Clock::new(self.cfg.clock_hz).time(cycle)
     }
 
     /// Record the values of `top` during `cycle`. Out of line: the
