@@ -317,6 +317,142 @@ impl<W: Word> Chip<W> {
         self.run_stalled_sampled(limit, |_| true)
     }
 
+    /// The untraced fast paths, tried in turn by the cycle loop before a
+    /// plain cycle: with the DMA idle (main memory, the FB and the context
+    /// memory then change only by TinyRISC's own writes),
+    ///
+    /// * a stream: TinyRISC waits for the array while a run streams: only
+    ///   the broadcast unit and the array work ([`Chip::run_stream`]);
+    /// * control: the array is idle and nothing is queued: only TinyRISC
+    ///   works, and its multi-cycle instructions' busy cycles pass at once
+    ///   ([`Chip::run_control`]);
+    ///
+    /// otherwise [`Chip::run_stalled`]. Each gives exactly the cycles
+    /// [`Clocked::eval`] + [`Clocked::commit`] would (tested against plain
+    /// stepping on every conformance program); returns the cycles run
+    /// (0: none applies, step one cycle).
+    #[inline(always)]
+    pub fn run_fast(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        use crate::tinyrisc::{State, Wait};
+        if self.dma.idle() {
+            if self.bcast.idle() {
+                return self.run_control(limit);
+            }
+            if self.risc.state == State::StallArray
+                && matches!(self.risc.wait, Wait::ArrayIdle | Wait::Issue)
+                && self.mem.read(self.risc.pc, 4) == self.risc.ir
+            {
+                return self.run_stream(limit);
+            }
+        }
+        self.run_stalled(limit)
+    }
+
+    /// A run streams while TinyRISC waits for the array and the DMA is
+    /// idle: the broadcast unit and the array cycle alone, TinyRISC's stall
+    /// counted at the end (its stalled evaluation changes nothing, and
+    /// with the DMA idle nothing can change its instruction word).
+    #[inline(never)]
+    fn run_stream(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        use crate::tinyrisc::Wait;
+        let wait = self.risc.wait;
+        let mut n = 0;
+        let mut active = 0u64;
+        let mut err = None;
+        while n < limit
+            && match wait {
+                Wait::ArrayIdle => !self.bcast.idle(),
+                _ => !self.bcast.can_issue(),
+            }
+        {
+            if let Err(f) = self
+                .bcast
+                .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
+            {
+                err = Some(f);
+                break;
+            }
+            if let Err(f) = self.array.eval() {
+                err = Some(f);
+                break;
+            }
+            self.array.commit();
+            active += self.array.active_now as u64;
+            if self.watch.any {
+                self.count_watched();
+            }
+            self.bcast.commit();
+            n += 1;
+        }
+        self.array_busy += n;
+        self.active_rc += active;
+        self.risc.add_stalled(n);
+        self.cycles += n;
+        match err {
+            None => (n, Ok(())),
+            Some(f) => (n, Err(self.locate(f))),
+        }
+    }
+
+    /// The array is idle, nothing is queued and the DMA is idle: TinyRISC
+    /// alone, until it issues a run or a transfer (or halts); its busy
+    /// cycles pass at once.
+    #[inline(never)]
+    fn run_control(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        let mut n = 0;
+        while n < limit && !self.risc.halted() {
+            let busy = self.risc.busy();
+            if busy > 0 {
+                let b = (busy as u64).min(limit - n);
+                self.risc.skip_busy(b as u32);
+                self.idle_control += b;
+                self.cycles += b;
+                n += b;
+                continue;
+            }
+            let view = View {
+                array: &self.array,
+                bcast: &self.bcast,
+                fb: &self.fb,
+                mem: &self.mem,
+                dma: &self.dma,
+                cycles: self.cycles,
+            };
+            if let Err(f) = self.risc.eval(&view) {
+                return (n, Err(self.locate(f)));
+            }
+            // The clock edge of an idle array, broadcast unit and DMA.
+            self.array.idle();
+            self.idle_control += 1;
+            let cmd = self.risc.cmd;
+            self.apply(cmd);
+            self.risc.commit();
+            self.cycles += 1;
+            n += 1;
+            if matches!(cmd, Command::Run(_) | Command::Dma(_)) {
+                break;
+            }
+        }
+        (n, Ok(()))
+    }
+
+    /// TinyRISC's write at the clock edge.
+    #[inline(always)]
+    fn apply(&mut self, cmd: Command) {
+        match cmd {
+            Command::None => {}
+            Command::Store { addr, size, value } => self.mem.write(addr, size, value),
+            Command::FbWrite { addr, value } => self.fb.write(addr, W::wrap(value as i64)),
+            Command::Wfb { addr } => {
+                for (i, v) in self.array.rc.out.iter().enumerate() {
+                    self.fb.write(addr + i as u16, *v);
+                }
+            }
+            Command::Dma(req) => self.dma.start(req, self.risc.pc),
+            Command::Run(run) => self.bcast.issue(run),
+        }
+    }
+
     /// [`Chip::run_stalled`], calling `sample` between each cycle's
     /// evaluation and its commit (a waveform samples the cycle; `false`
     /// stops before the commit).
@@ -434,18 +570,7 @@ impl<W: Word> Clocked for Chip<W> {
         self.bcast.commit();
         self.dma
             .tick(&mut self.mem, &mut self.fb, &mut self.ctx_mem);
-        match self.risc.cmd {
-            Command::None => {}
-            Command::Store { addr, size, value } => self.mem.write(addr, size, value),
-            Command::FbWrite { addr, value } => self.fb.write(addr, W::wrap(value as i64)),
-            Command::Wfb { addr } => {
-                for (i, v) in self.array.rc.out.iter().enumerate() {
-                    self.fb.write(addr + i as u16, *v);
-                }
-            }
-            Command::Dma(req) => self.dma.start(req, self.risc.pc),
-            Command::Run(run) => self.bcast.issue(run),
-        }
+        self.apply(self.risc.cmd);
         self.risc.commit();
         self.cycles += 1;
     }
@@ -605,7 +730,7 @@ fn cycles<W: Word, const TRACED: bool>(
         let stalled = if TRACED {
             sim.fast_forward_sampled(|c, sample| c.run_stalled_sampled(limit, sample))
         } else {
-            sim.fast_forward(|c| c.run_stalled(limit))
+            sim.fast_forward(|c| c.run_fast(limit))
         };
         if stalled.map_err(RunError::Step)? > 0 {
             continue;

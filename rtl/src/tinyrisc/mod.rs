@@ -188,6 +188,40 @@ impl TinyRisc {
         self.halted
     }
 
+    /// Cycles left of the multi-cycle instruction in progress (0: the
+    /// next cycle fetches).
+    #[inline(always)]
+    pub fn busy(&self) -> u32 {
+        self.busy
+    }
+
+    /// `n` (at most [`TinyRisc::busy`]) busy cycles at once, exactly as
+    /// `n` evaluations and clock edges would leave TinyRISC (the chip's
+    /// fast path while nothing else on the chip is working).
+    #[inline(always)]
+    pub fn skip_busy(&mut self, n: u32) {
+        debug_assert!(n <= self.busy && !self.halted);
+        self.busy -= n;
+        self.busy_cycles += n as u64;
+        self.d_busy = self.busy;
+        self.d_pc = self.pc;
+        self.d_reg = None;
+        self.d_halt = false;
+        self.cmd = Command::None;
+        self.state = State::Busy;
+    }
+
+    /// `n` more cycles of the stall evaluated last (the chip's fast path:
+    /// a stalled instruction changes nothing but its counter).
+    #[inline(always)]
+    pub fn add_stalled(&mut self, n: u64) {
+        match self.state {
+            State::StallArray => self.stall_array += n,
+            State::StallDma => self.stall_dma += n,
+            _ => debug_assert!(n == 0, "add_stalled while {:?}", self.state),
+        }
+    }
+
     /// Clock edge.
     #[inline]
     pub fn commit(&mut self) {
