@@ -173,6 +173,17 @@ impl<W: Word> Array<W> {
     }
 }
 
+impl<W: Word> Array<W> {
+    /// [`Clocked::eval`] and [`Clocked::commit`] in one call (the
+    /// untraced fast path: nothing samples between the two).
+    #[inline(always)]
+    pub fn step(&mut self) -> Result<(), Fault> {
+        self.eval()?;
+        self.commit();
+        Ok(())
+    }
+}
+
 impl<W: Word> Clocked for Array<W> {
     #[inline]
     fn eval(&mut self) -> Result<(), Fault> {

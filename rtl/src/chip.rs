@@ -317,43 +317,132 @@ impl<W: Word> Chip<W> {
         self.run_stalled_sampled(limit, |_| true)
     }
 
-    /// The untraced fast paths, tried in turn by the cycle loop before a
-    /// plain cycle: with the DMA idle (main memory, the FB and the context
-    /// memory then change only by TinyRISC's own writes),
-    ///
-    /// * a stream: TinyRISC waits for the array while a run streams: only
-    ///   the broadcast unit and the array work ([`Chip::run_stream`]);
-    /// * control: the array is idle and nothing is queued: only TinyRISC
-    ///   works, and its multi-cycle instructions' busy cycles pass at once
-    ///   ([`Chip::run_control`]);
-    ///
-    /// otherwise [`Chip::run_stalled`]. Each gives exactly the cycles
-    /// [`Clocked::eval`] + [`Clocked::commit`] would (tested against plain
-    /// stepping on every conformance program); returns the cycles run
-    /// (0: none applies, step one cycle).
+    /// The untraced fast path, tried by the cycle loop before a plain
+    /// cycle. While the DMA is idle (main memory, the FB and the context
+    /// memory then change only by TinyRISC's own writes) whole cycles run
+    /// in [`Chip::run_local`]; otherwise stalled cycles run in
+    /// [`Chip::run_stalled`]. Exactly the cycles [`Clocked::eval`] +
+    /// [`Clocked::commit`] would give (tested against plain stepping on
+    /// every conformance program); returns the cycles run (0: step one
+    /// cycle).
     #[inline(always)]
     pub fn run_fast(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        use crate::tinyrisc::{State, Wait};
         if self.dma.idle() {
-            if self.bcast.idle() {
-                return self.run_control(limit);
-            }
-            if self.risc.state == State::StallArray
-                && matches!(self.risc.wait, Wait::ArrayIdle | Wait::Issue)
-                && self.mem.read(self.risc.pc, 4) == self.risc.ir
-            {
-                return self.run_stream(limit);
-            }
+            return self.run_local(limit);
         }
         self.run_stalled(limit)
     }
 
-    /// A run streams while TinyRISC waits for the array and the DMA is
-    /// idle: the broadcast unit and the array cycle alone, TinyRISC's stall
-    /// counted at the end (its stalled evaluation changes nothing, and
-    /// with the DMA idle nothing can change its instruction word).
+    /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
+    /// fault, or `limit`; three kinds, each with less to do than a plain
+    /// cycle:
+    ///
+    /// * TinyRISC waits for the array while a run streams: the broadcast
+    ///   unit and the array cycle alone, the stall counted at the end (a
+    ///   stalled evaluation changes nothing, and nothing can change the
+    ///   waiting instruction's word);
+    /// * the array is idle and nothing is queued: TinyRISC alone, and its
+    ///   multi-cycle instructions' busy cycles pass at once;
+    /// * both work: TinyRISC, then the broadcast unit and the array (its
+    ///   evaluation and clock edge in one call), in the order of
+    ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
     #[inline(never)]
-    fn run_stream(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+    fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        use crate::tinyrisc::{State, Wait};
+        let mut n = 0;
+        // A stall evaluated before this call may wait on a word the DMA
+        // has just rewritten: then it is evaluated again.
+        let mut word_ok = self.mem.read(self.risc.pc, 4) == self.risc.ir;
+        while n < limit && !self.risc.halted() {
+            if self.bcast.idle() {
+                // TinyRISC alone.
+                let busy = self.risc.busy();
+                if busy > 0 {
+                    let b = (busy as u64).min(limit - n);
+                    self.risc.skip_busy(b as u32);
+                    self.idle_control += b;
+                    self.cycles += b;
+                    n += b;
+                    continue;
+                }
+                let view = View {
+                    array: &self.array,
+                    bcast: &self.bcast,
+                    fb: &self.fb,
+                    mem: &self.mem,
+                    dma: &self.dma,
+                    cycles: self.cycles,
+                };
+                if let Err(f) = self.risc.eval(&view) {
+                    return (n, Err(self.locate(f)));
+                }
+                word_ok = true;
+                self.array.idle();
+                if self.risc.state != State::StallDma {
+                    self.idle_control += 1;
+                }
+            } else if word_ok
+                && self.risc.state == State::StallArray
+                && match self.risc.wait {
+                    Wait::ArrayIdle => true,
+                    Wait::Issue => !self.bcast.can_issue(),
+                    _ => false,
+                }
+            {
+                // The array streams while TinyRISC waits.
+                let (k, r) = self.stream(limit - n);
+                n += k;
+                if r.is_err() {
+                    return (n, r);
+                }
+                continue;
+            } else {
+                // Both.
+                let view = View {
+                    array: &self.array,
+                    bcast: &self.bcast,
+                    fb: &self.fb,
+                    mem: &self.mem,
+                    dma: &self.dma,
+                    cycles: self.cycles,
+                };
+                if let Err(f) = self.risc.eval(&view) {
+                    return (n, Err(self.locate(f)));
+                }
+                word_ok = true;
+                if let Err(f) = self
+                    .bcast
+                    .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
+                {
+                    return (n, Err(self.locate(f)));
+                }
+                if let Err(f) = self.array.step() {
+                    return (n, Err(self.locate(f)));
+                }
+                self.array_busy += 1;
+                self.active_rc += self.array.active_now as u64;
+                if self.watch.any {
+                    self.count_watched();
+                }
+                self.bcast.commit();
+            }
+            let cmd = self.risc.cmd;
+            self.apply(cmd);
+            self.risc.commit();
+            self.cycles += 1;
+            n += 1;
+            if matches!(cmd, Command::Dma(_)) {
+                break;
+            }
+        }
+        (n, Ok(()))
+    }
+
+    /// The array streams while TinyRISC waits for it (the stall of the
+    /// last evaluation, `Wait::ArrayIdle` or `Wait::Issue`) and the DMA is
+    /// idle: until the wait is over or `limit`.
+    #[inline(always)]
+    fn stream(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
         use crate::tinyrisc::Wait;
         let wait = self.risc.wait;
         let mut n = 0;
@@ -372,11 +461,10 @@ impl<W: Word> Chip<W> {
                 err = Some(f);
                 break;
             }
-            if let Err(f) = self.array.eval() {
+            if let Err(f) = self.array.step() {
                 err = Some(f);
                 break;
             }
-            self.array.commit();
             active += self.array.active_now as u64;
             if self.watch.any {
                 self.count_watched();
@@ -392,48 +480,6 @@ impl<W: Word> Chip<W> {
             None => (n, Ok(())),
             Some(f) => (n, Err(self.locate(f))),
         }
-    }
-
-    /// The array is idle, nothing is queued and the DMA is idle: TinyRISC
-    /// alone, until it issues a run or a transfer (or halts); its busy
-    /// cycles pass at once.
-    #[inline(never)]
-    fn run_control(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        let mut n = 0;
-        while n < limit && !self.risc.halted() {
-            let busy = self.risc.busy();
-            if busy > 0 {
-                let b = (busy as u64).min(limit - n);
-                self.risc.skip_busy(b as u32);
-                self.idle_control += b;
-                self.cycles += b;
-                n += b;
-                continue;
-            }
-            let view = View {
-                array: &self.array,
-                bcast: &self.bcast,
-                fb: &self.fb,
-                mem: &self.mem,
-                dma: &self.dma,
-                cycles: self.cycles,
-            };
-            if let Err(f) = self.risc.eval(&view) {
-                return (n, Err(self.locate(f)));
-            }
-            // The clock edge of an idle array, broadcast unit and DMA.
-            self.array.idle();
-            self.idle_control += 1;
-            let cmd = self.risc.cmd;
-            self.apply(cmd);
-            self.risc.commit();
-            self.cycles += 1;
-            n += 1;
-            if matches!(cmd, Command::Run(_) | Command::Dma(_)) {
-                break;
-            }
-        }
-        (n, Ok(()))
     }
 
     /// TinyRISC's write at the clock edge.
