@@ -225,8 +225,8 @@ impl Broadcast {
     }
 
     /// Read the next datum of FB stream `s` (and advance its pointer in the
-    /// next state).
-    #[inline]
+    /// next state). The checks in one test; their messages out of line.
+    #[inline(always)]
     fn stream<W: Word>(
         &mut self,
         s: usize,
@@ -235,33 +235,41 @@ impl Broadcast {
         fbm: &FrameBuffer<W>,
         dma_fb_banks: u8,
     ) -> Result<W, Fault> {
-        if run.fb[s].is_none() {
-            return Err(Self::fault(
-                run,
-                addr,
-                format!("context reads fb{s} but the run streams no data of FB set {s}"),
-            ));
-        }
         let p = self.d_ptr[s];
-        if fb::set(p) != s {
-            return Err(Self::fault(
-                run,
-                addr,
-                format!("FB stream of set {s} ran past the end of the set"),
-            ));
-        }
-        if dma_fb_banks >> fb::bank(p) & 1 != 0 {
-            return Err(Self::fault(
-                run,
-                addr,
-                format!(
-                    "DMA conflict: the array reads FB bank {} (address 0x{p:04x}) while DMA transfers it",
-                    fb::bank(p)
-                ),
-            ));
+        if run.fb[s].is_none() || fb::set(p) != s || dma_fb_banks >> fb::bank(p) & 1 != 0 {
+            return Err(Self::stream_fault(s, run, addr, p, dma_fb_banks));
         }
         self.d_ptr[s] = p.wrapping_add(1);
         Ok(fbm.read(p))
+    }
+
+    /// Why stream `s` cannot give its next datum at `p`.
+    #[cold]
+    #[inline(never)]
+    fn stream_fault(s: usize, run: &Run, addr: u16, p: u16, dma_fb_banks: u8) -> Fault {
+        if run.fb[s].is_none() {
+            return Self::fault(
+                run,
+                addr,
+                format!("context reads fb{s} but the run streams no data of FB set {s}"),
+            );
+        }
+        if fb::set(p) != s {
+            return Self::fault(
+                run,
+                addr,
+                format!("FB stream of set {s} ran past the end of the set"),
+            );
+        }
+        debug_assert!(dma_fb_banks >> fb::bank(p) & 1 != 0);
+        Self::fault(
+            run,
+            addr,
+            format!(
+                "DMA conflict: the array reads FB bank {} (address 0x{p:04x}) while DMA transfers it",
+                fb::bank(p)
+            ),
+        )
     }
 
     /// Clock edge: advance the run; start the queued one when it ends.
