@@ -176,13 +176,19 @@ fn dma_conflict(dma: &Dma, bank: usize, what: &str) -> Fault {
     )
 }
 
+#[cold]
+fn fetch_fault(mem: &MainMemory, pc: u32) -> Fault {
+    let f = mem.fault(pc, 4);
+    Fault::new("tinyrisc", format!("instruction fetch: {}", f.message))
+}
+
 impl<W: Word> Machine for View<'_, W> {
     #[inline(always)]
     fn fetch(&self, pc: u32) -> Result<u32, Fault> {
-        self.mem
-            .check(pc, 4)
-            .map_err(|f| Fault::new("tinyrisc", format!("instruction fetch: {}", f.message)))?;
-        Ok(self.mem.read(pc, 4))
+        match self.mem.word(pc) {
+            Some(w) => Ok(w),
+            None => Err(fetch_fault(self.mem, pc)),
+        }
     }
     fn load(&self, addr: u32, size: u32) -> Result<u32, Fault> {
         self.mem.check(addr, size)?;
@@ -352,7 +358,7 @@ impl<W: Word> Chip<W> {
         let mut n = 0;
         // A stall evaluated before this call may wait on a word the DMA
         // has just rewritten: then it is evaluated again.
-        let mut word_ok = self.mem.read(self.risc.pc, 4) == self.risc.ir;
+        let mut word_ok = self.mem.word(self.risc.pc) == Some(self.risc.ir);
         while n < limit && !self.risc.halted() {
             if self.bcast.idle() {
                 // TinyRISC alone.

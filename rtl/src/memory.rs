@@ -31,24 +31,46 @@ impl MainMemory {
     }
 
     /// Check an access of `size` bytes (1, 2, 4): inside and aligned.
-    #[inline]
+    #[inline(always)]
     pub fn check(&self, addr: u32, size: u32) -> Result<(), Fault> {
+        if addr.is_multiple_of(size) && self.contains(addr, size) {
+            Ok(())
+        } else {
+            Err(self.fault(addr, size))
+        }
+    }
+
+    /// The aligned word at `addr`, if inside (an instruction fetch).
+    #[inline(always)]
+    pub fn word(&self, addr: u32) -> Option<u32> {
+        if !addr.is_multiple_of(4) {
+            return None;
+        }
+        let a = addr as usize;
+        let b = self.m.get(a..a.checked_add(4)?)?;
+        Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    }
+
+    /// Why an access of `size` bytes at `addr` is refused.
+    #[cold]
+    #[inline(never)]
+    pub fn fault(&self, addr: u32, size: u32) -> Fault {
         if !addr.is_multiple_of(size) {
-            return Err(Fault::new(
+            return Fault::new(
                 "memory",
                 format!("misaligned {size}-byte access at 0x{addr:08x}"),
-            ));
+            );
         }
         if !self.contains(addr, size) {
-            return Err(Fault::new(
+            return Fault::new(
                 "memory",
                 format!(
                     "address 0x{addr:08x} outside main memory (0..0x{:x})",
                     self.m.len()
                 ),
-            ));
+            );
         }
-        Ok(())
+        Fault::new("memory", format!("access of {size} bytes at 0x{addr:08x}"))
     }
 
     /// Read `size` bytes (zero-extended); the caller has checked the access.
@@ -58,7 +80,10 @@ impl MainMemory {
         match size {
             1 => self.m[a] as u32,
             2 => u16::from_le_bytes([self.m[a], self.m[a + 1]]) as u32,
-            _ => u32::from_le_bytes([self.m[a], self.m[a + 1], self.m[a + 2], self.m[a + 3]]),
+            _ => {
+                let b = &self.m[a..a + 4];
+                u32::from_le_bytes([b[0], b[1], b[2], b[3]])
+            }
         }
     }
 

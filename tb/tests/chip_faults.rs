@@ -212,3 +212,35 @@ fn an_empty_program_is_refused_with_its_name_not_run() {
         )
     );
 }
+
+/// A jump out of main memory, or to a misaligned address, stops at the
+/// fetch with the fetch's message (through the fast path of the cycle
+/// loop, which reads the instruction word it waits on, as through plain
+/// stepping).
+#[test]
+fn fetch_outside_memory_or_misaligned() {
+    let (m, out) = run_src(".text\nli r1, 0x7FFFFFF0\njr r1\n", 100);
+    assert!(
+        m.contains("tinyrisc: instruction fetch: address 0x7ffffff0 outside main memory"),
+        "{m}"
+    );
+    assert!(m.contains("pc 0x7ffffff0"), "{m}");
+    assert!(out.sim.cycle() < 10, "{m}");
+    // The jump lands while a transfer runs and the transfer ends before the
+    // fetch: the cycle loop's fast path starts again at a pc outside
+    // memory (some of these spacings give that).
+    for k in 0..24 {
+        let nops = "nop\n".repeat(k);
+        let src = format!(".text\nli r1, 0x7FFFFFF0\nli r2, 0x1000\nldfb r0, r2, 4\n{nops}jr r1\n");
+        let (m, _) = run_src(&src, 200);
+        assert!(
+            m.contains("instruction fetch: address 0x7ffffff0 outside main memory"),
+            "{k} nops: {m}"
+        );
+    }
+    let (m, _) = run_src(".text\nli r1, 6\njr r1\n", 100);
+    assert!(
+        m.contains("instruction fetch: misaligned 4-byte access at 0x00000006"),
+        "{m}"
+    );
+}
