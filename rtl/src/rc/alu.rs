@@ -29,63 +29,64 @@ macro_rules! alu_unit {
         pub mod $m {
             use super::{Cond, Flagged};
 
+            // Every operation below stays in the word's width (the flags
+            // from the top bits): a loop over 16-bit lanes then runs 32
+            // lanes to a 512-bit register and stores its results whole,
+            // where widening to 32 bits halved both (and a result stored in
+            // halves and loaded whole at the clock edge is not forwarded).
+            // The property tests compare every one with wide arithmetic.
+
+            /// `a + b + cin`; C the carry out of the top bit, V signed
+            /// overflow.
             #[inline(always)]
             pub fn add(a: $t, b: $t, cin: bool) -> Flagged<$t> {
-                let s = a as $u as $uw + b as $u as $uw + cin as $uw;
-                let value = s as $u as $t;
+                let value = a.wrapping_add(b).wrapping_add(cin as $t);
+                // Carry out of the top bit: both operand bits set, or one
+                // set and no sum bit (a carry came in and went on).
+                let c = ((a & b) | ((a | b) & !value)) < 0;
                 // Signed overflow: operands of equal sign, result of the other sign.
                 let v = ((a ^ value) & (b ^ value)) < 0;
-                Flagged {
-                    value,
-                    c: s > <$u>::MAX as $uw,
-                    v,
-                }
+                Flagged { value, c, v }
             }
 
+            /// `a - b - bin`; C the borrow (the unsigned `b + bin` exceeds
+            /// `a`), V signed overflow.
             #[inline(always)]
             pub fn sub(a: $t, b: $t, bin: bool) -> Flagged<$t> {
-                let value = (a as $u).wrapping_sub(b as $u).wrapping_sub(bin as $u) as $t;
-                let borrow = (a as $u as $uw) < (b as $u as $uw + bin as $uw);
+                let value = a.wrapping_sub(b).wrapping_sub(bin as $t);
+                // Borrow out of the top bit: 0 - 1 there, or equal bits and
+                // a borrow in (the difference bit set).
+                let c = ((!a & b) | (!(a ^ b) & value)) < 0;
                 let v = ((a ^ b) & (a ^ value)) < 0;
-                Flagged {
-                    value,
-                    c: borrow,
-                    v,
-                }
-            }
-
-            #[inline(always)]
-            fn sat(x: $sw) -> ($t, bool) {
-                if x > <$t>::MAX as $sw {
-                    (<$t>::MAX, true)
-                } else if x < <$t>::MIN as $sw {
-                    (<$t>::MIN, true)
-                } else {
-                    (x as $t, false)
-                }
+                Flagged { value, c, v }
             }
 
             /// Saturating addition; the flag is `true` when the result saturated.
             #[inline(always)]
             pub fn adds(a: $t, b: $t) -> ($t, bool) {
-                sat(a as $sw + b as $sw)
+                let w = a.wrapping_add(b);
+                (a.saturating_add(b), ((a ^ w) & (b ^ w)) < 0)
             }
 
             #[inline(always)]
             pub fn subs(a: $t, b: $t) -> ($t, bool) {
-                sat(a as $sw - b as $sw)
+                let w = a.wrapping_sub(b);
+                (a.saturating_sub(b), ((a ^ b) & (a ^ w)) < 0)
             }
 
             /// `|a|`, saturating: `|MIN| = MAX` with the flag set.
             #[inline(always)]
             pub fn abs(a: $t) -> ($t, bool) {
-                sat((a as $sw).abs())
+                (a.saturating_abs(), a == <$t>::MIN)
             }
 
-            /// `|a - b|`, saturating.
+            /// `|a - b|`, saturating: the larger minus the smaller is the
+            /// exact distance as an unsigned word.
             #[inline(always)]
             pub fn absd(a: $t, b: $t) -> ($t, bool) {
-                sat((a as $sw - b as $sw).abs())
+                let d = (a.max(b) as $u).wrapping_sub(a.min(b) as $u);
+                let max = <$t>::MAX as $u;
+                (d.min(max) as $t, d > max)
             }
 
             #[inline(always)]
