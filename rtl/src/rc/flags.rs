@@ -21,4 +21,10 @@ impl Flags {
     pub fn merge(old: Mask, en: Mask, new: Mask) -> Mask {
         (old & !en) | (new & en)
     }
+
+    /// [`Flags::merge`] computed another way (the same bits).
+    #[inline(always)]
+    pub fn merge_xor(old: Mask, en: Mask, new: Mask) -> Mask {
+        old ^ ((old ^ new) & en)
+    }
 }

@@ -70,6 +70,59 @@ pub fn select16<const N: usize>(dst: &mut [i16; N], mask: Mask, src: &[i16; N]) 
     select_word(dst, mask, src)
 }
 
+/// A signed lane type whose sign bits can be gathered into a mask.
+pub trait SignBits: Copy + Default {
+    /// The mask of the lanes of `x` whose sign bit is set (bit `i`: lane
+    /// `i`). With AVX-512 (a build for a CPU that has it) one instruction
+    /// per 512-bit register; otherwise through bools.
+    fn sign_mask<const N: usize>(x: &[Self; N]) -> Mask;
+    /// [`SignBits::sign_mask`] without AVX-512 (what other CPUs run).
+    fn sign_mask_portable<const N: usize>(x: &[Self; N]) -> Mask;
+    /// -1 if `b`, else 0 (a lane of a flag vector for [`SignBits::sign_mask`]).
+    fn flag(b: bool) -> Self;
+}
+
+macro_rules! sign_bits {
+    ($t:ty, $per:expr, $movemask:ident) => {
+        impl SignBits for $t {
+            #[inline(always)]
+            fn sign_mask<const N: usize>(x: &[$t; N]) -> Mask {
+                #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
+                if N == 64 {
+                    use std::arch::x86_64::{_mm512_loadu_si512, $movemask};
+                    let mut m = 0u64;
+                    for k in 0..64 / $per {
+                        // SAFETY: register k's lanes k * $per.. lie inside
+                        // the 64 lanes of `x`; an unaligned load.
+                        let bits = unsafe {
+                            $movemask(_mm512_loadu_si512(x.as_ptr().add(k * $per).cast()))
+                        };
+                        m |= (bits as u64) << (k * $per);
+                    }
+                    return m;
+                }
+                Self::sign_mask_portable(x)
+            }
+            #[inline(always)]
+            fn sign_mask_portable<const N: usize>(x: &[$t; N]) -> Mask {
+                let mut b = [false; N];
+                for i in 0..N {
+                    b[i] = x[i] < 0;
+                }
+                pack_bools(&b)
+            }
+            #[inline(always)]
+            fn flag(b: bool) -> $t {
+                -(b as $t)
+            }
+        }
+    };
+}
+
+sign_bits!(i16, 32, _mm512_movepi16_mask);
+sign_bits!(i32, 16, _mm512_movepi32_mask);
+sign_bits!(i64, 8, _mm512_movepi64_mask);
+
 /// One bool per lane from a mask.
 #[inline(always)]
 pub fn unpack<const N: usize>(mask: Mask) -> [bool; N] {
@@ -113,6 +166,34 @@ pub fn pack<const N: usize>(f: impl Fn(usize) -> bool) -> Mask {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Both ways of packing sign bits (AVX-512 where the build has it, and
+    /// the portable one other CPUs run) against the bits one by one.
+    #[test]
+    fn sign_masks_of_every_lane_width() {
+        fn check<T: SignBits + PartialOrd + From<i8> + std::fmt::Debug>(x: &[T; 64]) {
+            let want = (0..64).fold(0u64, |m, i| m | ((x[i] < T::from(0)) as u64) << i);
+            assert_eq!(T::sign_mask(x), want, "{x:?}");
+            assert_eq!(T::sign_mask_portable(x), want);
+            let x12: [T; 12] = std::array::from_fn(|i| x[i]);
+            assert_eq!(T::sign_mask(&x12), want & 0xFFF);
+        }
+        let mut r = 0x2545_F491_4F6C_DD1Du64;
+        for _ in 0..500 {
+            let mut next = || {
+                r ^= r << 13;
+                r ^= r >> 7;
+                r ^= r << 17;
+                r
+            };
+            check::<i16>(&std::array::from_fn(|_| next() as i16));
+            check::<i32>(&std::array::from_fn(|_| next() as i32));
+            check::<i64>(&std::array::from_fn(|_| next() as i64));
+            check::<i16>(&std::array::from_fn(|i| {
+                i16::flag(next() >> (i % 7) & 1 != 0)
+            }));
+        }
+    }
 
     #[test]
     fn pack_and_unpack_are_inverse() {

@@ -24,7 +24,7 @@ use crate::kernel::{Clocked, Fault};
 use crate::trace::{Display, Field, Filter, Probe, Traced};
 use context::{ASrc, BSrc, Cond, Context, Guard, Op};
 use flags::Flags;
-use lanes::{blend, expand, full, select_word, Mask};
+use lanes::{blend, expand, full, select_word, Mask, SignBits};
 use ram::Ram;
 use register_file::RegisterFile;
 pub use word::{Datapath, Word};
@@ -215,33 +215,35 @@ macro_rules! map {
     };
 }
 
-/// Run a flag-producing ALU function over every lane.
+/// Run a flag-producing ALU function over every lane. The flags are
+/// gathered as 0 / -1 lanes of the loop's own width and packed by their
+/// sign bits ([`SignBits::sign_mask`]).
 #[inline(always)]
 fn cv<W: Word, const N: usize>(
     res: &mut [W; N],
     f: impl Fn(usize) -> alu::Flagged<W>,
 ) -> (Mask, Mask) {
-    let mut c = [false; N];
-    let mut v = [false; N];
+    let mut c = [W::ZERO; N];
+    let mut v = [W::ZERO; N];
     for i in 0..N {
         let r = f(i);
         res[i] = r.value;
-        c[i] = r.c;
-        v[i] = r.v;
+        c[i] = W::flag(r.c);
+        v[i] = W::flag(r.v);
     }
-    (lanes::pack_bools(&c), lanes::pack_bools(&v))
+    (W::sign_mask(&c), W::sign_mask(&v))
 }
 
 /// Run a saturating function over every lane; returns the saturation mask.
 #[inline(always)]
 fn sat<W: Word, const N: usize>(res: &mut [W; N], f: impl Fn(usize) -> (W, bool)) -> Mask {
-    let mut v = [false; N];
+    let mut v = [W::ZERO; N];
     for i in 0..N {
         let (r, s) = f(i);
         res[i] = r;
-        v[i] = s;
+        v[i] = W::flag(s);
     }
-    lanes::pack_bools(&v)
+    W::sign_mask(&v)
 }
 
 /// The multiplier's output stage over every lane: the accumulator shifted
@@ -274,9 +276,13 @@ fn cmp_mask<W: Word, const N: usize>(
     vf: Mask,
 ) -> Mask {
     macro_rules! by {
-        ($k:expr) => {
-            lanes::pack::<N>(|i| W::cond($k, a[i], b[i], false, false))
-        };
+        ($k:expr) => {{
+            let mut f = [W::ZERO; N];
+            for i in 0..N {
+                f[i] = W::flag(W::cond($k, a[i], b[i], false, false));
+            }
+            W::sign_mask(&f)
+        }};
     }
     match cond {
         Cond::Eq => by!(Cond::Eq),
@@ -399,7 +405,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             Op::Mul | Op::Mac | Op::Msu => {
                 let acc = &self.acc;
                 let acc_d = &mut self.acc_d;
-                let mut s = [false; N];
+                let mut s = [W::Acc::default(); N];
                 // One loop per operation and rounding choice (chosen once,
                 // outside the lanes; `sh = 0` has no rounding bit either
                 // way): the product is scaled while it is in a register,
@@ -413,7 +419,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                                     acc_d[i] = p;
                                     let (r, s2) = W::scale(p, sh, $trunc);
                                     res[i] = r;
-                                    s[i] = s2;
+                                    s[i] = W::Acc::flag(s2);
                                 }
                             }
                             _ => {
@@ -424,7 +430,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                                     acc_d[i] = n;
                                     let (r, s2) = W::scale(n, sh, $trunc);
                                     res[i] = r;
-                                    s[i] = s1 | s2;
+                                    s[i] = W::Acc::flag(s1 | s2);
                                 }
                             }
                         }
@@ -435,7 +441,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 } else {
                     lanes!(false)
                 }
-                (self.d_v, self.d_c) = (lanes::pack_bools(&s), 0);
+                (self.d_v, self.d_c) = (W::Acc::sign_mask(&s), 0);
                 self.pend.cv = true;
                 self.pend.acc = true;
             }
@@ -541,8 +547,12 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             }
         }
         if p.cv {
+            // Two forms of the same merge: alike, the compiler did both
+            // with one 16-byte load of `d_c` and `d_v`, which `eval` has
+            // stored as two 8-byte words, and such a load waits until
+            // both stores are written (no store forwarding).
             self.flags.c = Flags::merge(self.flags.c, en, self.d_c);
-            self.flags.v = Flags::merge(self.flags.v, en, self.d_v);
+            self.flags.v = Flags::merge_xor(self.flags.v, en, self.d_v);
         }
         if p.f {
             self.flags.f = Flags::merge(self.flags.f, en, self.d_f);

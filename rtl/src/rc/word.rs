@@ -16,6 +16,7 @@ use std::ops::{BitAnd, BitOr, BitXor, Not};
 
 use super::alu::{self, Flagged};
 use super::context::Cond;
+use super::lanes::SignBits;
 use super::{multiplier, shifter};
 
 /// Which datapath a chip has.
@@ -59,7 +60,8 @@ impl fmt::Display for Datapath {
 
 /// A datapath word and every RC unit operation on it.
 pub trait Word:
-    Copy
+    SignBits
+    + Copy
     + Default
     + Eq
     + Ord
@@ -74,7 +76,7 @@ pub trait Word:
     + Not<Output = Self>
 {
     /// The accumulator (twice the word).
-    type Acc: Copy + Default + Eq + fmt::Debug + Send + Sync + 'static;
+    type Acc: Copy + Default + Eq + fmt::Debug + Send + Sync + 'static + SignBits;
     const DATAPATH: Datapath;
     const BITS: u32;
     const ZERO: Self;
