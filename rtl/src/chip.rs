@@ -371,16 +371,8 @@ impl<W: Word> Chip<W> {
                     n += b;
                     continue;
                 }
-                let view = View {
-                    array: &self.array,
-                    bcast: &self.bcast,
-                    fb: &self.fb,
-                    mem: &self.mem,
-                    dma: &self.dma,
-                    cycles: self.cycles,
-                };
-                if let Err(f) = self.risc.eval(&view) {
-                    return (n, Err(self.locate(f)));
+                if let Err(f) = self.eval_risc() {
+                    return (n, Err(f));
                 }
                 word_ok = true;
                 self.array.idle();
@@ -404,33 +396,17 @@ impl<W: Word> Chip<W> {
                 continue;
             } else {
                 // Both.
-                let view = View {
-                    array: &self.array,
-                    bcast: &self.bcast,
-                    fb: &self.fb,
-                    mem: &self.mem,
-                    dma: &self.dma,
-                    cycles: self.cycles,
-                };
-                if let Err(f) = self.risc.eval(&view) {
-                    return (n, Err(self.locate(f)));
+                if let Err(f) = self.eval_risc() {
+                    return (n, Err(f));
                 }
                 word_ok = true;
-                if let Err(f) = self
-                    .bcast
-                    .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
-                {
-                    return (n, Err(self.locate(f)));
+                match self.stream_cycle() {
+                    Ok(k) => {
+                        self.array_busy += 1;
+                        self.active_rc += k as u64;
+                    }
+                    Err(f) => return (n, Err(f)),
                 }
-                if let Err(f) = self.array.step() {
-                    return (n, Err(self.locate(f)));
-                }
-                self.array_busy += 1;
-                self.active_rc += self.array.active_now as u64;
-                if self.watch.any {
-                    self.count_watched();
-                }
-                self.bcast.commit();
             }
             let cmd = self.risc.cmd;
             self.apply(cmd);
@@ -460,22 +436,13 @@ impl<W: Word> Chip<W> {
                 _ => !self.bcast.can_issue(),
             }
         {
-            if let Err(f) = self
-                .bcast
-                .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
-            {
-                err = Some(f);
-                break;
+            match self.stream_cycle() {
+                Ok(k) => active += k as u64,
+                Err(f) => {
+                    err = Some(f);
+                    break;
+                }
             }
-            if let Err(f) = self.array.step() {
-                err = Some(f);
-                break;
-            }
-            active += self.array.active_now as u64;
-            if self.watch.any {
-                self.count_watched();
-            }
-            self.bcast.commit();
             n += 1;
         }
         self.array_busy += n;
@@ -484,8 +451,43 @@ impl<W: Word> Chip<W> {
         self.cycles += n;
         match err {
             None => (n, Ok(())),
-            Some(f) => (n, Err(self.locate(f))),
+            Some(f) => (n, Err(f)),
         }
+    }
+
+    /// TinyRISC's evaluation of the cycle, through its view of the chip.
+    #[inline(always)]
+    fn eval_risc(&mut self) -> Result<(), Fault> {
+        let view = View {
+            array: &self.array,
+            bcast: &self.bcast,
+            fb: &self.fb,
+            mem: &self.mem,
+            dma: &self.dma,
+            cycles: self.cycles,
+        };
+        self.risc.eval(&view).map_err(|f| self.locate(f))
+    }
+
+    /// One cycle of the broadcast unit and the array with the DMA idle,
+    /// evaluation and clock edge (the run's statistics to the caller):
+    /// the RCs that executed.
+    #[inline(always)]
+    fn stream_cycle(&mut self) -> Result<u32, Fault> {
+        if let Err(f) = self
+            .bcast
+            .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
+        {
+            return Err(self.locate(f));
+        }
+        if let Err(f) = self.array.step() {
+            return Err(self.locate(f));
+        }
+        if self.watch.any {
+            self.count_watched();
+        }
+        self.bcast.commit();
+        Ok(self.array.active_now)
     }
 
     /// TinyRISC's write at the clock edge.
@@ -581,17 +583,7 @@ impl<W: Word> Chip<W> {
 impl<W: Word> Clocked for Chip<W> {
     #[inline(always)]
     fn eval(&mut self) -> Result<(), Fault> {
-        let view = View {
-            array: &self.array,
-            bcast: &self.bcast,
-            fb: &self.fb,
-            mem: &self.mem,
-            dma: &self.dma,
-            cycles: self.cycles,
-        };
-        if let Err(f) = self.risc.eval(&view) {
-            return Err(self.locate(f));
-        }
+        self.eval_risc()?;
         if let Err(f) = self.bcast.eval(
             &self.ctx_mem,
             &self.fb,
