@@ -51,7 +51,8 @@ impl MainMemory {
         Some(u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
     }
 
-    /// Why an access of `size` bytes at `addr` is refused.
+    /// Why an access of `size` bytes at `addr` is refused (misaligned, or
+    /// else outside; called when [`MainMemory::check`] fails).
     #[cold]
     #[inline(never)]
     pub fn fault(&self, addr: u32, size: u32) -> Fault {
@@ -61,16 +62,13 @@ impl MainMemory {
                 format!("misaligned {size}-byte access at 0x{addr:08x}"),
             );
         }
-        if !self.contains(addr, size) {
-            return Fault::new(
-                "memory",
-                format!(
-                    "address 0x{addr:08x} outside main memory (0..0x{:x})",
-                    self.m.len()
-                ),
-            );
-        }
-        Fault::new("memory", format!("access of {size} bytes at 0x{addr:08x}"))
+        Fault::new(
+            "memory",
+            format!(
+                "address 0x{addr:08x} outside main memory (0..0x{:x})",
+                self.m.len()
+            ),
+        )
     }
 
     /// Read `size` bytes (zero-extended); the caller has checked the access.

@@ -153,16 +153,6 @@ pub fn pack_bools<const N: usize>(b: &[bool; N]) -> Mask {
     m
 }
 
-/// Pack one bool per lane, computed by `f`.
-#[inline(always)]
-pub fn pack<const N: usize>(f: impl Fn(usize) -> bool) -> Mask {
-    let mut b = [false; N];
-    for (i, x) in b.iter_mut().enumerate() {
-        *x = f(i);
-    }
-    pack_bools(&b)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
