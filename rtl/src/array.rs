@@ -230,7 +230,7 @@ impl<W: Word> Clocked for Array<W> {
 }
 
 impl<W: Word> Traced for Array<W> {
-    fn trace(&self, p: &mut dyn Probe) {
+    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
         // Asked once which of these are traced: a trace of one RC computes
         // none of them.
         const NAMES: [&str; 13] = [

@@ -339,6 +339,24 @@ impl<W: Word> Chip<W> {
         self.run_stalled(limit)
     }
 
+    /// [`Chip::run_fast`] with a waveform: `sample` is called between
+    /// each cycle's evaluation and its commit (`false`: stop before the
+    /// commit). While the DMA is idle the cycles run in
+    /// [`Chip::run_local`]'s loops, sampled one by one (multi-cycle
+    /// instructions' busy cycles evaluated one at a time); otherwise in
+    /// [`Chip::run_stalled_sampled`].
+    #[inline(always)]
+    pub fn run_fast_sampled(
+        &mut self,
+        limit: u64,
+        sample: &mut dyn FnMut(&Self) -> bool,
+    ) -> (u64, Result<(), Fault>) {
+        if self.dma.idle() {
+            return self.run_local_sampled(limit, sample);
+        }
+        self.run_stalled_sampled(limit, sample)
+    }
+
     /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
     /// fault, or `limit`; three kinds, each with less to do than a plain
     /// cycle:
@@ -354,6 +372,29 @@ impl<W: Word> Chip<W> {
     ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
     #[inline(never)]
     fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+        self.local_cycles::<false, _>(limit, &mut |_: &Self| true)
+    }
+
+    /// [`Chip::run_local`] sampled cycle by cycle (see
+    /// [`Chip::run_fast_sampled`]).
+    #[inline(never)]
+    fn run_local_sampled(
+        &mut self,
+        limit: u64,
+        sample: &mut dyn FnMut(&Self) -> bool,
+    ) -> (u64, Result<(), Fault>) {
+        self.local_cycles::<true, _>(limit, sample)
+    }
+
+    /// The loops of [`Chip::run_local`]; when `SAMPLED`, `sample` is
+    /// called between every cycle's evaluation and its commit, and busy
+    /// cycles are evaluated one by one.
+    #[inline(always)]
+    fn local_cycles<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+        &mut self,
+        limit: u64,
+        sample: &mut S,
+    ) -> (u64, Result<(), Fault>) {
         use crate::tinyrisc::{State, Wait};
         let mut n = 0;
         // A stall evaluated before this call may wait on a word the DMA
@@ -363,7 +404,7 @@ impl<W: Word> Chip<W> {
             if self.bcast.idle() {
                 // TinyRISC alone.
                 let busy = self.risc.busy();
-                if busy > 0 {
+                if !SAMPLED && busy > 0 {
                     let b = (busy as u64).min(limit - n);
                     self.risc.skip_busy(b as u32);
                     self.idle_control += b;
@@ -376,6 +417,9 @@ impl<W: Word> Chip<W> {
                 }
                 word_ok = true;
                 self.array.idle();
+                if SAMPLED && !sample(self) {
+                    break;
+                }
                 if self.risc.state != State::StallDma {
                     self.idle_control += 1;
                 }
@@ -388,10 +432,13 @@ impl<W: Word> Chip<W> {
                 }
             {
                 // The array streams while TinyRISC waits.
-                let (k, r) = self.stream(limit - n);
+                let (k, r) = self.stream::<SAMPLED, S>(limit - n, sample);
                 n += k;
                 if r.is_err() {
                     return (n, r);
+                }
+                if SAMPLED && k == 0 {
+                    break; // stopped by the waveform
                 }
                 continue;
             } else {
@@ -400,11 +447,12 @@ impl<W: Word> Chip<W> {
                     return (n, Err(f));
                 }
                 word_ok = true;
-                match self.stream_cycle() {
-                    Ok(k) => {
+                match self.stream_cycle::<SAMPLED, S>(sample) {
+                    Ok(Some(k)) => {
                         self.array_busy += 1;
                         self.active_rc += k as u64;
                     }
+                    Ok(None) => break,
                     Err(f) => return (n, Err(f)),
                 }
             }
@@ -422,9 +470,14 @@ impl<W: Word> Chip<W> {
 
     /// The array streams while TinyRISC waits for it (the stall of the
     /// last evaluation, `Wait::ArrayIdle` or `Wait::Issue`) and the DMA is
-    /// idle: until the wait is over or `limit`.
+    /// idle: until the wait is over, `limit`, or (`SAMPLED`) `sample`
+    /// stops it.
     #[inline(always)]
-    fn stream(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
+    fn stream<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+        &mut self,
+        limit: u64,
+        sample: &mut S,
+    ) -> (u64, Result<(), Fault>) {
         use crate::tinyrisc::Wait;
         let wait = self.risc.wait;
         let mut n = 0;
@@ -436,8 +489,9 @@ impl<W: Word> Chip<W> {
                 _ => !self.bcast.can_issue(),
             }
         {
-            match self.stream_cycle() {
-                Ok(k) => active += k as u64,
+            match self.stream_cycle::<SAMPLED, S>(sample) {
+                Ok(Some(k)) => active += k as u64,
+                Ok(None) => break,
                 Err(f) => {
                     err = Some(f);
                     break;
@@ -471,23 +525,35 @@ impl<W: Word> Chip<W> {
 
     /// One cycle of the broadcast unit and the array with the DMA idle,
     /// evaluation and clock edge (the run's statistics to the caller):
-    /// the RCs that executed.
+    /// the RCs that executed; `None` when (`SAMPLED`) `sample`, called
+    /// between the two, stopped it before the clock edge.
     #[inline(always)]
-    fn stream_cycle(&mut self) -> Result<u32, Fault> {
+    fn stream_cycle<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+        &mut self,
+        sample: &mut S,
+    ) -> Result<Option<u32>, Fault> {
         if let Err(f) = self
             .bcast
             .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
         {
             return Err(self.locate(f));
         }
-        if let Err(f) = self.array.step() {
+        if SAMPLED {
+            if let Err(f) = self.array.eval() {
+                return Err(self.locate(f));
+            }
+            if !sample(self) {
+                return Ok(None);
+            }
+            self.array.commit();
+        } else if let Err(f) = self.array.step() {
             return Err(self.locate(f));
         }
         if self.watch.any {
             self.count_watched();
         }
         self.bcast.commit();
-        Ok(self.array.active_now)
+        Ok(Some(self.array.active_now))
     }
 
     /// TinyRISC's write at the clock edge.
@@ -621,7 +687,7 @@ impl<W: Word> Clocked for Chip<W> {
 }
 
 impl<W: Word> Traced for Chip<W> {
-    fn trace(&self, p: &mut dyn Probe) {
+    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
         // Asked once which of the four are traced; the others are not
         // entered at all.
         const SCOPES: [&str; 4] = ["tinyrisc", "broadcast", "dma", "array"];
@@ -772,7 +838,7 @@ fn cycles<W: Word, const TRACED: bool>(
         }
         let limit = max_cycles - sim.cycle();
         let stalled = if TRACED {
-            sim.fast_forward_sampled(|c, sample| c.run_stalled_sampled(limit, sample))
+            sim.fast_forward_sampled(|c, sample| c.run_fast_sampled(limit, sample))
         } else {
             sim.fast_forward(|c| c.run_fast(limit))
         };

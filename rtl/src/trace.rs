@@ -21,9 +21,13 @@
 //!   those; a module's signals are one call ([`Probe::block`]), and a
 //!   register file that changes only when its version does is skipped
 //!   while the version holds ([`Probe::block_versioned`]).
-//! * The values a cycle reports are compared with the last ones written
-//!   after the cycle's walk; the changes go to the writing thread packed
-//!   in 64-bit words, and it computes the clock edges' times.
+//! * The values a cycle reports are kept and compared with the last ones
+//!   written after the cycle's walk, 64 at a time into a mask of the
+//!   changes; the changes go to the writing thread packed in 64-bit
+//!   words, and it computes the clock edges' times.
+//! * [`Traced::trace`] is generic over the probe: the walk is compiled
+//!   for the [`Tracer`], its calls inline, and the declaring half of each
+//!   call is a cold function of its own.
 //! * Names are GTKWave- and Surfer-safe: letters, digits and `_`, scopes for
 //!   hierarchy, never `name[3]` indices (`rc_r3_c4`, `r12`).
 //!
@@ -175,9 +179,12 @@ impl Field {
     }
 }
 
-/// A module that has signals.
+/// A module that has signals. Generic over the probe, so that a waveform's
+/// walk through the modules is compiled for the [`Tracer`] with its calls
+/// inline (through `dyn Probe` a traced cycle cost some twenty indirect
+/// calls).
 pub trait Traced {
-    fn trace(&self, p: &mut dyn Probe);
+    fn trace<P: Probe + ?Sized>(&self, p: &mut P);
 }
 
 /// What to trace.
@@ -246,11 +253,11 @@ enum Sink {
     Vcd(vcd::Writer<BufWriter<File>>, VcdBody),
     FstHeader(fst_writer::FstHeaderWriter<BufWriter<File>>),
     FstBody(fst_writer::FstBodyWriter<BufWriter<File>>),
-    /// While sampling: value changes go in batches to a thread that
-    /// writes them into the sink it owns (the simulation does not wait for
-    /// the formatting); [`Sink::join`] gets the sink back.
+    /// While sampling: value changes go in batches ([`Tracer::batch`])
+    /// to a thread that writes them into the sink it owns (the simulation
+    /// does not wait for the formatting); [`Sink::join`] gets the sink
+    /// back.
     Threaded {
-        batch: Vec<u64>,
         tx: std::sync::mpsc::SyncSender<Vec<u64>>,
         /// Emptied batches coming back from the writing thread.
         spare: std::sync::mpsc::Receiver<Vec<u64>>,
@@ -286,6 +293,20 @@ const MSG_VALUE: u64 = (1 << 48) - 1;
 /// is slower than the simulation.
 const BATCH: usize = 1 << 14;
 const QUEUED_BATCHES: usize = 8;
+
+/// Queue a message for the writing thread: a change of signal `i` to
+/// `v`, or (`i` = `None`) the start of cycle `v`.
+#[inline(always)]
+fn queue(batch: &mut Vec<u64>, i: Option<u32>, v: u64) {
+    let tag = i.map_or(MSG_CYCLE, u64::from);
+    let short = v <= MSG_VALUE && (tag < MSG_CYCLE || i.is_none());
+    if short {
+        batch.push(tag << 48 | v);
+    } else {
+        batch.push(MSG_LONG << 48 | i.map_or(LONG_CYCLE, u64::from));
+        batch.push(v);
+    }
+}
 
 /// One signal's handle in the file.
 #[derive(Clone, Copy)]
@@ -359,20 +380,16 @@ impl Clock {
     }
 }
 
-/// `"0"`..`"1"` for each of the 8 bits of a byte, most significant first.
-static BIN8: [[u8; 8]; 256] = {
-    let mut t = [[0u8; 8]; 256];
-    let mut b = 0;
-    while b < 256 {
-        let mut k = 0;
-        while k < 8 {
-            t[b][k] = b'0' + ((b >> (7 - k)) & 1) as u8;
-            k += 1;
-        }
-        b += 1;
-    }
-    t
-};
+/// The 8 bits of `b` as ASCII `0`/`1`, most significant first, in the
+/// bytes of a little-endian word: `b` copied into every byte, byte `j`
+/// masked to bit `7 - j`, each nonzero byte turned into 1 (adding 0x7F
+/// sets its top bit, with no carry out of the byte) and added to `'0'`.
+#[inline(always)]
+fn bin8(b: u8) -> u64 {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    let x = (b as u64).wrapping_mul(ONES) & 0x0102_0408_1020_4080;
+    (((x + 0x7F * ONES) >> 7) & ONES) | (b'0' as u64 * ONES)
+}
 
 /// Bytes of VCD body gathered before they are handed to the file.
 const VCD_CHUNK: usize = 1 << 16;
@@ -421,7 +438,7 @@ impl VcdBody {
     }
 
     /// `0!` for one bit, `b1011 !` for a vector (no leading zeros).
-    #[inline]
+    #[inline(always)]
     fn change(&mut self, id: u32, width: u32, v: u64) {
         let (code, n) = self.ids[id as usize];
         let dst = &mut self.buf[self.len..self.len + VCD_SLACK];
@@ -431,19 +448,23 @@ impl VcdBody {
             k = 1;
         } else {
             dst[0] = b'b';
-            // The digits of the significant bytes, most significant first,
-            // then the significant digits moved into place with one
-            // fixed-size copy.
+            // The significant digits, 8 at a time from the most
+            // significant byte, stored straight into place: the top
+            // byte's digits shifted down to its significant ones (the
+            // bytes stored past them are overwritten by the next ones, or
+            // lie in the slack).
             let bits = 64 - (v | 1).leading_zeros() as usize;
             let bytes = bits.div_ceil(8);
-            let mut all = [b'0'; 72];
-            for (byte, out) in all[..8 * bytes].chunks_exact_mut(8).enumerate() {
-                out.copy_from_slice(&BIN8[(v >> (8 * (bytes - 1 - byte))) as u8 as usize]);
+            let top = bits - 8 * (bytes - 1);
+            let first = bin8((v >> (8 * (bytes - 1))) as u8) >> (8 * (8 - top));
+            dst[1..9].copy_from_slice(&first.to_le_bytes());
+            k = 1 + top;
+            for byte in (0..bytes - 1).rev() {
+                dst[k..k + 8].copy_from_slice(&bin8((v >> (8 * byte)) as u8).to_le_bytes());
+                k += 8;
             }
-            let from = 8 * bytes - bits;
-            dst[1..65].copy_from_slice(&all[from..from + 64]);
-            dst[1 + bits] = b' ';
-            k = bits + 2;
+            dst[k] = b' ';
+            k += 1;
         }
         dst[k..k + 16].copy_from_slice(&code);
         k += n as usize;
@@ -453,13 +474,18 @@ impl VcdBody {
 
     /// Hand the gathered bytes to the file once a chunk is full (`all`:
     /// whatever is gathered).
-    #[inline]
+    #[inline(always)]
     fn flush(&mut self, out: &mut BufWriter<File>, all: bool) -> io::Result<()> {
         if self.len >= VCD_CHUNK || (all && self.len > 0) {
-            let n = std::mem::take(&mut self.len);
-            out.write_all(&self.buf[..n])?;
+            return self.write_out(out);
         }
         Ok(())
+    }
+
+    #[inline(never)]
+    fn write_out(&mut self, out: &mut BufWriter<File>) -> io::Result<()> {
+        let n = std::mem::take(&mut self.len);
+        out.write_all(&self.buf[..n])
     }
 }
 
@@ -610,21 +636,15 @@ impl Sink {
                 let seen = seen.into_iter().map(BTreeSet::from_iter).collect();
                 (sink, res, seen)
             })?;
-        Ok(Sink::Threaded {
-            batch: Vec::with_capacity(BATCH),
-            tx,
-            spare,
-            worker,
-        })
+        Ok(Sink::Threaded { tx, spare, worker })
     }
 
-    /// The sink back from its writing thread, every change written, and
-    /// the values of the signals with translate filters.
-    fn join(self) -> io::Result<(Sink, Vec<BTreeSet<u64>>)> {
+    /// The sink back from its writing thread, every change written (the
+    /// last ones in `batch`), and the values of the signals with translate
+    /// filters.
+    fn join(self, batch: Vec<u64>) -> io::Result<(Sink, Vec<BTreeSet<u64>>)> {
         match self {
-            Sink::Threaded {
-                batch, tx, worker, ..
-            } => {
+            Sink::Threaded { tx, worker, .. } => {
                 let sent = tx.send(batch);
                 drop(tx);
                 let (sink, res, seen) = worker
@@ -638,31 +658,17 @@ impl Sink {
         }
     }
 
-    /// Queue a message for the writing thread: a change of signal `i` to
-    /// `v`, or (`i` = `None`) the start of cycle `v`.
-    #[inline]
-    fn send(&mut self, i: Option<u32>, v: u64) -> io::Result<()> {
+    /// Hand a full batch to the writing thread; `batch` is left empty (a
+    /// batch the thread has emptied, or a new one).
+    fn hand_over(&mut self, batch: &mut Vec<u64>) -> io::Result<()> {
         match self {
-            Sink::Threaded {
-                batch, tx, spare, ..
-            } => {
-                let tag = i.map_or(MSG_CYCLE, u64::from);
-                let short = v <= MSG_VALUE && (tag < MSG_CYCLE || i.is_none());
-                if short {
-                    batch.push(tag << 48 | v);
-                } else {
-                    batch.push(MSG_LONG << 48 | i.map_or(LONG_CYCLE, u64::from));
-                    batch.push(v);
-                }
-                if batch.len() >= BATCH {
-                    let next = spare
-                        .try_recv()
-                        .unwrap_or_else(|_| Vec::with_capacity(BATCH));
-                    let full = std::mem::replace(batch, next);
-                    tx.send(full)
-                        .map_err(|_| io::Error::other("the waveform writer stopped"))?;
-                }
-                Ok(())
+            Sink::Threaded { tx, spare, .. } => {
+                let next = spare
+                    .try_recv()
+                    .unwrap_or_else(|_| Vec::with_capacity(batch.capacity()));
+                let full = std::mem::replace(batch, next);
+                tx.send(full)
+                    .map_err(|_| io::Error::other("the waveform writer stopped"))
             }
             _ => Err(io::Error::other("a value change outside sampling")),
         }
@@ -694,35 +700,58 @@ impl Sink {
         }
     }
 
-    /// A new value of a `width`-bit signal.
-    #[inline]
+    /// A new value of a `width`-bit signal. Inline in the writing
+    /// thread's loop for a VCD (a call per change cost as much as the
+    /// formatting).
+    #[inline(always)]
     fn change(&mut self, id: SigId, width: u32, v: u64) -> io::Result<()> {
         match (self, id) {
             (Sink::Vcd(w, body), SigId::Vcd(id)) => {
                 body.change(id, width, v);
                 body.flush(w.writer(), false)
             }
-            (Sink::FstBody(b), SigId::Fst(id)) => {
-                let mut bits = [b'0'; 64];
-                let w = width as usize;
-                for (k, bit) in bits[..w].iter_mut().enumerate() {
-                    if v >> (w - 1 - k) & 1 == 1 {
-                        *bit = b'1';
-                    }
-                }
-                b.signal_change(id, &bits[..w]).map_err(fst_err)
-            }
+            (Sink::FstBody(b), SigId::Fst(id)) => fst_change(b, id, width, v),
             _ => Ok(()),
         }
     }
 }
 
-/// A signal call's mask (of its width; 0 when not traced) and the value
-/// last written ([`Tracer::slots`]).
-#[derive(Clone, Copy)]
-struct Slot {
-    mask: u64,
-    last: u64,
+fn fst_change(
+    b: &mut fst_writer::FstBodyWriter<BufWriter<File>>,
+    id: fst_writer::FstSignalId,
+    width: u32,
+    v: u64,
+) -> io::Result<()> {
+    let mut bits = [b'0'; 64];
+    let w = width as usize;
+    for (k, bit) in bits[..w].iter_mut().enumerate() {
+        if v >> (w - 1 - k) & 1 == 1 {
+            *bit = b'1';
+        }
+    }
+    b.signal_change(id, &bits[..w]).map_err(fst_err)
+}
+
+/// `dst.copy_from_slice(src)` for the few values of a block, one 8-byte
+/// load per value: the caller has just stored them one by one, and a
+/// wider load of several such stores waits for them to reach the cache
+/// instead of taking them from the store buffer.
+#[inline(always)]
+fn copy_small(dst: &mut [u64], src: &[u64]) {
+    for (d, s) in dst.iter_mut().zip(src) {
+        // SAFETY: `s` is a reference to an initialised `u64`.
+        *d = unsafe { std::ptr::read_volatile(s) };
+    }
+}
+
+/// Bit k: `cur[k] & mask[k]` differs from `last[k]`.
+#[inline(always)]
+fn changed_mask(cur: &[u64; 64], mask: &[u64; 64], last: &[u64; 64]) -> u64 {
+    let mut bits = 0;
+    for k in 0..64 {
+        bits |= u64::from(cur[k] & mask[k] != last[k]) << k;
+    }
+    bits
 }
 
 /// [`Tracer::slot_decl`] of a signal call that is not traced.
@@ -769,19 +798,26 @@ pub struct Tracer {
     open_masks: Vec<u64>,
     open_i: usize,
     /// Per [`Probe::block_versioned`] call: the version last sampled and
-    /// the block's size; a buffer for its values.
+    /// the block's size.
     versions: Vec<(u64, usize)>,
     version_i: usize,
-    scratch: Vec<u64>,
-    /// Per signal call (in call order, traced or not): the mask of its
-    /// width (0 when it is not traced, so it never changes) and the value
-    /// last written.
-    slots: Vec<Slot>,
-    /// The calls whose value changed this cycle, with the new value: one
-    /// store per call and a count that moves on when the value differs
-    /// (no branch, and no wide load of what narrow stores just wrote).
-    changed: Vec<(u32, u64)>,
-    n_changed: usize,
+    /// Per signal call (in call order, traced or not), padded with
+    /// untraced calls to a multiple of 64: the mask of its width (0 when
+    /// it is not traced, so it never changes)...
+    masks: Vec<u64>,
+    /// ... the value last written...
+    lasts: Vec<u64>,
+    /// ... and the value reported in the cycle being sampled (a block
+    /// skipped while its version holds leaves the last one). The walk
+    /// only copies values here; they are compared with `lasts` after it,
+    /// 64 at a time.
+    cur: Vec<u64>,
+    /// Signal calls declared (before the padding).
+    n_slots: usize,
+    /// Messages for the writing thread ([`Sink::Threaded`]), handed over
+    /// once [`BATCH`] words wait (checked after each cycle: room for the
+    /// most a cycle adds is reserved beyond it).
+    batch: Vec<u64>,
     /// Per signal call: the index of its declaration, [`NOT_TRACED`] if none.
     slot_decl: Vec<u32>,
     // sampling state
@@ -944,7 +980,7 @@ impl Drop for Tracer {
 
 impl Tracer {
     /// Create the VCD file and declare the signals of `top` (named `top_name`).
-    pub fn create(cfg: TraceConfig, top_name: &str, top: &dyn Traced) -> io::Result<Tracer> {
+    pub fn create<T: Traced>(cfg: TraceConfig, top_name: &str, top: &T) -> io::Result<Tracer> {
         check_scope_patterns(&cfg.scope)
             .map_err(|e| io::Error::new(io::ErrorKind::InvalidInput, e))?;
         if let Some(dir) = cfg.path.parent() {
@@ -1047,10 +1083,11 @@ impl Tracer {
             open_i: 0,
             versions: Vec::new(),
             version_i: 0,
-            scratch: Vec::new(),
-            slots: Vec::new(),
-            changed: Vec::new(),
-            n_changed: 0,
+            masks: Vec::new(),
+            lasts: Vec::new(),
+            cur: Vec::new(),
+            n_slots: 0,
+            batch: Vec::new(),
             slot_decl: Vec::new(),
             scope_i: 0,
             slot_i: 0,
@@ -1123,7 +1160,12 @@ impl Tracer {
             t.cfg.fst_section_bytes,
         )?;
         t.clock = Clock::new(t.cfg.clock_hz);
-        t.changed = vec![(0, 0); t.slots.len() + 1];
+        t.n_slots = t.masks.len();
+        let padded = t.n_slots.next_multiple_of(64);
+        t.masks.resize(padded, 0);
+        t.lasts.resize(padded, 0);
+        t.cur = vec![0; padded];
+        t.batch = Vec::with_capacity(BATCH + 2 * padded + 2);
         t.phase = Phase::Sample;
         Ok(t)
     }
@@ -1148,28 +1190,29 @@ impl Tracer {
     /// Record the values of `top` during `cycle`. Out of line: the
     /// untraced cycle loop keeps only the test for a tracer.
     #[inline(never)]
-    pub fn sample(&mut self, cycle: u64, top: &dyn Traced) -> io::Result<()> {
+    pub fn sample<T: Traced>(&mut self, cycle: u64, top: &T) -> io::Result<()> {
         if !self.in_window(cycle) {
             return Ok(());
         }
         let t = self.clock.time(cycle);
-        self.w.send(None, cycle)?;
+        queue(&mut self.batch, None, cycle);
         self.scope_i = 0;
         self.slot_i = 0;
         self.open_i = 0;
         self.version_i = 0;
-        self.n_changed = 0;
         top.trace(self);
-        if self.slot_i != self.slots.len() {
+        if self.slot_i != self.n_slots {
             return Err(io::Error::other(format!(
                 "a module reported {} signals where it declared {}",
-                self.slot_i,
-                self.slots.len()
+                self.slot_i, self.n_slots
             )));
         }
         self.write_changes();
         if let Some(e) = self.err.take() {
             return Err(e);
+        }
+        if self.batch.len() >= BATCH {
+            self.w.hand_over(&mut self.batch)?;
         }
         // This cycle's own lines: two timestamps, the clock twice, the
         // cycle number in binary.
@@ -1205,7 +1248,8 @@ impl Tracer {
     pub fn finish(mut self) -> io::Result<Vec<PathBuf>> {
         let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
         let t = self.time(end);
-        let (w, seen) = std::mem::replace(&mut self.w, Sink::Gone).join()?;
+        let batch = std::mem::take(&mut self.batch);
+        let (w, seen) = std::mem::replace(&mut self.w, Sink::Gone).join(batch)?;
         self.w = w;
         self.seen = seen;
         self.w.timestamp(t)?;
@@ -1385,6 +1429,10 @@ impl Tracer {
 }
 
 impl Probe for Tracer {
+    // While sampling each call only moves on through the tables the
+    // declaration made; the declaring halves are cold functions of their
+    // own, so that these stay small (a shared body gave every call the
+    // prologue of the largest).
     fn block_versioned(
         &mut self,
         version: u64,
@@ -1392,10 +1440,7 @@ impl Probe for Tracer {
         fill: &mut dyn FnMut(&mut [u64]),
     ) {
         if let Phase::Declare = self.phase {
-            let n = fields().len();
-            self.versions.push((version, n));
-            self.scratch.resize(self.scratch.len().max(n), 0);
-            return self.block(fields, &vec![0; n]);
+            return self.declare_versioned(version, fields);
         }
         let Some(&(last, n)) = self.versions.get(self.version_i) else {
             self.err.get_or_insert(io::Error::other(
@@ -1405,24 +1450,88 @@ impl Probe for Tracer {
         };
         self.versions[self.version_i].0 = version;
         self.version_i += 1;
+        let start = self.slot_i;
+        self.slot_i += n;
         if version == last && !self.first_sample {
             // Unchanged: the values last written still hold.
-            self.slot_i += n;
             return;
         }
-        let mut values = std::mem::take(&mut self.scratch);
-        fill(&mut values[..n]);
-        self.sample_calls(&values[..n]);
-        self.scratch = values;
+        if let Some(cur) = self.cur.get_mut(start..start + n) {
+            fill(cur);
+        }
     }
 
     fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
-        if let Phase::Sample = self.phase {
-            return self.sample_calls(values);
+        if let Phase::Declare = self.phase {
+            return self.declare_block(fields, values);
         }
-        // Declaring: the scopes and signals `Probe::block` describes, with
-        // a slot for every field (those of scopes left out untraced), as
-        // the sampled cycles report every value.
+        self.sample_calls(values);
+    }
+
+    fn signal_row(&mut self, names: &[&str], width: u32, display: Display, values: &[u64]) {
+        if let Phase::Declare = self.phase {
+            for n in names {
+                self.declare_signal(n, width, display);
+            }
+            return;
+        }
+        self.sample_calls(&values[..names.len()]);
+    }
+
+    fn traced_signals(&mut self, names: &[&str]) -> u64 {
+        if let Phase::Declare = self.phase {
+            return self.declare_mask(names.len(), &mut |i| names[i].to_string(), true);
+        }
+        self.next_mask()
+    }
+
+    fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
+        if let Phase::Declare = self.phase {
+            return self.declare_mask(n, name, false);
+        }
+        self.next_mask()
+    }
+
+    fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
+        if let Phase::Declare = self.phase {
+            return self.declare_scope(name);
+        }
+        let on = self.scope_on.get(self.scope_i).copied().unwrap_or(false);
+        self.scope_i += 1;
+        on
+    }
+
+    fn end(&mut self) {
+        if let Phase::Declare = self.phase {
+            self.declare_end();
+        }
+    }
+
+    #[inline]
+    fn signal(&mut self, name: &str, width: u32, display: Display, value: u64) {
+        if let Phase::Declare = self.phase {
+            return self.declare_signal(name, width, display);
+        }
+        self.sample_calls(&[value]);
+    }
+}
+
+/// The declaring halves of the [`Probe`] calls.
+impl Tracer {
+    #[cold]
+    #[inline(never)]
+    fn declare_versioned(&mut self, version: u64, fields: &dyn Fn() -> Vec<Field>) {
+        let n = fields().len();
+        self.versions.push((version, n));
+        self.declare_block(fields, &vec![0; n]);
+    }
+
+    /// The scopes and signals [`Probe::block`] describes, with a slot for
+    /// every field (those of scopes left out untraced), as the sampled
+    /// cycles report every value.
+    #[cold]
+    #[inline(never)]
+    fn declare_block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
         let fields = fields();
         for (scope, run) in scope_runs(&fields) {
             let open = scope.is_empty() || {
@@ -1444,12 +1553,11 @@ impl Probe for Tracer {
                 if open {
                     self.declare_signal(f.name, f.width, f.display);
                 } else {
-                    self.slots.push(Slot { mask: 0, last: 0 });
-                    self.slot_decl.push(NOT_TRACED);
+                    self.untraced_slot();
                 }
             }
             if open && !scope.is_empty() {
-                self.end();
+                self.declare_end();
             }
         }
         if values.len() != fields.len() {
@@ -1461,78 +1569,57 @@ impl Probe for Tracer {
         }
     }
 
-    fn signal_row(&mut self, names: &[&str], width: u32, display: Display, values: &[u64]) {
-        if let Phase::Declare = self.phase {
-            for n in names {
-                self.declare_signal(n, width, display);
-            }
-            return;
+    #[cold]
+    #[inline(never)]
+    fn declare_scope(&mut self, name: fmt::Arguments<'_>) -> bool {
+        self.stack.push(name.to_string());
+        if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
+            self.top_scopes.push(self.stack[0].clone());
         }
-        self.sample_calls(&values[..names.len()]);
-    }
-
-    fn traced_signals(&mut self, names: &[&str]) -> u64 {
-        self.mask_of(names.len(), &mut |i| names[i].to_string(), true)
-    }
-
-    fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
-        self.mask_of(n, name, false)
-    }
-
-    fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
-        match self.phase {
-            Phase::Declare => {
-                self.stack.push(name.to_string());
-                if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
-                    self.top_scopes.push(self.stack[0].clone());
-                }
-                let on = self.matches_prefix(&self.stack, false);
-                self.scope_on.push(on);
-                if on {
-                    if let Err(e) = self.w.add_module(self.stack.last().unwrap()) {
-                        self.err.get_or_insert(e);
-                    }
-                } else {
-                    self.stack.pop();
-                }
-                on
-            }
-            Phase::Sample => {
-                let on = self.scope_on[self.scope_i];
-                self.scope_i += 1;
-                on
-            }
-        }
-    }
-
-    fn end(&mut self) {
-        if let Phase::Declare = self.phase {
-            self.stack.pop();
-            if let Err(e) = self.w.upscope() {
+        let on = self.matches_prefix(&self.stack, false);
+        self.scope_on.push(on);
+        if on {
+            if let Err(e) = self.w.add_module(self.stack.last().unwrap()) {
                 self.err.get_or_insert(e);
             }
+        } else {
+            self.stack.pop();
+        }
+        on
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn declare_end(&mut self) {
+        self.stack.pop();
+        if let Err(e) = self.w.upscope() {
+            self.err.get_or_insert(e);
         }
     }
 
+    /// The next answer of [`Probe::open_scopes`] or
+    /// [`Probe::traced_signals`], in the order they were declared.
     #[inline]
-    fn signal(&mut self, name: &str, width: u32, display: Display, value: u64) {
-        if let Phase::Declare = self.phase {
-            return self.declare_signal(name, width, display);
-        }
-        self.sample_calls(&[value]);
+    fn next_mask(&mut self) -> u64 {
+        let m = self.open_masks.get(self.open_i).copied().unwrap_or(0);
+        self.open_i += 1;
+        m
     }
 }
 
 impl Tracer {
     /// Which of `n` names under the current scope the patterns take in
     /// (`complete`: as signals, else as scopes that may hold some):
-    /// computed while declaring, replayed in the same order while sampling.
-    fn mask_of(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String, complete: bool) -> u64 {
-        if let Phase::Sample = self.phase {
-            let m = self.open_masks[self.open_i];
-            self.open_i += 1;
-            return m;
-        }
+    /// computed while declaring, replayed in the same order while sampling
+    /// ([`Tracer::next_mask`]).
+    #[cold]
+    #[inline(never)]
+    fn declare_mask(
+        &mut self,
+        n: usize,
+        name: &mut dyn FnMut(usize) -> String,
+        complete: bool,
+    ) -> u64 {
         let mut mask = 0u64;
         for i in 0..n.min(64) {
             let mut path = self.stack.clone();
@@ -1561,53 +1648,57 @@ impl Tracer {
                     SigId::Vcd(0)
                 }
             };
-            self.slots.push(Slot {
-                mask: u64::MAX >> (64 - width.clamp(1, 64)),
-                last: 0,
-            });
+            self.masks.push(u64::MAX >> (64 - width.clamp(1, 64)));
+            self.lasts.push(0);
             self.slot_decl.push(self.decls.len() as u32);
             self.decls.push(Decl {
                 path,
                 info: SigInfo { id, width, display },
             });
         } else {
-            self.slots.push(Slot { mask: 0, last: 0 });
-            self.slot_decl.push(NOT_TRACED);
+            self.untraced_slot();
         }
     }
 
-    /// The sampled cycle's next signal calls reported `values`: each kept
-    /// in [`Tracer::changed`] if it differs from the last value written
-    /// (masked to its width, to 0 when not traced). The counters live in
-    /// locals through the loop (stored back to `self` each time, they made
-    /// a chain of store-to-load forwards).
+    /// A signal call that is not traced: its value is masked to 0.
+    fn untraced_slot(&mut self) {
+        self.masks.push(0);
+        self.lasts.push(0);
+        self.slot_decl.push(NOT_TRACED);
+    }
+
+    /// The sampled cycle's next signal calls reported `values`: kept in
+    /// [`Tracer::cur`] until the walk is over.
     #[inline]
     fn sample_calls(&mut self, values: &[u64]) {
         let start = self.slot_i;
         self.slot_i += values.len();
-        let Some(slots) = self.slots.get(start..start + values.len()) else {
-            return; // more calls than declared: reported after the walk
-        };
-        let first = self.first_sample;
-        let changed = &mut self.changed[..];
-        let mut n = self.n_changed;
-        for (k, (s, &value)) in slots.iter().zip(values).enumerate() {
-            let v = value & s.mask;
-            // `n` <= the calls so far < `changed.len()`.
-            changed[n] = ((start + k) as u32, v);
-            n += (v != s.last || first) as usize;
-        }
-        self.n_changed = n;
+        if let Some(cur) = self.cur.get_mut(start..start + values.len()) {
+            copy_small(cur, values);
+        } // else more calls than declared: reported after the walk
     }
 
-    /// Write the values that changed in the cycle's walk (all traced ones
-    /// the first time).
+    /// Write the values of the cycle's walk that changed (all traced
+    /// ones the first time): the calls compared 64 at a time into a mask
+    /// of those that changed (no branch per call), then only those
+    /// written.
     fn write_changes(&mut self) {
         let first = std::mem::take(&mut self.first_sample);
-        for k in 0..self.n_changed {
-            let (i, v) = self.changed[k];
-            if !first || self.slot_decl[i as usize] != NOT_TRACED {
-                self.record_change(i as usize, v);
+        for base in (0..self.cur.len()).step_by(64) {
+            let mut bits = {
+                let c: &[u64; 64] = self.cur[base..base + 64].try_into().unwrap();
+                let m: &[u64; 64] = self.masks[base..base + 64].try_into().unwrap();
+                let l: &[u64; 64] = self.lasts[base..base + 64].try_into().unwrap();
+                if first {
+                    changed_mask(m, &[u64::MAX; 64], &[0; 64])
+                } else {
+                    changed_mask(c, m, l)
+                }
+            };
+            while bits != 0 {
+                let k = base + bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                self.record_change(k, self.cur[k] & self.masks[k]);
             }
         }
     }
@@ -1615,13 +1706,11 @@ impl Tracer {
     /// The signal of call `slot` changed to `v`: write it.
     #[inline]
     fn record_change(&mut self, slot: usize, v: u64) {
-        self.slots[slot].last = v;
+        self.lasts[slot] = v;
         let d = self.slot_decl[slot];
         // A change costs about its width in digits and 6 bytes more.
-        self.bytes += (self.slots[slot].mask.count_ones() + 6) as u64;
-        if let Err(e) = self.w.send(Some(d), v) {
-            self.err.get_or_insert(e);
-        }
+        self.bytes += (self.masks[slot].count_ones() + 6) as u64;
+        queue(&mut self.batch, Some(d), v);
     }
 }
 
@@ -1647,7 +1736,7 @@ mod tests {
     }
 
     impl Traced for Demo {
-        fn trace(&self, p: &mut dyn Probe) {
+        fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
             let t = self.t;
             let (a, b, c, d) = (t, t / 3, (t * 7) as i16 as u64, t % 2);
             let (r0, r1) = (t / 5, t / 5 * 3);
@@ -1722,6 +1811,40 @@ mod tests {
                 calls == blocks,
                 "{scope} from {first}: the waveforms differ"
             );
+        }
+    }
+
+    /// A value change is written as `core::fmt` writes it: `b`, the
+    /// binary digits without leading zeros, a space and the code (one
+    /// digit and the code for one bit).
+    #[test]
+    fn value_changes_are_formatted_as_core_fmt_formats_them() {
+        let mut body = VcdBody::new();
+        body.add_id("!").unwrap();
+        body.add_id("%a~").unwrap();
+        let mut values: Vec<u64> = vec![0, 1, 2, 3, 0xFF, 0x100, 0x8000, u64::MAX, 1 << 63];
+        let mut x = 0x9E37_79B9_7F4A_7C15u64;
+        for _ in 0..2000 {
+            // xorshift, with every width of value
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            values.push(x >> (x % 64));
+        }
+        let mut want = String::new();
+        for (k, &v) in values.iter().enumerate() {
+            let (id, code) = if k % 2 == 0 { (0, "!") } else { (1, "%a~") };
+            body.change(id, 64, v);
+            want.push_str(&format!("b{v:b} {code}\n"));
+            body.change(id, 1, v);
+            want.push_str(&format!("{}{code}\n", v & 1));
+            if body.len > VCD_CHUNK / 2 {
+                break;
+            }
+        }
+        assert_eq!(std::str::from_utf8(&body.buf[..body.len]).unwrap(), want);
+        for b in 0..=255u8 {
+            assert_eq!(bin8(b).to_le_bytes(), *format!("{b:08b}").as_bytes());
         }
     }
 

@@ -219,10 +219,11 @@ fn the_stall_fast_path_is_cycle_exact() {
     assert!(stalled >= 10, "only {stalled} programs stall");
 }
 
-/// With a waveform, the stalled cycles go through the same fast path
-/// (`Chip::run_stalled_sampled`), sampled cycle by cycle. Every program's
-/// full waveform (`--trace-scope all`), run that way, must be byte for byte
-/// the waveform of plain stepping through `Sim::step`.
+/// With a waveform, the cycles go through the same fast paths, sampled
+/// cycle by cycle (`Chip::run_fast_sampled`: while the DMA is idle the
+/// loops of `Chip::run_local`, otherwise `Chip::run_stalled_sampled`).
+/// Every program's full waveform (`--trace-scope all`), run that way, must
+/// be byte for byte the waveform of plain stepping through `Sim::step`.
 #[test]
 fn the_stall_fast_path_traces_the_same_waveform() {
     let tmp = tempfile::tempdir().unwrap();

@@ -260,7 +260,7 @@ pub static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
 };
 
 impl Traced for TinyRisc {
-    fn trace(&self, p: &mut dyn Probe) {
+    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
         p.block(
             &|| {
                 vec![
