@@ -395,6 +395,9 @@ fn bin8(b: u8) -> u64 {
 const VCD_CHUNK: usize = 1 << 16;
 /// Room after the chunk for the longest line (a 64-bit value, its code).
 const VCD_SLACK: usize = 128;
+/// Room after the chunk for a cycle's edges (five lines between two checks
+/// for a full chunk, [`vcd_batch`]).
+const VCD_ROOM: usize = 4 * VCD_SLACK;
 
 /// The body of a VCD file: timestamps and value changes, formatted into a
 /// buffer of its own and written to the file [`VCD_CHUNK`] bytes at a time.
@@ -409,7 +412,7 @@ impl VcdBody {
     fn new() -> VcdBody {
         VcdBody {
             ids: Vec::new(),
-            buf: vec![0; VCD_CHUNK + VCD_SLACK].into_boxed_slice(),
+            buf: vec![0; VCD_CHUNK + VCD_ROOM].into_boxed_slice(),
             len: 0,
         }
     }
@@ -426,7 +429,7 @@ impl VcdBody {
     }
 
     /// `#t`.
-    #[inline]
+    #[inline(always)]
     fn timestamp(&mut self, t: u64) {
         let mut digits = itoa::Buffer::new();
         let d = digits.format(t).as_bytes();
@@ -563,8 +566,19 @@ impl Sink {
                 let mut res = Ok(());
                 // Values of the filtered signals, deduplicated whenever a
                 // list doubles (a set insertion per change cost more).
-                let mut seen: Vec<Vec<u64>> = vec![Vec::new(); sigs.len()];
-                let mut seen_cap = vec![1024usize; sigs.len()];
+                let mut seen = Seen::new(sigs.len());
+                // A VCD's handles, for its own loop ([`vcd_batch`]).
+                let vcd_ids = match (clk, cycle_id) {
+                    (SigId::Vcd(clk), SigId::Vcd(cycle)) => sigs
+                        .iter()
+                        .map(|&(id, w, f)| match id {
+                            SigId::Vcd(id) => Some((id, w, f)),
+                            SigId::Fst(_) => None,
+                        })
+                        .collect::<Option<Vec<_>>>()
+                        .map(|s| (s, clk, cycle)),
+                    _ => None,
+                };
                 let mut clock = Clock::new(clock_hz);
                 // The falling edge of the last cycle begun, written when
                 // the next one begins or the trace ends.
@@ -572,17 +586,22 @@ impl Sink {
                 // A section can end only after a time step of its own (the
                 // FST writer cannot start one at the time it ended at).
                 let mut stepped = false;
-                let mut cycle = |sink: &mut Sink, c: u64| -> io::Result<()> {
+                let cycle = |sink: &mut Sink,
+                             c: u64,
+                             clock: &mut Clock,
+                             fall: &mut Option<u64>,
+                             stepped: &mut bool|
+                 -> io::Result<()> {
                     if let Some(t) = fall.take() {
                         sink.timestamp(t)?;
                         sink.change(clk, 1, 0)?;
-                        stepped = true;
+                        *stepped = true;
                     }
-                    if std::mem::take(&mut stepped) {
+                    if std::mem::take(stepped) {
                         sink.fst_section(section_bytes)?;
                     }
                     let (rise, f) = clock.edges(c);
-                    fall = Some(f);
+                    *fall = Some(f);
                     sink.timestamp(rise)?;
                     sink.change(clk, 1, 1)?;
                     sink.change(cycle_id, 64, c)
@@ -590,6 +609,13 @@ impl Sink {
                 for mut batch in rx {
                     if res.is_err() {
                         continue; // keep draining: the sender must not block
+                    }
+                    if let (Sink::Vcd(w, body), Some((ids, clk, cycle))) = (&mut sink, &vcd_ids) {
+                        let edges = (&mut clock, &mut fall, *clk, *cycle);
+                        res = vcd_batch(w.writer(), body, &batch, ids, &mut seen, edges);
+                        batch.clear();
+                        let _ = back.try_send(batch);
+                        continue;
                     }
                     let mut k = 0;
                     while k < batch.len() {
@@ -609,16 +635,11 @@ impl Sink {
                             Some(i) => {
                                 let (id, w, filtered) = sigs[i];
                                 if filtered {
-                                    seen[i].push(v);
-                                    if seen[i].len() >= seen_cap[i] {
-                                        seen[i].sort_unstable();
-                                        seen[i].dedup();
-                                        seen_cap[i] = (2 * seen[i].len()).max(1024);
-                                    }
+                                    seen.add(i, v);
                                 }
                                 sink.change(id, w, v)
                             }
-                            None => cycle(&mut sink, v),
+                            None => cycle(&mut sink, v, &mut clock, &mut fall, &mut stepped),
                         };
                         if let Err(e) = r {
                             res = Err(e);
@@ -633,7 +654,7 @@ impl Sink {
                         res = sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0));
                     }
                 }
-                let seen = seen.into_iter().map(BTreeSet::from_iter).collect();
+                let seen = seen.lists.into_iter().map(BTreeSet::from_iter).collect();
                 (sink, res, seen)
             })?;
         Ok(Sink::Threaded { tx, spare, worker })
@@ -752,6 +773,82 @@ fn changed_mask(cur: &[u64; 64], mask: &[u64; 64], last: &[u64; 64]) -> u64 {
         bits |= u64::from(cur[k] & mask[k] != last[k]) << k;
     }
     bits
+}
+
+/// The values each signal with a translate filter took, gathered by the
+/// writing thread and deduplicated whenever a list doubles (a set
+/// insertion per change cost more).
+struct Seen {
+    lists: Vec<Vec<u64>>,
+    cap: Vec<usize>,
+}
+
+impl Seen {
+    fn new(n: usize) -> Seen {
+        Seen {
+            lists: vec![Vec::new(); n],
+            cap: vec![1024; n],
+        }
+    }
+
+    #[inline(always)]
+    fn add(&mut self, i: usize, v: u64) {
+        let l = &mut self.lists[i];
+        l.push(v);
+        if l.len() >= self.cap[i] {
+            l.sort_unstable();
+            l.dedup();
+            self.cap[i] = (2 * l.len()).max(1024);
+        }
+    }
+}
+
+/// The writing thread's loop over a batch for a VCD (the general loop of
+/// [`Sink::threaded`] matches the sink and the handle at every message):
+/// `ids` each traced signal's code, width and whether it has a translate
+/// filter; `edges` the clock, the falling edge still to write, and the
+/// codes of `clk` and `cycle`.
+#[inline(never)]
+fn vcd_batch(
+    out: &mut BufWriter<File>,
+    body: &mut VcdBody,
+    batch: &[u64],
+    ids: &[(u32, u32, bool)],
+    seen: &mut Seen,
+    (clock, fall, clk, cycle): (&mut Clock, &mut Option<u64>, u32, u32),
+) -> io::Result<()> {
+    let mut k = 0;
+    while k < batch.len() {
+        let m = batch[k];
+        k += 1;
+        let (tag, mut v) = (m >> 48, m & MSG_VALUE);
+        let mut i = tag;
+        if tag == MSG_LONG {
+            i = v;
+            v = batch.get(k).copied().unwrap_or(0);
+            k += 1;
+        }
+        if tag == MSG_CYCLE || (tag == MSG_LONG && i == LONG_CYCLE) {
+            let (rise, f) = clock.edges(v);
+            if let Some(t) = fall.replace(f) {
+                body.timestamp(t);
+                body.change(clk, 1, 0);
+            }
+            body.timestamp(rise);
+            body.change(clk, 1, 1);
+            body.change(cycle, 64, v);
+        } else {
+            let Some(&(id, w, filtered)) = ids.get(i as usize) else {
+                return Err(io::Error::other("a change of a signal not declared"));
+            };
+            if filtered {
+                seen.add(i as usize, v);
+            }
+            body.change(id, w, v);
+        }
+        body.flush(out, false)?;
+    }
+    Ok(())
 }
 
 /// [`Tracer::slot_decl`] of a signal call that is not traced.
