@@ -753,18 +753,6 @@ fn fst_change(
     b.signal_change(id, &bits[..w]).map_err(fst_err)
 }
 
-/// `dst.copy_from_slice(src)` for the few values of a block, one 8-byte
-/// load per value: the caller has just stored them one by one, and a
-/// wider load of several such stores waits for them to reach the cache
-/// instead of taking them from the store buffer.
-#[inline(always)]
-fn copy_small(dst: &mut [u64], src: &[u64]) {
-    for (d, s) in dst.iter_mut().zip(src) {
-        // SAFETY: `s` is a reference to an initialised `u64`.
-        *d = unsafe { std::ptr::read_volatile(s) };
-    }
-}
-
 /// Bit k: `cur[k] & mask[k]` differs from `last[k]`.
 #[inline(always)]
 fn changed_mask(cur: &[u64; 64], mask: &[u64; 64], last: &[u64; 64]) -> u64 {
@@ -1771,7 +1759,7 @@ impl Tracer {
         let start = self.slot_i;
         self.slot_i += values.len();
         if let Some(cur) = self.cur.get_mut(start..start + values.len()) {
-            copy_small(cur, values);
+            cur.copy_from_slice(values);
         } // else more calls than declared: reported after the walk
     }
 
