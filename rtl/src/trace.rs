@@ -355,12 +355,12 @@ impl Clock {
     fn time(&mut self, c: u64) -> u64 {
         if c == self.c.wrapping_add(1) {
             self.c = c;
-            self.t += self.q;
             self.rem += self.r;
-            if self.rem >= self.hz {
-                self.rem -= self.hz;
-                self.t += 1;
-            }
+            // Without a branch: the carry comes every few cycles, at a
+            // rhythm the branch predictor missed.
+            let carry = (self.rem >= self.hz) as u64;
+            self.rem -= carry * self.hz;
+            self.t += self.q + carry;
         } else if c != self.c {
             let ps = c as u128 * 1_000_000_000_000u128;
             self.c = c;
@@ -913,11 +913,11 @@ pub struct Tracer {
     /// In the first sampled cycle every call counts as a change (and the
     /// traced ones are written).
     first_sample: bool,
-    clock: Clock,
-    /// The digits of the times written, and the time that takes one more
-    /// (the times only grow).
+    /// The digits of the times written, the time that takes one more (the
+    /// times only grow) and the first cycle at that time.
     digits: u64,
     digits_below: u64,
+    digits_cycle: u64,
     seen: Vec<BTreeSet<u64>>,
     clk: SigId,
     cycle_id: SigId,
@@ -1179,7 +1179,7 @@ impl Tracer {
             scope_i: 0,
             slot_i: 0,
             first_sample: true,
-            clock: Clock::new(1),
+            digits_cycle: 0,
             digits: 1,
             digits_below: 10,
             seen: Vec::new(),
@@ -1246,7 +1246,7 @@ impl Tracer {
             t.cfg.clock_hz,
             t.cfg.fst_section_bytes,
         )?;
-        t.clock = Clock::new(t.cfg.clock_hz);
+        t.digits_cycle = t.first_cycle_at(t.digits_below);
         t.n_slots = t.masks.len();
         let padded = t.n_slots.next_multiple_of(64);
         t.masks.resize(padded, 0);
@@ -1260,6 +1260,15 @@ impl Tracer {
     /// Number of signals that passed the scope filter.
     pub fn signal_count(&self) -> usize {
         self.decls.len()
+    }
+
+    /// The first cycle whose rising edge is at `t` ps or later.
+    fn first_cycle_at(&self, t: u64) -> u64 {
+        // `c * 1e12 / hz` rounded down is at least `t` when `c * 1e12 /
+        // hz` is: `c >= t * hz / 1e12`, rounded up.
+        let hz = self.cfg.clock_hz.max(1) as u128;
+        let c = (t as u128 * hz).div_ceil(1_000_000_000_000);
+        c.min(u64::MAX as u128) as u64
     }
 
     /// Is `cycle` inside the trace window?
@@ -1281,7 +1290,6 @@ impl Tracer {
         if !self.in_window(cycle) {
             return Ok(());
         }
-        let t = self.clock.time(cycle);
         queue(&mut self.batch, None, cycle);
         self.scope_i = 0;
         self.slot_i = 0;
@@ -1303,9 +1311,10 @@ impl Tracer {
         }
         // This cycle's own lines: two timestamps, the clock twice, the
         // cycle number in binary.
-        while t >= self.digits_below {
+        while cycle >= self.digits_cycle {
             self.digits += 1;
             self.digits_below = self.digits_below.saturating_mul(10);
+            self.digits_cycle = self.first_cycle_at(self.digits_below);
         }
         self.bytes += 2 * (self.digits + 2) + 6 + (64 - cycle.leading_zeros()).max(1) as u64 + 6;
         if self.bytes > self.cfg.max_bytes {
