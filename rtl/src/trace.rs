@@ -767,22 +767,38 @@ fn changed_mask(cur: &[u64; 64], mask: &[u64; 64], last: &[u64; 64]) -> u64 {
 
 /// The values each signal with a translate filter took, gathered by the
 /// writing thread and deduplicated whenever a list doubles (a set
-/// insertion per change cost more).
+/// insertion per change cost more). A value found in a small
+/// direct-mapped table of the values met last is not gathered again: an
+/// instruction word or a context word comes back thousands of times, and
+/// without the table the lists were sorted every few hundred changes.
 struct Seen {
     lists: Vec<Vec<u64>>,
     cap: Vec<usize>,
+    recent: Vec<[u64; RECENT]>,
 }
+
+/// Entries of [`Seen`]'s table of recent values, per signal.
+const RECENT: usize = 256;
 
 impl Seen {
     fn new(n: usize) -> Seen {
         Seen {
             lists: vec![Vec::new(); n],
             cap: vec![1024; n],
+            // u64::MAX is no value: no signal is wider than 64 bits, and
+            // a 64-bit one of all ones is simply gathered each time.
+            recent: vec![[u64::MAX; RECENT]; n],
         }
     }
 
     #[inline(always)]
     fn add(&mut self, i: usize, v: u64) {
+        let slot = (v.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 56) as usize % RECENT;
+        let r = &mut self.recent[i][slot];
+        if *r == v {
+            return;
+        }
+        *r = v;
         let l = &mut self.lists[i];
         l.push(v);
         if l.len() >= self.cap[i] {
