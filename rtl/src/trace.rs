@@ -1268,6 +1268,7 @@ impl Tracer {
         t.masks.resize(padded, 0);
         t.lasts.resize(padded, 0);
         t.cur = vec![0; padded];
+        t.slot_decl.resize(padded, NOT_TRACED);
         t.batch = Vec::with_capacity(BATCH + 2 * padded + 2);
         t.phase = Phase::Sample;
         Ok(t)
@@ -1796,33 +1797,27 @@ impl Tracer {
     /// written.
     fn write_changes(&mut self) {
         let first = std::mem::take(&mut self.first_sample);
-        for base in (0..self.cur.len()).step_by(64) {
-            let mut bits = {
-                let c: &[u64; 64] = self.cur[base..base + 64].try_into().unwrap();
-                let m: &[u64; 64] = self.masks[base..base + 64].try_into().unwrap();
-                let l: &[u64; 64] = self.lasts[base..base + 64].try_into().unwrap();
-                if first {
-                    changed_mask(m, &[u64::MAX; 64], &[0; 64])
-                } else {
-                    changed_mask(c, m, l)
-                }
+        let (cur, _) = self.cur.as_chunks::<64>();
+        let (masks, _) = self.masks.as_chunks::<64>();
+        let (lasts, _) = self.lasts.as_chunks_mut::<64>();
+        let (decls, _) = self.slot_decl.as_chunks::<64>();
+        for (((c, m), l), d) in cur.iter().zip(masks).zip(lasts).zip(decls) {
+            let mut bits = if first {
+                changed_mask(m, &[u64::MAX; 64], &[0; 64])
+            } else {
+                changed_mask(c, m, l)
             };
             while bits != 0 {
-                let k = base + bits.trailing_zeros() as usize;
+                // Below 64: no bounds checks.
+                let k = bits.trailing_zeros() as usize & 63;
                 bits &= bits - 1;
-                self.record_change(k, self.cur[k] & self.masks[k]);
+                let v = c[k] & m[k];
+                l[k] = v;
+                // A change costs about its width in digits and 6 bytes more.
+                self.bytes += u64::from(m[k].count_ones() + 6);
+                queue(&mut self.batch, Some(d[k]), v);
             }
         }
-    }
-
-    /// The signal of call `slot` changed to `v`: write it.
-    #[inline]
-    fn record_change(&mut self, slot: usize, v: u64) {
-        self.lasts[slot] = v;
-        let d = self.slot_decl[slot];
-        // A change costs about its width in digits and 6 bytes more.
-        self.bytes += (self.masks[slot].count_ones() + 6) as u64;
-        queue(&mut self.batch, Some(d), v);
     }
 }
 
