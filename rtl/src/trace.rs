@@ -1950,6 +1950,25 @@ mod tests {
             }
         }
         assert_eq!(std::str::from_utf8(&body.buf[..body.len]).unwrap(), want);
+        // Timestamps: every number of digits, and the edges of each.
+        let mut body = VcdBody::new();
+        let mut want = String::new();
+        let mut times = vec![0, 1, 9, 10, 99, 100, 999, u64::MAX, u64::MAX - 1];
+        for d in 1..20 {
+            let p = 10u64.pow(d);
+            times.extend([p - 1, p, p + 1, p + p / 3]);
+        }
+        for _ in 0..2000 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            times.push(x >> (x % 64));
+        }
+        for t in times {
+            body.timestamp(t);
+            want.push_str(&format!("#{t}\n"));
+        }
+        assert_eq!(std::str::from_utf8(&body.buf[..body.len]).unwrap(), want);
         for b in 0..=255u8 {
             assert_eq!(bin8(b).to_le_bytes(), *format!("{b:08b}").as_bytes());
         }
