@@ -432,13 +432,13 @@ impl<W: Word> Chip<W> {
                 }
             {
                 // The array streams while TinyRISC waits.
-                let (k, r) = self.stream::<SAMPLED, S>(limit - n, sample);
+                let (k, r, stopped) = self.stream::<SAMPLED, S>(limit - n, sample);
                 n += k;
                 if r.is_err() {
                     return (n, r);
                 }
-                if SAMPLED && k == 0 {
-                    break; // stopped by the waveform
+                if SAMPLED && stopped {
+                    break; // by the waveform
                 }
                 continue;
             } else {
@@ -471,18 +471,19 @@ impl<W: Word> Chip<W> {
     /// The array streams while TinyRISC waits for it (the stall of the
     /// last evaluation, `Wait::ArrayIdle` or `Wait::Issue`) and the DMA is
     /// idle: until the wait is over, `limit`, or (`SAMPLED`) `sample`
-    /// stops it.
+    /// stops it (the third value: whether it did).
     #[inline(always)]
     fn stream<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
         &mut self,
         limit: u64,
         sample: &mut S,
-    ) -> (u64, Result<(), Fault>) {
+    ) -> (u64, Result<(), Fault>, bool) {
         use crate::tinyrisc::Wait;
         let wait = self.risc.wait;
         let mut n = 0;
         let mut active = 0u64;
         let mut err = None;
+        let mut stopped = false;
         while n < limit
             && match wait {
                 Wait::ArrayIdle => !self.bcast.idle(),
@@ -491,7 +492,10 @@ impl<W: Word> Chip<W> {
         {
             match self.stream_cycle::<SAMPLED, S>(sample) {
                 Ok(Some(k)) => active += k as u64,
-                Ok(None) => break,
+                Ok(None) => {
+                    stopped = true;
+                    break;
+                }
                 Err(f) => {
                     err = Some(f);
                     break;
@@ -504,8 +508,8 @@ impl<W: Word> Chip<W> {
         self.risc.add_stalled(n);
         self.cycles += n;
         match err {
-            None => (n, Ok(())),
-            Some(f) => (n, Err(f)),
+            None => (n, Ok(()), stopped),
+            Some(f) => (n, Err(f), stopped),
         }
     }
 

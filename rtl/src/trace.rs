@@ -723,10 +723,8 @@ impl Sink {
         }
     }
 
-    /// A new value of a `width`-bit signal. Inline in the writing
-    /// thread's loop for a VCD (a call per change cost as much as the
-    /// formatting).
-    #[inline(always)]
+    /// A new value of a `width`-bit signal (a VCD's batches go through
+    /// [`vcd_batch`] instead).
     fn change(&mut self, id: SigId, width: u32, v: u64) -> io::Result<()> {
         match (self, id) {
             (Sink::Vcd(w, body), SigId::Vcd(id)) => {
@@ -1647,21 +1645,7 @@ impl Tracer {
     fn declare_block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
         let fields = fields();
         for (scope, run) in scope_runs(&fields) {
-            let open = scope.is_empty() || {
-                self.stack.push(scope.to_string());
-                if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
-                    self.top_scopes.push(self.stack[0].clone());
-                }
-                let on = self.matches_prefix(&self.stack, false);
-                if on {
-                    if let Err(e) = self.w.add_module(scope) {
-                        self.err.get_or_insert(e);
-                    }
-                } else {
-                    self.stack.pop();
-                }
-                on
-            };
+            let open = scope.is_empty() || self.enter_scope(scope.to_string());
             for f in &fields[run] {
                 if open {
                     self.declare_signal(f.name, f.width, f.display);
@@ -1685,12 +1669,20 @@ impl Tracer {
     #[cold]
     #[inline(never)]
     fn declare_scope(&mut self, name: fmt::Arguments<'_>) -> bool {
-        self.stack.push(name.to_string());
+        let on = self.enter_scope(name.to_string());
+        self.scope_on.push(on);
+        on
+    }
+
+    /// Enter scope `name` while declaring if the patterns may take in
+    /// something under it (then the caller leaves it with
+    /// [`Tracer::declare_end`]); whether it did.
+    fn enter_scope(&mut self, name: String) -> bool {
+        self.stack.push(name);
         if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
             self.top_scopes.push(self.stack[0].clone());
         }
         let on = self.matches_prefix(&self.stack, false);
-        self.scope_on.push(on);
         if on {
             if let Err(e) = self.w.add_module(self.stack.last().unwrap()) {
                 self.err.get_or_insert(e);
