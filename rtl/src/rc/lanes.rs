@@ -49,6 +49,9 @@ pub fn select_word<W: Word, const N: usize>(dst: &mut [W; N], mask: Mask, src: &
 /// a commit writes under the same mask.
 #[inline(always)]
 pub fn expand<W: Word, const N: usize>(mask: Mask) -> [W; N] {
+    if let Some(m) = W::from_mask(mask) {
+        return m;
+    }
     let mut m = [W::ZERO; N];
     for c in 0..N / 8 {
         m[c * 8..c * 8 + 8].copy_from_slice(W::expand8((mask >> (c * 8)) as usize & 255));
@@ -80,10 +83,14 @@ pub trait SignBits: Copy + Default {
     fn sign_mask_portable<const N: usize>(x: &[Self; N]) -> Mask;
     /// -1 if `b`, else 0 (a lane of a flag vector for [`SignBits::sign_mask`]).
     fn flag(b: bool) -> Self;
+    /// The inverse of [`SignBits::sign_mask`]: lane `i` is -1 where bit
+    /// `i` of `mask` is set, else 0. With AVX-512 one instruction per
+    /// 512-bit register; otherwise `None` (the caller's table does it).
+    fn from_mask<const N: usize>(mask: Mask) -> Option<[Self; N]>;
 }
 
 macro_rules! sign_bits {
-    ($t:ty, $per:expr, $movemask:ident) => {
+    ($t:ty, $per:expr, $movemask:ident, $movm:ident) => {
         impl SignBits for $t {
             #[inline(always)]
             fn sign_mask<const N: usize>(x: &[$t; N]) -> Mask {
@@ -115,13 +122,32 @@ macro_rules! sign_bits {
             fn flag(b: bool) -> $t {
                 -(b as $t)
             }
+            #[inline(always)]
+            #[allow(unused_variables)]
+            fn from_mask<const N: usize>(mask: Mask) -> Option<[$t; N]> {
+                #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
+                if N == 64 {
+                    use std::arch::x86_64::{_mm512_storeu_si512, $movm};
+                    let mut x = [0 as $t; N];
+                    for k in 0..64 / $per {
+                        // SAFETY: register k's lanes k * $per.. lie inside
+                        // the 64 lanes of `x`; an unaligned store.
+                        unsafe {
+                            let v = $movm((mask >> (k * $per)) as _);
+                            _mm512_storeu_si512(x.as_mut_ptr().add(k * $per).cast(), v);
+                        }
+                    }
+                    return Some(x);
+                }
+                None
+            }
         }
     };
 }
 
-sign_bits!(i16, 32, _mm512_movepi16_mask);
-sign_bits!(i32, 16, _mm512_movepi32_mask);
-sign_bits!(i64, 8, _mm512_movepi64_mask);
+sign_bits!(i16, 32, _mm512_movepi16_mask, _mm512_movm_epi16);
+sign_bits!(i32, 16, _mm512_movepi32_mask, _mm512_movm_epi32);
+sign_bits!(i64, 8, _mm512_movepi64_mask, _mm512_movm_epi64);
 
 /// One bool per lane from a mask.
 #[inline(always)]
@@ -212,6 +238,21 @@ mod tests {
             select_word(&mut d, x, &src);
             for i in 0..64 {
                 assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
+            // Masks expanded to 0 / -1 lanes of every width (by AVX-512
+            // where the build has it, else by table), against the bits.
+            let e16 = expand::<i16, 64>(x);
+            let e32 = expand::<i32, 64>(x);
+            let e8 = expand::<i16, 8>(x);
+            for i in 0..64 {
+                let want = -((x >> i & 1) as i64);
+                assert_eq!((e16[i] as i64, e32[i] as i64), (want, want));
+                if i < 8 {
+                    assert_eq!(e8[i] as i64, want);
+                }
+            }
+            if let Some(e64) = i64::from_mask::<64>(x) {
+                assert!((0..64).all(|i| e64[i] == -((x >> i & 1) as i64)));
             }
             // The accumulators of both datapaths (i32 and i64 lanes).
             let mut d = [7i32; 64];

@@ -241,6 +241,14 @@ fn cv<W: Word, const N: usize>(
     (W::sign_mask(&c), W::sign_mask(&v))
 }
 
+/// Is every lane of `x` alike? (An OR of differences: it vectorises,
+/// where a comparison that stops at the first difference did not.)
+#[inline(always)]
+fn same<W: Word, const N: usize>(x: &[W; N]) -> bool {
+    let x0 = x[0];
+    x.iter().fold(W::ZERO, |m, &v| m | (v ^ x0)) == W::ZERO
+}
+
 /// Run a saturating function over every lane; returns the saturation mask.
 #[inline(always)]
 fn sat<W: Word, const N: usize>(res: &mut [W; N], f: impl Fn(usize) -> (W, bool)) -> Mask {
@@ -400,7 +408,14 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             Op::Clz => map!(res, |i| W::clz(a[i])),
             Op::Sel => {
                 let f = self.flags.f;
-                map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
+                if N.is_multiple_of(8) {
+                    // F expanded to 0 / -1 lanes and blended (the bit
+                    // tested lane by lane did not vectorise).
+                    let m = expand::<W, N>(f);
+                    map!(res, |i| (a[i] & m[i]) | (b[i] & !m[i]))
+                } else {
+                    map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
+                }
             }
             Op::Cmp => {
                 self.d_f = cmp_mask(c.cond(), a, b, self.flags.c, self.flags.v);
@@ -476,23 +491,45 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             }
             Op::Ld | Op::St => {
                 let store = c.op == Op::St;
-                let mut addr = [0i32; N];
-                if store {
-                    map!(addr, |i| W::addr1(b[i]));
-                } else {
-                    map!(addr, |i| W::addr(a[i], b[i]));
-                }
-                // One address in every lane (constants, the stack, the hit
-                // record): a whole RAM row, one address to check and keep;
-                // otherwise one word per lane.
-                // (lane 0's address from its operands, not read back from
-                // `addr`: a scalar load of a vector just stored stalls)
+                // lane 0's address from its operands
                 let a0 = if store {
                     W::addr1(b[0])
                 } else {
                     W::addr(a[0], b[0])
                 };
-                self.uniform = addr.iter().fold(true, |u, &x| u & (x == a0));
+                // One address in every lane (constants, the stack, the hit
+                // record): a whole RAM row, one address to check and keep;
+                // otherwise one word per lane. Operands alike in every lane
+                // (an immediate, one base) give one address without
+                // computing 64; otherwise the addresses are compared.
+                let b_same = matches!(c.b, BSrc::Imm(_)) || same(b);
+                self.uniform = if b_same && (store || same(a)) {
+                    true
+                } else {
+                    let mut addr = [0i32; N];
+                    if store {
+                        map!(addr, |i| W::addr1(b[i]));
+                    } else {
+                        map!(addr, |i| W::addr(a[i], b[i]));
+                    }
+                    let uniform = addr.iter().fold(true, |u, &x| u & (x == a0));
+                    if !uniform {
+                        let mut bad = [false; N];
+                        for i in 0..N {
+                            bad[i] = !Ram::<N, W>::valid(addr[i]);
+                        }
+                        let bad = lanes::pack_bools(&bad) & en;
+                        if bad != 0 {
+                            let i = bad.trailing_zeros() as usize;
+                            let msg = format!("RAM address {} outside 0..=511", addr[i]);
+                            return Err(self.lane_fault(i, msg));
+                        }
+                        for i in 0..N {
+                            self.addr[i] = addr[i].clamp(0, 511) as u16;
+                        }
+                    }
+                    uniform
+                };
                 if self.uniform {
                     if !Ram::<N, W>::valid(a0) {
                         let i = en.trailing_zeros() as usize;
@@ -500,20 +537,6 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                         return Err(self.lane_fault(i, msg));
                     }
                     self.addr0 = a0 as u16;
-                } else {
-                    let mut bad = [false; N];
-                    for i in 0..N {
-                        bad[i] = !Ram::<N, W>::valid(addr[i]);
-                    }
-                    let bad = lanes::pack_bools(&bad) & en;
-                    if bad != 0 {
-                        let i = bad.trailing_zeros() as usize;
-                        let msg = format!("RAM address {} outside 0..=511", addr[i]);
-                        return Err(self.lane_fault(i, msg));
-                    }
-                    for i in 0..N {
-                        self.addr[i] = addr[i].clamp(0, 511) as u16;
-                    }
                 }
                 if store {
                     // A store has no result: `res` carries its data to the edge.

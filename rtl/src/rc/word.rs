@@ -178,6 +178,10 @@ macro_rules! impl_word {
             fn select_acc<const N: usize>(dst: &mut [$acc; N], mask: u64, src: &[$acc; N]) {
                 if N <= 64 && mask == u64::MAX >> (64 - N) {
                     *dst = *src;
+                } else if let Some(m) = <$acc as SignBits>::from_mask::<N>(mask) {
+                    for i in 0..N {
+                        dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
+                    }
                 } else if mask != 0 {
                     for i in 0..N {
                         let m = (((mask >> i) & 1) as $acc).wrapping_neg();
