@@ -94,6 +94,18 @@ impl<W: Word> Array<W> {
         self.rc.lane_enable = u64::MAX;
     }
 
+    /// A whole SIMD cycle of a context that reads no FB data:
+    /// [`Array::drive_simd`] and [`Array::step`] in one (the untraced
+    /// streaming loop). Returns the RCs that executed.
+    #[inline(always)]
+    pub fn step_simd(&mut self, word: u32, ctx: &Context) -> Result<u32, Fault> {
+        self.drive_simd(word, ctx, [W::ZERO; 2]);
+        self.rc.eval()?;
+        self.active_now = self.rc.executed().count_ones();
+        self.rc.commit();
+        Ok(self.active_now)
+    }
+
     /// Drive an 8-word group in row or column mode.
     pub fn drive_group(&mut self, mode: Mode, words: [u32; 8], ctx: [Context; 8], fb: [W; 2]) {
         self.active = true;

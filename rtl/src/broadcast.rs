@@ -224,6 +224,60 @@ impl Broadcast {
         Ok(())
     }
 
+    /// The untraced streaming loop of SIMD runs, with the DMA idle and
+    /// nothing sampled between a cycle's evaluation and its clock edge:
+    /// whole cycles ([`Broadcast::eval`], [`Array::step`],
+    /// [`Broadcast::commit`]) of contexts that read no FB data, without
+    /// the checks that cannot fail then. Stops before a cycle it does not
+    /// run this way (a row or column run, an FB read, a context word that
+    /// does not decode), when nothing streams, with `until_issue` when the
+    /// queue empties, after `limit` cycles, or at a fault. With
+    /// `watch_starts`, `on_start` is called after the first context of
+    /// each run with its address and the RCs that executed it (where the
+    /// chip's cycle counts it). Returns the cycles run and the RCs that
+    /// executed in them.
+    #[inline(always)]
+    pub fn stream_simd<W: Word>(
+        &mut self,
+        cm: &ContextMemory,
+        array: &mut Array<W>,
+        limit: u64,
+        until_issue: bool,
+        watch_starts: bool,
+        mut on_start: impl FnMut(u16, u32),
+    ) -> (u64, u64, Result<(), Fault>) {
+        let (mut n, mut active) = (0, 0u64);
+        while n < limit {
+            let Some(cur) = &mut self.cur else { break };
+            if cur.run.mode != Mode::Simd || (until_issue && self.queued.is_none()) {
+                break;
+            }
+            let addr = cur.run.ctx + cur.k;
+            let Ok(c) = cm.context(addr) else { break };
+            if c.asrc == ASrc::Fb {
+                break;
+            }
+            self.d_ptr = cur.ptr;
+            self.word = cm.word(addr);
+            match array.step_simd(self.word, c) {
+                Ok(k) => {
+                    active += k as u64;
+                    if watch_starts && cur.k == 0 {
+                        on_start(cur.run.ctx, k);
+                    }
+                }
+                Err(f) => return (n, active, Err(f)),
+            }
+            self.steps += 1;
+            cur.k += 1;
+            if cur.k == cur.run.count {
+                self.cur = self.queued.take().map(Self::start);
+            }
+            n += 1;
+        }
+        (n, active, Ok(()))
+    }
+
     /// Read the next datum of FB stream `s` (and advance its pointer in the
     /// next state). The checks in one test; their messages out of line.
     #[inline(always)]

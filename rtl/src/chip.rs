@@ -124,6 +124,25 @@ impl Watch {
     }
 }
 
+impl Watch {
+    /// A run that starts at `ctx` has executed its first context on `rcs`
+    /// RCs.
+    #[inline(never)]
+    fn count(&mut self, ctx: u16, rcs: u32) {
+        if let Some(&e) = self.class.get(&ctx) {
+            if let Some(t) = e.tag {
+                self.tag = t;
+            }
+            if let Some(c) = e.class {
+                let n = rcs as u64;
+                self.runs[c] += 1;
+                self.rcs[c] += n;
+                self.rcs_by_tag[c][self.tag] += n;
+            }
+        }
+    }
+}
+
 impl Stats {
     /// Fraction of the RCs that executed, over the array's busy cycles.
     pub fn active_rc_fraction(&self) -> f64 {
@@ -447,10 +466,10 @@ impl<W: Word> Chip<W> {
                     return (n, Err(f));
                 }
                 word_ok = true;
-                match self.stream_cycle::<SAMPLED, S>(sample) {
+                match self.stream_one::<SAMPLED, S>(sample) {
                     Ok(Some(k)) => {
                         self.array_busy += 1;
-                        self.active_rc += k as u64;
+                        self.active_rc += k;
                     }
                     Ok(None) => break,
                     Err(f) => return (n, Err(f)),
@@ -490,6 +509,25 @@ impl<W: Word> Chip<W> {
                 _ => !self.bcast.can_issue(),
             }
         {
+            if !SAMPLED {
+                let (k, a, r) = self.bcast.stream_simd(
+                    &self.ctx_mem,
+                    &mut self.array,
+                    limit - n,
+                    wait != Wait::ArrayIdle,
+                    self.watch.any,
+                    |ctx, rcs| self.watch.count(ctx, rcs),
+                );
+                n += k;
+                active += a;
+                if let Err(f) = r {
+                    err = Some(self.locate(f));
+                    break;
+                }
+                if k > 0 {
+                    continue;
+                }
+            }
             match self.stream_cycle::<SAMPLED, S>(sample) {
                 Ok(Some(k)) => active += k as u64,
                 Ok(None) => {
@@ -511,6 +549,33 @@ impl<W: Word> Chip<W> {
             None => (n, Ok(()), stopped),
             Some(f) => (n, Err(f), stopped),
         }
+    }
+
+    /// One cycle of the broadcast unit and the array with the DMA idle:
+    /// [`Broadcast::stream_simd`]'s when it runs it (untraced), else
+    /// [`Chip::stream_cycle`]'s.
+    #[inline(always)]
+    fn stream_one<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+        &mut self,
+        sample: &mut S,
+    ) -> Result<Option<u64>, Fault> {
+        if !SAMPLED {
+            let (k, a, r) = self.bcast.stream_simd(
+                &self.ctx_mem,
+                &mut self.array,
+                1,
+                false,
+                self.watch.any,
+                |ctx, rcs| self.watch.count(ctx, rcs),
+            );
+            if let Err(f) = r {
+                return Err(self.locate(f));
+            }
+            if k == 1 {
+                return Ok(Some(a));
+            }
+        }
+        Ok(self.stream_cycle::<SAMPLED, S>(sample)?.map(u64::from))
     }
 
     /// TinyRISC's evaluation of the cycle, through its view of the chip.
@@ -623,17 +688,7 @@ impl<W: Word> Chip<W> {
     #[cold]
     fn count_watched(&mut self) {
         if let Some((run, 0, _)) = self.bcast.current() {
-            if let Some(&e) = self.watch.class.get(&run.ctx) {
-                if let Some(t) = e.tag {
-                    self.watch.tag = t;
-                }
-                if let Some(c) = e.class {
-                    let n = self.array.active_now as u64;
-                    self.watch.runs[c] += 1;
-                    self.watch.rcs[c] += n;
-                    self.watch.rcs_by_tag[c][self.watch.tag] += n;
-                }
-            }
+            self.watch.count(run.ctx, self.array.active_now);
         }
     }
 
