@@ -94,12 +94,11 @@ impl<W: Word> Array<W> {
         self.rc.lane_enable = u64::MAX;
     }
 
-    /// A whole SIMD cycle of a context that reads no FB data:
-    /// [`Array::drive_simd`] and [`Array::step`] in one (the untraced
-    /// streaming loop). Returns the RCs that executed.
+    /// A whole SIMD cycle: [`Array::drive_simd`] and [`Array::step`] in
+    /// one (the untraced streaming loop). Returns the RCs that executed.
     #[inline(always)]
-    pub fn step_simd(&mut self, word: u32, ctx: &Context) -> Result<u32, Fault> {
-        self.drive_simd(word, ctx, [W::ZERO; 2]);
+    pub fn step_simd(&mut self, word: u32, ctx: &Context, fb: [W; 2]) -> Result<u32, Fault> {
+        self.drive_simd(word, ctx, fb);
         self.rc.eval()?;
         self.active_now = self.rc.executed().count_ones();
         self.rc.commit();

@@ -227,10 +227,11 @@ impl Broadcast {
     /// The untraced streaming loop of SIMD runs, with the DMA idle and
     /// nothing sampled between a cycle's evaluation and its clock edge:
     /// whole cycles ([`Broadcast::eval`], [`Array::step`],
-    /// [`Broadcast::commit`]) of contexts that read no FB data, without
-    /// the checks that cannot fail then. Stops before a cycle it does not
-    /// run this way (a row or column run, an FB read, a context word that
-    /// does not decode), when nothing streams, with `until_issue` when the
+    /// [`Broadcast::commit`]) without the checks that cannot fail then (no
+    /// bank is the DMA's). Stops before a cycle it does not run this way (a
+    /// row or column run, a context word that does not decode, an FB read
+    /// that faults: the unit's own evaluation reports those), when nothing
+    /// streams, with `until_issue` when the
     /// queue empties, after `limit` cycles, or at a fault. With
     /// `watch_starts`, `on_start` is called after the first context of
     /// each run with its address and the RCs that executed it (where the
@@ -240,6 +241,7 @@ impl Broadcast {
     pub fn stream_simd<W: Word>(
         &mut self,
         cm: &ContextMemory,
+        fbm: &FrameBuffer<W>,
         array: &mut Array<W>,
         limit: u64,
         until_issue: bool,
@@ -254,12 +256,24 @@ impl Broadcast {
             }
             let addr = cur.run.ctx + cur.k;
             let Ok(c) = cm.context(addr) else { break };
-            if c.asrc == ASrc::Fb {
-                break;
-            }
             self.d_ptr = cur.ptr;
-            self.word = cm.word(addr);
-            match array.step_simd(self.word, c) {
+            let word = cm.word(addr);
+            self.word = word;
+            let r = if c.asrc == ASrc::Fb {
+                let s = (c.ra & 1) as usize;
+                let p = cur.ptr[s];
+                if cur.run.fb[s].is_none() || fb::set(p) != s {
+                    break;
+                }
+                let p1 = p.wrapping_add(1);
+                self.d_ptr[s] = p1;
+                cur.ptr[s] = p1;
+                let v = fbm.read(p);
+                array.step_simd(word, c, if s == 0 { [v, W::ZERO] } else { [W::ZERO, v] })
+            } else {
+                array.step_simd(word, c, [W::ZERO; 2])
+            };
+            match r {
                 Ok(k) => {
                     active += k as u64;
                     if watch_starts && cur.k == 0 {

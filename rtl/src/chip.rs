@@ -512,6 +512,7 @@ impl<W: Word> Chip<W> {
             if !SAMPLED {
                 let (k, a, r) = self.bcast.stream_simd(
                     &self.ctx_mem,
+                    &self.fb,
                     &mut self.array,
                     limit - n,
                     wait != Wait::ArrayIdle,
@@ -562,6 +563,7 @@ impl<W: Word> Chip<W> {
         if !SAMPLED {
             let (k, a, r) = self.bcast.stream_simd(
                 &self.ctx_mem,
+                &self.fb,
                 &mut self.array,
                 1,
                 false,
