@@ -95,12 +95,12 @@ macro_rules! sign_bits {
             #[inline(always)]
             fn sign_mask<const N: usize>(x: &[$t; N]) -> Mask {
                 #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
-                if N == 64 {
+                if N <= 64 && N % $per == 0 {
                     use std::arch::x86_64::{_mm512_loadu_si512, $movemask};
                     let mut m = 0u64;
-                    for k in 0..64 / $per {
+                    for k in 0..N / $per {
                         // SAFETY: register k's lanes k * $per.. lie inside
-                        // the 64 lanes of `x`; an unaligned load.
+                        // the N lanes of `x`; an unaligned load.
                         let bits = unsafe {
                             $movemask(_mm512_loadu_si512(x.as_ptr().add(k * $per).cast()))
                         };

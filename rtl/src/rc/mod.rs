@@ -249,6 +249,45 @@ fn same<W: Word, const N: usize>(x: &[W; N]) -> bool {
     x.iter().fold(W::ZERO, |m, &v| m | (v ^ x0)) == W::ZERO
 }
 
+/// Run a multiplier lane function (lane `i`'s new accumulator, result and
+/// saturation) over every lane; returns the saturation mask. 32 lanes at a
+/// time, so that each 32 results are stored whole: computed in 16 lanes of
+/// the accumulator's width, they were stored as halves, and the clock
+/// edge's whole-register load of them could not be forwarded from the two
+/// stores (it waited for them to reach the cache).
+#[inline(always)]
+fn mul_lanes<W: Word, const N: usize>(
+    res: &mut [W; N],
+    acc_d: &mut [W::Acc; N],
+    f: impl Fn(usize) -> (W::Acc, W, bool),
+) -> Mask {
+    const C: usize = 32;
+    if N.is_multiple_of(C) {
+        let mut m = 0;
+        for k in 0..N / C {
+            let mut r = [W::ZERO; C];
+            let mut s = [W::Acc::default(); C];
+            for j in 0..C {
+                let (n, x, v) = f(k * C + j);
+                acc_d[k * C + j] = n;
+                r[j] = x;
+                s[j] = W::Acc::flag(v);
+            }
+            res[k * C..k * C + C].copy_from_slice(&r);
+            m |= W::Acc::sign_mask(&s) << (k * C);
+        }
+        return m;
+    }
+    let mut s = [W::Acc::default(); N];
+    for i in 0..N {
+        let (n, x, v) = f(i);
+        acc_d[i] = n;
+        res[i] = x;
+        s[i] = W::Acc::flag(v);
+    }
+    W::Acc::sign_mask(&s)
+}
+
 /// Run a saturating function over every lane; returns the saturation mask.
 #[inline(always)]
 fn sat<W: Word, const N: usize>(res: &mut [W; N], f: impl Fn(usize) -> (W, bool)) -> Mask {
@@ -427,7 +466,6 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
             Op::Mul | Op::Mac | Op::Msu => {
                 let acc = &self.acc;
                 let acc_d = &mut self.acc_d;
-                let mut s = [W::Acc::default(); N];
                 // One loop per operation and rounding choice (chosen once,
                 // outside the lanes; `sh = 0` has no rounding bit either
                 // way): the product is scaled while it is in a register,
@@ -435,35 +473,29 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 macro_rules! lanes {
                     ($trunc:expr) => {
                         match c.op {
-                            Op::Mul => {
-                                for i in 0..N {
-                                    let p = W::product(a[i], b[i]);
-                                    acc_d[i] = p;
-                                    let (r, s2) = W::scale(p, sh, $trunc);
-                                    res[i] = r;
-                                    s[i] = W::Acc::flag(s2);
-                                }
-                            }
+                            Op::Mul => mul_lanes(res, acc_d, |i| {
+                                let p = W::product(a[i], b[i]);
+                                let (r, s2) = W::scale(p, sh, $trunc);
+                                (p, r, s2)
+                            }),
                             _ => {
                                 let sub = c.op == Op::Msu;
-                                for i in 0..N {
+                                mul_lanes(res, acc_d, |i| {
                                     let p = W::product(a[i], b[i]);
                                     let (n, s1) = W::accumulate(acc[i], p, sub);
-                                    acc_d[i] = n;
                                     let (r, s2) = W::scale(n, sh, $trunc);
-                                    res[i] = r;
-                                    s[i] = W::Acc::flag(s1 | s2);
-                                }
+                                    (n, r, s1 | s2)
+                                })
                             }
                         }
                     };
                 }
-                if trunc || sh & (2 * W::BITS - 1) == 0 {
+                let v = if trunc || sh & (2 * W::BITS - 1) == 0 {
                     lanes!(true)
                 } else {
                     lanes!(false)
-                }
-                (self.d_v, self.d_c) = (W::Acc::sign_mask(&s), 0);
+                };
+                (self.d_v, self.d_c) = (v, 0);
                 self.pend.cv = true;
                 self.pend.acc = true;
             }

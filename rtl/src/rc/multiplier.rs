@@ -11,10 +11,11 @@
 //!
 //! `V` is set when the accumulator or the result saturated.
 
-/// `$t` the word, `$acc` the accumulator (twice as wide), `$w` wider still
-/// (exact sums and shifts), `$smask` the shift field mask.
+/// `$t` the word, `$acc` the accumulator (twice as wide) and `$uacc` its
+/// unsigned pattern, `$w` wider still (exact sums and shifts), `$smask` the
+/// shift field mask.
 macro_rules! multiplier_unit {
-    ($m:ident, $t:ty, $acc:ty, $w:ty, $smask:expr, $accumulate:ident, $doc:literal) => {
+    ($m:ident, $t:ty, $acc:ty, $uacc:ty, $w:ty, $smask:expr, $accumulate:ident, $doc:literal) => {
         #[doc = $doc]
         pub mod $m {
             /// The full product of two words.
@@ -42,8 +43,12 @@ macro_rules! multiplier_unit {
                 if !trunc && sh > 0 {
                     w += (acc >> (sh - 1)) & 1;
                 }
-                let r = w.clamp(<$t>::MIN as $acc, <$t>::MAX as $acc);
-                (r as $t, r != w)
+                // Saturated where `w` lies outside the word's range: one
+                // unsigned comparison of `w - MIN` (vectorised: an add and
+                // a compare, where `clamp(w) != w` took three operations).
+                let out = (w as $uacc).wrapping_sub(<$t>::MIN as $acc as $uacc)
+                    > (<$t>::MAX as $acc).wrapping_sub(<$t>::MIN as $acc) as $uacc;
+                (w.clamp(<$t>::MIN as $acc, <$t>::MAX as $acc) as $t, out)
             }
 
             /// `ldacc`: `acc = sat(a * 2^sh)`.
@@ -111,6 +116,7 @@ multiplier_unit!(
     w16,
     i16,
     i32,
+    u32,
     i64,
     31,
     accumulate32,
@@ -120,6 +126,7 @@ multiplier_unit!(
     w32,
     i32,
     i64,
+    u64,
     i128,
     63,
     accumulate64,
