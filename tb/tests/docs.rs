@@ -77,6 +77,11 @@ const SPECIAL: &[(&str, &str, Special)] = &[
         Special::Skip("a benchmark: speed is measured, never run as a test"),
     ),
     (
+        "docs/performance.md",
+        "cargo bench -p morphosys-tb --bench simulator -- rc_array_op",
+        Special::Skip("a benchmark: speed is measured, never run as a test"),
+    ),
+    (
         "README.md",
         "morphosys fuzz --count 1000000 --seed 7",
         Special::RunAs(
