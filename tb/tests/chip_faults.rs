@@ -244,3 +244,44 @@ fn fetch_outside_memory_or_misaligned() {
         "{m}"
     );
 }
+
+/// A fault met in the fast loops (the untraced streaming loop of SIMD runs
+/// among them) stops at the cycle plain stepping through `Sim::step`
+/// stops at, with the same message, and leaves the same statistics.
+#[test]
+fn faults_in_the_fast_loops_stop_where_plain_stepping_does() {
+    let programs = [
+        // RC RAM address out of range, in the third context of a run
+        // TinyRISC waits on
+        ".ctx\nk: add r1, r1, #1\nadd r1, r1, #2\nld r2, [r0 + #600]\n.text\nli r1, k\nldctxt r1, r0, 3\ndwait\ncbcast r0, 3\nhalt\n",
+        // an address per RC (a row-mode run gives each row its own base),
+        // out of range in the last row only
+        ".ctx\ng: add r1, r1, #0\nadd r1, r1, #70\nadd r1, r1, #140\nadd r1, r1, #210\nadd r1, r1, #280\nadd r1, r1, #350\nadd r1, r1, #420\nadd r1, r1, #490\nld r2, [r1 + #40]\n.text\nli r1, g\nldctxt r1, r0, 9\ndwait\ncbcr r0, r0, 1\nli r3, 8\ncbcast r3, 1\nrcany r4\nhalt\n",
+        // an FB stream that runs past the end of its set on its third datum
+        ".ctx\nk: mov r1, fb0\nmov r1, fb0\nmov r1, fb0\nmov r1, fb0\n.text\nli r1, k\nldctxt r1, r0, 4\ndwait\nli r2, 0x7FFE\nsbcb r0, r2, 4\nhalt\n",
+        // a context word that does not decode, after two good runs
+        ".ctx\nk: add r1, r1, #1\nw: .word 0xFC000000\n.text\nli r1, k\nldctxt r1, r0, 2\ndwait\ncbcast r0, 1\ncbcast r0, 1\nli r3, 1\ncbcast r3, 1\nhalt\n",
+    ];
+    let expect = [
+        "RAM address 600 outside",
+        "RAM address 530 outside",
+        "ran past the end of the set",
+        "illegal RC opcode",
+    ];
+    for (src, want) in programs.into_iter().zip(expect) {
+        let (m, fast) = run_src(src, 1000);
+        assert!(m.contains(want), "{m}");
+        let img = firmware::asm::assemble(src, "t.s").unwrap();
+        let mut chip = rtl::Chip::new(Timing::default(), tb::cmd_run::DEFAULT_MEMORY);
+        img.load(&mut chip).unwrap();
+        let mut slow = rtl::Sim::new(chip);
+        let e = loop {
+            if let Err(e) = slow.step() {
+                break e.to_string();
+            }
+            assert!(!slow.top.halted(), "plain stepping halted: {src}");
+        };
+        assert_eq!(m, e, "{src}");
+        assert_eq!(fast.sim.top.stats(), slow.top.stats(), "{src}");
+    }
+}

@@ -219,6 +219,41 @@ fn the_stall_fast_path_is_cycle_exact() {
     assert!(stalled >= 10, "only {stalled} programs stall");
 }
 
+/// The render counts the runs that start at watched context addresses
+/// (`Watch`, the object tests' kernels), and the untraced streaming loop
+/// (`Broadcast::stream_simd`) counts them itself. Every program of the
+/// suite with every context address watched (two classes, tags every
+/// fifth address), through the fast paths and through `Sim::step`: the
+/// same counts, run for run.
+#[test]
+fn the_fast_paths_count_watched_runs_as_plain_stepping() {
+    let watched = |img: &firmware::asm::Image| {
+        let mut chip = rtl::Chip::new(Timing::default(), tb::cmd_run::DEFAULT_MEMORY);
+        img.load(&mut chip).unwrap();
+        for a in 0..rtl::context_memory::WORDS as u16 {
+            chip.watch.add(a, usize::from(a % 3 == 0));
+            if a % 5 == 0 {
+                chip.watch.tag(a, usize::from(a / 5) % rtl::chip::WATCH_TAGS);
+            }
+        }
+        rtl::Sim::new(chip)
+    };
+    let mut counted = 0;
+    for name in LISTED.iter().chain(REPORTED) {
+        let img = load_program(&dir().join(name)).unwrap();
+        let mut fast = watched(&img);
+        rtl::chip::run_to_halt(&mut fast, 2_000_000).unwrap();
+        let mut slow = watched(&img);
+        while !slow.top.halted() {
+            slow.step().unwrap();
+        }
+        let (f, s) = (fast.top.stats(), slow.top.stats());
+        assert_eq!(f, s, "{name}: statistics");
+        counted += usize::from(f.watched_runs.iter().sum::<u64>() > 0);
+    }
+    assert!(counted >= 10, "only {counted} programs start a watched run");
+}
+
 /// With a waveform, the cycles go through the same fast paths, sampled
 /// cycle by cycle (`Chip::run_fast_sampled`: while the DMA is idle the
 /// loops of `Chip::run_local`, otherwise `Chip::run_stalled_sampled`).
