@@ -233,7 +233,8 @@ fn the_fast_paths_count_watched_runs_as_plain_stepping() {
         for a in 0..rtl::context_memory::WORDS as u16 {
             chip.watch.add(a, usize::from(a % 3 == 0));
             if a % 5 == 0 {
-                chip.watch.tag(a, usize::from(a / 5) % rtl::chip::WATCH_TAGS);
+                chip.watch
+                    .tag(a, usize::from(a / 5) % rtl::chip::WATCH_TAGS);
             }
         }
         rtl::Sim::new(chip)
