@@ -231,12 +231,11 @@ impl Broadcast {
     /// bank is the DMA's). Stops before a cycle it does not run this way (a
     /// row or column run, a context word that does not decode, an FB read
     /// that faults: the unit's own evaluation reports those), when nothing
-    /// streams, with `until_issue` when the
-    /// queue empties, after `limit` cycles, or at a fault. With
-    /// `watch_starts`, `on_start` is called after the first context of
-    /// each run with its address and the RCs that executed it (where the
-    /// chip's cycle counts it). Returns the cycles run and the RCs that
-    /// executed in them.
+    /// streams, with `until_issue` when the queue empties, after `limit`
+    /// cycles, or at a fault. `on_start`, if any, is called after the
+    /// first context of each run with its address and the RCs that
+    /// executed it (where the chip's cycle counts it). Returns the cycles
+    /// run and the RCs that executed in them.
     #[inline(always)]
     pub fn stream_simd<W: Word>(
         &mut self,
@@ -245,8 +244,7 @@ impl Broadcast {
         array: &mut Array<W>,
         limit: u64,
         until_issue: bool,
-        watch_starts: bool,
-        mut on_start: impl FnMut(u16, u32),
+        mut on_start: Option<impl FnMut(u16, u32)>,
     ) -> (u64, u64, Result<(), Fault>) {
         let (mut n, mut active) = (0, 0u64);
         while n < limit {
@@ -276,8 +274,8 @@ impl Broadcast {
             match r {
                 Ok(k) => {
                     active += k as u64;
-                    if watch_starts && cur.k == 0 {
-                        on_start(cur.run.ctx, k);
+                    if let Some(f) = on_start.as_mut().filter(|_| cur.k == 0) {
+                        f(cur.run.ctx, k);
                     }
                 }
                 Err(f) => return (n, active, Err(f)),

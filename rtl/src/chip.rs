@@ -516,8 +516,9 @@ impl<W: Word> Chip<W> {
                     &mut self.array,
                     limit - n,
                     wait != Wait::ArrayIdle,
-                    self.watch.any,
-                    |ctx, rcs| self.watch.count(ctx, rcs),
+                    self.watch
+                        .any
+                        .then_some(|ctx, rcs| self.watch.count(ctx, rcs)),
                 );
                 n += k;
                 active += a;
@@ -567,8 +568,9 @@ impl<W: Word> Chip<W> {
                 &mut self.array,
                 1,
                 false,
-                self.watch.any,
-                |ctx, rcs| self.watch.count(ctx, rcs),
+                self.watch
+                    .any
+                    .then_some(|ctx, rcs| self.watch.count(ctx, rcs)),
             );
             if let Err(f) = r {
                 return Err(self.locate(f));
