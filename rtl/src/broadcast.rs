@@ -186,6 +186,7 @@ impl Broadcast {
             // the hot path: one context
             let c = get(addr)?;
             self.d_ptr = cur.ptr;
+            self.word = cm.word(addr);
             // Built whole from the datum (a store into one half of the pair
             // read back at once as the whole pair stalls the forwarding).
             let fbd = if c.asrc == ASrc::Fb {
@@ -199,7 +200,6 @@ impl Broadcast {
             } else {
                 [W::ZERO; 2]
             };
-            self.word = cm.word(addr);
             array.drive_simd(self.word, c, fbd);
             return Ok(());
         }
@@ -254,6 +254,7 @@ impl Broadcast {
             }
             let addr = cur.run.ctx + cur.k;
             let Ok(c) = cm.context(addr) else { break };
+            // written before the FB stream's check, as `eval` writes them
             self.d_ptr = cur.ptr;
             let word = cm.word(addr);
             self.word = word;

@@ -122,9 +122,7 @@ impl Watch {
         self.class.entry(ctx).or_default().tag = Some(tag.min(WATCH_TAGS - 1));
         self.any = true;
     }
-}
 
-impl Watch {
     /// A run that starts at `ctx` has executed its first context on `rcs`
     /// RCs.
     #[inline(never)]

@@ -193,6 +193,13 @@ mod tests {
             assert_eq!(T::sign_mask_portable(x), want);
             let x12: [T; 12] = std::array::from_fn(|i| x[i]);
             assert_eq!(T::sign_mask(&x12), want & 0xFFF);
+            // 8, 16 and 32 lanes: whole registers of some widths
+            let x8: [T; 8] = std::array::from_fn(|i| x[i]);
+            assert_eq!(T::sign_mask(&x8), want & 0xFF);
+            let x16: [T; 16] = std::array::from_fn(|i| x[i]);
+            assert_eq!(T::sign_mask(&x16), want & 0xFFFF);
+            let x32: [T; 32] = std::array::from_fn(|i| x[i + 32]);
+            assert_eq!(T::sign_mask(&x32), want >> 32);
         }
         let mut r = 0x2545_F491_4F6C_DD1Du64;
         for _ in 0..500 {

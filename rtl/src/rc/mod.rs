@@ -251,10 +251,9 @@ fn same<W: Word, const N: usize>(x: &[W; N]) -> bool {
 
 /// Run a multiplier lane function (lane `i`'s new accumulator, result and
 /// saturation) over every lane; returns the saturation mask. 32 lanes at a
-/// time, so that each 32 results are stored whole: computed in 16 lanes of
-/// the accumulator's width, they were stored as halves, and the clock
-/// edge's whole-register load of them could not be forwarded from the two
-/// stores (it waited for them to reach the cache).
+/// time, each chunk's flags gathered into the mask at once (one loop over
+/// all the lanes with the flags stored as a lane array and gathered after
+/// it: `mul` 13.3 ns a context in `rc_array_op`, this 10.0).
 #[inline(always)]
 fn mul_lanes<W: Word, const N: usize>(
     res: &mut [W; N],
