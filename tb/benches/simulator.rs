@@ -34,30 +34,9 @@ fn render_one_chip_instance(b: Bencher) {
         .bench(|| pool.install(|| tb::render::render_chip(&scene, &opt, false, None).unwrap()));
 }
 
-/// The RC datapath alone: 64 lanes, one multiply-accumulate context.
-#[divan::bench]
-fn rc_array_mac(b: Bencher) {
-    use rtl::kernel::Clocked;
-    use rtl::rc::context::{Context, Op};
-    let mut rc: Box<rtl::rc::RcArray<64>> =
-        Box::new(rtl::rc::RcArray::new(rtl::rc::LaneNames::Grid));
-    let c = Context {
-        shift: 8,
-        ..Context::rrr(Op::Mac, 1, 1, 2)
-    };
-    let w = c.encode();
-    b.counter(ItemsCount::new(1000u32)).bench_local(|| {
-        for _ in 0..1000 {
-            rc.set_context(w, c);
-            rc.eval().unwrap();
-            rc.commit();
-        }
-    });
-}
-
-/// One context of each kind on the 64-lane datapath alone (eval and clock
-/// edge), with varied register contents: what each operation costs per
-/// cycle, against the mix of a render (`render_one_chip_instance`).
+/// The RC datapath alone: one context of each kind on 64 lanes (eval and
+/// clock edge), with varied register contents: what each operation costs
+/// per cycle, against the mix of a render (`render_one_chip_instance`).
 #[divan::bench(args = [
     "add", "sub", "mov", "min", "cmp", "sel", "mul", "mul_trunc", "mac", "msu",
     "ldacc", "ld_uniform", "ld_lanes", "st_uniform", "nop_guarded", "add_guarded",
