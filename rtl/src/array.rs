@@ -99,9 +99,8 @@ impl<W: Word> Array<W> {
     #[inline(always)]
     pub fn step_simd(&mut self, word: u32, ctx: &Context, fb: [W; 2]) -> Result<u32, Fault> {
         self.drive_simd(word, ctx, fb);
-        self.rc.eval()?;
+        self.rc.step()?;
         self.active_now = self.rc.executed().count_ones();
-        self.rc.commit();
         Ok(self.active_now)
     }
 
@@ -223,9 +222,8 @@ impl<W: Word> Clocked for Array<W> {
         for g in 0..8 {
             self.rc.set_context(self.words[g], self.ctx[g]);
             self.rc.lane_enable = group_mask(self.mode, g);
-            self.rc.eval()?;
+            self.rc.step()?;
             n += self.rc.executed().count_ones();
-            self.rc.commit();
         }
         self.rc.lane_enable = u64::MAX;
         self.active_now = n;

@@ -35,14 +35,14 @@ fn render_one_chip_instance(b: Bencher) {
 }
 
 /// The RC datapath alone: one context of each kind on 64 lanes (eval and
-/// clock edge), with varied register contents: what each operation costs
+/// clock edge in one `RcArray::step`, as the untraced loop runs them),
+/// with varied register contents: what each operation costs
 /// per cycle, against the mix of a render (`render_one_chip_instance`).
 #[divan::bench(args = [
     "add", "sub", "mov", "min", "cmp", "sel", "mul", "mul_trunc", "mac", "msu",
     "ldacc", "ld_uniform", "ld_lanes", "st_uniform", "nop_guarded", "add_guarded",
 ])]
 fn rc_array_op(b: Bencher, kind: &str) {
-    use rtl::kernel::Clocked;
     use rtl::rc::context::{Context, Guard, Op};
     let mut rc: Box<rtl::rc::RcArray<64>> =
         Box::new(rtl::rc::RcArray::new(rtl::rc::LaneNames::Grid));
@@ -104,8 +104,7 @@ fn rc_array_op(b: Bencher, kind: &str) {
     b.counter(ItemsCount::new(1000u32)).bench_local(|| {
         for _ in 0..1000 {
             rc.set_context(w, c);
-            rc.eval().unwrap();
-            rc.commit();
+            rc.step().unwrap();
         }
     });
 }

@@ -359,18 +359,76 @@ fn cmp_mask<W: Word, const N: usize>(
 
 impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
     fn eval(&mut self) -> Result<(), Fault> {
+        self.exec::<false>()
+    }
+
+    fn commit(&mut self) {
+        if self.en != 0 {
+            self.write_back(self.pend);
+            self.sleep_wake();
+        }
+    }
+}
+
+/// What the clock edge of each kind of operation writes.
+const P_NONE: Pending = Pending {
+    result: false,
+    cv: false,
+    f: false,
+    acc: false,
+    store: false,
+};
+const P_RES: Pending = Pending {
+    result: true,
+    ..P_NONE
+};
+const P_CV: Pending = Pending { cv: true, ..P_RES };
+const P_MUL: Pending = Pending { acc: true, ..P_CV };
+const P_F: Pending = Pending { f: true, ..P_NONE };
+const P_ACC: Pending = Pending {
+    acc: true,
+    ..P_NONE
+};
+const P_ST: Pending = Pending {
+    store: true,
+    ..P_NONE
+};
+
+impl<const N: usize, W: Word> RcArray<N, W> {
+    /// [`Clocked::eval`] and [`Clocked::commit`] in one call (nothing
+    /// samples between the two): each operation's clock edge is written
+    /// in its own arm, knowing what it writes (no branch on the pending
+    /// updates).
+    #[inline(never)]
+    pub fn step(&mut self) -> Result<(), Fault> {
+        self.exec::<true>()
+    }
+
+    /// The evaluation; with `STEP` the clock edge too.
+    #[inline(always)]
+    fn exec<const STEP: bool>(&mut self) -> Result<(), Fault> {
+        // What the clock edge writes: with `STEP` written now, each arm
+        // knowing its kind, else left pending for `commit`.
+        macro_rules! fin {
+            ($p:expr) => {
+                if STEP {
+                    self.write_back($p)
+                } else {
+                    self.pend = $p
+                }
+            };
+        }
         // The fields one at a time (a copy of the whole context was one
         // wide load reaching past it into `lane_enable`, both just stored
         // by the array: the load could not be forwarded and stalled).
         let c = &self.ctx;
         let en = self.enabled();
         self.en = en;
-        self.pend = Pending {
-            result: c.op.has_result(),
-            ..Pending::default()
-        };
+        if !STEP || en == 0 {
+            // (nothing pending if the evaluation faults)
+            self.pend = P_NONE;
+        }
         if en == 0 {
-            self.pend = Pending::default();
             return Ok(());
         }
         let imm;
@@ -390,60 +448,97 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
         let (sh, trunc) = (c.shift as u32, c.trunc);
         let cin = self.flags.c;
         match c.op {
-            Op::Nop | Op::Sleep | Op::Wake => {}
+            Op::Nop | Op::Sleep | Op::Wake => {
+                fin!(P_NONE);
+                if STEP {
+                    self.sleep_wake();
+                }
+            }
             Op::Add => {
                 (self.d_c, self.d_v) = cv(res, |i| W::add(a[i], b[i], false));
-                self.pend.cv = true;
+                fin!(P_CV);
             }
             Op::Adc => {
                 (self.d_c, self.d_v) = cv(res, |i| W::add(a[i], b[i], cin >> i & 1 != 0));
-                self.pend.cv = true;
+                fin!(P_CV);
             }
             Op::Sub => {
                 (self.d_c, self.d_v) = cv(res, |i| W::sub(a[i], b[i], false));
-                self.pend.cv = true;
+                fin!(P_CV);
             }
             Op::Sbc => {
                 (self.d_c, self.d_v) = cv(res, |i| W::sub(a[i], b[i], cin >> i & 1 != 0));
-                self.pend.cv = true;
+                fin!(P_CV);
             }
             Op::Rsb => {
                 (self.d_c, self.d_v) = cv(res, |i| W::sub(b[i], a[i], false));
-                self.pend.cv = true;
+                fin!(P_CV);
             }
             Op::Neg => {
                 (self.d_c, self.d_v) = cv(res, |i| W::sub(W::ZERO, a[i], false));
-                self.pend.cv = true;
+                fin!(P_CV);
             }
             Op::Adds => {
                 self.d_v = sat(res, |i| W::adds(a[i], b[i]));
-                (self.d_c, self.pend.cv) = (0, true);
+                self.d_c = 0;
+                fin!(P_CV);
             }
             Op::Subs => {
                 self.d_v = sat(res, |i| W::subs(a[i], b[i]));
-                (self.d_c, self.pend.cv) = (0, true);
+                self.d_c = 0;
+                fin!(P_CV);
             }
             Op::Abs => {
                 self.d_v = sat(res, |i| W::abs(a[i]));
-                (self.d_c, self.pend.cv) = (0, true);
+                self.d_c = 0;
+                fin!(P_CV);
             }
             Op::Absd => {
                 self.d_v = sat(res, |i| W::absd(a[i], b[i]));
-                (self.d_c, self.pend.cv) = (0, true);
+                self.d_c = 0;
+                fin!(P_CV);
             }
             Op::Asl => {
                 self.d_v = sat(res, |i| W::asl(a[i], W::amount(b[i])));
-                (self.d_c, self.pend.cv) = (0, true);
+                self.d_c = 0;
+                fin!(P_CV);
             }
-            Op::And => map!(res, |i| a[i] & b[i]),
-            Op::Or => map!(res, |i| a[i] | b[i]),
-            Op::Xor => map!(res, |i| a[i] ^ b[i]),
-            Op::Not => map!(res, |i| !a[i]),
-            Op::Mov => *res = *a,
-            Op::Movb => *res = *b,
-            Op::Min => map!(res, |i| a[i].min(b[i])),
-            Op::Max => map!(res, |i| a[i].max(b[i])),
-            Op::Clz => map!(res, |i| W::clz(a[i])),
+            Op::And => {
+                map!(res, |i| a[i] & b[i]);
+                fin!(P_RES);
+            }
+            Op::Or => {
+                map!(res, |i| a[i] | b[i]);
+                fin!(P_RES);
+            }
+            Op::Xor => {
+                map!(res, |i| a[i] ^ b[i]);
+                fin!(P_RES);
+            }
+            Op::Not => {
+                map!(res, |i| !a[i]);
+                fin!(P_RES);
+            }
+            Op::Mov => {
+                *res = *a;
+                fin!(P_RES);
+            }
+            Op::Movb => {
+                *res = *b;
+                fin!(P_RES);
+            }
+            Op::Min => {
+                map!(res, |i| a[i].min(b[i]));
+                fin!(P_RES);
+            }
+            Op::Max => {
+                map!(res, |i| a[i].max(b[i]));
+                fin!(P_RES);
+            }
+            Op::Clz => {
+                map!(res, |i| W::clz(a[i]));
+                fin!(P_RES);
+            }
             Op::Sel => {
                 let f = self.flags.f;
                 if N.is_multiple_of(8) {
@@ -454,14 +549,24 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 } else {
                     map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
                 }
+                fin!(P_RES);
             }
             Op::Cmp => {
                 self.d_f = cmp_mask(c.cond(), a, b, self.flags.c, self.flags.v);
-                self.pend.f = true;
+                fin!(P_F);
             }
-            Op::Sll => map!(res, |i| W::sll(a[i], W::amount(b[i]))),
-            Op::Srl => map!(res, |i| W::srl(a[i], W::amount(b[i]))),
-            Op::Sra => map!(res, |i| W::sra(a[i], W::amount(b[i]))),
+            Op::Sll => {
+                map!(res, |i| W::sll(a[i], W::amount(b[i])));
+                fin!(P_RES);
+            }
+            Op::Srl => {
+                map!(res, |i| W::srl(a[i], W::amount(b[i])));
+                fin!(P_RES);
+            }
+            Op::Sra => {
+                map!(res, |i| W::sra(a[i], W::amount(b[i])));
+                fin!(P_RES);
+            }
             Op::Mul | Op::Mac | Op::Msu => {
                 let acc = &self.acc;
                 let acc_d = &mut self.acc_d;
@@ -495,15 +600,21 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                     lanes!(false)
                 };
                 (self.d_v, self.d_c) = (v, 0);
-                self.pend.cv = true;
-                self.pend.acc = true;
+                fin!(P_MUL);
             }
             Op::Acc => {
                 self.d_v = scale_lanes(&self.acc, sh, trunc, res);
-                (self.d_c, self.pend.cv) = (0, true);
+                self.d_c = 0;
+                fin!(P_CV);
             }
-            Op::Acch => map!(res, |i| W::acch(self.acc[i])),
-            Op::Accl => map!(res, |i| W::accl(self.acc[i])),
+            Op::Acch => {
+                map!(res, |i| W::acch(self.acc[i]));
+                fin!(P_RES);
+            }
+            Op::Accl => {
+                map!(res, |i| W::accl(self.acc[i]));
+                fin!(P_RES);
+            }
             Op::Ldacc => {
                 let acc_d = &mut self.acc_d;
                 // The shift the tracer uses (a Q.14 or Q.30 product's
@@ -518,7 +629,7 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                         acc_d[i] = W::ldacc(a[i], sh);
                     }
                 }
-                self.pend.acc = true;
+                fin!(P_ACC);
             }
             Op::Ld | Op::St => {
                 let store = c.op == Op::St;
@@ -579,19 +690,22 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                         res[i] = self.ram.read(i, self.addr[i] as usize);
                     }
                 }
-                self.pend.store = store;
+                if store {
+                    fin!(P_ST);
+                } else {
+                    fin!(P_RES);
+                }
             }
         }
         Ok(())
     }
 
-    fn commit(&mut self) {
+    /// The clock edge of the lanes that executed (not none): `p` says
+    /// what it writes.
+    #[inline(always)]
+    fn write_back(&mut self, p: Pending) {
         let en = self.en;
-        if en == 0 {
-            return;
-        }
         let c = self.ctx;
-        let p = self.pend;
         if p.result {
             if en == Self::FULL || !N.is_multiple_of(8) {
                 select_word(&mut self.out, en, &self.res);
@@ -632,9 +746,14 @@ impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
                 }
             }
         }
-        match c.op {
-            Op::Sleep => self.flags.sleep |= en,
-            Op::Wake => self.flags.sleep &= !en,
+    }
+
+    /// `sleep` and `wake` at the clock edge.
+    #[inline(always)]
+    fn sleep_wake(&mut self) {
+        match self.ctx.op {
+            Op::Sleep => self.flags.sleep |= self.en,
+            Op::Wake => self.flags.sleep &= !self.en,
             _ => {}
         }
     }
