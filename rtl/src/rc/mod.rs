@@ -411,6 +411,9 @@ impl<const N: usize, W: Word> RcArray<N, W> {
         // knowing its kind, else left pending for `commit`.
         macro_rules! fin {
             ($p:expr) => {
+                // The arms' kinds agree with the ISA's table of the
+                // operations with a result (tests run with debug assertions).
+                debug_assert_eq!($p.result, self.ctx.op.has_result(), "{:?}", self.ctx.op);
                 if STEP {
                     self.write_back($p)
                 } else {
@@ -424,7 +427,7 @@ impl<const N: usize, W: Word> RcArray<N, W> {
         let c = &self.ctx;
         let en = self.enabled();
         self.en = en;
-        if !STEP || en == 0 {
+        if !STEP {
             // (nothing pending if the evaluation faults)
             self.pend = P_NONE;
         }
