@@ -38,7 +38,7 @@
 use std::collections::BTreeSet;
 use std::fmt;
 use std::fs::File;
-use std::io::{self, BufWriter, Write};
+use std::io::{self, BufWriter, Seek, Write};
 use std::path::{Path, PathBuf};
 
 use vcd::TimescaleUnit;
@@ -408,15 +408,55 @@ struct VcdBody {
     ids: Vec<([u8; 16], u8)>,
     buf: Box<[u8]>,
     len: usize,
+    /// Bytes of body handed to the file so far.
+    written: u64,
+    /// The file's blocks are allocated ahead of the writes up to here
+    /// ([`VcdBody::reserve`]); `None` when the file cannot be (a device,
+    /// a pipe, a file system without `fallocate`).
+    reserved: Option<u64>,
 }
 
+/// Bytes of a VCD file allocated at a time ahead of its writes.
+const VCD_RESERVE: u64 = 4 << 20;
+
 impl VcdBody {
-    fn new() -> VcdBody {
+    /// `reserve`: allocate the file's blocks ahead of the writes (a
+    /// regular file; trimmed by [`VcdBody::trim`]).
+    fn new(reserve: bool) -> VcdBody {
         VcdBody {
             ids: Vec::new(),
             buf: vec![0; VCD_CHUNK + VCD_ROOM].into_boxed_slice(),
             len: 0,
+            written: 0,
+            reserved: reserve.then_some(0),
         }
+    }
+
+    /// Allocate the file's blocks some megabytes ahead of the next `n`
+    /// bytes (the header counted generously), without changing its
+    /// length: the kernel then copies the writes into blocks it has
+    /// instead of reserving space page by page (30 MB written to ext4 in
+    /// 256 KB pieces: 4.8-5.1 ms, 2.7-2.8 ms allocated ahead). Where the
+    /// file system cannot allocate ahead, the file is simply written.
+    fn reserve(&mut self, out: &BufWriter<File>, n: usize) {
+        let Some(r) = self.reserved else { return };
+        let end = self.written + n as u64 + (1 << 16);
+        if end <= r {
+            return;
+        }
+        let to = end.next_multiple_of(VCD_RESERVE) + VCD_RESERVE;
+        self.reserved = allocate_ahead(out.get_ref(), r, to - r).then_some(to);
+    }
+
+    /// Give back the blocks allocated past the end of the file.
+    fn trim(&self, out: &mut BufWriter<File>) -> io::Result<()> {
+        if self.reserved.is_some_and(|r| r > 0) {
+            out.flush()?;
+            let f = out.get_mut();
+            let len = f.stream_position()?;
+            f.set_len(len)?;
+        }
+        Ok(())
     }
 
     fn add_id(&mut self, code: &str) -> io::Result<u32> {
@@ -490,8 +530,22 @@ impl VcdBody {
     #[inline(never)]
     fn write_out(&mut self, out: &mut BufWriter<File>) -> io::Result<()> {
         let n = std::mem::take(&mut self.len);
+        self.reserve(out, n);
+        self.written += n as u64;
         out.write_all(&self.buf[..n])
     }
+}
+
+/// Allocate `len` bytes of `f`'s blocks from `offset` on, its length
+/// unchanged; whether it could.
+#[cfg(target_os = "linux")]
+fn allocate_ahead(f: &File, offset: u64, len: u64) -> bool {
+    rustix::fs::fallocate(f, rustix::fs::FallocateFlags::KEEP_SIZE, offset, len).is_ok()
+}
+
+#[cfg(not(target_os = "linux"))]
+fn allocate_ahead(_: &File, _: u64, _: u64) -> bool {
+    false
 }
 
 impl Sink {
@@ -1150,7 +1204,7 @@ impl Tracer {
             let mut w = vcd::Writer::new(out);
             w.version(version)?;
             w.timescale(1, TimescaleUnit::PS)?;
-            Sink::Vcd(w, VcdBody::new())
+            Sink::Vcd(w, VcdBody::new(tmp_path.is_some()))
         };
         w.add_module(top_name)?;
         let clk = w.add_wire(1, "clk")?;
@@ -1374,6 +1428,7 @@ impl Tracer {
                     w.comment(n)?;
                 }
                 w.flush()?;
+                body.trim(w.writer())?;
                 let Some(tmp_path) = self.tmp_path.take() else {
                     // Written through to a device or FIFO: no file to save beside.
                     return Ok(vec![self.cfg.path.clone()]);
@@ -1913,12 +1968,53 @@ mod tests {
         }
     }
 
+    /// A waveform of some megabytes is written to blocks allocated ahead
+    /// of it, and the file keeps none of them past its end: its length is
+    /// its content (it ends with the last falling edge and the time the
+    /// trace ends at) and it occupies
+    /// no more than that.
+    #[test]
+    fn a_long_waveform_keeps_no_blocks_past_its_end() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("long.vcd");
+        let mut sim = Sim::new(Demo {
+            t: 0,
+            by_block: true,
+        });
+        sim.trace(TraceConfig::new(&path), "demo").unwrap();
+        let cycles = 60_000;
+        for _ in 0..cycles {
+            sim.step().unwrap();
+        }
+        sim.finish_trace().unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.len() > 3 << 20, "{} bytes", text.len());
+        let end = Clock::new(TraceConfig::new("x").clock_hz).time(cycles);
+        assert!(
+            text.ends_with(&format!("\n0!\n#{end}\n")),
+            "ends with {:?}",
+            &text[text.len() - 40..]
+        );
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::unix::fs::MetadataExt;
+            let m = std::fs::metadata(&path).unwrap();
+            assert_eq!(m.len(), text.len() as u64);
+            assert!(
+                m.blocks() * 512 < m.len() + (64 << 10),
+                "{} bytes in {} blocks of 512",
+                m.len(),
+                m.blocks()
+            );
+        }
+    }
+
     /// A value change is written as `core::fmt` writes it: `b`, the
     /// binary digits without leading zeros, a space and the code (one
     /// digit and the code for one bit).
     #[test]
     fn value_changes_are_formatted_as_core_fmt_formats_them() {
-        let mut body = VcdBody::new();
+        let mut body = VcdBody::new(false);
         body.add_id("!").unwrap();
         body.add_id("%a~").unwrap();
         let mut values: Vec<u64> = vec![0, 1, 2, 3, 0xFF, 0x100, 0x8000, u64::MAX, 1 << 63];
@@ -1943,7 +2039,7 @@ mod tests {
         }
         assert_eq!(std::str::from_utf8(&body.buf[..body.len]).unwrap(), want);
         // Timestamps: every number of digits, and the edges of each.
-        let mut body = VcdBody::new();
+        let mut body = VcdBody::new(false);
         let mut want = String::new();
         let mut times = vec![0, 1, 9, 10, 99, 100, 999, u64::MAX, u64::MAX - 1];
         for d in 1..20 {
