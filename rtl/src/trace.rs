@@ -392,6 +392,98 @@ fn bin8(b: u8) -> u64 {
     (((x + 0x7F * ONES) >> 7) & ONES) | (b'0' as u64 * ONES)
 }
 
+/// The 8 decimal digits of `x` < 10^8, most significant first, in the
+/// bytes of a little-endian word (digit values, not ASCII): the halves
+/// `x / 10^4` and `x % 10^4` in two 32-bit lanes, each split into
+/// hundreds and the rest in 16-bit lanes, each of those into tens and
+/// units in bytes; every division a multiplication by a reciprocal, exact
+/// in its range.
+#[inline(always)]
+fn digits8(x: u64) -> u64 {
+    let abcd_efgh = x / 10_000 | (x % 10_000) << 32;
+    let ab_ef = ((abcd_efgh * 10_486) >> 20) & 0x0000_007F_0000_007F;
+    let ab_cd_ef_gh = ab_ef | (abcd_efgh - ab_ef * 100) << 16;
+    let a_c_e_g = ((ab_cd_ef_gh * 103) >> 10) & 0x000F_000F_000F_000F;
+    a_c_e_g | (ab_cd_ef_gh - a_c_e_g * 10) << 8
+}
+
+/// The 16 decimal digits of `x` < 10^16 as byte values, the units in the
+/// lowest byte.
+#[inline(always)]
+fn digits16(x: u64) -> u128 {
+    (digits8(x / 100_000_000) as u128 | (digits8(x % 100_000_000) as u128) << 64).swap_bytes()
+}
+
+/// The times of a VCD (they only grow, mostly by the same few steps: half
+/// a clock period, rounded down or up) in decimal, each the one before
+/// plus the step, added 16 digits at once: the step's digits from a
+/// table of four (refilled around a step not in it), the carries between
+/// digits made by the addition itself (each digit biased by 246, so that
+/// 10 or more carries out of its byte; those that did not carry out lose
+/// the bias again).
+struct Decimal {
+    /// The last time, and its digits ([`digits16`]); `None` before the
+    /// first one and after one of 10^16 or more.
+    last: Option<(u64, u128)>,
+    /// The steps in the table: `base` to `base + 3`.
+    base: u64,
+    steps: [u128; 4],
+}
+
+/// 10^16: the times [`Decimal`] writes are below.
+const DECIMAL_LIMIT: u64 = 10_000_000_000_000_000;
+
+impl Decimal {
+    fn new() -> Decimal {
+        Decimal {
+            last: None,
+            // No step (below 10^16) is within 4 of this one: the first
+            // step refills the table.
+            base: DECIMAL_LIMIT,
+            steps: [0; 4],
+        }
+    }
+
+    /// `t` in ASCII without leading zeros, in the low bytes of the result
+    /// (the first digit in the lowest), and its digit count; `None` from
+    /// 10^16 on.
+    #[inline(always)]
+    fn next(&mut self, t: u64) -> Option<(u128, usize)> {
+        const BIAS: u128 = u128::from_le_bytes([246; 16]);
+        const ONES: u128 = u128::from_le_bytes([1; 16]);
+        const ZEROS: u128 = u128::from_le_bytes([b'0'; 16]);
+        if t >= DECIMAL_LIMIT {
+            self.last = None;
+            return None;
+        }
+        let d = match self.last {
+            Some((before, digits)) if t >= before => {
+                let mut i = (t - before).wrapping_sub(self.base);
+                if i >= 4 {
+                    self.refill(t - before);
+                    i = t - before - self.base;
+                }
+                let x = digits + self.steps[(i & 3) as usize] + BIAS;
+                x - ((x >> 7) & ONES) * 246
+            }
+            _ => digits16(t),
+        };
+        self.last = Some((t, d));
+        let n = 16 - ((d | 1).leading_zeros() / 8) as usize;
+        Some(((d.swap_bytes() | ZEROS) >> (8 * (16 - n)), n))
+    }
+
+    /// The table around `step`: `step - 1` to `step + 2`.
+    #[cold]
+    #[inline(never)]
+    fn refill(&mut self, step: u64) {
+        self.base = step.saturating_sub(1);
+        for (k, s) in self.steps.iter_mut().enumerate() {
+            *s = digits16((self.base + k as u64).min(DECIMAL_LIMIT - 1));
+        }
+    }
+}
+
 /// Bytes of VCD body gathered before they are handed to the file: 256 KB
 /// (one `write` of 64 KB each took the kernel more in all: the bench's
 /// traced frame 0.027-0.028 s against 0.025-0.026 s).
@@ -409,6 +501,7 @@ struct VcdBody {
     ids: Vec<([u8; 16], u8)>,
     buf: Box<[u8]>,
     len: usize,
+    time: Decimal,
     /// Bytes of body handed to the file so far.
     written: u64,
     /// The file's blocks are allocated ahead of the writes up to here
@@ -428,6 +521,7 @@ impl VcdBody {
             ids: Vec::new(),
             buf: vec![0; VCD_CHUNK + VCD_ROOM].into_boxed_slice(),
             len: 0,
+            time: Decimal::new(),
             written: 0,
             reserved: reserve.then_some(0),
         }
@@ -471,16 +565,28 @@ impl VcdBody {
         Ok(self.ids.len() as u32 - 1)
     }
 
-    /// `#t`.
+    /// `#t`: below 10^16 (about three hours of simulated time in
+    /// picoseconds) carried forward in decimal from the time written
+    /// before ([`Decimal`]) and stored as one 16-byte word; `itoa`, twice
+    /// a cycle, was a sixth of the writing thread.
     #[inline(always)]
     fn timestamp(&mut self, t: u64) {
-        let mut digits = itoa::Buffer::new();
-        let d = digits.format(t).as_bytes();
         let dst = &mut self.buf[self.len..self.len + VCD_SLACK];
         dst[0] = b'#';
-        dst[1..1 + d.len()].copy_from_slice(d);
-        dst[1 + d.len()] = b'\n';
-        self.len += d.len() + 2;
+        let n = match self.time.next(t) {
+            Some((ascii, n)) => {
+                dst[1..17].copy_from_slice(&ascii.to_le_bytes());
+                n
+            }
+            None => {
+                let mut digits = itoa::Buffer::new();
+                let d = digits.format(t).as_bytes();
+                dst[1..1 + d.len()].copy_from_slice(d);
+                d.len()
+            }
+        };
+        dst[1 + n] = b'\n';
+        self.len += n + 2;
     }
 
     /// `0!` for one bit, `b1011 !` for a vector (no leading zeros).
@@ -2167,6 +2273,51 @@ mod tests {
                 m.len(),
                 m.blocks()
             );
+        }
+    }
+
+    /// Timestamps are written as `core::fmt` writes them: times growing
+    /// by the half periods of several clocks (across digit counts and
+    /// 10^16), by larger steps, and times out of order.
+    #[test]
+    fn timestamps_are_formatted_as_core_fmt_formats_them() {
+        let mut x = 0x2545_F491_4F6C_DD1Du64;
+        let mut next = move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        };
+        let mut runs: Vec<Vec<u64>> = Vec::new();
+        for hz in [300_000_000u64, 1_000_000_000_000, 7, 123_456_789] {
+            for start in [0u64, 99_990_000, 999_999_999_999_000, 9_999_999_999_990_000] {
+                let mut clock = Clock::new(hz);
+                let c0 = start * hz / 1_000_000_000_000;
+                let mut ts = Vec::new();
+                for c in c0..c0 + 3000 {
+                    let (rise, fall) = clock.edges(c);
+                    ts.extend([rise, fall]);
+                }
+                runs.push(ts);
+            }
+        }
+        let mut t = 0u64;
+        runs.push((0..3000).map(|_| { t += next() % 1_000_000_000; t }).collect());
+        runs.push((0..3000).map(|_| next() >> (next() % 64)).collect());
+        runs.push(vec![0, 0, 1, 9, 10, 99, 100, u64::MAX, 5, DECIMAL_LIMIT - 1, DECIMAL_LIMIT, 3]);
+        for (r, times) in runs.iter().enumerate() {
+            let mut body = VcdBody::new(false);
+            let mut want = String::new();
+            for (k, &t) in times.iter().enumerate() {
+                body.timestamp(t);
+                want.push_str(&format!("#{t}\n"));
+                if body.len > VCD_CHUNK || k + 1 == times.len() {
+                    let got = std::str::from_utf8(&body.buf[..body.len]).unwrap();
+                    assert!(got == want, "run {r}, up to time {k}");
+                    body.len = 0;
+                    want.clear();
+                }
+            }
         }
     }
 
