@@ -2333,7 +2333,7 @@ mod tests {
         for hz in [300_000_000u64, 1_000_000_000_000, 7, 123_456_789] {
             for start in [0u64, 99_990_000, 999_999_999_999_000, 9_999_999_999_990_000] {
                 let mut clock = Clock::new(hz);
-                let c0 = start * hz / 1_000_000_000_000;
+                let c0 = (start as u128 * hz as u128 / 1_000_000_000_000) as u64;
                 let mut ts = Vec::new();
                 for c in c0..c0 + 3000 {
                     let (rise, fall) = clock.edges(c);
