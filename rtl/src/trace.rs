@@ -2325,18 +2325,22 @@ mod tests {
         }
     }
 
+    /// A xorshift generator of test values from `seed`.
+    fn xorshift(mut x: u64) -> impl FnMut() -> u64 {
+        move || {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            x
+        }
+    }
+
     /// Timestamps are written as `core::fmt` writes them: times growing
     /// by the half periods of several clocks (across digit counts and
     /// 10^16), by larger steps, and times out of order.
     #[test]
     fn timestamps_are_formatted_as_core_fmt_formats_them() {
-        let mut x = 0x2545_F491_4F6C_DD1Du64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut next = xorshift(0x2545_F491_4F6C_DD1D);
         let mut runs: Vec<Vec<u64>> = Vec::new();
         for hz in [300_000_000u64, 1_000_000_000_000, 7, 123_456_789] {
             for start in [0u64, 99_990_000, 999_999_999_999_000, 9_999_999_999_990_000] {
@@ -2394,11 +2398,9 @@ mod tests {
     /// AVX-512 where the build has it) and are `core::fmt`'s.
     #[test]
     fn binary_digits_are_core_fmt_binary_digits() {
-        let mut x = 0x0123_4567_89AB_CDEFu64;
+        let mut next = xorshift(0x0123_4567_89AB_CDEF);
         for round in 0..20_000 {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
+            let x = next();
             let v = if round < 128 {
                 (1u64 << (round % 64)) - (round / 64)
             } else {
@@ -2421,13 +2423,7 @@ mod tests {
     /// with the bytes their changes add.
     #[test]
     fn chunk_messages_hold_the_changed_values_in_order() {
-        let mut x = 0x9E37_79B9_7F4A_7C15u64;
-        let mut next = move || {
-            x ^= x << 13;
-            x ^= x >> 7;
-            x ^= x << 17;
-            x
-        };
+        let mut next = xorshift(0x9E37_79B9_7F4A_7C15);
         for round in 0..2000 {
             let (mut c, mut m, mut l, mut cost) = ([0u64; 64], [0u64; 64], [0u64; 64], [0u8; 64]);
             let density = next() % 65;
