@@ -305,7 +305,7 @@ fn queue_cycle(batch: &mut Vec<u64>, c: u64) {
     }
 }
 
-/// Append `src` to `dst`. With AVX-512 the whole cache lines
+/// Append `src` to `dst`. With AVX-512 the whole cache lines are stored
 /// by non-temporal stores, which go to memory without taking the lines
 /// into this core's caches: the sampling thread writes its messages into
 /// one batch of its own that stays in its caches, and the copies the
@@ -1219,7 +1219,8 @@ pub struct Tracer {
     /// Per signal call: the bytes a change of it adds to the waveform
     /// (about).
     costs: Vec<u8>,
-    /// Messages for the writing thread ([`Sink::Threaded`]), handed over
+    /// Messages for the writing thread ([`Sink::Threaded`]): this
+    /// thread's own batch, handed over as a copy ([`copy_streaming`])
     /// once [`BATCH`] words wait (checked after each cycle: room for the
     /// most a cycle adds is reserved beyond it).
     batch: Vec<u64>,
