@@ -2127,12 +2127,23 @@ impl Tracer {
         let (masks, _) = self.masks.as_chunks::<64>();
         let (lasts, _) = self.lasts.as_chunks_mut::<64>();
         let (costs, _) = self.costs.as_chunks::<64>();
-        for (j, (((c, m), l), cost)) in cur.iter().zip(masks).zip(lasts).zip(costs).enumerate() {
+        // Indexed, not zipped: the zip's length (the least of four) took
+        // a chain of vector instructions in front of every sample.
+        let mut left = self.n_slots;
+        let mut j = 0;
+        while left > 0 {
             // The groups of 8 calls that hold declared ones (the padding
             // after the last holds none).
-            let groups = (self.n_slots - 64 * j).min(64).div_ceil(8);
-            let chunk = Chunk { c, m, l, cost };
+            let groups = left.min(64).div_ceil(8);
+            left = left.saturating_sub(64);
+            let chunk = Chunk {
+                c: &cur[j],
+                m: &masks[j],
+                l: &mut lasts[j],
+                cost: &costs[j],
+            };
             self.bytes += chunk.changes(&mut self.batch, j as u64, first, groups);
+            j += 1;
         }
     }
 }
