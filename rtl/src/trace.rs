@@ -258,9 +258,7 @@ enum Sink {
     /// does not wait for the formatting); [`Sink::join`] gets the sink
     /// back.
     Threaded {
-        tx: std::sync::mpsc::SyncSender<Vec<u64>>,
-        /// Emptied batches coming back from the writing thread.
-        spare: std::sync::mpsc::Receiver<Vec<u64>>,
+        queue: std::sync::Arc<Handoff>,
         worker: std::thread::JoinHandle<Written>,
     },
     /// Between the two FST phases, or after finishing.
@@ -293,6 +291,124 @@ const MSG_VALUE: u64 = (1 << 48) - 1;
 /// is slower than the simulation.
 const BATCH: usize = 1 << 14;
 const QUEUED_BATCHES: usize = 8;
+
+/// The batches between the two threads, handed over without a system
+/// call while both are busy. A channel woke the writing thread at every
+/// batch it waited for: a system call on the simulating thread each time
+/// (0.5-1 ms of the bench's traced frame). Here the writing thread polls
+/// every [`POLL`] while batches come, and only after [`IDLE_POLLS`] empty
+/// polls says it is asleep and waits to be woken.
+struct Handoff {
+    full: std::sync::Mutex<std::collections::VecDeque<Vec<u64>>>,
+    /// Emptied batches, for the simulating thread to fill again.
+    empty: std::sync::Mutex<Vec<Vec<u64>>>,
+    /// The writing thread waits to be woken.
+    asleep: std::sync::atomic::AtomicBool,
+    /// The simulating thread has handed over its last batch.
+    done: std::sync::atomic::AtomicBool,
+    /// The writing thread takes no more batches (it ended or panicked).
+    gone: std::sync::atomic::AtomicBool,
+}
+
+const POLL: std::time::Duration = std::time::Duration::from_micros(50);
+const IDLE_POLLS: u32 = 20;
+
+impl Handoff {
+    fn new() -> Handoff {
+        use std::sync::atomic::AtomicBool;
+        Handoff {
+            full: Default::default(),
+            empty: Default::default(),
+            asleep: AtomicBool::new(false),
+            done: AtomicBool::new(false),
+            gone: AtomicBool::new(false),
+        }
+    }
+
+    /// Queue `batch` for the writing thread `writer`: at once while fewer
+    /// than [`QUEUED_BATCHES`] wait, else once one is taken (the disk is
+    /// slower than the simulation). `false`: the writing thread is gone.
+    fn send(&self, batch: Vec<u64>, writer: &std::thread::Thread) -> bool {
+        use std::sync::atomic::{fence, Ordering::SeqCst};
+        let mut batch = Some(batch);
+        loop {
+            if self.gone.load(SeqCst) {
+                return false;
+            }
+            {
+                let mut q = self.full.lock().unwrap_or_else(|e| e.into_inner());
+                if q.len() < QUEUED_BATCHES {
+                    q.extend(batch.take());
+                }
+            }
+            // Seen asleep after the batch is queued: wake it (it said so
+            // before it looked at the queue a last time).
+            fence(SeqCst);
+            if self.asleep.swap(false, SeqCst) || batch.is_some() {
+                writer.unpark();
+            }
+            if batch.is_none() {
+                return true;
+            }
+            std::thread::sleep(POLL);
+        }
+    }
+
+    /// The next batch, waiting for it; `None` once the last is taken.
+    fn recv(&self) -> Option<Vec<u64>> {
+        use std::sync::atomic::{fence, Ordering::SeqCst};
+        let mut idle = 0;
+        loop {
+            let done = self.done.load(SeqCst);
+            if let Some(b) = self
+                .full
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .pop_front()
+            {
+                return Some(b);
+            }
+            if done {
+                return None;
+            }
+            idle += 1;
+            if idle < IDLE_POLLS {
+                std::thread::park_timeout(POLL);
+                continue;
+            }
+            self.asleep.store(true, SeqCst);
+            fence(SeqCst);
+            let empty = self
+                .full
+                .lock()
+                .unwrap_or_else(|e| e.into_inner())
+                .is_empty();
+            if empty && !self.done.load(SeqCst) {
+                std::thread::park();
+            }
+            self.asleep.store(false, SeqCst);
+            idle = 0;
+        }
+    }
+
+    /// An emptied batch for the simulating thread to fill again.
+    fn give_back(&self, mut batch: Vec<u64>) {
+        batch.clear();
+        let mut e = self.empty.lock().unwrap_or_else(|e| e.into_inner());
+        if e.len() < QUEUED_BATCHES + 2 {
+            e.push(batch);
+        }
+    }
+}
+
+/// Marks the [`Handoff`] gone when the writing thread ends, however.
+struct WriterGone(std::sync::Arc<Handoff>);
+
+impl Drop for WriterGone {
+    fn drop(&mut self) {
+        self.0.gone.store(true, std::sync::atomic::Ordering::SeqCst);
+    }
+}
 
 /// Queue the start of cycle `c` for the writing thread.
 #[inline(always)]
@@ -806,8 +922,8 @@ impl Sink {
         clock_hz: u64,
         section_bytes: usize,
     ) -> io::Result<Sink> {
-        let (tx, rx) = std::sync::mpsc::sync_channel::<Vec<u64>>(QUEUED_BATCHES);
-        let (back, spare) = std::sync::mpsc::sync_channel::<Vec<u64>>(QUEUED_BATCHES + 2);
+        let queue = std::sync::Arc::new(Handoff::new());
+        let rx = WriterGone(queue.clone());
         let worker = std::thread::Builder::new()
             .name("waveform writer".into())
             .spawn(move || {
@@ -857,15 +973,14 @@ impl Sink {
                     sink.change(clk, 1, 1)?;
                     sink.change(cycle_id, 64, c)
                 };
-                for mut batch in rx {
+                while let Some(batch) = rx.0.recv() {
                     if res.is_err() {
                         continue; // keep draining: the sender must not block
                     }
                     if let (Sink::Vcd(w, body), Some((ids, clk, cycle))) = (&mut sink, &vcd_ids) {
                         let edges = (&mut clock, &mut fall, *clk, *cycle);
                         res = vcd_batch(w.writer(), body, &batch, ids, &mut seen, edges);
-                        batch.clear();
-                        let _ = back.try_send(batch);
+                        rx.0.give_back(batch);
                         continue;
                     }
                     let mut k = 0;
@@ -915,8 +1030,7 @@ impl Sink {
                             break;
                         }
                     }
-                    batch.clear();
-                    let _ = back.try_send(batch);
+                    rx.0.give_back(batch);
                 }
                 if res.is_ok() {
                     if let Some(t) = fall {
@@ -926,7 +1040,7 @@ impl Sink {
                 let seen = seen.lists.into_iter().map(BTreeSet::from_iter).collect();
                 (sink, res, seen)
             })?;
-        Ok(Sink::Threaded { tx, spare, worker })
+        Ok(Sink::Threaded { queue, worker })
     }
 
     /// The sink back from its writing thread, every change written (the
@@ -934,14 +1048,17 @@ impl Sink {
     /// filters.
     fn join(self, batch: Vec<u64>) -> io::Result<(Sink, Vec<BTreeSet<u64>>)> {
         match self {
-            Sink::Threaded { tx, worker, .. } => {
-                let sent = tx.send(batch);
-                drop(tx);
+            Sink::Threaded { queue, worker } => {
+                let sent = queue.send(batch, worker.thread());
+                queue.done.store(true, std::sync::atomic::Ordering::SeqCst);
+                worker.thread().unpark();
                 let (sink, res, seen) = worker
                     .join()
                     .map_err(|_| io::Error::other("the waveform writer panicked"))?;
                 res?;
-                sent.map_err(|_| io::Error::other("the waveform writer stopped"))?;
+                if !sent {
+                    return Err(io::Error::other("the waveform writer stopped"));
+                }
                 Ok((sink, seen))
             }
             other => Ok((other, Vec::new())),
@@ -952,15 +1069,17 @@ impl Sink {
     /// batch the thread has emptied, or a new one), `batch` left empty.
     fn hand_over(&mut self, batch: &mut Vec<u64>) -> io::Result<()> {
         match self {
-            Sink::Threaded { tx, spare, .. } => {
-                let mut copy = spare
-                    .try_recv()
-                    .unwrap_or_else(|_| Vec::with_capacity(batch.capacity()));
+            Sink::Threaded { queue, worker } => {
+                let spare = queue.empty.lock().unwrap_or_else(|e| e.into_inner()).pop();
+                let mut copy = spare.unwrap_or_else(|| Vec::with_capacity(batch.capacity()));
                 copy.clear();
                 copy_streaming(&mut copy, batch);
                 batch.clear();
-                tx.send(copy)
-                    .map_err(|_| io::Error::other("the waveform writer stopped"))
+                if queue.send(copy, worker.thread()) {
+                    Ok(())
+                } else {
+                    Err(io::Error::other("the waveform writer stopped"))
+                }
             }
             _ => Err(io::Error::other("a value change outside sampling")),
         }
@@ -2439,6 +2558,68 @@ mod tests {
                 assert!(dst == want, "{len} words after {skew}");
             }
         }
+    }
+
+    /// Batches handed over arrive whole and in order, whether the writing
+    /// thread polls for them, has fallen asleep (long gaps: the first
+    /// batch after one wakes it) or is behind (a full queue); a writing
+    /// thread that ends stops the sender instead of leaving it waiting.
+    #[test]
+    fn handed_over_batches_arrive_in_order() {
+        use std::sync::Arc;
+        use std::time::Duration;
+        let q = Arc::new(Handoff::new());
+        let rx = WriterGone(q.clone());
+        let (ack, acks) = std::sync::mpsc::channel();
+        let reader = std::thread::spawn(move || {
+            let mut got = Vec::new();
+            while let Some(b) = rx.0.recv() {
+                if got.len() % 50 < 20 {
+                    // Behind: the queue fills.
+                    std::thread::sleep(Duration::from_micros(200));
+                }
+                got.push(b.clone());
+                rx.0.give_back(b);
+                let _ = ack.send(got.len());
+            }
+            got
+        });
+        let mut sent = Vec::new();
+        for k in 0..300u64 {
+            let mut b = q.empty.lock().unwrap().pop().unwrap_or_default();
+            assert!(b.is_empty());
+            b.extend((0..k % 7).map(|i| k << 8 | i));
+            sent.push(b.clone());
+            assert!(q.send(b, reader.thread()));
+            if k % 60 == 0 && k > 0 {
+                // The batch after the sleep woke the reader (it would
+                // otherwise sleep until the queue is full).
+                while acks.recv_timeout(Duration::from_secs(10)).expect("woken") <= k as usize {}
+            }
+            if k % 60 == 59 {
+                // Long enough for the reader to fall asleep.
+                std::thread::sleep(POLL * IDLE_POLLS * 20);
+            }
+        }
+        q.done.store(true, std::sync::atomic::Ordering::SeqCst);
+        reader.thread().unpark();
+        assert!(reader.join().unwrap() == sent);
+
+        // A reader that takes two batches and ends.
+        let q = Arc::new(Handoff::new());
+        let rx = WriterGone(q.clone());
+        let reader = std::thread::spawn(move || {
+            rx.0.recv();
+            rx.0.recv();
+        });
+        let thread = reader.thread().clone();
+        let mut sent = 0;
+        while q.send(vec![1], &thread) {
+            sent += 1;
+            assert!(sent < 100_000, "the sender never saw the reader gone");
+        }
+        reader.join().unwrap();
+        assert!((2..=2 + QUEUED_BATCHES).contains(&sent), "{sent} sent");
     }
 
     /// Timestamps are written as `core::fmt` writes them: times growing
