@@ -170,6 +170,12 @@ pub struct Chip<W: Word = i16> {
     idle_control: u64,
     /// Runs counted for the statistics ([`Watch`]).
     pub watch: Watch,
+    /// Set only while a waveform samples a cycle in which TinyRISC alone
+    /// worked, as it did in the cycle before: the broadcast unit, the
+    /// DMA and the array then show what they showed in that cycle (none
+    /// of them changed; see [`Chip::local_cycles`]), and the waveform
+    /// skips them.
+    quiet: bool,
 }
 
 /// TinyRISC's view of the chip.
@@ -286,6 +292,7 @@ impl<W: Word> Chip<W> {
             active_rc: 0,
             idle_control: 0,
             watch: Watch::default(),
+            quiet: false,
         }
     }
 
@@ -417,7 +424,10 @@ impl<W: Word> Chip<W> {
         // A stall evaluated before this call may wait on a word the DMA
         // has just rewritten: then it is evaluated again.
         let mut word_ok = self.mem.word(self.risc.pc) == Some(self.risc.ir);
+        // The cycle before was one of TinyRISC alone, in this loop.
+        let mut alone = false;
         while n < limit && !self.risc.halted() {
+            let alone_before = std::mem::take(&mut alone);
             if self.bcast.idle() {
                 // TinyRISC alone.
                 let busy = self.risc.busy();
@@ -434,9 +444,21 @@ impl<W: Word> Chip<W> {
                 }
                 word_ok = true;
                 self.array.idle();
-                if SAMPLED && !sample(self) {
-                    break;
+                if SAMPLED {
+                    // Nothing but TinyRISC works in this cycle and did in
+                    // the one before: the broadcast unit and the DMA were
+                    // idle in both, nothing issued a run or a transfer
+                    // between them (either ends TinyRISC's time alone),
+                    // and the array, idle in both, was neither evaluated
+                    // nor clocked since the last sample.
+                    self.quiet = alone_before;
+                    let go_on = sample(self);
+                    self.quiet = false;
+                    if !go_on {
+                        break;
+                    }
                 }
+                alone = true;
                 if self.risc.state != State::StallDma {
                     self.idle_control += 1;
                 }
@@ -757,6 +779,10 @@ impl<W: Word> Traced for Chip<W> {
             self.risc.trace(p);
             p.end();
         }
+        // The rest, unchanged while TinyRISC works alone (`quiet`).
+        if !p.section(self.quiet) {
+            return;
+        }
         if on & 2 != 0 && p.scope(format_args!("broadcast")) {
             let (busy, ctx, k, ptr) = match self.bcast.current() {
                 Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
@@ -815,6 +841,7 @@ impl<W: Word> Traced for Chip<W> {
             self.array.trace(p);
             p.end();
         }
+        p.end_section();
     }
 }
 

@@ -121,6 +121,17 @@ pub trait Probe {
             }
         }
     }
+    /// A part of the walk, up to the matching [`Probe::end_section`],
+    /// that reports (when `unchanged`) the values it reported in the last
+    /// cycle sampled. `false`: the probe skips it (the caller does not
+    /// walk it, nor call `end_section`). A probe that keeps the last
+    /// values may skip it; the part must make the same calls every cycle.
+    fn section(&mut self, unchanged: bool) -> bool {
+        let _ = unchanged;
+        true
+    }
+    /// The end of a [`Probe::section`] walked.
+    fn end_section(&mut self) {}
     /// [`Probe::block`] for signals that change only when `version` does
     /// (a register file and its count of writes): `fill` writes their
     /// values into the slice it is given. A probe that remembers the
@@ -1322,6 +1333,12 @@ pub struct Tracer {
     /// of its fields is traced (its values are then not kept at all).
     block_n: Vec<u32>,
     block_i: usize,
+    /// Per [`Probe::section`]: the calls of each table it holds
+    /// ([`Progress`]), which a section skipped moves on by.
+    sections: Vec<Progress>,
+    section_i: usize,
+    /// While declaring: the sections open, and where they began.
+    open_sections: Vec<(usize, Progress)>,
     /// Per signal call (in call order, traced or not), padded with
     /// untraced calls to a multiple of 64: the mask of its width (0 when
     /// it is not traced, so it never changes)...
@@ -1610,6 +1627,9 @@ impl Tracer {
             version_i: 0,
             block_n: Vec::new(),
             block_i: 0,
+            sections: Vec::new(),
+            section_i: 0,
+            open_sections: Vec::new(),
             masks: Vec::new(),
             lasts: Vec::new(),
             cur: Vec::new(),
@@ -1634,6 +1654,10 @@ impl Tracer {
             costs: Vec::new(),
         };
         top.trace(&mut t);
+        if !t.open_sections.is_empty() {
+            t.err
+                .get_or_insert(io::Error::other("a module began a section it did not end"));
+        }
         if let Some(e) = t.err.take() {
             return Err(e);
         }
@@ -1746,6 +1770,7 @@ impl Tracer {
         self.open_i = 0;
         self.version_i = 0;
         self.block_i = 0;
+        self.section_i = 0;
         top.trace(self);
         if self.slot_i != self.n_slots {
             return Err(io::Error::other(format!(
@@ -2062,6 +2087,34 @@ impl Probe for Tracer {
         }
     }
 
+    fn section(&mut self, unchanged: bool) -> bool {
+        if let Phase::Declare = self.phase {
+            self.declare_section();
+            return true;
+        }
+        let d = self.sections.get(self.section_i).copied();
+        self.section_i += 1;
+        match d {
+            Some(d) if unchanged && !self.first_sample => {
+                // The values of its calls are those in `cur` already.
+                self.scope_i += d.scopes;
+                self.slot_i += d.slots;
+                self.block_i += d.blocks;
+                self.open_i += d.masks;
+                self.version_i += d.versions;
+                self.section_i += d.sections;
+                false
+            }
+            _ => true,
+        }
+    }
+
+    fn end_section(&mut self) {
+        if let Phase::Declare = self.phase {
+            self.declare_end_section();
+        }
+    }
+
     #[inline]
     fn signal(&mut self, name: &str, width: u32, display: Display, value: u64) {
         if let Phase::Declare = self.phase {
@@ -2118,6 +2171,46 @@ impl Tracer {
             return 0;
         }
         fields.len()
+    }
+
+    /// The calls of each table declared so far.
+    fn progress(&self) -> Progress {
+        Progress {
+            scopes: self.scope_on.len(),
+            slots: self.masks.len(),
+            blocks: self.block_n.len(),
+            masks: self.open_masks.len(),
+            versions: self.versions.len(),
+            sections: self.sections.len(),
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn declare_section(&mut self) {
+        self.sections.push(Progress::default());
+        let start = self.progress();
+        self.open_sections.push((self.sections.len() - 1, start));
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn declare_end_section(&mut self) {
+        let Some((i, start)) = self.open_sections.pop() else {
+            self.err.get_or_insert(io::Error::other(
+                "a module ended a section it did not begin",
+            ));
+            return;
+        };
+        let end = self.progress();
+        self.sections[i] = Progress {
+            scopes: end.scopes - start.scopes,
+            slots: end.slots - start.slots,
+            blocks: end.blocks - start.blocks,
+            masks: end.masks - start.masks,
+            versions: end.versions - start.versions,
+            sections: end.sections - start.sections,
+        };
     }
 
     #[cold]
@@ -2267,6 +2360,18 @@ impl Tracer {
     }
 }
 
+/// The calls of each of the tracer's per-call tables (from a point of the
+/// walk on, or within a [`Probe::section`]).
+#[derive(Clone, Copy, Default)]
+struct Progress {
+    scopes: usize,
+    slots: usize,
+    blocks: usize,
+    masks: usize,
+    versions: usize,
+    sections: usize,
+}
+
 /// A chunk of 64 signal calls in a sampled cycle: the values the walk
 /// reported, the masks of their widths (0 for a call not traced), the
 /// values last written, and the bytes a change of each adds (about).
@@ -2413,6 +2518,7 @@ mod tests {
             let t = self.t;
             let (a, b, c, d) = (t, t / 3, (t * 7) as i16 as u64, t % 2);
             let (r0, r1) = (t / 5, t / 5 * 3);
+            let (e, f) = (t / 2 % 16, t / 2 % 4);
             if self.by_block {
                 p.block(
                     &|| {
@@ -2425,19 +2531,37 @@ mod tests {
                     },
                     &[a, b, c, d],
                 );
-                p.block_versioned(
-                    t / 5,
-                    &|| {
-                        vec![
-                            Field::new("regs", "r0", 8, Display::Hex),
-                            Field::new("regs", "r1", 8, Display::Hex),
-                        ]
-                    },
-                    &mut |v| {
-                        v[0] = r0;
-                        v[1] = r1;
-                    },
-                );
+                // The registers change every fifth cycle, and two nested
+                // sections say so; `e` every second.
+                if p.section(t % 5 != 0) {
+                    if p.section(t % 5 != 0) {
+                        p.block_versioned(
+                            t / 5,
+                            &|| {
+                                vec![
+                                    Field::new("regs", "r0", 8, Display::Hex),
+                                    Field::new("regs", "r1", 8, Display::Hex),
+                                ]
+                            },
+                            &mut |v| {
+                                v[0] = r0;
+                                v[1] = r1;
+                            },
+                        );
+                        p.end_section();
+                    }
+                    p.end_section();
+                }
+                if p.section(t % 2 == 1) {
+                    p.block_versioned(
+                        t / 2,
+                        &|| vec![Field::new("w", "e", 4, Display::Hex)],
+                        &mut |v| v[0] = e,
+                    );
+                    p.block(&|| vec![Field::new("v", "f", 2, Display::Hex)], &[f]);
+                    p.end_section();
+                }
+                p.block(&|| vec![Field::new("u", "g", 1, Display::Bin)], &[d]);
             } else {
                 p.signal("a", 8, Display::Hex, a);
                 if p.scope(format_args!("x")) {
@@ -2449,8 +2573,30 @@ mod tests {
                     p.signal("d", 1, Display::Bin, d);
                     p.end();
                 }
-                if p.scope(format_args!("regs")) {
-                    p.signal_row(&["r0", "r1"], 8, Display::Hex, &[r0, r1]);
+                if p.section(t % 5 != 0) {
+                    if p.scope(format_args!("regs")) {
+                        p.signal_row(&["r0", "r1"], 8, Display::Hex, &[r0, r1]);
+                        p.end();
+                    }
+                    p.end_section();
+                }
+                if p.section(t % 2 == 1) {
+                    if p.scope(format_args!("w")) {
+                        p.signal("e", 4, Display::Hex, e);
+                        p.end();
+                    }
+                    if p.scope(format_args!("v")) {
+                        if p.traced_signals(&["f"]) & 1 != 0 {
+                            p.signal("f", 2, Display::Hex, f);
+                        }
+                        p.end();
+                    }
+                    p.end_section();
+                }
+                if p.scope(format_args!("u")) {
+                    if p.traced_signals(&["g"]) & 1 != 0 {
+                        p.signal("g", 1, Display::Bin, d);
+                    }
                     p.end();
                 }
             }
@@ -2472,7 +2618,9 @@ mod tests {
     }
 
     /// Blocks and versioned blocks write the waveform that one call per
-    /// scope and signal writes, whatever the scope filter and window.
+    /// scope and signal writes, whatever the scope filter and window; and
+    /// so do sections skipped while unchanged (the registers' scope, and
+    /// their versioned block within two nested sections).
     #[test]
     fn blocks_write_what_single_calls_write() {
         let dir = tempfile::tempdir().unwrap();
@@ -2482,6 +2630,9 @@ mod tests {
             ("y", 7),
             ("regs.r1,a", 13),
             ("regs", 3),
+            ("regs,w", 0),
+            ("v.f,x", 5),
+            ("v,u.x", 4),
         ] {
             let calls = waveform(dir.path(), false, scope, first);
             let blocks = waveform(dir.path(), true, scope, first);
