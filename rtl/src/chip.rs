@@ -176,6 +176,10 @@ pub struct Chip<W: Word = i16> {
     /// of them changed; see [`Chip::local_cycles`]), and the waveform
     /// skips them.
     quiet: bool,
+    /// Set only while a waveform samples a cycle of a stream after its
+    /// first: TinyRISC, waiting, shows what it showed in the cycle before
+    /// (see [`Chip::stream`]).
+    risc_quiet: bool,
 }
 
 /// TinyRISC's view of the chip.
@@ -293,6 +297,7 @@ impl<W: Word> Chip<W> {
             idle_control: 0,
             watch: Watch::default(),
             quiet: false,
+            risc_quiet: false,
         }
     }
 
@@ -550,7 +555,13 @@ impl<W: Word> Chip<W> {
                     continue;
                 }
             }
-            match self.stream_cycle::<SAMPLED, S>(sample) {
+            // TinyRISC waits through the whole stream, neither evaluated
+            // nor clocked: after the stream's first cycle it shows what
+            // it showed in the cycle before.
+            self.risc_quiet = SAMPLED && n > 0;
+            let r = self.stream_cycle::<SAMPLED, S>(sample);
+            self.risc_quiet = false;
+            match r {
                 Ok(Some(k)) => active += k as u64,
                 Ok(None) => {
                     stopped = true;
@@ -775,9 +786,13 @@ impl<W: Word> Traced for Chip<W> {
         // entered at all.
         const SCOPES: [&str; 4] = ["tinyrisc", "broadcast", "dma", "array"];
         let on = p.open_scopes(4, &mut |i| SCOPES[i].to_string());
-        if on & 1 != 0 && p.scope(format_args!("tinyrisc")) {
-            self.risc.trace(p);
-            p.end();
+        // TinyRISC, unchanged while it waits for a stream (`risc_quiet`).
+        if p.section(self.risc_quiet) {
+            if on & 1 != 0 && p.scope(format_args!("tinyrisc")) {
+                self.risc.trace(p);
+                p.end();
+            }
+            p.end_section();
         }
         // The rest, unchanged while TinyRISC works alone (`quiet`).
         if !p.section(self.quiet) {
