@@ -558,9 +558,13 @@ impl<W: Word> Chip<W> {
             // TinyRISC waits through the whole stream, neither evaluated
             // nor clocked: after the stream's first cycle it shows what
             // it showed in the cycle before.
-            self.risc_quiet = SAMPLED && n > 0;
+            if SAMPLED {
+                self.risc_quiet = n > 0;
+            }
             let r = self.stream_cycle::<SAMPLED, S>(sample);
-            self.risc_quiet = false;
+            if SAMPLED {
+                self.risc_quiet = false;
+            }
             match r {
                 Ok(Some(k)) => active += k as u64,
                 Ok(None) => {
