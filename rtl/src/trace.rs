@@ -1339,17 +1339,25 @@ pub struct Tracer {
     section_i: usize,
     /// While declaring: the sections open, and where they began.
     open_sections: Vec<(usize, Progress)>,
-    /// Per signal call (in call order, traced or not), padded with
-    /// untraced calls to a multiple of 64: the mask of its width (0 when
-    /// it is not traced, so it never changes)...
+    /// Per signal call (in call order, traced or not), while declaring:
+    /// the mask of its width (0 when it is not traced, so it never
+    /// changes) and its last value (0).
     masks: Vec<u64>,
-    /// ... the value last written...
     lasts: Vec<u64>,
-    /// ... and the value reported in the cycle being sampled (a block
-    /// skipped while its version holds leaves the last one). The walk
-    /// only copies values here; they are compared with `lasts` after it,
-    /// 64 at a time.
+    /// While sampling, from word [`Tracer::hot_at`] on, three arrays of a
+    /// word per signal call padded with untraced calls to a multiple of
+    /// 64 ([`Tracer::hot`]): the value reported in the cycle being sampled
+    /// (a block or section skipped leaves the last one; the walk only
+    /// copies values here, they are compared 64 at a time after it), the
+    /// mask of its width, and the value last written. One allocation,
+    /// each array on whole cache lines, so that no vector access splits a
+    /// line or a page: with the arrays wherever the heap put them (the
+    /// last values once straddled a 4 KB page), a throwaway allocation
+    /// before them moved the simulating thread's time for the bench's
+    /// frame by up to 0.8 ms; laid out here, 0.0173-0.0177 s against
+    /// 0.0176-0.0179 s (docs/performance.md).
     cur: Vec<u64>,
+    hot_at: usize,
     /// Signal calls declared (before the padding).
     n_slots: usize,
     /// Per signal call: the bytes a change of it adds to the waveform
@@ -1633,6 +1641,7 @@ impl Tracer {
             masks: Vec::new(),
             lasts: Vec::new(),
             cur: Vec::new(),
+            hot_at: 0,
             n_slots: 0,
             batch: Vec::new(),
             slot_decl: Vec::new(),
@@ -1718,7 +1727,10 @@ impl Tracer {
         let padded = t.n_slots.next_multiple_of(64);
         t.masks.resize(padded, 0);
         t.lasts.resize(padded, 0);
-        t.cur = vec![0; padded];
+        t.cur = vec![0; 3 * padded + 8];
+        t.hot_at = (64 - t.cur.as_ptr() as usize % 64) % 64 / 8;
+        let masks = t.hot_at + padded;
+        t.cur[masks..masks + padded].copy_from_slice(&t.masks);
         t.slot_decl.resize(padded, NOT_TRACED);
         // A change costs about its width in digits and 6 bytes more.
         t.costs = t.masks.iter().map(|m| m.count_ones() as u8 + 6).collect();
@@ -2030,7 +2042,8 @@ impl Probe for Tracer {
             // hold.
             return;
         }
-        if let Some(cur) = self.cur.get_mut(start..start + n) {
+        let at = self.hot_at + start;
+        if let Some(cur) = self.cur.get_mut(at..at + n) {
             fill(cur);
         }
     }
@@ -2325,7 +2338,8 @@ impl Tracer {
     fn sample_calls(&mut self, values: &[u64]) {
         let start = self.slot_i;
         self.slot_i += values.len();
-        if let Some(cur) = self.cur.get_mut(start..start + values.len()) {
+        let at = self.hot_at + start;
+        if let Some(cur) = self.cur.get_mut(at..at + values.len()) {
             cur.copy_from_slice(values);
         } // else more calls than declared: reported after the walk
     }
@@ -2335,9 +2349,13 @@ impl Tracer {
     /// changed and their values queued as one message ([`MSG_CHUNK`]).
     fn write_changes(&mut self) {
         let first = std::mem::take(&mut self.first_sample);
-        let (cur, _) = self.cur.as_chunks::<64>();
-        let (masks, _) = self.masks.as_chunks::<64>();
-        let (lasts, _) = self.lasts.as_chunks_mut::<64>();
+        let padded = self.n_slots.next_multiple_of(64);
+        let hot = self.cur.get_mut(self.hot_at..).unwrap_or_default();
+        let (cur, rest) = hot.split_at_mut(padded.min(hot.len()));
+        let (masks, lasts) = rest.split_at_mut(padded.min(rest.len()));
+        let (cur, _) = cur.as_chunks::<64>();
+        let (masks, _) = masks.as_chunks::<64>();
+        let (lasts, _) = lasts.as_chunks_mut::<64>();
         let (costs, _) = self.costs.as_chunks::<64>();
         // Indexed, not zipped: the zip's length (the least of four) took
         // a chain of vector instructions in front of every sample.
