@@ -1341,12 +1341,11 @@ pub struct Tracer {
     open_sections: Vec<(usize, Progress)>,
     /// Per signal call (in call order, traced or not), while declaring:
     /// the mask of its width (0 when it is not traced, so it never
-    /// changes) and its last value (0).
+    /// changes).
     masks: Vec<u64>,
-    lasts: Vec<u64>,
     /// While sampling, from word [`Tracer::hot_at`] on, three arrays of a
     /// word per signal call padded with untraced calls to a multiple of
-    /// 64 ([`Tracer::hot`]): the value reported in the cycle being sampled
+    /// 64: the value reported in the cycle being sampled
     /// (a block or section skipped leaves the last one; the walk only
     /// copies values here, they are compared 64 at a time after it), the
     /// mask of its width, and the value last written. One allocation,
@@ -1356,7 +1355,7 @@ pub struct Tracer {
     /// before them moved the simulating thread's time for the bench's
     /// frame by up to 0.8 ms; laid out here, 0.0173-0.0177 s against
     /// 0.0176-0.0179 s (docs/performance.md).
-    cur: Vec<u64>,
+    hot: Vec<u64>,
     hot_at: usize,
     /// Signal calls declared (before the padding).
     n_slots: usize,
@@ -1639,8 +1638,7 @@ impl Tracer {
             section_i: 0,
             open_sections: Vec::new(),
             masks: Vec::new(),
-            lasts: Vec::new(),
-            cur: Vec::new(),
+            hot: Vec::new(),
             hot_at: 0,
             n_slots: 0,
             batch: Vec::new(),
@@ -1726,11 +1724,10 @@ impl Tracer {
         t.n_slots = t.masks.len();
         let padded = t.n_slots.next_multiple_of(64);
         t.masks.resize(padded, 0);
-        t.lasts.resize(padded, 0);
-        t.cur = vec![0; 3 * padded + 8];
-        t.hot_at = (64 - t.cur.as_ptr() as usize % 64) % 64 / 8;
+        t.hot = vec![0; 3 * padded + 8];
+        t.hot_at = (64 - t.hot.as_ptr() as usize % 64) % 64 / 8;
         let masks = t.hot_at + padded;
-        t.cur[masks..masks + padded].copy_from_slice(&t.masks);
+        t.hot[masks..masks + padded].copy_from_slice(&t.masks);
         t.slot_decl.resize(padded, NOT_TRACED);
         // A change costs about its width in digits and 6 bytes more.
         t.costs = t.masks.iter().map(|m| m.count_ones() as u8 + 6).collect();
@@ -2043,7 +2040,7 @@ impl Probe for Tracer {
             return;
         }
         let at = self.hot_at + start;
-        if let Some(cur) = self.cur.get_mut(at..at + n) {
+        if let Some(cur) = self.hot.get_mut(at..at + n) {
             fill(cur);
         }
     }
@@ -2179,7 +2176,6 @@ impl Tracer {
         }
         if self.decls.len() == decls {
             self.masks.truncate(slots);
-            self.lasts.truncate(slots);
             self.slot_decl.truncate(slots);
             return 0;
         }
@@ -2314,7 +2310,6 @@ impl Tracer {
                 }
             };
             self.masks.push(u64::MAX >> (64 - width.clamp(1, 64)));
-            self.lasts.push(0);
             self.slot_decl.push(self.decls.len() as u32);
             self.decls.push(Decl {
                 path,
@@ -2328,7 +2323,6 @@ impl Tracer {
     /// A signal call that is not traced: its value is masked to 0.
     fn untraced_slot(&mut self) {
         self.masks.push(0);
-        self.lasts.push(0);
         self.slot_decl.push(NOT_TRACED);
     }
 
@@ -2339,7 +2333,7 @@ impl Tracer {
         let start = self.slot_i;
         self.slot_i += values.len();
         let at = self.hot_at + start;
-        if let Some(cur) = self.cur.get_mut(at..at + values.len()) {
+        if let Some(cur) = self.hot.get_mut(at..at + values.len()) {
             cur.copy_from_slice(values);
         } // else more calls than declared: reported after the walk
     }
@@ -2350,7 +2344,7 @@ impl Tracer {
     fn write_changes(&mut self) {
         let first = std::mem::take(&mut self.first_sample);
         let padded = self.n_slots.next_multiple_of(64);
-        let hot = self.cur.get_mut(self.hot_at..).unwrap_or_default();
+        let hot = self.hot.get_mut(self.hot_at..).unwrap_or_default();
         let (cur, rest) = hot.split_at_mut(padded.min(hot.len()));
         let (masks, lasts) = rest.split_at_mut(padded.min(rest.len()));
         let (cur, _) = cur.as_chunks::<64>();
