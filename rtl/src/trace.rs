@@ -1297,11 +1297,6 @@ struct Decl {
     info: SigInfo,
 }
 
-enum Phase {
-    Declare,
-    Sample,
-}
-
 /// The VCD writer. Attach it to a [`crate::kernel::Sim`].
 pub struct Tracer {
     cfg: TraceConfig,
@@ -1312,7 +1307,6 @@ pub struct Tracer {
     target: PathBuf,
     top: String,
     w: Sink,
-    phase: Phase,
     patterns: Vec<Vec<String>>,
     // declaration state
     stack: Vec<String>,
@@ -1324,21 +1318,18 @@ pub struct Tracer {
     scope_on: Vec<bool>,
     /// Answers of [`Probe::open_scopes`], in call order.
     open_masks: Vec<u64>,
-    open_i: usize,
     /// Per [`Probe::block_versioned`] call: the version last sampled and
     /// the block's size.
     versions: Vec<(u64, usize)>,
-    version_i: usize,
     /// Per [`Probe::block`] call: the signal calls it takes, 0 when none
     /// of its fields is traced (its values are then not kept at all).
     block_n: Vec<u32>,
-    block_i: usize,
-    /// Per [`Probe::section`]: the calls of each table it holds
-    /// ([`Progress`]), which a section skipped moves on by.
+    /// Per [`Probe::section`]: the calls of each table made by its end
+    /// ([`Progress`], counted from the walk's start; the walk makes the
+    /// same calls every cycle), where a section skipped moves on to.
     sections: Vec<Progress>,
-    section_i: usize,
-    /// While declaring: the sections open, and where they began.
-    open_sections: Vec<(usize, Progress)>,
+    /// While declaring: the sections open.
+    open_sections: Vec<usize>,
     /// Per signal call (in call order, traced or not), while declaring:
     /// the mask of its width (0 when it is not traced, so it never
     /// changes).
@@ -1370,8 +1361,6 @@ pub struct Tracer {
     /// Per signal call: the index of its declaration, [`NOT_TRACED`] if none.
     slot_decl: Vec<u32>,
     // sampling state
-    scope_i: usize,
-    slot_i: usize,
     /// In the first sampled cycle every call counts as a change (and the
     /// traced ones are written).
     first_sample: bool,
@@ -1622,20 +1611,15 @@ impl Tracer {
             target,
             top: top_name.to_string(),
             w,
-            phase: Phase::Declare,
             patterns,
             stack: Vec::new(),
             top_scopes: Vec::new(),
             decls: Vec::new(),
             scope_on: Vec::new(),
             open_masks: Vec::new(),
-            open_i: 0,
             versions: Vec::new(),
-            version_i: 0,
             block_n: Vec::new(),
-            block_i: 0,
             sections: Vec::new(),
-            section_i: 0,
             open_sections: Vec::new(),
             masks: Vec::new(),
             hot: Vec::new(),
@@ -1643,8 +1627,6 @@ impl Tracer {
             n_slots: 0,
             batch: Vec::new(),
             slot_decl: Vec::new(),
-            scope_i: 0,
-            slot_i: 0,
             first_sample: true,
             digits_cycle: 0,
             digits: 1,
@@ -1660,7 +1642,7 @@ impl Tracer {
             truncated_at: None,
             costs: Vec::new(),
         };
-        top.trace(&mut t);
+        top.trace(&mut Declaring(&mut t));
         if !t.open_sections.is_empty() {
             t.err
                 .get_or_insert(io::Error::other("a module began a section it did not end"));
@@ -1736,7 +1718,6 @@ impl Tracer {
         // last ones stored as 8 words wherever they end, see
         // `Chunk::changes`).
         t.batch = Vec::with_capacity(BATCH + 2 + 2 * padded + 8);
-        t.phase = Phase::Sample;
         Ok(t)
     }
 
@@ -1774,17 +1755,30 @@ impl Tracer {
             return Ok(());
         }
         queue_cycle(&mut self.batch, cycle);
-        self.scope_i = 0;
-        self.slot_i = 0;
-        self.open_i = 0;
-        self.version_i = 0;
-        self.block_i = 0;
-        self.section_i = 0;
-        top.trace(self);
-        if self.slot_i != self.n_slots {
+        let padded = self.n_slots.next_multiple_of(64);
+        let at = self.hot_at;
+        let mut s = Sampler {
+            scope_on: &self.scope_on,
+            open_masks: &self.open_masks,
+            versions: &mut self.versions,
+            block_n: &self.block_n,
+            sections: &self.sections,
+            cur: self.hot.get_mut(at..at + padded).unwrap_or_default(),
+            first: self.first_sample,
+            at: Progress::default(),
+            undeclared: false,
+        };
+        top.trace(&mut s);
+        let (slots, undeclared) = (s.at.slots, s.undeclared);
+        if undeclared {
+            return Err(io::Error::other(
+                "a module reported a block of signals it did not declare",
+            ));
+        }
+        if slots != self.n_slots {
             return Err(io::Error::other(format!(
                 "a module reported {} signals where it declared {}",
-                self.slot_i, self.n_slots
+                slots, self.n_slots
             )));
         }
         self.write_changes();
@@ -2010,127 +2004,187 @@ impl Tracer {
     }
 }
 
-impl Probe for Tracer {
-    // While sampling each call only moves on through the tables the
-    // declaration made; the declaring halves are cold functions of their
-    // own, so that these stay small (a shared body gave every call the
-    // prologue of the largest).
+/// The declaration's walk ([`Tracer::new`]): each [`Probe`] call
+/// declares what it reports and records in the tracer's tables what the
+/// sampled walks ([`Sampler`]) replay.
+struct Declaring<'a>(&'a mut Tracer);
+
+impl Probe for Declaring<'_> {
     fn block_versioned(
         &mut self,
         version: u64,
         fields: &dyn Fn() -> Vec<Field>,
+        _fill: &mut dyn FnMut(&mut [u64]),
+    ) {
+        self.0.declare_versioned(version, fields);
+    }
+
+    fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
+        let n = self.0.declare_block(fields, values);
+        self.0.block_n.push(n as u32);
+    }
+
+    fn signal_row(&mut self, names: &[&str], width: u32, display: Display, _values: &[u64]) {
+        for n in names {
+            self.0.declare_signal(n, width, display);
+        }
+    }
+
+    fn traced_signals(&mut self, names: &[&str]) -> u64 {
+        self.0
+            .declare_mask(names.len(), &mut |i| names[i].to_string(), true)
+    }
+
+    fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
+        self.0.declare_mask(n, name, false)
+    }
+
+    fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
+        self.0.declare_scope(name)
+    }
+
+    fn end(&mut self) {
+        self.0.declare_end();
+    }
+
+    fn section(&mut self, _unchanged: bool) -> bool {
+        self.0.declare_section();
+        true
+    }
+
+    fn end_section(&mut self) {
+        self.0.declare_end_section();
+    }
+
+    fn signal(&mut self, name: &str, width: u32, display: Display, _value: u64) {
+        self.0.declare_signal(name, width, display);
+    }
+}
+
+/// A sampled cycle's walk ([`Tracer::sample`]): each [`Probe`] call only
+/// moves on through the tables the declaration made and copies the
+/// values it reports, with no test of a phase. A section skipped moves
+/// on to where it ends, a copy: when it added its counts, the compiler
+/// added the six indices with vector instructions that loaded them right
+/// after the calls before had stored them one by one, a store the
+/// processor cannot forward. Moved here from the tracer, the walk took as
+/// long; with the copy, the simulating thread's time for the bench's
+/// traced frame went from 0.0166 to 0.0155 s (docs/performance.md).
+struct Sampler<'a> {
+    scope_on: &'a [bool],
+    open_masks: &'a [u64],
+    /// Per [`Probe::block_versioned`]: the version last sampled and the
+    /// block's size.
+    versions: &'a mut [(u64, usize)],
+    block_n: &'a [u32],
+    sections: &'a [Progress],
+    /// A word per signal call: the value reported in this cycle (a block
+    /// or section skipped leaves the last one).
+    cur: &'a mut [u64],
+    /// Every call counts as changed (the first cycle sampled).
+    first: bool,
+    /// The calls of each table so far.
+    at: Progress,
+    /// A block reported that was not declared.
+    undeclared: bool,
+}
+
+impl Sampler<'_> {
+    /// The next signal calls reported `values`.
+    #[inline]
+    fn calls(&mut self, values: &[u64]) {
+        let start = self.at.slots;
+        self.at.slots += values.len();
+        if let Some(cur) = self.cur.get_mut(start..start + values.len()) {
+            cur.copy_from_slice(values);
+        } // else more calls than declared: reported after the walk
+    }
+
+    /// The next answer of [`Probe::open_scopes`] or
+    /// [`Probe::traced_signals`], in the order they were declared.
+    #[inline]
+    fn next_mask(&mut self) -> u64 {
+        let m = self.open_masks.get(self.at.masks).copied().unwrap_or(0);
+        self.at.masks += 1;
+        m
+    }
+}
+
+impl Probe for Sampler<'_> {
+    fn block_versioned(
+        &mut self,
+        version: u64,
+        _fields: &dyn Fn() -> Vec<Field>,
         fill: &mut dyn FnMut(&mut [u64]),
     ) {
-        if let Phase::Declare = self.phase {
-            return self.declare_versioned(version, fields);
-        }
-        let Some(&(last, n)) = self.versions.get(self.version_i) else {
-            self.err.get_or_insert(io::Error::other(
-                "a module reported a block of signals it did not declare",
-            ));
+        let Some(v) = self.versions.get_mut(self.at.versions) else {
+            self.undeclared = true;
             return;
         };
-        self.versions[self.version_i].0 = version;
-        self.version_i += 1;
-        let start = self.slot_i;
-        self.slot_i += n;
-        if n == 0 || (version == last && !self.first_sample) {
+        let (last, n) = *v;
+        v.0 = version;
+        self.at.versions += 1;
+        let start = self.at.slots;
+        self.at.slots += n;
+        if n == 0 || (version == last && !self.first) {
             // Nothing traced, or unchanged: the values last written still
             // hold.
             return;
         }
-        let at = self.hot_at + start;
-        if let Some(cur) = self.hot.get_mut(at..at + n) {
+        if let Some(cur) = self.cur.get_mut(start..start + n) {
             fill(cur);
         }
     }
 
-    fn block(&mut self, fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
-        if let Phase::Declare = self.phase {
-            let n = self.declare_block(fields, values);
-            self.block_n.push(n as u32);
-            return;
-        }
-        let n = self.block_n.get(self.block_i).copied();
-        self.block_i += 1;
+    fn block(&mut self, _fields: &dyn Fn() -> Vec<Field>, values: &[u64]) {
+        let n = self.block_n.get(self.at.blocks).copied();
+        self.at.blocks += 1;
         if n != Some(0) {
-            self.sample_calls(values);
+            self.calls(values);
         }
     }
 
-    fn signal_row(&mut self, names: &[&str], width: u32, display: Display, values: &[u64]) {
-        if let Phase::Declare = self.phase {
-            for n in names {
-                self.declare_signal(n, width, display);
-            }
-            return;
-        }
-        self.sample_calls(&values[..names.len()]);
+    fn signal_row(&mut self, names: &[&str], _width: u32, _display: Display, values: &[u64]) {
+        self.calls(&values[..names.len()]);
     }
 
-    fn traced_signals(&mut self, names: &[&str]) -> u64 {
-        if let Phase::Declare = self.phase {
-            return self.declare_mask(names.len(), &mut |i| names[i].to_string(), true);
-        }
+    fn traced_signals(&mut self, _names: &[&str]) -> u64 {
         self.next_mask()
     }
 
-    fn open_scopes(&mut self, n: usize, name: &mut dyn FnMut(usize) -> String) -> u64 {
-        if let Phase::Declare = self.phase {
-            return self.declare_mask(n, name, false);
-        }
+    fn open_scopes(&mut self, _n: usize, _name: &mut dyn FnMut(usize) -> String) -> u64 {
         self.next_mask()
     }
 
-    fn scope(&mut self, name: fmt::Arguments<'_>) -> bool {
-        if let Phase::Declare = self.phase {
-            return self.declare_scope(name);
-        }
-        let on = self.scope_on.get(self.scope_i).copied().unwrap_or(false);
-        self.scope_i += 1;
+    fn scope(&mut self, _name: fmt::Arguments<'_>) -> bool {
+        let on = self.scope_on.get(self.at.scopes).copied().unwrap_or(false);
+        self.at.scopes += 1;
         on
     }
 
-    fn end(&mut self) {
-        if let Phase::Declare = self.phase {
-            self.declare_end();
-        }
-    }
+    fn end(&mut self) {}
 
     fn section(&mut self, unchanged: bool) -> bool {
-        if let Phase::Declare = self.phase {
-            self.declare_section();
-            return true;
-        }
-        let d = self.sections.get(self.section_i).copied();
-        self.section_i += 1;
-        match d {
-            Some(d) if unchanged && !self.first_sample => {
-                // The values of its calls are those in `cur` already.
-                self.scope_i += d.scopes;
-                self.slot_i += d.slots;
-                self.block_i += d.blocks;
-                self.open_i += d.masks;
-                self.version_i += d.versions;
-                self.section_i += d.sections;
+        let end = self.sections.get(self.at.sections).copied();
+        match end {
+            Some(end) if unchanged && !self.first => {
+                // The values of its calls are those in `cur` already: on
+                // to where it ends.
+                self.at = end;
                 false
             }
-            _ => true,
+            _ => {
+                self.at.sections += 1;
+                true
+            }
         }
     }
 
-    fn end_section(&mut self) {
-        if let Phase::Declare = self.phase {
-            self.declare_end_section();
-        }
-    }
+    fn end_section(&mut self) {}
 
     #[inline]
-    fn signal(&mut self, name: &str, width: u32, display: Display, value: u64) {
-        if let Phase::Declare = self.phase {
-            return self.declare_signal(name, width, display);
-        }
-        self.sample_calls(&[value]);
+    fn signal(&mut self, _name: &str, _width: u32, _display: Display, value: u64) {
+        self.calls(&[value]);
     }
 }
 
@@ -2198,28 +2252,19 @@ impl Tracer {
     #[inline(never)]
     fn declare_section(&mut self) {
         self.sections.push(Progress::default());
-        let start = self.progress();
-        self.open_sections.push((self.sections.len() - 1, start));
+        self.open_sections.push(self.sections.len() - 1);
     }
 
     #[cold]
     #[inline(never)]
     fn declare_end_section(&mut self) {
-        let Some((i, start)) = self.open_sections.pop() else {
+        let Some(i) = self.open_sections.pop() else {
             self.err.get_or_insert(io::Error::other(
                 "a module ended a section it did not begin",
             ));
             return;
         };
-        let end = self.progress();
-        self.sections[i] = Progress {
-            scopes: end.scopes - start.scopes,
-            slots: end.slots - start.slots,
-            blocks: end.blocks - start.blocks,
-            masks: end.masks - start.masks,
-            versions: end.versions - start.versions,
-            sections: end.sections - start.sections,
-        };
+        self.sections[i] = self.progress();
     }
 
     #[cold]
@@ -2256,15 +2301,6 @@ impl Tracer {
         if let Err(e) = self.w.upscope() {
             self.err.get_or_insert(e);
         }
-    }
-
-    /// The next answer of [`Probe::open_scopes`] or
-    /// [`Probe::traced_signals`], in the order they were declared.
-    #[inline]
-    fn next_mask(&mut self) -> u64 {
-        let m = self.open_masks.get(self.open_i).copied().unwrap_or(0);
-        self.open_i += 1;
-        m
     }
 }
 
@@ -2326,18 +2362,6 @@ impl Tracer {
         self.slot_decl.push(NOT_TRACED);
     }
 
-    /// The sampled cycle's next signal calls reported `values`: kept in
-    /// [`Tracer::cur`] until the walk is over.
-    #[inline]
-    fn sample_calls(&mut self, values: &[u64]) {
-        let start = self.slot_i;
-        self.slot_i += values.len();
-        let at = self.hot_at + start;
-        if let Some(cur) = self.hot.get_mut(at..at + values.len()) {
-            cur.copy_from_slice(values);
-        } // else more calls than declared: reported after the walk
-    }
-
     /// Write the values of the cycle's walk that changed (all traced
     /// ones the first time): per chunk of 64 calls, the mask of those that
     /// changed and their values queued as one message ([`MSG_CHUNK`]).
@@ -2372,8 +2396,8 @@ impl Tracer {
     }
 }
 
-/// The calls of each of the tracer's per-call tables (from a point of the
-/// walk on, or within a [`Probe::section`]).
+/// The calls of each of the tracer's per-call tables made so far in a
+/// walk (or by the end of a [`Probe::section`]).
 #[derive(Clone, Copy, Default)]
 struct Progress {
     scopes: usize,
