@@ -1364,6 +1364,9 @@ pub struct Tracer {
     /// In the first sampled cycle every call counts as a change (and the
     /// traced ones are written).
     first_sample: bool,
+    /// The cycle sampled last, its values in [`Tracer::hot`] still to be
+    /// compared and written ([`Tracer::sample`]).
+    pending: Option<u64>,
     /// The digits of the times written, the time that takes one more (the
     /// times only grow) and the first cycle at that time.
     digits: u64,
@@ -1628,6 +1631,7 @@ impl Tracer {
             batch: Vec::new(),
             slot_decl: Vec::new(),
             first_sample: true,
+            pending: None,
             digits_cycle: 0,
             digits: 1,
             digits_below: 10,
@@ -1749,12 +1753,21 @@ impl Tracer {
 
     /// Record the values of `top` during `cycle`. Out of line: the
     /// untraced cycle loop keeps only the test for a tracer.
+    ///
+    /// The values are written one sample late: this call first writes
+    /// the changes of the cycle sampled before ([`Tracer::pending`]), then
+    /// walks `top`. The comparison then loads the values long after the
+    /// walk stored them; right after it, its vector loads waited for the
+    /// walk's narrower stores to reach the cache (a store the processor
+    /// cannot forward to a wider load).
     #[inline(never)]
     pub fn sample<T: Traced>(&mut self, cycle: u64, top: &T) -> io::Result<()> {
+        if let Some(c) = self.pending.take() {
+            self.write_cycle(c)?;
+        }
         if !self.in_window(cycle) {
             return Ok(());
         }
-        queue_cycle(&mut self.batch, cycle);
         let padded = self.n_slots.next_multiple_of(64);
         let at = self.hot_at;
         let mut s = Sampler {
@@ -1781,6 +1794,15 @@ impl Tracer {
                 slots, self.n_slots
             )));
         }
+        self.pending = Some(cycle);
+        self.sampled += 1;
+        self.last_cycle = Some(cycle);
+        Ok(())
+    }
+
+    /// Write the changes of `cycle`, sampled last.
+    fn write_cycle(&mut self, cycle: u64) -> io::Result<()> {
+        queue_cycle(&mut self.batch, cycle);
         self.write_changes();
         if let Some(e) = self.err.take() {
             return Err(e);
@@ -1808,8 +1830,6 @@ impl Tracer {
             eprintln!("morphosys: warning: {msg}");
             self.note.get_or_insert(msg);
         }
-        self.sampled += 1;
-        self.last_cycle = Some(cycle);
         Ok(())
     }
 
@@ -1821,6 +1841,9 @@ impl Tracer {
     /// Close the VCD and write `<stem>.gtkw` and the filter files beside it.
     /// Returns the paths written.
     pub fn finish(mut self) -> io::Result<Vec<PathBuf>> {
+        if let Some(c) = self.pending.take() {
+            self.write_cycle(c)?;
+        }
         let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
         let t = self.time(end);
         let batch = std::mem::take(&mut self.batch);
