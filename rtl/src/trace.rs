@@ -302,6 +302,8 @@ const MSG_VALUE: u64 = (1 << 48) - 1;
 /// is slower than the simulation.
 const BATCH: usize = 1 << 14;
 const QUEUED_BATCHES: usize = 8;
+/// Emptied batches the writing thread makes ready before the first comes.
+const SPARE_BATCHES: usize = 3;
 
 /// The batches between the two threads, handed over without a system
 /// call while both are busy. A channel woke the writing thread at every
@@ -735,16 +737,35 @@ struct VcdBody {
 const VCD_RESERVE: u64 = 4 << 20;
 
 impl VcdBody {
-    /// `reserve`: allocate the file's blocks ahead of the writes (a
-    /// regular file; trimmed by [`VcdBody::trim`]).
+    /// A body with its buffer (the tests'; the tracer's is allocated by
+    /// its writing thread).
+    #[cfg(test)]
     fn new(reserve: bool) -> VcdBody {
+        let mut b = VcdBody::unallocated(reserve);
+        b.allocate();
+        b
+    }
+
+    /// `reserve`: allocate the file's blocks ahead of the writes (a
+    /// regular file; trimmed by [`VcdBody::trim`]). Without its buffer,
+    /// for the writing thread to allocate ([`VcdBody::allocate`]).
+    fn unallocated(reserve: bool) -> VcdBody {
         VcdBody {
             ids: Vec::new(),
-            buf: vec![0; VCD_CHUNK + VCD_ROOM].into_boxed_slice(),
+            buf: Box::default(),
             len: 0,
             time: Decimal::new(),
             written: 0,
             reserved: reserve.then_some(0),
+        }
+    }
+
+    /// Allocate the buffer, by the thread that writes it: its pages are
+    /// then first touched there (allocated with the tracer, the
+    /// simulating thread took the page faults of a quarter megabyte).
+    fn allocate(&mut self) {
+        if self.buf.is_empty() {
+            self.buf = vec![0; VCD_CHUNK + VCD_ROOM].into_boxed_slice();
         }
     }
 
@@ -923,7 +944,9 @@ impl Sink {
     /// (its values are kept if it has a translate filter); `signals`: how
     /// many signals are traced; `clk` and `cycle`: the signals a cycle's
     /// edges set; `clock_hz`: the clock the times are in;
-    /// `section_bytes`: see [`TraceConfig::fst_section_bytes`].
+    /// `section_bytes`: see [`TraceConfig::fst_section_bytes`];
+    /// `batch_words`: the capacity of a batch.
+    #[allow(clippy::too_many_arguments)]
     fn threaded(
         self,
         slots: Vec<Option<Slot>>,
@@ -932,6 +955,7 @@ impl Sink {
         cycle_id: SigId,
         clock_hz: u64,
         section_bytes: usize,
+        batch_words: usize,
     ) -> io::Result<Sink> {
         let queue = std::sync::Arc::new(Handoff::new());
         let rx = WriterGone(queue.clone());
@@ -939,6 +963,16 @@ impl Sink {
             .name("waveform writer".into())
             .spawn(move || {
                 let mut sink = self;
+                if let Sink::Vcd(_, body) = &mut sink {
+                    body.allocate();
+                }
+                // Batches for the simulating thread to copy its messages
+                // into, their pages touched here rather than there.
+                for _ in 0..SPARE_BATCHES {
+                    let mut b = vec![0u64; batch_words];
+                    b.clear();
+                    rx.0.give_back(b);
+                }
                 let mut res = Ok(());
                 // Values of the filtered signals, deduplicated whenever a
                 // list doubles (a set insertion per change cost more).
@@ -1590,7 +1624,7 @@ impl Tracer {
             let mut w = vcd::Writer::new(out);
             w.version(version)?;
             w.timescale(1, TimescaleUnit::PS)?;
-            Sink::Vcd(w, VcdBody::new(tmp_path.is_some()))
+            Sink::Vcd(w, VcdBody::unallocated(tmp_path.is_some()))
         };
         w.add_module(top_name)?;
         let clk = w.add_wire(1, "clk")?;
@@ -1698,6 +1732,13 @@ impl Tracer {
                 Some((d.info.id, d.info.width, filtered, i))
             })
             .collect();
+        t.n_slots = t.masks.len();
+        let padded = t.n_slots.next_multiple_of(64);
+        // Room beyond a full batch for the most a cycle adds: its start,
+        // and per chunk of calls its message, mask and 64 values (the
+        // last ones stored as 8 words wherever they end, see
+        // `Chunk::changes`).
+        let batch_words = BATCH + 2 + 2 * padded + 8;
         t.w = std::mem::replace(&mut t.w, Sink::Gone).threaded(
             slots,
             t.decls.len(),
@@ -1705,10 +1746,9 @@ impl Tracer {
             t.cycle_id,
             t.cfg.clock_hz,
             t.cfg.fst_section_bytes,
+            batch_words,
         )?;
         t.digits_cycle = t.first_cycle_at(t.digits_below);
-        t.n_slots = t.masks.len();
-        let padded = t.n_slots.next_multiple_of(64);
         t.masks.resize(padded, 0);
         t.hot = vec![0; 3 * padded + 8];
         t.hot_at = (64 - t.hot.as_ptr() as usize % 64) % 64 / 8;
@@ -1717,11 +1757,7 @@ impl Tracer {
         t.slot_decl.resize(padded, NOT_TRACED);
         // A change costs about its width in digits and 6 bytes more.
         t.costs = t.masks.iter().map(|m| m.count_ones() as u8 + 6).collect();
-        // Room beyond a full batch for the most a cycle adds: its start,
-        // and per chunk of calls its message, mask and 64 values (the
-        // last ones stored as 8 words wherever they end, see
-        // `Chunk::changes`).
-        t.batch = Vec::with_capacity(BATCH + 2 + 2 * padded + 8);
+        t.batch = Vec::with_capacity(batch_words);
         Ok(t)
     }
 
