@@ -239,7 +239,7 @@ impl<W: Word> Clocked for Array<W> {
 }
 
 impl<W: Word> Traced for Array<W> {
-    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
+    fn trace<P: Probe>(&self, p: &mut P) {
         // Asked once which of these are traced: a trace of one RC computes
         // none of them.
         const NAMES: [&str; 13] = [

@@ -785,7 +785,7 @@ impl<W: Word> Clocked for Chip<W> {
 }
 
 impl<W: Word> Traced for Chip<W> {
-    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
+    fn trace<P: Probe>(&self, p: &mut P) {
         // Asked once which of the four are traced; the others are not
         // entered at all.
         const SCOPES: [&str; 4] = ["tinyrisc", "broadcast", "dma", "array"];
@@ -803,11 +803,7 @@ impl<W: Word> Traced for Chip<W> {
             return;
         }
         if on & 2 != 0 && p.scope(format_args!("broadcast")) {
-            let (busy, ctx, k, ptr) = match self.bcast.current() {
-                Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
-                None => (0, 0, 0, [0, 0]),
-            };
-            p.block(
+            p.block_with(
                 &|| {
                     vec![
                         Field::new("", "busy", 1, Display::Bin),
@@ -818,23 +814,25 @@ impl<W: Word> Traced for Chip<W> {
                         Field::new("", "fb1_ptr", 16, Display::Hex),
                     ]
                 },
-                &[
-                    busy,
-                    !self.bcast.can_issue() as u64,
-                    ctx,
-                    k,
-                    ptr[0] as u64,
-                    ptr[1] as u64,
-                ],
+                |v| {
+                    let (busy, ctx, k, ptr) = match self.bcast.current() {
+                        Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
+                        None => (0, 0, 0, [0, 0]),
+                    };
+                    *v = [
+                        busy,
+                        !self.bcast.can_issue() as u64,
+                        ctx,
+                        k,
+                        ptr[0] as u64,
+                        ptr[1] as u64,
+                    ];
+                },
             );
             p.end();
         }
         if on & 4 != 0 && p.scope(format_args!("dma")) {
-            let (kind, mem, local) = match self.dma.current() {
-                Some((r, _)) => (r.kind as u64, r.mem as u64, r.local as u64),
-                None => (0, 0, 0),
-            };
-            p.block(
+            p.block_with(
                 &|| {
                     vec![
                         Field::new("", "kind", 2, Display::Hex),
@@ -845,14 +843,20 @@ impl<W: Word> Traced for Chip<W> {
                         Field::new("", "ctx_banks", 2, Display::Bin),
                     ]
                 },
-                &[
-                    kind,
-                    mem,
-                    local,
-                    self.dma.remaining() as u64,
-                    self.dma.owned_fb_banks() as u64,
-                    self.dma.owned_ctx_banks() as u64,
-                ],
+                |v| {
+                    let (kind, mem, local) = match self.dma.current() {
+                        Some((r, _)) => (r.kind as u64, r.mem as u64, r.local as u64),
+                        None => (0, 0, 0),
+                    };
+                    *v = [
+                        kind,
+                        mem,
+                        local,
+                        self.dma.remaining() as u64,
+                        self.dma.owned_fb_banks() as u64,
+                        self.dma.owned_ctx_banks() as u64,
+                    ];
+                },
             );
             p.end();
         }

@@ -227,7 +227,7 @@ mod tests {
     }
 
     impl Traced for Swap {
-        fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
+        fn trace<P: Probe>(&self, p: &mut P) {
             p.signal("a", 32, crate::trace::Display::Hex, self.q[0] as u64);
         }
     }

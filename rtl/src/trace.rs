@@ -121,6 +121,22 @@ pub trait Probe {
             }
         }
     }
+    /// [`Probe::block`] with its `N` values written by `fill` into the
+    /// array it is given: a probe that keeps the values may give it its
+    /// own storage, so that they are not gathered first and copied, and
+    /// need not call it at all when none of the fields is traced (`fill`
+    /// only computes values).
+    fn block_with<const N: usize>(
+        &mut self,
+        fields: &dyn Fn() -> Vec<Field>,
+        fill: impl FnOnce(&mut [u64; N]),
+    ) where
+        Self: Sized,
+    {
+        let mut v = [0; N];
+        fill(&mut v);
+        self.block(fields, &v);
+    }
     /// A part of the walk, up to the matching [`Probe::end_section`],
     /// that reports (when `unchanged`) the values it reported in the last
     /// cycle sampled. `false`: the probe skips it (the caller does not
@@ -195,7 +211,7 @@ impl Field {
 /// inline (through `dyn Probe` a traced cycle cost some twenty indirect
 /// calls).
 pub trait Traced {
-    fn trace<P: Probe + ?Sized>(&self, p: &mut P);
+    fn trace<P: Probe>(&self, p: &mut P);
 }
 
 /// What to trace.
@@ -2203,6 +2219,28 @@ impl Probe for Sampler<'_> {
         }
     }
 
+    #[inline]
+    fn block_with<const N: usize>(
+        &mut self,
+        _fields: &dyn Fn() -> Vec<Field>,
+        fill: impl FnOnce(&mut [u64; N]),
+    ) {
+        let n = self.block_n.get(self.at.blocks).copied();
+        self.at.blocks += 1;
+        if n == Some(0) {
+            return;
+        }
+        let start = self.at.slots;
+        self.at.slots += N;
+        if let Some(cur) = self
+            .cur
+            .get_mut(start..start + N)
+            .and_then(|c| <&mut [u64; N]>::try_from(c).ok())
+        {
+            fill(cur);
+        } // else more calls than declared: reported after the walk
+    }
+
     fn signal_row(&mut self, names: &[&str], _width: u32, _display: Display, values: &[u64]) {
         self.calls(&values[..names.len()]);
     }
@@ -2592,8 +2630,9 @@ mod tests {
     use super::*;
     use crate::kernel::{Clocked, Fault, Sim};
 
-    /// A counter reporting the same signals through blocks (and a
-    /// versioned block) or through one call per scope and signal.
+    /// A counter reporting the same signals through blocks (of values
+    /// given and filled in, and versioned ones) or through one call per
+    /// scope and signal.
     struct Demo {
         t: u64,
         by_block: bool,
@@ -2609,13 +2648,13 @@ mod tests {
     }
 
     impl Traced for Demo {
-        fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
+        fn trace<P: Probe>(&self, p: &mut P) {
             let t = self.t;
             let (a, b, c, d) = (t, t / 3, (t * 7) as i16 as u64, t % 2);
             let (r0, r1) = (t / 5, t / 5 * 3);
             let (e, f) = (t / 2 % 16, t / 2 % 4);
             if self.by_block {
-                p.block(
+                p.block_with(
                     &|| {
                         vec![
                             Field::new("", "a", 8, Display::Hex),
@@ -2624,7 +2663,7 @@ mod tests {
                             Field::new("y", "d", 1, Display::Bin),
                         ]
                     },
-                    &[a, b, c, d],
+                    |v| *v = [a, b, c, d],
                 );
                 // The registers change every fifth cycle, and two nested
                 // sections say so; `e` every second.
@@ -2653,7 +2692,9 @@ mod tests {
                         &|| vec![Field::new("w", "e", 4, Display::Hex)],
                         &mut |v| v[0] = e,
                     );
-                    p.block(&|| vec![Field::new("v", "f", 2, Display::Hex)], &[f]);
+                    p.block_with(&|| vec![Field::new("v", "f", 2, Display::Hex)], |v| {
+                        *v = [f]
+                    });
                     p.end_section();
                 }
                 p.block(&|| vec![Field::new("u", "g", 1, Display::Bin)], &[d]);

@@ -768,12 +768,12 @@ const REG_NAMES: [&str; 16] = [
 ];
 
 impl<const N: usize, W: Word> Traced for RcArray<N, W> {
-    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
+    fn trace<P: Probe>(&self, p: &mut P) {
         let c = &self.ctx;
         let en = self.enabled();
         // The array at a glance: its context, and which RCs are awake and
         // which have F set (bit i: RC i, row-major).
-        p.block(
+        p.block_with(
             &|| {
                 vec![
                     Field::new("", "ctx", 32, Display::Translate(&CTX_FILTER)),
@@ -782,12 +782,14 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
                     Field::new("", "flag_f", N as u32, Display::Hex),
                 ]
             },
-            &[
-                self.ctx_word as u64,
-                c.op as u64,
-                !self.flags.sleep & Self::FULL,
-                self.flags.f & Self::FULL,
-            ],
+            |v| {
+                *v = [
+                    self.ctx_word as u64,
+                    c.op as u64,
+                    !self.flags.sleep & Self::FULL,
+                    self.flags.f & Self::FULL,
+                ]
+            },
         );
         let bits = W::BITS;
         let mask = |b: u32| if b >= 64 { u64::MAX } else { (1u64 << b) - 1 };
@@ -812,21 +814,22 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
             // Two blocks per RC: out, alu, mul, flags and the register
             // file; ram.
             let bit = |m: Mask| m >> i & 1;
-            let mut v = [0u64; 26];
-            v[0] = sig(self.out[i]);
-            v[1] = sig(self.operand_a(i));
-            v[2] = sig(self.operand_b(i));
-            v[3] = sig(self.res[i]);
-            v[4] = bit(en);
-            v[5] = W::acc_i128(self.acc[i]) as u64 & mask(2 * bits);
-            v[6] = bit(self.flags.f);
-            v[7] = bit(self.flags.c);
-            v[8] = bit(self.flags.v);
-            v[9] = bit(self.flags.sleep);
-            for (k, r) in v[10..].iter_mut().enumerate() {
-                *r = sig(self.regs.r[k][i]);
-            }
-            p.block(
+            let fill = |v: &mut [u64; 26]| {
+                v[0] = sig(self.out[i]);
+                v[1] = sig(self.operand_a(i));
+                v[2] = sig(self.operand_b(i));
+                v[3] = sig(self.res[i]);
+                v[4] = bit(en);
+                v[5] = W::acc_i128(self.acc[i]) as u64 & mask(2 * bits);
+                v[6] = bit(self.flags.f);
+                v[7] = bit(self.flags.c);
+                v[8] = bit(self.flags.v);
+                v[9] = bit(self.flags.sleep);
+                for (k, r) in v[10..].iter_mut().enumerate() {
+                    *r = sig(self.regs.r[k][i]);
+                }
+            };
+            p.block_with(
                 &|| {
                     let mut f = vec![
                         Field::new("", "out", bits, Display::Signed),
@@ -843,20 +846,22 @@ impl<const N: usize, W: Word> Traced for RcArray<N, W> {
                     f.extend(REG_NAMES.map(|r| Field::new("regfile", r, bits, Display::Signed)));
                     f
                 },
-                &v,
+                fill,
             );
             let mem = matches!(c.op, Op::Ld | Op::St) && en >> i & 1 != 0;
-            p.block(
+            p.block_with(
                 &|| {
                     vec![
                         Field::new("ram", "addr", 9, Display::Hex),
                         Field::new("ram", "we", 1, Display::Bin),
                     ]
                 },
-                &[
-                    if mem { self.ram_addr(i) as u64 } else { 0 },
-                    (mem && c.op == Op::St) as u64,
-                ],
+                |v| {
+                    *v = [
+                        if mem { self.ram_addr(i) as u64 } else { 0 },
+                        (mem && c.op == Op::St) as u64,
+                    ]
+                },
             );
             p.end();
         }

@@ -260,8 +260,8 @@ pub static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
 };
 
 impl Traced for TinyRisc {
-    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
-        p.block(
+    fn trace<P: Probe>(&self, p: &mut P) {
+        p.block_with(
             &|| {
                 vec![
                     Field::new("", "pc", 32, Display::Hex),
@@ -269,7 +269,7 @@ impl Traced for TinyRisc {
                     Field::new("", "state", 3, Display::Translate(&STATE_FILTER)),
                 ]
             },
-            &[self.pc as u64, self.ir as u64, self.state as u64],
+            |v| *v = [self.pc as u64, self.ir as u64, self.state as u64],
         );
         // The register file, skipped by a waveform while no instruction
         // issues (only an issuing cycle writes a register, and `issued`

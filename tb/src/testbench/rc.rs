@@ -46,7 +46,7 @@ impl Clocked for RcBench {
 }
 
 impl Traced for RcBench {
-    fn trace<P: Probe + ?Sized>(&self, p: &mut P) {
+    fn trace<P: Probe>(&self, p: &mut P) {
         if p.scope(format_args!("stim")) {
             p.signal("step", 32, rtl::trace::Display::Signed, self.pc as u64);
             p.signal(
