@@ -287,14 +287,17 @@ enum Sink {
     Threaded {
         queue: std::sync::Arc<Handoff>,
         worker: std::thread::JoinHandle<Written>,
+        /// The values of the signals with translate filters, sent once
+        /// the last batch is written (before the file is closed).
+        seen: std::sync::mpsc::Receiver<Vec<BTreeSet<u64>>>,
     },
     /// Between the two FST phases, or after finishing.
     Gone,
 }
 
-/// What the writing thread hands back: the sink, how writing went, and
-/// per traced signal the values it took if it has a translate filter.
-type Written = (Sink, io::Result<()>, Vec<BTreeSet<u64>>);
+/// What the writing thread hands back: the sink, closed, and how writing
+/// went.
+type Written = (Sink, io::Result<()>);
 
 /// What the sampling thread hands the writing thread, packed in 64-bit
 /// words (the messages are most of the traffic between the two cores):
@@ -335,6 +338,9 @@ struct Handoff {
     asleep: std::sync::atomic::AtomicBool,
     /// The simulating thread has handed over its last batch.
     done: std::sync::atomic::AtomicBool,
+    /// Set before `done`: the time the waveform ends at, and the note to
+    /// leave in it ([`Tracer::note`]).
+    end: std::sync::Mutex<Option<(u64, Option<String>)>>,
     /// The writing thread takes no more batches (it ended or panicked).
     gone: std::sync::atomic::AtomicBool,
 }
@@ -350,6 +356,7 @@ impl Handoff {
             empty: Default::default(),
             asleep: AtomicBool::new(false),
             done: AtomicBool::new(false),
+            end: Default::default(),
             gone: AtomicBool::new(false),
         }
     }
@@ -427,6 +434,37 @@ impl Handoff {
         if e.len() < QUEUED_BATCHES + 2 {
             e.push(batch);
         }
+    }
+}
+
+/// A waveform its writing thread is finishing ([`Sink::hand_last`]).
+struct Closing {
+    worker: std::thread::JoinHandle<Written>,
+    seen: std::sync::mpsc::Receiver<Vec<BTreeSet<u64>>>,
+    /// The last batch reached the thread.
+    sent: bool,
+}
+
+impl Closing {
+    /// Per traced signal the values it took if it has a translate filter,
+    /// once every change is written.
+    fn seen(&self) -> io::Result<Vec<BTreeSet<u64>>> {
+        self.seen
+            .recv()
+            .map_err(|_| io::Error::other("the waveform writer stopped"))
+    }
+
+    /// Wait for the file to be closed; how writing went.
+    fn join(self) -> io::Result<()> {
+        let (_sink, res) = self
+            .worker
+            .join()
+            .map_err(|_| io::Error::other("the waveform writer panicked"))?;
+        res?;
+        if !self.sent {
+            return Err(io::Error::other("the waveform writer stopped"));
+        }
+        Ok(())
     }
 }
 
@@ -975,6 +1013,7 @@ impl Sink {
     ) -> io::Result<Sink> {
         let queue = std::sync::Arc::new(Handoff::new());
         let rx = WriterGone(queue.clone());
+        let (seen_tx, seen_rx) = std::sync::mpsc::sync_channel(1);
         let worker = std::thread::Builder::new()
             .name("waveform writer".into())
             .spawn(move || {
@@ -1098,31 +1137,68 @@ impl Sink {
                         res = sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0));
                     }
                 }
+                // The values first, so that the filter files are written
+                // while this thread closes the waveform.
                 let seen = seen.lists.into_iter().map(BTreeSet::from_iter).collect();
-                (sink, res, seen)
+                let _ = seen_tx.send(seen);
+                if res.is_ok() {
+                    let end = rx.0.end.lock().unwrap_or_else(|e| e.into_inner()).take();
+                    res = match end {
+                        Some((t, note)) => sink.close(t, note.as_deref()),
+                        None => Err(io::Error::other("the waveform ended without an end time")),
+                    };
+                }
+                (sink, res)
             })?;
-        Ok(Sink::Threaded { queue, worker })
+        Ok(Sink::Threaded {
+            queue,
+            worker,
+            seen: seen_rx,
+        })
     }
 
-    /// The sink back from its writing thread, every change written (the
-    /// last ones in `batch`), and the values of the signals with translate
-    /// filters.
-    fn join(self, batch: Vec<u64>) -> io::Result<(Sink, Vec<BTreeSet<u64>>)> {
+    /// Write the end of the waveform at time `t`, with `note`, flush it and
+    /// give back the blocks allocated past its end. Not synced to the
+    /// disk: the rename in [`Tracer::finish`] keeps an interrupted run
+    /// from leaving a partial file under the waveform's name; an fsync of
+    /// a 30 MB trace took longer than simulating it.
+    fn close(&mut self, t: u64, note: Option<&str>) -> io::Result<()> {
+        self.timestamp(t)?;
         match self {
-            Sink::Threaded { queue, worker } => {
+            Sink::Vcd(w, body) => {
+                body.flush(w.writer(), true)?;
+                if let Some(n) = note {
+                    w.comment(n)?;
+                }
+                w.flush()?;
+                body.trim(w.writer())
+            }
+            Sink::FstBody(_) => match std::mem::replace(self, Sink::Gone) {
+                // FST has no comments: the note went to standard error.
+                Sink::FstBody(b) => b.finish().map_err(fst_err)?.flush(),
+                _ => unreachable!(),
+            },
+            _ => Err(io::Error::other("waveform finished twice")),
+        }
+    }
+
+    /// Hand the writing thread the last batch, the time the waveform ends
+    /// at and `note`: it writes them and closes the file
+    /// ([`Sink::close`]) while this thread goes on ([`Closing`]).
+    fn hand_last(self, batch: Vec<u64>, t: u64, note: Option<String>) -> io::Result<Closing> {
+        match self {
+            Sink::Threaded {
+                queue,
+                worker,
+                seen,
+            } => {
                 let sent = queue.send(batch, worker.thread());
+                *queue.end.lock().unwrap_or_else(|e| e.into_inner()) = Some((t, note));
                 queue.done.store(true, std::sync::atomic::Ordering::SeqCst);
                 worker.thread().unpark();
-                let (sink, res, seen) = worker
-                    .join()
-                    .map_err(|_| io::Error::other("the waveform writer panicked"))?;
-                res?;
-                if !sent {
-                    return Err(io::Error::other("the waveform writer stopped"));
-                }
-                Ok((sink, seen))
+                Ok(Closing { worker, seen, sent })
             }
-            other => Ok((other, Vec::new())),
+            _ => Err(io::Error::other("waveform finished twice")),
         }
     }
 
@@ -1130,7 +1206,7 @@ impl Sink {
     /// batch the thread has emptied, or a new one), `batch` left empty.
     fn hand_over(&mut self, batch: &mut Vec<u64>) -> io::Result<()> {
         match self {
-            Sink::Threaded { queue, worker } => {
+            Sink::Threaded { queue, worker, .. } => {
                 let spare = queue.empty.lock().unwrap_or_else(|e| e.into_inner()).pop();
                 let mut copy = spare.unwrap_or_else(|| Vec::with_capacity(batch.capacity()));
                 copy.clear();
@@ -1503,7 +1579,8 @@ fn remove_stale_partials(dir: &Path, name: &str) {
 }
 
 /// Write a small text file through a temporary file and a rename.
-fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
+/// `text` in a temporary file beside `path`, to be renamed onto it.
+fn stage(path: &Path, text: &str) -> io::Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
@@ -1511,8 +1588,15 @@ fn write_atomic(path: &Path, text: &str) -> io::Result<()> {
     let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
     readable(tmp.as_file())?;
     tmp.write_all(text.as_bytes())?;
-    tmp.persist(path).map_err(|e| e.error)?;
-    Ok(())
+    Ok(tmp)
+}
+
+/// The files written beside a waveform ([`Tracer::side_files`]).
+struct SideFiles {
+    vcd_abs: PathBuf,
+    gtkw: PathBuf,
+    /// Per translate filter its name and file.
+    filters: Vec<(&'static str, PathBuf)>,
 }
 
 fn glob(p: &str, s: &str) -> bool {
@@ -1899,51 +1983,47 @@ impl Tracer {
         let end = self.last_cycle.map_or(self.cfg.first, |c| c + 1);
         let t = self.time(end);
         let batch = std::mem::take(&mut self.batch);
-        let (w, seen) = std::mem::replace(&mut self.w, Sink::Gone).join(batch)?;
-        self.w = w;
-        self.seen = seen;
-        self.w.timestamp(t)?;
-        // Not synced to the disk: the rename below keeps an interrupted
-        // run from leaving a partial file under the waveform's name; an
-        // fsync of a 30 MB trace took longer than simulating it.
-        match std::mem::replace(&mut self.w, Sink::Gone) {
-            Sink::Vcd(mut w, mut body) => {
-                body.flush(w.writer(), true)?;
-                if let Some(n) = &self.note {
-                    w.comment(n)?;
-                }
-                w.flush()?;
-                body.trim(w.writer())?;
-                let Some(tmp_path) = self.tmp_path.take() else {
-                    // Written through to a device or FIFO: no file to save beside.
-                    return Ok(vec![self.cfg.path.clone()]);
-                };
-                self.tmp_path = Some(tmp_path);
-            }
-            Sink::FstBody(b) => {
-                // FST has no comments: the note went to standard error.
-                b.finish().map_err(fst_err)?.flush()?;
-            }
-            _ => return Err(io::Error::other("waveform finished twice")),
+        let closing =
+            std::mem::replace(&mut self.w, Sink::Gone).hand_last(batch, t, self.note.clone())?;
+        let Some(tmp_path) = self.tmp_path.take() else {
+            // Written through to a device or FIFO: no file to save beside.
+            closing.seen()?;
+            closing.join()?;
+            return Ok(vec![self.cfg.path.clone()]);
         };
-        let tmp_path = self.tmp_path.take().expect("a regular file");
-        let gtkw = self.write_gtkw()?;
+        // While the writing thread writes the last changes and closes the
+        // file: the save file, then the filter files once the values are
+        // all known, each in a temporary file beside its name, renamed
+        // into place only when the waveform is complete (the two threads'
+        // shares of the end in turn took 0.7 ms of the bench's frame).
+        let files = self.side_files()?;
+        let save = stage(&files.gtkw, &self.save_file(&files))?;
+        self.seen = closing.seen()?;
+        let mut filters = Vec::new();
+        for (name, path) in &files.filters {
+            filters.push(stage(path, &self.filter_file(name))?);
+        }
+        closing.join()?;
+        // The filter files, the save file, the waveform last.
+        for (tmp, (_, path)) in filters.into_iter().zip(&files.filters) {
+            tmp.persist(path).map_err(|e| e.error)?;
+        }
+        save.persist(&files.gtkw).map_err(|e| e.error)?;
         let partial = tmp_path.to_path_buf();
         let done = tmp_path.persist(&self.target).map_err(|e| e.error);
         forget_partial(&partial);
         done?;
-        let mut written = vec![self.cfg.path.clone()];
-        written.extend(gtkw);
+        let mut written = vec![self.cfg.path.clone(), files.gtkw];
+        written.extend(files.filters.into_iter().map(|(_, p)| p));
         Ok(written)
     }
 
-    fn write_gtkw(&self) -> io::Result<Vec<PathBuf>> {
+    /// The files beside the waveform: its save file and a filter file
+    /// per translate filter.
+    fn side_files(&self) -> io::Result<SideFiles> {
         let vcd_abs = std::path::absolute(&self.cfg.path)?;
         let stem = vcd_abs.with_extension("");
         let gtkw = vcd_abs.with_extension("gtkw");
-        let mut out = Vec::new();
-        // Filter files: one per filter, with every value seen in the trace
-        // (plus the filter's whole table when it is small).
         let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
         for d in &self.decls {
             if let Display::Translate(f) = d.info.display {
@@ -1953,39 +2033,50 @@ impl Tracer {
                 }
             }
         }
-        for (name, path) in &filters {
-            let mut vals: BTreeSet<(u32, u64)> = BTreeSet::new();
-            let mut filter: Option<&Filter> = None;
-            for (i, d) in self.decls.iter().enumerate() {
-                if let Display::Translate(f) = d.info.display {
-                    if f.name == *name {
-                        filter = Some(f);
-                        for v in &self.seen[i] {
-                            vals.insert((d.info.width, *v));
-                        }
-                        if d.info.width <= 8 {
-                            for v in 0..(1u64 << d.info.width) {
-                                vals.insert((d.info.width, v));
-                            }
+        Ok(SideFiles {
+            vcd_abs,
+            gtkw,
+            filters,
+        })
+    }
+
+    /// The filter file of the filter `name`: every value seen in the
+    /// trace (plus the filter's whole table when it is small).
+    fn filter_file(&self, name: &str) -> String {
+        let mut vals: BTreeSet<(u32, u64)> = BTreeSet::new();
+        let mut filter: Option<&Filter> = None;
+        for (i, d) in self.decls.iter().enumerate() {
+            if let Display::Translate(f) = d.info.display {
+                if f.name == name {
+                    filter = Some(f);
+                    for v in &self.seen[i] {
+                        vals.insert((d.info.width, *v));
+                    }
+                    if d.info.width <= 8 {
+                        for v in 0..(1u64 << d.info.width) {
+                            vals.insert((d.info.width, v));
                         }
                     }
                 }
             }
-            let f = filter.expect("filter has a declaration");
-            let mut s = String::new();
-            s.push_str(&format!(
-                "# GTKWave translate filter `{name}` written by morphosys\n"
-            ));
-            for (w, v) in vals {
-                if let Some(text) = (f.text)(v) {
-                    let digits = w.div_ceil(4) as usize;
-                    s.push_str(&format!("{v:0digits$X} {text}\n"));
-                }
-            }
-            write_atomic(path, &s)?;
-            out.push(path.clone());
         }
+        let f = filter.expect("filter has a declaration");
+        let mut s = String::new();
+        s.push_str(&format!(
+            "# GTKWave translate filter `{name}` written by morphosys\n"
+        ));
+        for (w, v) in vals {
+            if let Some(text) = (f.text)(v) {
+                let digits = w.div_ceil(4) as usize;
+                s.push_str(&format!("{v:0digits$X} {text}\n"));
+            }
+        }
+        s
+    }
 
+    /// The GTKWave save file.
+    fn save_file(&self, files: &SideFiles) -> String {
+        let (vcd_abs, gtkw, filters) = (&files.vcd_abs, &files.gtkw, &files.filters);
         let mut s = String::new();
         s.push_str("[*]\n[*] GTKWave save file written by morphosys\n[*]\n");
         s.push_str(&format!("[dumpfile] \"{}\"\n", vcd_abs.display()));
@@ -2051,9 +2142,7 @@ impl Tracer {
             }
             s.push_str(&format!("@{:x}\n-{label}\n", 0x1000200));
         }
-        write_atomic(&gtkw, &s)?;
-        out.insert(0, gtkw);
-        Ok(out)
+        s
     }
 
     /// Paths of the files [`Tracer::finish`] writes, before it writes them.
