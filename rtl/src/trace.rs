@@ -282,8 +282,8 @@ enum Sink {
     FstBody(fst_writer::FstBodyWriter<BufWriter<File>>),
     /// While sampling: value changes go in batches ([`Tracer::batch`])
     /// to a thread that writes them into the sink it owns (the simulation
-    /// does not wait for the formatting); [`Sink::join`] gets the sink
-    /// back.
+    /// does not wait for the formatting); [`Sink::hand_last`] hands it
+    /// the end.
     Threaded {
         queue: std::sync::Arc<Handoff>,
         worker: std::thread::JoinHandle<Written>,
@@ -1891,7 +1891,7 @@ impl Tracer {
     /// untraced cycle loop keeps only the test for a tracer.
     ///
     /// The values are written one sample late: this call first writes
-    /// the changes of the cycle sampled before ([`Tracer::pending`]), then
+    /// the changes of the cycle sampled before (kept pending), then
     /// walks `top`. The comparison then loads the values long after the
     /// walk stored them; right after it, its vector loads waited for the
     /// walk's narrower stores to reach the cache (a store the processor
@@ -2168,7 +2168,7 @@ impl Tracer {
     }
 }
 
-/// The declaration's walk ([`Tracer::new`]): each [`Probe`] call
+/// The declaration's walk ([`Tracer::create`]): each [`Probe`] call
 /// declares what it reports and records in the tracer's tables what the
 /// sampled walks ([`Sampler`]) replay.
 struct Declaring<'a>(&'a mut Tracer);
@@ -2494,7 +2494,7 @@ impl Tracer {
     /// Which of `n` names under the current scope the patterns take in
     /// (`complete`: as signals, else as scopes that may hold some):
     /// computed while declaring, replayed in the same order while sampling
-    /// ([`Tracer::next_mask`]).
+    /// ([`Sampler::next_mask`]).
     #[cold]
     #[inline(never)]
     fn declare_mask(
