@@ -447,11 +447,10 @@ struct Closing {
 
 impl Closing {
     /// Per traced signal the values it took if it has a translate filter,
-    /// once every change is written.
-    fn seen(&self) -> io::Result<Vec<BTreeSet<u64>>> {
-        self.seen
-            .recv()
-            .map_err(|_| io::Error::other("the waveform writer stopped"))
+    /// once every change is written; `None` when the thread ended without
+    /// sending them ([`Closing::join`] then says how).
+    fn seen(&self) -> Option<Vec<BTreeSet<u64>>> {
+        self.seen.recv().ok()
     }
 
     /// Wait for the file to be closed; how writing went.
@@ -1987,7 +1986,6 @@ impl Tracer {
             std::mem::replace(&mut self.w, Sink::Gone).hand_last(batch, t, self.note.clone())?;
         let Some(tmp_path) = self.tmp_path.take() else {
             // Written through to a device or FIFO: no file to save beside.
-            closing.seen()?;
             closing.join()?;
             return Ok(vec![self.cfg.path.clone()]);
         };
@@ -1998,7 +1996,11 @@ impl Tracer {
         // shares of the end in turn took 0.7 ms of the bench's frame).
         let files = self.side_files()?;
         let save = stage(&files.gtkw, &self.save_file(&files))?;
-        self.seen = closing.seen()?;
+        let Some(seen) = closing.seen() else {
+            closing.join()?;
+            return Err(io::Error::other("the waveform writer stopped"));
+        };
+        self.seen = seen;
         let mut filters = Vec::new();
         for (name, path) in &files.filters {
             filters.push(stage(path, &self.filter_file(name))?);
