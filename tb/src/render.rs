@@ -46,6 +46,10 @@ pub struct ChipRender {
     /// With [`RenderSettings::profile`]: where the tile loops' cycles went
     /// (every chip instance).
     pub profile: Option<crate::profile::Profile>,
+    /// Host seconds the chip instances ran, summed over them: from the
+    /// waveform's creation, if any, to its end (the frame's setup, the
+    /// firmware and the image's assembly, aside).
+    pub chip_seconds: f64,
 }
 
 /// How the host runs a render (not part of the chip or the firmware).
@@ -229,6 +233,8 @@ struct Group {
     /// Per tile, the 256 output words.
     out: Vec<Vec<i32>>,
     profile: Option<crate::profile::Profile>,
+    /// Host seconds from the waveform's creation to its end.
+    seconds: f64,
 }
 
 fn sym(img: &Image, name: &str) -> Result<u32> {
@@ -295,6 +301,7 @@ fn run_group<W: Word>(
     chip.load(mem::TILE_LIST, &list)
         .map_err(|f| anyhow!("{f}"))?;
     let mut sim = Sim::new(chip);
+    let t0 = std::time::Instant::now();
     if let Some(cfg) = trace {
         let path = cfg.path.clone();
         sim.trace(cfg, "morphosys")
@@ -337,6 +344,7 @@ fn run_group<W: Word>(
     let files = sim
         .finish_trace()
         .map_err(|e| anyhow!("writing the waveform: {e}"))?;
+    let seconds = t0.elapsed().as_secs_f64();
     // (Not for `bench`, whose waveforms are temporary.)
     if say_files {
         for f in files {
@@ -370,6 +378,7 @@ fn run_group<W: Word>(
         startup,
         out,
         profile: prof,
+        seconds,
     })
 }
 
@@ -725,6 +734,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     let mut hits = vec![NO_HIT; (w * h) as usize];
     let mut stats = Stats::default();
     let (mut cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
+    let mut chip_seconds = 0.0;
     let mut profile = None;
     for (gi, r) in results.into_iter().enumerate() {
         let mut g = r?;
@@ -738,6 +748,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             startup = g.start;
         }
         cycles += g.end.saturating_sub(g.start);
+        chip_seconds += g.seconds;
         tests += g.tests;
         passes += g.passes;
         add_stats(&mut stats, &g.stats);
@@ -778,5 +789,6 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         chips: groups.len(),
         firmware: fw,
         profile,
+        chip_seconds,
     })
 }

@@ -394,6 +394,14 @@ fn bench_does_not_announce_its_temporary_waveforms() {
     assert_eq!(j["repeat"], 2);
     assert!(!j["host_cpu"].as_str().unwrap().is_empty());
     assert!(j["traced_slowdown"].as_f64().unwrap() > 1.0, "{j}");
+    // The same for the chip instance alone (the frame's setup aside), and
+    // the two frames' times it comes from.
+    assert!(j["traced_slowdown_chip"].as_f64().unwrap() > 0.0, "{j}");
+    assert!(j["host_seconds_traced"].as_f64().unwrap() > 0.0, "{j}");
+    assert!(
+        j["host_seconds_untraced_small"].as_f64().unwrap() > 0.0,
+        "{j}"
+    );
 }
 
 /// `render --hits` and `reference --hits` make the hit maps `compare --hits`
