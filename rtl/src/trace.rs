@@ -1649,6 +1649,15 @@ impl Drop for Tracer {
         if let Some(t) = &self.tmp_path {
             forget_partial(t);
         }
+        // The writing thread, if any, is told there is no more and waited
+        // for (it writes what it has into the file that goes and ends
+        // without an end time); else it would wait for batches for the
+        // rest of the process.
+        if let Sink::Threaded { queue, worker, .. } = std::mem::replace(&mut self.w, Sink::Gone) {
+            queue.done.store(true, std::sync::atomic::Ordering::SeqCst);
+            worker.thread().unpark();
+            let _ = worker.join();
+        }
     }
 }
 
@@ -2869,6 +2878,33 @@ mod tests {
                 "{scope} from {first}: the waveforms differ"
             );
         }
+    }
+
+    /// A tracer dropped without being finished (a run that failed) ends
+    /// its writing thread and leaves no file.
+    #[test]
+    fn an_unfinished_waveform_ends_its_writer_and_leaves_nothing() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("cut.vcd");
+        let p = path.clone();
+        let (tx, rx) = std::sync::mpsc::channel();
+        std::thread::spawn(move || {
+            let mut sim = Sim::new(Demo {
+                t: 0,
+                by_block: true,
+            });
+            sim.trace(TraceConfig::new(&p), "demo").unwrap();
+            for _ in 0..40_000 {
+                sim.step().unwrap();
+            }
+            drop(sim);
+            tx.send(()).unwrap();
+        });
+        rx.recv_timeout(std::time::Duration::from_secs(20))
+            .expect("dropping the tracer waited for its writer for ever");
+        assert!(!path.exists());
+        let left: Vec<_> = std::fs::read_dir(dir.path()).unwrap().collect();
+        assert!(left.is_empty(), "{left:?}");
     }
 
     /// A waveform of some megabytes is written to blocks allocated ahead
