@@ -188,11 +188,11 @@ pub fn program(
         objk.push(("k_disc", k::planar(Inside::Disc, lay.kt_disc, nm.approx())));
     }
     if has(ChipType::Cone) {
-        objk.push(("k_cone", k::cone(lay.ks_cone, lay.ep_cone, nm.newton_steps)));
+        objk.push(("k_cone", k::cone(lay.ks_cone, lay.ep_cone, nm.approx())));
         if !has(ChipType::Cylinder) {
             objk.push((
                 "k_disc",
-                k::planar(Inside::Disc, lay.kt_disc, nm.newton_steps),
+                k::planar(Inside::Disc, lay.kt_disc, nm.approx()),
             ));
         }
     }
@@ -245,11 +245,11 @@ pub fn program(
     if has(ChipType::GlassCone) {
         objk.push((
             "k_gconef",
-            k::cone_side(lay.ks_cone, lay.ep_cone, nm.newton_steps, false),
+            k::cone_side(lay.ks_cone, lay.ep_cone, nm.approx(), false),
         ));
         objk.push((
             "k_gconeb",
-            k::cone_side(lay.ks_cone, lay.ep_cone, nm.newton_steps, true),
+            k::cone_side(lay.ks_cone, lay.ep_cone, nm.approx(), true),
         ));
     }
     if has(ChipType::GlassCylinder) || has(ChipType::GlassCone) {

@@ -373,18 +373,19 @@ pub fn divide(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: impl Into<Ap
 
 /// [`divide`] with one more bit of range: `q = num * 2^13 / den` for `num >= 0`,
 /// `den` in (0, 32767], the caller having checked `num < 4 den`.
-pub fn divide_q13(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: u32) {
+pub fn divide_q13(k: &mut K, num: u8, den: u8, out: u8, t: [u8; 5], nr: impl Into<Approx>) {
+    let nr: Approx = nr.into();
     let (n, d, o) = (r(num), r(den), r(out));
     let [sh, dn, rc, w, one] = t.map(r);
     k.comment("divide (Q.13 quotient)");
     k.c(format!("clz {sh}, {d}"))
         .c(format!("sub {sh}, {sh}, #1"))
         .c(format!("sll {dn}, {d}, {sh}"))
-        .cq(format!("srl {rc}, {dn}, #7"))
-        .c(format!("and {rc}, {rc}, #127"))
+        .c(format!("srl {rc}, {dn}, #{}", q(7) + nr.coarse()))
+        .c(format!("and {rc}, {rc}, #{}", nr.table_entries - 1))
         .c(format!("ld {rc}, [{rc} + #{}]", ram::RCP))
         .c(format!("ld {one}, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr {
+    for _ in 0..nr.newton_steps {
         k.cq(format!("mul {w}, {dn}, {rc}, >>15"))
             .c(format!("sub {w}, {w}, {one}"))
             .cq(format!("ldacc {rc}, <<14"))
@@ -1341,17 +1342,18 @@ fn cylinder_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>, f
 /// (`A < 0`) needs no special case. `t = b + S tau`; the hit's height
 /// `|q_z + tau d_z| <= hh`; the normal is the gradient
 /// `sg (c^2 p_perp, -s c rho)` at the hit, normalised, in the scene's axes.
-pub fn cone(ks: u32, ep: u32, nr: u32) -> K {
+pub fn cone(ks: u32, ep: u32, nr: impl Into<Approx>) -> K {
     cone_sides(ks, ep, nr, None)
 }
 
 /// The body of a transmitting cone, one side per run (its record holds the
 /// body twice, with `sg` and `-sg`), as [`cylinder_side`].
-pub fn cone_side(ks: u32, ep: u32, nr: u32, back: bool) -> K {
+pub fn cone_side(ks: u32, ep: u32, nr: impl Into<Approx>, back: bool) -> K {
     cone_sides(ks, ep, nr, Some(back))
 }
 
-fn cone_sides(ks: u32, ep: u32, nr: u32, back: Option<bool>) -> K {
+fn cone_sides(ks: u32, ep: u32, nr: impl Into<Approx>, back: Option<bool>) -> K {
+    let nr: Approx = nr.into();
     let ct = ram::CONE_TMP;
     let mut k = K::default();
     k.comment("cone: bounding sphere about M: b = (M - o).d, p = (M - o) - b d");
