@@ -2,550 +2,761 @@
 ; 256x256, 64 ways (8x8 tiles), depth 2, 16-bit datapath, scene format Q5.10, fine normals
 ; packet traversal, BSP sah split to depth 15, at most 5 objects per leaf, collapse auto
         .datapath 16
-; FB image (750 words) at 0x40000, tile list at 0x60000: loaded by the host.
-CTXBASE = 0x20000
-FBIMG = 0x40000
-FBWORDS = 750
-TILELIST = 0x60000
-FB_EYE = 258
-FB_POST = 272
-ROOT = 653
-MAILBOX = 1048576
-NOBJ = 10
+;
+; Every number the program uses is named below. TinyRISC code (.text) steers the
+; traversal and broadcasts RC kernels (.ctx) with their FB streams; each routine
+; and kernel is headed by what it does, its inputs and its outputs.
 
+; ---- number formats (Qn: the 16-bit chip's n fraction bits on this datapath) ----
+X = 0                   ; extra fraction bits of the datapath (16 on the 32-bit chip)
+Q7 = 7 + X
+Q8 = 8 + X
+Q10 = 10 + X
+Q11 = 11 + X            ; Q.11: the square of a vector in normalize
+Q12 = 12 + X            ; colours and weights (Q3.12)
+Q13 = 13 + X            ; Q.13: halves of Q1.14 quantities
+Q14 = 14 + X            ; unit vectors, cosines (Q1.14)
+Q15 = 15 + X            ; Q.15: products of two Q1.14 with one more bit
+Q16 = 16 + X
+TABLE_ENTRIES = 128     ; entries of the RSQ and RCP tables
+RSQ_SHIFT = Q8 + 0      ; X (Q.11) >> RSQ_SHIFT indexes RSQ
+RCP_SHIFT = Q7 + 0      ; a divisor in [2^Q14, 2^Q15) >> RCP_SHIFT ...
+RCP_MASK = 127          ; ... & RCP_MASK indexes RCP
+
+; ---- the scene's fit ----
+TILE_W = 8              ; the tile: TILE_W x TILE_H rays, one per RC
+TILE_H = 8
+KD = 23                 ; eye rays: the pixel steps B, C scaled by 2^KD
+EPS_LSB = 0             ; spawned rays start this far off the surface (LSB)
+P_TOL = 4               ; split planes widened by this many LSB
+KS_SPHERE = 9           ; spheres: invr = 2^(Q14+KS_SPHERE) / r
+EP_SPHERE = 3           ; spheres: extra fraction bits of the perpendicular vector
+KS_CYL = 10             ; cylinders: invr = 2^(Q14+KS_CYL) / r
+EP_CYL = 4              ; cylinders: extra fraction bits of p
+KT_RECT = 14            ; rectangles: edge duals scaled by 2^KT_RECT
+KT_TRI = 11             ; triangles: edge duals scaled by 2^KT_TRI
+KT_DISC = 10            ; discs (caps): axes scaled by 2^KT_DISC
+INSIDE_TOL = 2          ; tolerance of the planar inside tests, Q.14
+
+; ---- main memory (byte addresses) ----
+CTXBASE = 0x20000       ; the kernels (loaded into context memory)
+FBIMG = 0x40000         ; the FB image, loaded by the host
+FBWORDS = 750           ; its words
+TILELIST = 0x60000      ; the tile list, written by the host:
+TL_COUNT = 0            ;   the number of tiles
+TL_FIRST = 4            ;   the first tile's entry:
+TILE_PX = 0             ;     its corner's pixel column
+TILE_PY = 4             ;     its corner's pixel row
+TILE_OUT = 8            ;     where its output goes in main memory
+TILE_BYTES = 12         ;   bytes of an entry
+MASK_HI = 4             ; the high word of a 64-bit mask (RCs 32..63)
+AXIS_X = 0              ; a per-axis table's words
+AXIS_Y = 4
+AXIS_Z = 8
+
+; ---- FB set 0 (word addresses) ----
+FB_EYE = 258            ; eye stream: px0, py0, eye.xyz, (A, B, C) per axis
+EYE_PX = 0              ;   the tile's corner, written per tile
+EYE_PY = 1
+FB_POST = 272           ; post-pass stream: background, (material, Ks) per material
+FB_LIGHT0 = 287         ; light streams: the position (a scale shift first where far)
+FB_LIGHT1 = 290
+FB_LIGHT2 = 293
+FB_SHADE0 = 296         ; shading streams: per material its Phong terms for the light
+FB_SHADE1 = 338
+FB_SHADE2 = 380
+ROOTBOX = 422           ; the root cell widened by P_TOL: per axis min, max
+FB_SPHERE = 428         ; the sphere records
+SPHERE_WORDS = 8        ;   words of one
+FB_CYLINDER = 452       ; the cylinder records
+CYLINDER_WORDS = 77     ;   words of one
+FB_BOX = 529            ; the box records
+BOX_WORDS = 24          ;   words of one
+FB_RECTANGLE = 553      ; the rectangle records
+RECTANGLE_WORDS = 20    ;   words of one
+FB_TRIANGLE = 573       ; the triangle records
+TRIANGLE_WORDS = 20     ;   words of one
+ROOT = 653              ; the BSP root node
+MAILBOX = 1048576       ; the mailboxes (main memory)
+NOBJ = 10               ; objects in the scene
+
+; ---- record fields (FB words from a record's start) ----
+CYL_CAPS = 0            ; cylinder record: caps flag
+CYL_BODY = 1            ; cylinder record: the body's stream
+CYL_CAP0 = 37           ; cylinder record: base cap (a disc)
+CYL_CAP1 = 57           ; cylinder record: apex cap
+
+; ---- BSP nodes ----
+PN_FLAGS = 0            ; packet node: the split axis, or bit 15 a leaf
+PN_PARENT_SLOT = 1      ;   the RAM slot its parent pushed it with
+PN_SPLIT = 2            ;   inner: the split's position
+PN_SLOT = 3             ;   inner: the RAM slot of its depth
+PN_LEFT = 4             ;   inner: the children (FB addresses)
+PN_RIGHT = 5
+PL_OBJECTS = 2          ;   leaf: its objects
+PL_SHARED = 3           ;   leaf: of those, in other leaves too (a mailbox)
+PL_LISTS = 4            ;   leaf: per type a count, then an entry per object:
+LE_RECORD = 0           ;     its record (FB address)
+LE_MAILBOX = 1          ;     its mailbox index (-1: none)
+LE_WORDS = 2
+MB_SHIFT = 4            ; a mailbox (main memory, 16 bytes, MAILBOX + index << MB_SHIFT):
+MB_PASS = 0             ;   the pass that last tested the object
+MB_RAYS = 4             ;   the rays that did (64-bit mask)
+
+; ---- FB set 1: output banks (word addresses) ----
+OUT_BANK0 = 32768       ; the two output banks, alternating by tile
+OUT_BANK1 = 49152
+OUT_R = 0               ; a bank's words: red of RCs 0..63
+OUT_G = 64              ; green
+OUT_B = 128             ; blue
+OUT_ID = 192            ; the eye ray's object id
+OUT_WORDS = 256         ; words a tile's output moves by DMA
+
+; ---- RC RAM (word addresses in every RC) ----
+RSQ = 0                 ; reciprocal square root table, Q1.14
+RCP = 128               ; reciprocal table, 2^29 / d
+C_ONE = 256             ; 1.0 in Q1.14
+C_INF = 257             ; the largest word: no hit
+LANE_ROW = 258          ; the RC's row in the array, 0..7
+LANE_COL = 259          ; the RC's column, 0..7
+LANE_ACT = 260          ; 1 if the RC traces a ray of the tile (the ways), else 0
+HIT_OBJ = 261           ; closest hit of the pass: object id
+HIT_MAT = 262           ; closest hit: material id
+HIT_N = 263             ; closest hit: normal, 3 words Q1.14
+PASS_T0 = 266           ; tbest at the pass's start (a hit: tbest < PASS_T0)
+SH_P = 267              ; hit point being shaded, 3 words
+SH_N = 270              ; its shading normal, 3 words
+SH_MAT = 273            ; its material id
+SH_D = 274              ; direction of the ray that hit, 3 words
+ACT = 277               ; 1 if the ray being shaded hit something
+COL = 278               ; colour of this level, 3 words Q3.12
+OUT_OBJ = 281           ; object id of the eye ray's hit (-1: none)
+SH_KS = 282             ; reflectance Ks of the hit's material
+SH_NL = 283             ; N.L towards the current light
+SH_RV = 284             ; R.V of the current light
+LIT = 285               ; 1 if the light is in front of the surface
+TMP0 = 286              ; temporaries of one kernel
+TMP1 = 287
+TMP2 = 288
+TMP3 = 289
+TMP4 = 290
+CONE_TMP = 291          ; the cone kernel's temporaries, 8 words
+TMP5 = 291              ; the cylinder kernel's (CONE_TMP's words)
+TMP6 = 292
+ORIG_OBJ = 299          ; the object the rays leave (-1: none): not hit again
+STACK = 300             ; per recursion level: colour so far and reflection weight
+UNORD = 340             ; unordered subtrees entered against the ray's direction
+HIT_NS = 341            ; closest smooth triangle: shading normal, 3 words
+HIT_NS_OBJ = 344        ; its object id
+SH_NG = 345             ; geometric normal of the hit being shaded, 3 words
+HIT_BACK_OBJ = 348      ; closest object hit from its back (-1: none)
+SH_BACK = 349           ; 1 if the hit being shaded is a back hit
+REFR = 350              ; per recursion level: the refracted ray to trace
+P_ALIVE = 400           ; 1 while the ray takes part in the pass
+P_Z = 403               ; per axis: shift z - 1 of 1/d
+P_R = 406               ; per axis: signed mantissa of 1/d
+P_DT = 409              ; per axis: a plane's widening in t
+P_SLOT = 416            ; per BSP depth: the pushed child's interval (tmax, tmin)
+ORIG_STACK = 480        ; per recursion level: the object its refracted ray leaves
+STACK_FRAME = 4         ; words of a STACK frame
+REFR_FRAME = 7          ; words of a REFR frame
+STACK_L0 = STACK + 0*STACK_FRAME; the frame of recursion level 0, 1, ...
+REFR_L0 = REFR + 0*REFR_FRAME; the refraction frame of level 0, 1, ...
+FR_COL = 0              ; frame: colour so far, 3 words
+FR_KS = 3               ; frame: reflection weight
+RF_O = 0                ; refraction frame: origin, 3 words
+RF_D = 3                ; refraction frame: direction, 3 words
+RF_T = 6                ; refraction frame: weight T (0: no ray)
+SLOT_TMAX = 0           ; slot: far end of the interval
+SLOT_TMIN = 1           ; slot: near end
+
+; ==== TinyRISC data ====
         .data
-PASS:   .word 0
-MODE:   .word 0
-SAVE_LR: .word 0
-AWAKE:  .word 0, 0
-NEG:    .word 0, 0, 0, 0, 0, 0
-T_START: .word 0
-T_END:  .word 0
-TESTS:  .word 0
-PASSES: .word 0
-TL_PTR: .word 0
-TL_CNT: .word 0
-TL_BANK: .word 0
-CUR_OUT: .word 0
-NSTACK: .space 256
-
-NK:     .word 0, 0, 0
-NF:     .word 0, 0, 0
-NS:     .word 0, 0, 0
-CUR_BLK: .word 0
-ROOTBOX = 422
+PASS:           .word 0                 ; the ray pass's number (mailboxes)
+MODE:           .word 0                 ; 0: closest hit, 1: any hit (shadow rays)
+SAVE_LR:        .word 0                 ; trace's return address
+AWAKE:          .word 0, 0              ; the RCs awake (RCs 0..31, 32..63)
+NEG:
+NEG_X:          .word 0, 0              ; per axis, the rays going down along it
+NEG_Y:          .word 0, 0
+NEG_Z:          .word 0, 0
+T_START:        .word 0                 ; the cycle counter at the tile loop's start
+T_END:          .word 0                 ; ... and at its end
+TESTS:          .word 0                 ; object tests broadcast
+PASSES:         .word 0                 ; ray passes
+TL_PTR:         .word 0                 ; the tile list's current entry
+TL_CNT:         .word 0                 ; tiles left
+TL_BANK:        .word 0                 ; the output bank of this tile (0, 1)
+CUR_OUT:        .word 0                 ; where this tile's output goes
+NSTACK:         .space 256              ; the node stack
+NK:             .word 0, 0, 0           ; per axis: the node kernel of the pass's child order
+NF:             .word 0, 0, 0           ; per axis: the first child's field in a node
+NS:             .word 0, 0, 0           ; per axis: the second child's field
+CUR_BLK:        .word 0                 ; the leaf block in SBANK
         .text
-_start: li r1, FBIMG
+
+; _start: the FB image and the contexts in by DMA, every RC's RAM tables and lane words,
+; then the tile loop; T_START, T_END: the cycle counter around it.
+_start:
+        li r1, FBIMG
         li r2, 0
         li r3, FBWORDS
-        ldfb r1, r2, r3
+        ldfb r1, r2, r3                 ; the FB image into FB set 0
         dwait
-li r1, CTXBASE
+        li r1, CTXBASE
         li r2, 0
         li r3, (ctx_end - CTXBASE) / 4
-        ldctxt r1, r2, r3
+        ldctxt r1, r2, r3               ; the kernels into context memory
         dwait
         li r1, (k_init - CTXBASE) / 4
         li r2, 0
-        sbcb r1, r2, (k_init_end - k_init) / 4
+        sbcb r1, r2, (k_init_end - k_init) / 4 ; RSQ, RCP, C_ONE, C_INF from the FB
         li r1, (k_rows - CTXBASE) / 4
-        cbcr r1, r0, 1
+        cbcr r1, r0, 1                  ; row i: r8 = i
         li r1, (k_strow - CTXBASE) / 4
         cbcast r1, (k_strow_end - k_strow) / 4
         li r1, (k_rows - CTXBASE) / 4
-        cbcc r1, r0, 1
+        cbcc r1, r0, 1                  ; column j: r8 = j
         li r1, (k_stcol - CTXBASE) / 4
         cbcast r1, (k_stcol_end - k_stcol) / 4
         li r1, (k_lanes - CTXBASE) / 4
-        cbcast r1, (k_lanes_end - k_lanes) / 4
-        rcany r1
+        cbcast r1, (k_lanes_end - k_lanes) / 4 ; the RCs outside the tile sleep
+        rcany r1                        ; the array done
         rdcyc r1
         sw r1, T_START(r0)
         li r1, TILELIST
-        lw r2, 0(r1)
-        addi r1, r1, 4
-sw r1, TL_PTR(r0)
+        lw r2, TL_COUNT(r1)
+        addi r1, r1, TL_FIRST
+        sw r1, TL_PTR(r0)
         sw r2, TL_CNT(r0)
-tile:   lw r2, TL_CNT(r0)
+
+; tile: one tile of the list (TL_PTR: its entry, TL_CNT: tiles left): eye rays, the ray
+; tree, the pixels out.
+tile:
+        lw r2, TL_CNT(r0)
         beqz r2, finish
         lw r1, TL_PTR(r0)
-        lw r3, 0(r1)
-        lw r4, 4(r1)
-        lw r5, 8(r1)
-sw r5, CUR_OUT(r0)
+        lw r3, TILE_PX(r1)
+        lw r4, TILE_PY(r1)
+        lw r5, TILE_OUT(r1)
+        sw r5, CUR_OUT(r0)
         li r6, FB_EYE
-        sfb r3, 0(r6)
-        sfb r4, 1(r6)
+        sfb r3, EYE_PX(r6)
+        sfb r4, EYE_PY(r6)              ; the tile's corner into the eye stream
         li r1, (k_eye - CTXBASE) / 4
         li r2, FB_EYE
-        sbcb r1, r2, (k_eye_end - k_eye) / 4
+        sbcb r1, r2, (k_eye_end - k_eye) / 4 ; eye rays
+        ; level 0: the rays' closest hits
         sw r0, MODE(r0)
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_post0 - CTXBASE) / 4
         li r2, FB_POST
-        sbcb r1, r2, (k_post0_end - k_post0) / 4
+        sbcb r1, r2, (k_post0_end - k_post0) / 4 ; the hits' shading state
+        ; light 0: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 287
+        li r2, FB_LIGHT0
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 296
+        li r2, FB_SHADE0
         sbcb r1, r2, (k_shade_end - k_shade) / 4
+        ; light 1: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 290
+        li r2, FB_LIGHT1
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 338
+        li r2, FB_SHADE1
         sbcb r1, r2, (k_shade_end - k_shade) / 4
+        ; light 2: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 293
+        li r2, FB_LIGHT2
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 380
+        li r2, FB_SHADE2
         sbcb r1, r2, (k_shade_end - k_shade) / 4
         li r1, (k_refl0 - CTXBASE) / 4
-        cbcast r1, (k_refl0_end - k_refl0) / 4
+        cbcast r1, (k_refl0_end - k_refl0) / 4 ; level 0's reflected rays
+        ; level 1: the rays' closest hits
         sw r0, MODE(r0)
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_post1 - CTXBASE) / 4
         li r2, FB_POST
-        sbcb r1, r2, (k_post1_end - k_post1) / 4
+        sbcb r1, r2, (k_post1_end - k_post1) / 4 ; the hits' shading state
+        ; light 0: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 287
+        li r2, FB_LIGHT0
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 296
+        li r2, FB_SHADE0
         sbcb r1, r2, (k_shade_end - k_shade) / 4
+        ; light 1: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 290
+        li r2, FB_LIGHT1
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 338
+        li r2, FB_SHADE1
         sbcb r1, r2, (k_shade_end - k_shade) / 4
+        ; light 2: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 293
+        li r2, FB_LIGHT2
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 380
+        li r2, FB_SHADE2
         sbcb r1, r2, (k_shade_end - k_shade) / 4
         li r1, (k_pop0 - CTXBASE) / 4
-        cbcast r1, (k_pop0_end - k_pop0) / 4
+        cbcast r1, (k_pop0_end - k_pop0) / 4 ; their colour added
+        ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)
-        li r4, 32768
-        beqz r5, outb0
-        li r4, 49152
-outb0:  dwait
+        li r4, OUT_BANK0
+        beqz r5, out_bank
+        li r4, OUT_BANK1
+out_bank:
+        dwait                           ; the bank's last DMA done
         li r1, (k_out0 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 0
+        wfb r4, OUT_R
         li r1, (k_out1 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 64
+        wfb r4, OUT_G
         li r1, (k_out2 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 128
+        wfb r4, OUT_B
         li r1, (k_out3 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 192
+        wfb r4, OUT_ID
         lw r3, CUR_OUT(r0)
-        stfb r3, r4, 256
+        stfb r3, r4, OUT_WORDS          ; DMA to main memory
         lw r5, TL_BANK(r0)
         xori r5, r5, 1
-        sw r5, TL_BANK(r0)
-lw r1, TL_PTR(r0)
-        addi r1, r1, 12
+        sw r5, TL_BANK(r0)              ; the other bank next
+        lw r1, TL_PTR(r0)
+        addi r1, r1, TILE_BYTES
         sw r1, TL_PTR(r0)
         lw r2, TL_CNT(r0)
         addi r2, r2, -1
         sw r2, TL_CNT(r0)
         j tile
-finish: dwait
+finish:
+        dwait
         rdcyc r1
         sw r1, T_END(r0)
         halt
 
-; trace (packet traversal): the RCs hold o, d, tbest; MODE 0 closest hit, 1 any hit (shadow).
-trace:  sw r15, SAVE_LR(r0)
+; trace: one ray pass, the packet traversal of a resident scene. In: the rays in r1..r7 of
+; every RC, MODE (0: closest hit, 1: any hit). Out: the hits in HIT_*, r7.
+; Clobbers r1..r15 (r15 kept in SAVE_LR).
+trace:
+        sw r15, SAVE_LR(r0)
         lw r1, PASSES(r0)
         addi r1, r1, 1
-        sw r1, PASSES(r0)
-lw r1, PASS(r0)
+        sw r1, PASSES(r0)               ; ray passes, for the statistics
+        lw r1, PASS(r0)
         addi r1, r1, 1
         sw r1, PASS(r0)
-        li r13, 0
+        li r13, 0                       ; object tests of the pass
         li r1, (k_pinit - CTXBASE) / 4
         li r2, ROOTBOX
-        sbcb r1, r2, (k_pinit_end - k_pinit) / 4
+        sbcb r1, r2, (k_pinit_end - k_pinit) / 4 ; intervals in the root cell, 1/d
         li r1, (k_sign0 - CTXBASE) / 4
         cbcast r1, 1
-        rcst r3
+        rcst r3                         ; the awake rays going down along x: none, some, all
         li r4, 2
-        beq r3, r4, pdone
+        beq r3, r4, trace_done          ; no ray awake
         li r8, 0
-        beqz r3, ord0
+        beqz r3, order_x
         li r8, 1
         li r4, 3
-        beq r3, r4, ord0
-        jal majority
-ord0:   li r1, (k_pn0b - CTXBASE) / 4
-        li r2, 4
-        li r3, 5
-        beqz r8, ordb0
+        beq r3, r4, order_x
+        jal majority                    ; some: r8 = most go down
+order_x:
+        li r1, (k_pn0b - CTXBASE) / 4
+        li r2, PN_LEFT
+        li r3, PN_RIGHT
+        beqz r8, order_x_set
         li r1, (k_pn0a - CTXBASE) / 4
-        li r2, 5
-        li r3, 4
-ordb0:  sw r1, NK+0(r0)
-        sw r2, NF+0(r0)
-        sw r3, NS+0(r0)
+        li r2, PN_RIGHT
+        li r3, PN_LEFT                  ; most go down: above first
+order_x_set:
+        sw r1, NK+AXIS_X(r0)
+        sw r2, NF+AXIS_X(r0)
+        sw r3, NS+AXIS_X(r0)            ; node kernel, first and second child
         li r1, (k_sign1 - CTXBASE) / 4
         cbcast r1, 1
-        rcst r3
+        rcst r3                         ; the awake rays going down along y: none, some, all
         li r8, 0
-        beqz r3, ord1
+        beqz r3, order_y
         li r8, 1
         li r4, 3
-        beq r3, r4, ord1
-        jal majority
-ord1:   li r1, (k_pn1b - CTXBASE) / 4
-        li r2, 4
-        li r3, 5
-        beqz r8, ordb1
+        beq r3, r4, order_y
+        jal majority                    ; some: r8 = most go down
+order_y:
+        li r1, (k_pn1b - CTXBASE) / 4
+        li r2, PN_LEFT
+        li r3, PN_RIGHT
+        beqz r8, order_y_set
         li r1, (k_pn1a - CTXBASE) / 4
-        li r2, 5
-        li r3, 4
-ordb1:  sw r1, NK+4(r0)
-        sw r2, NF+4(r0)
-        sw r3, NS+4(r0)
+        li r2, PN_RIGHT
+        li r3, PN_LEFT                  ; most go down: above first
+order_y_set:
+        sw r1, NK+AXIS_Y(r0)
+        sw r2, NF+AXIS_Y(r0)
+        sw r3, NS+AXIS_Y(r0)            ; node kernel, first and second child
         li r1, (k_sign2 - CTXBASE) / 4
         cbcast r1, 1
-        rcst r3
+        rcst r3                         ; the awake rays going down along z: none, some, all
         li r8, 0
-        beqz r3, ord2
+        beqz r3, order_z
         li r8, 1
         li r4, 3
-        beq r3, r4, ord2
-        jal majority
-ord2:   li r1, (k_pn2b - CTXBASE) / 4
-        li r2, 4
-        li r3, 5
-        beqz r8, ordb2
+        beq r3, r4, order_z
+        jal majority                    ; some: r8 = most go down
+order_z:
+        li r1, (k_pn2b - CTXBASE) / 4
+        li r2, PN_LEFT
+        li r3, PN_RIGHT
+        beqz r8, order_z_set
         li r1, (k_pn2a - CTXBASE) / 4
-        li r2, 5
-        li r3, 4
-ordb2:  sw r1, NK+8(r0)
-        sw r2, NF+8(r0)
-        sw r3, NS+8(r0)
+        li r2, PN_RIGHT
+        li r3, PN_LEFT                  ; most go down: above first
+order_z_set:
+        sw r1, NK+AXIS_Z(r0)
+        sw r2, NF+AXIS_Z(r0)
+        sw r3, NS+AXIS_Z(r0)            ; node kernel, first and second child
         li r14, NSTACK
         li r5, ROOT
-        lfb r6, 0(r5)
+        lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
         slli r7, r6, 2
         lw r1, NK(r7)
-        addi r2, r5, 2
-        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4
-        j vnode
-vnode:  lw r8, NF(r7)
+        addi r2, r5, PN_SPLIT
+        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
+        j inner_node
+        ; r5 = a node whose kernel runs: read its children, issue the first's kernel
+inner_node:
+        lw r8, NF(r7)
         add r8, r8, r5
-        lfb r9, 0(r8)
+        lfb r9, (r8)                    ; r9 = the first child
         lw r10, NS(r7)
         add r10, r10, r5
-        lfb r10, 0(r10)
-lfb r6, 0(r9)
+        lfb r10, (r10)                  ; r10 = the second child
+        lfb r6, PN_FLAGS(r9)
         andi r3, r6, 3
         slli r3, r3, 2
-        lw r11, NK(r3)
-        addi r12, r5, 3
-rcst r4
+        lw r11, NK(r3)                  ; r11 = its kernel, if inner
+        addi r12, r5, PN_SLOT           ; r12 = the second child's slot (stream)
+        rcst r4                         ; the awake rays reaching the first child: none, some, all
         addi r1, r4, -3
-        beqz r1, vall
+        beqz r1, all_first
         addi r1, r4, -1
-        beqz r1, vboth
-        bnez r4, pop
-li r1, (k_ptake - CTXBASE) / 4
-        cbcast r1, (k_ptake_end - k_ptake) / 4
+        beqz r1, some_first
+        bnez r4, pop_node               ; no ray awake
+        li r1, (k_ptake - CTXBASE) / 4
+        cbcast r1, (k_ptake_end - k_ptake) / 4 ; none: the second child only
         mv r5, r10
-        lfb r6, 0(r5)
+        lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
         slli r7, r6, 2
         lw r1, NK(r7)
-        addi r2, r5, 2
-        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4
-        j vnode
-vboth:
+        addi r2, r5, PN_SPLIT
+        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
+        j inner_node
+some_first:
         li r1, (k_ppush - CTXBASE) / 4
-        sbcb r1, r12, (k_ppush_end - k_ppush) / 4
-        sw r10, 0(r14)
-        addi r14, r14, 4
+        sbcb r1, r12, (k_ppush_end - k_ppush) / 4 ; the rays' intervals for the second child
+        sw r10, (r14)
+        addi r14, r14, 4                ; push it
         li r1, (k_psl - CTXBASE) / 4
-        cbcast r1, 1
+        cbcast r1, 1                    ; the rays not reaching the first sleep
         mv r5, r9
         blt r6, r0, leaf
         mv r7, r3
-        addi r2, r5, 2
-        sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4
-        j vnode
-vall:   li r1, (k_p2nd - CTXBASE) / 4
+        addi r2, r5, PN_SPLIT
+        sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4 ; the first child's node kernel
+        j inner_node
+all_first:
+        li r1, (k_p2nd - CTXBASE) / 4
         cbcast r1, 1
         rcany r4
-        beqz r4, vfirst
+        beqz r4, visit_first            ; no ray reaches the second
         li r1, (k_ppush - CTXBASE) / 4
-        sbcb r1, r12, (k_ppush_end - k_ppush) / 4
-        sw r10, 0(r14)
-        addi r14, r14, 4
-vfirst:
+        sbcb r1, r12, (k_ppush_end - k_ppush) / 4 ; the rays' intervals for the second child
+        sw r10, (r14)
+        addi r14, r14, 4                ; push it
+visit_first:
         mv r5, r9
         blt r6, r0, leaf
         mv r7, r3
-        addi r2, r5, 2
-        sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4
-        j vnode
-; The leaf (r5). An object in more than one leaf has a mailbox: the pass that last tested it and
-; which rays did; it is broadcast unless every awake ray has tested it in this pass.
-leaf:   lfb r1, 2(r5)
-        beqz r1, lf_done
-        lfb r1, 3(r5)
-        beqz r1, leaf_go
+        addi r2, r5, PN_SPLIT
+        sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4 ; the first child's node kernel
+        j inner_node
+        ; the leaf r5: an object in more than one leaf has a mailbox (the pass that last
+        ; tested it and which rays did); it is broadcast unless every awake ray has tested it
+leaf:
+        lfb r1, PL_OBJECTS(r5)
+        beqz r1, leaf_done              ; an empty leaf
+        lfb r1, PL_SHARED(r5)
+        beqz r1, leaf_objects           ; no mailbox to check
         rcsl r4
         rcsh r10
         nor r4, r4, r0
-        nor r10, r10, r0
+        nor r10, r10, r0                ; r4, r10: the awake rays
         lw r11, PASS(r0)
-leaf_go: li r12, MAILBOX
-        addi r6, r5, 4
-        lfb r9, 0(r6)
+leaf_objects:
+        li r12, MAILBOX
+        addi r6, r5, PL_LISTS
+        lfb r9, (r6)
         addi r6, r6, 1
-        beqz r9, psphere_end
-psphere_loop:
-        lfb r7, 0(r6)
-        lfb r8, 1(r6)
-        addi r6, r6, 2
-        blt r8, r0, psphere_go
-        slli r8, r8, 4
-        add r8, r8, r12
-        lw r1, 0(r8)
-        bne r1, r11, psphere_fresh
-        lw r2, 4(r8)
-        lw r3, 8(r8)
+        beqz r9, lo_sphere_end          ; spheres in the leaf
+lo_sphere_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_sphere_go        ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        lw r1, MB_PASS(r8)
+        bne r1, r11, lo_sphere_fresh    ; not tested in this pass yet
+        lw r2, MB_RAYS(r8)
+        lw r3, MB_RAYS+MASK_HI(r8)
         or r1, r2, r4
-        bne r1, r2, psphere_upd
+        bne r1, r2, lo_sphere_upd
         or r1, r3, r10
-        beq r1, r3, psphere_next
-psphere_upd: or r2, r2, r4
+        beq r1, r3, lo_sphere_next      ; every awake ray has tested it
+lo_sphere_upd:
+        or r2, r2, r4
         or r3, r3, r10
-        sw r2, 4(r8)
-        sw r3, 8(r8)
-        j psphere_go
-psphere_fresh: sw r11, 0(r8)
-        sw r4, 4(r8)
-        sw r10, 8(r8)
-psphere_go:  addi r13, r13, 1
+        sw r2, MB_RAYS(r8)
+        sw r3, MB_RAYS+MASK_HI(r8)
+        j lo_sphere_go
+lo_sphere_fresh:
+        sw r11, MB_PASS(r8)
+        sw r4, MB_RAYS(r8)
+        sw r10, MB_RAYS+MASK_HI(r8)
+lo_sphere_go:
+        addi r13, r13, 1
         li r1, (k_sphere - CTXBASE) / 4
         sbcb r1, r7, (k_sphere_end - k_sphere) / 4
-psphere_next:
+lo_sphere_next:
         addi r9, r9, -1
-        bnez r9, psphere_loop
-psphere_end:
-        lfb r9, 0(r6)
+        bnez r9, lo_sphere_obj
+lo_sphere_end:
+        lfb r9, (r6)
         addi r6, r6, 1
-        beqz r9, pcylinder_end
-pcylinder_loop:
-        lfb r7, 0(r6)
-        lfb r8, 1(r6)
-        addi r6, r6, 2
-        blt r8, r0, pcylinder_go
-        slli r8, r8, 4
-        add r8, r8, r12
-        lw r1, 0(r8)
-        bne r1, r11, pcylinder_fresh
-        lw r2, 4(r8)
-        lw r3, 8(r8)
+        beqz r9, lo_cylinder_end        ; cylinders in the leaf
+lo_cylinder_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_cylinder_go      ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        lw r1, MB_PASS(r8)
+        bne r1, r11, lo_cylinder_fresh  ; not tested in this pass yet
+        lw r2, MB_RAYS(r8)
+        lw r3, MB_RAYS+MASK_HI(r8)
         or r1, r2, r4
-        bne r1, r2, pcylinder_upd
+        bne r1, r2, lo_cylinder_upd
         or r1, r3, r10
-        beq r1, r3, pcylinder_next
-pcylinder_upd: or r2, r2, r4
+        beq r1, r3, lo_cylinder_next    ; every awake ray has tested it
+lo_cylinder_upd:
+        or r2, r2, r4
         or r3, r3, r10
-        sw r2, 4(r8)
-        sw r3, 8(r8)
-        j pcylinder_go
-pcylinder_fresh: sw r11, 0(r8)
-        sw r4, 4(r8)
-        sw r10, 8(r8)
-pcylinder_go:  addi r13, r13, 1
+        sw r2, MB_RAYS(r8)
+        sw r3, MB_RAYS+MASK_HI(r8)
+        j lo_cylinder_go
+lo_cylinder_fresh:
+        sw r11, MB_PASS(r8)
+        sw r4, MB_RAYS(r8)
+        sw r10, MB_RAYS+MASK_HI(r8)
+lo_cylinder_go:
+        addi r13, r13, 1
         li r1, (k_cyl - CTXBASE) / 4
-        addi r2, r7, 1
-        sbcb r1, r2, (k_cyl_end - k_cyl) / 4
-        lfb r3, 0(r7)
-        beqz r3, pcylinder_nocap
+        addi r2, r7, CYL_BODY
+        sbcb r1, r2, (k_cyl_end - k_cyl) / 4 ; the body
+        lfb r3, CYL_CAPS(r7)
+        beqz r3, lo_cylinder_nocap
         li r1, (k_disc - CTXBASE) / 4
-        addi r2, r7, 37
+        addi r2, r7, CYL_CAP0
         sbcb r1, r2, (k_disc_end - k_disc) / 4
         li r1, (k_disc - CTXBASE) / 4
-        addi r2, r7, 57
-        sbcb r1, r2, (k_disc_end - k_disc) / 4
-pcylinder_nocap:
-pcylinder_next:
+        addi r2, r7, CYL_CAP1
+        sbcb r1, r2, (k_disc_end - k_disc) / 4 ; the caps
+lo_cylinder_nocap:
+lo_cylinder_next:
         addi r9, r9, -1
-        bnez r9, pcylinder_loop
-pcylinder_end:
-        lfb r9, 0(r6)
+        bnez r9, lo_cylinder_obj
+lo_cylinder_end:
+        lfb r9, (r6)
         addi r6, r6, 1
-        beqz r9, pbox_end
-pbox_loop:
-        lfb r7, 0(r6)
-        lfb r8, 1(r6)
-        addi r6, r6, 2
-        blt r8, r0, pbox_go
-        slli r8, r8, 4
-        add r8, r8, r12
-        lw r1, 0(r8)
-        bne r1, r11, pbox_fresh
-        lw r2, 4(r8)
-        lw r3, 8(r8)
+        beqz r9, lo_box_end             ; boxs in the leaf
+lo_box_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_box_go           ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        lw r1, MB_PASS(r8)
+        bne r1, r11, lo_box_fresh       ; not tested in this pass yet
+        lw r2, MB_RAYS(r8)
+        lw r3, MB_RAYS+MASK_HI(r8)
         or r1, r2, r4
-        bne r1, r2, pbox_upd
+        bne r1, r2, lo_box_upd
         or r1, r3, r10
-        beq r1, r3, pbox_next
-pbox_upd: or r2, r2, r4
+        beq r1, r3, lo_box_next         ; every awake ray has tested it
+lo_box_upd:
+        or r2, r2, r4
         or r3, r3, r10
-        sw r2, 4(r8)
-        sw r3, 8(r8)
-        j pbox_go
-pbox_fresh: sw r11, 0(r8)
-        sw r4, 4(r8)
-        sw r10, 8(r8)
-pbox_go:  addi r13, r13, 1
+        sw r2, MB_RAYS(r8)
+        sw r3, MB_RAYS+MASK_HI(r8)
+        j lo_box_go
+lo_box_fresh:
+        sw r11, MB_PASS(r8)
+        sw r4, MB_RAYS(r8)
+        sw r10, MB_RAYS+MASK_HI(r8)
+lo_box_go:
+        addi r13, r13, 1
         li r1, (k_box - CTXBASE) / 4
         sbcb r1, r7, (k_box_end - k_box) / 4
-pbox_next:
+lo_box_next:
         addi r9, r9, -1
-        bnez r9, pbox_loop
-pbox_end:
-        lfb r9, 0(r6)
+        bnez r9, lo_box_obj
+lo_box_end:
+        lfb r9, (r6)
         addi r6, r6, 1
-        beqz r9, prectangle_end
-prectangle_loop:
-        lfb r7, 0(r6)
-        lfb r8, 1(r6)
-        addi r6, r6, 2
-        blt r8, r0, prectangle_go
-        slli r8, r8, 4
-        add r8, r8, r12
-        lw r1, 0(r8)
-        bne r1, r11, prectangle_fresh
-        lw r2, 4(r8)
-        lw r3, 8(r8)
+        beqz r9, lo_rectangle_end       ; rectangles in the leaf
+lo_rectangle_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_rectangle_go     ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        lw r1, MB_PASS(r8)
+        bne r1, r11, lo_rectangle_fresh ; not tested in this pass yet
+        lw r2, MB_RAYS(r8)
+        lw r3, MB_RAYS+MASK_HI(r8)
         or r1, r2, r4
-        bne r1, r2, prectangle_upd
+        bne r1, r2, lo_rectangle_upd
         or r1, r3, r10
-        beq r1, r3, prectangle_next
-prectangle_upd: or r2, r2, r4
+        beq r1, r3, lo_rectangle_next   ; every awake ray has tested it
+lo_rectangle_upd:
+        or r2, r2, r4
         or r3, r3, r10
-        sw r2, 4(r8)
-        sw r3, 8(r8)
-        j prectangle_go
-prectangle_fresh: sw r11, 0(r8)
-        sw r4, 4(r8)
-        sw r10, 8(r8)
-prectangle_go:  addi r13, r13, 1
+        sw r2, MB_RAYS(r8)
+        sw r3, MB_RAYS+MASK_HI(r8)
+        j lo_rectangle_go
+lo_rectangle_fresh:
+        sw r11, MB_PASS(r8)
+        sw r4, MB_RAYS(r8)
+        sw r10, MB_RAYS+MASK_HI(r8)
+lo_rectangle_go:
+        addi r13, r13, 1
         li r1, (k_rect - CTXBASE) / 4
         sbcb r1, r7, (k_rect_end - k_rect) / 4
-prectangle_next:
+lo_rectangle_next:
         addi r9, r9, -1
-        bnez r9, prectangle_loop
-prectangle_end:
-        lfb r9, 0(r6)
+        bnez r9, lo_rectangle_obj
+lo_rectangle_end:
+        lfb r9, (r6)
         addi r6, r6, 1
-        beqz r9, ptriangle_end
-ptriangle_loop:
-        lfb r7, 0(r6)
-        lfb r8, 1(r6)
-        addi r6, r6, 2
-        blt r8, r0, ptriangle_go
-        slli r8, r8, 4
-        add r8, r8, r12
-        lw r1, 0(r8)
-        bne r1, r11, ptriangle_fresh
-        lw r2, 4(r8)
-        lw r3, 8(r8)
+        beqz r9, lo_triangle_end        ; triangles in the leaf
+lo_triangle_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_triangle_go      ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        lw r1, MB_PASS(r8)
+        bne r1, r11, lo_triangle_fresh  ; not tested in this pass yet
+        lw r2, MB_RAYS(r8)
+        lw r3, MB_RAYS+MASK_HI(r8)
         or r1, r2, r4
-        bne r1, r2, ptriangle_upd
+        bne r1, r2, lo_triangle_upd
         or r1, r3, r10
-        beq r1, r3, ptriangle_next
-ptriangle_upd: or r2, r2, r4
+        beq r1, r3, lo_triangle_next    ; every awake ray has tested it
+lo_triangle_upd:
+        or r2, r2, r4
         or r3, r3, r10
-        sw r2, 4(r8)
-        sw r3, 8(r8)
-        j ptriangle_go
-ptriangle_fresh: sw r11, 0(r8)
-        sw r4, 4(r8)
-        sw r10, 8(r8)
-ptriangle_go:  addi r13, r13, 1
+        sw r2, MB_RAYS(r8)
+        sw r3, MB_RAYS+MASK_HI(r8)
+        j lo_triangle_go
+lo_triangle_fresh:
+        sw r11, MB_PASS(r8)
+        sw r4, MB_RAYS(r8)
+        sw r10, MB_RAYS+MASK_HI(r8)
+lo_triangle_go:
+        addi r13, r13, 1
         li r1, (k_tri - CTXBASE) / 4
         sbcb r1, r7, (k_tri_end - k_tri) / 4
-ptriangle_next:
+lo_triangle_next:
         addi r9, r9, -1
-        bnez r9, ptriangle_loop
-ptriangle_end:
-lf_done: lw r1, MODE(r0)
-        beqz r1, pop
+        bnez r9, lo_triangle_obj
+lo_triangle_end:
+leaf_done:
+        lw r1, MODE(r0)
+        beqz r1, pop_node
         li r1, (k_pleafa - CTXBASE) / 4
-        cbcast r1, (k_pleafa_end - k_pleafa) / 4
-pop:    li r9, NSTACK
-        beq r14, r9, pdone
+        cbcast r1, (k_pleafa_end - k_pleafa) / 4 ; any hit: the rays with a hit are done
+pop_node:
+        li r9, NSTACK
+        beq r14, r9, trace_done
         addi r14, r14, -4
-        lw r5, 0(r14)
+        lw r5, (r14)
         li r1, (k_ppop - CTXBASE) / 4
-        addi r2, r5, 1
-        sbcb r1, r2, (k_ppop_end - k_ppop) / 4
-lfb r6, 0(r5)
+        addi r2, r5, PN_PARENT_SLOT
+        sbcb r1, r2, (k_ppop_end - k_ppop) / 4 ; the rays take their intervals for it
+        lfb r6, PN_FLAGS(r5)
         rcany r4
-        beqz r4, pop
+        beqz r4, pop_node               ; no ray needs it
         blt r6, r0, leaf
         slli r7, r6, 2
         lw r1, NK(r7)
-        addi r2, r5, 2
-        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4
-        j vnode
-pdone:  lw r1, TESTS(r0)
+        addi r2, r5, PN_SPLIT
+        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
+        j inner_node
+trace_done:
+        lw r1, TESTS(r0)
         add r1, r1, r13
         sw r1, TESTS(r0)
         lw r15, SAVE_LR(r0)
         ret
 
+; majority: r8 = 1 if more awake RCs have F set than not. Clobbers r1..r6, r9, r10.
 majority:
         rcfl r1
         rcfh r2
@@ -553,74 +764,78 @@ majority:
         rcsh r4
         nor r3, r3, r0
         nor r4, r4, r0
-and r5, r1, r3
-        and r6, r2, r4
+        and r5, r1, r3
+        and r6, r2, r4                  ; r5, r6: awake with F
         nor r1, r1, r0
         nor r2, r2, r0
         and r1, r1, r3
-        and r2, r2, r4
+        and r2, r2, r4                  ; r1, r2: awake without F
+        ; r5 = the number of bits set in r5
         srli r9, r5, 1
         li r10, 0x55555555
         and r9, r9, r10
         sub r5, r5, r9
-li r10, 0x33333333
+        li r10, 0x33333333
         and r9, r5, r10
         srli r5, r5, 2
         and r5, r5, r10
         add r5, r5, r9
-srli r9, r5, 4
+        srli r9, r5, 4
         add r5, r5, r9
         li r10, 0x0f0f0f0f
         and r5, r5, r10
-li r10, 0x01010101
+        li r10, 0x01010101
         mul r5, r5, r10
         srli r5, r5, 24
+        ; r6 = the number of bits set in r6
         srli r9, r6, 1
         li r10, 0x55555555
         and r9, r9, r10
         sub r6, r6, r9
-li r10, 0x33333333
+        li r10, 0x33333333
         and r9, r6, r10
         srli r6, r6, 2
         and r6, r6, r10
         add r6, r6, r9
-srli r9, r6, 4
+        srli r9, r6, 4
         add r6, r6, r9
         li r10, 0x0f0f0f0f
         and r6, r6, r10
-li r10, 0x01010101
+        li r10, 0x01010101
         mul r6, r6, r10
         srli r6, r6, 24
+        ; r1 = the number of bits set in r1
         srli r9, r1, 1
         li r10, 0x55555555
         and r9, r9, r10
         sub r1, r1, r9
-li r10, 0x33333333
+        li r10, 0x33333333
         and r9, r1, r10
         srli r1, r1, 2
         and r1, r1, r10
         add r1, r1, r9
-srli r9, r1, 4
+        srli r9, r1, 4
         add r1, r1, r9
         li r10, 0x0f0f0f0f
         and r1, r1, r10
-li r10, 0x01010101
+        li r10, 0x01010101
         mul r1, r1, r10
         srli r1, r1, 24
+        ; r2 = the number of bits set in r2
         srli r9, r2, 1
         li r10, 0x55555555
         and r9, r9, r10
         sub r2, r2, r9
-li r10, 0x33333333
+        li r10, 0x33333333
         and r9, r2, r10
         srli r2, r2, 2
         and r2, r2, r10
         add r2, r2, r9
-srli r9, r2, 4
+        srli r9, r2, 4
         add r2, r2, r9
         li r10, 0x0f0f0f0f
         and r2, r2, r10
-li r10, 0x01010101
+        li r10, 0x01010101
         mul r2, r2, r10
         srli r2, r2, 24
         add r5, r5, r6
@@ -628,465 +843,205 @@ li r10, 0x01010101
         slt r8, r1, r5
         ret
 
+; ==== RC context kernels (context memory) ====
         .ctx
         .org CTXBASE
+
+; k_rows: a group of 8 contexts, one per row (row mode) or column (column mode):
+; row i gets r8 = i. Broadcast twice, its results stored to LANE_ROW and LANE_COL.
 k_rows:
-        movb r8, #0
-        movb r8, #1
-        movb r8, #2
-        movb r8, #3
-        movb r8, #4
-        movb r8, #5
-        movb r8, #6
-        movb r8, #7
+        .rept 8, i
+        movb r8, #i
+        .endr
 k_rows_end:
+
+; k_init: every RC's RAM from the FB image's start (stream): the RSQ and RCP tables,
+; 1.0 and the no-hit distance. Out: r0 = 0 in every RC.
 k_init:
         movb r0, #0
-        st fb0, [#0]
-        st fb0, [#1]
-        st fb0, [#2]
-        st fb0, [#3]
-        st fb0, [#4]
-        st fb0, [#5]
-        st fb0, [#6]
-        st fb0, [#7]
-        st fb0, [#8]
-        st fb0, [#9]
-        st fb0, [#10]
-        st fb0, [#11]
-        st fb0, [#12]
-        st fb0, [#13]
-        st fb0, [#14]
-        st fb0, [#15]
-        st fb0, [#16]
-        st fb0, [#17]
-        st fb0, [#18]
-        st fb0, [#19]
-        st fb0, [#20]
-        st fb0, [#21]
-        st fb0, [#22]
-        st fb0, [#23]
-        st fb0, [#24]
-        st fb0, [#25]
-        st fb0, [#26]
-        st fb0, [#27]
-        st fb0, [#28]
-        st fb0, [#29]
-        st fb0, [#30]
-        st fb0, [#31]
-        st fb0, [#32]
-        st fb0, [#33]
-        st fb0, [#34]
-        st fb0, [#35]
-        st fb0, [#36]
-        st fb0, [#37]
-        st fb0, [#38]
-        st fb0, [#39]
-        st fb0, [#40]
-        st fb0, [#41]
-        st fb0, [#42]
-        st fb0, [#43]
-        st fb0, [#44]
-        st fb0, [#45]
-        st fb0, [#46]
-        st fb0, [#47]
-        st fb0, [#48]
-        st fb0, [#49]
-        st fb0, [#50]
-        st fb0, [#51]
-        st fb0, [#52]
-        st fb0, [#53]
-        st fb0, [#54]
-        st fb0, [#55]
-        st fb0, [#56]
-        st fb0, [#57]
-        st fb0, [#58]
-        st fb0, [#59]
-        st fb0, [#60]
-        st fb0, [#61]
-        st fb0, [#62]
-        st fb0, [#63]
-        st fb0, [#64]
-        st fb0, [#65]
-        st fb0, [#66]
-        st fb0, [#67]
-        st fb0, [#68]
-        st fb0, [#69]
-        st fb0, [#70]
-        st fb0, [#71]
-        st fb0, [#72]
-        st fb0, [#73]
-        st fb0, [#74]
-        st fb0, [#75]
-        st fb0, [#76]
-        st fb0, [#77]
-        st fb0, [#78]
-        st fb0, [#79]
-        st fb0, [#80]
-        st fb0, [#81]
-        st fb0, [#82]
-        st fb0, [#83]
-        st fb0, [#84]
-        st fb0, [#85]
-        st fb0, [#86]
-        st fb0, [#87]
-        st fb0, [#88]
-        st fb0, [#89]
-        st fb0, [#90]
-        st fb0, [#91]
-        st fb0, [#92]
-        st fb0, [#93]
-        st fb0, [#94]
-        st fb0, [#95]
-        st fb0, [#96]
-        st fb0, [#97]
-        st fb0, [#98]
-        st fb0, [#99]
-        st fb0, [#100]
-        st fb0, [#101]
-        st fb0, [#102]
-        st fb0, [#103]
-        st fb0, [#104]
-        st fb0, [#105]
-        st fb0, [#106]
-        st fb0, [#107]
-        st fb0, [#108]
-        st fb0, [#109]
-        st fb0, [#110]
-        st fb0, [#111]
-        st fb0, [#112]
-        st fb0, [#113]
-        st fb0, [#114]
-        st fb0, [#115]
-        st fb0, [#116]
-        st fb0, [#117]
-        st fb0, [#118]
-        st fb0, [#119]
-        st fb0, [#120]
-        st fb0, [#121]
-        st fb0, [#122]
-        st fb0, [#123]
-        st fb0, [#124]
-        st fb0, [#125]
-        st fb0, [#126]
-        st fb0, [#127]
-        st fb0, [#128]
-        st fb0, [#129]
-        st fb0, [#130]
-        st fb0, [#131]
-        st fb0, [#132]
-        st fb0, [#133]
-        st fb0, [#134]
-        st fb0, [#135]
-        st fb0, [#136]
-        st fb0, [#137]
-        st fb0, [#138]
-        st fb0, [#139]
-        st fb0, [#140]
-        st fb0, [#141]
-        st fb0, [#142]
-        st fb0, [#143]
-        st fb0, [#144]
-        st fb0, [#145]
-        st fb0, [#146]
-        st fb0, [#147]
-        st fb0, [#148]
-        st fb0, [#149]
-        st fb0, [#150]
-        st fb0, [#151]
-        st fb0, [#152]
-        st fb0, [#153]
-        st fb0, [#154]
-        st fb0, [#155]
-        st fb0, [#156]
-        st fb0, [#157]
-        st fb0, [#158]
-        st fb0, [#159]
-        st fb0, [#160]
-        st fb0, [#161]
-        st fb0, [#162]
-        st fb0, [#163]
-        st fb0, [#164]
-        st fb0, [#165]
-        st fb0, [#166]
-        st fb0, [#167]
-        st fb0, [#168]
-        st fb0, [#169]
-        st fb0, [#170]
-        st fb0, [#171]
-        st fb0, [#172]
-        st fb0, [#173]
-        st fb0, [#174]
-        st fb0, [#175]
-        st fb0, [#176]
-        st fb0, [#177]
-        st fb0, [#178]
-        st fb0, [#179]
-        st fb0, [#180]
-        st fb0, [#181]
-        st fb0, [#182]
-        st fb0, [#183]
-        st fb0, [#184]
-        st fb0, [#185]
-        st fb0, [#186]
-        st fb0, [#187]
-        st fb0, [#188]
-        st fb0, [#189]
-        st fb0, [#190]
-        st fb0, [#191]
-        st fb0, [#192]
-        st fb0, [#193]
-        st fb0, [#194]
-        st fb0, [#195]
-        st fb0, [#196]
-        st fb0, [#197]
-        st fb0, [#198]
-        st fb0, [#199]
-        st fb0, [#200]
-        st fb0, [#201]
-        st fb0, [#202]
-        st fb0, [#203]
-        st fb0, [#204]
-        st fb0, [#205]
-        st fb0, [#206]
-        st fb0, [#207]
-        st fb0, [#208]
-        st fb0, [#209]
-        st fb0, [#210]
-        st fb0, [#211]
-        st fb0, [#212]
-        st fb0, [#213]
-        st fb0, [#214]
-        st fb0, [#215]
-        st fb0, [#216]
-        st fb0, [#217]
-        st fb0, [#218]
-        st fb0, [#219]
-        st fb0, [#220]
-        st fb0, [#221]
-        st fb0, [#222]
-        st fb0, [#223]
-        st fb0, [#224]
-        st fb0, [#225]
-        st fb0, [#226]
-        st fb0, [#227]
-        st fb0, [#228]
-        st fb0, [#229]
-        st fb0, [#230]
-        st fb0, [#231]
-        st fb0, [#232]
-        st fb0, [#233]
-        st fb0, [#234]
-        st fb0, [#235]
-        st fb0, [#236]
-        st fb0, [#237]
-        st fb0, [#238]
-        st fb0, [#239]
-        st fb0, [#240]
-        st fb0, [#241]
-        st fb0, [#242]
-        st fb0, [#243]
-        st fb0, [#244]
-        st fb0, [#245]
-        st fb0, [#246]
-        st fb0, [#247]
-        st fb0, [#248]
-        st fb0, [#249]
-        st fb0, [#250]
-        st fb0, [#251]
-        st fb0, [#252]
-        st fb0, [#253]
-        st fb0, [#254]
-        st fb0, [#255]
-        st fb0, [#256]
-        st fb0, [#257]
-        st r0, [#400]
+        .rept 256, i
+        st fb0, [#RSQ+i]
+        .endr
+        st fb0, [#C_ONE]
+        st fb0, [#C_INF]
+        st r0, [#P_ALIVE]               ; no ray alive
         movb r8, #-1
-        st r8, [#416]
-        st r8, [#418]
-        st r8, [#420]
-        st r8, [#422]
-        st r8, [#424]
-        st r8, [#426]
-        st r8, [#428]
-        st r8, [#430]
-        st r8, [#432]
-        st r8, [#434]
-        st r8, [#436]
-        st r8, [#438]
-        st r8, [#440]
-        st r8, [#442]
-        st r8, [#444]
-        st r8, [#446]
-        st r8, [#448]
-        st r8, [#450]
-        st r8, [#452]
-        st r8, [#454]
-        st r8, [#456]
-        st r8, [#458]
-        st r8, [#460]
-        st r8, [#462]
-        st r8, [#464]
-        st r8, [#466]
-        st r8, [#468]
-        st r8, [#470]
-        st r8, [#472]
-        st r8, [#474]
-        st r8, [#476]
-        st r8, [#478]
+        .rept 32, d
+        st r8, [#P_SLOT+2*d+SLOT_TMAX]
+        .endr
 k_init_end:
+
+; k_lanes: the RCs inside the TILE_W x TILE_H tile trace its rays (LANE_ACT = 1);
+; the others sleep for good.
 k_lanes:
-        ld r8, [r0 + #258]
-        ld r9, [r0 + #259]
+        ld r8, [r0 + #LANE_ROW]
+        ld r9, [r0 + #LANE_COL]
         movb r10, #0
-        cmp.lt r8, #8
-        (f) cmp.lt r9, #8
+        cmp.lt r8, #TILE_H
+        (f) cmp.lt r9, #TILE_W
         (f) movb r10, #1
-        st r10, [#260]
+        st r10, [#LANE_ACT]
         (!f) sleep
 k_lanes_end:
+
+; k_wake: every RC of the tile awake again after a pass (the others asleep).
 k_wake:
         wake
-        st r0, [#400]
-        ld r8, [r0 + #260]
+        st r0, [#P_ALIVE]
+        ld r8, [r0 + #LANE_ACT]
         cmp.eq r8, #0
         (f) sleep
 k_wake_end:
+
+; k_sign0: F = the ray goes down along x (dx < 0).
 k_sign0:
         cmp.lt r4, #0
 k_sign0_end:
+
+; k_sign1: F = the ray goes down along y (dy < 0).
 k_sign1:
         cmp.lt r5, #0
 k_sign1_end:
+
+; k_sign2: F = the ray goes down along z (dz < 0).
 k_sign2:
         cmp.lt r6, #0
 k_sign2_end:
+
+; k_pinit: a pass starts (stream: the root cell widened by P_TOL, per axis min, max).
+; Out: P_ALIVE = 1, per axis P_Z, P_R (1/d = R >> z) and P_DT (P_TOL / |d|); the interval
+; (r8, r9) = [0, tbest] clipped to the root cell; the rays that miss it sleep, not alive.
 k_pinit:
         movb r8, #1
-        st r8, [#400]
-        ld r9, [r0 + #256]
+        st r8, [#P_ALIVE]
+        ld r9, [r0 + #C_ONE]
         sub r9, r9, #1
-        ld r15, [r0 + #256]
-        ; 1 / d0
+        ld r15, [r0 + #C_ONE]
+        ; 1 / dx
         abs r8, r4
         max r8, r8, #1
         min r8, r8, r9
         clz r10, r8
         sub r10, r10, #1
-        sll r11, r8, r10
-        srl r12, r11, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        mul r14, r11, r12, >>15
+        sll r11, r8, r10                ; |d| normalised
+        srl r12, r11, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]
+        mul r14, r11, r12, >>Q15
         sub r14, r14, r15
-        ldacc r12, <<14
-        msu r12, r12, r14, >>14
+        ldacc r12, <<Q14
+        msu r12, r12, r14, >>Q14
         sub r10, r10, #1
-        st r10, [#403]
-        movb r13, #4
+        st r10, [#P_Z]
+        movb r13, #P_TOL
         asl r13, r13, r10
-        mul r13, r13, r12, >>14
-        st r13, [#409]
+        mul r13, r13, r12, >>Q14
+        st r13, [#P_DT]
         cmp.lt r4, #0
         (f) neg r12, r12
-        st r12, [#406]
-        ; 1 / d1
+        st r12, [#P_R]
+        ; 1 / dy
         abs r8, r5
         max r8, r8, #1
         min r8, r8, r9
         clz r10, r8
         sub r10, r10, #1
-        sll r11, r8, r10
-        srl r12, r11, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        mul r14, r11, r12, >>15
+        sll r11, r8, r10                ; |d| normalised
+        srl r12, r11, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]
+        mul r14, r11, r12, >>Q15
         sub r14, r14, r15
-        ldacc r12, <<14
-        msu r12, r12, r14, >>14
+        ldacc r12, <<Q14
+        msu r12, r12, r14, >>Q14
         sub r10, r10, #1
-        st r10, [#404]
-        movb r13, #4
+        st r10, [#P_Z+1]
+        movb r13, #P_TOL
         asl r13, r13, r10
-        mul r13, r13, r12, >>14
-        st r13, [#410]
+        mul r13, r13, r12, >>Q14
+        st r13, [#P_DT+1]
         cmp.lt r5, #0
         (f) neg r12, r12
-        st r12, [#407]
-        ; 1 / d2
+        st r12, [#P_R+1]
+        ; 1 / dz
         abs r8, r6
         max r8, r8, #1
         min r8, r8, r9
         clz r10, r8
         sub r10, r10, #1
-        sll r11, r8, r10
-        srl r12, r11, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        mul r14, r11, r12, >>15
+        sll r11, r8, r10                ; |d| normalised
+        srl r12, r11, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]
+        mul r14, r11, r12, >>Q15
         sub r14, r14, r15
-        ldacc r12, <<14
-        msu r12, r12, r14, >>14
+        ldacc r12, <<Q14
+        msu r12, r12, r14, >>Q14
         sub r10, r10, #1
-        st r10, [#405]
-        movb r13, #4
+        st r10, [#P_Z+2]
+        movb r13, #P_TOL
         asl r13, r13, r10
-        mul r13, r13, r12, >>14
-        st r13, [#411]
+        mul r13, r13, r12, >>Q14
+        st r13, [#P_DT+2]
         cmp.lt r6, #0
         (f) neg r12, r12
-        st r12, [#408]
+        st r12, [#P_R+2]
         ; root interval
         movb r8, #0
         mov r9, r7
-        ld r12, [r0 + #403]
-        ld r13, [r0 + #406]
+        ld r12, [r0 + #P_Z]
+        ld r13, [r0 + #P_R]
         sub r10, fb0, r1
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
+        mul r10, r10, r13, >>Q14
         sub r11, fb0, r1
         asl r11, r11, r12
-        mul r11, r11, r13, >>14
+        mul r11, r11, r13, >>Q14
         min r14, r10, r11
         max r10, r10, r11
         max r8, r8, r14
         min r9, r9, r10
-        ld r12, [r0 + #404]
-        ld r13, [r0 + #407]
+        ld r12, [r0 + #P_Z+1]
+        ld r13, [r0 + #P_R+1]
         sub r10, fb0, r2
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
+        mul r10, r10, r13, >>Q14
         sub r11, fb0, r2
         asl r11, r11, r12
-        mul r11, r11, r13, >>14
+        mul r11, r11, r13, >>Q14
         min r14, r10, r11
         max r10, r10, r11
         max r8, r8, r14
         min r9, r9, r10
-        ld r12, [r0 + #405]
-        ld r13, [r0 + #408]
+        ld r12, [r0 + #P_Z+2]
+        ld r13, [r0 + #P_R+2]
         sub r10, fb0, r3
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
+        mul r10, r10, r13, >>Q14
         sub r11, fb0, r3
         asl r11, r11, r12
-        mul r11, r11, r13, >>14
+        mul r11, r11, r13, >>Q14
         min r14, r10, r11
         max r10, r10, r11
         max r8, r8, r14
         min r9, r9, r10
-        cmp.lt r8, r9
+        cmp.lt r8, r9                   ; F: the ray meets the root cell
         movb r10, #0
-        (!f) st r10, [#400]
+        (!f) st r10, [#P_ALIVE]
         (!f) sleep
 k_pinit_end:
+
+; k_pn0b: an inner node split across x, the child below the plane first (stream: the
+; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
+; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
+; Out: F = reaches the first child.
 k_pn0b:
-        ld r12, [r0 + #403]
-        ld r13, [r0 + #406]
+        ld r12, [r0 + #P_Z]
+        ld r13, [r0 + #P_R]
         sub r10, fb0, r1
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
-        ld r12, [r0 + #409]
+        mul r10, r10, r13, >>Q14        ; t(s)
+        ld r12, [r0 + #P_DT]
         subs r11, r10, r12
         adds r10, r10, r12
         ; near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]
@@ -1099,16 +1054,21 @@ k_pn0b:
         sel r8, r8, r13
         cmp.lt r11, r14
         (!f) cmp.lt r8, r9
-        (!f) sleep
+        (!f) sleep                      ; neither child
         cmp.lt r8, r9
 k_pn0b_end:
+
+; k_pn0a: an inner node split across x, the child above the plane first (stream: the
+; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
+; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
+; Out: F = reaches the first child.
 k_pn0a:
-        ld r12, [r0 + #403]
-        ld r13, [r0 + #406]
+        ld r12, [r0 + #P_Z]
+        ld r13, [r0 + #P_R]
         sub r10, fb0, r1
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
-        ld r12, [r0 + #409]
+        mul r10, r10, r13, >>Q14        ; t(s)
+        ld r12, [r0 + #P_DT]
         subs r11, r10, r12
         adds r10, r10, r12
         ; near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]
@@ -1121,16 +1081,21 @@ k_pn0a:
         sel r8, r8, r13
         cmp.lt r11, r14
         (!f) cmp.lt r8, r9
-        (!f) sleep
+        (!f) sleep                      ; neither child
         cmp.lt r8, r9
 k_pn0a_end:
+
+; k_pn1b: an inner node split across y, the child below the plane first (stream: the
+; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
+; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
+; Out: F = reaches the first child.
 k_pn1b:
-        ld r12, [r0 + #404]
-        ld r13, [r0 + #407]
+        ld r12, [r0 + #P_Z+1]
+        ld r13, [r0 + #P_R+1]
         sub r10, fb0, r2
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
-        ld r12, [r0 + #410]
+        mul r10, r10, r13, >>Q14        ; t(s)
+        ld r12, [r0 + #P_DT+1]
         subs r11, r10, r12
         adds r10, r10, r12
         ; near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]
@@ -1143,16 +1108,21 @@ k_pn1b:
         sel r8, r8, r13
         cmp.lt r11, r14
         (!f) cmp.lt r8, r9
-        (!f) sleep
+        (!f) sleep                      ; neither child
         cmp.lt r8, r9
 k_pn1b_end:
+
+; k_pn1a: an inner node split across y, the child above the plane first (stream: the
+; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
+; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
+; Out: F = reaches the first child.
 k_pn1a:
-        ld r12, [r0 + #404]
-        ld r13, [r0 + #407]
+        ld r12, [r0 + #P_Z+1]
+        ld r13, [r0 + #P_R+1]
         sub r10, fb0, r2
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
-        ld r12, [r0 + #410]
+        mul r10, r10, r13, >>Q14        ; t(s)
+        ld r12, [r0 + #P_DT+1]
         subs r11, r10, r12
         adds r10, r10, r12
         ; near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]
@@ -1165,16 +1135,21 @@ k_pn1a:
         sel r8, r8, r13
         cmp.lt r11, r14
         (!f) cmp.lt r8, r9
-        (!f) sleep
+        (!f) sleep                      ; neither child
         cmp.lt r8, r9
 k_pn1a_end:
+
+; k_pn2b: an inner node split across z, the child below the plane first (stream: the
+; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
+; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
+; Out: F = reaches the first child.
 k_pn2b:
-        ld r12, [r0 + #405]
-        ld r13, [r0 + #408]
+        ld r12, [r0 + #P_Z+2]
+        ld r13, [r0 + #P_R+2]
         sub r10, fb0, r3
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
-        ld r12, [r0 + #411]
+        mul r10, r10, r13, >>Q14        ; t(s)
+        ld r12, [r0 + #P_DT+2]
         subs r11, r10, r12
         adds r10, r10, r12
         ; near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]
@@ -1187,16 +1162,21 @@ k_pn2b:
         sel r8, r8, r13
         cmp.lt r11, r14
         (!f) cmp.lt r8, r9
-        (!f) sleep
+        (!f) sleep                      ; neither child
         cmp.lt r8, r9
 k_pn2b_end:
+
+; k_pn2a: an inner node split across z, the child above the plane first (stream: the
+; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
+; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
+; Out: F = reaches the first child.
 k_pn2a:
-        ld r12, [r0 + #405]
-        ld r13, [r0 + #408]
+        ld r12, [r0 + #P_Z+2]
+        ld r13, [r0 + #P_R+2]
         sub r10, fb0, r3
         asl r10, r10, r12
-        mul r10, r10, r13, >>14
-        ld r12, [r0 + #411]
+        mul r10, r10, r13, >>Q14        ; t(s)
+        ld r12, [r0 + #P_DT+2]
         subs r11, r10, r12
         adds r10, r10, r12
         ; near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]
@@ -1209,62 +1189,81 @@ k_pn2a:
         sel r8, r8, r13
         cmp.lt r11, r14
         (!f) cmp.lt r8, r9
-        (!f) sleep
+        (!f) sleep                      ; neither child
         cmp.lt r8, r9
 k_pn2a_end:
+
+; k_p2nd: after a node kernel, F = the ray reaches the second child too.
 k_p2nd:
         cmp.lt r11, r14
 k_p2nd_end:
+
+; k_psl: the rays that do not reach the first child sleep until the second is popped.
 k_psl:
         (!f) sleep
 k_psl_end:
+
+; k_ptake: only the second child is visited: its interval becomes the current one.
 k_ptake:
         mov r8, r11
         mov r9, r14
 k_ptake_end:
+
+; k_ppush: the second child pushed: every awake ray's interval for it into its slot
+; (stream: the slot's RAM address).
 k_ppush:
         mov r15, fb0
-        st r14, [r15]
+        st r14, [r15]                   ; SLOT_TMAX
         add r15, r15, #1
-        st r11, [r15]
+        st r11, [r15]                   ; SLOT_TMIN
 k_ppush_end:
+
+; k_ppop: a popped node (stream: its slot's RAM address): every RC wakes and takes its
+; interval from the slot, emptied; the rays not alive, or whose interval is empty or
+; beyond their hit, sleep again. Out: F = awake.
 k_ppop:
         wake
         mov r15, fb0
-        ld r9, [r15 + #0]
-        ld r8, [r15 + #1]
+        ld r9, [r15 + #SLOT_TMAX]
+        ld r8, [r15 + #SLOT_TMIN]
         movb r10, #-1
-        st r10, [r15]
+        st r10, [r15]                   ; empty
         min r9, r9, r7
-        ld r11, [r0 + #400]
+        ld r11, [r0 + #P_ALIVE]
         cmp.ne r11, #0
         (f) cmp.lt r8, r9
         (!f) sleep
 k_ppop_end:
+
+; k_pleafa: after a leaf, any-hit pass: the rays with a hit are done (not alive) and sleep.
 k_pleafa:
-        ld r8, [r0 + #266]
+        ld r8, [r0 + #PASS_T0]
         cmp.lt r7, r8
         movb r9, #0
-        (f) st r9, [#400]
+        (f) st r9, [#P_ALIVE]
         (f) sleep
 k_pleafa_end:
+
+; k_eye: the tile's eye rays (stream: px0, py0, eye.xyz, (A, B, C) per axis).
+; Out: r1..r3 = eye, r4..r6 = normalize(A + i B + j C) for pixel (px0 + col, py0 + row),
+; r7 = C_INF; a new level (PASS_T0, COL = 0, SH_D), OUT_OBJ = -1.
 k_eye:
-        ld r8, [r0 + #259]
-        add r8, fb0, r8
-        ld r9, [r0 + #258]
-        add r9, fb0, r9
+        ld r8, [r0 + #LANE_COL]
+        add r8, fb0, r8                 ; i
+        ld r9, [r0 + #LANE_ROW]
+        add r9, fb0, r9                 ; j
         mov r1, fb0
         mov r2, fb0
         mov r3, fb0
-        ldacc fb0, <<10
+        ldacc fb0, <<KD-Q13
         mac out, fb0, r8
-        mac r10, fb0, r9, >>10
-        ldacc fb0, <<10
+        mac r10, fb0, r9, >>KD-Q13
+        ldacc fb0, <<KD-Q13
         mac out, fb0, r8
-        mac r11, fb0, r9, >>10
-        ldacc fb0, <<10
+        mac r11, fb0, r9, >>KD-Q13
+        ldacc fb0, <<KD-Q13
         mac out, fb0, r8
-        mac r12, fb0, r9, >>10
+        mac r12, fb0, r9, >>KD-Q13
         ; normalize
         sra r10, r10, #1
         sra r11, r11, #1
@@ -1275,157 +1274,147 @@ k_eye:
         abs r14, r12
         max r13, r13, r14
         clz r13, r13
-        sub r13, r13, #2
+        sub r13, r13, #2                ; shift to the top of the word
         sll r10, r10, r13
         sll r11, r11, r13
         sll r12, r12, r13
         mul out, r10, r10
         mac out, r11, r11
-        mac r14, r12, r12, >>15
-        srl r15, r14, #8
-        ld r15, [r15 + #0]
-        ld r9, [r0 + #256]
-        mul r8, r15, r15, >>14
-        mul r8, r8, r14, >>11
+        mac r14, r12, r12, >>Q15        ; X = |v|^2, Q.11
+        srl r15, r14, #RSQ_SHIFT
+        ld r15, [r15 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r9, [r0 + #C_ONE]
+        mul r8, r15, r15, >>Q14         ; Newton: y += y (1 - X y^2) / 2
+        mul r8, r8, r14, >>Q11
         sub r8, r8, r9
-        ldacc r15, <<15
-        msu r15, r15, r8, >>15
-        mul r8, r15, r15, >>14
-        mul r8, r8, r14, >>11
+        ldacc r15, <<Q15
+        msu r15, r15, r8, >>Q15
+        mul r8, r15, r15, >>Q14         ; Newton: y += y (1 - X y^2) / 2
+        mul r8, r8, r14, >>Q11
         sub r8, r8, r9
-        ldacc r15, <<15
-        msu r15, r15, r8, >>15
-        mul r10, r10, r15, >>13
-        mul r11, r11, r15, >>13
-        mul r12, r12, r15, >>13
+        ldacc r15, <<Q15
+        msu r15, r15, r8, >>Q15
+        mul r10, r10, r15, >>Q13
+        mul r11, r11, r15, >>Q13
+        mul r12, r12, r15, >>Q13
         mov r4, r10
         mov r5, r11
         mov r6, r12
-        ld r7, [r0 + #257]
-        st r7, [#266]
+        ld r7, [r0 + #C_INF]
+        st r7, [#PASS_T0]
         movb r8, #0
-        st r8, [#278]
-        st r8, [#279]
-        st r8, [#280]
-        st r4, [#274]
-        st r5, [#275]
-        st r6, [#276]
+        st r8, [#COL]
+        st r8, [#COL+1]
+        st r8, [#COL+2]
+        st r4, [#SH_D]
+        st r5, [#SH_D+1]
+        st r6, [#SH_D+2]
         movb r8, #-1
-        st r8, [#281]
+        st r8, [#OUT_OBJ]
 k_eye_end:
+
+; k_post0: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
+; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
+; COL = the background where no hit; OUT_OBJ, the eye ray's object.
 k_post0:
-        ld r8, [r0 + #257]
-        cmp.lt r7, r8
+        ld r8, [r0 + #C_INF]
+        cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
         (f) movb r9, #1
-        st r9, [#277]
-        ld r10, [r0 + #261]
+        st r9, [#ACT]
+        ld r10, [r0 + #HIT_OBJ]
         movb r11, #-1
         (f) mov r11, r10
-        st r11, [#281]
-        (!f) st fb0, [#278]
-        (!f) st fb0, [#279]
-        (!f) st fb0, [#280]
-        movb r12, #0
-        ld r8, [r0 + #263]
-        st r8, [#270]
-        ldacc r1, <<14
+        st r11, [#OUT_OBJ]
+        (!f) st fb0, [#COL]
+        (!f) st fb0, [#COL+1]
+        (!f) st fb0, [#COL+2]           ; the background where no hit
+        movb r12, #EPS_LSB
+        ld r8, [r0 + #HIT_N]
+        st r8, [#SH_N]
+        ldacc r1, <<Q14
         mac out, r7, r4
-        mac r11, r8, r12, >>14
-        st r11, [#267]
-        ld r8, [r0 + #264]
-        st r8, [#271]
-        ldacc r2, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P]
+        ld r8, [r0 + #HIT_N+1]
+        st r8, [#SH_N+1]
+        ldacc r2, <<Q14
         mac out, r7, r5
-        mac r11, r8, r12, >>14
-        st r11, [#268]
-        ld r8, [r0 + #265]
-        st r8, [#272]
-        ldacc r3, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+1]
+        ld r8, [r0 + #HIT_N+2]
+        st r8, [#SH_N+2]
+        ldacc r3, <<Q14
         mac out, r7, r6
-        mac r11, r8, r12, >>14
-        st r11, [#269]
-        ld r13, [r0 + #262]
-        st r13, [#273]
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+2]               ; P = o + t d + EPS_LSB n
+        ld r13, [r0 + #HIT_MAT]
+        st r13, [#SH_MAT]
         movb r14, #0
-        st r14, [#282]
+        st r14, [#SH_KS]
+        ; Ks of the hit's material: one test per material
+        .rept 6, m
         cmp.ne r9, #0
         (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
+        (f) st fb0, [#SH_KS]
+        .endr
 k_post0_end:
+
+; k_post1: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
+; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
+; COL = the background where no hit.
 k_post1:
-        ld r8, [r0 + #257]
-        cmp.lt r7, r8
+        ld r8, [r0 + #C_INF]
+        cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
         (f) movb r9, #1
-        st r9, [#277]
-        (!f) st fb0, [#278]
-        (!f) st fb0, [#279]
-        (!f) st fb0, [#280]
-        movb r12, #0
-        ld r8, [r0 + #263]
-        st r8, [#270]
-        ldacc r1, <<14
+        st r9, [#ACT]
+        (!f) st fb0, [#COL]
+        (!f) st fb0, [#COL+1]
+        (!f) st fb0, [#COL+2]           ; the background where no hit
+        movb r12, #EPS_LSB
+        ld r8, [r0 + #HIT_N]
+        st r8, [#SH_N]
+        ldacc r1, <<Q14
         mac out, r7, r4
-        mac r11, r8, r12, >>14
-        st r11, [#267]
-        ld r8, [r0 + #264]
-        st r8, [#271]
-        ldacc r2, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P]
+        ld r8, [r0 + #HIT_N+1]
+        st r8, [#SH_N+1]
+        ldacc r2, <<Q14
         mac out, r7, r5
-        mac r11, r8, r12, >>14
-        st r11, [#268]
-        ld r8, [r0 + #265]
-        st r8, [#272]
-        ldacc r3, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+1]
+        ld r8, [r0 + #HIT_N+2]
+        st r8, [#SH_N+2]
+        ldacc r3, <<Q14
         mac out, r7, r6
-        mac r11, r8, r12, >>14
-        st r11, [#269]
-        ld r13, [r0 + #262]
-        st r13, [#273]
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+2]               ; P = o + t d + EPS_LSB n
+        ld r13, [r0 + #HIT_MAT]
+        st r13, [#SH_MAT]
         movb r14, #0
-        st r14, [#282]
+        st r14, [#SH_KS]
+        ; Ks of the hit's material: one test per material
+        .rept 6, m
         cmp.ne r9, #0
         (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
-        cmp.ne r9, #0
-        (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
+        (f) st fb0, [#SH_KS]
+        .endr
 k_post1_end:
+
+; k_light: the shadow rays towards one light (stream: the light's position).
+; In: SH_P, SH_N, SH_D, ACT. Out: r1..r7 the shadow rays (tbest: the light's distance less 2 LSB),
+; SH_NL, SH_RV, LIT; the RCs with no hit or the light behind the surface sleep.
 k_light:
-        ld r1, [r0 + #267]
-        ld r2, [r0 + #268]
-        ld r3, [r0 + #269]
+        ld r1, [r0 + #SH_P]
+        ld r2, [r0 + #SH_P+1]
+        ld r3, [r0 + #SH_P+2]
         sub r8, fb0, r1
         sub r9, fb0, r2
-        sub r10, fb0, r3
+        sub r10, fb0, r3                ; L - P
         ; normalize
         sra r8, r8, #1
         sra r9, r9, #1
@@ -1436,442 +1425,481 @@ k_light:
         abs r12, r10
         max r11, r11, r12
         clz r11, r11
-        sub r11, r11, #2
+        sub r11, r11, #2                ; shift to the top of the word
         sll r8, r8, r11
         sll r9, r9, r11
         sll r10, r10, r11
         mul out, r8, r8
         mac out, r9, r9
-        mac r12, r10, r10, >>15
-        srl r13, r12, #8
-        ld r13, [r13 + #0]
-        ld r15, [r0 + #256]
-        mul r14, r13, r13, >>14
-        mul r14, r14, r12, >>11
+        mac r12, r10, r10, >>Q15        ; X = |v|^2, Q.11
+        srl r13, r12, #RSQ_SHIFT
+        ld r13, [r13 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r15, [r0 + #C_ONE]
+        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r14, r14, r12, >>Q11
         sub r14, r14, r15
-        ldacc r13, <<15
-        msu r13, r13, r14, >>15
-        mul r14, r13, r13, >>14
-        mul r14, r14, r12, >>11
+        ldacc r13, <<Q15
+        msu r13, r13, r14, >>Q15
+        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r14, r14, r12, >>Q11
         sub r14, r14, r15
-        ldacc r13, <<15
-        msu r13, r13, r14, >>15
-        mul r12, r12, r13, >>12
+        ldacc r13, <<Q15
+        msu r13, r13, r14, >>Q15
+        mul r12, r12, r13, >>Q12        ; |v| = X y, the shifts undone
         sra r12, r12, r11
         adds r11, r12, r12
-        mul r8, r8, r13, >>13
-        mul r9, r9, r13, >>13
-        mul r10, r10, r13, >>13
+        mul r8, r8, r13, >>Q13
+        mul r9, r9, r13, >>Q13
+        mul r10, r10, r13, >>Q13
         mov r4, r8
         mov r5, r9
         mov r6, r10
-        sub r7, r11, #2
-        st r7, [#266]
-        ld r12, [r0 + #270]
+        sub r7, r11, #2                 ; tbest = |L - P| - 2
+        st r7, [#PASS_T0]
+        ; nl = N.L
+        ld r12, [r0 + #SH_N]
         mul out, r12, r4
-        ld r13, [r0 + #271]
+        ld r13, [r0 + #SH_N+1]
         mac out, r13, r5
-        ld r14, [r0 + #272]
-        mac r15, r14, r6, >>14
-        st r15, [#283]
-        ld r8, [r0 + #274]
-        ld r9, [r0 + #275]
-        ld r10, [r0 + #276]
+        ld r14, [r0 + #SH_N+2]
+        mac r15, r14, r6, >>Q14
+        st r15, [#SH_NL]
+        ; nd = N.D, ld = L.D, rv = ld - 2 nl nd
+        ld r8, [r0 + #SH_D]
+        ld r9, [r0 + #SH_D+1]
+        ld r10, [r0 + #SH_D+2]
         mul out, r12, r8
         mac out, r13, r9
-        mac r11, r14, r10, >>14
+        mac r11, r14, r10, >>Q14        ; nd
         mul out, r4, r8
         mac out, r5, r9
-        mac r12, r6, r10, >>14
-        ldacc r12, <<14
+        mac r12, r6, r10, >>Q14         ; ld
+        ldacc r12, <<Q14
         msu out, r15, r11
-        msu r12, r15, r11, >>14
+        msu r12, r15, r11, >>Q14
         max r12, r12, #0
-        st r12, [#284]
-        ld r8, [r0 + #277]
+        st r12, [#SH_RV]
+        ld r8, [r0 + #ACT]
         cmp.ne r8, #0
-        (f) cmp.gt r15, #0
+        (f) cmp.gt r15, #0              ; F: a hit lit from its front
         movb r9, #0
         (f) movb r9, #1
-        st r9, [#285]
+        st r9, [#LIT]
         (!f) sleep
 k_light_end:
+
+; k_shade: after a shadow pass, the light's Phong terms where it is visible
+; (stream per material: id, [f, 1 - f,] then per channel kd c lc, ks lc).
+; In: LIT, PASS_T0, r7 (no hit: tbest >= PASS_T0), SH_NL, SH_RV, SH_MAT. Out: COL += kd c lc N.L + ks lc (R.V)^n.
 k_shade:
-        ld r8, [r0 + #285]
+        ld r8, [r0 + #LIT]
         cmp.ne r8, #0
-        ld r9, [r0 + #266]
-        (f) cmp.ge r7, r9
+        ld r9, [r0 + #PASS_T0]
+        (f) cmp.ge r7, r9               ; F: lit and not shadowed
         movb r10, #0
         (f) movb r10, #1
-        ld r11, [r0 + #283]
-        ld r12, [r0 + #284]
-        ld r13, [r0 + #273]
+        ld r11, [r0 + #SH_NL]
+        ld r12, [r0 + #SH_RV]
+        ld r13, [r0 + #SH_MAT]
+        ; material 0: exponent 60
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^60
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
+        ; material 1: exponent 10
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^10
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
+        ; material 2: exponent 80
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^80
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
+        ; material 3: exponent 30
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^30
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
+        ; material 4: exponent 200
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^200
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
+        ; material 5: exponent 40
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^40
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
 k_shade_end:
+
+; k_out0: the pixel's red into the output register (for wfb).
 k_out0:
-        ld out, [r0 + #278]
+        ld out, [r0 + #COL]
 k_out0_end:
+
+; k_out1: the pixel's green into the output register (for wfb).
 k_out1:
-        ld out, [r0 + #279]
+        ld out, [r0 + #COL+1]
 k_out1_end:
+
+; k_out2: the pixel's blue into the output register (for wfb).
 k_out2:
-        ld out, [r0 + #280]
+        ld out, [r0 + #COL+2]
 k_out2_end:
+
+; k_out3: the pixel's object id into the output register (for wfb).
 k_out3:
-        ld out, [r0 + #281]
+        ld out, [r0 + #OUT_OBJ]
 k_out3_end:
+
+; k_strow: r8 (the row or column [`k_rows`] gave) into LANE_ROW.
 k_strow:
-        st r8, [#258]
+        st r8, [#LANE_ROW]
 k_strow_end:
+
+; k_stcol: r8 (the row or column [`k_rows`] gave) into LANE_COL.
 k_stcol:
-        st r8, [#259]
+        st r8, [#LANE_COL]
 k_stcol_end:
+
+; k_refl0: level 0's colour and Ks onto the stack (STACK_L0); the reflected rays
+; d - 2 (d.N) N from SH_P where Ks > 0, the others sleep. Out: r1..r7 the rays, a new level.
 k_refl0:
-        ld r8, [r0 + #282]
-        st r8, [#303]
+        ld r8, [r0 + #SH_KS]
+        st r8, [#STACK_L0+FR_KS]
         movb r10, #0
-        ld r9, [r0 + #278]
-        st r9, [#300]
-        st r10, [#278]
-        ld r9, [r0 + #279]
-        st r9, [#301]
-        st r10, [#279]
-        ld r9, [r0 + #280]
-        st r9, [#302]
-        st r10, [#280]
-        ld r1, [r0 + #267]
-        ld r2, [r0 + #268]
-        ld r3, [r0 + #269]
-        ld r8, [r0 + #274]
-        ld r9, [r0 + #275]
-        ld r10, [r0 + #276]
-        ld r11, [r0 + #270]
-        ld r12, [r0 + #271]
-        ld r13, [r0 + #272]
+        ld r9, [r0 + #COL]
+        st r9, [#STACK_L0+FR_COL]
+        st r10, [#COL]
+        ld r9, [r0 + #COL+1]
+        st r9, [#STACK_L0+FR_COL+1]
+        st r10, [#COL+1]
+        ld r9, [r0 + #COL+2]
+        st r9, [#STACK_L0+FR_COL+2]
+        st r10, [#COL+2]
+        ld r1, [r0 + #SH_P]
+        ld r2, [r0 + #SH_P+1]
+        ld r3, [r0 + #SH_P+2]
+        ld r8, [r0 + #SH_D]
+        ld r9, [r0 + #SH_D+1]
+        ld r10, [r0 + #SH_D+2]
+        ld r11, [r0 + #SH_N]
+        ld r12, [r0 + #SH_N+1]
+        ld r13, [r0 + #SH_N+2]
         mul out, r8, r11
         mac out, r9, r12
-        mac r14, r10, r13, >>14
-        ldacc r8, <<14
+        mac r14, r10, r13, >>Q14        ; d.N
+        ldacc r8, <<Q14
         msu out, r14, r11
-        msu r4, r14, r11, >>14
-        ldacc r9, <<14
+        msu r4, r14, r11, >>Q14
+        ldacc r9, <<Q14
         msu out, r14, r12
-        msu r5, r14, r12, >>14
-        ldacc r10, <<14
+        msu r5, r14, r12, >>Q14
+        ldacc r10, <<Q14
         msu out, r14, r13
-        msu r6, r14, r13, >>14
-        ld r7, [r0 + #257]
-        st r7, [#266]
-        st r4, [#274]
-        st r5, [#275]
-        st r6, [#276]
-        ld r9, [r0 + #277]
-        ld r8, [r0 + #282]
+        msu r6, r14, r13, >>Q14         ; r = d - 2 (d.N) N
+        ld r7, [r0 + #C_INF]
+        st r7, [#PASS_T0]
+        st r4, [#SH_D]
+        st r5, [#SH_D+1]
+        st r6, [#SH_D+2]
+        ld r9, [r0 + #ACT]
+        ld r8, [r0 + #SH_KS]
         cmp.ne r9, #0
-        (f) cmp.gt r8, #0
+        (f) cmp.gt r8, #0               ; F: a hit that reflects
         (!f) sleep
 k_refl0_end:
+
+; k_pop0: back from level 0's reflected rays: COL = STACK_L0's colour + Ks COL.
 k_pop0:
-        ld r10, [r0 + #303]
-        ld r8, [r0 + #300]
-        ld r9, [r0 + #278]
-        mul r9, r9, r10, >>12
+        ld r10, [r0 + #STACK_L0+FR_KS]
+        ld r8, [r0 + #STACK_L0+FR_COL]
+        ld r9, [r0 + #COL]
+        mul r9, r9, r10, >>Q12
         adds r9, r8, r9
-        st r9, [#278]
-        ld r8, [r0 + #301]
-        ld r9, [r0 + #279]
-        mul r9, r9, r10, >>12
+        st r9, [#COL]
+        ld r8, [r0 + #STACK_L0+FR_COL+1]
+        ld r9, [r0 + #COL+1]
+        mul r9, r9, r10, >>Q12
         adds r9, r8, r9
-        st r9, [#279]
-        ld r8, [r0 + #302]
-        ld r9, [r0 + #280]
-        mul r9, r9, r10, >>12
+        st r9, [#COL+1]
+        ld r8, [r0 + #STACK_L0+FR_COL+2]
+        ld r9, [r0 + #COL+2]
+        mul r9, r9, r10, >>Q12
         adds r9, r8, r9
-        st r9, [#280]
+        st r9, [#COL+2]
 k_pop0_end:
+
+; k_sphere: the sphere test of one record (the stream), for every awake ray.
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F (a nearer hit): r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; b = (c - o).d, p = (c - o) - b d, s = 1 - |p/r|^2, t = b - sg r sqrt(s), n = -(sg p/r + sqrt(s) d)
 k_sphere:
-        ; sphere: oc = c - o
+        ; oc = c - o
         sub r8, fb0, r1
         sub r9, fb0, r2
         sub r10, fb0, r3
         mul out, r8, r4
         mac out, r9, r5
-        mac r11, r10, r6, >>14
-        ldacc r8, <<14
-        msu r8, r11, r4, >>11
-        ldacc r9, <<14
-        msu r9, r11, r5, >>11
-        ldacc r10, <<14
-        msu r10, r11, r6, >>11
+        mac r11, r10, r6, >>Q14         ; b = oc.d
+        ; p = oc - b d, with EP_SPHERE more fraction bits
+        ldacc r8, <<Q14
+        msu r8, r11, r4, >>Q14-EP_SPHERE
+        ldacc r9, <<Q14
+        msu r9, r11, r5, >>Q14-EP_SPHERE
+        ldacc r10, <<Q14
+        msu r10, r11, r6, >>Q14-EP_SPHERE
         mul out, r8, r4
         mac out, r9, r5
-        mac r12, r10, r6, >>14
-        ldacc r8, <<14
-        msu r8, r12, r4, >>14
-        ldacc r9, <<14
-        msu r9, r12, r5, >>14
-        ldacc r10, <<14
-        msu r10, r12, r6, >>14
-        mov r12, fb0
-        mov r13, fb0
-        mul r8, r8, r13, >>12
-        st r8, [#286]
-        mul r9, r9, r13, >>12
-        st r9, [#287]
-        mul r10, r10, r13, >>12
-        st r10, [#288]
-        ld r14, [r0 + #256]
-        ldacc r14, <<14
+        mac r12, r10, r6, >>Q14
+        ldacc r8, <<Q14
+        msu r8, r12, r4, >>Q14
+        ldacc r9, <<Q14
+        msu r9, r12, r5, >>Q14
+        ldacc r10, <<Q14
+        msu r10, r12, r6, >>Q14
+        mov r12, fb0                    ; r
+        mov r13, fb0                    ; invr
+        mul r8, r8, r13, >>KS_SPHERE+EP_SPHERE
+        st r8, [#TMP0]
+        mul r9, r9, r13, >>KS_SPHERE+EP_SPHERE
+        st r9, [#TMP0+1]
+        mul r10, r10, r13, >>KS_SPHERE+EP_SPHERE
+        st r10, [#TMP0+2]               ; p/r in TMP0..2
+        ld r14, [r0 + #C_ONE]
+        ldacc r14, <<Q14
         msu out, r8, r8
         msu out, r9, r9
-        msu r15, r10, r10, >>14
-        cmp.gt r15, #0
+        msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
+        cmp.gt r15, #0                  ; F: the line meets the sphere
         ; sqrt
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
         min r8, r15, r14
         clz r9, r8
         sub r9, r9, #2
-        or r9, r9, #1
+        or r9, r9, #1                   ; an odd shift e
         sll r10, r8, r9
-        srl r13, r10, #8
-        ld r13, [r13 + #0]
-        ld r14, [r0 + #256]
-        mul r8, r13, r13, >>14
-        mul r8, r8, r10, >>11
+        srl r13, r10, #RSQ_SHIFT
+        ld r13, [r13 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r14, [r0 + #C_ONE]
+        mul r8, r13, r13, >>Q14
+        mul r8, r8, r10, >>Q11
         sub r8, r8, r14
-        ldacc r13, <<15
-        msu r13, r13, r8, >>15
-        mul r8, r13, r13, >>14
-        mul r8, r8, r10, >>11
+        ldacc r13, <<Q15
+        msu r13, r13, r8, >>Q15
+        mul r8, r13, r13, >>Q14
+        mul r8, r8, r10, >>Q11
         sub r8, r8, r14
-        ldacc r13, <<15
-        msu r13, r13, r8, >>15
-        mul r8, r10, r13, >>13
+        ldacc r13, <<Q15
+        msu r13, r13, r8, >>Q15
+        mul r8, r10, r13, >>Q13         ; sqrt(X) = X y, Q.12
         sub r9, r9, #1
         sra r9, r9, #1
         sra r8, r8, r9
-        mul r9, r12, r8, >>14
-        mov r10, fb0
-        mul r9, r9, r10, >>14
-        sub r9, r11, r9
+        mul r9, r12, r8, >>Q14          ; h = r sqrt(s)
+        mov r10, fb0                    ; sg
+        mul r9, r9, r10, >>Q14
+        sub r9, r11, r9                 ; t = b - sg h
         (f) cmp.gt r9, #0
-        (f) cmp.lt r9, r7
+        (f) cmp.lt r9, r7               ; F: a hit ahead, nearer than tbest
         ; normal = -(sg p/r + sqrt(s) d)
-        ld r11, [r0 + #286]
+        ld r11, [r0 + #TMP0]
         mul out, r8, r4
-        mac r11, r10, r11, >>14
+        mac r11, r10, r11, >>Q14
         neg r11, r11
-        ld r12, [r0 + #287]
+        ld r12, [r0 + #TMP0+1]
         mul out, r8, r5
-        mac r12, r10, r12, >>14
+        mac r12, r10, r12, >>Q14
         neg r12, r12
-        ld r13, [r0 + #288]
+        ld r13, [r0 + #TMP0+2]
         mul out, r8, r6
-        mac r13, r10, r13, >>14
+        mac r13, r10, r13, >>Q14
         neg r13, r13
         (f) mov r7, r9
-        (f) st r11, [#263]
-        (f) st r12, [#264]
-        (f) st r13, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        (f) st r11, [#HIT_N]
+        (f) st r12, [#HIT_N+1]
+        (f) st r13, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_sphere_end:
+
+; k_cyl: the open cylinder test of one body record (the stream).
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; Across the axis: d2 = (d.e1, d.e2) normalised, p2 = oc2 - b d2n, s = 1 - |p2/r|^2,
+; tau = b - sg r sqrt(s), t = tau / |d2|; the axial coordinate within [-2, H+2].
 k_cyl:
-        ; cylinder: oc = B - o, projected on e1, e2
+        ; oc = B - o, projected on e1, e2
         sub r8, fb0, r1
         sub r9, fb0, r2
         sub r10, fb0, r3
         mul out, fb0, r8
         mac out, fb0, r9
-        mac r11, fb0, r10, >>14
+        mac r11, fb0, r10, >>Q14
         accl r14
-        sll r15, r11, #14
+        sll r15, r11, #Q14
         sub r14, r14, r15
         add r14, fb0, r14
-        st r14, [#291]
+        st r14, [#TMP5]                 ; the projection's remainder, plus B's
         mul out, fb0, r8
         mac out, fb0, r9
-        mac r12, fb0, r10, >>14
+        mac r12, fb0, r10, >>Q14
         accl r15
-        sll r13, r12, #14
+        sll r13, r12, #Q14
         sub r15, r15, r13
         add r15, fb0, r15
-        st r15, [#292]
-        st r11, [#286]
-        st r12, [#287]
+        st r15, [#TMP6]                 ; the projection's remainder, plus B's
+        st r11, [#TMP0]
+        st r12, [#TMP1]                 ; oc2
         mul out, fb0, r4
         mac out, fb0, r5
-        mac r8, fb0, r6, >>14
+        mac r8, fb0, r6, >>Q14
         mul out, fb0, r4
         mac out, fb0, r5
-        mac r9, fb0, r6, >>14
+        mac r9, fb0, r6, >>Q14          ; d2 = (d.e1, d.e2)
         movb r10, #0
         ; normalize
         sra r8, r8, #1
@@ -1883,555 +1911,571 @@ k_cyl:
         abs r12, r10
         max r11, r11, r12
         clz r11, r11
-        sub r11, r11, #2
+        sub r11, r11, #2                ; shift to the top of the word
         sll r8, r8, r11
         sll r9, r9, r11
         sll r10, r10, r11
         mul out, r8, r8
         mac out, r9, r9
-        mac r12, r10, r10, >>15
-        srl r13, r12, #8
-        ld r13, [r13 + #0]
-        ld r15, [r0 + #256]
-        mul r14, r13, r13, >>14
-        mul r14, r14, r12, >>11
+        mac r12, r10, r10, >>Q15        ; X = |v|^2, Q.11
+        srl r13, r12, #RSQ_SHIFT
+        ld r13, [r13 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r15, [r0 + #C_ONE]
+        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r14, r14, r12, >>Q11
         sub r14, r14, r15
-        ldacc r13, <<15
-        msu r13, r13, r14, >>15
-        mul r14, r13, r13, >>14
-        mul r14, r14, r12, >>11
+        ldacc r13, <<Q15
+        msu r13, r13, r14, >>Q15
+        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r14, r14, r12, >>Q11
         sub r14, r14, r15
-        ldacc r13, <<15
-        msu r13, r13, r14, >>15
-        mul r12, r12, r13, >>12
+        ldacc r13, <<Q15
+        msu r13, r13, r14, >>Q15
+        mul r12, r12, r13, >>Q12        ; |v| = X y, the shifts undone
         sra r12, r12, r11
         adds r11, r12, r12
-        mul r8, r8, r13, >>13
-        mul r9, r9, r13, >>13
-        mul r10, r10, r13, >>13
-        mov r10, r11
-        st r8, [#288]
-        st r9, [#289]
-        ld r11, [r0 + #286]
-        ld r12, [r0 + #287]
+        mul r8, r8, r13, >>Q13
+        mul r9, r9, r13, >>Q13
+        mul r10, r10, r13, >>Q13
+        mov r10, r11                    ; |d2|, Q.14
+        st r8, [#TMP2]
+        st r9, [#TMP3]                  ; d2n
+        ld r11, [r0 + #TMP0]
+        ld r12, [r0 + #TMP1]
         mul out, r11, r8
-        mac r13, r12, r9, >>14
-        ld r14, [r0 + #291]
-        ld r15, [r0 + #292]
-        ldacc r11, <<14
+        mac r13, r12, r9, >>Q14         ; b = oc2.d2n
+        ld r14, [r0 + #TMP5]
+        ld r15, [r0 + #TMP6]
+        ldacc r11, <<Q14
         mac out, r14, #1
-        msu r11, r13, r8, >>10
-        ldacc r12, <<14
+        msu r11, r13, r8, >>Q14-EP_CYL
+        ldacc r12, <<Q14
         mac out, r15, #1
-        msu r12, r13, r9, >>10
+        msu r12, r13, r9, >>Q14-EP_CYL  ; p2 = oc2 - b d2n
         mul out, r11, r8
-        mac r14, r12, r9, >>14
-        ldacc r11, <<14
-        msu r11, r14, r8, >>14
-        ldacc r12, <<14
-        msu r12, r14, r9, >>14
-        mov r14, fb0
-        mul r11, r11, r14, >>14
-        mul r12, r12, r14, >>14
-        st r11, [#286]
-        st r12, [#287]
-        ld r14, [r0 + #256]
-        ldacc r14, <<14
+        mac r14, r12, r9, >>Q14
+        ldacc r11, <<Q14
+        msu r11, r14, r8, >>Q14
+        ldacc r12, <<Q14
+        msu r12, r14, r9, >>Q14
+        mov r14, fb0                    ; invr
+        mul r11, r11, r14, >>KS_CYL+EP_CYL
+        mul r12, r12, r14, >>KS_CYL+EP_CYL
+        st r11, [#TMP0]
+        st r12, [#TMP1]                 ; p2/r
+        ld r14, [r0 + #C_ONE]
+        ldacc r14, <<Q14
         msu out, r11, r11
-        msu r15, r12, r12, >>14
+        msu r15, r12, r12, >>Q14        ; s = 1 - |p2/r|^2
         cmp.gt r15, #0
         (f) cmp.gt r10, #0
         ; sqrt
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
         min r8, r15, r14
         clz r9, r8
         sub r9, r9, #2
-        or r9, r9, #1
+        or r9, r9, #1                   ; an odd shift e
         sll r11, r8, r9
-        srl r12, r11, #8
-        ld r12, [r12 + #0]
-        ld r14, [r0 + #256]
-        mul r8, r12, r12, >>14
-        mul r8, r8, r11, >>11
+        srl r12, r11, #RSQ_SHIFT
+        ld r12, [r12 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r14, [r0 + #C_ONE]
+        mul r8, r12, r12, >>Q14
+        mul r8, r8, r11, >>Q11
         sub r8, r8, r14
-        ldacc r12, <<15
-        msu r12, r12, r8, >>15
-        mul r8, r12, r12, >>14
-        mul r8, r8, r11, >>11
+        ldacc r12, <<Q15
+        msu r12, r12, r8, >>Q15
+        mul r8, r12, r12, >>Q14
+        mul r8, r8, r11, >>Q11
         sub r8, r8, r14
-        ldacc r12, <<15
-        msu r12, r12, r8, >>15
-        mul r8, r11, r12, >>13
+        ldacc r12, <<Q15
+        msu r12, r12, r8, >>Q15
+        mul r8, r11, r12, >>Q13         ; sqrt(X) = X y, Q.12
         sub r9, r9, #1
         sra r9, r9, #1
         sra r8, r8, r9
-        st r8, [#290]
+        st r8, [#TMP4]
         mov r9, fb0
-        mul r9, r9, r8, >>18
+        mul r9, r9, r8, >>Q14+EP_CYL    ; h = r sqrt(s)
         mov r11, fb0
-        mul r9, r9, r11, >>14
-        sub r9, r13, r9
+        mul r9, r9, r11, >>Q14
+        sub r9, r13, r9                 ; tau = b - sg h
         (f) cmp.gt r9, #0
-        ldacc r9, <<14
+        ldacc r9, <<Q14
         msu out, r7, r10
         acch r11
-        (f) cmp.lt r11, #0
+        (f) cmp.lt r11, #0              ; F: tau < tbest |d2|
         ; divide
         clz r8, r10
         sub r8, r8, #1
-        sll r11, r10, r8
-        srl r12, r11, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        ld r14, [r0 + #256]
-        mul r13, r11, r12, >>15
+        sll r11, r10, r8                ; the divisor normalised
+        srl r12, r11, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]            ; r = 1/den from the table
+        ld r14, [r0 + #C_ONE]
+        mul r13, r11, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul r13, r11, r12, >>15
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul r13, r11, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul out, r9, r12
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul out, r9, r12                ; num r in the accumulator, scaled back
         acch r13
         accl r11
         add r14, r8, #1
         sll r13, r13, r14
-        rsb r14, r8, #15
+        rsb r14, r8, #Q15
         srl r11, r11, r14
         or r9, r13, r11
         ; axial coordinate of the hit
-        ldacc r1, <<14
-        mac r11, r9, r4, >>14
+        ldacc r1, <<Q14
+        mac r11, r9, r4, >>Q14
         rsb r11, fb0, r11
-        ldacc r2, <<14
-        mac r12, r9, r5, >>14
+        ldacc r2, <<Q14
+        mac r12, r9, r5, >>Q14
         rsb r12, fb0, r12
-        ldacc r3, <<14
-        mac r13, r9, r6, >>14
+        ldacc r3, <<Q14
+        mac r13, r9, r6, >>Q14
         rsb r13, fb0, r13
         mul out, fb0, r11
         mac out, fb0, r12
-        mac r14, fb0, r13, >>14
+        mac r14, fb0, r13, >>Q14        ; z
         (f) cmp.ge r14, #-2
         mov r15, fb0
-        (f) cmp.le r14, r15
+        (f) cmp.le r14, r15             ; F: within the height
         ; normal: n2 = -(sg p2 / r + sqrt(s) d2n) across the axis, n = n2.x e1 + n2.y e2
         (f) mov r7, r9
         mov r15, fb0
-        ld r8, [r0 + #290]
-        ld r11, [r0 + #286]
-        ld r13, [r0 + #288]
+        ld r8, [r0 + #TMP4]
+        ld r11, [r0 + #TMP0]
+        ld r13, [r0 + #TMP2]
         mul out, r8, r13
-        mac r11, r15, r11, >>14
+        mac r11, r15, r11, >>Q14
         neg r11, r11
-        ld r12, [r0 + #287]
-        ld r13, [r0 + #289]
+        ld r12, [r0 + #TMP1]
+        ld r13, [r0 + #TMP3]
         mul out, r8, r13
-        mac r12, r15, r12, >>14
+        mac r12, r15, r12, >>Q14
         neg r12, r12
         mul out, fb0, r11
-        mac r13, fb0, r12, >>14
+        mac r13, fb0, r12, >>Q14
         mul out, fb0, r11
-        mac r14, fb0, r12, >>14
+        mac r14, fb0, r12, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r12, >>14
-        (f) st r13, [#263]
-        (f) st r14, [#264]
-        (f) st r15, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        mac r15, fb0, r12, >>Q14
+        (f) st r13, [#HIT_N]
+        (f) st r14, [#HIT_N+1]
+        (f) st r15, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_cyl_end:
+
+; k_disc: the disc test of one record (the stream).
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew
 k_disc:
-        ; planar: den = n.d, num = n.(v0 - o)
+        ; den = -n.d, num = -n.(v0 - o)
         mov r8, fb0
         mov r9, fb0
         mov r10, fb0
         mul out, r8, r4
         mac out, r9, r5
-        mac r11, r10, r6, >>14
+        mac r11, r10, r6, >>Q14
         sub r12, fb0, r1
         sub r13, fb0, r2
         sub r14, fb0, r3
         mul out, r8, r12
         mac out, r9, r13
-        mac r15, r10, r14, >>14
+        mac r15, r10, r14, >>Q14
         neg r11, r11
         neg r15, r15
         cmp.gt r11, #0
         (f) cmp.gt r15, #0
-        ldacc r15, <<14
+        ldacc r15, <<Q14
         msu out, r7, r11
         acch r8
-        (f) cmp.lt r8, #0
+        (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
         ; divide
         clz r8, r11
         sub r8, r8, #1
-        sll r10, r11, r8
-        srl r12, r10, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        ld r14, [r0 + #256]
-        mul r13, r10, r12, >>15
+        sll r10, r11, r8                ; the divisor normalised
+        srl r12, r10, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]            ; r = 1/den from the table
+        ld r14, [r0 + #C_ONE]
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul r13, r10, r12, >>15
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul out, r15, r12
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul out, r15, r12               ; num r in the accumulator, scaled back
         acch r13
         accl r10
         add r14, r8, #1
         sll r13, r13, r14
-        rsb r14, r8, #15
+        rsb r14, r8, #Q15
         srl r10, r10, r14
         or r9, r13, r10
         ; P - v0
-        ldacc r1, <<14
-        mac r10, r9, r4, >>14
+        ldacc r1, <<Q14
+        mac r10, r9, r4, >>Q14
         rsb r10, fb0, r10
-        ldacc r2, <<14
-        mac r11, r9, r5, >>14
+        ldacc r2, <<Q14
+        mac r11, r9, r5, >>Q14
         rsb r11, fb0, r11
-        ldacc r3, <<14
-        mac r12, r9, r6, >>14
+        ldacc r3, <<Q14
+        mac r12, r9, r6, >>Q14
         rsb r12, fb0, r12
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r13, fb0, r12, >>10
+        mac r13, fb0, r12, >>KT_DISC    ; u
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r14, fb0, r12, >>10
-        ld r8, [r0 + #256]
-        add r8, r8, #2
+        mac r14, fb0, r12, >>KT_DISC    ; w
+        ld r8, [r0 + #C_ONE]
+        add r8, r8, #INSIDE_TOL
         mul out, r13, r13
-        mac r15, r14, r14, >>14
-        (f) cmp.le r15, r8
+        mac r15, r14, r14, >>Q14
+        (f) cmp.le r15, r8              ; F: inside the disc
         (f) mov r7, r9
-        (f) st fb0, [#263]
-        (f) st fb0, [#264]
-        (f) st fb0, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        (f) st fb0, [#HIT_N]
+        (f) st fb0, [#HIT_N+1]
+        (f) st fb0, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_disc_end:
+
+; k_box: the box test of one record (the stream), one section per axis.
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; Per axis a: the face facing the ray, t = |face - o_a| / |d_a|, inside the other two slabs.
 k_box:
-        ; box: faces across axis 0
-        cmp.lt r4, #0
-        ld r15, [r0 + #256]
+        ; faces across x
+        cmp.lt r4, #0                   ; F: the max face
+        ld r15, [r0 + #C_ONE]
         (!f) neg r15, r15
-        st r15, [#286]
+        st r15, [#TMP0]                 ; the normal's component
         mov r8, fb0
         sel r8, fb0, r8
         sub r8, r8, r1
-        (f) neg r8, r8
+        (f) neg r8, r8                  ; |face - o_a|
         abs r9, r4
         cmp.gt r9, #0
         (f) cmp.gt r8, #0
-        ldacc r8, <<14
+        ldacc r8, <<Q14
         msu out, r7, r9
         acch r10
-        (f) cmp.lt r10, #0
+        (f) cmp.lt r10, #0              ; F: ahead, nearer than tbest
         ; divide
         clz r10, r9
         sub r10, r10, #1
-        sll r12, r9, r10
-        srl r13, r12, #7
-        and r13, r13, #127
-        ld r13, [r13 + #128]
-        ld r15, [r0 + #256]
-        mul r14, r12, r13, >>15
+        sll r12, r9, r10                ; the divisor normalised
+        srl r13, r12, #RCP_SHIFT
+        and r13, r13, #RCP_MASK
+        ld r13, [r13 + #RCP]            ; r = 1/den from the table
+        ld r15, [r0 + #C_ONE]
+        mul r14, r12, r13, >>Q15        ; Newton: r -= r (den r - 1)
         sub r14, r14, r15
-        ldacc r13, <<14
-        msu r13, r13, r14, >>14
-        mul r14, r12, r13, >>15
+        ldacc r13, <<Q14
+        msu r13, r13, r14, >>Q14
+        mul r14, r12, r13, >>Q15        ; Newton: r -= r (den r - 1)
         sub r14, r14, r15
-        ldacc r13, <<14
-        msu r13, r13, r14, >>14
-        mul out, r8, r13
+        ldacc r13, <<Q14
+        msu r13, r13, r14, >>Q14
+        mul out, r8, r13                ; num r in the accumulator, scaled back
         acch r14
         accl r12
         add r15, r10, #1
         sll r14, r14, r15
-        rsb r15, r10, #15
+        rsb r15, r10, #Q15
         srl r12, r12, r15
         or r11, r14, r12
-        ldacc r2, <<14
-        mac r12, r11, r5, >>14
-        ldacc r3, <<14
-        mac r13, r11, r6, >>14
+        ldacc r2, <<Q14
+        mac r12, r11, r5, >>Q14
+        ldacc r3, <<Q14
+        mac r13, r11, r6, >>Q14
         (f) cmp.le fb0, r12
         (f) cmp.ge fb0, r12
         (f) cmp.le fb0, r13
-        (f) cmp.ge fb0, r13
+        (f) cmp.ge fb0, r13             ; F: within the other slabs
         (f) mov r7, r11
-        ld r15, [r0 + #286]
-        (f) st r15, [#263]
-        (f) st r0, [#264]
-        (f) st r0, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
-        ; box: faces across axis 1
-        cmp.lt r5, #0
-        ld r15, [r0 + #256]
+        ld r15, [r0 + #TMP0]
+        (f) st r15, [#HIT_N]
+        (f) st r0, [#HIT_N+1]
+        (f) st r0, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
+        ; faces across y
+        cmp.lt r5, #0                   ; F: the max face
+        ld r15, [r0 + #C_ONE]
         (!f) neg r15, r15
-        st r15, [#286]
+        st r15, [#TMP0]                 ; the normal's component
         mov r8, fb0
         sel r8, fb0, r8
         sub r8, r8, r2
-        (f) neg r8, r8
+        (f) neg r8, r8                  ; |face - o_a|
         abs r9, r5
         cmp.gt r9, #0
         (f) cmp.gt r8, #0
-        ldacc r8, <<14
+        ldacc r8, <<Q14
         msu out, r7, r9
         acch r10
-        (f) cmp.lt r10, #0
+        (f) cmp.lt r10, #0              ; F: ahead, nearer than tbest
         ; divide
         clz r10, r9
         sub r10, r10, #1
-        sll r12, r9, r10
-        srl r13, r12, #7
-        and r13, r13, #127
-        ld r13, [r13 + #128]
-        ld r15, [r0 + #256]
-        mul r14, r12, r13, >>15
+        sll r12, r9, r10                ; the divisor normalised
+        srl r13, r12, #RCP_SHIFT
+        and r13, r13, #RCP_MASK
+        ld r13, [r13 + #RCP]            ; r = 1/den from the table
+        ld r15, [r0 + #C_ONE]
+        mul r14, r12, r13, >>Q15        ; Newton: r -= r (den r - 1)
         sub r14, r14, r15
-        ldacc r13, <<14
-        msu r13, r13, r14, >>14
-        mul r14, r12, r13, >>15
+        ldacc r13, <<Q14
+        msu r13, r13, r14, >>Q14
+        mul r14, r12, r13, >>Q15        ; Newton: r -= r (den r - 1)
         sub r14, r14, r15
-        ldacc r13, <<14
-        msu r13, r13, r14, >>14
-        mul out, r8, r13
+        ldacc r13, <<Q14
+        msu r13, r13, r14, >>Q14
+        mul out, r8, r13                ; num r in the accumulator, scaled back
         acch r14
         accl r12
         add r15, r10, #1
         sll r14, r14, r15
-        rsb r15, r10, #15
+        rsb r15, r10, #Q15
         srl r12, r12, r15
         or r11, r14, r12
-        ldacc r3, <<14
-        mac r12, r11, r6, >>14
-        ldacc r1, <<14
-        mac r13, r11, r4, >>14
+        ldacc r3, <<Q14
+        mac r12, r11, r6, >>Q14
+        ldacc r1, <<Q14
+        mac r13, r11, r4, >>Q14
         (f) cmp.le fb0, r12
         (f) cmp.ge fb0, r12
         (f) cmp.le fb0, r13
-        (f) cmp.ge fb0, r13
+        (f) cmp.ge fb0, r13             ; F: within the other slabs
         (f) mov r7, r11
-        ld r15, [r0 + #286]
-        (f) st r15, [#264]
-        (f) st r0, [#265]
-        (f) st r0, [#263]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
-        ; box: faces across axis 2
-        cmp.lt r6, #0
-        ld r15, [r0 + #256]
+        ld r15, [r0 + #TMP0]
+        (f) st r15, [#HIT_N+1]
+        (f) st r0, [#HIT_N+2]
+        (f) st r0, [#HIT_N]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
+        ; faces across z
+        cmp.lt r6, #0                   ; F: the max face
+        ld r15, [r0 + #C_ONE]
         (!f) neg r15, r15
-        st r15, [#286]
+        st r15, [#TMP0]                 ; the normal's component
         mov r8, fb0
         sel r8, fb0, r8
         sub r8, r8, r3
-        (f) neg r8, r8
+        (f) neg r8, r8                  ; |face - o_a|
         abs r9, r6
         cmp.gt r9, #0
         (f) cmp.gt r8, #0
-        ldacc r8, <<14
+        ldacc r8, <<Q14
         msu out, r7, r9
         acch r10
-        (f) cmp.lt r10, #0
+        (f) cmp.lt r10, #0              ; F: ahead, nearer than tbest
         ; divide
         clz r10, r9
         sub r10, r10, #1
-        sll r12, r9, r10
-        srl r13, r12, #7
-        and r13, r13, #127
-        ld r13, [r13 + #128]
-        ld r15, [r0 + #256]
-        mul r14, r12, r13, >>15
+        sll r12, r9, r10                ; the divisor normalised
+        srl r13, r12, #RCP_SHIFT
+        and r13, r13, #RCP_MASK
+        ld r13, [r13 + #RCP]            ; r = 1/den from the table
+        ld r15, [r0 + #C_ONE]
+        mul r14, r12, r13, >>Q15        ; Newton: r -= r (den r - 1)
         sub r14, r14, r15
-        ldacc r13, <<14
-        msu r13, r13, r14, >>14
-        mul r14, r12, r13, >>15
+        ldacc r13, <<Q14
+        msu r13, r13, r14, >>Q14
+        mul r14, r12, r13, >>Q15        ; Newton: r -= r (den r - 1)
         sub r14, r14, r15
-        ldacc r13, <<14
-        msu r13, r13, r14, >>14
-        mul out, r8, r13
+        ldacc r13, <<Q14
+        msu r13, r13, r14, >>Q14
+        mul out, r8, r13                ; num r in the accumulator, scaled back
         acch r14
         accl r12
         add r15, r10, #1
         sll r14, r14, r15
-        rsb r15, r10, #15
+        rsb r15, r10, #Q15
         srl r12, r12, r15
         or r11, r14, r12
-        ldacc r1, <<14
-        mac r12, r11, r4, >>14
-        ldacc r2, <<14
-        mac r13, r11, r5, >>14
+        ldacc r1, <<Q14
+        mac r12, r11, r4, >>Q14
+        ldacc r2, <<Q14
+        mac r13, r11, r5, >>Q14
         (f) cmp.le fb0, r12
         (f) cmp.ge fb0, r12
         (f) cmp.le fb0, r13
-        (f) cmp.ge fb0, r13
+        (f) cmp.ge fb0, r13             ; F: within the other slabs
         (f) mov r7, r11
-        ld r15, [r0 + #286]
-        (f) st r15, [#265]
-        (f) st r0, [#263]
-        (f) st r0, [#264]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        ld r15, [r0 + #TMP0]
+        (f) st r15, [#HIT_N+2]
+        (f) st r0, [#HIT_N]
+        (f) st r0, [#HIT_N+1]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_box_end:
+
+; k_rect: the rectangle test of one record (the stream).
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew
 k_rect:
-        ; planar: den = n.d, num = n.(v0 - o)
+        ; den = -n.d, num = -n.(v0 - o)
         mov r8, fb0
         mov r9, fb0
         mov r10, fb0
         mul out, r8, r4
         mac out, r9, r5
-        mac r11, r10, r6, >>14
+        mac r11, r10, r6, >>Q14
         sub r12, fb0, r1
         sub r13, fb0, r2
         sub r14, fb0, r3
         mul out, r8, r12
         mac out, r9, r13
-        mac r15, r10, r14, >>14
+        mac r15, r10, r14, >>Q14
         neg r11, r11
         neg r15, r15
         cmp.gt r11, #0
         (f) cmp.gt r15, #0
-        ldacc r15, <<14
+        ldacc r15, <<Q14
         msu out, r7, r11
         acch r8
-        (f) cmp.lt r8, #0
+        (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
         ; divide
         clz r8, r11
         sub r8, r8, #1
-        sll r10, r11, r8
-        srl r12, r10, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        ld r14, [r0 + #256]
-        mul r13, r10, r12, >>15
+        sll r10, r11, r8                ; the divisor normalised
+        srl r12, r10, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]            ; r = 1/den from the table
+        ld r14, [r0 + #C_ONE]
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul r13, r10, r12, >>15
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul out, r15, r12
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul out, r15, r12               ; num r in the accumulator, scaled back
         acch r13
         accl r10
         add r14, r8, #1
         sll r13, r13, r14
-        rsb r14, r8, #15
+        rsb r14, r8, #Q15
         srl r10, r10, r14
         or r9, r13, r10
         ; P - v0
-        ldacc r1, <<14
-        mac r10, r9, r4, >>14
+        ldacc r1, <<Q14
+        mac r10, r9, r4, >>Q14
         rsb r10, fb0, r10
-        ldacc r2, <<14
-        mac r11, r9, r5, >>14
+        ldacc r2, <<Q14
+        mac r11, r9, r5, >>Q14
         rsb r11, fb0, r11
-        ldacc r3, <<14
-        mac r12, r9, r6, >>14
+        ldacc r3, <<Q14
+        mac r12, r9, r6, >>Q14
         rsb r12, fb0, r12
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r13, fb0, r12, >>14
+        mac r13, fb0, r12, >>KT_RECT    ; u
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r14, fb0, r12, >>14
-        ld r8, [r0 + #256]
-        add r8, r8, #2
-        (f) cmp.ge r13, #-2
-        (f) cmp.ge r14, #-2
+        mac r14, fb0, r12, >>KT_RECT    ; w
+        ld r8, [r0 + #C_ONE]
+        add r8, r8, #INSIDE_TOL
+        (f) cmp.ge r13, #-INSIDE_TOL
+        (f) cmp.ge r14, #-INSIDE_TOL
         (f) cmp.le r13, r8
-        (f) cmp.le r14, r8
+        (f) cmp.le r14, r8              ; F: inside the rectangle
         (f) mov r7, r9
-        (f) st fb0, [#263]
-        (f) st fb0, [#264]
-        (f) st fb0, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        (f) st fb0, [#HIT_N]
+        (f) st fb0, [#HIT_N+1]
+        (f) st fb0, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_rect_end:
+
+; k_tri: the triangle test of one record (the stream).
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew
 k_tri:
-        ; planar: den = n.d, num = n.(v0 - o)
+        ; den = -n.d, num = -n.(v0 - o)
         mov r8, fb0
         mov r9, fb0
         mov r10, fb0
         mul out, r8, r4
         mac out, r9, r5
-        mac r11, r10, r6, >>14
+        mac r11, r10, r6, >>Q14
         sub r12, fb0, r1
         sub r13, fb0, r2
         sub r14, fb0, r3
         mul out, r8, r12
         mac out, r9, r13
-        mac r15, r10, r14, >>14
+        mac r15, r10, r14, >>Q14
         neg r11, r11
         neg r15, r15
         cmp.gt r11, #0
         (f) cmp.gt r15, #0
-        ldacc r15, <<14
+        ldacc r15, <<Q14
         msu out, r7, r11
         acch r8
-        (f) cmp.lt r8, #0
+        (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
         ; divide
         clz r8, r11
         sub r8, r8, #1
-        sll r10, r11, r8
-        srl r12, r10, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        ld r14, [r0 + #256]
-        mul r13, r10, r12, >>15
+        sll r10, r11, r8                ; the divisor normalised
+        srl r12, r10, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]            ; r = 1/den from the table
+        ld r14, [r0 + #C_ONE]
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul r13, r10, r12, >>15
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul out, r15, r12
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul out, r15, r12               ; num r in the accumulator, scaled back
         acch r13
         accl r10
         add r14, r8, #1
         sll r13, r13, r14
-        rsb r14, r8, #15
+        rsb r14, r8, #Q15
         srl r10, r10, r14
         or r9, r13, r10
         ; P - v0
-        ldacc r1, <<14
-        mac r10, r9, r4, >>14
+        ldacc r1, <<Q14
+        mac r10, r9, r4, >>Q14
         rsb r10, fb0, r10
-        ldacc r2, <<14
-        mac r11, r9, r5, >>14
+        ldacc r2, <<Q14
+        mac r11, r9, r5, >>Q14
         rsb r11, fb0, r11
-        ldacc r3, <<14
-        mac r12, r9, r6, >>14
+        ldacc r3, <<Q14
+        mac r12, r9, r6, >>Q14
         rsb r12, fb0, r12
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r13, fb0, r12, >>11
+        mac r13, fb0, r12, >>KT_TRI     ; u
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r14, fb0, r12, >>11
-        ld r8, [r0 + #256]
-        add r8, r8, #2
-        (f) cmp.ge r13, #-2
-        (f) cmp.ge r14, #-2
+        mac r14, fb0, r12, >>KT_TRI     ; w
+        ld r8, [r0 + #C_ONE]
+        add r8, r8, #INSIDE_TOL
+        (f) cmp.ge r13, #-INSIDE_TOL
+        (f) cmp.ge r14, #-INSIDE_TOL
         adds r15, r13, r14
-        (f) cmp.le r15, r8
+        (f) cmp.le r15, r8              ; F: inside the triangle
         (f) mov r7, r9
-        (f) st fb0, [#263]
-        (f) st fb0, [#264]
-        (f) st fb0, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        (f) st fb0, [#HIT_N]
+        (f) st fb0, [#HIT_N+1]
+        (f) st fb0, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_tri_end:
 ctx_end:

@@ -2,623 +2,553 @@
 ; 256x256, 64 ways (8x8 tiles), depth 2, 16-bit datapath, scene format Q4.11, fine normals
 ; paper traversal, BSP median split to depth 15, at most 5 objects per leaf, fig5 nodes
         .datapath 16
-; FB image (383 words) at 0x40000, tile list at 0x60000: loaded by the host.
-CTXBASE = 0x20000
-FBIMG = 0x40000
-FBWORDS = 383
-TILELIST = 0x60000
-FB_EYE = 258
-FB_POST = 272
-ROOT = 368
-MAILBOX = 379
-NOBJ = 4
+;
+; Every number the program uses is named below. TinyRISC code (.text) steers the
+; traversal and broadcasts RC kernels (.ctx) with their FB streams; each routine
+; and kernel is headed by what it does, its inputs and its outputs.
 
+; ---- number formats (Qn: the 16-bit chip's n fraction bits on this datapath) ----
+X = 0                   ; extra fraction bits of the datapath (16 on the 32-bit chip)
+Q7 = 7 + X
+Q8 = 8 + X
+Q10 = 10 + X
+Q11 = 11 + X            ; Q.11: the square of a vector in normalize
+Q12 = 12 + X            ; colours and weights (Q3.12)
+Q13 = 13 + X            ; Q.13: halves of Q1.14 quantities
+Q14 = 14 + X            ; unit vectors, cosines (Q1.14)
+Q15 = 15 + X            ; Q.15: products of two Q1.14 with one more bit
+Q16 = 16 + X
+TABLE_ENTRIES = 128     ; entries of the RSQ and RCP tables
+RSQ_SHIFT = Q8 + 0      ; X (Q.11) >> RSQ_SHIFT indexes RSQ
+RCP_SHIFT = Q7 + 0      ; a divisor in [2^Q14, 2^Q15) >> RCP_SHIFT ...
+RCP_MASK = 127          ; ... & RCP_MASK indexes RCP
+
+; ---- the scene's fit ----
+TILE_W = 8              ; the tile: TILE_W x TILE_H rays, one per RC
+TILE_H = 8
+KD = 23                 ; eye rays: the pixel steps B, C scaled by 2^KD
+EPS_LSB = 0             ; spawned rays start this far off the surface (LSB)
+KT_TRI = 13             ; triangles: edge duals scaled by 2^KT_TRI
+INSIDE_TOL = 2          ; tolerance of the planar inside tests, Q.14
+
+; ---- main memory (byte addresses) ----
+CTXBASE = 0x20000       ; the kernels (loaded into context memory)
+FBIMG = 0x40000         ; the FB image, loaded by the host
+FBWORDS = 383           ; its words
+TILELIST = 0x60000      ; the tile list, written by the host:
+TL_COUNT = 0            ;   the number of tiles
+TL_FIRST = 4            ;   the first tile's entry:
+TILE_PX = 0             ;     its corner's pixel column
+TILE_PY = 4             ;     its corner's pixel row
+TILE_OUT = 8            ;     where its output goes in main memory
+TILE_BYTES = 12         ;   bytes of an entry
+MASK_HI = 4             ; the high word of a 64-bit mask (RCs 32..63)
+AXIS_X = 0              ; a per-axis table's words
+AXIS_Y = 4
+AXIS_Z = 8
+
+; ---- FB set 0 (word addresses) ----
+FB_EYE = 258            ; eye stream: px0, py0, eye.xyz, (A, B, C) per axis
+EYE_PX = 0              ;   the tile's corner, written per tile
+EYE_PY = 1
+FB_POST = 272           ; post-pass stream: background, (material, Ks) per material
+FB_LIGHT0 = 277         ; light streams: the position (a scale shift first where far)
+FB_SHADE0 = 281         ; shading streams: per material its Phong terms for the light
+FB_TRIANGLE = 288       ; the triangle records
+TRIANGLE_WORDS = 20     ;   words of one
+MB_TRIANGLE = 379       ;   their mailboxes
+ROOT = 368              ; the BSP root node
+MAILBOX = 379           ; the mailboxes: per object the pass that last tested it
+NOBJ = 4                ; objects in the scene
+PASS_WRAP = 0x7fff      ; pass numbers wrap here (16-bit mailboxes)
+
+; ---- BSP nodes ----
+N_FLAGS = 0             ; Fig. 5 node: bit 15 a leaf, bits 1..0 the split axis
+N_SPLIT = 1             ;   the split's position
+N_LEFT = 2              ;   the child below (FB address)
+N_RIGHT = 3             ;   the child above
+N_BOUNDS = 4            ;   the cell, widened by 2 LSB: min.xyz, max.xyz
+N_BV_TRIANGLE = 10      ;   the triangles under it, a bit each
+BV_WORDS_TRIANGLE = 1   ;   words of that bit vector
+
+; ---- FB set 1: output banks (word addresses) ----
+OUT_BANK0 = 32768       ; the two output banks, alternating by tile
+OUT_BANK1 = 49152
+OUT_R = 0               ; a bank's words: red of RCs 0..63
+OUT_G = 64              ; green
+OUT_B = 128             ; blue
+OUT_ID = 192            ; the eye ray's object id
+OUT_WORDS = 256         ; words a tile's output moves by DMA
+
+; ---- RC RAM (word addresses in every RC) ----
+RSQ = 0                 ; reciprocal square root table, Q1.14
+RCP = 128               ; reciprocal table, 2^29 / d
+C_ONE = 256             ; 1.0 in Q1.14
+C_INF = 257             ; the largest word: no hit
+LANE_ROW = 258          ; the RC's row in the array, 0..7
+LANE_COL = 259          ; the RC's column, 0..7
+LANE_ACT = 260          ; 1 if the RC traces a ray of the tile (the ways), else 0
+HIT_OBJ = 261           ; closest hit of the pass: object id
+HIT_MAT = 262           ; closest hit: material id
+HIT_N = 263             ; closest hit: normal, 3 words Q1.14
+PASS_T0 = 266           ; tbest at the pass's start (a hit: tbest < PASS_T0)
+SH_P = 267              ; hit point being shaded, 3 words
+SH_N = 270              ; its shading normal, 3 words
+SH_MAT = 273            ; its material id
+SH_D = 274              ; direction of the ray that hit, 3 words
+ACT = 277               ; 1 if the ray being shaded hit something
+COL = 278               ; colour of this level, 3 words Q3.12
+OUT_OBJ = 281           ; object id of the eye ray's hit (-1: none)
+SH_KS = 282             ; reflectance Ks of the hit's material
+SH_NL = 283             ; N.L towards the current light
+SH_RV = 284             ; R.V of the current light
+LIT = 285               ; 1 if the light is in front of the surface
+TMP0 = 286              ; temporaries of one kernel
+TMP1 = 287
+TMP2 = 288
+TMP3 = 289
+TMP4 = 290
+CONE_TMP = 291          ; the cone kernel's temporaries, 8 words
+TMP5 = 291              ; the cylinder kernel's (CONE_TMP's words)
+TMP6 = 292
+ORIG_OBJ = 299          ; the object the rays leave (-1: none): not hit again
+STACK = 300             ; per recursion level: colour so far and reflection weight
+UNORD = 340             ; unordered subtrees entered against the ray's direction
+HIT_NS = 341            ; closest smooth triangle: shading normal, 3 words
+HIT_NS_OBJ = 344        ; its object id
+SH_NG = 345             ; geometric normal of the hit being shaded, 3 words
+HIT_BACK_OBJ = 348      ; closest object hit from its back (-1: none)
+SH_BACK = 349           ; 1 if the hit being shaded is a back hit
+REFR = 350              ; per recursion level: the refracted ray to trace
+P_ALIVE = 400           ; 1 while the ray takes part in the pass
+P_Z = 403               ; per axis: shift z - 1 of 1/d
+P_R = 406               ; per axis: signed mantissa of 1/d
+P_DT = 409              ; per axis: a plane's widening in t
+P_SLOT = 416            ; per BSP depth: the pushed child's interval (tmax, tmin)
+ORIG_STACK = 480        ; per recursion level: the object its refracted ray leaves
+STACK_FRAME = 4         ; words of a STACK frame
+REFR_FRAME = 7          ; words of a REFR frame
+STACK_L0 = STACK + 0*STACK_FRAME; the frame of recursion level 0, 1, ...
+REFR_L0 = REFR + 0*REFR_FRAME; the refraction frame of level 0, 1, ...
+FR_COL = 0              ; frame: colour so far, 3 words
+FR_KS = 3               ; frame: reflection weight
+RF_O = 0                ; refraction frame: origin, 3 words
+RF_D = 3                ; refraction frame: direction, 3 words
+RF_T = 6                ; refraction frame: weight T (0: no ray)
+SLOT_TMAX = 0           ; slot: far end of the interval
+SLOT_TMIN = 1           ; slot: near end
+
+; ==== TinyRISC data ====
         .data
-PASS:   .word 0
-MODE:   .word 0
-SAVE_LR: .word 0
-AWAKE:  .word 0, 0
-NEG:    .word 0, 0, 0, 0, 0, 0
-T_START: .word 0
-T_END:  .word 0
-TESTS:  .word 0
-PASSES: .word 0
-TL_PTR: .word 0
-TL_CNT: .word 0
-TL_BANK: .word 0
-CUR_OUT: .word 0
-NSTACK: .space 256
-
+PASS:           .word 0                 ; the ray pass's number (mailboxes)
+MODE:           .word 0                 ; 0: closest hit, 1: any hit (shadow rays)
+SAVE_LR:        .word 0                 ; trace's return address
+AWAKE:          .word 0, 0              ; the RCs awake (RCs 0..31, 32..63)
+NEG:
+NEG_X:          .word 0, 0              ; per axis, the rays going down along it
+NEG_Y:          .word 0, 0
+NEG_Z:          .word 0, 0
+T_START:        .word 0                 ; the cycle counter at the tile loop's start
+T_END:          .word 0                 ; ... and at its end
+TESTS:          .word 0                 ; object tests broadcast
+PASSES:         .word 0                 ; ray passes
+TL_PTR:         .word 0                 ; the tile list's current entry
+TL_CNT:         .word 0                 ; tiles left
+TL_BANK:        .word 0                 ; the output bank of this tile (0, 1)
+CUR_OUT:        .word 0                 ; where this tile's output goes
+NSTACK:         .space 256              ; the node stack
         .text
-_start: li r1, FBIMG
+
+; _start: the FB image and the contexts in by DMA, every RC's RAM tables and lane words,
+; then the tile loop; T_START, T_END: the cycle counter around it.
+_start:
+        li r1, FBIMG
         li r2, 0
         li r3, FBWORDS
-        ldfb r1, r2, r3
+        ldfb r1, r2, r3                 ; the FB image into FB set 0
         dwait
-li r1, CTXBASE
+        li r1, CTXBASE
         li r2, 0
         li r3, (ctx_end - CTXBASE) / 4
-        ldctxt r1, r2, r3
+        ldctxt r1, r2, r3               ; the kernels into context memory
         dwait
         li r1, (k_init - CTXBASE) / 4
         li r2, 0
-        sbcb r1, r2, (k_init_end - k_init) / 4
+        sbcb r1, r2, (k_init_end - k_init) / 4 ; RSQ, RCP, C_ONE, C_INF from the FB
         li r1, (k_rows - CTXBASE) / 4
-        cbcr r1, r0, 1
+        cbcr r1, r0, 1                  ; row i: r8 = i
         li r1, (k_strow - CTXBASE) / 4
         cbcast r1, (k_strow_end - k_strow) / 4
         li r1, (k_rows - CTXBASE) / 4
-        cbcc r1, r0, 1
+        cbcc r1, r0, 1                  ; column j: r8 = j
         li r1, (k_stcol - CTXBASE) / 4
         cbcast r1, (k_stcol_end - k_stcol) / 4
         li r1, (k_lanes - CTXBASE) / 4
-        cbcast r1, (k_lanes_end - k_lanes) / 4
-        rcany r1
+        cbcast r1, (k_lanes_end - k_lanes) / 4 ; the RCs outside the tile sleep
+        rcany r1                        ; the array done
         rdcyc r1
         sw r1, T_START(r0)
         li r1, TILELIST
-        lw r2, 0(r1)
-        addi r1, r1, 4
-sw r1, TL_PTR(r0)
+        lw r2, TL_COUNT(r1)
+        addi r1, r1, TL_FIRST
+        sw r1, TL_PTR(r0)
         sw r2, TL_CNT(r0)
-tile:   lw r2, TL_CNT(r0)
+
+; tile: one tile of the list (TL_PTR: its entry, TL_CNT: tiles left): eye rays, the ray
+; tree, the pixels out.
+tile:
+        lw r2, TL_CNT(r0)
         beqz r2, finish
         lw r1, TL_PTR(r0)
-        lw r3, 0(r1)
-        lw r4, 4(r1)
-        lw r5, 8(r1)
-sw r5, CUR_OUT(r0)
+        lw r3, TILE_PX(r1)
+        lw r4, TILE_PY(r1)
+        lw r5, TILE_OUT(r1)
+        sw r5, CUR_OUT(r0)
         li r6, FB_EYE
-        sfb r3, 0(r6)
-        sfb r4, 1(r6)
+        sfb r3, EYE_PX(r6)
+        sfb r4, EYE_PY(r6)              ; the tile's corner into the eye stream
         li r1, (k_eye - CTXBASE) / 4
         li r2, FB_EYE
-        sbcb r1, r2, (k_eye_end - k_eye) / 4
+        sbcb r1, r2, (k_eye_end - k_eye) / 4 ; eye rays
+        ; level 0: the rays' closest hits
         sw r0, MODE(r0)
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_post0 - CTXBASE) / 4
         li r2, FB_POST
-        sbcb r1, r2, (k_post0_end - k_post0) / 4
+        sbcb r1, r2, (k_post0_end - k_post0) / 4 ; the hits' shading state
+        ; light 0: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 277
+        li r2, FB_LIGHT0
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 281
+        li r2, FB_SHADE0
         sbcb r1, r2, (k_shade_end - k_shade) / 4
         li r1, (k_refl0 - CTXBASE) / 4
-        cbcast r1, (k_refl0_end - k_refl0) / 4
+        cbcast r1, (k_refl0_end - k_refl0) / 4 ; level 0's reflected rays
+        ; level 1: the rays' closest hits
         sw r0, MODE(r0)
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_post1 - CTXBASE) / 4
         li r2, FB_POST
-        sbcb r1, r2, (k_post1_end - k_post1) / 4
+        sbcb r1, r2, (k_post1_end - k_post1) / 4 ; the hits' shading state
+        ; light 0: shadow rays, then its Phong terms where lit
         li r1, (k_light - CTXBASE) / 4
-        li r2, 277
+        li r2, FB_LIGHT0
         sbcb r1, r2, (k_light_end - k_light) / 4
         li r1, 1
-        sw r1, MODE(r0)
+        sw r1, MODE(r0)                 ; any hit
         jal trace
         li r1, (k_wake - CTXBASE) / 4
         cbcast r1, (k_wake_end - k_wake) / 4
         li r1, (k_shade - CTXBASE) / 4
-        li r2, 281
+        li r2, FB_SHADE0
         sbcb r1, r2, (k_shade_end - k_shade) / 4
         li r1, (k_pop0 - CTXBASE) / 4
-        cbcast r1, (k_pop0_end - k_pop0) / 4
+        cbcast r1, (k_pop0_end - k_pop0) / 4 ; their colour added
+        ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)
-        li r4, 32768
-        beqz r5, outb0
-        li r4, 49152
-outb0:  dwait
+        li r4, OUT_BANK0
+        beqz r5, out_bank
+        li r4, OUT_BANK1
+out_bank:
+        dwait                           ; the bank's last DMA done
         li r1, (k_out0 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 0
+        wfb r4, OUT_R
         li r1, (k_out1 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 64
+        wfb r4, OUT_G
         li r1, (k_out2 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 128
+        wfb r4, OUT_B
         li r1, (k_out3 - CTXBASE) / 4
         cbcast r1, 1
-        wfb r4, 192
+        wfb r4, OUT_ID
         lw r3, CUR_OUT(r0)
-        stfb r3, r4, 256
+        stfb r3, r4, OUT_WORDS          ; DMA to main memory
         lw r5, TL_BANK(r0)
         xori r5, r5, 1
-        sw r5, TL_BANK(r0)
-lw r1, TL_PTR(r0)
-        addi r1, r1, 12
+        sw r5, TL_BANK(r0)              ; the other bank next
+        lw r1, TL_PTR(r0)
+        addi r1, r1, TILE_BYTES
         sw r1, TL_PTR(r0)
         lw r2, TL_CNT(r0)
         addi r2, r2, -1
         sw r2, TL_CNT(r0)
         j tile
-finish: dwait
+finish:
+        dwait
         rdcyc r1
         sw r1, T_END(r0)
         halt
 
-; trace: the RCs hold o, d, tbest; MODE 0 closest hit, 1 any hit (shadow).
-trace:  sw r15, SAVE_LR(r0)
+; trace: one ray pass, the paper's traversal. In: the rays in r1..r7 of every RC, MODE
+; (0: closest hit, 1: any hit). Out: the hits in HIT_*, r7. Clobbers r1..r14.
+; Nodes: Fig. 5 (head, per type a membership bit vector).
+trace:
+        sw r15, SAVE_LR(r0)
         lw r1, PASSES(r0)
         addi r1, r1, 1
-        sw r1, PASSES(r0)
-lw r1, PASS(r0)
+        sw r1, PASSES(r0)               ; ray passes, for the statistics
+        lw r1, PASS(r0)
         addi r1, r1, 1
-        li r2, 0x7fff
-        blt r1, r2, pass_ok
-        jal clear_mailbox
+        li r2, PASS_WRAP
+        blt r1, r2, trace_numbered
+        jal clear_mailbox               ; the mailboxes hold 16-bit pass numbers
         li r1, 1
-pass_ok: sw r1, PASS(r0)
+trace_numbered:
+        sw r1, PASS(r0)
         li r1, (k_sign0 - CTXBASE) / 4
         cbcast r1, (k_sign0_end - k_sign0) / 4
         rcfl r2
         rcfh r3
-        sw r2, NEG+0(r0)
-        sw r3, NEG+4(r0)
+        sw r2, NEG_X(r0)
+        sw r3, NEG_X+MASK_HI(r0)        ; the rays going down along this axis
         li r1, (k_sign1 - CTXBASE) / 4
         cbcast r1, (k_sign1_end - k_sign1) / 4
         rcfl r2
         rcfh r3
-        sw r2, NEG+8(r0)
-        sw r3, NEG+12(r0)
+        sw r2, NEG_Y(r0)
+        sw r3, NEG_Y+MASK_HI(r0)        ; the rays going down along this axis
         li r1, (k_sign2 - CTXBASE) / 4
         cbcast r1, (k_sign2_end - k_sign2) / 4
         rcfl r2
         rcfh r3
-        sw r2, NEG+16(r0)
-        sw r3, NEG+20(r0)
-        jal awake
+        sw r2, NEG_Z(r0)
+        sw r3, NEG_Z+MASK_HI(r0)        ; the rays going down along this axis
+        jal read_awake
         li r14, NSTACK
         li r5, ROOT
-visit:  lw r11, AWAKE(r0)
-        lw r12, AWAKE+4(r0)
+visit_node:
+        lw r11, AWAKE(r0)
+        lw r12, AWAKE+MASK_HI(r0)
         or r1, r11, r12
-        beqz r1, done
-lfb r6, 0(r5)
+        beqz r1, trace_done             ; no ray awake
+        lfb r6, N_FLAGS(r5)
         blt r6, r0, leaf
-        andi r7, r6, 3
+        andi r7, r6, 3                  ; the split's axis
         li r1, (k_cls0 - CTXBASE) / 4
         li r2, (k_cls1 - CTXBASE) / 4
-beqz r7, cls_go
+        beqz r7, classify
         li r1, (k_cls1 - CTXBASE) / 4
         li r2, (k_cls2 - CTXBASE) / 4
         slti r3, r7, 2
-        bnez r3, cls_go
+        bnez r3, classify
         li r1, (k_cls2 - CTXBASE) / 4
-cls_go: addi r2, r5, 1
-        sbcb r1, r2, (k_cls0_end - k_cls0) / 4
+classify:
+        addi r2, r5, N_SPLIT
+        sbcb r1, r2, (k_cls0_end - k_cls0) / 4 ; the segments against the plane
         rcfl r1
-        rcfh r2
+        rcfh r2                         ; r1, r2: the rays reaching below
         li r8, (k_clsr - CTXBASE) / 4
         cbcast r8, 1
         rcfl r3
-        rcfh r4
-and r1, r1, r11
+        rcfh r4                         ; r3, r4: the rays reaching above
+        and r1, r1, r11
         and r2, r2, r12
         and r3, r3, r11
         and r4, r4, r12
-or r9, r3, r4
-        bnez r9, hasr
+        or r9, r3, r4
+        bnez r9, some_above
         or r9, r1, r2
-        beqz r9, pop
-        lfb r5, 2(r5)
-        j visit
-hasr:   or r9, r1, r2
-        bnez r9, both
-        lfb r5, 3(r5)
-        j visit
-both:   bne r1, r3, incoh
-        bne r2, r4, incoh
+        beqz r9, pop_node
+        lfb r5, N_LEFT(r5)              ; all below
+        j visit_node
+some_above:
+        or r9, r1, r2
+        bnez r9, both_sides
+        lfb r5, N_RIGHT(r5)             ; all above
+        j visit_node
+both_sides:
+        bne r1, r3, incoherent
+        bne r2, r4, incoherent          ; every ray crosses the plane:
         slli r9, r7, 3
         lw r10, NEG(r9)
-        lw r13, NEG+4(r9)
-and r10, r10, r11
+        lw r13, NEG+MASK_HI(r9)
+        and r10, r10, r11
         and r13, r13, r12
         or r9, r10, r13
-        beqz r9, posdir
-        bne r10, r11, incoh
-        bne r13, r12, incoh
-lfb r9, 2(r5)
-        sw r9, 0(r14)
-        addi r14, r14, 4
-        lfb r5, 3(r5)
-        j visit
-posdir: lfb r9, 3(r5)
-        sw r9, 0(r14)
-        addi r14, r14, 4
-        lfb r5, 2(r5)
-        j visit
-incoh:  jal test_objects
-        j pop
-leaf:   jal test_objects
+        beqz r9, positive_first         ; all in the same direction?
+        bne r10, r11, incoherent
+        bne r13, r12, incoherent
+        lfb r9, N_LEFT(r5)
+        sw r9, (r14)
+        addi r14, r14, 4                ; push below
+        lfb r5, N_RIGHT(r5)             ; visit above first
+        j visit_node
+positive_first:
+        lfb r9, N_RIGHT(r5)
+        sw r9, (r14)
+        addi r14, r14, 4                ; push above
+        lfb r5, N_LEFT(r5)              ; visit below first
+        j visit_node
+incoherent:
+        jal test_objects                ; every object under the node
+        j pop_node
+leaf:
+        jal test_objects
         lw r1, MODE(r0)
-        bnez r1, leaf_any
+        bnez r1, leaf_any_hit
         li r1, (k_leafc - CTXBASE) / 4
-        addi r2, r5, 4
-        sbcb r1, r2, (k_leafc_end - k_leafc) / 4
-        j leaf_aw
-leaf_any: li r1, (k_leafa - CTXBASE) / 4
-        cbcast r1, (k_leafa_end - k_leafa) / 4
-leaf_aw: jal awake
-pop:    li r9, NSTACK
-        beq r14, r9, done
+        addi r2, r5, N_BOUNDS
+        sbcb r1, r2, (k_leafc_end - k_leafc) / 4 ; the rays with a hit in the cell sleep
+        j leaf_done
+leaf_any_hit:
+        li r1, (k_leafa - CTXBASE) / 4
+        cbcast r1, (k_leafa_end - k_leafa) / 4 ; the rays with a hit sleep
+leaf_done:
+        jal read_awake
+pop_node:
+        li r9, NSTACK
+        beq r14, r9, trace_done
         addi r14, r14, -4
-        lw r5, 0(r14)
-        j visit
-done:   lw r15, SAVE_LR(r0)
+        lw r5, (r14)
+        j visit_node
+trace_done:
+        lw r15, SAVE_LR(r0)
         ret
 
-awake:  rcsl r1
+; read_awake: AWAKE = the mask of the RCs awake (rcsl/rcsh: the sleeping ones).
+; Clobbers r1, r2.
+read_awake:
+        rcsl r1
         rcsh r2
         nor r1, r1, r0
         nor r2, r2, r0
         sw r1, AWAKE(r0)
-        sw r2, AWAKE+4(r0)
+        sw r2, AWAKE+MASK_HI(r0)
         ret
 
+; clear_mailbox: every mailbox (FB, one word per object) to 0. Clobbers r2, r3.
 clear_mailbox:
         li r2, MAILBOX
         li r3, NOBJ
-        beqz r3, cm_done
-cm_loop: sfb r0, 0(r2)
+        beqz r3, clear_mailbox_done
+clear_mailbox_loop:
+        sfb r0, (r2)
         addi r2, r2, 1
         addi r3, r3, -1
-        bnez r3, cm_loop
-cm_done: ret
+        bnez r3, clear_mailbox_loop
+clear_mailbox_done:
+        ret
 
-; test_objects: r5 = node (compact: r6 = its lists); every object of the node's bit vectors not yet
-; tested in this pass (mailbox) is broadcast with its type's kernel.
+; test_objects: every object of the node (r5) not yet tested in this pass (its mailbox
+; holds PASS) is broadcast with its type's kernels, type by type (object test reordering).
+; Clobbers r1..r4, r6..r10, r12, r13; counts TESTS.
 test_objects:
         lw r13, PASS(r0)
-        addi r6, r5, 10
-        li r7, 288
-        li r8, 379
-        li r9, 1
-triangle_word:
-        lfb r10, 0(r6)
+        ; triangles: the node's bit vector, 16 objects a word
+        addi r6, r5, N_BV_TRIANGLE
+        li r7, FB_TRIANGLE
+        li r8, MB_TRIANGLE
+        li r9, BV_WORDS_TRIANGLE
+to_triangle_word:
+        lfb r10, (r6)
         addi r6, r6, 1
         slli r10, r10, 16
         li r4, 16
-triangle_bit:
-        beqz r10, triangle_skip
-        bge r10, r0, triangle_next
-        lfb r1, 0(r8)
-        beq r1, r13, triangle_next
-        sfb r13, 0(r8)
-lw r1, TESTS(r0)
+to_triangle_obj:
+        beqz r10, to_triangle_skip      ; no more in this word
+        bge r10, r0, to_triangle_next   ; bit clear: not under the node
+        lfb r1, (r8)
+        beq r1, r13, to_triangle_next   ; tested in this pass
+        sfb r13, (r8)
+        lw r1, TESTS(r0)
         addi r1, r1, 1
         sw r1, TESTS(r0)
         li r1, (k_tri - CTXBASE) / 4
         sbcb r1, r7, (k_tri_end - k_tri) / 4
-triangle_next:
-        addi r7, r7, 20
+to_triangle_next:
+        addi r7, r7, TRIANGLE_WORDS
         addi r8, r8, 1
         slli r10, r10, 1
         addi r4, r4, -1
-        bnez r4, triangle_bit
-        j triangle_wend
-triangle_skip:
-        li r1, 20
+        bnez r4, to_triangle_obj
+        j to_triangle_end
+to_triangle_skip:
+        li r1, TRIANGLE_WORDS
         mul r1, r1, r4
         add r7, r7, r1
-        add r8, r8, r4
-triangle_wend:
+        add r8, r8, r4                  ; past the word's other objects
+to_triangle_end:
         addi r9, r9, -1
-        bnez r9, triangle_word
+        bnez r9, to_triangle_word
         ret
 
+; ==== RC context kernels (context memory) ====
         .ctx
         .org CTXBASE
+
+; k_rows: a group of 8 contexts, one per row (row mode) or column (column mode):
+; row i gets r8 = i. Broadcast twice, its results stored to LANE_ROW and LANE_COL.
 k_rows:
-        movb r8, #0
-        movb r8, #1
-        movb r8, #2
-        movb r8, #3
-        movb r8, #4
-        movb r8, #5
-        movb r8, #6
-        movb r8, #7
+        .rept 8, i
+        movb r8, #i
+        .endr
 k_rows_end:
+
+; k_init: every RC's RAM from the FB image's start (stream): the RSQ and RCP tables,
+; 1.0 and the no-hit distance. Out: r0 = 0 in every RC.
 k_init:
         movb r0, #0
-        st fb0, [#0]
-        st fb0, [#1]
-        st fb0, [#2]
-        st fb0, [#3]
-        st fb0, [#4]
-        st fb0, [#5]
-        st fb0, [#6]
-        st fb0, [#7]
-        st fb0, [#8]
-        st fb0, [#9]
-        st fb0, [#10]
-        st fb0, [#11]
-        st fb0, [#12]
-        st fb0, [#13]
-        st fb0, [#14]
-        st fb0, [#15]
-        st fb0, [#16]
-        st fb0, [#17]
-        st fb0, [#18]
-        st fb0, [#19]
-        st fb0, [#20]
-        st fb0, [#21]
-        st fb0, [#22]
-        st fb0, [#23]
-        st fb0, [#24]
-        st fb0, [#25]
-        st fb0, [#26]
-        st fb0, [#27]
-        st fb0, [#28]
-        st fb0, [#29]
-        st fb0, [#30]
-        st fb0, [#31]
-        st fb0, [#32]
-        st fb0, [#33]
-        st fb0, [#34]
-        st fb0, [#35]
-        st fb0, [#36]
-        st fb0, [#37]
-        st fb0, [#38]
-        st fb0, [#39]
-        st fb0, [#40]
-        st fb0, [#41]
-        st fb0, [#42]
-        st fb0, [#43]
-        st fb0, [#44]
-        st fb0, [#45]
-        st fb0, [#46]
-        st fb0, [#47]
-        st fb0, [#48]
-        st fb0, [#49]
-        st fb0, [#50]
-        st fb0, [#51]
-        st fb0, [#52]
-        st fb0, [#53]
-        st fb0, [#54]
-        st fb0, [#55]
-        st fb0, [#56]
-        st fb0, [#57]
-        st fb0, [#58]
-        st fb0, [#59]
-        st fb0, [#60]
-        st fb0, [#61]
-        st fb0, [#62]
-        st fb0, [#63]
-        st fb0, [#64]
-        st fb0, [#65]
-        st fb0, [#66]
-        st fb0, [#67]
-        st fb0, [#68]
-        st fb0, [#69]
-        st fb0, [#70]
-        st fb0, [#71]
-        st fb0, [#72]
-        st fb0, [#73]
-        st fb0, [#74]
-        st fb0, [#75]
-        st fb0, [#76]
-        st fb0, [#77]
-        st fb0, [#78]
-        st fb0, [#79]
-        st fb0, [#80]
-        st fb0, [#81]
-        st fb0, [#82]
-        st fb0, [#83]
-        st fb0, [#84]
-        st fb0, [#85]
-        st fb0, [#86]
-        st fb0, [#87]
-        st fb0, [#88]
-        st fb0, [#89]
-        st fb0, [#90]
-        st fb0, [#91]
-        st fb0, [#92]
-        st fb0, [#93]
-        st fb0, [#94]
-        st fb0, [#95]
-        st fb0, [#96]
-        st fb0, [#97]
-        st fb0, [#98]
-        st fb0, [#99]
-        st fb0, [#100]
-        st fb0, [#101]
-        st fb0, [#102]
-        st fb0, [#103]
-        st fb0, [#104]
-        st fb0, [#105]
-        st fb0, [#106]
-        st fb0, [#107]
-        st fb0, [#108]
-        st fb0, [#109]
-        st fb0, [#110]
-        st fb0, [#111]
-        st fb0, [#112]
-        st fb0, [#113]
-        st fb0, [#114]
-        st fb0, [#115]
-        st fb0, [#116]
-        st fb0, [#117]
-        st fb0, [#118]
-        st fb0, [#119]
-        st fb0, [#120]
-        st fb0, [#121]
-        st fb0, [#122]
-        st fb0, [#123]
-        st fb0, [#124]
-        st fb0, [#125]
-        st fb0, [#126]
-        st fb0, [#127]
-        st fb0, [#128]
-        st fb0, [#129]
-        st fb0, [#130]
-        st fb0, [#131]
-        st fb0, [#132]
-        st fb0, [#133]
-        st fb0, [#134]
-        st fb0, [#135]
-        st fb0, [#136]
-        st fb0, [#137]
-        st fb0, [#138]
-        st fb0, [#139]
-        st fb0, [#140]
-        st fb0, [#141]
-        st fb0, [#142]
-        st fb0, [#143]
-        st fb0, [#144]
-        st fb0, [#145]
-        st fb0, [#146]
-        st fb0, [#147]
-        st fb0, [#148]
-        st fb0, [#149]
-        st fb0, [#150]
-        st fb0, [#151]
-        st fb0, [#152]
-        st fb0, [#153]
-        st fb0, [#154]
-        st fb0, [#155]
-        st fb0, [#156]
-        st fb0, [#157]
-        st fb0, [#158]
-        st fb0, [#159]
-        st fb0, [#160]
-        st fb0, [#161]
-        st fb0, [#162]
-        st fb0, [#163]
-        st fb0, [#164]
-        st fb0, [#165]
-        st fb0, [#166]
-        st fb0, [#167]
-        st fb0, [#168]
-        st fb0, [#169]
-        st fb0, [#170]
-        st fb0, [#171]
-        st fb0, [#172]
-        st fb0, [#173]
-        st fb0, [#174]
-        st fb0, [#175]
-        st fb0, [#176]
-        st fb0, [#177]
-        st fb0, [#178]
-        st fb0, [#179]
-        st fb0, [#180]
-        st fb0, [#181]
-        st fb0, [#182]
-        st fb0, [#183]
-        st fb0, [#184]
-        st fb0, [#185]
-        st fb0, [#186]
-        st fb0, [#187]
-        st fb0, [#188]
-        st fb0, [#189]
-        st fb0, [#190]
-        st fb0, [#191]
-        st fb0, [#192]
-        st fb0, [#193]
-        st fb0, [#194]
-        st fb0, [#195]
-        st fb0, [#196]
-        st fb0, [#197]
-        st fb0, [#198]
-        st fb0, [#199]
-        st fb0, [#200]
-        st fb0, [#201]
-        st fb0, [#202]
-        st fb0, [#203]
-        st fb0, [#204]
-        st fb0, [#205]
-        st fb0, [#206]
-        st fb0, [#207]
-        st fb0, [#208]
-        st fb0, [#209]
-        st fb0, [#210]
-        st fb0, [#211]
-        st fb0, [#212]
-        st fb0, [#213]
-        st fb0, [#214]
-        st fb0, [#215]
-        st fb0, [#216]
-        st fb0, [#217]
-        st fb0, [#218]
-        st fb0, [#219]
-        st fb0, [#220]
-        st fb0, [#221]
-        st fb0, [#222]
-        st fb0, [#223]
-        st fb0, [#224]
-        st fb0, [#225]
-        st fb0, [#226]
-        st fb0, [#227]
-        st fb0, [#228]
-        st fb0, [#229]
-        st fb0, [#230]
-        st fb0, [#231]
-        st fb0, [#232]
-        st fb0, [#233]
-        st fb0, [#234]
-        st fb0, [#235]
-        st fb0, [#236]
-        st fb0, [#237]
-        st fb0, [#238]
-        st fb0, [#239]
-        st fb0, [#240]
-        st fb0, [#241]
-        st fb0, [#242]
-        st fb0, [#243]
-        st fb0, [#244]
-        st fb0, [#245]
-        st fb0, [#246]
-        st fb0, [#247]
-        st fb0, [#248]
-        st fb0, [#249]
-        st fb0, [#250]
-        st fb0, [#251]
-        st fb0, [#252]
-        st fb0, [#253]
-        st fb0, [#254]
-        st fb0, [#255]
-        st fb0, [#256]
-        st fb0, [#257]
+        .rept 256, i
+        st fb0, [#RSQ+i]
+        .endr
+        st fb0, [#C_ONE]
+        st fb0, [#C_INF]
 k_init_end:
+
+; k_lanes: the RCs inside the TILE_W x TILE_H tile trace its rays (LANE_ACT = 1);
+; the others sleep for good.
 k_lanes:
-        ld r8, [r0 + #258]
-        ld r9, [r0 + #259]
+        ld r8, [r0 + #LANE_ROW]
+        ld r9, [r0 + #LANE_COL]
         movb r10, #0
-        cmp.lt r8, #8
-        (f) cmp.lt r9, #8
+        cmp.lt r8, #TILE_H
+        (f) cmp.lt r9, #TILE_W
         (f) movb r10, #1
-        st r10, [#260]
+        st r10, [#LANE_ACT]
         (!f) sleep
 k_lanes_end:
+
+; k_wake: every RC of the tile awake again after a pass (the others asleep).
 k_wake:
         wake
-        ld r8, [r0 + #260]
+        ld r8, [r0 + #LANE_ACT]
         cmp.eq r8, #0
         (f) sleep
 k_wake_end:
+
+; k_sign0: F = the ray goes down along x (dx < 0).
 k_sign0:
         cmp.lt r4, #0
 k_sign0_end:
+
+; k_sign1: F = the ray goes down along y (dy < 0).
 k_sign1:
         cmp.lt r5, #0
 k_sign1_end:
+
+; k_sign2: F = the ray goes down along z (dz < 0).
 k_sign2:
         cmp.lt r6, #0
 k_sign2_end:
+
+; k_cls0: the segment [o, o + tbest d] against a split plane across x (stream: its
+; position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1
+; (for k_clsr).
 k_cls0:
-        ldacc r1, <<14
-        mac r8, r7, r4, >>14
+        ldacc r1, <<Q14
+        mac r8, r7, r4, >>Q14           ; o + tbest d
         min r9, r1, r8
         max r10, r1, r8
         mov r11, fb0
@@ -626,9 +556,13 @@ k_cls0:
         sub r13, r11, #1
         cmp.le r9, r12
 k_cls0_end:
+
+; k_cls1: the segment [o, o + tbest d] against a split plane across y (stream: its
+; position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1
+; (for k_clsr).
 k_cls1:
-        ldacc r2, <<14
-        mac r8, r7, r5, >>14
+        ldacc r2, <<Q14
+        mac r8, r7, r5, >>Q14           ; o + tbest d
         min r9, r2, r8
         max r10, r2, r8
         mov r11, fb0
@@ -636,9 +570,13 @@ k_cls1:
         sub r13, r11, #1
         cmp.le r9, r12
 k_cls1_end:
+
+; k_cls2: the segment [o, o + tbest d] against a split plane across z (stream: its
+; position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1
+; (for k_clsr).
 k_cls2:
-        ldacc r3, <<14
-        mac r8, r7, r6, >>14
+        ldacc r3, <<Q14
+        mac r8, r7, r6, >>Q14           ; o + tbest d
         min r9, r3, r8
         max r10, r3, r8
         mov r11, fb0
@@ -646,48 +584,59 @@ k_cls2:
         sub r13, r11, #1
         cmp.le r9, r12
 k_cls2_end:
+
+; k_clsr: after k_clsN, F = the segment reaches above the plane.
 k_clsr:
         cmp.ge r10, r13
 k_clsr_end:
+
+; k_leafc: after a leaf's objects, closest-hit pass: the rays whose hit lies in the leaf's cell
+; (stream: min.xyz, max.xyz) are done and sleep.
 k_leafc:
-        ld r8, [r0 + #266]
-        cmp.lt r7, r8
-        ldacc r1, <<14
-        mac r9, r7, r4, >>14
-        ldacc r2, <<14
-        mac r10, r7, r5, >>14
-        ldacc r3, <<14
-        mac r11, r7, r6, >>14
+        ld r8, [r0 + #PASS_T0]
+        cmp.lt r7, r8                   ; F: a hit in this pass
+        ldacc r1, <<Q14
+        mac r9, r7, r4, >>Q14
+        ldacc r2, <<Q14
+        mac r10, r7, r5, >>Q14
+        ldacc r3, <<Q14
+        mac r11, r7, r6, >>Q14          ; the hit point
         (f) cmp.le fb0, r9
         (f) cmp.le fb0, r10
         (f) cmp.le fb0, r11
         (f) cmp.ge fb0, r9
         (f) cmp.ge fb0, r10
-        (f) cmp.ge fb0, r11
+        (f) cmp.ge fb0, r11             ; F: inside the cell
         (f) sleep
 k_leafc_end:
+
+; k_leafa: after a leaf's objects, any-hit pass: the rays with a hit are done and sleep.
 k_leafa:
-        ld r8, [r0 + #266]
+        ld r8, [r0 + #PASS_T0]
         cmp.lt r7, r8
         (f) sleep
 k_leafa_end:
+
+; k_eye: the tile's eye rays (stream: px0, py0, eye.xyz, (A, B, C) per axis).
+; Out: r1..r3 = eye, r4..r6 = normalize(A + i B + j C) for pixel (px0 + col, py0 + row),
+; r7 = C_INF; a new level (PASS_T0, COL = 0, SH_D), OUT_OBJ = -1.
 k_eye:
-        ld r8, [r0 + #259]
-        add r8, fb0, r8
-        ld r9, [r0 + #258]
-        add r9, fb0, r9
+        ld r8, [r0 + #LANE_COL]
+        add r8, fb0, r8                 ; i
+        ld r9, [r0 + #LANE_ROW]
+        add r9, fb0, r9                 ; j
         mov r1, fb0
         mov r2, fb0
         mov r3, fb0
-        ldacc fb0, <<10
+        ldacc fb0, <<KD-Q13
         mac out, fb0, r8
-        mac r10, fb0, r9, >>10
-        ldacc fb0, <<10
+        mac r10, fb0, r9, >>KD-Q13
+        ldacc fb0, <<KD-Q13
         mac out, fb0, r8
-        mac r11, fb0, r9, >>10
-        ldacc fb0, <<10
+        mac r11, fb0, r9, >>KD-Q13
+        ldacc fb0, <<KD-Q13
         mac out, fb0, r8
-        mac r12, fb0, r9, >>10
+        mac r12, fb0, r9, >>KD-Q13
         ; normalize
         sra r10, r10, #1
         sra r11, r11, #1
@@ -698,132 +647,152 @@ k_eye:
         abs r14, r12
         max r13, r13, r14
         clz r13, r13
-        sub r13, r13, #2
+        sub r13, r13, #2                ; shift to the top of the word
         sll r10, r10, r13
         sll r11, r11, r13
         sll r12, r12, r13
         mul out, r10, r10
         mac out, r11, r11
-        mac r14, r12, r12, >>15
-        srl r15, r14, #8
-        ld r15, [r15 + #0]
-        ld r9, [r0 + #256]
-        mul r8, r15, r15, >>14
-        mul r8, r8, r14, >>11
+        mac r14, r12, r12, >>Q15        ; X = |v|^2, Q.11
+        srl r15, r14, #RSQ_SHIFT
+        ld r15, [r15 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r9, [r0 + #C_ONE]
+        mul r8, r15, r15, >>Q14         ; Newton: y += y (1 - X y^2) / 2
+        mul r8, r8, r14, >>Q11
         sub r8, r8, r9
-        ldacc r15, <<15
-        msu r15, r15, r8, >>15
-        mul r8, r15, r15, >>14
-        mul r8, r8, r14, >>11
+        ldacc r15, <<Q15
+        msu r15, r15, r8, >>Q15
+        mul r8, r15, r15, >>Q14         ; Newton: y += y (1 - X y^2) / 2
+        mul r8, r8, r14, >>Q11
         sub r8, r8, r9
-        ldacc r15, <<15
-        msu r15, r15, r8, >>15
-        mul r10, r10, r15, >>13
-        mul r11, r11, r15, >>13
-        mul r12, r12, r15, >>13
+        ldacc r15, <<Q15
+        msu r15, r15, r8, >>Q15
+        mul r10, r10, r15, >>Q13
+        mul r11, r11, r15, >>Q13
+        mul r12, r12, r15, >>Q13
         mov r4, r10
         mov r5, r11
         mov r6, r12
-        ld r7, [r0 + #257]
-        st r7, [#266]
+        ld r7, [r0 + #C_INF]
+        st r7, [#PASS_T0]
         movb r8, #0
-        st r8, [#278]
-        st r8, [#279]
-        st r8, [#280]
-        st r4, [#274]
-        st r5, [#275]
-        st r6, [#276]
+        st r8, [#COL]
+        st r8, [#COL+1]
+        st r8, [#COL+2]
+        st r4, [#SH_D]
+        st r5, [#SH_D+1]
+        st r6, [#SH_D+2]
         movb r8, #-1
-        st r8, [#281]
+        st r8, [#OUT_OBJ]
 k_eye_end:
+
+; k_post0: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
+; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
+; COL = the background where no hit; OUT_OBJ, the eye ray's object.
 k_post0:
-        ld r8, [r0 + #257]
-        cmp.lt r7, r8
+        ld r8, [r0 + #C_INF]
+        cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
         (f) movb r9, #1
-        st r9, [#277]
-        ld r10, [r0 + #261]
+        st r9, [#ACT]
+        ld r10, [r0 + #HIT_OBJ]
         movb r11, #-1
         (f) mov r11, r10
-        st r11, [#281]
-        (!f) st fb0, [#278]
-        (!f) st fb0, [#279]
-        (!f) st fb0, [#280]
-        movb r12, #0
-        ld r8, [r0 + #263]
-        st r8, [#270]
-        ldacc r1, <<14
+        st r11, [#OUT_OBJ]
+        (!f) st fb0, [#COL]
+        (!f) st fb0, [#COL+1]
+        (!f) st fb0, [#COL+2]           ; the background where no hit
+        movb r12, #EPS_LSB
+        ld r8, [r0 + #HIT_N]
+        st r8, [#SH_N]
+        ldacc r1, <<Q14
         mac out, r7, r4
-        mac r11, r8, r12, >>14
-        st r11, [#267]
-        ld r8, [r0 + #264]
-        st r8, [#271]
-        ldacc r2, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P]
+        ld r8, [r0 + #HIT_N+1]
+        st r8, [#SH_N+1]
+        ldacc r2, <<Q14
         mac out, r7, r5
-        mac r11, r8, r12, >>14
-        st r11, [#268]
-        ld r8, [r0 + #265]
-        st r8, [#272]
-        ldacc r3, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+1]
+        ld r8, [r0 + #HIT_N+2]
+        st r8, [#SH_N+2]
+        ldacc r3, <<Q14
         mac out, r7, r6
-        mac r11, r8, r12, >>14
-        st r11, [#269]
-        ld r13, [r0 + #262]
-        st r13, [#273]
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+2]               ; P = o + t d + EPS_LSB n
+        ld r13, [r0 + #HIT_MAT]
+        st r13, [#SH_MAT]
         movb r14, #0
-        st r14, [#282]
+        st r14, [#SH_KS]
+        ; Ks of the hit's material: one test per material
+        .rept 1, m
         cmp.ne r9, #0
         (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
+        (f) st fb0, [#SH_KS]
+        .endr
 k_post0_end:
+
+; k_post1: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
+; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
+; COL = the background where no hit.
 k_post1:
-        ld r8, [r0 + #257]
-        cmp.lt r7, r8
+        ld r8, [r0 + #C_INF]
+        cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
         (f) movb r9, #1
-        st r9, [#277]
-        (!f) st fb0, [#278]
-        (!f) st fb0, [#279]
-        (!f) st fb0, [#280]
-        movb r12, #0
-        ld r8, [r0 + #263]
-        st r8, [#270]
-        ldacc r1, <<14
+        st r9, [#ACT]
+        (!f) st fb0, [#COL]
+        (!f) st fb0, [#COL+1]
+        (!f) st fb0, [#COL+2]           ; the background where no hit
+        movb r12, #EPS_LSB
+        ld r8, [r0 + #HIT_N]
+        st r8, [#SH_N]
+        ldacc r1, <<Q14
         mac out, r7, r4
-        mac r11, r8, r12, >>14
-        st r11, [#267]
-        ld r8, [r0 + #264]
-        st r8, [#271]
-        ldacc r2, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P]
+        ld r8, [r0 + #HIT_N+1]
+        st r8, [#SH_N+1]
+        ldacc r2, <<Q14
         mac out, r7, r5
-        mac r11, r8, r12, >>14
-        st r11, [#268]
-        ld r8, [r0 + #265]
-        st r8, [#272]
-        ldacc r3, <<14
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+1]
+        ld r8, [r0 + #HIT_N+2]
+        st r8, [#SH_N+2]
+        ldacc r3, <<Q14
         mac out, r7, r6
-        mac r11, r8, r12, >>14
-        st r11, [#269]
-        ld r13, [r0 + #262]
-        st r13, [#273]
+        mac r11, r8, r12, >>Q14
+        st r11, [#SH_P+2]               ; P = o + t d + EPS_LSB n
+        ld r13, [r0 + #HIT_MAT]
+        st r13, [#SH_MAT]
         movb r14, #0
-        st r14, [#282]
+        st r14, [#SH_KS]
+        ; Ks of the hit's material: one test per material
+        .rept 1, m
         cmp.ne r9, #0
         (f) cmp.eq fb0, r13
-        (f) st fb0, [#282]
+        (f) st fb0, [#SH_KS]
+        .endr
 k_post1_end:
+
+; k_light: the shadow rays towards one light (stream: a scale shift k, the light's position).
+; In: SH_P, SH_N, SH_D, ACT. Out: r1..r7 the shadow rays (tbest: the light's distance less 2 LSB),
+; SH_NL, SH_RV, LIT; the RCs with no hit or the light behind the surface sleep.
 k_light:
-        ld r1, [r0 + #267]
-        ld r2, [r0 + #268]
-        ld r3, [r0 + #269]
-        mov r15, fb0
+        ld r1, [r0 + #SH_P]
+        ld r2, [r0 + #SH_P+1]
+        ld r3, [r0 + #SH_P+2]
+        mov r15, fb0                    ; k
         sra r8, r1, r15
         sub r8, fb0, r8
         sra r9, r2, r15
         sub r9, fb0, r9
         sra r10, r3, r15
-        sub r10, fb0, r10
-        st r15, [#286]
+        sub r10, fb0, r10               ; L / 2^k - P / 2^k
+        st r15, [#TMP0]
         ; normalize
         sra r8, r8, #1
         sra r9, r9, #1
@@ -834,267 +803,295 @@ k_light:
         abs r12, r10
         max r11, r11, r12
         clz r11, r11
-        sub r11, r11, #2
+        sub r11, r11, #2                ; shift to the top of the word
         sll r8, r8, r11
         sll r9, r9, r11
         sll r10, r10, r11
         mul out, r8, r8
         mac out, r9, r9
-        mac r12, r10, r10, >>15
-        srl r13, r12, #8
-        ld r13, [r13 + #0]
-        ld r15, [r0 + #256]
-        mul r14, r13, r13, >>14
-        mul r14, r14, r12, >>11
+        mac r12, r10, r10, >>Q15        ; X = |v|^2, Q.11
+        srl r13, r12, #RSQ_SHIFT
+        ld r13, [r13 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r15, [r0 + #C_ONE]
+        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r14, r14, r12, >>Q11
         sub r14, r14, r15
-        ldacc r13, <<15
-        msu r13, r13, r14, >>15
-        mul r14, r13, r13, >>14
-        mul r14, r14, r12, >>11
+        ldacc r13, <<Q15
+        msu r13, r13, r14, >>Q15
+        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r14, r14, r12, >>Q11
         sub r14, r14, r15
-        ldacc r13, <<15
-        msu r13, r13, r14, >>15
-        mul r12, r12, r13, >>12
+        ldacc r13, <<Q15
+        msu r13, r13, r14, >>Q15
+        mul r12, r12, r13, >>Q12        ; |v| = X y, the shifts undone
         sra r12, r12, r11
         adds r11, r12, r12
-        mul r8, r8, r13, >>13
-        mul r9, r9, r13, >>13
-        mul r10, r10, r13, >>13
+        mul r8, r8, r13, >>Q13
+        mul r9, r9, r13, >>Q13
+        mul r10, r10, r13, >>Q13
         mov r4, r8
         mov r5, r9
         mov r6, r10
-        ld r15, [r0 + #286]
+        ld r15, [r0 + #TMP0]
         cmp.gt r15, #0
-        (f) ld r11, [r0 + #257]
-        sub r7, r11, #2
-        st r7, [#266]
-        ld r12, [r0 + #270]
+        (f) ld r11, [r0 + #C_INF]       ; a far light: no end
+        sub r7, r11, #2                 ; tbest = |L - P| - 2
+        st r7, [#PASS_T0]
+        ; nl = N.L
+        ld r12, [r0 + #SH_N]
         mul out, r12, r4
-        ld r13, [r0 + #271]
+        ld r13, [r0 + #SH_N+1]
         mac out, r13, r5
-        ld r14, [r0 + #272]
-        mac r15, r14, r6, >>14
-        st r15, [#283]
-        ld r8, [r0 + #274]
-        ld r9, [r0 + #275]
-        ld r10, [r0 + #276]
+        ld r14, [r0 + #SH_N+2]
+        mac r15, r14, r6, >>Q14
+        st r15, [#SH_NL]
+        ; nd = N.D, ld = L.D, rv = ld - 2 nl nd
+        ld r8, [r0 + #SH_D]
+        ld r9, [r0 + #SH_D+1]
+        ld r10, [r0 + #SH_D+2]
         mul out, r12, r8
         mac out, r13, r9
-        mac r11, r14, r10, >>14
+        mac r11, r14, r10, >>Q14        ; nd
         mul out, r4, r8
         mac out, r5, r9
-        mac r12, r6, r10, >>14
-        ldacc r12, <<14
+        mac r12, r6, r10, >>Q14         ; ld
+        ldacc r12, <<Q14
         msu out, r15, r11
-        msu r12, r15, r11, >>14
+        msu r12, r15, r11, >>Q14
         max r12, r12, #0
-        st r12, [#284]
-        ld r8, [r0 + #277]
+        st r12, [#SH_RV]
+        ld r8, [r0 + #ACT]
         cmp.ne r8, #0
-        (f) cmp.gt r15, #0
+        (f) cmp.gt r15, #0              ; F: a hit lit from its front
         movb r9, #0
         (f) movb r9, #1
-        st r9, [#285]
+        st r9, [#LIT]
         (!f) sleep
 k_light_end:
+
+; k_shade: after a shadow pass, the light's Phong terms where it is visible
+; (stream per material: id, [f, 1 - f,] then per channel kd c lc, ks lc).
+; In: LIT, PASS_T0, r7 (no hit: tbest >= PASS_T0), SH_NL, SH_RV, SH_MAT. Out: COL += kd c lc N.L + ks lc (R.V)^n.
 k_shade:
-        ld r8, [r0 + #285]
+        ld r8, [r0 + #LIT]
         cmp.ne r8, #0
-        ld r9, [r0 + #266]
-        (f) cmp.ge r7, r9
+        ld r9, [r0 + #PASS_T0]
+        (f) cmp.ge r7, r9               ; F: lit and not shadowed
         movb r10, #0
         (f) movb r10, #1
-        ld r11, [r0 + #283]
-        ld r12, [r0 + #284]
-        ld r13, [r0 + #273]
+        ld r11, [r0 + #SH_NL]
+        ld r12, [r0 + #SH_RV]
+        ld r13, [r0 + #SH_MAT]
+        ; material 0: exponent 4096
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
         ; pow ^4096
-        ld r14, [r0 + #256]
+        ld r14, [r0 + #C_ONE]
         mov r15, r12
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r15, r15, r15, >>14
-        mul r14, r14, r15, >>14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r15, r15, r15, >>Q14
+        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #278]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL]
         adds r9, r9, r15
-        (f) st r9, [#278]
+        (f) st r9, [#COL]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #279]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+1]
         adds r9, r9, r15
-        (f) st r9, [#279]
+        (f) st r9, [#COL+1]
         mul out, fb0, r11
-        mac r15, fb0, r14, >>14
-        ld r9, [r0 + #280]
+        mac r15, fb0, r14, >>Q14
+        ld r9, [r0 + #COL+2]
         adds r9, r9, r15
-        (f) st r9, [#280]
+        (f) st r9, [#COL+2]
 k_shade_end:
+
+; k_out0: the pixel's red into the output register (for wfb).
 k_out0:
-        ld out, [r0 + #278]
+        ld out, [r0 + #COL]
 k_out0_end:
+
+; k_out1: the pixel's green into the output register (for wfb).
 k_out1:
-        ld out, [r0 + #279]
+        ld out, [r0 + #COL+1]
 k_out1_end:
+
+; k_out2: the pixel's blue into the output register (for wfb).
 k_out2:
-        ld out, [r0 + #280]
+        ld out, [r0 + #COL+2]
 k_out2_end:
+
+; k_out3: the pixel's object id into the output register (for wfb).
 k_out3:
-        ld out, [r0 + #281]
+        ld out, [r0 + #OUT_OBJ]
 k_out3_end:
+
+; k_strow: r8 (the row or column [`k_rows`] gave) into LANE_ROW.
 k_strow:
-        st r8, [#258]
+        st r8, [#LANE_ROW]
 k_strow_end:
+
+; k_stcol: r8 (the row or column [`k_rows`] gave) into LANE_COL.
 k_stcol:
-        st r8, [#259]
+        st r8, [#LANE_COL]
 k_stcol_end:
+
+; k_refl0: level 0's colour and Ks onto the stack (STACK_L0); the reflected rays
+; d - 2 (d.N) N from SH_P where Ks > 0, the others sleep. Out: r1..r7 the rays, a new level.
 k_refl0:
-        ld r8, [r0 + #282]
-        st r8, [#303]
+        ld r8, [r0 + #SH_KS]
+        st r8, [#STACK_L0+FR_KS]
         movb r10, #0
-        ld r9, [r0 + #278]
-        st r9, [#300]
-        st r10, [#278]
-        ld r9, [r0 + #279]
-        st r9, [#301]
-        st r10, [#279]
-        ld r9, [r0 + #280]
-        st r9, [#302]
-        st r10, [#280]
-        ld r1, [r0 + #267]
-        ld r2, [r0 + #268]
-        ld r3, [r0 + #269]
-        ld r8, [r0 + #274]
-        ld r9, [r0 + #275]
-        ld r10, [r0 + #276]
-        ld r11, [r0 + #270]
-        ld r12, [r0 + #271]
-        ld r13, [r0 + #272]
+        ld r9, [r0 + #COL]
+        st r9, [#STACK_L0+FR_COL]
+        st r10, [#COL]
+        ld r9, [r0 + #COL+1]
+        st r9, [#STACK_L0+FR_COL+1]
+        st r10, [#COL+1]
+        ld r9, [r0 + #COL+2]
+        st r9, [#STACK_L0+FR_COL+2]
+        st r10, [#COL+2]
+        ld r1, [r0 + #SH_P]
+        ld r2, [r0 + #SH_P+1]
+        ld r3, [r0 + #SH_P+2]
+        ld r8, [r0 + #SH_D]
+        ld r9, [r0 + #SH_D+1]
+        ld r10, [r0 + #SH_D+2]
+        ld r11, [r0 + #SH_N]
+        ld r12, [r0 + #SH_N+1]
+        ld r13, [r0 + #SH_N+2]
         mul out, r8, r11
         mac out, r9, r12
-        mac r14, r10, r13, >>14
-        ldacc r8, <<14
+        mac r14, r10, r13, >>Q14        ; d.N
+        ldacc r8, <<Q14
         msu out, r14, r11
-        msu r4, r14, r11, >>14
-        ldacc r9, <<14
+        msu r4, r14, r11, >>Q14
+        ldacc r9, <<Q14
         msu out, r14, r12
-        msu r5, r14, r12, >>14
-        ldacc r10, <<14
+        msu r5, r14, r12, >>Q14
+        ldacc r10, <<Q14
         msu out, r14, r13
-        msu r6, r14, r13, >>14
-        ld r7, [r0 + #257]
-        st r7, [#266]
-        st r4, [#274]
-        st r5, [#275]
-        st r6, [#276]
-        ld r9, [r0 + #277]
-        ld r8, [r0 + #282]
+        msu r6, r14, r13, >>Q14         ; r = d - 2 (d.N) N
+        ld r7, [r0 + #C_INF]
+        st r7, [#PASS_T0]
+        st r4, [#SH_D]
+        st r5, [#SH_D+1]
+        st r6, [#SH_D+2]
+        ld r9, [r0 + #ACT]
+        ld r8, [r0 + #SH_KS]
         cmp.ne r9, #0
-        (f) cmp.gt r8, #0
+        (f) cmp.gt r8, #0               ; F: a hit that reflects
         (!f) sleep
 k_refl0_end:
+
+; k_pop0: back from level 0's reflected rays: COL = STACK_L0's colour + Ks COL.
 k_pop0:
-        ld r10, [r0 + #303]
-        ld r8, [r0 + #300]
-        ld r9, [r0 + #278]
-        mul r9, r9, r10, >>12
+        ld r10, [r0 + #STACK_L0+FR_KS]
+        ld r8, [r0 + #STACK_L0+FR_COL]
+        ld r9, [r0 + #COL]
+        mul r9, r9, r10, >>Q12
         adds r9, r8, r9
-        st r9, [#278]
-        ld r8, [r0 + #301]
-        ld r9, [r0 + #279]
-        mul r9, r9, r10, >>12
+        st r9, [#COL]
+        ld r8, [r0 + #STACK_L0+FR_COL+1]
+        ld r9, [r0 + #COL+1]
+        mul r9, r9, r10, >>Q12
         adds r9, r8, r9
-        st r9, [#279]
-        ld r8, [r0 + #302]
-        ld r9, [r0 + #280]
-        mul r9, r9, r10, >>12
+        st r9, [#COL+1]
+        ld r8, [r0 + #STACK_L0+FR_COL+2]
+        ld r9, [r0 + #COL+2]
+        mul r9, r9, r10, >>Q12
         adds r9, r8, r9
-        st r9, [#280]
+        st r9, [#COL+2]
 k_pop0_end:
+
+; k_tri: the triangle test of one record (the stream).
+; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
+; t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew
 k_tri:
-        ; planar: den = n.d, num = n.(v0 - o)
+        ; den = -n.d, num = -n.(v0 - o)
         mov r8, fb0
         mov r9, fb0
         mov r10, fb0
         mul out, r8, r4
         mac out, r9, r5
-        mac r11, r10, r6, >>14
+        mac r11, r10, r6, >>Q14
         sub r12, fb0, r1
         sub r13, fb0, r2
         sub r14, fb0, r3
         mul out, r8, r12
         mac out, r9, r13
-        mac r15, r10, r14, >>14
+        mac r15, r10, r14, >>Q14
         neg r11, r11
         neg r15, r15
         cmp.gt r11, #0
         (f) cmp.gt r15, #0
-        ldacc r15, <<14
+        ldacc r15, <<Q14
         msu out, r7, r11
         acch r8
-        (f) cmp.lt r8, #0
+        (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
         ; divide
         clz r8, r11
         sub r8, r8, #1
-        sll r10, r11, r8
-        srl r12, r10, #7
-        and r12, r12, #127
-        ld r12, [r12 + #128]
-        ld r14, [r0 + #256]
-        mul r13, r10, r12, >>15
+        sll r10, r11, r8                ; the divisor normalised
+        srl r12, r10, #RCP_SHIFT
+        and r12, r12, #RCP_MASK
+        ld r12, [r12 + #RCP]            ; r = 1/den from the table
+        ld r14, [r0 + #C_ONE]
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul r13, r10, r12, >>15
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul r13, r10, r12, >>Q15        ; Newton: r -= r (den r - 1)
         sub r13, r13, r14
-        ldacc r12, <<14
-        msu r12, r12, r13, >>14
-        mul out, r15, r12
+        ldacc r12, <<Q14
+        msu r12, r12, r13, >>Q14
+        mul out, r15, r12               ; num r in the accumulator, scaled back
         acch r13
         accl r10
         add r14, r8, #1
         sll r13, r13, r14
-        rsb r14, r8, #15
+        rsb r14, r8, #Q15
         srl r10, r10, r14
         or r9, r13, r10
         ; P - v0
-        ldacc r1, <<14
-        mac r10, r9, r4, >>14
+        ldacc r1, <<Q14
+        mac r10, r9, r4, >>Q14
         rsb r10, fb0, r10
-        ldacc r2, <<14
-        mac r11, r9, r5, >>14
+        ldacc r2, <<Q14
+        mac r11, r9, r5, >>Q14
         rsb r11, fb0, r11
-        ldacc r3, <<14
-        mac r12, r9, r6, >>14
+        ldacc r3, <<Q14
+        mac r12, r9, r6, >>Q14
         rsb r12, fb0, r12
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r13, fb0, r12, >>13
+        mac r13, fb0, r12, >>KT_TRI     ; u
         mul out, fb0, r10
         mac out, fb0, r11
-        mac r14, fb0, r12, >>13
-        ld r8, [r0 + #256]
-        add r8, r8, #2
-        (f) cmp.ge r13, #-2
-        (f) cmp.ge r14, #-2
+        mac r14, fb0, r12, >>KT_TRI     ; w
+        ld r8, [r0 + #C_ONE]
+        add r8, r8, #INSIDE_TOL
+        (f) cmp.ge r13, #-INSIDE_TOL
+        (f) cmp.ge r14, #-INSIDE_TOL
         adds r15, r13, r14
-        (f) cmp.le r15, r8
+        (f) cmp.le r15, r8              ; F: inside the triangle
         (f) mov r7, r9
-        (f) st fb0, [#263]
-        (f) st fb0, [#264]
-        (f) st fb0, [#265]
-        (f) st fb0, [#261]
-        (f) st fb0, [#262]
+        (f) st fb0, [#HIT_N]
+        (f) st fb0, [#HIT_N+1]
+        (f) st fb0, [#HIT_N+2]
+        (f) st fb0, [#HIT_OBJ]
+        (f) st fb0, [#HIT_MAT]
 k_tri_end:
 ctx_end:

@@ -334,7 +334,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
     }
-    if !firmware::tracer::kernels::TABLE_SIZES.contains(&a.table_entries) {
+    if !firmware::tracer::math::TABLE_SIZES.contains(&a.table_entries) {
         anyhow::bail!(
             "--table-entries {}: must be 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM)",
             a.table_entries

@@ -143,7 +143,7 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
         });
     }
     // Reciprocal / square-root table size, with one and two Newton steps.
-    for table_entries in firmware::tracer::kernels::TABLE_SIZES {
+    for table_entries in firmware::tracer::math::TABLE_SIZES {
         for newton_steps in [1, 2] {
             v.push(Knob {
                 knob: "table_entries",

@@ -320,7 +320,7 @@ enum Command {
         guard_bits: u32,
         /// Offset of spawned (shadow, reflected, refracted) rays along the
         /// normal, in LSBs of the coordinate format (0..=64).
-        #[arg(long, value_name = "N", default_value_t = firmware::tracer::kernels::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
+        #[arg(long, value_name = "N", default_value_t = firmware::tracer::shading::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
         ray_offset_lsb: i32,
         /// Normals of spheres and cylinders: fine (the eye moved onto the
         /// coordinate format's grid with the whole scene, and the
@@ -402,7 +402,7 @@ enum Bench {
 /// `--table-entries`: the table sizes that fit a 128-word slot of an RC's RAM.
 fn parse_table_entries(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
-        Ok(n) if firmware::tracer::kernels::TABLE_SIZES.contains(&n) => Ok(n),
+        Ok(n) if firmware::tracer::math::TABLE_SIZES.contains(&n) => Ok(n),
         _ => Err(format!(
             "expected 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM), found '{s}'"
         )),

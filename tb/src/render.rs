@@ -154,35 +154,13 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     }
 }
 
-/// Kernels whose runs start an object test (their RCs at the first context
-/// are the rays tested), and the kernel that starts a ray pass (its RCs are
-/// the pass's rays).
-const TEST_KERNELS: [&str; 16] = [
-    "k_sphere",
-    "k_gsphere",
-    "k_cyl",
-    "k_cone",
-    "k_box",
-    "k_rect",
-    "k_grect",
-    "k_tri",
-    "k_gtri",
-    "k_tris",
-    "k_polyh",
-    "k_gpolyh",
-    "k_gbox",
-    "k_gcylf",
-    "k_gconef",
-    "k_gtris",
-];
-
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
     let mut w = rtl::chip::Watch::default();
     let ctx = |n: &str| {
         img.symbol(n)
             .map(|v| ((v as u32 - mem::CTX_BASE) / 4) as u16)
     };
-    for k in TEST_KERNELS {
+    for k in tracer::primitives::TEST_KERNELS {
         if let Some(a) = ctx(k) {
             w.add(a, 0);
         }

@@ -13,11 +13,11 @@
 
 use firmware::asm;
 use firmware::scene::{Object, Scene, Shape, Vec3};
-use firmware::tracer::kernels::{self as k, ram, Inside};
-use firmware::tracer::layout::{
-    cyl_body_words, ChipType, CONE_BODY_WORDS, PLANAR_WORDS, POLY_EDGE_WORDS, POLY_HEAD_WORDS,
-};
-use firmware::tracer::{self, mem, Options};
+use firmware::tracer::emit::{Code, R1, R2, R7};
+use firmware::tracer::layout::ChipType;
+use firmware::tracer::memory_map::ram;
+use firmware::tracer::primitives::{kaddr, klen};
+use firmware::tracer::{self, Firmware, Options};
 use rtl::rc::Word;
 use rtl::{Chip, Sim, Timing};
 use tb::reference::shapes::{intersect, Ray};
@@ -36,19 +36,43 @@ impl Lcg {
     }
 }
 
-/// Run the kernels of `shape` (in a one-object scene) for 64 rays on the
-/// chip of datapath `W`. Returns per lane (t in scene LSBs or None,
-/// normal), and the LSB.
-fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(f64, Vec3)>>, f64) {
-    k::with_datapath(W::DATAPATH, || run_in::<W>(shape, rays, transmit))
+/// The generated program of `fw` with a test driver of its own appended
+/// (its entry): it loads the FB image and the kernels, runs `k_init`,
+/// waits at `wait` for `GO` (the test sets up the RCs meanwhile), runs
+/// `body`'s TinyRISC code, waits for the array and halts.
+fn with_driver(fw: &Firmware, body: impl FnOnce(&mut Code)) -> asm::Image {
+    let mut t = Code::new();
+    t.directive(".data").raw("GO: .word 0").directive(".text");
+    t.label("driver")
+        .li(R1, "FBIMG")
+        .li(R2, 0)
+        .li(firmware::tracer::emit::R3, "FBWORDS")
+        .ldfb(R1, R2, firmware::tracer::emit::R3)
+        .dwait()
+        .li(R1, "CTXBASE")
+        .li(R2, 0)
+        .li(firmware::tracer::emit::R3, "(ctx_end - CTXBASE) / 4")
+        .ldctxt(R1, R2, firmware::tracer::emit::R3)
+        .dwait()
+        .li(R1, kaddr("k_init"))
+        .li(R2, 0)
+        .sbcb(R1, R2, klen("k_init"))
+        .rcany(R1);
+    t.label("wait")
+        .lw(R1, firmware::tracer::emit::at("GO", firmware::tracer::emit::R0))
+        .beqz(R1, "wait");
+    body(&mut t);
+    t.rcany(R1).halt().directive(".entry driver");
+    let src = format!("{}{}", fw.source, t.text());
+    asm::assemble(&src, "kernel-test.s").unwrap()
 }
 
-/// `transmit`: the object's material transmits (two-sided kernels).
-fn run_in<W: Word>(
-    shape: Shape,
-    rays: &[Ray; 64],
-    transmit: bool,
-) -> (Vec<Option<(f64, Vec3)>>, f64) {
+/// Run the test of `shape` (in a one-object scene) for 64 rays on the chip
+/// of datapath `W`: the generated firmware's own kernels, broadcast by its
+/// own code for the type ([`ChipType::broadcast`]). `transmit`: the
+/// object's material transmits (two-sided kernels). Returns per lane (t in
+/// scene LSBs or None, normal), and the LSB.
+fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(f64, Vec3)>>, f64) {
     let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
     if transmit {
         scene.materials[0].t = 0.8;
@@ -73,215 +97,14 @@ fn run_in<W: Word>(
     };
     let fw = tracer::build_with(&scene, &opt, &nm).unwrap();
     let lay = &fw.layout;
-    let t = &lay.types[0];
-    let first = t.first as u32;
-    type Runs = Vec<(&'static str, u32)>;
-    type Kernels = Vec<(&'static str, k::K)>;
-    let (runs, kernels): (Runs, Kernels) = match t.ty {
-        ChipType::Sphere => (
-            vec![("k_sphere", first)],
-            vec![(
-                "k_sphere",
-                k::sphere_with(
-                    lay.ks_sphere,
-                    lay.ep_sphere,
-                    2,
-                    lay.sphere_fine,
-                    lay.fine_normals,
-                ),
-            )],
-        ),
-        ChipType::Rectangle => (
-            vec![("k_rect", first)],
-            vec![("k_rect", k::planar(Inside::Rectangle, lay.kt_rect, 2))],
-        ),
-        ChipType::Triangle => (
-            vec![("k_tri", first)],
-            vec![("k_tri", k::planar(Inside::Triangle, lay.kt_tri, 2))],
-        ),
-        ChipType::GlassSphere => (
-            vec![("k_gsphere", first)],
-            vec![(
-                "k_gsphere",
-                k::sphere_two_sided(
-                    lay.ks_sphere,
-                    lay.ep_sphere,
-                    2,
-                    lay.sphere_fine,
-                    lay.fine_normals,
-                ),
-            )],
-        ),
-        ChipType::SmoothTriangle => (
-            vec![("k_tris", first)],
-            vec![("k_tris", k::smooth_triangle(lay.kt_tri, 2))],
-        ),
-        ChipType::GlassRectangle => (
-            vec![("k_grect", first)],
-            vec![(
-                "k_grect",
-                k::planar_two_sided(Inside::Rectangle, lay.kt_rect, 2),
-            )],
-        ),
-        ChipType::GlassTriangle => (
-            vec![("k_gtri", first)],
-            vec![(
-                "k_gtri",
-                k::planar_two_sided(Inside::Triangle, lay.kt_tri, 2),
-            )],
-        ),
-        ChipType::GlassPolygon => {
-            let mut runs = vec![("k_gpolyh", first + 1)];
-            let fan0 = first + 1 + POLY_HEAD_WORDS as u32;
-            for f in 0..t.fan as u32 {
-                runs.push(("k_polye", fan0 + f * POLY_EDGE_WORDS as u32));
-            }
-            runs.push(("k_gpolyt", fan0 + t.fan as u32 * POLY_EDGE_WORDS as u32));
-            (
-                runs,
-                vec![
-                    ("k_gpolyh", k::polygon_head_two_sided(2)),
-                    ("k_polye", k::polygon_edge()),
-                    ("k_gpolyt", k::polygon_tail_two_sided()),
-                ],
-            )
-        }
-        ChipType::Box => (vec![("k_box", first)], vec![("k_box", k::aabox(2))]),
-        ChipType::GlassCylinder => (
-            std::iter::once(("k_gcylf", first + 1))
-                .chain(std::iter::once((
-                    "k_gcylb",
-                    first + 1 + cyl_body_words(lay.fine_normals) as u32,
-                )))
-                .chain((0..2u32).filter(|_| lay.fb[t.first] != 0).map(|c| {
-                    (
-                        "k_gdisc",
-                        first
-                            + 1
-                            + 2 * cyl_body_words(lay.fine_normals) as u32
-                            + c * PLANAR_WORDS as u32,
-                    )
-                }))
-                .collect(),
-            vec![
-                (
-                    "k_gcylf",
-                    k::cylinder_side(lay.ks_cyl, lay.ep_cyl, 2, false, lay.fine_normals),
-                ),
-                (
-                    "k_gcylb",
-                    k::cylinder_side(lay.ks_cyl, lay.ep_cyl, 2, true, lay.fine_normals),
-                ),
-                ("k_gdisc", k::planar_two_sided(Inside::Disc, lay.kt_disc, 2)),
-            ],
-        ),
-        ChipType::GlassCone => (
-            std::iter::once(("k_gconef", first + 1))
-                .chain(std::iter::once((
-                    "k_gconeb",
-                    first + 1 + CONE_BODY_WORDS as u32,
-                )))
-                .chain((0..2u32).filter(|_| lay.fb[t.first] != 0).map(|c| {
-                    (
-                        "k_gdisc",
-                        first + 1 + 2 * CONE_BODY_WORDS as u32 + c * PLANAR_WORDS as u32,
-                    )
-                }))
-                .collect(),
-            vec![
-                ("k_gconef", k::cone_side(lay.ks_cone, lay.ep_cone, 2, false)),
-                ("k_gconeb", k::cone_side(lay.ks_cone, lay.ep_cone, 2, true)),
-                ("k_gdisc", k::planar_two_sided(Inside::Disc, lay.kt_disc, 2)),
-            ],
-        ),
-        ChipType::GlassSmoothTriangle => (
-            vec![("k_gtris", first)],
-            vec![("k_gtris", k::smooth_triangle_two_sided(lay.kt_tri, 2))],
-        ),
-        ChipType::GlassBox => (
-            vec![("k_gbox", first)],
-            vec![("k_gbox", k::aabox_two_sided(2))],
-        ),
-        ChipType::Polygon => {
-            let mut runs = vec![("k_polyh", first + 1)];
-            let fan0 = first + 1 + POLY_HEAD_WORDS as u32;
-            for f in 0..t.fan as u32 {
-                runs.push(("k_polye", fan0 + f * POLY_EDGE_WORDS as u32));
-            }
-            runs.push(("k_polyt", fan0 + t.fan as u32 * POLY_EDGE_WORDS as u32));
-            (
-                runs,
-                vec![
-                    ("k_polyh", k::polygon_head(2)),
-                    ("k_polye", k::polygon_edge()),
-                    ("k_polyt", k::polygon_tail()),
-                ],
-            )
-        }
-        ChipType::Cylinder => (
-            vec![
-                ("k_cyl", first + 1),
-                (
-                    "k_disc",
-                    first + 1 + cyl_body_words(lay.fine_normals) as u32,
-                ),
-                (
-                    "k_disc",
-                    first + 1 + cyl_body_words(lay.fine_normals) as u32 + PLANAR_WORDS as u32,
-                ),
-            ],
-            vec![
-                (
-                    "k_cyl",
-                    k::cylinder(lay.ks_cyl, lay.ep_cyl, 2, lay.fine_normals),
-                ),
-                ("k_disc", k::planar(Inside::Disc, lay.kt_disc, 2)),
-            ],
-        ),
-        ChipType::Cone => (
-            // The caps (discs) only where the record's caps flag says so,
-            // as the tracer does.
-            std::iter::once(("k_cone", first + 1))
-                .chain((0..2u32).filter(|_| lay.fb[t.first] != 0).map(|c| {
-                    (
-                        "k_disc",
-                        first + 1 + CONE_BODY_WORDS as u32 + c * PLANAR_WORDS as u32,
-                    )
-                }))
-                .collect(),
-            vec![
-                ("k_cone", k::cone(lay.ks_cone, lay.ep_cone, 2)),
-                ("k_disc", k::planar(Inside::Disc, lay.kt_disc, 2)),
-            ],
-        ),
-    };
-    let mut src = format!(
-        "        .datapath {}\nCTXBASE = 0x{:x}\n        .data\nGO:     .word 0\n        .text\n\
-_start: li r1, 0x{:x}\n        li r2, 0\n        li r3, {}\n        ldfb r1, r2, r3\n        dwait\n\
-        li r1, CTXBASE\n        li r2, 0\n        li r3, (ctx_end - CTXBASE) / 4\n        ldctxt r1, r2, r3\n        dwait\n\
-        li r1, (k_init - CTXBASE) / 4\n        li r2, 0\n        sbcb r1, r2, (k_init_end - k_init) / 4\n        rcany r1\n\
-wait:   lw r1, GO(r0)\n        beqz r1, wait\n",
-        W::BITS,
-        mem::CTX_BASE,
-        mem::FB_IMAGE,
-        fw.fb.len()
-    );
-    for (name, addr) in &runs {
-        src += &format!(
-            "        li r1, ({name} - CTXBASE) / 4\n        li r2, {addr}\n        sbcb r1, r2, ({name}_end - {name}) / 4\n"
-        );
-    }
-    src += "        rcany r1\n        halt\n        .ctx\n        .org CTXBASE\n";
-    src += &k::init().text("k_init");
-    for (n, kk) in &kernels {
-        src += &kk.text(n);
-    }
-    src += "ctx_end:\n";
-    let img = asm::assemble(&src, "kernel-test.s").unwrap();
+    let ty = lay.types[0].ty;
+    let img = with_driver(&fw, |t| {
+        t.li(R7, format!("FB_{}", ty.name().to_uppercase()));
+        ty.broadcast(t, "test", &lay.fit);
+    });
     let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
     img.load(&mut chip).unwrap();
-    let fb = fw.fb_bytes();
-    chip.load(mem::FB_IMAGE, &fb).unwrap();
+    chip.load(tracer::mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
     let mut sim = Sim::new(chip);
     let wait = img.symbol("wait").unwrap() as u32;
     while sim.top.risc.pc != wait {
@@ -309,30 +132,23 @@ wait:   lw r1, GO(r0)\n        beqz r1, wait\n",
     // Rays that leave no object (two-sided planar kernels skip the one
     // their rays leave).
     for i in 0..64 {
-        sim.top
-            .array
-            .rc
-            .ram
-            .write(i, ram::ORIG_OBJ as usize, W::wrap(-1));
+        sim.top.array.rc.ram.write(i, ram::ORIG_OBJ.at(), W::wrap(-1));
     }
     let go = img.symbol("GO").unwrap() as u32;
     sim.top.mem.write(go, 4, 1);
     rtl::chip::run_to_halt(&mut sim, 10_000_000).unwrap();
     let rc = &sim.top.array.rc;
     // A smooth triangle's shading normal (the face normal is in HIT_N).
-    let at = if matches!(
-        t.ty,
-        ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle
-    ) {
-        ram::HIT_NS
+    let at = if matches!(ty, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) {
+        ram::HIT_NS.at()
     } else {
-        ram::HIT_N
+        ram::HIT_N.at()
     };
     let out = (0..64)
         .map(|i| {
             let t = rc.regs.read(7)[i].to_i64() as f64;
             (t < max).then(|| {
-                let n = |k: u32| rc.ram.read(i, (at + k) as usize).to_i64() as f64 / one;
+                let n = |k: usize| rc.ram.read(i, at + k).to_i64() as f64 / one;
                 (t, Vec3::new(n(0), n(1), n(2)))
             })
         })
@@ -936,119 +752,102 @@ fn every_kernel_on_the_32_bit_chip() {
     }
 }
 
-/// Snell's law in the RC (`kernels::refract_prepare`, which `k_tset`
+/// Snell's law in the RC (`shading::refract_prepare`, which `k_tset0`
 /// runs): for 64 random incident directions and normals facing them,
 /// entering (eta = 1/ior) or leaving (eta = ior) a material of index
 /// `ior`, the refracted direction and total internal reflection against
 /// f64, on both datapaths. Rays within 2e-3 of the critical angle may
 /// disagree on TIR.
 fn snell_on<W: Word>(ior: f64, seed: u64) -> (usize, f64) {
-    k::with_datapath(W::DATAPATH, || {
-        let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
-        scene.materials[0].t = 0.8;
-        scene.materials[0].ior = ior;
-        scene.objects = vec![Object {
-            shape: shape_sphere(),
-            material: 0,
-            line: 1,
-        }];
-        let opt = Options {
-            datapath: W::DATAPATH,
-            depth: 2,
-            ..Options::default()
+    let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
+    scene.materials[0].t = 0.8;
+    scene.materials[0].ior = ior;
+    scene.objects = vec![Object {
+        shape: shape_sphere(),
+        material: 0,
+        line: 1,
+    }];
+    let opt = Options {
+        datapath: W::DATAPATH,
+        depth: 2,
+        ..Options::default()
+    };
+    let fw = tracer::build(&scene, &opt).unwrap();
+    let lay = &fw.layout;
+    assert!(lay.refract && lay.transmit_materials == 1);
+    let img = with_driver(&fw, |t| {
+        t.li(R1, kaddr("k_tset0"))
+            .li(R2, "FB_TRANSMIT")
+            .sbcb(R1, R2, klen("k_tset0"));
+    });
+    let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
+    img.load(&mut chip).unwrap();
+    chip.load(tracer::mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
+    let mut sim = Sim::new(chip);
+    let wait = img.symbol("wait").unwrap() as u32;
+    while sim.top.risc.pc != wait {
+        sim.step().unwrap();
+    }
+    let one = ((W::BITS - 2) as f64).exp2();
+    let max = ((W::BITS - 1) as f64).exp2() - 1.0;
+    let u = |x: f64| W::wrap((x * one).round().clamp(-max - 1.0, max) as i64);
+    let mut g = Lcg(seed);
+    let mut cases = Vec::new();
+    for lane in 0..64 {
+        let n = Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+        let mut d =
+            Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+        if d.dot(n) > -0.02 {
+            d = (d - n * (d.dot(n) + 0.3)).normalized();
+        }
+        let back = lane % 2 == 1;
+        let ram_ = &mut sim.top.array.rc.ram;
+        for i in 0..3 {
+            ram_.write(lane, ram::SH_D.at() + i, u(d.axis(i)));
+            ram_.write(lane, ram::SH_N.at() + i, u(n.axis(i)));
+            ram_.write(lane, ram::SH_P.at() + i, W::wrap(0));
+        }
+        ram_.write(lane, ram::ACT.at(), W::wrap(1));
+        ram_.write(lane, ram::SH_MAT.at(), W::wrap(0));
+        ram_.write(lane, ram::SH_BACK.at(), W::wrap(back as i64));
+        cases.push((d, n, back));
+    }
+    let go = img.symbol("GO").unwrap() as u32;
+    sim.top.mem.write(go, 4, 1);
+    rtl::chip::run_to_halt(&mut sim, 1_000_000).unwrap();
+    let rc = &sim.top.array.rc;
+    // Level 0's refraction frame.
+    let rf = ram::REFR.at();
+    let (mut disagree, mut worst) = (0, 0.0f64);
+    for (lane, (d, n, back)) in cases.into_iter().enumerate() {
+        // The f64 rule on the directions the chip holds (rounded).
+        let r = |v: Vec3| {
+            Vec3::new(
+                (v.x * one).round() / one,
+                (v.y * one).round() / one,
+                (v.z * one).round() / one,
+            )
         };
-        let fw = tracer::build(&scene, &opt).unwrap();
-        let lay = &fw.layout;
-        assert!(lay.refract && lay.transmit_materials == 1);
-        let src = format!(
-            "        .datapath {}\nCTXBASE = 0x{:x}\n        .data\nGO:     .word 0\n        .text\n\
-_start: li r1, 0x{:x}\n        li r2, 0\n        li r3, {}\n        ldfb r1, r2, r3\n        dwait\n\
-        li r1, CTXBASE\n        li r2, 0\n        li r3, (ctx_end - CTXBASE) / 4\n        ldctxt r1, r2, r3\n        dwait\n\
-        li r1, (k_init - CTXBASE) / 4\n        li r2, 0\n        sbcb r1, r2, (k_init_end - k_init) / 4\n        rcany r1\n\
-wait:   lw r1, GO(r0)\n        beqz r1, wait\n\
-        li r1, (k_tset - CTXBASE) / 4\n        li r2, {}\n        sbcb r1, r2, (k_tset_end - k_tset) / 4\n\
-        rcany r1\n        halt\n        .ctx\n        .org CTXBASE\n{}{}ctx_end:\n",
-            W::BITS,
-            mem::CTX_BASE,
-            mem::FB_IMAGE,
-            fw.fb.len(),
-            lay.transmit,
-            k::init().text("k_init"),
-            k::refract_prepare(0, 1, 2).text("k_tset"),
-        );
-        let img = asm::assemble(&src, "snell-test.s").unwrap();
-        let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
-        img.load(&mut chip).unwrap();
-        chip.load(mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
-        let mut sim = Sim::new(chip);
-        let wait = img.symbol("wait").unwrap() as u32;
-        while sim.top.risc.pc != wait {
-            sim.step().unwrap();
+        let (d, n) = (r(d), r(n));
+        let eta = if back { ior } else { 1.0 / ior };
+        let c1 = -d.dot(n);
+        let kk = 1.0 - eta * eta * (1.0 - c1 * c1);
+        let weight = rc.ram.read(lane, rf + ram::RF_T.at()).to_i64();
+        let tir_chip = weight == 0;
+        if (kk <= 0.0) != tir_chip {
+            if kk.abs() > 2e-3 {
+                disagree += 1;
+            }
+            continue;
         }
-        let one = ((W::BITS - 2) as f64).exp2();
-        let max = ((W::BITS - 1) as f64).exp2() - 1.0;
-        let u = |x: f64| W::wrap((x * one).round().clamp(-max - 1.0, max) as i64);
-        let mut g = Lcg(seed);
-        let mut cases = Vec::new();
-        for lane in 0..64 {
-            let n =
-                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
-            let mut d =
-                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
-            if d.dot(n) > -0.02 {
-                d = (d - n * (d.dot(n) + 0.3)).normalized();
-            }
-            let back = lane % 2 == 1;
-            let ram = &mut sim.top.array.rc.ram;
-            for i in 0..3 {
-                ram.write(lane, (ram::SH_D + i) as usize, u(d.axis(i as usize)));
-                ram.write(lane, (ram::SH_N + i) as usize, u(n.axis(i as usize)));
-                ram.write(lane, (ram::SH_P + i) as usize, W::wrap(0));
-            }
-            ram.write(lane, ram::ACT as usize, W::wrap(1));
-            ram.write(lane, ram::SH_MAT as usize, W::wrap(0));
-            ram.write(lane, ram::SH_BACK as usize, W::wrap(back as i64));
-            cases.push((d, n, back));
+        if kk > 0.0 {
+            let t = (d * eta + n * (eta * c1 - kk.sqrt())).normalized();
+            let dir = |k: usize| rc.ram.read(lane, rf + ram::RF_D.at() + k).to_i64() as f64 / one;
+            let c = Vec3::new(dir(0), dir(1), dir(2));
+            worst = worst.max((t - c).length());
         }
-        let go = img.symbol("GO").unwrap() as u32;
-        sim.top.mem.write(go, 4, 1);
-        rtl::chip::run_to_halt(&mut sim, 1_000_000).unwrap();
-        let rc = &sim.top.array.rc;
-        let rf = ram::REFR as usize;
-        let (mut disagree, mut worst) = (0, 0.0f64);
-        for (lane, (d, n, back)) in cases.into_iter().enumerate() {
-            // The f64 rule on the directions the chip holds (rounded).
-            let r = |v: Vec3| {
-                Vec3::new(
-                    (v.x * one).round() / one,
-                    (v.y * one).round() / one,
-                    (v.z * one).round() / one,
-                )
-            };
-            let (d, n) = (r(d), r(n));
-            let eta = if back { ior } else { 1.0 / ior };
-            let c1 = -d.dot(n);
-            let kk = 1.0 - eta * eta * (1.0 - c1 * c1);
-            let weight = rc.ram.read(lane, rf + 6).to_i64();
-            let tir_chip = weight == 0;
-            if (kk <= 0.0) != tir_chip {
-                if kk.abs() > 2e-3 {
-                    disagree += 1;
-                }
-                continue;
-            }
-            if kk > 0.0 {
-                let t = (d * eta + n * (eta * c1 - kk.sqrt())).normalized();
-                let c = Vec3::new(
-                    rc.ram.read(lane, rf + 3).to_i64() as f64 / one,
-                    rc.ram.read(lane, rf + 4).to_i64() as f64 / one,
-                    rc.ram.read(lane, rf + 5).to_i64() as f64 / one,
-                );
-                worst = worst.max((t - c).length());
-            }
-        }
-        (disagree, worst)
-    })
+    }
+    (disagree, worst)
 }
 
 #[test]

@@ -10,7 +10,8 @@
 //! * expressions with `+ - * / % << >> & | ^ ~`, parentheses, `.` (the
 //!   current address), numbers in decimal, `0x` hex, `0b` binary, `'c'`;
 //! * data: `.word`, `.half`, `.byte`, `.space N[, FILL]`, `.align N`,
-//!   `.ascii "..."`, `.rept N` ... `.endr`; `.entry EXPR` (default: `_start`, else the start of
+//!   `.ascii "..."`, `.rept N[, VAR]` ... `.endr` (VAR counting 0..N-1 in
+//!   the body); `.entry EXPR` (default: `_start`, else the start of
 //!   `.text`);
 //! * `.datapath 16|32`: the RC datapath the contexts are for (default 16;
 //!   32 allows multiplier shifts up to 63, encoded with `f[10]`);
@@ -331,8 +332,29 @@ impl Asm {
             };
             let mut p = expr::Parser::new(&toks[1..]);
             let n = match p.expr(&c) {
-                Ok(Some(n)) if p.pos + 1 == toks.len() && (0..=65536).contains(&n) => n,
+                Ok(Some(n)) if (0..=65536).contains(&n) => n,
                 _ => return Err(lc.err_at(Some(1), "`.rept N` needs a count 0..=65536 known here")),
+            };
+            // `.rept N, VAR`: VAR stands for 0, 1, ..., N - 1 in the body.
+            let var = match &toks[p.pos + 1..] {
+                [] => None,
+                [comma, name] if comma.tok == Tok::P(",") => match &name.tok {
+                    Tok::Ident(v) if !v.starts_with('.') && !tinyrisc::is_register(v) => {
+                        Some(v.clone())
+                    }
+                    _ => {
+                        return Err(lc.err_at(
+                            Some(p.pos + 3),
+                            "`.rept N, VAR`: VAR must be a name (not a register or directive)",
+                        ))
+                    }
+                },
+                _ => {
+                    return Err(lc.err_at(
+                        Some(p.pos + 1),
+                        "expected `.rept N` or `.rept N, VAR` (VAR counts 0..N-1 in the body)",
+                    ))
+                }
             };
             let end = (k + 1..lines.len())
                 .find(|&j| is(&lines[j].2, ".endr") || is(&lines[j].2, ".rept"));
@@ -342,8 +364,23 @@ impl Asm {
                     "`.rept` without `.endr` (nesting is not supported)",
                 ));
             };
-            for _ in 0..n {
-                out.extend(lines[k + 1..end].iter().cloned());
+            for i in 0..n {
+                for (no, text, toks) in &lines[k + 1..end] {
+                    let toks = match &var {
+                        Some(v) => toks
+                            .iter()
+                            .map(|t| match &t.tok {
+                                Tok::Ident(x) if x == v => Token {
+                                    tok: Tok::Int(i),
+                                    col: t.col,
+                                },
+                                _ => t.clone(),
+                            })
+                            .collect(),
+                        None => toks.clone(),
+                    };
+                    out.push((*no, text.clone(), toks));
+                }
             }
             k = end + 1;
         }

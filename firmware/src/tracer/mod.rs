@@ -25,9 +25,15 @@
 //! 128 entries (a knob: 16..=128) in every RC's RAM plus two Newton-Raphson
 //! steps.
 
-pub mod control;
-pub mod kernels;
+pub mod emit;
 pub mod layout;
+pub mod math;
+pub mod memory_map;
+pub mod primitives;
+pub mod program;
+pub mod shading;
+pub mod tiles;
+pub mod traversal;
 
 use crate::bsp::{BspParams, SplitRule};
 use crate::scene::Scene;
@@ -217,7 +223,7 @@ pub struct Numerics {
     /// Offset of spawned rays along the normal, in LSBs, 0..=64.
     pub eps_lsb: i32,
     /// Entries of the reciprocal and reciprocal square root tables in every
-    /// RC's RAM: 16, 32, 64 or 128 ([`kernels::TABLE_SIZES`]).
+    /// RC's RAM: 16, 32, 64 or 128 ([`math::TABLE_SIZES`]).
     pub table_entries: u32,
     /// Fine or coarse normals ([`Normals`]).
     pub normals: Normals,
@@ -275,8 +281,8 @@ impl std::str::FromStr for Normals {
 
 impl Numerics {
     /// The kernels' reciprocal / square root approximation.
-    pub fn approx(&self) -> kernels::Approx {
-        kernels::Approx {
+    pub fn approx(&self) -> math::Approx {
+        math::Approx {
             newton_steps: self.newton_steps,
             table_entries: self.table_entries,
         }
@@ -288,8 +294,8 @@ impl Default for Numerics {
         Numerics {
             newton_steps: 2,
             guard_bits: 2,
-            eps_lsb: kernels::EPS_LSB,
-            table_entries: kernels::TABLE_ENTRIES,
+            eps_lsb: shading::EPS_LSB,
+            table_entries: math::TABLE_ENTRIES,
             normals: Normals::Auto,
         }
     }
@@ -525,7 +531,7 @@ fn build_one(
             "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 0..=64"
         ));
     }
-    if !kernels::TABLE_SIZES.contains(&nm.table_entries) {
+    if !math::TABLE_SIZES.contains(&nm.table_entries) {
         return Err(format!(
             "table size {}: must be 16, 32, 64 or 128 entries (each table has a 128-word slot of the RC's 512-word RAM)",
             nm.table_entries
@@ -608,9 +614,7 @@ fn build_one(
         nm.table_entries as usize,
         opt.datapath.bits() - 16,
     ));
-    let prog = kernels::with_datapath(opt.datapath, || {
-        control::program(scene, &lay, opt, nm, tw, th)
-    })?;
+    let prog = program::program(scene, &lay, opt, nm, tw, th)?;
     Ok(Firmware {
         source: prog.source,
         fb: lay.fb.clone(),
@@ -662,7 +666,7 @@ pub fn chip_warnings(scene: &Scene, notes: &[String]) -> Vec<crate::scene::Warni
         .iter()
         .filter(|o| {
             let m = &scene.materials[o.material];
-            m.ks > 0.0 && m.shine > layout::MAX_SHINE
+            m.ks > 0.0 && m.shine > shading::MAX_SHINE
         })
         .map(|o| o.line)
         .collect();
@@ -673,9 +677,9 @@ pub fn chip_warnings(scene: &Scene, notes: &[String]) -> Vec<crate::scene::Warni
         format!(
             "{} a Phong exponent over {}: the chip's highlight is computed with {} (wider where R.V is within a few 1/{} of 1)",
             plural(n, "object has", "objects have"),
-            layout::MAX_SHINE,
-            layout::MAX_SHINE,
-            layout::MAX_SHINE
+            shading::MAX_SHINE,
+            shading::MAX_SHINE,
+            shading::MAX_SHINE
         ),
     );
     // One warning per distinct note of the scene compiler (the exponent is

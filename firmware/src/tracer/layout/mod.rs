@@ -1,0 +1,972 @@
+//! The frame-buffer image the tracer reads (FB set 0, word addresses):
+//!
+//! ```text
+//! 0     RSQ table (128) | RCP table (128) | 1.0 | 32767      init stream
+//! EYE   px0, py0 (written per tile), from.xyz, (A, B, C) x 3  eye stream
+//! POST  background.rgb, (material id, ks) per material
+//! TRANSMIT per transmitting material: id, T, 1/ior, ior (refracting scenes)
+//! LIGHT per light: [scale shift,] position.xyz
+//! SHADE per light, per material: id, then per channel kd c lc, ks lc
+//! ROOTBOX the root cell widened (packet traversal)
+//! objects, grouped by type, fixed record size per type (one module per
+//!     primitive in `primitives/`; polygons padded to the largest fan)
+//! BSP nodes: the paper's traversal's (paper_nodes.rs) or the packet
+//!     traversal's (packet_nodes.rs), and the paper's mailboxes
+//! ```
+//!
+//! A scene whose image does not fit FB set 0 gets a streamed layout
+//! ([`Stream`]): only the part up to SHADE (and ROOTBOX) stays in the FB
+//! (bank 0, plus the split words); nodes, per-leaf blocks of records and
+//! mailboxes go to main memory, and bank 1 is the streaming buffer. The
+//! program's header names every address and field of this image.
+
+mod packet_nodes;
+mod paper_nodes;
+
+use crate::scene::{PrimType, Scene, Shape, Vec3};
+use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
+
+pub use super::primitives::ChipType;
+use super::primitives::{aabox, cone, cylinder, planar, polygon, smooth_triangle, sphere, Fit};
+use super::shading::split_shine;
+use super::{NodeLayout, Options, Traversal};
+pub use packet_nodes::{PK_INNER, PK_LEAF_HEAD, PK_MAILBOX_BYTES};
+pub use paper_nodes::{compact_head, COMPACT_INNER_HEAD, COMPACT_LEAF_HEAD, NODE_HEAD};
+
+/// Words of FB set 0.
+pub const FB_LIMIT: usize = 0x8000;
+
+/// One type present in the scene.
+#[derive(Clone, Debug)]
+pub struct TypeInfo {
+    pub ty: ChipType,
+    /// Scene object indices, in slot order.
+    pub objects: Vec<usize>,
+    pub first: usize,
+    pub size: usize,
+    /// Offset of the type's bit vector in a Fig. 5 node.
+    pub bv_offset: usize,
+    pub bv_words: usize,
+    pub mailbox: usize,
+    /// Polygons: edges per record (the largest polygon's non-horizontal
+    /// edges in its projection).
+    pub fan: usize,
+}
+
+/// The laid-out image and everything the generator needs to know of it.
+#[derive(Clone, Debug)]
+pub struct Layout {
+    /// FB words as values: 16-bit on the 16-bit chip; on the 32-bit chip
+    /// numeric words use the whole word and the others (flags, addresses,
+    /// bit vectors, counts) are the 16-bit words sign-extended.
+    pub fb: Vec<i32>,
+    pub frac: u32,
+    pub eye: usize,
+    pub post: usize,
+    /// FB address of the refraction table (`id, T, 1/ior, ior` per
+    /// transmitting material) and its entries; `refract`: the scene has
+    /// refracting objects (the ray tree branches).
+    pub transmit: usize,
+    pub transmit_materials: usize,
+    pub refract: bool,
+    pub lights: Vec<usize>,
+    pub shades: Vec<usize>,
+    pub types: Vec<TypeInfo>,
+    pub root: usize,
+    /// Words (32-bit words when streamed) of a node; 0 for compact nodes,
+    /// whose size varies.
+    pub node_words: usize,
+    /// The node format of the resident layout (the option; the streamed
+    /// layout has per-leaf lists whichever it is).
+    pub node_layout: NodeLayout,
+    /// The traversal the nodes are laid out for.
+    pub traversal: Traversal,
+    /// Packet traversal: FB address of the root cell widened by
+    /// [`super::traversal::packet::P_TOL`] (6 words: per axis min, max).
+    pub root_box: usize,
+    /// Packet traversal: the tree it walks is a single leaf.
+    pub root_leaf: bool,
+    /// Packet traversal: the expected array cycles of a packet's walk from
+    /// the root, by the surface-area cost model of [`super::Collapse::Auto`]
+    /// (0 for the paper's traversal).
+    pub expected_cost: f64,
+    /// FB words the resident image needs with this node format (tables to
+    /// mailboxes), whether or not it fits and was used.
+    pub resident_words: usize,
+    /// Of those, the BSP nodes.
+    pub resident_node_words: usize,
+    pub mailbox: usize,
+    pub objects: usize,
+    pub materials: usize,
+    /// Phong exponents: integer part and fraction (see [`split_shine`]).
+    pub shines: Vec<(u32, f64)>,
+    /// Scale shift of the eye rays' pixel steps.
+    pub kd: u32,
+    /// The kernels' scale shifts and record variants.
+    pub fit: Fit,
+    /// Fine normals ([`super::Normals`], resolved for the datapath).
+    pub fine_normals: bool,
+    /// Light records carry a scale shift (some light is too far for
+    /// `light - P` to fit the format, [`light_shift`]).
+    pub light_shifted: bool,
+    /// The streamed layout (scenes that do not fit FB set 0), or `None`
+    /// when the whole scene is resident in the FB.
+    pub stream: Option<Stream>,
+}
+
+/// FB bank 1 (set 0): the streaming buffer of the streamed layout.
+pub const STREAM_BANK: usize = 0x4000;
+/// Words at the start of a streamed leaf block: the cell bounds.
+pub const BLOCK_HEAD: usize = 6;
+/// Bytes of a node record in main memory (streamed layout).
+pub const NODE_BYTES: usize = 64;
+
+/// The streamed layout: the scene lives in main memory and TinyRISC moves
+/// each leaf's block (cell bounds, then the records of its objects grouped
+/// by type) into FB bank 1 by DMA when the traversal reaches it (the node
+/// records: `traversal/streamed.rs`, `traversal/packet.rs`).
+#[derive(Clone, Debug)]
+pub struct Stream {
+    /// Main-memory byte address of [`Stream::image`].
+    pub base: u32,
+    pub image: Vec<u8>,
+    pub root: u32,
+    pub mailbox: u32,
+    /// FB word (bank 0) the split value of the node being classified is
+    /// written to.
+    pub split_slot: usize,
+    pub nodes: usize,
+    pub largest_block: usize,
+    /// Packet traversal: leaf blocks beyond one per leaf (a leaf whose
+    /// records exceed FB bank 1 is moved in pieces).
+    pub extra_pieces: usize,
+}
+
+/// Reciprocal square root table of `n` entries (a power of two up to 128):
+/// entry k = 1/sqrt(X) for X = (k + 0.5) 2^(15 - log2 n) in Q.11, Q1.14
+/// (saturated at the bottom, where it is never used).
+pub fn rsq_table(n: usize) -> Vec<i32> {
+    rsq_table_for(n, 0)
+}
+
+/// [`rsq_table`] with `x` extra fraction bits (16 on the 32-bit chip: the
+/// same entries in Q1.30, indexed by X in Q.27).
+pub fn rsq_table_for(n: usize, x: u32) -> Vec<i32> {
+    let w = 32768.0 / n as f64;
+    let one = ((14 + x) as f64).exp2();
+    (0..n)
+        .map(|k| {
+            let v = (k as f64 + 0.5) * w / 2048.0;
+            ((1.0 / v.sqrt()) * one).round().min(word_max(x)) as i32
+        })
+        .collect()
+}
+
+/// Reciprocal table of `n` entries: entry k = 2^29 / d for
+/// d = 2^14 + (k + 0.5) 2^14 / n.
+pub fn rcp_table(n: usize) -> Vec<i32> {
+    rcp_table_for(n, 0)
+}
+
+/// [`rcp_table`] with `x` extra fraction bits: `2^(29 + 2x) / d` for
+/// `d = 2^(14 + x) + (k + 0.5) 2^(14 + x) / n`.
+pub fn rcp_table_for(n: usize, x: u32) -> Vec<i32> {
+    let w = 16384.0 / n as f64;
+    (0..n)
+        .map(|k| {
+            let d = 16384.0 + (k as f64 + 0.5) * w;
+            (((29 + x) as f64).exp2() / d).round().min(word_max(x)) as i32
+        })
+        .collect()
+}
+
+/// The two 128-word table slots at the start of the init stream (RC RAM
+/// `RSQ` and `RCP`): tables of `n` entries, the rest of each slot zero.
+pub fn table_slots(n: usize) -> Vec<i32> {
+    table_slots_for(n, 0)
+}
+
+/// [`table_slots`] with `x` extra fraction bits (the 32-bit chip: 16).
+pub fn table_slots_for(n: usize, x: u32) -> Vec<i32> {
+    let mut v = vec![0i32; 256];
+    v[..n].copy_from_slice(&rsq_table_for(n, x));
+    v[128..128 + n].copy_from_slice(&rcp_table_for(n, x));
+    v
+}
+
+/// The largest word value with `x` extra bits (16-bit: 32767).
+fn word_max(x: u32) -> f64 {
+    ((15 + x) as f64).exp2() - 1.0
+}
+
+/// The FB image as it is written: words (16-bit values, or 32-bit on the
+/// 32-bit chip) in the order the kernels stream them.
+pub(crate) struct W {
+    pub(crate) fb: Vec<i32>,
+    /// LSBs per scene unit (`2^frac`).
+    pub(crate) s: f64,
+    /// Fraction bits of the scene format.
+    pub(crate) frac: u32,
+    /// Extra bits of the datapath (0 or 16).
+    pub(crate) x: u32,
+}
+
+impl W {
+    pub(crate) fn max(&self) -> f64 {
+        word_max(self.x)
+    }
+    /// Round and saturate to the word.
+    pub(crate) fn sat(&self, v: f64) -> i32 {
+        v.round().clamp(-self.max() - 1.0, self.max()) as i32
+    }
+    pub(crate) fn push(&mut self, v: f64) {
+        let v = self.sat(v);
+        self.fb.push(v);
+    }
+    /// A 16-bit structural word (flags, bit vectors), sign-extended.
+    pub(crate) fn word16(&mut self, v: u16) {
+        self.fb.push(v as i16 as i32);
+    }
+    /// One in Q1.14 (16-bit chip) or Q1.30.
+    pub(crate) fn one(&self) -> f64 {
+        ((14 + self.x) as f64).exp2()
+    }
+    pub(crate) fn coord(&mut self, x: f64) {
+        self.push(x * self.s);
+    }
+    pub(crate) fn point(&mut self, v: Vec3) {
+        for x in v.to_array() {
+            self.coord(x);
+        }
+    }
+    pub(crate) fn unit(&mut self, v: Vec3) {
+        let k = Q_UNIT.lsb().recip() * (self.x as f64).exp2();
+        for x in v.to_array() {
+            self.push(x * k);
+        }
+    }
+    /// One component of a unit vector (Q1.14).
+    pub(crate) fn unit_axis(&mut self, x: f64) {
+        self.push(x * Q_UNIT.lsb().recip() * (self.x as f64).exp2());
+    }
+    pub(crate) fn col(&mut self, x: f64) {
+        self.push(x * Q_MATERIAL.lsb().recip() * (self.x as f64).exp2());
+    }
+    pub(crate) fn raw(&mut self, x: i64) {
+        self.push(x as f64);
+    }
+    pub(crate) fn scaled(&mut self, v: Vec3, scale: f64) {
+        for x in v.to_array() {
+            self.push(x * scale);
+        }
+    }
+}
+
+/// FB words as the bytes DMA moves: 2 per word (16-bit chip, `x` = 0) or
+/// 4 (32-bit chip), little-endian.
+pub fn fb_word_bytes(words: &[i32], x: u32) -> Vec<u8> {
+    if x == 0 {
+        words
+            .iter()
+            .flat_map(|w| (*w as i16).to_le_bytes())
+            .collect()
+    } else {
+        words.iter().flat_map(|w| w.to_le_bytes()).collect()
+    }
+}
+
+/// The scale shifts of the kernels, fitted to the word of the datapath.
+pub(crate) struct Fitter {
+    /// Extra bits of the datapath (0 or 16).
+    pub(crate) x: u32,
+}
+
+impl Fitter {
+    /// Largest shift `k` with `m * 2^k` within the word, clamped to 0..=max.
+    pub(crate) fn shift(&self, m: f64, max: u32) -> u32 {
+        fit_shift_w(m, max, self.x)
+    }
+    /// `KS` of a kernel whose record holds `2^(14+KS) / v` for the smallest
+    /// `v` (LSB) of the scene: as large as keeps it in the word, at most 16
+    /// (plus the datapath's extra bits); 8 where there is none.
+    pub(crate) fn ks(&self, min: f64) -> u32 {
+        if min.is_finite() {
+            self.shift(((14 + self.x) as f64).exp2() / min, 16 + self.x)
+        } else {
+            8
+        }
+    }
+}
+
+/// The scene's distinct materials, and per scene material its index among
+/// them (materials equal in every field are one).
+fn distinct_materials(scene: &Scene) -> (Vec<usize>, Vec<crate::scene::Material>) {
+    let key = |m: &crate::scene::Material| {
+        [
+            m.color.x, m.color.y, m.color.z, m.kd, m.ks, m.shine, m.t, m.ior,
+        ]
+        .map(f64::to_bits)
+    };
+    let mut seen = std::collections::HashMap::new();
+    let mut mats = Vec::new();
+    let of = scene
+        .materials
+        .iter()
+        .map(|m| {
+            *seen.entry(key(m)).or_insert_with(|| {
+                mats.push(m.clone());
+                mats.len() - 1
+            })
+        })
+        .collect();
+    (of, mats)
+}
+
+/// Largest shift `k` with `m * 2^k` within the word (`<= 2^(15+x) - 1`:
+/// 32767 on the 16-bit chip), clamped to 0..=max.
+pub(crate) fn fit_shift_w(m: f64, max: u32, x: u32) -> u32 {
+    if m <= 0.0 {
+        return max;
+    }
+    let k = (word_max(x) / m).log2().floor();
+    k.clamp(0.0, max as f64) as u32
+}
+
+/// Largest absolute coordinate of the eye and of every object's bounds.
+fn extent(scene: &Scene) -> f64 {
+    let mut m: f64 = scene.camera.from.max_abs();
+    for o in &scene.objects {
+        let b = o.shape.bounds();
+        m = m.max(b.min.max_abs()).max(b.max.max_abs());
+    }
+    m
+}
+
+/// The tracer's coordinate format: the finest `Qm.n` in which every object
+/// and the eye fit with two guard bits (so that differences of points and
+/// distances across the scene fit); never coarser than the scene
+/// compiler's format (whose BSP planes are snapped to its LSB, hence exact
+/// in a finer one). Lights do not take part: only their difference to a
+/// point of the scene is ever formed, at a coarser scale when needed
+/// ([`light_shift`]).
+pub fn fit_frac(scene: &Scene, compiler_frac: u32, guard_bits: u32) -> u32 {
+    let m = extent(scene);
+    (compiler_frac..=14)
+        .rev()
+        .find(|&n| m * (guard_bits as f64).exp2() < ((15 - n) as f64).exp2() * 0.999)
+        .unwrap_or(compiler_frac)
+}
+
+/// Scale of a light in the shadow-ray kernel: the smallest `k` for which
+/// `(light - P) / 2^k` fits the format `frac` for every point `P` of the
+/// scene (`|P| <= m`, [`extent`]). The light is stored divided by `2^k`
+/// and the kernel forms `light / 2^k - P / 2^k`; its direction is all a
+/// shadow ray needs. A light with `k > 0` lies outside the box `[-m, m]^3`
+/// that holds every object (`l + m >= 2^(15 - frac) > 2 m`), so no object
+/// lies beyond it along the shadow ray and the ray's segment may end at
+/// "no hit" (32767) instead of at the light.
+pub fn light_shift(position: Vec3, m: f64, frac: u32) -> Option<u32> {
+    light_shift_w(position, m, frac, 0)
+}
+
+/// [`light_shift`] for words with `x` extra bits (`frac` includes them).
+pub fn light_shift_w(position: Vec3, m: f64, frac: u32, x: u32) -> Option<u32> {
+    let range = ((15 + x - frac) as f64).exp2() * 0.999;
+    let l = position.max_abs();
+    (0..=15u32).find(|&k| (l + m) < range * (k as f64).exp2())
+}
+
+/// Lay out the scene.
+pub fn build(
+    scene: &Scene,
+    image: &SceneImage,
+    opt: &Options,
+    guard_bits: u32,
+    fine_normals: bool,
+    force_stream: bool,
+) -> Result<Layout, String> {
+    if !force_stream {
+        let lay = build_as(scene, image, opt, guard_bits, fine_normals, false, false)?;
+        if lay.stream.is_none() {
+            return Ok(lay);
+        }
+    }
+    // A streamed scene has thousands of objects, many of them a few LSB
+    // small: it is laid out again in the finest format with one guard bit
+    // (differences of two points of the scene still fit), the compiler's
+    // rule, and sphere records carry the unrounded radius's reciprocal.
+    build_as(
+        scene,
+        image,
+        opt,
+        guard_bits.min(1),
+        fine_normals,
+        true,
+        true,
+    )
+}
+
+/// Lay out the scene for the packet traversal. `fine`: the format of the
+/// streamed layout (one guard bit, unrounded sphere radii), which the
+/// paper's layout takes for scenes it streams; the packet traversal's
+/// nodes are much smaller, so it keeps resident many scenes the paper's
+/// layout streams, but its format follows the paper's decision (the same
+/// numbers, hence the same hits up to ties). Streamed when it does not fit
+/// FB set 0 or with `force_stream`.
+pub fn build_packet(
+    scene: &Scene,
+    image: &SceneImage,
+    opt: &Options,
+    guard_bits: u32,
+    fine_normals: bool,
+    force_stream: bool,
+    fine: bool,
+) -> Result<Layout, String> {
+    let g = if fine { guard_bits.min(1) } else { guard_bits };
+    build_as(scene, image, opt, g, fine_normals, fine, force_stream)
+}
+
+/// The geometry a primitive's record is written from, computed once for
+/// the fit of the scale shifts and again for the records.
+enum Shape2 {
+    None,
+    Planars(Vec<planar::Planar>),
+    Cone(cone::ConeFit, [planar::Planar; 2]),
+}
+
+fn build_as(
+    scene: &Scene,
+    image: &SceneImage,
+    opt: &Options,
+    guard_bits: u32,
+    fine_normals: bool,
+    fine: bool,
+    streamed: bool,
+) -> Result<Layout, String> {
+    // The 32-bit chip: every format gets `xb` more fraction bits.
+    let xb = opt.datapath.bits() - 16;
+    let fitter = Fitter { x: xb };
+    let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
+    let s = (frac as f64).exp2();
+    let err = |line: usize, m: String| {
+        if line > 0 {
+            format!("{}:{line}: {m}", scene.source)
+        } else {
+            format!("{}: {m}", scene.source)
+        }
+    };
+
+    // Objects by chip type.
+    let mut by: Vec<Vec<usize>> = vec![Vec::new(); ChipType::ALL.len()];
+    let mut slot = vec![(0usize, 0usize); scene.objects.len()];
+    for (i, o) in scene.objects.iter().enumerate() {
+        let t = ChipType::of_object(&o.shape, scene.materials[o.material].t > 0.0);
+        let ti = t as usize;
+        slot[i] = (ti, by[ti].len());
+        by[ti].push(i);
+    }
+    // Materials: identical ones are one (an NFF file repeats its `f` line
+    // for every object: SPD rings, 841 lines, 7 materials); the kernels
+    // shade per distinct material.
+    let (mat_of, mats) = distinct_materials(scene);
+    if mats.len() > 1000 || scene.lights.len() > 64 {
+        return Err(err(
+            0,
+            "more than 1000 distinct materials or 64 lights".into(),
+        ));
+    }
+
+    // The geometry of every record, to fit the kernels' scale shifts.
+    let mut geo: Vec<Shape2> = Vec::with_capacity(scene.objects.len());
+    let mut fan = 0usize;
+    for o in &scene.objects {
+        geo.push(match &o.shape {
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+                ..
+            } if o.shape.prim_type() == PrimType::Cone => {
+                let f = cone::ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
+                let caps = f.caps(*base, *base_radius, *apex, *apex_radius, s);
+                Shape2::Cone(f, caps)
+            }
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                ..
+            } => Shape2::Planars(cylinder::caps(*base, *apex, base_radius.abs()).to_vec()),
+            Shape::Rectangle {
+                corner,
+                edge1,
+                edge2,
+            } => Shape2::Planars(vec![planar::Planar::rectangle(
+                *corner,
+                *edge1,
+                *edge2,
+                edge1.cross(*edge2).normalized(),
+            )]),
+            Shape::Triangle { v, .. } => {
+                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+                Shape2::Planars(vec![planar::Planar::triangle(v[0], v[1], v[2], n)])
+            }
+            Shape::Polygon { v, .. } => {
+                fan = fan.max(polygon::edges(v, s).1.len());
+                Shape2::None
+            }
+            Shape::Sphere { .. } | Shape::Box { .. } => Shape2::None,
+        });
+    }
+    let mut m = [0.0f64; 3];
+    for g in &geo {
+        let ps: &[planar::Planar] = match g {
+            Shape2::Planars(p) => p,
+            Shape2::Cone(_, c) => c,
+            Shape2::None => &[],
+        };
+        for p in ps {
+            let k = p.kind.kt_index();
+            m[k] = m[k].max(p.dual_max((14 + xb) as i32 - frac as i32));
+        }
+    }
+    let kt = m.map(|m| fitter.shift(m, 24 + xb));
+    let radii = scene.objects.iter().filter_map(|o| match o.shape {
+        Shape::Sphere { radius, .. } => Some(radius.abs() * s),
+        _ => None,
+    });
+    let (ks_sphere, ep_sphere, sphere_fine) = sphere::fit(radii, &fitter);
+    let cyl_radii = scene.objects.iter().filter_map(|o| match o.shape {
+        Shape::Cone { base_radius, .. } if o.shape.prim_type() == PrimType::Cylinder => {
+            Some(base_radius.abs() * s)
+        }
+        _ => None,
+    });
+    let base_radii = scene.objects.iter().filter_map(|o| match o.shape {
+        Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
+        _ => None,
+    });
+    let (ks_cyl, ep_cyl) = cylinder::fit(cyl_radii, base_radii, &fitter);
+    let cone_fits = geo.iter().filter_map(|g| match g {
+        Shape2::Cone(f, _) => Some(*f),
+        _ => None,
+    });
+    let (ks_cone, ep_cone) = cone::fit(cone_fits, &fitter);
+    let fit = Fit {
+        ks_sphere,
+        ep_sphere,
+        sphere_fine,
+        ks_cyl,
+        ep_cyl,
+        ks_cone,
+        ep_cone,
+        kt,
+        fine_normals,
+    };
+
+    let mut w = W {
+        fb: Vec::new(),
+        s,
+        frac,
+        x: xb,
+    };
+    // Init stream.
+    w.fb.extend(table_slots_for(128, xb));
+    w.push(w.one());
+    w.push(w.max());
+    let (eye, kd) = camera(&mut w, scene, opt).map_err(|m| err(0, m))?;
+
+    // Post: background, (id, ks) per material.
+    let post = w.fb.len();
+    for x in scene.background.to_array() {
+        w.col(x);
+    }
+    for (i, mt) in mats.iter().enumerate() {
+        w.raw(i as i64);
+        w.col(mt.ks);
+    }
+    // Refraction: per transmitting material `id, T, 1/ior, ior` (the
+    // stream of `k_tset`), only when a refracting object uses one.
+    let refract = ChipType::ALL
+        .iter()
+        .any(|c| c.refracts() && !by[*c as usize].is_empty());
+    let transmit = w.fb.len();
+    let mut transmit_materials = 0;
+    if refract {
+        for (i, mt) in mats.iter().enumerate().filter(|(_, m)| m.t > 0.0) {
+            w.raw(i as i64);
+            w.col(mt.t);
+            w.col(1.0 / mt.ior);
+            w.col(mt.ior);
+            transmit_materials += 1;
+        }
+    }
+    let (lights, shades, light_shifted) =
+        lights(&mut w, scene, &mats, frac, xb).map_err(|m| err(0, m))?;
+    let shines: Vec<(u32, f64)> = mats.iter().map(|m| split_shine(m.shine)).collect();
+
+    // Packet traversal: the root cell widened by the traversal's tolerance
+    // (the stream of its pass-start kernel), resident in either layout.
+    let packet = opt.traversal == Traversal::Packet;
+    let root_box = if packet {
+        let at = w.fb.len();
+        let b = image.bsp.nodes[0].bounds;
+        let tol = super::traversal::packet::P_TOL as f64;
+        for a in 0..3 {
+            w.push((b.min.axis(a) * s).floor() - tol);
+            w.push((b.max.axis(a) * s).ceil() + tol);
+        }
+        at
+    } else {
+        0
+    };
+
+    // Object records, grouped by type.
+    let records_start = w.fb.len();
+    let mut types = Vec::new();
+    let mut bv_offset = NODE_HEAD;
+    let mut mailbox_slots = 0;
+    for t in ChipType::ALL {
+        let objs = &by[t as usize];
+        if objs.is_empty() {
+            continue;
+        }
+        let size = t.record_words(&fit, fan);
+        let first = w.fb.len();
+        for &i in objs {
+            let o = &scene.objects[i];
+            let mat = mat_of[o.material];
+            let start = w.fb.len();
+            match (&o.shape, &geo[i]) {
+                (
+                    Shape::Cone {
+                        inside, caps: on, ..
+                    },
+                    Shape2::Cone(cf, caps),
+                ) => cone::write(&mut w, &fit, t.sides(), cf, *inside, *on, caps, i, mat)
+                    .map_err(|m| err(o.line, m))?,
+                (
+                    Shape::Sphere {
+                        center,
+                        radius,
+                        inside,
+                    },
+                    _,
+                ) => sphere::write(&mut w, &fit, fine, *center, *radius, *inside, i, mat),
+                (
+                    Shape::Cone {
+                        base,
+                        base_radius,
+                        apex,
+                        inside,
+                        caps: on,
+                        ..
+                    },
+                    Shape2::Planars(caps),
+                ) => cylinder::write(
+                    &mut w,
+                    &fit,
+                    t.sides(),
+                    *base,
+                    *apex,
+                    *base_radius,
+                    *inside,
+                    *on,
+                    &[caps[0], caps[1]],
+                    i,
+                    mat,
+                ),
+                (Shape::Box { min, max }, _) => aabox::write(&mut w, t.sides(), *min, *max, i, mat),
+                (Shape::Polygon { v, .. }, _) => polygon::write(&mut w, v, size, i, mat),
+                (
+                    Shape::Triangle {
+                        normals: Some(ns), ..
+                    },
+                    Shape2::Planars(p),
+                ) if matches!(t, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) => {
+                    smooth_triangle::write(&mut w, &fit.kt, &p[0], *ns, i, mat)
+                }
+                (_, Shape2::Planars(ps)) => {
+                    for p in ps {
+                        planar::write(&mut w, &fit.kt, p, i, mat);
+                    }
+                }
+                _ => {}
+            }
+            debug_assert_eq!(w.fb.len() - start, size, "{t:?}");
+            if w.fb.len() - start != size {
+                return Err(format!(
+                    "internal: {} record of {} words, expected {size}",
+                    t.name(),
+                    w.fb.len() - start
+                ));
+            }
+        }
+        let bv_words = objs.len().div_ceil(16);
+        types.push(TypeInfo {
+            ty: t,
+            objects: objs.clone(),
+            first,
+            size,
+            bv_offset,
+            bv_words,
+            mailbox: mailbox_slots,
+            fan,
+        });
+        bv_offset += bv_words;
+        mailbox_slots += objs.len();
+    }
+
+    let nodes = &image.bsp.nodes;
+    let fin = Finish {
+        frac,
+        eye,
+        post,
+        lights,
+        shades,
+        objects: scene.objects.len(),
+        materials: mats.len(),
+        transmit,
+        transmit_materials,
+        refract,
+        shines,
+        kd,
+        fit,
+        light_shifted,
+        node_layout: opt.layout,
+        traversal: opt.traversal,
+        root_box,
+        collapse: opt.collapse,
+        cost: if packet {
+            packet_nodes::object_costs(scene, s, &fit)
+        } else {
+            Vec::new()
+        },
+    };
+    if packet {
+        return packet_nodes::packet_nodes(
+            w,
+            fin,
+            types,
+            nodes,
+            &slot,
+            records_start,
+            streamed,
+            &err,
+        );
+    }
+    paper_nodes::paper_nodes(
+        w,
+        fin,
+        types,
+        nodes,
+        &slot,
+        records_start,
+        streamed,
+        opt.layout,
+        bv_offset,
+        mailbox_slots,
+        &err,
+    )
+}
+
+/// The eye stream (`D(i, j) = A + i B + j C`): its FB address and the
+/// scale shift `KD` of B and C.
+fn camera(w: &mut W, scene: &Scene, opt: &Options) -> Result<(usize, u32), String> {
+    let xb = w.x;
+    let c = &scene.camera;
+    let (wd, hd) = (opt.width.max(1), opt.height.max(1));
+    let ww = (c.at - c.from).normalized();
+    let uu = ww.cross(c.up).normalized();
+    let vv = uu.cross(ww);
+    let half = (c.angle.to_radians() / 2.0).tan();
+    let (ax, ay) = if wd >= hd {
+        (wd as f64 / hd as f64, 1.0)
+    } else {
+        (1.0, hd as f64 / wd as f64)
+    };
+    let mut a = ww;
+    let mut b = Vec3::ZERO;
+    let mut cc = Vec3::ZERO;
+    if wd > 1 {
+        a = a - uu * (ax * half);
+        b = uu * (ax * half * 2.0 / (wd - 1) as f64);
+    }
+    if hd > 1 {
+        a = a + vv * (ay * half);
+        cc = vv * (-ay * half * 2.0 / (hd - 1) as f64);
+    }
+    let max_bc = b.max_abs().max(cc.max_abs());
+    let kd = fit_shift_w(max_bc, 28 + xb, xb).max(13 + xb);
+    let corner_far = a + b * (wd - 1) as f64 + cc * (hd - 1) as f64;
+    if a.max_abs() >= 3.9 || corner_far.max_abs() >= 3.9 {
+        let aspect = ax.max(ay);
+        let long = 2.0 * (aspect * half).atan().to_degrees();
+        return Err(if aspect > 1.0 {
+            format!(
+                "a {wd}x{hd} image ({aspect:.1}:1) with the camera angle {} across its shorter side spans {long:.0} degrees across its longer: too wide for the chip's Q2.13 eye-ray directions (at most about 150 degrees); a squarer image or a narrower angle fits",
+                c.angle
+            )
+        } else {
+            format!(
+                "camera angle {} too wide for the chip's Q2.13 eye-ray directions (at most about 150 degrees)",
+                c.angle
+            )
+        });
+    }
+    let eye = w.fb.len();
+    w.raw(0);
+    w.raw(0);
+    w.point(c.from);
+    for k in 0..3 {
+        w.push(a.axis(k) * w.one() / 2.0);
+        w.push(b.axis(k) * (kd as f64).exp2());
+        w.push(cc.axis(k) * (kd as f64).exp2());
+    }
+    Ok((eye, kd))
+}
+
+/// The light and shading streams: per light its position (with a scale
+/// shift where some light is far), then per light, per material its Phong
+/// terms. Returns their FB addresses and whether lights carry a shift.
+fn lights(
+    w: &mut W,
+    scene: &Scene,
+    mats: &[crate::scene::Material],
+    frac: u32,
+    xb: u32,
+) -> Result<(Vec<usize>, Vec<usize>, bool), String> {
+    let nl = scene.lights.len().max(1) as f64;
+    let m = extent(scene);
+    let mut shifts = Vec::new();
+    for l in &scene.lights {
+        shifts.push(light_shift_w(l.position, m, frac, xb).ok_or_else(|| {
+            format!(
+                "light at {:?} too far from the scene for the format's differences",
+                l.position.to_array()
+            )
+        })?);
+    }
+    let light_shifted = shifts.iter().any(|&k| k > 0);
+    let mut lights = Vec::new();
+    for (l, &k) in scene.lights.iter().zip(&shifts) {
+        lights.push(w.fb.len());
+        if light_shifted {
+            w.raw(k as i64);
+        }
+        w.point(l.position * (-(k as f64)).exp2());
+    }
+    let mut shades = Vec::new();
+    for l in &scene.lights {
+        shades.push(w.fb.len());
+        let lc = l.color.unwrap_or(Vec3::ONE * (1.0 / nl.sqrt()));
+        for (i, mt) in mats.iter().enumerate() {
+            w.raw(i as i64);
+            let (_, f) = split_shine(mt.shine);
+            if f > 0.0 {
+                w.push(f * w.one());
+                w.push((1.0 - f) * w.one());
+            }
+            // Per channel: kd c lc, then ks lc (the kernel's read order).
+            let k = mt.color.mul_elem(lc) * mt.kd;
+            let sp = lc * mt.ks;
+            for c in 0..3 {
+                w.col(k.axis(c));
+                w.col(sp.axis(c));
+            }
+        }
+    }
+    Ok((lights, shades, light_shifted))
+}
+
+/// What every node format's [`Layout`] shares (the part laid out before
+/// the BSP nodes).
+pub(super) struct Finish {
+    frac: u32,
+    eye: usize,
+    post: usize,
+    transmit: usize,
+    transmit_materials: usize,
+    refract: bool,
+    lights: Vec<usize>,
+    shades: Vec<usize>,
+    objects: usize,
+    materials: usize,
+    shines: Vec<(u32, f64)>,
+    kd: u32,
+    fit: Fit,
+    light_shifted: bool,
+    node_layout: NodeLayout,
+    traversal: Traversal,
+    root_box: usize,
+    collapse: super::Collapse,
+    /// Per scene object, the array cycles of its test (kernel contexts and
+    /// the TinyRISC loop around them).
+    cost: Vec<f64>,
+}
+
+impl Finish {
+    #[allow(clippy::too_many_arguments)]
+    pub(super) fn layout(
+        self,
+        fb: Vec<i32>,
+        types: Vec<TypeInfo>,
+        root: usize,
+        node_words: usize,
+        resident_words: usize,
+        resident_node_words: usize,
+        mailbox: usize,
+        stream: Option<Stream>,
+    ) -> Layout {
+        Layout {
+            fb,
+            frac: self.frac,
+            eye: self.eye,
+            post: self.post,
+            transmit: self.transmit,
+            transmit_materials: self.transmit_materials,
+            refract: self.refract,
+            lights: self.lights,
+            shades: self.shades,
+            types,
+            root,
+            node_words,
+            node_layout: self.node_layout,
+            traversal: self.traversal,
+            root_box: self.root_box,
+            root_leaf: false,
+            expected_cost: 0.0,
+            resident_words,
+            resident_node_words,
+            mailbox,
+            objects: self.objects,
+            materials: self.materials,
+            shines: self.shines,
+            kd: self.kd,
+            fit: self.fit,
+            fine_normals: self.fit.fine_normals,
+            light_shifted: self.light_shifted,
+            stream,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tables against the functions they sample.
+    #[test]
+    fn tables_match_their_definitions() {
+        let rsq = rsq_table(128);
+        for (k, &y) in rsq.iter().enumerate().skip(8) {
+            let x = (k as f64 + 0.5) * 256.0 / 2048.0;
+            assert!((y as f64 / 16384.0 - 1.0 / x.sqrt()).abs() < 1e-4);
+        }
+        let rcp = rcp_table(128);
+        for (k, &r) in rcp.iter().enumerate() {
+            assert!(r > 16384 && r < 32768, "{k}");
+        }
+    }
+}

@@ -1,0 +1,419 @@
+//! Open cylinder with optional end caps (`tb/src/reference/shapes.rs`:
+//! `cone` with equal radii; the caps `disc`).
+//!
+//! **Record**: a caps flag (`CYL_CAPS`), the body (`CYL_BODY`), then the
+//! two caps as disc records ([`super::planar`], `CYL_CAP0`, `CYL_CAP1`)
+//! whether or not the flag is set. The body (36 words): `B.xyz, e1.xyz,
+//! b1, e2.xyz, b2, e1.xyz, e2.xyz, invr, r, sg, B.xyz, a.xyz, H+2, sg, (e1,
+//! e2) x, (e1, e2) y, (e1, e2) z, obj, mat` (e1, e2, a an orthonormal
+//! frame, a along the axis, B the base centre rounded to the LSB and `b1`,
+//! `b2` what the rounding left of it along e1 and e2 in 2^-14 LSB, H the
+//! height, scene units; `r` with `EP_CYL` extra fraction bits, `invr =
+//! 2^(14+KS_CYL) / r` of the unrounded radius). With coarse normals the
+//! body has no `b1`, `b2` (34 words), `r` is rounded to the LSB and `invr`
+//! is of that. A glass cylinder's record holds the body twice (`sg`, then
+//! `-sg`: `GCYL_INNER`) before its caps (`GCYL_CAP0`, `GCYL_CAP1`).
+//!
+//! **Method**: in the plane across the axis the ray is a 2D ray: its
+//! direction `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D
+//! problem is the sphere's perpendicular method, and `t = tau / |d2|`;
+//! the hit's axial coordinate must lie in `[-2, H + 2]` LSB. The
+//! perpendicular vector keeps `EP_CYL` extra fraction bits, formed (fine
+//! normals) from the unrounded `(B - o).e1`, `(B - o).e2` (the rounding
+//! remainders of the projections and of B added back in the accumulator)
+//! and made perpendicular to the 2D direction; the normal `n2 = -(sg p2 /
+//! r + sqrt(s) d2n)` across the axis follows from it without the hit
+//! point, `n = n2.x e1 + n2.y e2`.
+//!
+//! **Two-sided** (a transmitting cylinder): one run per copy of the body
+//! ([`Body::Outer`], [`Body::Inner`]: the far root, normal turned inwards,
+//! a back hit); both accept a root only more than `SELF_LSB` ahead along
+//! the ray (a ray starting on the surface, however rounded, does not hit
+//! it there again); the caps are two-sided discs.
+//!
+//! **Registers**: r1..r7 the ray (r7 the new `tbest` where F); r8..r15
+//! temporaries; RAM `TMP0..TMP6`.
+//!
+//! **Error** against the f64 cylinder (`tb/tests/kernels.rs`): `t` within
+//! 3 LSB, the normal within 0.03; fine normals beat coarse ones on a thin
+//! cylinder.
+
+use super::super::emit::{at, define, Code, K, R1, R2, R3, R7};
+use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
+use super::super::memory_map::ram;
+use super::planar::{self, Inside, Planar};
+use super::{commit_obj_mat, kaddr, klen, perpendicular, self_margin, Body, Fit, Gen, Sides};
+use crate::scene::Vec3;
+use crate::tracer::layout::{Fitter, W};
+
+/// Words of the body, fine and coarse normals.
+pub const BODY_WORDS: usize = 36;
+pub const BODY_WORDS_COARSE: usize = 34;
+
+/// Words of a body.
+pub const fn body_words(fine_normals: bool) -> usize {
+    if fine_normals {
+        BODY_WORDS
+    } else {
+        BODY_WORDS_COARSE
+    }
+}
+
+/// Words of a record: caps flag, body (twice for a glass cylinder), caps.
+pub fn words(fit: &Fit, s: Sides) -> usize {
+    let bodies = if s == Sides::Both { 2 } else { 1 };
+    1 + bodies * body_words(fit.fine_normals) + 2 * planar::WORDS
+}
+
+/// The record's fields the broadcast addresses (header lines).
+pub fn header(fit: &Fit, types_sides: &[Sides]) -> Vec<String> {
+    let body = body_words(fit.fine_normals);
+    let mut v = vec![
+        define("CYL_CAPS", 0, "cylinder record: caps flag"),
+        define("CYL_BODY", 1, "cylinder record: the body's stream"),
+    ];
+    if types_sides.contains(&Sides::Front) {
+        v.push(define(
+            "CYL_CAP0",
+            1 + body,
+            "cylinder record: base cap (a disc)",
+        ));
+        v.push(define(
+            "CYL_CAP1",
+            1 + body + planar::WORDS,
+            "cylinder record: apex cap",
+        ));
+    }
+    if types_sides.contains(&Sides::Both) {
+        v.push(define(
+            "GCYL_INNER",
+            1 + body,
+            "glass cylinder record: the inner body",
+        ));
+        v.push(define(
+            "GCYL_CAP0",
+            1 + 2 * body,
+            "glass cylinder record: base cap",
+        ));
+        v.push(define(
+            "GCYL_CAP1",
+            1 + 2 * body + planar::WORDS,
+            "glass cylinder record: apex cap",
+        ));
+    }
+    v
+}
+
+fn body_name(b: Body) -> &'static str {
+    match b {
+        Body::Opaque => "k_cyl",
+        Body::Outer => "k_gcylf",
+        Body::Inner => "k_gcylb",
+    }
+}
+
+/// The kernels of a cylinder's test, in load order: the body run(s), the
+/// caps' disc.
+pub fn kernels(g: &Gen, s: Sides) -> Vec<(&'static str, K)> {
+    let cap = planar::kernel_name(Inside::Disc, s);
+    match s {
+        Sides::Front => vec![
+            (body_name(Body::Opaque), kernel(g, Body::Opaque)),
+            (cap, planar::kernel(g, Inside::Disc, s)),
+        ],
+        Sides::Both => vec![
+            (body_name(Body::Outer), kernel(g, Body::Outer)),
+            (body_name(Body::Inner), kernel(g, Body::Inner)),
+            (cap, planar::kernel(g, Inside::Disc, s)),
+        ],
+    }
+}
+
+/// The scale shifts of the cylinders: `(KS_CYL, EP_CYL)` from the
+/// cylinders' radii in LSB and the largest base radius of every cone-like
+/// object (cylinders and cones).
+pub(crate) fn fit(
+    radii: impl Iterator<Item = f64>,
+    all_base_radii: impl Iterator<Item = f64>,
+    f: &Fitter,
+) -> (u32, u32) {
+    let r_min = radii.fold(f64::INFINITY, f64::min);
+    let r_max = all_base_radii.fold(1.0f64, f64::max);
+    (f.ks(r_min), f.shift(2.0 * r_max, 4))
+}
+
+/// The caps of a cylinder from `base` to `apex` of radius `r`, as discs.
+pub fn caps(base: Vec3, apex: Vec3, r: f64) -> [Planar; 2] {
+    let a = (apex - base).normalized();
+    let e1 = perpendicular(a);
+    let e2 = a.cross(e1);
+    [
+        Planar::disc(base, e1, e2, r, -a),
+        Planar::disc(apex, e1, e2, r, a),
+    ]
+}
+
+/// Write the record of a cylinder (its caps from [`caps`]).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn write(
+    w: &mut W,
+    fit: &Fit,
+    sides: Sides,
+    base: Vec3,
+    apex: Vec3,
+    radius: f64,
+    inside: bool,
+    caps_on: bool,
+    caps: &[Planar; 2],
+    id: usize,
+    mat: usize,
+) {
+    let s = w.s;
+    let axis = apex - base;
+    let h = axis.length();
+    let av = axis * (1.0 / h);
+    let e1 = perpendicular(av);
+    let e2 = av.cross(e1);
+    let rs = radius.abs() * s;
+    // Fine normals: the radius with `ep` extra bits and its reciprocal
+    // unrounded; otherwise both of the rounded radius.
+    let rq = rs.round().max(1.0);
+    let invr = ((14 + w.x + fit.ks_cyl) as f64).exp2() / if fit.fine_normals { rs } else { rq };
+    // The base's rounding remainder along e1 and e2.
+    let bq = Vec3::from(base.to_array().map(|x| w.sat(x * s) as f64));
+    let brem = base * s - bq;
+    let sg = if inside { -1.0 } else { 1.0 };
+    w.raw(caps_on as i64);
+    // A transmitting cylinder: the body twice, the second seen from the
+    // other side.
+    let copies: &[f64] = if sides == Sides::Both {
+        &[1.0, -1.0]
+    } else {
+        &[1.0]
+    };
+    for &side in copies {
+        let sg = sg * side;
+        w.point(base);
+        w.unit(e1);
+        if fit.fine_normals {
+            w.push(brem.dot(e1) * w.one());
+        }
+        w.unit(e2);
+        if fit.fine_normals {
+            w.push(brem.dot(e2) * w.one());
+        }
+        w.unit(e1);
+        w.unit(e2);
+        w.push(invr);
+        if fit.fine_normals {
+            w.push(rs * (fit.ep_cyl as f64).exp2());
+        } else {
+            w.push(rq);
+        }
+        w.push(sg * w.one());
+        w.point(base);
+        w.unit(av);
+        w.raw((h * s).round() as i64 + 2);
+        w.push(sg * w.one());
+        for c in 0..3 {
+            w.push(e1.axis(c) * w.one());
+            w.push(e2.axis(c) * w.one());
+        }
+        w.raw(id as i64);
+        w.raw(mat as i64);
+    }
+    for p in caps {
+        let mut p = *p;
+        p.n = p.n * sg;
+        planar::write(w, &fit.kt, &p, id, mat);
+    }
+}
+
+/// One run of the cylinder body kernel.
+pub fn kernel(g: &Gen, body: Body) -> K {
+    let fine = g.fine_normals;
+    let nr = g.approx;
+    let mut k = K::new();
+    k.doc(&format!(
+        "{}: the open cylinder test of one body record (the stream){}.\n\
+         In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT{}.\n\
+         Across the axis: d2 = (d.e1, d.e2) normalised, p2 = oc2 - b d2n, s = 1 - |p2/r|^2,\n\
+         tau = b - sg r sqrt(s), t = tau / |d2|; the axial coordinate within [-2, H+2].",
+        body_name(body),
+        match body {
+            Body::Opaque => "",
+            Body::Outer => ", a glass cylinder's outer surface",
+            Body::Inner => ", a glass cylinder's inner surface (its second body)",
+        },
+        if body == Body::Opaque {
+            ""
+        } else {
+            ", HIT_BACK_OBJ"
+        },
+    ));
+    k.comment("oc = B - o, projected on e1, e2");
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    // oc2 = (oc.e1, oc.e2) rounded to LSB, and what the rounding left (in
+    // 2^-14 LSB, the accumulator's low half minus the rounded value's, exact
+    // below 2^13): added back when the perpendicular vector is formed, whose
+    // half-LSB error over a radius of a few dozen LSB would tilt the normal.
+    for (x, rem, t, tmp) in [(11, 14, 15, ram::TMP5), (12, 15, 13, ram::TMP6)] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r9")
+            .c(format!("mac r{x}, fb0, r10, >>Q14"));
+        if fine {
+            k.c(format!("accl r{rem}"))
+                .c(format!("sll r{t}, r{x}, #Q14"))
+                .c(format!("sub r{rem}, r{rem}, r{t}"))
+                .c(format!("add r{rem}, fb0, r{rem}"))
+                .c(format!("st r{rem}, [#{tmp}]"))
+                .note("the projection's remainder, plus B's");
+        }
+    }
+    k.c(format!("st r11, [#{}]", ram::TMP0))
+        .c(format!("st r12, [#{}]", ram::TMP1))
+        .note("oc2");
+    k.c("mul out, fb0, r4")
+        .c("mac out, fb0, r5")
+        .c("mac r8, fb0, r6, >>Q14");
+    k.c("mul out, fb0, r4")
+        .c("mac out, fb0, r5")
+        .c("mac r9, fb0, r6, >>Q14")
+        .note("d2 = (d.e1, d.e2)");
+    k.c("movb r10, #0");
+    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+    k.c("mov r10, r11")
+        .note("|d2|, Q.14")
+        .c(format!("st r8, [#{}]", ram::TMP2))
+        .c(format!("st r9, [#{}]", ram::TMP3))
+        .note("d2n");
+    k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
+        .c(format!("ld r12, [r0 + #{}]", ram::TMP1));
+    k.c("mul out, r11, r8")
+        .c("mac r13, r12, r9, >>Q14")
+        .note("b = oc2.d2n");
+    if fine {
+        k.c(format!("ld r14, [r0 + #{}]", ram::TMP5))
+            .c(format!("ld r15, [r0 + #{}]", ram::TMP6));
+    }
+    for (x, rem, d) in [(11, 14, 8), (12, 15, 9)] {
+        k.c(format!("ldacc r{x}, <<Q14"));
+        if fine {
+            k.c(format!("mac out, r{rem}, #1"));
+        }
+        k.c(format!("msu r{x}, r13, r{d}, >>Q14-EP_CYL"));
+    }
+    k.note("p2 = oc2 - b d2n");
+    if fine {
+        // p2 perpendicular to the 2D direction d2n
+        perpendicular_to(&mut k, &[11, 12], &[8, 9], 14);
+    }
+    k.c("mov r14, fb0")
+        .note("invr")
+        .c("mul r11, r11, r14, >>KS_CYL+EP_CYL")
+        .c("mul r12, r12, r14, >>KS_CYL+EP_CYL")
+        .c(format!("st r11, [#{}]", ram::TMP0))
+        .c(format!("st r12, [#{}]", ram::TMP1))
+        .note("p2/r");
+    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("ldacc r14, <<Q14")
+        .c("msu out, r11, r11")
+        .c("msu r15, r12, r12, >>Q14")
+        .note("s = 1 - |p2/r|^2")
+        .c("cmp.gt r15, #0")
+        .c("(f) cmp.gt r10, #0");
+    sqrt_q14(&mut k, 15, 8, [9, 11, 12, 14], nr);
+    k.c(format!("st r8, [#{}]", ram::TMP4));
+    let er = if fine { "+EP_CYL" } else { "" };
+    k.c("mov r9, fb0")
+        .c(format!("mul r9, r9, r8, >>Q14{er}"))
+        .note("h = r sqrt(s)")
+        .c("mov r11, fb0")
+        .c("mul r9, r9, r11, >>Q14")
+        .c("sub r9, r13, r9")
+        .note("tau = b - sg h")
+        .c("(f) cmp.gt r9, #0")
+        .c("ldacc r9, <<Q14")
+        .c("msu out, r7, r10")
+        .c("acch r11")
+        .c("(f) cmp.lt r11, #0")
+        .note("F: tau < tbest |d2|");
+    divide(&mut k, 9, 10, 9, [8, 11, 12, 13, 14], nr);
+    if body != Body::Opaque {
+        self_margin(&mut k, 8, g.datapath);
+        k.c("(f) cmp.gt r9, r8");
+    }
+    k.comment("axial coordinate of the hit");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 11 + i;
+        k.c(format!("ldacc r{o}, <<Q14"))
+            .c(format!("mac r{x}, r9, r{d}, >>Q14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("mul out, fb0, r11")
+        .c("mac out, fb0, r12")
+        .c("mac r14, fb0, r13, >>Q14")
+        .note("z");
+    k.c("(f) cmp.ge r14, #-2")
+        .c("mov r15, fb0")
+        .c("(f) cmp.le r14, r15")
+        .note("F: within the height");
+    k.comment("normal: n2 = -(sg p2 / r + sqrt(s) d2n) across the axis, n = n2.x e1 + n2.y e2");
+    k.c("(f) mov r7, r9")
+        .c("mov r15, fb0")
+        .c(format!("ld r8, [r0 + #{}]", ram::TMP4));
+    for (x, pn, dn) in [(11, ram::TMP0, ram::TMP2), (12, ram::TMP1, ram::TMP3)] {
+        k.c(format!("ld r{x}, [r0 + #{pn}]"))
+            .c(format!("ld r13, [r0 + #{dn}]"))
+            .c("mul out, r8, r13")
+            .c(format!("mac r{x}, r15, r{x}, >>Q14"))
+            .c(format!("neg r{x}, r{x}"));
+    }
+    for x in [13, 14, 15] {
+        k.c("mul out, fb0, r11")
+            .c(format!("mac r{x}, fb0, r12, >>Q14"));
+    }
+    for (i, x) in [13, 14, 15].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+    commit_obj_mat(&mut k, body);
+    k
+}
+
+/// Broadcast a cylinder's test (record at r7): the body (both runs for a
+/// glass cylinder), then the caps where its flag is set. Labels begin
+/// with `lbl`.
+pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides) {
+    let cap = planar::kernel_name(Inside::Disc, sides);
+    let nocap = format!("{lbl}_nocap");
+    let caps: [&str; 2] = match sides {
+        Sides::Front => {
+            let k = body_name(Body::Opaque);
+            t.li(R1, kaddr(k))
+                .addi(R2, R7, "CYL_BODY")
+                .sbcb(R1, R2, klen(k))
+                .c("the body");
+            ["CYL_CAP0", "CYL_CAP1"]
+        }
+        Sides::Both => {
+            let (f, b) = (body_name(Body::Outer), body_name(Body::Inner));
+            t.li(R1, kaddr(f))
+                .addi(R2, R7, "CYL_BODY")
+                .sbcb(R1, R2, klen(f))
+                .c("the body's outside")
+                .li(R1, kaddr(b))
+                .addi(R2, R7, "GCYL_INNER")
+                .sbcb(R1, R2, klen(b))
+                .c("its inside");
+            ["GCYL_CAP0", "GCYL_CAP1"]
+        }
+    };
+    t.lfb(R3, at("CYL_CAPS", R7)).beqz(R3, &nocap);
+    for c in caps {
+        t.li(R1, kaddr(cap)).addi(R2, R7, c).sbcb(R1, R2, klen(cap));
+    }
+    t.c("the caps");
+    t.label(nocap);
+}

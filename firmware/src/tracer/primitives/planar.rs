@@ -1,0 +1,293 @@
+//! The planar primitives: rectangle, triangle and disc (the caps of
+//! cylinders and cones), in `tb/src/reference/shapes.rs`: `rectangle`,
+//! `triangle`, `disc`. The polygon and the smooth triangle start with the
+//! same plane test ([`plane_hit`]).
+//!
+//! **Record** (20 words): `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz,
+//! n.xyz, obj, mat`, where `u = (P - v0).eu`, `w = (P - v0).ew` (the
+//! edge duals scaled by `2^KT_RECT`, `2^KT_TRI` or `2^KT_DISC`) are the
+//! barycentric or edge coordinates of the hit point in Q.14.
+//!
+//! **Method**: `den = -n.d > 0` (the front face), `num = -n.(v0 - o) > 0`;
+//! the test `num 2^14 < tbest den` is done in the accumulator before the
+//! division, so the quotient `t = num / den` always fits; then `u`, `w` of
+//! `P = o + t d` and the inside test, with a tolerance of `INSIDE_TOL`:
+//! triangle `u, w >= 0, u + w <= 1`; rectangle `0 <= u, w <= 1`; disc
+//! `u^2 + w^2 <= 1`.
+//!
+//! **Two-sided** ([`Sides::Both`], a transmitting object): where the plane
+//! is seen from its back `den` and `num` change sign, the normal turns to
+//! the ray and the hit is a back hit (`HIT_BACK_OBJ`); a ray leaving the
+//! object (`ORIG_OBJ`) does not hit it again (a distance margin would also
+//! drop the hits of rays starting near an edge on the next face).
+//!
+//! **Registers**: r1..r7 the ray (r7 the new `tbest` where F); r8..r15
+//! temporaries; RAM `TMP3` (two-sided: the back flag).
+//!
+//! **Error** against the f64 shapes (`tb/tests/kernels.rs`, 256 rays):
+//! `t` within 3 LSB (mean under 1.5), normal within 0.01; the largest `t`
+//! errors at grazing incidence, where the Q1.14 rounding of the direction
+//! is amplified.
+
+use super::super::emit::K;
+use super::super::math::divide;
+use super::super::memory_map::ram;
+use super::{commit_streamed_normal, commit_streamed_normal_two, Gen, Sides};
+use crate::scene::Vec3;
+use crate::tracer::layout::W;
+
+/// Record words.
+pub const WORDS: usize = 20;
+
+/// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
+pub const INSIDE_TOL: i32 = 2;
+
+/// Which inside test a planar kernel ends with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Inside {
+    /// Barycentric: u >= 0, w >= 0, u + w <= 1.
+    Triangle,
+    /// 0 <= u <= 1, 0 <= w <= 1.
+    Rectangle,
+    /// u^2 + w^2 <= 1 (a cylinder's end cap).
+    Disc,
+}
+
+impl Inside {
+    /// Index of the kind's scale shift in `Fit::kt`.
+    pub fn kt_index(self) -> usize {
+        match self {
+            Inside::Rectangle => 0,
+            Inside::Triangle => 1,
+            Inside::Disc => 2,
+        }
+    }
+    /// The header's name of the kind's scale shift.
+    fn kt_name(self) -> &'static str {
+        match self {
+            Inside::Rectangle => "KT_RECT",
+            Inside::Triangle => "KT_TRI",
+            Inside::Disc => "KT_DISC",
+        }
+    }
+}
+
+pub fn kernel_name(i: Inside, s: Sides) -> &'static str {
+    match (i, s) {
+        (Inside::Rectangle, Sides::Front) => "k_rect",
+        (Inside::Triangle, Sides::Front) => "k_tri",
+        (Inside::Disc, Sides::Front) => "k_disc",
+        (Inside::Rectangle, Sides::Both) => "k_grect",
+        (Inside::Triangle, Sides::Both) => "k_gtri",
+        (Inside::Disc, Sides::Both) => "k_gdisc",
+    }
+}
+
+/// A planar record's geometry: normal, origin vertex, edge duals.
+#[derive(Clone, Copy, Debug)]
+pub struct Planar {
+    pub n: Vec3,
+    pub v0: Vec3,
+    pub eu: Vec3,
+    pub ew: Vec3,
+    pub kind: Inside,
+}
+
+impl Planar {
+    /// A triangle `a, b, c` with normal `n`.
+    pub fn triangle(a: Vec3, b: Vec3, c: Vec3, n: Vec3) -> Planar {
+        let (e1, e2) = (b - a, c - a);
+        let x = e2.cross(n);
+        let y = n.cross(e1);
+        let (dx, dy) = (e1.dot(x), e2.dot(y));
+        if dx.abs() < 1e-300 || dy.abs() < 1e-300 {
+            // Degenerate: a record that never hits (zero normal).
+            return Planar::never(a, Inside::Triangle);
+        }
+        Planar {
+            n,
+            v0: a,
+            eu: x * (1.0 / dx),
+            ew: y * (1.0 / dy),
+            kind: Inside::Triangle,
+        }
+    }
+
+    /// A rectangle from `corner` along `e1`, `e2`.
+    pub fn rectangle(corner: Vec3, e1: Vec3, e2: Vec3, n: Vec3) -> Planar {
+        Planar {
+            n,
+            v0: corner,
+            eu: e1 * (1.0 / e1.dot(e1)),
+            ew: e2 * (1.0 / e2.dot(e2)),
+            kind: Inside::Rectangle,
+        }
+    }
+
+    /// A disc of radius `r` about `center`, spanned by the unit `e1`, `e2`.
+    pub fn disc(center: Vec3, e1: Vec3, e2: Vec3, r: f64, n: Vec3) -> Planar {
+        Planar {
+            n,
+            v0: center,
+            eu: e1 * (1.0 / r),
+            ew: e2 * (1.0 / r),
+            kind: Inside::Disc,
+        }
+    }
+
+    /// A record that never hits (zero normal): a degenerate triangle, the
+    /// tip of a pointed cone.
+    pub fn never(at: Vec3, kind: Inside) -> Planar {
+        Planar {
+            n: Vec3::ZERO,
+            v0: at,
+            eu: Vec3::ZERO,
+            ew: Vec3::ZERO,
+            kind,
+        }
+    }
+
+    /// The largest component of the edge duals as the record holds them
+    /// before the kind's scale shift (for the fit of `KT_*`).
+    pub fn dual_max(&self, w_frac: i32) -> f64 {
+        self.eu
+            .to_array()
+            .into_iter()
+            .chain(self.ew.to_array())
+            .map(|x| x.abs() * (w_frac as f64).exp2())
+            .fold(0.0, f64::max)
+    }
+}
+
+/// Write the record of planar `p` (object `id`, material `mat`); `kt`:
+/// the scale shifts of [`super::Fit::kt`].
+pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize) {
+    let k = kt[p.kind.kt_index()];
+    let sc = ((14 + w.x) as f64 - w.frac as f64 + k as f64).exp2();
+    w.unit(p.n);
+    w.point(p.v0);
+    w.point(p.v0);
+    w.scaled(p.eu, sc);
+    w.scaled(p.ew, sc);
+    w.unit(p.n);
+    w.raw(id as i64);
+    w.raw(mat as i64);
+}
+
+/// The ray-plane part shared by the planar, polygon and smooth triangle
+/// kernels: reads the plane normal and a vertex from the stream, and
+/// leaves `t = num / den` in r9 with F set where the plane is hit in
+/// front (two-sided: on either side, `TMP3` = 1 on the back), closer than
+/// `tbest`.
+pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides) {
+    k.comment("den = -n.d, num = -n.(v0 - o)");
+    k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .c("mac r11, r10, r6, >>Q14");
+    k.c("sub r12, fb0, r1")
+        .c("sub r13, fb0, r2")
+        .c("sub r14, fb0, r3");
+    k.c("mul out, r8, r12")
+        .c("mac out, r9, r13")
+        .c("mac r15, r10, r14, >>Q14");
+    k.c("neg r11, r11").c("neg r15, r15");
+    if sides == Sides::Both {
+        k.c("movb r12, #0")
+            .c("cmp.lt r11, #0")
+            .note("the back: den and num change sign")
+            .c("(f) movb r12, #1")
+            .c("(f) neg r11, r11")
+            .c("(f) neg r15, r15")
+            .c(format!("st r12, [#{}]", ram::TMP3))
+            .note("1: a back hit");
+    }
+    k.c("cmp.gt r11, #0")
+        .c("(f) cmp.gt r15, #0")
+        .c("ldacc r15, <<Q14")
+        .c("msu out, r7, r11")
+        .c("acch r8")
+        .c("(f) cmp.lt r8, #0")
+        .note("F: num 2^14 < tbest den, t fits");
+    divide(k, 15, 11, 9, [8, 10, 12, 13, 14], g.approx);
+}
+
+/// After [`plane_hit`]: the hit point relative to `v0` (the stream's
+/// `v0.xyz`), its coordinates `u` (r13), `w` (r14) along the record's dual
+/// edge vectors, and F kept only where they are inside the primitive
+/// (`u + w` in r15 for a triangle), with a tolerance of [`INSIDE_TOL`].
+pub fn inside_test(k: &mut K, inside: Inside) {
+    let kt = inside.kt_name();
+    k.comment("P - v0");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let x = 10 + i;
+        k.c(format!("ldacc r{o}, <<Q14"))
+            .c(format!("mac r{x}, r9, r{d}, >>Q14"))
+            .c(format!("rsb r{x}, fb0, r{x}"));
+    }
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r13, fb0, r12, >>{kt}"))
+        .note("u");
+    k.c("mul out, fb0, r10")
+        .c("mac out, fb0, r11")
+        .c(format!("mac r14, fb0, r12, >>{kt}"))
+        .note("w");
+    k.c(format!("ld r8, [r0 + #{}]", ram::C_ONE))
+        .c("add r8, r8, #INSIDE_TOL");
+    match inside {
+        Inside::Triangle => {
+            k.c("(f) cmp.ge r13, #-INSIDE_TOL")
+                .c("(f) cmp.ge r14, #-INSIDE_TOL")
+                .c("adds r15, r13, r14")
+                .c("(f) cmp.le r15, r8")
+                .note("F: inside the triangle");
+        }
+        Inside::Rectangle => {
+            k.c("(f) cmp.ge r13, #-INSIDE_TOL")
+                .c("(f) cmp.ge r14, #-INSIDE_TOL")
+                .c("(f) cmp.le r13, r8")
+                .c("(f) cmp.le r14, r8")
+                .note("F: inside the rectangle");
+        }
+        Inside::Disc => {
+            k.c("mul out, r13, r13")
+                .c("mac r15, r14, r14, >>Q14")
+                .c("(f) cmp.le r15, r8")
+                .note("F: inside the disc");
+        }
+    }
+}
+
+/// The kernel of a planar primitive.
+pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
+    let mut k = K::new();
+    k.doc(&format!(
+        "{}: the {} test of one record (the stream){}.\n\
+         In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT{}.\n\
+         t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew",
+        kernel_name(inside, sides),
+        match inside {
+            Inside::Rectangle => "rectangle",
+            Inside::Triangle => "triangle",
+            Inside::Disc => "disc",
+        },
+        if sides == Sides::Both {
+            ", seen from either side"
+        } else {
+            ""
+        },
+        if sides == Sides::Both {
+            ", HIT_BACK_OBJ"
+        } else {
+            ""
+        },
+    ));
+    plane_hit(&mut k, g, sides);
+    inside_test(&mut k, inside);
+    match sides {
+        Sides::Front => commit_streamed_normal(&mut k, 9),
+        Sides::Both => commit_streamed_normal_two(&mut k, 9),
+    }
+    k
+}

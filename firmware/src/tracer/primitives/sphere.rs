@@ -1,0 +1,241 @@
+//! Sphere (`tb/src/reference/shapes.rs`: `sphere`).
+//!
+//! **Record** (8 words): `c.xyz, r, invr, sg, obj, mat`, with `invr =
+//! 2^(14+KS_SPHERE) / r` (scene LSBs) and `sg` = +1 (Q1.14) for a sphere
+//! seen from outside, -1 for NFF's inside-visible sphere. Fine records
+//! (11 words, where the smallest sphere is under [`FINE_BELOW_LSB`] LSB in
+//! radius): `c.xyz, cl.xyz, r, invr, sg, obj, mat`, with the centre's
+//! rounding remainder `cl` in units of 2^-14 LSB and `r` with `EP_SPHERE`
+//! extra fraction bits: spheres a few LSB across, whose rounded centre
+//! and radius would move their silhouettes and shadows by a sizeable part
+//! of their size.
+//!
+//! **Method** (perpendicular, no hit point needed for the normal):
+//! `b = (c - o).d`, `p = (c - o) - b d` kept with `EP_SPHERE` extra
+//! fraction bits (it saturates only beyond twice the largest radius, which
+//! is a miss); only `p / r` is squared: `s = 1 - |p / r|^2`,
+//! `t = b - sg r sqrt(s)`, `n = -(sg p / r + sqrt(s) d)`. With a fine
+//! record, `p` is formed in the accumulator from the unrounded centre:
+//! `p = (c - o) + cl - b d` to 2^-EP_SPHERE LSB. With fine normals `p` is
+//! then made perpendicular to `d` ([`perpendicular_to`], which also takes
+//! out what `b`'s rounding left along `d`); with a fine record and coarse
+//! normals `b`'s remainder below an LSB is read back with `accl` and taken
+//! out along `d` instead.
+//!
+//! **Two-sided** (a transmitting sphere, [`Sides::Both`]): where the near
+//! root is not ahead of the ray by more than `SELF_LSB` the far root, the
+//! normal turned to the ray; a far-side hit records the object in
+//! `HIT_BACK_OBJ`.
+//!
+//! **Registers**: r1..r7 the ray (kept but r7, which becomes the new
+//! `tbest` where F); r8..r15 temporaries; RAM `TMP0..TMP3`.
+//!
+//! **Error** against the f64 sphere (`tb/tests/kernels.rs`, 256 rays, the
+//! default scene's Q5.10): `t` within 3 LSB at most (mean under 1.5), the
+//! normal within 0.03; a sphere 6 LSB in radius with a fine record within
+//! 2 LSB and 0.1.
+
+use super::super::emit::K;
+use super::super::math::{perpendicular_to, sqrt_q14};
+use super::super::memory_map::ram;
+use super::{self_margin, Fit, Gen, Sides};
+use crate::scene::Vec3;
+use crate::tracer::layout::{Fitter, W};
+
+/// Record words, coarse and fine.
+pub const WORDS: usize = 8;
+pub const FINE_WORDS: usize = 11;
+
+/// Spheres get the fine record when the smallest is under this many LSB in
+/// radius (the rounding of the centre, up to 0.87 LSB, is then over 1.4% of
+/// the radius).
+pub const FINE_BELOW_LSB: f64 = 64.0;
+
+/// Words of a record.
+pub fn words(fit: &Fit) -> usize {
+    if fit.sphere_fine {
+        FINE_WORDS
+    } else {
+        WORDS
+    }
+}
+
+pub fn kernel_name(s: Sides) -> &'static str {
+    match s {
+        Sides::Front => "k_sphere",
+        Sides::Both => "k_gsphere",
+    }
+}
+
+/// The scale shifts of the spheres of the scene, whose radii in LSB are
+/// `radii`: `(KS_SPHERE, EP_SPHERE, fine record)`.
+pub(crate) fn fit(radii: impl Iterator<Item = f64> + Clone, f: &Fitter) -> (u32, u32, bool) {
+    let r_min = radii.clone().fold(f64::INFINITY, f64::min);
+    let r_max = radii.fold(1.0f64, f64::max);
+    // Extra fraction bits of the perpendicular vector: up to 4, as long as
+    // twice the largest radius still fits.
+    (f.ks(r_min), f.shift(2.0 * r_max, 4), r_min < FINE_BELOW_LSB)
+}
+
+/// Write the record of a sphere (object `id`, material `mat`).
+/// `unrounded`: `invr` of the unrounded radius (the streamed layout's
+/// format; fine records always).
+pub(crate) fn write(
+    w: &mut W,
+    fit: &Fit,
+    unrounded: bool,
+    center: Vec3,
+    radius: f64,
+    inside: bool,
+    id: usize,
+    mat: usize,
+) {
+    let s = w.s;
+    let rq = (radius.abs() * s).round().max(1.0);
+    let invr = ((14 + w.x + fit.ks_sphere) as f64).exp2()
+        / if unrounded || fit.sphere_fine {
+            radius.abs() * s
+        } else {
+            rq
+        };
+    let sg = if inside { -1.0 } else { 1.0 };
+    w.point(center);
+    if fit.sphere_fine {
+        for x in center.to_array() {
+            let hi = w.sat(x * s) as f64;
+            w.push((x * s - hi) * w.one());
+        }
+        w.push(radius.abs() * s * (fit.ep_sphere as f64).exp2());
+    } else {
+        w.push(rq);
+    }
+    w.push(invr);
+    w.push(sg * w.one());
+    w.raw(id as i64);
+    w.raw(mat as i64);
+}
+
+/// The sphere kernel for records of `fit` and the sides `sides`.
+pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
+    let (fine, perp, two) = (fit.sphere_fine, g.fine_normals, sides == Sides::Both);
+    let nr = g.approx;
+    let mut k = K::new();
+    k.doc(&format!(
+        "{}: the sphere test of one record (the stream), for every awake ray.\n\
+         In: r1..r3 o, r4..r6 d, r7 tbest. Out where F (a nearer hit): r7 = t, HIT_N, HIT_OBJ, HIT_MAT{}.\n\
+         b = (c - o).d, p = (c - o) - b d, s = 1 - |p/r|^2, t = b - sg r sqrt(s), n = -(sg p/r + sqrt(s) d)",
+        kernel_name(sides),
+        if two { ", HIT_BACK_OBJ (the far side)" } else { "" }
+    ));
+    k.comment("oc = c - o");
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .c("mac r11, r10, r6, >>Q14")
+        .note("b = oc.d");
+    if fine && !perp {
+        // b's remainder: the accumulator minus round(b) 2^14, below 2^13
+        // in magnitude, so its low half is exact (the wrap is intended).
+        k.c("accl r12")
+            .c("sll r14, r11, #Q14")
+            .c("sub r12, r12, r14")
+            .note("b's remainder below an LSB");
+    }
+    k.comment("p = oc - b d, with EP_SPHERE more fraction bits");
+    for (x, d) in [(8, 4), (9, 5), (10, 6)] {
+        if fine && !perp {
+            k.c(format!("mul r13, r12, r{d}, >>Q14"))
+                .c(format!("ldacc r{x}, <<Q14"))
+                .c("mac out, fb0, #1")
+                .c("msu out, r13, #1");
+        } else {
+            k.c(format!("ldacc r{x}, <<Q14"));
+            if fine {
+                k.c("mac out, fb0, #1").note("+ the centre's remainder");
+            }
+        }
+        k.c(format!("msu r{x}, r11, r{d}, >>Q14-EP_SPHERE"));
+    }
+    if perp {
+        perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
+    }
+    let er = if fine { "+EP_SPHERE" } else { "" };
+    k.c("mov r12, fb0").note("r").c("mov r13, fb0").note("invr");
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        k.c(format!("mul r{x}, r{x}, r13, >>KS_SPHERE+EP_SPHERE"))
+            .c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
+    }
+    k.note("p/r in TMP0..2");
+    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("ldacc r14, <<Q14")
+        .c("msu out, r8, r8")
+        .c("msu out, r9, r9")
+        .c("msu r15, r10, r10, >>Q14")
+        .note("s = 1 - |p/r|^2")
+        .c("cmp.gt r15, #0")
+        .note("F: the line meets the sphere");
+    sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
+    if two {
+        k.c(format!("mul r9, r12, r8, >>Q14{er}"))
+            .note("h = r sqrt(s)")
+            .c("mov r10, fb0")
+            .note("sg")
+            .c("mul r14, r9, r10, >>Q14")
+            .c("sub r9, r11, r14")
+            .note("t1 = b - sg h")
+            .c("movb r15, #0")
+            .c("(f) movb r15, #1")
+            .c("movb r12, #0");
+        self_margin(&mut k, 13, g.datapath);
+        k.c("cmp.le r9, r13")
+            .c("(f) add r9, r11, r14")
+            .note("not ahead: t2 = b + sg h, the far side")
+            .c("(f) neg r10, r10")
+            .c("(f) movb r12, #1")
+            .c(format!("st r12, [#{}]", ram::TMP3))
+            .c("cmp.ne r15, #0")
+            .c("(f) cmp.gt r9, r13")
+            .c("(f) cmp.lt r9, r7")
+            .note("F: a hit ahead, nearer than tbest");
+    } else {
+        k.c(format!("mul r9, r12, r8, >>Q14{er}"))
+            .note("h = r sqrt(s)")
+            .c("mov r10, fb0")
+            .note("sg")
+            .c("mul r9, r9, r10, >>Q14")
+            .c("sub r9, r11, r9")
+            .note("t = b - sg h")
+            .c("(f) cmp.gt r9, #0")
+            .c("(f) cmp.lt r9, r7")
+            .note("F: a hit ahead, nearer than tbest");
+    }
+    k.comment("normal = -(sg p/r + sqrt(s) d)");
+    for (i, (x, d)) in [(11, 4), (12, 5), (13, 6)].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP0 + i as u32))
+            .c(format!("mul out, r8, r{d}"))
+            .c(format!("mac r{x}, r10, r{x}, >>Q14"))
+            .c(format!("neg r{x}, r{x}"));
+    }
+    k.c("(f) mov r7, r9");
+    for (i, x) in [11, 12, 13].into_iter().enumerate() {
+        k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+    if two {
+        // HIT_BACK_OBJ = obj where the far side was hit, else -1.
+        k.c("mov r8, fb0")
+            .c(format!("(f) st r8, [#{}]", ram::HIT_OBJ))
+            .c(format!("ld r9, [r0 + #{}]", ram::TMP3))
+            .c("neg r9, r9")
+            .c("add r13, r8, #1")
+            .c("and r13, r13, r9")
+            .c("sub r13, r13, #1")
+            .c(format!("(f) st r13, [#{}]", ram::HIT_BACK_OBJ))
+            .note("obj on a far-side hit, else -1");
+    } else {
+        k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
+    }
+    k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+    k
+}

@@ -1,0 +1,743 @@
+//! The whole assembly source of one build: a header naming every number
+//! the program uses (formats, the scene's fitted shifts, main memory, the
+//! FB image and its records, the RC RAM map), TinyRISC's data and code
+//! (the tile loop, [`super::tiles`]; the traversal,
+//! [`super::traversal`]), and the RC kernels in context memory.
+
+use super::emit::{define, Code, K};
+use super::layout::{Layout, STREAM_BANK};
+use super::memory_map::{format_lines, ram_lines};
+use super::primitives::{self, ChipType, Gen};
+use super::{mem, shading, tiles, traversal, NodeLayout, Numerics, Options, Traversal};
+use crate::scene::Scene;
+
+/// The program of one build.
+pub struct Program {
+    pub source: String,
+    pub context_words: usize,
+    pub kernels: Vec<(String, usize)>,
+}
+
+/// Output banks of FB set 1 (alternating, so DMA drains one while the next
+/// tile is written to the other).
+pub const OUT_BANK: [u32; 2] = [0x8000, 0xC000];
+
+/// The program for `lay` (the scene laid out for `opt`).
+pub fn program(
+    scene: &Scene,
+    lay: &Layout,
+    opt: &Options,
+    nm: &Numerics,
+    tw: u32,
+    th: u32,
+) -> Result<Program, String> {
+    let g = Gen {
+        datapath: opt.datapath,
+        approx: nm.approx(),
+        fine_normals: lay.fine_normals,
+    };
+    let kernels = kernels(lay, opt, nm, &g, tw, th);
+    let mut s = header(scene, lay, opt, nm, tw, th);
+    s.push_str(&data(lay));
+    let mut t = Code::new();
+    t.directive(".text");
+    tiles::main(&mut t, lay, opt.depth);
+    match (lay.traversal, lay.stream.is_some()) {
+        (Traversal::Packet, _) => traversal::packet::trace(&mut t, lay),
+        (Traversal::Paper, false) => traversal::paper::trace(&mut t, lay),
+        (Traversal::Paper, true) => traversal::streamed::trace(&mut t, lay),
+    }
+    s.push_str(&t.text());
+    s.push_str("\n; ==== RC context kernels (context memory) ====\n");
+    s.push_str("        .ctx\n        .org CTXBASE\n");
+    let mut names = Vec::new();
+    let mut words = 0usize;
+    for (n, k) in &kernels {
+        s.push('\n');
+        s.push_str(&k.text(n));
+        names.push((n.clone(), k.len()));
+        words += k.len();
+    }
+    s.push_str("ctx_end:\n");
+    if words > 8192 {
+        return Err(format!(
+            "the kernels need {words} context words; the context memory holds 8192"
+        ));
+    }
+    Ok(Program {
+        source: s,
+        context_words: words,
+        kernels: names,
+    })
+}
+
+/// Every kernel of the program, in load order (the row-mode group first:
+/// it must be 8-aligned).
+fn kernels(
+    lay: &Layout,
+    opt: &Options,
+    nm: &Numerics,
+    g: &Gen,
+    tw: u32,
+    th: u32,
+) -> Vec<(String, K)> {
+    let _ = (tw, th);
+    let packet = lay.traversal == Traversal::Packet;
+    let mut init = shading::init();
+    if packet {
+        traversal::packet::init_ram(&mut init);
+    }
+    let mut v: Vec<(String, K)> = vec![
+        ("k_rows".into(), shading::rows()),
+        ("k_init".into(), init),
+        ("k_lanes".into(), shading::lanes()),
+        ("k_wake".into(), shading::wake_restore(packet)),
+    ];
+    for a in 0..3u8 {
+        v.push((format!("k_sign{a}"), traversal::sign(a)));
+    }
+    if packet {
+        v.extend(traversal::packet::kernels(nm.approx()));
+    } else {
+        v.extend(traversal::paper::kernels());
+    }
+    // Smooth triangles: the shading normal and the reflection's fallback.
+    let smooth = lay.types.iter().any(|x| {
+        matches!(
+            x.ty,
+            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle
+        )
+    });
+    v.push(("k_eye".into(), shading::eye(nm.approx(), lay.refract)));
+    v.push((
+        "k_post0".into(),
+        shading::post(true, lay.materials, smooth, lay.refract),
+    ));
+    v.push((
+        "k_post1".into(),
+        shading::post(false, lay.materials, smooth, lay.refract),
+    ));
+    v.push((
+        "k_light".into(),
+        shading::light_setup(nm.approx(), lay.light_shifted),
+    ));
+    v.push(("k_shade".into(), shading::shade(&lay.shines)));
+    for i in 0..4 {
+        v.push((format!("k_out{i}"), shading::out_word(i)));
+    }
+    v.push((
+        "k_strow".into(),
+        shading::store_lane("k_strow", super::memory_map::ram::LANE_ROW),
+    ));
+    v.push((
+        "k_stcol".into(),
+        shading::store_lane("k_stcol", super::memory_map::ram::LANE_COL),
+    ));
+    for l in 0..opt.depth.saturating_sub(1) {
+        v.push((format!("k_refl{l}"), shading::reflect_setup(l, smooth)));
+        v.push((format!("k_pop{l}"), shading::reflect_pop(l)));
+        if lay.refract {
+            v.push((
+                format!("k_tset{l}"),
+                shading::refract_prepare(l, lay.transmit_materials, nm.approx()),
+            ));
+            v.push((format!("k_refr{l}"), shading::refract_setup(l)));
+            v.push((format!("k_rpop{l}"), shading::refract_pop(l)));
+        }
+    }
+    if lay.stream.is_some() && !packet {
+        v.extend(traversal::streamed::kernels());
+    }
+    // Object kernels: the types present, each kernel once.
+    for ty in ChipType::LOAD_ORDER {
+        if lay.types.iter().any(|x| x.ty == ty) {
+            for (n, k) in ty.kernels(g, &lay.fit) {
+                if !v.iter().any(|(m, _)| m == n) {
+                    v.push((n.to_string(), k));
+                }
+            }
+        }
+    }
+    v
+}
+
+/// A block of header lines under a title.
+fn block(s: &mut String, title: &str, lines: impl IntoIterator<Item = String>) {
+    s.push_str(&format!("\n; ---- {title} ----\n"));
+    for l in lines {
+        s.push_str(&l);
+        s.push('\n');
+    }
+}
+
+/// The header: what the program was generated for, and every name it
+/// uses.
+fn header(scene: &Scene, lay: &Layout, opt: &Options, nm: &Numerics, tw: u32, th: u32) -> String {
+    let mut s = String::new();
+    s.push_str(&format!(
+        "; MorphoSys BSP ray tracer, generated by firmware::tracer for {}\n",
+        scene.source
+    ));
+    s.push_str(&format!(
+        "; {}x{}, {} ways ({}x{} tiles), depth {}, {} datapath, scene format Q{}.{}, {} normals\n",
+        opt.width,
+        opt.height,
+        opt.ways,
+        tw,
+        th,
+        opt.depth,
+        opt.datapath,
+        opt.datapath.bits() - 1 - lay.frac,
+        lay.frac,
+        if lay.fine_normals { "fine" } else { "coarse" }
+    ));
+    s.push_str(&format!(
+        "; {} traversal, BSP {} split to depth {}, at most {} objects per leaf{}\n",
+        opt.traversal,
+        format!("{:?}", opt.bsp.rule).to_lowercase(),
+        opt.bsp.max_depth,
+        opt.bsp.max_leaf,
+        if opt.traversal == Traversal::Packet {
+            format!(", collapse {}", opt.collapse)
+        } else {
+            format!(", {} nodes", opt.layout)
+        }
+    ));
+    s.push_str(&format!("        .datapath {}\n", opt.datapath.bits()));
+    s.push_str(
+        ";\n; Every number the program uses is named below. TinyRISC code (.text) steers the\n\
+         ; traversal and broadcasts RC kernels (.ctx) with their FB streams; each routine\n\
+         ; and kernel is headed by what it does, its inputs and its outputs.\n",
+    );
+    let types: Vec<ChipType> = lay.types.iter().map(|t| t.ty).collect();
+    let mut f = format_lines(opt.datapath.bits() - 16);
+    f.extend(nm.approx().header());
+    block(
+        &mut s,
+        "number formats (Qn: the 16-bit chip's n fraction bits on this datapath)",
+        f,
+    );
+    let mut fit = vec![
+        define("TILE_W", tw, "the tile: TILE_W x TILE_H rays, one per RC"),
+        define("TILE_H", th, ""),
+        define(
+            "KD",
+            lay.kd,
+            "eye rays: the pixel steps B, C scaled by 2^KD",
+        ),
+        define(
+            "EPS_LSB",
+            nm.eps_lsb,
+            "spawned rays start this far off the surface (LSB)",
+        ),
+    ];
+    if lay.traversal == Traversal::Packet {
+        fit.push(define(
+            "P_TOL",
+            traversal::packet::P_TOL,
+            "split planes widened by this many LSB",
+        ));
+    }
+    fit.extend(lay.fit.header(&types));
+    block(&mut s, "the scene's fit", fit);
+    block(&mut s, "main memory (byte addresses)", main_memory(lay));
+    block(&mut s, "FB set 0 (word addresses)", fb(lay));
+    let mut rec = Vec::new();
+    let sides = |a: ChipType, b: ChipType| -> Vec<primitives::Sides> {
+        [a, b]
+            .into_iter()
+            .filter(|t| types.contains(t))
+            .map(|t| t.sides())
+            .collect()
+    };
+    let cyl = sides(ChipType::Cylinder, ChipType::GlassCylinder);
+    if !cyl.is_empty() {
+        rec.extend(primitives::cylinder::header(&lay.fit, &cyl));
+    }
+    let cone = sides(ChipType::Cone, ChipType::GlassCone);
+    if !cone.is_empty() {
+        rec.extend(primitives::cone::header(&cone));
+    }
+    if types
+        .iter()
+        .any(|t| matches!(t, ChipType::Polygon | ChipType::GlassPolygon))
+    {
+        rec.extend(primitives::polygon::header());
+    }
+    if !rec.is_empty() {
+        block(
+            &mut s,
+            "record fields (FB words from a record's start)",
+            rec,
+        );
+    }
+    block(&mut s, "BSP nodes", nodes(lay));
+    block(
+        &mut s,
+        "FB set 1: output banks (word addresses)",
+        [
+            define(
+                "OUT_BANK0",
+                OUT_BANK[0],
+                "the two output banks, alternating by tile",
+            ),
+            define("OUT_BANK1", OUT_BANK[1], ""),
+            define("OUT_R", 0, "a bank's words: red of RCs 0..63"),
+            define("OUT_G", 64, "green"),
+            define("OUT_B", 128, "blue"),
+            define("OUT_ID", 192, "the eye ray's object id"),
+            define("OUT_WORDS", 256, "words a tile's output moves by DMA"),
+        ],
+    );
+    block(
+        &mut s,
+        "RC RAM (word addresses in every RC)",
+        ram_lines(opt.depth),
+    );
+    s
+}
+
+fn main_memory(lay: &Layout) -> Vec<String> {
+    vec![
+        define(
+            "CTXBASE",
+            format!("0x{:x}", mem::CTX_BASE),
+            "the kernels (loaded into context memory)",
+        ),
+        define(
+            "FBIMG",
+            format!("0x{:x}", mem::FB_IMAGE),
+            "the FB image, loaded by the host",
+        ),
+        define("FBWORDS", lay.fb.len(), "its words"),
+        define(
+            "TILELIST",
+            format!("0x{:x}", mem::TILE_LIST),
+            "the tile list, written by the host:",
+        ),
+        define("TL_COUNT", 0, "  the number of tiles"),
+        define("TL_FIRST", 4, "  the first tile's entry:"),
+        define("TILE_PX", 0, "    its corner's pixel column"),
+        define("TILE_PY", 4, "    its corner's pixel row"),
+        define("TILE_OUT", 8, "    where its output goes in main memory"),
+        define("TILE_BYTES", 12, "  bytes of an entry"),
+        define("MASK_HI", 4, "the high word of a 64-bit mask (RCs 32..63)"),
+        define("AXIS_X", 0, "a per-axis table's words"),
+        define("AXIS_Y", 4, ""),
+        define("AXIS_Z", 8, ""),
+    ]
+}
+
+fn fb(lay: &Layout) -> Vec<String> {
+    let mut v = vec![
+        define(
+            "FB_EYE",
+            lay.eye,
+            "eye stream: px0, py0, eye.xyz, (A, B, C) per axis",
+        ),
+        define("EYE_PX", 0, "  the tile's corner, written per tile"),
+        define("EYE_PY", 1, ""),
+        define(
+            "FB_POST",
+            lay.post,
+            "post-pass stream: background, (material, Ks) per material",
+        ),
+    ];
+    if lay.refract {
+        v.push(define(
+            "FB_TRANSMIT",
+            lay.transmit,
+            "refraction stream: (material, T, 1/ior, ior) per transmitting material",
+        ));
+    }
+    for (i, l) in lay.lights.iter().enumerate() {
+        v.push(define(
+            &format!("FB_LIGHT{i}"),
+            l,
+            if i == 0 {
+                "light streams: the position (a scale shift first where far)"
+            } else {
+                ""
+            },
+        ));
+    }
+    for (i, l) in lay.shades.iter().enumerate() {
+        v.push(define(
+            &format!("FB_SHADE{i}"),
+            l,
+            if i == 0 {
+                "shading streams: per material its Phong terms for the light"
+            } else {
+                ""
+            },
+        ));
+    }
+    if lay.traversal == Traversal::Packet {
+        v.push(define(
+            "ROOTBOX",
+            lay.root_box,
+            "the root cell widened by P_TOL: per axis min, max",
+        ));
+    }
+    let resident = lay.stream.is_none();
+    for t in &lay.types {
+        let up = t.ty.name().to_uppercase();
+        let name = t.ty.name().replace('_', " ");
+        if resident {
+            v.push(define(
+                &format!("FB_{up}"),
+                t.first,
+                &format!("the {name} records"),
+            ));
+        }
+        v.push(define(&format!("{up}_WORDS"), t.size, "  words of one"));
+        if resident && lay.traversal == Traversal::Paper {
+            v.push(define(&format!("MB_{up}"), t.mailbox, "  their mailboxes"));
+        }
+    }
+    if resident {
+        v.push(define("ROOT", lay.root, "the BSP root node"));
+    } else {
+        v.push(define("ROOT", lay.root, "the BSP root node (main memory)"));
+    }
+    v.push(define(
+        "MAILBOX",
+        lay.mailbox,
+        if resident && lay.traversal == Traversal::Paper {
+            "the mailboxes: per object the pass that last tested it"
+        } else {
+            "the mailboxes (main memory)"
+        },
+    ));
+    v.push(define("NOBJ", lay.objects, "objects in the scene"));
+    if lay.traversal == Traversal::Paper {
+        v.push(define(
+            "PASS_WRAP",
+            "0x7fff",
+            "pass numbers wrap here (16-bit mailboxes)",
+        ));
+    }
+    if let Some(st) = &lay.stream {
+        v.push(define(
+            "SPLIT",
+            st.split_slot,
+            "the split of the node being classified",
+        ));
+        if lay.traversal == Traversal::Packet {
+            v.push(define("SPLIT_SLOT", "SPLIT + 1", "its slot's RAM address"));
+            v.push(define(
+                "POP_SLOT",
+                "SPLIT + 2",
+                "a popped node's parent slot",
+            ));
+        }
+        v.push(define(
+            "SBANK",
+            format!("0x{STREAM_BANK:x}"),
+            "FB bank 1: the leaf blocks, by DMA",
+        ));
+        if lay.traversal == Traversal::Paper {
+            v.push(define(
+                "BLOCK_HEAD",
+                super::layout::BLOCK_HEAD,
+                "a block's cell bounds before its records",
+            ));
+        }
+    }
+    v
+}
+
+fn nodes(lay: &Layout) -> Vec<String> {
+    let mut v = Vec::new();
+    match (lay.traversal, lay.stream.is_some()) {
+        (Traversal::Paper, false) if lay.node_layout == NodeLayout::Fig5 => {
+            v.push(define(
+                "N_FLAGS",
+                0,
+                "Fig. 5 node: bit 15 a leaf, bits 1..0 the split axis",
+            ));
+            v.push(define("N_SPLIT", 1, "  the split's position"));
+            v.push(define("N_LEFT", 2, "  the child below (FB address)"));
+            v.push(define("N_RIGHT", 3, "  the child above"));
+            v.push(define(
+                "N_BOUNDS",
+                4,
+                "  the cell, widened by 2 LSB: min.xyz, max.xyz",
+            ));
+            for t in &lay.types {
+                let up = t.ty.name().to_uppercase();
+                v.push(define(
+                    &format!("N_BV_{up}"),
+                    t.bv_offset,
+                    &format!(
+                        "  the {}s under it, a bit each",
+                        t.ty.name().replace('_', " ")
+                    ),
+                ));
+                v.push(define(
+                    &format!("BV_WORDS_{up}"),
+                    t.bv_words,
+                    "  words of that bit vector",
+                ));
+            }
+        }
+        (Traversal::Paper, false) => {
+            v.push(define(
+                "N_FLAGS",
+                0,
+                "compact node: bit 15 a leaf, bits 1..0 the split axis",
+            ));
+            v.push(define("N_SPLIT", 1, "  inner: the split's position"));
+            v.push(define("N_LEFT", 2, "  inner: the child below (FB address)"));
+            v.push(define("N_RIGHT", 3, "  inner: the child above"));
+            v.push(define(
+                "NC_INNER_LISTS",
+                super::layout::COMPACT_INNER_HEAD,
+                "  inner: per type, a count and the slot indices",
+            ));
+            v.push(define(
+                "NC_LEAF_BOUNDS",
+                1,
+                "  leaf: the cell, widened by 2 LSB",
+            ));
+            v.push(define(
+                "NC_LEAF_LISTS",
+                super::layout::COMPACT_LEAF_HEAD,
+                "  leaf: per type, a count and the slot indices",
+            ));
+        }
+        (Traversal::Paper, true) => {
+            v.push(define(
+                "NODE_BYTES",
+                super::layout::NODE_BYTES,
+                "a node record (main memory):",
+            ));
+            v.push(define(
+                "SN_FLAGS",
+                0,
+                "  -32768 a leaf, else the split axis",
+            ));
+            v.push(define("SN_SPLIT", 4, "  the split's position"));
+            v.push(define("SN_LEFT", 8, "  the children (byte addresses)"));
+            v.push(define("SN_RIGHT", 12, ""));
+            v.push(define(
+                "SN_BLOCK",
+                16,
+                "  leaf: its block (bounds, records)",
+            ));
+            v.push(define("SN_BLOCK_WORDS", 20, "  leaf: the block's words"));
+            v.push(define(
+                "SN_LIST",
+                24,
+                "  leaf: its list of mailbox addresses",
+            ));
+            for (j, t) in lay.types.iter().enumerate() {
+                v.push(define(
+                    &format!("SN_COUNT_{}", t.ty.name().to_uppercase()),
+                    28 + 4 * j,
+                    if j == 0 {
+                        "  leaf: objects of each type"
+                    } else {
+                        ""
+                    },
+                ));
+            }
+            v.push(define("SN_OBJECTS", 56, "  leaf: objects in all"));
+            v.push(define(
+                "U_NSTACK",
+                0,
+                "an unordered subtree (USTK): the node stack where it ends",
+            ));
+            v.push(define("U_AXIS", 4, "  its split axis"));
+            v.push(define("U_FRAME", 8, "  bytes"));
+        }
+        (Traversal::Packet, false) => {
+            v.push(define(
+                "PN_FLAGS",
+                0,
+                "packet node: the split axis, or bit 15 a leaf",
+            ));
+            v.push(define(
+                "PN_PARENT_SLOT",
+                1,
+                "  the RAM slot its parent pushed it with",
+            ));
+            v.push(define("PN_SPLIT", 2, "  inner: the split's position"));
+            v.push(define("PN_SLOT", 3, "  inner: the RAM slot of its depth"));
+            v.push(define("PN_LEFT", 4, "  inner: the children (FB addresses)"));
+            v.push(define("PN_RIGHT", 5, ""));
+            v.push(define("PL_OBJECTS", 2, "  leaf: its objects"));
+            v.push(define(
+                "PL_SHARED",
+                3,
+                "  leaf: of those, in other leaves too (a mailbox)",
+            ));
+            v.push(define(
+                "PL_LISTS",
+                super::layout::PK_LEAF_HEAD,
+                "  leaf: per type a count, then an entry per object:",
+            ));
+            v.push(define("LE_RECORD", 0, "    its record (FB address)"));
+            v.push(define("LE_MAILBOX", 1, "    its mailbox index (-1: none)"));
+            v.push(define("LE_WORDS", 2, ""));
+            v.extend(mailbox_fields());
+        }
+        (Traversal::Packet, true) => {
+            v.push(define(
+                "NODE_BYTES",
+                super::layout::NODE_BYTES,
+                "a packet node record (main memory):",
+            ));
+            v.push(define(
+                "PS_FLAGS",
+                0,
+                "  -32768 a leaf or a piece, else the split axis",
+            ));
+            v.push(define(
+                "PS_PARENT_SLOT",
+                4,
+                "  the RAM slot its parent pushed it with",
+            ));
+            v.push(define("PS_SPLIT", 8, "  inner: the split's position"));
+            v.push(define("PS_SLOT", 12, "  inner: the RAM slot of its depth"));
+            v.push(define(
+                "PS_LEFT",
+                16,
+                "  inner: the children (byte addresses)",
+            ));
+            v.push(define("PS_RIGHT", 20, ""));
+            v.push(define(
+                "PS_LIST",
+                8,
+                "  leaf: per object its mailbox's address (0: none)",
+            ));
+            v.push(define("PS_BLOCK", 16, "  leaf: its block of records"));
+            v.push(define("PS_BLOCK_WORDS", 20, "  leaf: the block's words"));
+            v.push(define("PS_NEXT", 24, "  leaf: its next piece (0: none)"));
+            for (j, t) in lay.types.iter().enumerate() {
+                v.push(define(
+                    &format!("PS_COUNT_{}", t.ty.name().to_uppercase()),
+                    28 + 4 * j,
+                    if j == 0 {
+                        "  leaf: objects of each type"
+                    } else {
+                        ""
+                    },
+                ));
+            }
+            v.push(define("PS_OBJECTS", 56, "  leaf: objects in all"));
+            v.push(define("PS_SHARED", 60, "  leaf: of those, with a mailbox"));
+            v.extend(mailbox_fields());
+        }
+    }
+    v
+}
+
+fn mailbox_fields() -> Vec<String> {
+    vec![
+        define(
+            "MB_SHIFT",
+            4,
+            "a mailbox (main memory, 16 bytes, MAILBOX + index << MB_SHIFT):",
+        ),
+        define("MB_PASS", 0, "  the pass that last tested the object"),
+        define("MB_RAYS", 4, "  the rays that did (64-bit mask)"),
+    ]
+}
+
+/// TinyRISC's data.
+fn data(lay: &Layout) -> String {
+    let mut t = Code::new();
+    t.raw("\n; ==== TinyRISC data ====").directive(".data");
+    let d = |t: &mut Code, name: &str, what: &str, doc: &str| {
+        let head = format!("{:<16}{what}", format!("{name}:"));
+        t.raw(if doc.is_empty() {
+            head
+        } else {
+            format!("{head:<40}; {doc}")
+        });
+    };
+    d(
+        &mut t,
+        "PASS",
+        ".word 0",
+        "the ray pass's number (mailboxes)",
+    );
+    d(
+        &mut t,
+        "MODE",
+        ".word 0",
+        "0: closest hit, 1: any hit (shadow rays)",
+    );
+    d(&mut t, "SAVE_LR", ".word 0", "trace's return address");
+    d(
+        &mut t,
+        "AWAKE",
+        ".word 0, 0",
+        "the RCs awake (RCs 0..31, 32..63)",
+    );
+    t.raw("NEG:");
+    d(
+        &mut t,
+        "NEG_X",
+        ".word 0, 0",
+        "per axis, the rays going down along it",
+    );
+    d(&mut t, "NEG_Y", ".word 0, 0", "");
+    d(&mut t, "NEG_Z", ".word 0, 0", "");
+    d(
+        &mut t,
+        "T_START",
+        ".word 0",
+        "the cycle counter at the tile loop's start",
+    );
+    d(&mut t, "T_END", ".word 0", "... and at its end");
+    d(&mut t, "TESTS", ".word 0", "object tests broadcast");
+    d(&mut t, "PASSES", ".word 0", "ray passes");
+    d(&mut t, "TL_PTR", ".word 0", "the tile list's current entry");
+    d(&mut t, "TL_CNT", ".word 0", "tiles left");
+    d(
+        &mut t,
+        "TL_BANK",
+        ".word 0",
+        "the output bank of this tile (0, 1)",
+    );
+    d(
+        &mut t,
+        "CUR_OUT",
+        ".word 0",
+        "where this tile's output goes",
+    );
+    d(&mut t, "NSTACK", ".space 256", "the node stack");
+    if lay.traversal == Traversal::Packet {
+        d(
+            &mut t,
+            "NK",
+            ".word 0, 0, 0",
+            "per axis: the node kernel of the pass's child order",
+        );
+        d(
+            &mut t,
+            "NF",
+            ".word 0, 0, 0",
+            "per axis: the first child's field in a node",
+        );
+        d(
+            &mut t,
+            "NS",
+            ".word 0, 0, 0",
+            "per axis: the second child's field",
+        );
+        d(&mut t, "CUR_BLK", ".word 0", "the leaf block in SBANK");
+    } else if lay.stream.is_some() {
+        d(
+            &mut t,
+            "UPTR",
+            ".word 0",
+            "the unordered-subtree stack's top",
+        );
+        d(&mut t, "USTK", ".space 160", "the unordered-subtree stack");
+        d(&mut t, "CUR_BLK", ".word 0", "the leaf block in SBANK");
+    }
+    t.text()
+}

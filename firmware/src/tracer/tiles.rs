@@ -1,0 +1,177 @@
+//! TinyRISC's main program: start-up, the tile loop and the ray tree of
+//! each tile, and the pixels out by DMA. The traversal it calls for every
+//! ray pass (`trace`) is in [`super::traversal`]; the RC kernels it
+//! broadcasts between passes are in [`super::shading`].
+//!
+//! ```text
+//! _start: FB image and contexts in by DMA; RC RAM tables; lanes
+//! tile:   for each tile of the list:
+//!           eye rays; shade(level 0)
+//!             shade(l): trace (closest hit); post;
+//!                       per light: shadow rays, trace (any hit), Phong
+//!                       if l + 1 < depth: reflected rays, shade(l + 1), pop
+//!                         (and the refracted rays' subtree, where any)
+//!           pixels into an output bank of FB set 1, DMA to main memory
+//!           (the other bank drains while the next tile is traced)
+//! finish: cycle counter into T_END; halt
+//! ```
+//!
+//! The tile loop keeps its state in memory (`TL_PTR`, `TL_CNT`, `TL_BANK`,
+//! `CUR_OUT`), so that `trace` may use r1..r14.
+
+use super::emit::{at, Code, R0, R1, R2, R3, R4, R5, R6};
+use super::layout::Layout;
+use super::primitives::{kaddr, klen};
+
+/// `li r1, kernel; cbcast r1, len`: broadcast a kernel without a stream.
+fn cb<'a>(t: &'a mut Code, k: &str) -> &'a mut Code {
+    t.li(R1, kaddr(k)).cbcast(R1, klen(k))
+}
+
+/// `li r1, kernel; li r2, stream; sbcb r1, r2, len`: broadcast a kernel
+/// with its FB stream.
+fn sb<'a>(t: &'a mut Code, k: &str, stream: &str) -> &'a mut Code {
+    t.li(R1, kaddr(k)).li(R2, stream).sbcb(R1, R2, klen(k))
+}
+
+/// The main program: `_start`, the tile loop, `finish`.
+pub fn main(t: &mut Code, lay: &Layout, depth: u32) {
+    t.doc(
+        "_start: the FB image and the contexts in by DMA, every RC's RAM tables and lane words,\n\
+         then the tile loop; T_START, T_END: the cycle counter around it.",
+    );
+    t.label("_start")
+        .li(R1, "FBIMG")
+        .li(R2, 0)
+        .li(R3, "FBWORDS")
+        .ldfb(R1, R2, R3)
+        .c("the FB image into FB set 0")
+        .dwait()
+        .li(R1, "CTXBASE")
+        .li(R2, 0)
+        .li(R3, "(ctx_end - CTXBASE) / 4")
+        .ldctxt(R1, R2, R3)
+        .c("the kernels into context memory")
+        .dwait();
+    sb(t, "k_init", "0").c("RSQ, RCP, C_ONE, C_INF from the FB");
+    t.li(R1, kaddr("k_rows")).cbcr(R1, R0, 1).c("row i: r8 = i");
+    cb(t, "k_strow");
+    t.li(R1, kaddr("k_rows"))
+        .cbcc(R1, R0, 1)
+        .c("column j: r8 = j");
+    cb(t, "k_stcol");
+    cb(t, "k_lanes").c("the RCs outside the tile sleep");
+    t.rcany(R1)
+        .c("the array done")
+        .rdcyc(R1)
+        .sw(R1, at("T_START", R0))
+        .li(R1, "TILELIST")
+        .lw(R2, at("TL_COUNT", R1))
+        .addi(R1, R1, "TL_FIRST")
+        .sw(R1, at("TL_PTR", R0))
+        .sw(R2, at("TL_CNT", R0));
+    t.doc(
+        "tile: one tile of the list (TL_PTR: its entry, TL_CNT: tiles left): eye rays, the ray\n\
+         tree, the pixels out.",
+    );
+    t.label("tile")
+        .lw(R2, at("TL_CNT", R0))
+        .beqz(R2, "finish")
+        .lw(R1, at("TL_PTR", R0))
+        .lw(R3, at("TILE_PX", R1))
+        .lw(R4, at("TILE_PY", R1))
+        .lw(R5, at("TILE_OUT", R1))
+        .sw(R5, at("CUR_OUT", R0))
+        .li(R6, "FB_EYE")
+        .sfb(R3, at("EYE_PX", R6))
+        .sfb(R4, at("EYE_PY", R6))
+        .c("the tile's corner into the eye stream");
+    sb(t, "k_eye", "FB_EYE").c("eye rays");
+    let mut skips = 0;
+    tree(t, lay, 0, depth.max(1), &mut skips);
+    output(t);
+    t.label("finish")
+        .dwait()
+        .rdcyc(R1)
+        .sw(R1, at("T_END", R0))
+        .halt();
+}
+
+/// One level's shading: its closest-hit pass, the hit's shading state,
+/// then per light a shadow pass and the Phong terms.
+fn shade_level(t: &mut Code, lay: &Layout, level: u32) {
+    t.comment(format!("level {level}: the rays' closest hits"))
+        .sw(R0, at("MODE", R0))
+        .jal("trace");
+    cb(t, "k_wake");
+    sb(t, if level == 0 { "k_post0" } else { "k_post1" }, "FB_POST").c("the hits' shading state");
+    for i in 0..lay.lights.len() {
+        t.comment(format!(
+            "light {i}: shadow rays, then its Phong terms where lit"
+        ));
+        sb(t, "k_light", &format!("FB_LIGHT{i}"));
+        t.li(R1, 1).sw(R1, at("MODE", R0)).c("any hit").jal("trace");
+        cb(t, "k_wake");
+        sb(t, "k_shade", &format!("FB_SHADE{i}"));
+    }
+}
+
+/// The ray tree, depth first: a level's shading, then its reflected ray's
+/// subtree and, where the scene refracts, its refracted ray's (skipped
+/// when no ray of the tile refracts there).
+fn tree(t: &mut Code, lay: &Layout, level: u32, levels: u32, skips: &mut u32) {
+    shade_level(t, lay, level);
+    if level + 1 >= levels {
+        return;
+    }
+    if lay.refract {
+        sb(t, &format!("k_tset{level}"), "FB_TRANSMIT")
+            .c(format!("level {level}'s refracted rays, for later"));
+    }
+    cb(t, &format!("k_refl{level}")).c(format!("level {level}'s reflected rays"));
+    tree(t, lay, level + 1, levels, skips);
+    cb(t, &format!("k_pop{level}")).c("their colour added");
+    if lay.refract {
+        *skips += 1;
+        let skip = format!("no_refraction{}", *skips);
+        cb(t, &format!("k_refr{level}")).c(format!("level {level}'s refracted rays"));
+        t.rcany(R1).beqz(R1, &skip).c("none in the tile");
+        tree(t, lay, level + 1, levels, skips);
+        t.label(&skip);
+        cb(t, "k_wake");
+        cb(t, &format!("k_rpop{level}")).c("their colour added");
+    }
+}
+
+/// Four words per lane through the FB (an output bank of FB set 1), then
+/// DMA to the tile's place in main memory; the next tile.
+fn output(t: &mut Code) {
+    t.comment("the pixels: R, G, B, object id per RC into an output bank, then DMA out")
+        .lw(R5, at("TL_BANK", R0))
+        .li(R4, "OUT_BANK0")
+        .beqz(R5, "out_bank")
+        .li(R4, "OUT_BANK1");
+    t.label("out_bank").dwait().c("the bank's last DMA done");
+    for (i, w) in ["OUT_R", "OUT_G", "OUT_B", "OUT_ID"]
+        .into_iter()
+        .enumerate()
+    {
+        t.li(R1, kaddr(&format!("k_out{i}")))
+            .cbcast(R1, 1)
+            .wfb(R4, w);
+    }
+    t.lw(R3, at("CUR_OUT", R0))
+        .stfb(R3, R4, "OUT_WORDS")
+        .c("DMA to main memory")
+        .lw(R5, at("TL_BANK", R0))
+        .xori(R5, R5, 1)
+        .sw(R5, at("TL_BANK", R0))
+        .c("the other bank next")
+        .lw(R1, at("TL_PTR", R0))
+        .addi(R1, R1, "TILE_BYTES")
+        .sw(R1, at("TL_PTR", R0))
+        .lw(R2, at("TL_CNT", R0))
+        .addi(R2, R2, -1)
+        .sw(R2, at("TL_CNT", R0))
+        .j("tile");
+}

@@ -1,0 +1,748 @@
+//! Masked packet traversal (`--traversal packet`, the default), resident
+//! or streamed: each ray keeps its parametric interval `[tmin, tmax]`
+//! inside the cell being visited (r8, r9 of its RC); a child is visited
+//! only by the rays whose interval reaches it (the others sleep), near
+//! child first, the far child pushed with every ray's interval for it; a
+//! ray whose hit lies before a popped cell drops out.
+//!
+//! ```text
+//! trace:
+//!   PASS += 1; k_pinit: every awake ray alive, its interval [0, tbest]
+//!     clipped to the root cell, 1/d per axis
+//!   per axis: the child order the majority of the awake rays meets first
+//!     (NK: the node kernel, NF/NS: the first and second child's field)
+//!   node = ROOT
+//!   loop:
+//!     if node is a leaf:
+//!       every object not yet tested by every awake ray (its mailbox) is
+//!       broadcast; any-hit pass: the rays with a hit are done
+//!     else:
+//!       node kernel: each awake ray splits its interval at the plane;
+//!       rcst says which children some awake ray reaches:
+//!         none: pop; the second only: its intervals, node = second
+//!         some the first: push second, the others sleep, node = first
+//!         all the first: push second if some ray reaches it, node = first
+//!       (the next node's kernel is issued before its children are read)
+//!     pop: node = the stack's top; every RC wakes, takes its interval for
+//!       it; the rays not alive, or whose interval is empty or beyond
+//!       their hit, sleep again; a node no ray needs is popped too
+//! ```
+//!
+//! The distance to a split plane at `x` along axis `a` is `t(x) = (x -
+//! o_a) / d_a`, from the reciprocal of the direction computed once per
+//! pass ([`pass_start`]): `|D|` (Q1.14, clamped to [1, 2^14 - 1]) is
+//! normalised by `z = clz(|D|) - 1` into [2^14, 2^15), `R = ±2^29 / (|D|
+//! << z)` (table and Newton-Raphson steps, the sign of `d_a`), and `t(x) =
+//! ((x - o_a) << (z - 1)) * R >> 14`. The shift saturates exactly when `t`
+//! does (`|R| >= 2^14`), so a saturated `t` lies beyond every segment.
+//! Every plane is widened by `P_TOL` LSB on both sides: a ray meets the
+//! cell below for `t` up to `t(s) + dt` and the cell above from `t(s) -
+//! dt` on, `dt = P_TOL / |d_a|`, more than the error of `t` (2.5 LSB at the
+//! end of the range), so an interval never misses a cell its ray meets.
+//! The far child's intervals are pushed into RC RAM, one slot per BSP
+//! depth (`P_SLOT`), only when TinyRISC pushes the child; a pop reads and
+//! clears the slot in every RC.
+//!
+//! Nodes (resident, FB): inner `PN_FLAGS (the axis), PN_PARENT_SLOT, PN_SPLIT,
+//! PN_SLOT, PN_LEFT, PN_RIGHT`; leaf `PL_FLAGS, PL_PARENT_SLOT,
+//! PL_OBJECTS, PL_SHARED`, then per type present a count and per object
+//! its record's FB address and its mailbox index (-1: in one leaf only, no
+//! mailbox). Streamed (main memory, `NODE_BYTES`): the same with byte
+//! addresses (`PS_*`); a leaf's records are a block (in pieces where they
+//! exceed FB bank 1, chained by `PS_NEXT`) moved into `SBANK` by DMA.
+//! Mailboxes (main memory, `MB_BYTES` each): the pass that last tested
+//! the object and which rays did (`MB_PASS`, `MB_RAYS`).
+//!
+//! TinyRISC registers: r5 the node, r6 its flags, r7 its axis times 4,
+//! r13 the pass's object tests, r14 the node stack pointer (`NSTACK`).
+
+use super::super::emit::{
+    at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
+};
+use super::super::layout::Layout;
+use super::super::math::Approx;
+use super::super::memory_map::ram;
+use super::super::primitives::{kaddr, klen};
+
+/// Widening of every split plane and of the root box in the packet
+/// traversal, in LSB of the scene format.
+pub const P_TOL: i32 = 4;
+
+/// Newton-Raphson steps of the traversal's direction reciprocals: the
+/// intervals' widening assumes a relative error under 2^-14, which one
+/// step reaches from the 128-entry table (0.4% before the step, 1.5e-5
+/// after) and two from any smaller one.
+fn p_newton(nr: Approx) -> u32 {
+    if nr.table_entries >= 128 {
+        1
+    } else {
+        2
+    }
+}
+
+/// The packet traversal's kernels, in load order (after the signs).
+pub fn kernels(nr: Approx) -> Vec<(String, K)> {
+    let mut v = vec![("k_pinit".to_string(), pass_start(nr))];
+    for a in 0..3u8 {
+        v.push((format!("k_pn{a}b"), node(a, false)));
+        v.push((format!("k_pn{a}a"), node(a, true)));
+    }
+    v.push(("k_p2nd".into(), second()));
+    v.push(("k_psl".into(), sleep_first()));
+    v.push(("k_ptake".into(), take()));
+    v.push(("k_ppush".into(), push()));
+    v.push(("k_ppop".into(), pop()));
+    v.push(("k_pleafa".into(), leaf_any()));
+    v
+}
+
+/// Appended to the init kernel: no ray alive, every interval slot empty.
+pub fn init_ram(k: &mut K) {
+    k.c(format!("st r0, [#{}]", ram::P_ALIVE))
+        .note("no ray alive")
+        .c("movb r8, #-1");
+    k.rept(ram::P_SLOTS, "d", |k| {
+        k.c(format!("st r8, [#{}+2*d+SLOT_TMAX]", ram::P_SLOT));
+    });
+}
+
+/// `t(x)` for the operand `x` (a register or `fb0`) into `out`:
+/// `out = ((x - o) << zr) * rr >> 14`.
+fn distance(k: &mut K, out: u8, x: &str, o: u8, zr: u8, rr: u8) {
+    k.c(format!("sub r{out}, {x}, r{o}"))
+        .c(format!("asl r{out}, r{out}, r{zr}"))
+        .c(format!("mul r{out}, r{out}, r{rr}, >>Q14"));
+}
+
+/// Start of a packet pass (stream: the root box widened by `P_TOL`, per
+/// axis min then max). Every awake ray takes part (`P_ALIVE` = 1); per
+/// axis the direction's reciprocal (`P_Z`, `P_R`) and `dt` (`P_DT`) are
+/// computed, and the interval (r8, r9) is `[0, tbest]` clipped to the root
+/// box; a ray that misses the box is not alive and sleeps.
+pub fn pass_start(nr: Approx) -> K {
+    let mut k = K::new();
+    k.doc(
+        "k_pinit: a pass starts (stream: the root cell widened by P_TOL, per axis min, max).\n\
+         Out: P_ALIVE = 1, per axis P_Z, P_R (1/d = R >> z) and P_DT (P_TOL / |d|); the interval\n\
+         (r8, r9) = [0, tbest] clipped to the root cell; the rays that miss it sleep, not alive.",
+    );
+    k.c("movb r8, #1").c(format!("st r8, [#{}]", ram::P_ALIVE));
+    k.c(format!("ld r9, [r0 + #{}]", ram::C_ONE))
+        .c("sub r9, r9, #1")
+        .c(format!("ld r15, [r0 + #{}]", ram::C_ONE));
+    for a in 0..3u32 {
+        let d = 4 + a;
+        k.comment(&format!("1 / d{}", ["x", "y", "z"][a as usize]));
+        k.c(format!("abs r8, r{d}"))
+            .c("max r8, r8, #1")
+            .c("min r8, r8, r9")
+            .c("clz r10, r8")
+            .c("sub r10, r10, #1")
+            .c("sll r11, r8, r10")
+            .note("|d| normalised")
+            .c("srl r12, r11, #RCP_SHIFT")
+            .c("and r12, r12, #RCP_MASK")
+            .c(format!("ld r12, [r12 + #{}]", ram::RCP));
+        for _ in 0..p_newton(nr) {
+            k.c("mul r14, r11, r12, >>Q15")
+                .c("sub r14, r14, r15")
+                .c("ldacc r12, <<Q14")
+                .c("msu r12, r12, r14, >>Q14");
+        }
+        k.c("sub r10, r10, #1")
+            .c(format!("st r10, [#{}]", ram::P_Z + a))
+            .c("movb r13, #P_TOL")
+            .c("asl r13, r13, r10")
+            .c("mul r13, r13, r12, >>Q14")
+            .c(format!("st r13, [#{}]", ram::P_DT + a))
+            .c(format!("cmp.lt r{d}, #0"))
+            .c("(f) neg r12, r12")
+            .c(format!("st r12, [#{}]", ram::P_R + a));
+    }
+    k.comment("root interval");
+    k.c("movb r8, #0").c("mov r9, r7");
+    for a in 0..3u32 {
+        k.c(format!("ld r12, [r0 + #{}]", ram::P_Z + a))
+            .c(format!("ld r13, [r0 + #{}]", ram::P_R + a));
+        distance(&mut k, 10, "fb0", 1 + a as u8, 12, 13);
+        distance(&mut k, 11, "fb0", 1 + a as u8, 12, 13);
+        k.c("min r14, r10, r11")
+            .c("max r10, r10, r11")
+            .c("max r8, r8, r14")
+            .c("min r9, r9, r10");
+    }
+    k.c("cmp.lt r8, r9")
+        .note("F: the ray meets the root cell")
+        .c("movb r10, #0")
+        .c(format!("(!f) st r10, [#{}]", ram::P_ALIVE))
+        .c("(!f) sleep");
+    k
+}
+
+/// Inner node on `axis` (stream: the split). Each awake ray cuts its
+/// interval (r8, r9; `r9 <= tbest`: the pass start and every pop clip it,
+/// and no hit is found between two inner nodes) at the plane into the part
+/// below and the part above (each reaching `P_TOL` LSB past the plane);
+/// `first_above` names the child the packet visits first. The first
+/// child's interval becomes the current one (r8, r9), the second's is left
+/// in r11, r14 for [`second`], [`push`] and [`take`]; rays that reach
+/// neither child sleep; F = reaches the first child.
+pub fn node(axis: u8, first_above: bool) -> K {
+    let (o, d) = (1 + axis, 4 + axis);
+    let a = axis as u32;
+    let mut k = K::new();
+    k.doc(&format!(
+        "k_pn{axis}{}: an inner node split across {}, the child {} the plane first (stream: the\n\
+         split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first\n\
+         child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.\n\
+         Out: F = reaches the first child.",
+        if first_above { "a" } else { "b" },
+        ["x", "y", "z"][axis as usize],
+        if first_above { "above" } else { "below" }
+    ));
+    k.c(format!("ld r12, [r0 + #{}]", ram::P_Z + a))
+        .c(format!("ld r13, [r0 + #{}]", ram::P_R + a));
+    distance(&mut k, 10, "fb0", o, 12, 13);
+    k.note("t(s)");
+    k.c(format!("ld r12, [r0 + #{}]", ram::P_DT + a))
+        .c("subs r11, r10, r12")
+        .c("adds r10, r10, r12")
+        .comment("near = [tmin, min(hi, t + dt)], far = [max(tmin, t - dt), hi]")
+        .c("min r12, r9, r10")
+        .c("max r13, r8, r11")
+        .c(if first_above {
+            format!("cmp.lt r{d}, #0")
+        } else {
+            format!("cmp.ge r{d}, #0")
+        })
+        .c("sel r14, r9, r12")
+        .c("sel r9, r12, r9")
+        .c("sel r11, r13, r8")
+        .c("sel r8, r8, r13")
+        .c("cmp.lt r11, r14")
+        .c("(!f) cmp.lt r8, r9")
+        .c("(!f) sleep")
+        .note("neither child")
+        .c("cmp.lt r8, r9");
+    k
+}
+
+/// After [`node`], when every awake ray reaches the first child: F =
+/// reaches the second too.
+pub fn second() -> K {
+    let mut k = K::new();
+    k.doc("k_p2nd: after a node kernel, F = the ray reaches the second child too.");
+    k.c("cmp.lt r11, r14");
+    k
+}
+
+/// After [`node`], when the packet visits both children: the rays that
+/// do not reach the first sleep until the second is popped.
+pub fn sleep_first() -> K {
+    let mut k = K::new();
+    k.doc("k_psl: the rays that do not reach the first child sleep until the second is popped.");
+    k.c("(!f) sleep");
+    k
+}
+
+/// After [`node`], the second child is pushed (stream: the node's slot
+/// address): every awake ray stores its interval for it.
+pub fn push() -> K {
+    let mut k = K::new();
+    k.doc("k_ppush: the second child pushed: every awake ray's interval for it into its slot\n(stream: the slot's RAM address).");
+    k.c("mov r15, fb0")
+        .c("st r14, [r15]")
+        .note("SLOT_TMAX")
+        .c("add r15, r15, #1")
+        .c("st r11, [r15]")
+        .note("SLOT_TMIN");
+    k
+}
+
+/// After [`node`], the packet visits the second child only (every awake
+/// ray reaches it): its interval becomes the current one.
+pub fn take() -> K {
+    let mut k = K::new();
+    k.doc("k_ptake: only the second child is visited: its interval becomes the current one.");
+    k.c("mov r8, r11").c("mov r9, r14");
+    k
+}
+
+/// A popped node (stream: the slot its parent pushed it with): every RC
+/// wakes, takes its interval from the slot and clears the slot; the rays
+/// that are not alive in this pass, or whose interval is empty or lies
+/// beyond their hit, sleep again (F = awake).
+pub fn pop() -> K {
+    let mut k = K::new();
+    k.doc(
+        "k_ppop: a popped node (stream: its slot's RAM address): every RC wakes and takes its\n\
+         interval from the slot, emptied; the rays not alive, or whose interval is empty or\n\
+         beyond their hit, sleep again. Out: F = awake.",
+    );
+    k.c("wake")
+        .c("mov r15, fb0")
+        .c("ld r9, [r15 + #SLOT_TMAX]")
+        .c("ld r8, [r15 + #SLOT_TMIN]")
+        .c("movb r10, #-1")
+        .c("st r10, [r15]")
+        .note("empty")
+        .c("min r9, r9, r7")
+        .c(format!("ld r11, [r0 + #{}]", ram::P_ALIVE))
+        .c("cmp.ne r11, #0")
+        .c("(f) cmp.lt r8, r9")
+        .c("(!f) sleep");
+    k
+}
+
+/// Any-hit (shadow) pass, after a leaf: a ray that found a hit is done for
+/// the pass.
+pub fn leaf_any() -> K {
+    let mut k = K::new();
+    k.doc(
+        "k_pleafa: after a leaf, any-hit pass: the rays with a hit are done (not alive) and sleep.",
+    );
+    k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
+        .c("cmp.lt r7, r8")
+        .c("movb r9, #0")
+        .c(format!("(f) st r9, [#{}]", ram::P_ALIVE))
+        .c("(f) sleep");
+    k
+}
+
+/// The node fields the traversal reads, resident (FB words) or streamed
+/// (bytes of a node record in main memory).
+struct Fields {
+    streamed: bool,
+}
+
+impl Fields {
+    fn n(&self, resident: &'static str, streamed: &'static str) -> &'static str {
+        if self.streamed {
+            streamed
+        } else {
+            resident
+        }
+    }
+    /// Load a node's word: `lfb` (resident) or `lw` (streamed).
+    fn load(&self, t: &mut Code, rt: Reg, m: super::super::emit::Mem) {
+        if self.streamed {
+            t.lw(rt, m);
+        } else {
+            t.lfb(rt, m);
+        }
+    }
+}
+
+/// The packet `trace`, its leaf loop and `majority`.
+pub fn trace(t: &mut Code, lay: &Layout) {
+    let streamed = lay.stream.is_some();
+    let f = Fields { streamed };
+    let flags = f.n("PN_FLAGS", "PS_FLAGS");
+    t.doc(&format!(
+        "trace: one ray pass, the packet traversal of a {} scene. In: the rays in r1..r7 of\n\
+         every RC, MODE (0: closest hit, 1: any hit). Out: the hits in HIT_*, r7.\n\
+         Clobbers r1..r15 (r15 kept in SAVE_LR).",
+        if streamed { "streamed" } else { "resident" }
+    ));
+    t.label("trace")
+        .sw(R15, at("SAVE_LR", R0))
+        .lw(R1, at("PASSES", R0))
+        .addi(R1, R1, 1)
+        .sw(R1, at("PASSES", R0))
+        .c("ray passes, for the statistics")
+        .lw(R1, at("PASS", R0))
+        .addi(R1, R1, 1)
+        .sw(R1, at("PASS", R0))
+        .li(R13, 0)
+        .c("object tests of the pass");
+    if lay.root_leaf {
+        // The whole tree is one leaf: its objects are tested by the awake
+        // rays, nothing to walk. (`k_sign0` runs only to mark the pass's
+        // start for the simulator's count of the rays traced: its RCs are
+        // the pass's.)
+        t.comment("the tree is one leaf: its objects, tested by the awake rays")
+            .li(R1, kaddr("k_sign0"))
+            .cbcast(R1, 1)
+            .li(R14, "NSTACK")
+            .li(R5, "ROOT")
+            .rcsl(R4)
+            .rcsh(R10)
+            .nor(R4, R4, R0)
+            .nor(R10, R10, R0)
+            .or(R1, R4, R10)
+            .beqz(R1, "trace_done")
+            .lw(R11, at("PASS", R0))
+            .j("leaf_objects");
+    }
+    t.li(R1, kaddr("k_pinit"))
+        .li(R2, "ROOTBOX")
+        .sbcb(R1, R2, klen("k_pinit"))
+        .c("intervals in the root cell, 1/d");
+    for (a, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
+        let lo = axis.to_lowercase();
+        t.li(R1, kaddr(&format!("k_sign{a}")))
+            .cbcast(R1, 1)
+            .rcst(R3)
+            .c(format!(
+                "the awake rays going down along {lo}: none, some, all"
+            ));
+        if a == 0 {
+            t.li(R4, 2).beq(R3, R4, "trace_done").c("no ray awake");
+        }
+        t.li(R8, 0)
+            .beqz(R3, format!("order_{lo}"))
+            .li(R8, 1)
+            .li(R4, 3)
+            .beq(R3, R4, format!("order_{lo}"))
+            .jal("majority")
+            .c("some: r8 = most go down");
+        t.label(format!("order_{lo}"))
+            .li(R1, kaddr(&format!("k_pn{a}b")))
+            .li(R2, f.n("PN_LEFT", "PS_LEFT"))
+            .li(R3, f.n("PN_RIGHT", "PS_RIGHT"))
+            .beqz(R8, format!("order_{lo}_set"))
+            .li(R1, kaddr(&format!("k_pn{a}a")))
+            .li(R2, f.n("PN_RIGHT", "PS_RIGHT"))
+            .li(R3, f.n("PN_LEFT", "PS_LEFT"))
+            .c("most go down: above first");
+        t.label(format!("order_{lo}_set"))
+            .sw(R1, at(format!("NK+AXIS_{axis}"), R0))
+            .sw(R2, at(format!("NF+AXIS_{axis}"), R0))
+            .sw(R3, at(format!("NS+AXIS_{axis}"), R0))
+            .c("node kernel, first and second child");
+    }
+    t.li(R14, "NSTACK").li(R5, "ROOT");
+    f.load(t, R6, at(flags, R5));
+    dispatch_full(t, &f);
+    t.comment("r5 = a node whose kernel runs: read its children, issue the first's kernel");
+    t.label("inner_node").lw(R8, at("NF", R7)).add(R8, R8, R5);
+    f.load(t, R9, deref(R8));
+    t.c("r9 = the first child");
+    t.lw(R10, at("NS", R7)).add(R10, R10, R5);
+    f.load(t, R10, deref(R10));
+    t.c("r10 = the second child");
+    f.load(t, R6, at(flags, R9));
+    t.andi(R3, R6, 3)
+        .slli(R3, R3, 2)
+        .lw(R11, at("NK", R3))
+        .c("r11 = its kernel, if inner");
+    if streamed {
+        t.lw(R15, at("PS_SPLIT", R9)).c("r15 = its split");
+        t.lw(R12, at("PS_SLOT", R5));
+    } else {
+        t.addi(R12, R5, "PN_SLOT");
+    }
+    t.c("r12 = the second child's slot (stream)");
+    t.rcst(R4)
+        .c("the awake rays reaching the first child: none, some, all")
+        .addi(R1, R4, -3)
+        .beqz(R1, "all_first")
+        .addi(R1, R4, -1)
+        .beqz(R1, "some_first")
+        .bnez(R4, "pop_node")
+        .c("no ray awake")
+        .li(R1, kaddr("k_ptake"))
+        .cbcast(R1, klen("k_ptake"))
+        .c("none: the second child only")
+        .mv(R5, R10);
+    f.load(t, R6, at(flags, R5));
+    dispatch_full(t, &f);
+    t.label("some_first");
+    push_second(t, &f);
+    t.li(R1, kaddr("k_psl"))
+        .cbcast(R1, 1)
+        .c("the rays not reaching the first sleep");
+    dispatch_first(t, &f);
+    t.label("all_first")
+        .li(R1, kaddr("k_p2nd"))
+        .cbcast(R1, 1)
+        .rcany(R4)
+        .beqz(R4, "visit_first")
+        .c("no ray reaches the second");
+    push_second(t, &f);
+    t.label("visit_first");
+    dispatch_first(t, &f);
+    leaf(t, lay, &f);
+    t.label("leaf_done")
+        .lw(R1, at("MODE", R0))
+        .beqz(R1, "pop_node")
+        .li(R1, kaddr("k_pleafa"))
+        .cbcast(R1, klen("k_pleafa"))
+        .c("any hit: the rays with a hit are done");
+    t.label("pop_node")
+        .li(R9, "NSTACK")
+        .beq(R14, R9, "trace_done")
+        .addi(R14, R14, -4)
+        .lw(R5, deref(R14))
+        .li(R1, kaddr("k_ppop"));
+    if streamed {
+        t.lw(R2, at("PS_PARENT_SLOT", R5))
+            .sfb(R2, at("POP_SLOT", R0))
+            .li(R2, "POP_SLOT");
+    } else {
+        t.addi(R2, R5, "PN_PARENT_SLOT");
+    }
+    t.sbcb(R1, R2, klen("k_ppop"))
+        .c("the rays take their intervals for it");
+    f.load(t, R6, at(flags, R5));
+    t.rcany(R4).beqz(R4, "pop_node").c("no ray needs it");
+    dispatch_full(t, &f);
+    t.label("trace_done")
+        .lw(R1, at("TESTS", R0))
+        .add(R1, R1, R13)
+        .sw(R1, at("TESTS", R0))
+        .lw(R15, at("SAVE_LR", R0))
+        .ret();
+    majority(t);
+}
+
+/// r5 = a node, r6 = its flags: a leaf, or its kernel issued (the split
+/// streamed), then `inner_node`.
+fn dispatch_full(t: &mut Code, f: &Fields) {
+    t.blt(R6, R0, "leaf").slli(R7, R6, 2).lw(R1, at("NK", R7));
+    if f.streamed {
+        t.lw(R2, at("PS_SPLIT", R5))
+            .sfb(R2, at("SPLIT", R0))
+            .li(R2, "SPLIT");
+    } else {
+        t.addi(R2, R5, "PN_SPLIT");
+    }
+    t.sbcb(R1, R2, klen("k_pn0b"))
+        .c("its node kernel")
+        .j("inner_node");
+}
+
+/// Visit the first child (r9, flags r6, kernel r11, axis r3 read by
+/// `inner_node`): a leaf, or its kernel issued at once.
+fn dispatch_first(t: &mut Code, f: &Fields) {
+    t.mv(R5, R9).blt(R6, R0, "leaf").mv(R7, R3);
+    if f.streamed {
+        t.sfb(R15, at("SPLIT", R0)).li(R2, "SPLIT");
+    } else {
+        t.addi(R2, R5, "PN_SPLIT");
+    }
+    t.sbcb(R11, R2, klen("k_pn0b"))
+        .c("the first child's node kernel")
+        .j("inner_node");
+}
+
+/// Push the second child (r10) with every awake ray's interval for it
+/// (the push kernel streams the node's slot address, r12).
+fn push_second(t: &mut Code, f: &Fields) {
+    if f.streamed {
+        t.sfb(R12, at("SPLIT_SLOT", R0))
+            .li(R2, "SPLIT_SLOT")
+            .li(R1, kaddr("k_ppush"))
+            .sbcb(R1, R2, klen("k_ppush"));
+    } else {
+        t.li(R1, kaddr("k_ppush")).sbcb(R1, R12, klen("k_ppush"));
+    }
+    t.c("the rays' intervals for the second child")
+        .sw(R10, deref(R14))
+        .addi(R14, R14, 4)
+        .c("push it");
+}
+
+/// The mailbox check of the object whose mailbox address is in r8: on to
+/// `{n}_next` when every awake ray (r4, r10) has tested it in this pass
+/// (r11), else the mailbox is updated and the object goes to `{n}_go`.
+fn mailbox_check(t: &mut Code, n: &str) {
+    t.lw(R1, at("MB_PASS", R8))
+        .bne(R1, R11, format!("{n}_fresh"))
+        .c("not tested in this pass yet")
+        .lw(R2, at("MB_RAYS", R8))
+        .lw(R3, at("MB_RAYS+MASK_HI", R8))
+        .or(R1, R2, R4)
+        .bne(R1, R2, format!("{n}_upd"))
+        .or(R1, R3, R10)
+        .beq(R1, R3, format!("{n}_next"))
+        .c("every awake ray has tested it");
+    t.label(format!("{n}_upd"))
+        .or(R2, R2, R4)
+        .or(R3, R3, R10)
+        .sw(R2, at("MB_RAYS", R8))
+        .sw(R3, at("MB_RAYS+MASK_HI", R8))
+        .j(format!("{n}_go"));
+    t.label(format!("{n}_fresh"))
+        .sw(R11, at("MB_PASS", R8))
+        .sw(R4, at("MB_RAYS", R8))
+        .sw(R10, at("MB_RAYS+MASK_HI", R8));
+    t.label(format!("{n}_go")).addi(R13, R13, 1);
+}
+
+/// The leaf (r5): every object not yet tested by every awake ray in this
+/// pass, by type.
+fn leaf(t: &mut Code, lay: &Layout, f: &Fields) {
+    t.comment("the leaf r5: an object in more than one leaf has a mailbox (the pass that last")
+        .comment(
+            "tested it and which rays did); it is broadcast unless every awake ray has tested it",
+        );
+    let awake = |t: &mut Code| {
+        t.rcsl(R4)
+            .rcsh(R10)
+            .nor(R4, R4, R0)
+            .nor(R10, R10, R0)
+            .c("r4, r10: the awake rays")
+            .lw(R11, at("PASS", R0));
+    };
+    if f.streamed {
+        // The block's DMA starts at once: the array reads bank 1 only in a
+        // leaf's object tests, and a pop or a node decision (which waits
+        // for the array) lies between two leaves; the mailbox scan runs
+        // while it moves, and `dwait` only comes before the first object.
+        // A leaf's further pieces wait for the array to finish the last.
+        t.label("leaf")
+            .lw(R1, at("PS_OBJECTS", R5))
+            .beqz(R1, "leaf_done")
+            .c("an empty leaf")
+            .lw(R1, at("PS_SHARED", R5))
+            .lw(R2, at("PS_NEXT", R5))
+            .or(R1, R1, R2)
+            .beqz(R1, "leaf_piece")
+            .c("no mailbox to check");
+        awake(t);
+        t.label("leaf_objects");
+        t.label("leaf_piece")
+            .lw(R1, at("PS_BLOCK", R5))
+            .lw(R3, at("PS_BLOCK_WORDS", R5))
+            .lw(R2, at("CUR_BLK", R0))
+            .beq(R1, R2, "leaf_scan_start")
+            .c("the block is in SBANK already")
+            .li(R2, "SBANK")
+            .ldfb(R1, R2, R3)
+            .c("its DMA starts")
+            .sw(R1, at("CUR_BLK", R0));
+        t.label("leaf_scan_start")
+            .lw(R6, at("PS_LIST", R5))
+            .lw(R9, at("PS_OBJECTS", R5));
+        t.comment("while the block moves: is there an object some awake ray has not tested?");
+        t.label("leaf_scan")
+            .lw(R8, deref(R6))
+            .addi(R6, R6, 4)
+            .beqz(R8, "leaf_load")
+            .c("no mailbox: to be tested")
+            .lw(R1, at("MB_PASS", R8))
+            .bne(R1, R11, "leaf_load")
+            .lw(R2, at("MB_RAYS", R8))
+            .nor(R2, R2, R0)
+            .and(R2, R2, R4)
+            .bnez(R2, "leaf_load")
+            .lw(R3, at("MB_RAYS+MASK_HI", R8))
+            .nor(R3, R3, R0)
+            .and(R3, R3, R10)
+            .bnez(R3, "leaf_load")
+            .addi(R9, R9, -1)
+            .bnez(R9, "leaf_scan")
+            .j("leaf_next_piece")
+            .c("every object tested by every awake ray");
+        t.label("leaf_load")
+            .dwait()
+            .li(R7, "SBANK")
+            .c("r7: the first record")
+            .lw(R6, at("PS_LIST", R5));
+        for ti in &lay.types {
+            let n = format!("lo_{}", ti.ty.name());
+            let up = ti.ty.name().to_uppercase();
+            t.lw(R9, at(format!("PS_COUNT_{up}"), R5))
+                .beqz(R9, format!("{n}_end"));
+            t.label(format!("{n}_obj"))
+                .lw(R8, deref(R6))
+                .addi(R6, R6, 4)
+                .beqz(R8, format!("{n}_go"))
+                .c("no mailbox");
+            mailbox_check(t, &n);
+            ti.ty.broadcast(t, &n, &lay.fit);
+            t.label(format!("{n}_next"))
+                .addi(R7, R7, format!("{up}_WORDS"))
+                .addi(R9, R9, -1)
+                .bnez(R9, format!("{n}_obj"));
+            t.label(format!("{n}_end"));
+        }
+        t.label("leaf_next_piece")
+            .lw(R5, at("PS_NEXT", R5))
+            .beqz(R5, "leaf_done")
+            .rcany(R2)
+            .c("the array done with the bank")
+            .j("leaf_piece");
+    } else {
+        t.label("leaf")
+            .lfb(R1, at("PL_OBJECTS", R5))
+            .beqz(R1, "leaf_done")
+            .c("an empty leaf")
+            .lfb(R1, at("PL_SHARED", R5))
+            .beqz(R1, "leaf_objects")
+            .c("no mailbox to check");
+        awake(t);
+        t.label("leaf_objects")
+            .li(R12, "MAILBOX")
+            .addi(R6, R5, "PL_LISTS");
+        for ti in &lay.types {
+            let n = format!("lo_{}", ti.ty.name());
+            t.lfb(R9, deref(R6))
+                .addi(R6, R6, 1)
+                .beqz(R9, format!("{n}_end"))
+                .c(format!("{}s in the leaf", ti.ty.name()));
+            t.label(format!("{n}_obj"))
+                .lfb(R7, at("LE_RECORD", R6))
+                .lfb(R8, at("LE_MAILBOX", R6))
+                .addi(R6, R6, "LE_WORDS")
+                .blt(R8, R0, format!("{n}_go"))
+                .c("no mailbox")
+                .slli(R8, R8, "MB_SHIFT")
+                .add(R8, R8, R12)
+                .c("r8: its mailbox");
+            mailbox_check(t, &n);
+            ti.ty.broadcast(t, &n, &lay.fit);
+            t.label(format!("{n}_next"))
+                .addi(R9, R9, -1)
+                .bnez(R9, format!("{n}_obj"));
+            t.label(format!("{n}_end"));
+        }
+    }
+}
+
+/// `majority`: r8 = 1 when more awake rays have F (a negative direction
+/// component) than not.
+fn majority(t: &mut Code) {
+    t.doc("majority: r8 = 1 if more awake RCs have F set than not. Clobbers r1..r6, r9, r10.");
+    t.label("majority")
+        .rcfl(R1)
+        .rcfh(R2)
+        .rcsl(R3)
+        .rcsh(R4)
+        .nor(R3, R3, R0)
+        .nor(R4, R4, R0)
+        .and(R5, R1, R3)
+        .and(R6, R2, R4)
+        .c("r5, r6: awake with F")
+        .nor(R1, R1, R0)
+        .nor(R2, R2, R0)
+        .and(R1, R1, R3)
+        .and(R2, R2, R4)
+        .c("r1, r2: awake without F");
+    for x in [R5, R6, R1, R2] {
+        popcount(t, x, R9, R10);
+    }
+    t.add(R5, R5, R6).add(R1, R1, R2).slt(R8, R1, R5).ret();
+}
+
+/// Popcount of `x` into `x` (SWAR), clobbering `t1`, `t2`.
+fn popcount(t: &mut Code, x: Reg, t1: Reg, t2: Reg) {
+    t.comment(format!("{x} = the number of bits set in {x}"))
+        .srli(t1, x, 1)
+        .li(t2, "0x55555555")
+        .and(t1, t1, t2)
+        .sub(x, x, t1)
+        .li(t2, "0x33333333")
+        .and(t1, x, t2)
+        .srli(x, x, 2)
+        .and(x, x, t2)
+        .add(x, x, t1)
+        .srli(t1, x, 4)
+        .add(x, x, t1)
+        .li(t2, "0x0f0f0f0f")
+        .and(x, x, t2)
+        .li(t2, "0x01010101")
+        .mul(x, x, t2)
+        .srli(x, x, 24);
+}
