@@ -170,6 +170,105 @@ RF_T = 6                ; refraction frame: weight T (0: no ray)
 SLOT_TMAX = 0           ; slot: far end of the interval
 SLOT_TMIN = 1           ; slot: near end
 
+; ---- macros ----
+; BCAST k: broadcast kernel k to the array (its contexts, no FB stream). Clobbers r1.
+.macro BCAST k
+        li r1, (\k - CTXBASE) / 4
+        cbcast r1, (\k\()_end - \k) / 4
+.endm
+
+; BCAST_FB k, fb: broadcast kernel k with the FB words from address fb as its stream.
+; Clobbers r1, r2.
+.macro BCAST_FB k, fb
+        li r1, (\k - CTXBASE) / 4
+        li r2, \fb
+        sbcb r1, r2, (\k\()_end - \k) / 4
+.endm
+
+; BCAST_AT k, ra: broadcast kernel k with the FB words from the address in ra as its
+; stream. Clobbers r1.
+.macro BCAST_AT k, ra
+        li r1, (\k - CTXBASE) / 4
+        sbcb r1, \ra, (\k\()_end - \k) / 4
+.endm
+
+; BCAST_REC k, ra, field: broadcast kernel k with the FB words from `field` of the
+; record (or node) at ra as its stream. Clobbers r1, r2.
+.macro BCAST_REC k, ra, field
+        li r1, (\k - CTXBASE) / 4
+        addi r2, \ra, \field
+        sbcb r1, r2, (\k\()_end - \k) / 4
+.endm
+
+; SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream
+; `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.
+.macro SHADOW_PASS light, shade
+        BCAST_FB k_light, \light
+        li r1, 1
+        sw r1, MODE(r0)                 ; any hit
+        jal trace
+        BCAST k_wake
+        BCAST_FB k_shade, \shade
+.endm
+
+; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
+; (kernel `post`: k_post0 for the eye rays, k_post1 after), then every light's
+; shadow pass (3 lights).
+.macro SHADE_LEVEL post
+        sw r0, MODE(r0)                 ; closest hit
+        jal trace
+        BCAST k_wake
+        BCAST_FB \post, FB_POST
+        SHADOW_PASS FB_LIGHT0, FB_SHADE0
+        SHADOW_PASS FB_LIGHT1, FB_SHADE1
+        SHADOW_PASS FB_LIGHT2, FB_SHADE2
+.endm
+; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,
+; r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the
+; pass and the rays, and on to `p_go` (r13 counts the test). Clobbers r1..r3.
+.macro MAILBOX_CHECK p
+        lw r1, MB_PASS(r8)
+        bne r1, r11, \p\()_fresh        ; not tested in this pass yet
+        lw r2, MB_RAYS(r8)
+        lw r3, MB_RAYS+MASK_HI(r8)
+        or r1, r2, r4
+        bne r1, r2, \p\()_upd
+        or r1, r3, r10
+        beq r1, r3, \p\()_next          ; every awake ray has tested it
+\p\()_upd:
+        or r2, r2, r4
+        or r3, r3, r10
+        sw r2, MB_RAYS(r8)
+        sw r3, MB_RAYS+MASK_HI(r8)
+        j \p\()_go
+\p\()_fresh:
+        sw r11, MB_PASS(r8)
+        sw r4, MB_RAYS(r8)
+        sw r10, MB_RAYS+MASK_HI(r8)
+\p\()_go:
+        addi r13, r13, 1                ; one more object test
+.endm
+
+; POPCOUNT x, t1, t2: x = the number of bits set in x (SWAR). Clobbers t1, t2.
+.macro POPCOUNT x, t1, t2
+        srli \t1, \x, 1
+        li \t2, 0x55555555
+        and \t1, \t1, \t2
+        sub \x, \x, \t1                 ; pairs
+        li \t2, 0x33333333
+        and \t1, \x, \t2
+        srli \x, \x, 2
+        and \x, \x, \t2
+        add \x, \x, \t1                 ; nibbles
+        srli \t1, \x, 4
+        add \x, \x, \t1
+        li \t2, 0x0f0f0f0f
+        and \x, \x, \t2                 ; bytes
+        li \t2, 0x01010101
+        mul \x, \x, \t2
+        srli \x, \x, 24                 ; their sum
+.endm
+
 ; ==== TinyRISC data ====
         .data
 PASS:           .word 0                 ; the ray pass's number (mailboxes)
@@ -208,19 +307,14 @@ _start:
         li r3, (ctx_end - CTXBASE) / 4
         ldctxt r1, r2, r3               ; the kernels into context memory
         dwait
-        li r1, (k_init - CTXBASE) / 4
-        li r2, 0
-        sbcb r1, r2, (k_init_end - k_init) / 4 ; RSQ, RCP, C_ONE, C_INF from the FB
+        BCAST_FB k_init, 0              ; RSQ, RCP, C_ONE, C_INF from the FB
         li r1, (k_rows - CTXBASE) / 4
         cbcr r1, r0, 1                  ; row i: r8 = i
-        li r1, (k_strow - CTXBASE) / 4
-        cbcast r1, (k_strow_end - k_strow) / 4
+        BCAST k_strow
         li r1, (k_rows - CTXBASE) / 4
         cbcc r1, r0, 1                  ; column j: r8 = j
-        li r1, (k_stcol - CTXBASE) / 4
-        cbcast r1, (k_stcol_end - k_stcol) / 4
-        li r1, (k_lanes - CTXBASE) / 4
-        cbcast r1, (k_lanes_end - k_lanes) / 4 ; the RCs outside the tile sleep
+        BCAST k_stcol
+        BCAST k_lanes                   ; the RCs outside the tile sleep
         rcany r1                        ; the array done
         rdcyc r1
         sw r1, T_START(r0)
@@ -243,101 +337,11 @@ tile:
         li r6, FB_EYE
         sfb r3, EYE_PX(r6)
         sfb r4, EYE_PY(r6)              ; the tile's corner into the eye stream
-        li r1, (k_eye - CTXBASE) / 4
-        li r2, FB_EYE
-        sbcb r1, r2, (k_eye_end - k_eye) / 4 ; eye rays
-        ; level 0: the rays' closest hits
-        sw r0, MODE(r0)
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_post0 - CTXBASE) / 4
-        li r2, FB_POST
-        sbcb r1, r2, (k_post0_end - k_post0) / 4 ; the hits' shading state
-        ; light 0: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT0
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE0
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        ; light 1: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT1
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE1
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        ; light 2: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT2
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE2
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        li r1, (k_refl0 - CTXBASE) / 4
-        cbcast r1, (k_refl0_end - k_refl0) / 4 ; level 0's reflected rays
-        ; level 1: the rays' closest hits
-        sw r0, MODE(r0)
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_post1 - CTXBASE) / 4
-        li r2, FB_POST
-        sbcb r1, r2, (k_post1_end - k_post1) / 4 ; the hits' shading state
-        ; light 0: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT0
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE0
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        ; light 1: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT1
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE1
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        ; light 2: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT2
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE2
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        li r1, (k_pop0 - CTXBASE) / 4
-        cbcast r1, (k_pop0_end - k_pop0) / 4 ; their colour added
+        BCAST_FB k_eye, FB_EYE          ; eye rays
+        SHADE_LEVEL k_post0             ; level 0: trace, shade, every light
+        BCAST k_refl0                   ; level 0's reflected rays
+        SHADE_LEVEL k_post1             ; level 1: trace, shade, every light
+        BCAST k_pop0                    ; their colour added
         ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)
         li r4, OUT_BANK0
@@ -345,17 +349,13 @@ tile:
         li r4, OUT_BANK1
 out_bank:
         dwait                           ; the bank's last DMA done
-        li r1, (k_out0 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out0
         wfb r4, OUT_R
-        li r1, (k_out1 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out1
         wfb r4, OUT_G
-        li r1, (k_out2 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out2
         wfb r4, OUT_B
-        li r1, (k_out3 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out3
         wfb r4, OUT_ID
         lw r3, CUR_OUT(r0)
         stfb r3, r4, OUT_WORDS          ; DMA to main memory
@@ -387,11 +387,8 @@ trace:
         addi r1, r1, 1
         sw r1, PASS(r0)
         li r13, 0                       ; object tests of the pass
-        li r1, (k_pinit - CTXBASE) / 4
-        li r2, ROOTBOX
-        sbcb r1, r2, (k_pinit_end - k_pinit) / 4 ; intervals in the root cell, 1/d
-        li r1, (k_sign0 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST_FB k_pinit, ROOTBOX       ; intervals in the root cell, 1/d
+        BCAST k_sign0
         rcst r3                         ; the awake rays going down along x: none, some, all
         li r4, 2
         beq r3, r4, trace_done          ; no ray awake
@@ -413,8 +410,7 @@ order_x_set:
         sw r1, NK+AXIS_X(r0)
         sw r2, NF+AXIS_X(r0)
         sw r3, NS+AXIS_X(r0)            ; node kernel, first and second child
-        li r1, (k_sign1 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_sign1
         rcst r3                         ; the awake rays going down along y: none, some, all
         li r8, 0
         beqz r3, order_y
@@ -434,8 +430,7 @@ order_y_set:
         sw r1, NK+AXIS_Y(r0)
         sw r2, NF+AXIS_Y(r0)
         sw r3, NS+AXIS_Y(r0)            ; node kernel, first and second child
-        li r1, (k_sign2 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_sign2
         rcst r3                         ; the awake rays going down along z: none, some, all
         li r8, 0
         beqz r3, order_z
@@ -483,8 +478,7 @@ inner_node:
         addi r1, r4, -1
         beqz r1, some_first
         bnez r4, pop_node               ; no ray awake
-        li r1, (k_ptake - CTXBASE) / 4
-        cbcast r1, (k_ptake_end - k_ptake) / 4 ; none: the second child only
+        BCAST k_ptake                   ; none: the second child only
         mv r5, r10
         lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
@@ -494,12 +488,10 @@ inner_node:
         sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
         j inner_node
 some_first:
-        li r1, (k_ppush - CTXBASE) / 4
-        sbcb r1, r12, (k_ppush_end - k_ppush) / 4 ; the rays' intervals for the second child
+        BCAST_AT k_ppush, r12           ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
-        li r1, (k_psl - CTXBASE) / 4
-        cbcast r1, 1                    ; the rays not reaching the first sleep
+        BCAST k_psl                     ; the rays not reaching the first sleep
         mv r5, r9
         blt r6, r0, leaf
         mv r7, r3
@@ -507,12 +499,10 @@ some_first:
         sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4 ; the first child's node kernel
         j inner_node
 all_first:
-        li r1, (k_p2nd - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_p2nd
         rcany r4
         beqz r4, visit_first            ; no ray reaches the second
-        li r1, (k_ppush - CTXBASE) / 4
-        sbcb r1, r12, (k_ppush_end - k_ppush) / 4 ; the rays' intervals for the second child
+        BCAST_AT k_ppush, r12           ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
 visit_first:
@@ -547,28 +537,8 @@ lo_sphere_obj:
         blt r8, r0, lo_sphere_go        ; no mailbox
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
-        lw r1, MB_PASS(r8)
-        bne r1, r11, lo_sphere_fresh    ; not tested in this pass yet
-        lw r2, MB_RAYS(r8)
-        lw r3, MB_RAYS+MASK_HI(r8)
-        or r1, r2, r4
-        bne r1, r2, lo_sphere_upd
-        or r1, r3, r10
-        beq r1, r3, lo_sphere_next      ; every awake ray has tested it
-lo_sphere_upd:
-        or r2, r2, r4
-        or r3, r3, r10
-        sw r2, MB_RAYS(r8)
-        sw r3, MB_RAYS+MASK_HI(r8)
-        j lo_sphere_go
-lo_sphere_fresh:
-        sw r11, MB_PASS(r8)
-        sw r4, MB_RAYS(r8)
-        sw r10, MB_RAYS+MASK_HI(r8)
-lo_sphere_go:
-        addi r13, r13, 1
-        li r1, (k_sphere - CTXBASE) / 4
-        sbcb r1, r7, (k_sphere_end - k_sphere) / 4
+        MAILBOX_CHECK lo_sphere
+        BCAST_AT k_sphere, r7
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -583,37 +553,12 @@ lo_cylinder_obj:
         blt r8, r0, lo_cylinder_go      ; no mailbox
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
-        lw r1, MB_PASS(r8)
-        bne r1, r11, lo_cylinder_fresh  ; not tested in this pass yet
-        lw r2, MB_RAYS(r8)
-        lw r3, MB_RAYS+MASK_HI(r8)
-        or r1, r2, r4
-        bne r1, r2, lo_cylinder_upd
-        or r1, r3, r10
-        beq r1, r3, lo_cylinder_next    ; every awake ray has tested it
-lo_cylinder_upd:
-        or r2, r2, r4
-        or r3, r3, r10
-        sw r2, MB_RAYS(r8)
-        sw r3, MB_RAYS+MASK_HI(r8)
-        j lo_cylinder_go
-lo_cylinder_fresh:
-        sw r11, MB_PASS(r8)
-        sw r4, MB_RAYS(r8)
-        sw r10, MB_RAYS+MASK_HI(r8)
-lo_cylinder_go:
-        addi r13, r13, 1
-        li r1, (k_cyl - CTXBASE) / 4
-        addi r2, r7, CYL_BODY
-        sbcb r1, r2, (k_cyl_end - k_cyl) / 4 ; the body
+        MAILBOX_CHECK lo_cylinder
+        BCAST_REC k_cyl, r7, CYL_BODY   ; the body
         lfb r3, CYL_CAPS(r7)
         beqz r3, lo_cylinder_nocap
-        li r1, (k_disc - CTXBASE) / 4
-        addi r2, r7, CYL_CAP0
-        sbcb r1, r2, (k_disc_end - k_disc) / 4
-        li r1, (k_disc - CTXBASE) / 4
-        addi r2, r7, CYL_CAP1
-        sbcb r1, r2, (k_disc_end - k_disc) / 4 ; the caps
+        BCAST_REC k_disc, r7, CYL_CAP0
+        BCAST_REC k_disc, r7, CYL_CAP1  ; the caps
 lo_cylinder_nocap:
 lo_cylinder_next:
         addi r9, r9, -1
@@ -629,28 +574,8 @@ lo_box_obj:
         blt r8, r0, lo_box_go           ; no mailbox
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
-        lw r1, MB_PASS(r8)
-        bne r1, r11, lo_box_fresh       ; not tested in this pass yet
-        lw r2, MB_RAYS(r8)
-        lw r3, MB_RAYS+MASK_HI(r8)
-        or r1, r2, r4
-        bne r1, r2, lo_box_upd
-        or r1, r3, r10
-        beq r1, r3, lo_box_next         ; every awake ray has tested it
-lo_box_upd:
-        or r2, r2, r4
-        or r3, r3, r10
-        sw r2, MB_RAYS(r8)
-        sw r3, MB_RAYS+MASK_HI(r8)
-        j lo_box_go
-lo_box_fresh:
-        sw r11, MB_PASS(r8)
-        sw r4, MB_RAYS(r8)
-        sw r10, MB_RAYS+MASK_HI(r8)
-lo_box_go:
-        addi r13, r13, 1
-        li r1, (k_box - CTXBASE) / 4
-        sbcb r1, r7, (k_box_end - k_box) / 4
+        MAILBOX_CHECK lo_box
+        BCAST_AT k_box, r7
 lo_box_next:
         addi r9, r9, -1
         bnez r9, lo_box_obj
@@ -665,28 +590,8 @@ lo_rectangle_obj:
         blt r8, r0, lo_rectangle_go     ; no mailbox
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
-        lw r1, MB_PASS(r8)
-        bne r1, r11, lo_rectangle_fresh ; not tested in this pass yet
-        lw r2, MB_RAYS(r8)
-        lw r3, MB_RAYS+MASK_HI(r8)
-        or r1, r2, r4
-        bne r1, r2, lo_rectangle_upd
-        or r1, r3, r10
-        beq r1, r3, lo_rectangle_next   ; every awake ray has tested it
-lo_rectangle_upd:
-        or r2, r2, r4
-        or r3, r3, r10
-        sw r2, MB_RAYS(r8)
-        sw r3, MB_RAYS+MASK_HI(r8)
-        j lo_rectangle_go
-lo_rectangle_fresh:
-        sw r11, MB_PASS(r8)
-        sw r4, MB_RAYS(r8)
-        sw r10, MB_RAYS+MASK_HI(r8)
-lo_rectangle_go:
-        addi r13, r13, 1
-        li r1, (k_rect - CTXBASE) / 4
-        sbcb r1, r7, (k_rect_end - k_rect) / 4
+        MAILBOX_CHECK lo_rectangle
+        BCAST_AT k_rect, r7
 lo_rectangle_next:
         addi r9, r9, -1
         bnez r9, lo_rectangle_obj
@@ -701,28 +606,8 @@ lo_triangle_obj:
         blt r8, r0, lo_triangle_go      ; no mailbox
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
-        lw r1, MB_PASS(r8)
-        bne r1, r11, lo_triangle_fresh  ; not tested in this pass yet
-        lw r2, MB_RAYS(r8)
-        lw r3, MB_RAYS+MASK_HI(r8)
-        or r1, r2, r4
-        bne r1, r2, lo_triangle_upd
-        or r1, r3, r10
-        beq r1, r3, lo_triangle_next    ; every awake ray has tested it
-lo_triangle_upd:
-        or r2, r2, r4
-        or r3, r3, r10
-        sw r2, MB_RAYS(r8)
-        sw r3, MB_RAYS+MASK_HI(r8)
-        j lo_triangle_go
-lo_triangle_fresh:
-        sw r11, MB_PASS(r8)
-        sw r4, MB_RAYS(r8)
-        sw r10, MB_RAYS+MASK_HI(r8)
-lo_triangle_go:
-        addi r13, r13, 1
-        li r1, (k_tri - CTXBASE) / 4
-        sbcb r1, r7, (k_tri_end - k_tri) / 4
+        MAILBOX_CHECK lo_triangle
+        BCAST_AT k_tri, r7
 lo_triangle_next:
         addi r9, r9, -1
         bnez r9, lo_triangle_obj
@@ -730,8 +615,7 @@ lo_triangle_end:
 leaf_done:
         lw r1, MODE(r0)
         beqz r1, pop_node
-        li r1, (k_pleafa - CTXBASE) / 4
-        cbcast r1, (k_pleafa_end - k_pleafa) / 4 ; any hit: the rays with a hit are done
+        BCAST k_pleafa                  ; any hit: the rays with a hit are done
 pop_node:
         li r9, NSTACK
         beq r14, r9, trace_done
@@ -770,74 +654,10 @@ majority:
         nor r2, r2, r0
         and r1, r1, r3
         and r2, r2, r4                  ; r1, r2: awake without F
-        ; r5 = the number of bits set in r5
-        srli r9, r5, 1
-        li r10, 0x55555555
-        and r9, r9, r10
-        sub r5, r5, r9
-        li r10, 0x33333333
-        and r9, r5, r10
-        srli r5, r5, 2
-        and r5, r5, r10
-        add r5, r5, r9
-        srli r9, r5, 4
-        add r5, r5, r9
-        li r10, 0x0f0f0f0f
-        and r5, r5, r10
-        li r10, 0x01010101
-        mul r5, r5, r10
-        srli r5, r5, 24
-        ; r6 = the number of bits set in r6
-        srli r9, r6, 1
-        li r10, 0x55555555
-        and r9, r9, r10
-        sub r6, r6, r9
-        li r10, 0x33333333
-        and r9, r6, r10
-        srli r6, r6, 2
-        and r6, r6, r10
-        add r6, r6, r9
-        srli r9, r6, 4
-        add r6, r6, r9
-        li r10, 0x0f0f0f0f
-        and r6, r6, r10
-        li r10, 0x01010101
-        mul r6, r6, r10
-        srli r6, r6, 24
-        ; r1 = the number of bits set in r1
-        srli r9, r1, 1
-        li r10, 0x55555555
-        and r9, r9, r10
-        sub r1, r1, r9
-        li r10, 0x33333333
-        and r9, r1, r10
-        srli r1, r1, 2
-        and r1, r1, r10
-        add r1, r1, r9
-        srli r9, r1, 4
-        add r1, r1, r9
-        li r10, 0x0f0f0f0f
-        and r1, r1, r10
-        li r10, 0x01010101
-        mul r1, r1, r10
-        srli r1, r1, 24
-        ; r2 = the number of bits set in r2
-        srli r9, r2, 1
-        li r10, 0x55555555
-        and r9, r9, r10
-        sub r2, r2, r9
-        li r10, 0x33333333
-        and r9, r2, r10
-        srli r2, r2, 2
-        and r2, r2, r10
-        add r2, r2, r9
-        srli r9, r2, 4
-        add r2, r2, r9
-        li r10, 0x0f0f0f0f
-        and r2, r2, r10
-        li r10, 0x01010101
-        mul r2, r2, r10
-        srli r2, r2, 24
+        POPCOUNT r5, r9, r10
+        POPCOUNT r6, r9, r10
+        POPCOUNT r1, r9, r10
+        POPCOUNT r2, r9, r10
         add r5, r5, r6
         add r1, r1, r2
         slt r8, r1, r5

@@ -63,11 +63,11 @@ NOBJ = 4                ; objects in the scene
 PASS_WRAP = 0x7fff      ; pass numbers wrap here (16-bit mailboxes)
 
 ; ---- BSP nodes ----
-N_FLAGS = 0             ; Fig. 5 node: bit 15 a leaf, bits 1..0 the split axis
-N_SPLIT = 1             ;   the split's position
-N_LEFT = 2              ;   the child below (FB address)
-N_RIGHT = 3             ;   the child above
-N_BOUNDS = 4            ;   the cell, widened by 2 LSB: min.xyz, max.xyz
+N_FLAGS = 0             ; node: bit 15 a leaf, bits 1..0 the split axis
+N_SPLIT = 1             ;   inner: the split's position
+N_LEFT = 2              ;   inner: the child below (FB address)
+N_RIGHT = 3             ;   inner: the child above
+N_BOUNDS = 4            ;   Fig. 5: the cell, widened by 2 LSB: min.xyz, max.xyz
 N_BV_TRIANGLE = 10      ;   the triangles under it, a bit each
 BV_WORDS_TRIANGLE = 1   ;   words of that bit vector
 
@@ -138,6 +138,58 @@ RF_T = 6                ; refraction frame: weight T (0: no ray)
 SLOT_TMAX = 0           ; slot: far end of the interval
 SLOT_TMIN = 1           ; slot: near end
 
+; ---- macros ----
+; BCAST k: broadcast kernel k to the array (its contexts, no FB stream). Clobbers r1.
+.macro BCAST k
+        li r1, (\k - CTXBASE) / 4
+        cbcast r1, (\k\()_end - \k) / 4
+.endm
+
+; BCAST_FB k, fb: broadcast kernel k with the FB words from address fb as its stream.
+; Clobbers r1, r2.
+.macro BCAST_FB k, fb
+        li r1, (\k - CTXBASE) / 4
+        li r2, \fb
+        sbcb r1, r2, (\k\()_end - \k) / 4
+.endm
+
+; BCAST_AT k, ra: broadcast kernel k with the FB words from the address in ra as its
+; stream. Clobbers r1.
+.macro BCAST_AT k, ra
+        li r1, (\k - CTXBASE) / 4
+        sbcb r1, \ra, (\k\()_end - \k) / 4
+.endm
+
+; BCAST_REC k, ra, field: broadcast kernel k with the FB words from `field` of the
+; record (or node) at ra as its stream. Clobbers r1, r2.
+.macro BCAST_REC k, ra, field
+        li r1, (\k - CTXBASE) / 4
+        addi r2, \ra, \field
+        sbcb r1, r2, (\k\()_end - \k) / 4
+.endm
+
+; SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream
+; `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.
+.macro SHADOW_PASS light, shade
+        BCAST_FB k_light, \light
+        li r1, 1
+        sw r1, MODE(r0)                 ; any hit
+        jal trace
+        BCAST k_wake
+        BCAST_FB k_shade, \shade
+.endm
+
+; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
+; (kernel `post`: k_post0 for the eye rays, k_post1 after), then every light's
+; shadow pass (1 light).
+.macro SHADE_LEVEL post
+        sw r0, MODE(r0)                 ; closest hit
+        jal trace
+        BCAST k_wake
+        BCAST_FB \post, FB_POST
+        SHADOW_PASS FB_LIGHT0, FB_SHADE0
+.endm
+
 ; ==== TinyRISC data ====
         .data
 PASS:           .word 0                 ; the ray pass's number (mailboxes)
@@ -172,19 +224,14 @@ _start:
         li r3, (ctx_end - CTXBASE) / 4
         ldctxt r1, r2, r3               ; the kernels into context memory
         dwait
-        li r1, (k_init - CTXBASE) / 4
-        li r2, 0
-        sbcb r1, r2, (k_init_end - k_init) / 4 ; RSQ, RCP, C_ONE, C_INF from the FB
+        BCAST_FB k_init, 0              ; RSQ, RCP, C_ONE, C_INF from the FB
         li r1, (k_rows - CTXBASE) / 4
         cbcr r1, r0, 1                  ; row i: r8 = i
-        li r1, (k_strow - CTXBASE) / 4
-        cbcast r1, (k_strow_end - k_strow) / 4
+        BCAST k_strow
         li r1, (k_rows - CTXBASE) / 4
         cbcc r1, r0, 1                  ; column j: r8 = j
-        li r1, (k_stcol - CTXBASE) / 4
-        cbcast r1, (k_stcol_end - k_stcol) / 4
-        li r1, (k_lanes - CTXBASE) / 4
-        cbcast r1, (k_lanes_end - k_lanes) / 4 ; the RCs outside the tile sleep
+        BCAST k_stcol
+        BCAST k_lanes                   ; the RCs outside the tile sleep
         rcany r1                        ; the array done
         rdcyc r1
         sw r1, T_START(r0)
@@ -207,53 +254,11 @@ tile:
         li r6, FB_EYE
         sfb r3, EYE_PX(r6)
         sfb r4, EYE_PY(r6)              ; the tile's corner into the eye stream
-        li r1, (k_eye - CTXBASE) / 4
-        li r2, FB_EYE
-        sbcb r1, r2, (k_eye_end - k_eye) / 4 ; eye rays
-        ; level 0: the rays' closest hits
-        sw r0, MODE(r0)
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_post0 - CTXBASE) / 4
-        li r2, FB_POST
-        sbcb r1, r2, (k_post0_end - k_post0) / 4 ; the hits' shading state
-        ; light 0: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT0
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE0
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        li r1, (k_refl0 - CTXBASE) / 4
-        cbcast r1, (k_refl0_end - k_refl0) / 4 ; level 0's reflected rays
-        ; level 1: the rays' closest hits
-        sw r0, MODE(r0)
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_post1 - CTXBASE) / 4
-        li r2, FB_POST
-        sbcb r1, r2, (k_post1_end - k_post1) / 4 ; the hits' shading state
-        ; light 0: shadow rays, then its Phong terms where lit
-        li r1, (k_light - CTXBASE) / 4
-        li r2, FB_LIGHT0
-        sbcb r1, r2, (k_light_end - k_light) / 4
-        li r1, 1
-        sw r1, MODE(r0)                 ; any hit
-        jal trace
-        li r1, (k_wake - CTXBASE) / 4
-        cbcast r1, (k_wake_end - k_wake) / 4
-        li r1, (k_shade - CTXBASE) / 4
-        li r2, FB_SHADE0
-        sbcb r1, r2, (k_shade_end - k_shade) / 4
-        li r1, (k_pop0 - CTXBASE) / 4
-        cbcast r1, (k_pop0_end - k_pop0) / 4 ; their colour added
+        BCAST_FB k_eye, FB_EYE          ; eye rays
+        SHADE_LEVEL k_post0             ; level 0: trace, shade, every light
+        BCAST k_refl0                   ; level 0's reflected rays
+        SHADE_LEVEL k_post1             ; level 1: trace, shade, every light
+        BCAST k_pop0                    ; their colour added
         ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)
         li r4, OUT_BANK0
@@ -261,17 +266,13 @@ tile:
         li r4, OUT_BANK1
 out_bank:
         dwait                           ; the bank's last DMA done
-        li r1, (k_out0 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out0
         wfb r4, OUT_R
-        li r1, (k_out1 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out1
         wfb r4, OUT_G
-        li r1, (k_out2 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out2
         wfb r4, OUT_B
-        li r1, (k_out3 - CTXBASE) / 4
-        cbcast r1, 1
+        BCAST k_out3
         wfb r4, OUT_ID
         lw r3, CUR_OUT(r0)
         stfb r3, r4, OUT_WORDS          ; DMA to main memory
@@ -307,20 +308,17 @@ trace:
         li r1, 1
 trace_numbered:
         sw r1, PASS(r0)
-        li r1, (k_sign0 - CTXBASE) / 4
-        cbcast r1, (k_sign0_end - k_sign0) / 4
+        BCAST k_sign0
         rcfl r2
         rcfh r3
         sw r2, NEG_X(r0)
         sw r3, NEG_X+MASK_HI(r0)        ; the rays going down along this axis
-        li r1, (k_sign1 - CTXBASE) / 4
-        cbcast r1, (k_sign1_end - k_sign1) / 4
+        BCAST k_sign1
         rcfl r2
         rcfh r3
         sw r2, NEG_Y(r0)
         sw r3, NEG_Y+MASK_HI(r0)        ; the rays going down along this axis
-        li r1, (k_sign2 - CTXBASE) / 4
-        cbcast r1, (k_sign2_end - k_sign2) / 4
+        BCAST k_sign2
         rcfl r2
         rcfh r3
         sw r2, NEG_Z(r0)
@@ -398,13 +396,10 @@ leaf:
         jal test_objects
         lw r1, MODE(r0)
         bnez r1, leaf_any_hit
-        li r1, (k_leafc - CTXBASE) / 4
-        addi r2, r5, N_BOUNDS
-        sbcb r1, r2, (k_leafc_end - k_leafc) / 4 ; the rays with a hit in the cell sleep
+        BCAST_REC k_leafc, r5, N_BOUNDS ; the rays with a hit in the cell sleep
         j leaf_done
 leaf_any_hit:
-        li r1, (k_leafa - CTXBASE) / 4
-        cbcast r1, (k_leafa_end - k_leafa) / 4 ; the rays with a hit sleep
+        BCAST k_leafa                   ; the rays with a hit sleep
 leaf_done:
         jal read_awake
 pop_node:
@@ -465,8 +460,7 @@ to_triangle_obj:
         lw r1, TESTS(r0)
         addi r1, r1, 1
         sw r1, TESTS(r0)
-        li r1, (k_tri - CTXBASE) / 4
-        sbcb r1, r7, (k_tri_end - k_tri) / 4
+        BCAST_AT k_tri, r7
 to_triangle_next:
         addi r7, r7, TRIANGLE_WORDS
         addi r8, r8, 1

@@ -6,7 +6,7 @@
 
 use std::collections::BTreeMap;
 
-use firmware::asm::Image;
+use firmware::asm::{Image, Section};
 use rtl::rc::Word;
 use rtl::{Chip, Sim};
 
@@ -51,35 +51,18 @@ pub struct Names {
 }
 
 impl Names {
-    pub fn new(img: &Image, source: &str, ctx_base: u32) -> Names {
-        let mut section = ".text";
-        let mut text_labels = Vec::new();
-        for line in source.lines() {
-            let l = line.trim_start();
-            if l.starts_with(".text") || l.starts_with(".data") || l.starts_with(".ctx") {
-                section = &l[..5.min(l.len())];
-                continue;
-            }
-            if section == ".text" && !line.starts_with(' ') {
-                if let Some((name, _)) = line.split_once(':') {
-                    if !name.is_empty() && name.chars().all(|c| c.is_alphanumeric() || c == '_') {
-                        text_labels.push(name.to_string());
-                    }
-                }
-            }
-        }
-        let mut labels: Vec<(u32, String)> = text_labels
-            .into_iter()
-            .filter_map(|n| img.symbol(&n).map(|v| (v as u32, n)))
+    pub fn new(img: &Image, ctx_base: u32) -> Names {
+        // TinyRISC's code labels (the macros' included), and the kernels:
+        // the context labels `k_NAME` (not their `k_NAME_end`).
+        let labels = img
+            .labels_in(Section::Text)
+            .map(|l| (l.addr, l.name.clone()))
             .collect();
-        labels.sort();
-        let mut kernels: Vec<(u32, String)> = img
-            .symbols
-            .iter()
-            .filter(|(n, v)| n.starts_with("k_") && !n.ends_with("_end") && **v >= ctx_base as i64)
-            .map(|(n, v)| (((*v as u32) - ctx_base) / 4, n.clone()))
+        let kernels = img
+            .labels_in(Section::Ctx)
+            .filter(|l| l.name.starts_with("k_") && !l.name.ends_with("_end") && l.addr >= ctx_base)
+            .map(|l| ((l.addr - ctx_base) / 4, l.name.clone()))
             .collect();
-        kernels.sort();
         Names { kernels, labels }
     }
 

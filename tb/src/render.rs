@@ -307,7 +307,7 @@ fn run_group<W: Word>(
     let mut prof = None;
     if result.is_ok() {
         if profile {
-            let names = crate::profile::Names::new(img, &fw.source, mem::CTX_BASE);
+            let names = crate::profile::Names::new(img, mem::CTX_BASE);
             match crate::profile::run(&mut sim, &names, MAX_CYCLES_PER_CHIP) {
                 Ok(p) => {
                     result = Ok(p.cycles);

@@ -85,3 +85,72 @@ fn the_generated_firmware_is_the_golden_one() {
         failures.join("\n\n")
     );
 }
+
+/// The golden programs read as hand-written firmware: every RC RAM
+/// address and every TinyRISC load/store offset by name (no `[#286]`, no
+/// `[r0 + #256]`, no `lw r2, 8(r5)`), no instruction at column 0 (labels,
+/// constants, data and directives only), and at least 15% of the lines
+/// commented.
+#[test]
+fn the_golden_firmware_names_its_numbers() {
+    let is_name = |s: &str| {
+        s.chars()
+            .next()
+            .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
+    };
+    for (file, _, _) in GOLDEN {
+        let path = root().join("firmware/golden").join(file);
+        let text = std::fs::read_to_string(&path).unwrap();
+        let mut problems = Vec::new();
+        let (mut lines, mut commented) = (0usize, 0usize);
+        for (k, line) in text.lines().enumerate() {
+            lines += 1;
+            commented += line.contains(';') as usize;
+            let code = line.split(';').next().unwrap_or("");
+            let at = |what: &str| format!("{file}:{}: {what}: {line}", k + 1);
+            // RC memory operands: `[B]` or `[A + B]` with B an immediate.
+            if let (Some(a), Some(b)) = (code.find('['), code.find(']')) {
+                let inner = &code[a + 1..b];
+                let imm = inner.rsplit('+').next().unwrap_or("").trim();
+                if let Some(v) = imm.strip_prefix('#') {
+                    if !is_name(v.trim()) {
+                        problems.push(at("a bare RAM address"));
+                    }
+                }
+            }
+            let trimmed = code.trim_start();
+            let word = trimmed.split_whitespace().next().unwrap_or("");
+            // TinyRISC loads and stores: `OFFSET(rB)` with a named offset or none.
+            if ["lw", "lh", "lhu", "lb", "lbu", "sw", "sh", "sb", "lfb", "sfb"].contains(&word) {
+                if let Some(p) = code.find('(') {
+                    let off = code[..p].rsplit(',').next().unwrap_or("").trim();
+                    if !off.is_empty() && !is_name(off) {
+                        problems.push(at("a bare load/store offset"));
+                    }
+                }
+            }
+            // Nothing but labels, constants, data, directives and
+            // comments at column 0.
+            if !code.is_empty() && !code.starts_with(char::is_whitespace) && !code.starts_with('.')
+            {
+                let label_only = code.trim_end().ends_with(':');
+                let constant = code.contains('=');
+                let data = code
+                    .split_once(':')
+                    .is_some_and(|(_, rest)| rest.trim_start().starts_with('.'));
+                if !(label_only || constant || data) {
+                    problems.push(at("an instruction at column 0"));
+                }
+            }
+        }
+        let share = commented as f64 / lines as f64;
+        eprintln!("{file}: {lines} lines, {:.1}% commented", 100.0 * share);
+        if share < 0.15 {
+            problems.push(format!(
+                "{file}: {:.1}% of the lines have a comment, under 15%",
+                100.0 * share
+            ));
+        }
+        assert!(problems.is_empty(), "{}", problems.join("\n"));
+    }
+}

@@ -281,3 +281,9 @@ pub(crate) fn guard_prefix(t: &[Token], i: usize) -> (Guard, usize) {
         (Guard::Always, i)
     }
 }
+
+/// An RC operation's name (with or without its suffixes).
+pub(crate) fn is_mnemonic(w: &str) -> bool {
+    let base = w.split('.').next().unwrap_or("");
+    ALL_OPS.iter().any(|o| o.mnemonic() == base)
+}

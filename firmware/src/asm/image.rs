@@ -41,6 +41,18 @@ pub struct Image {
     pub entry: u32,
     pub segments: Vec<Segment>,
     pub symbols: BTreeMap<String, i64>,
+    /// The labels (`name:`, not constants), with their sections, in
+    /// address order: what a waveform or a profile names an address by.
+    /// Not kept in the image file.
+    pub labels: Vec<Label>,
+}
+
+/// A label of the source: its name, its section and its address.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Label {
+    pub addr: u32,
+    pub section: Section,
+    pub name: String,
 }
 
 const MAGIC: &[u8; 8] = b"MSYSIMG1";
@@ -103,6 +115,7 @@ impl Image {
             entry,
             segments,
             symbols: BTreeMap::new(),
+            labels: Vec::new(),
         })
     }
 
@@ -118,6 +131,25 @@ impl Image {
     /// The address of a symbol.
     pub fn symbol(&self, name: &str) -> Option<i64> {
         self.symbols.get(name).copied()
+    }
+
+    /// The labels of one section, in address order.
+    pub fn labels_in(&self, section: Section) -> impl Iterator<Item = &Label> {
+        self.labels.iter().filter(move |l| l.section == section)
+    }
+
+    /// `label+offset` for an address of `section` (the nearest label at or
+    /// before it; `label` alone at the label), or `None` before the
+    /// section's first label.
+    pub fn locate(&self, section: Section, addr: u32) -> Option<String> {
+        let l = self
+            .labels_in(section)
+            .take_while(|l| l.addr <= addr)
+            .last()?;
+        Some(match addr - l.addr {
+            0 => l.name.clone(),
+            d => format!("{}+{d}", l.name),
+        })
     }
 }
 

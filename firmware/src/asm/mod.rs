@@ -27,12 +27,13 @@ mod context;
 mod expr;
 mod image;
 mod lexer;
+mod macros;
 mod tinyrisc;
 
 use std::collections::{BTreeMap, HashMap};
 use std::fmt;
 
-pub use image::{disassemble_image, Image, Section, Segment};
+pub use image::{disassemble_image, Image, Label, Section, Segment};
 use lexer::{Tok, Token};
 
 /// An assembly error at `file:line:col`, with the offending line.
@@ -135,17 +136,25 @@ pub fn assemble(src: &str, file: &str) -> Result<Image, AsmErrors> {
         entry: None,
         wide: false,
         pending_equ: Vec::new(),
+        labels: Vec::new(),
     };
-    for (i, text) in src.lines().enumerate() {
+    let is_mnemonic = |w: &str| tinyrisc::is_mnemonic(w) || context::is_mnemonic(w);
+    let expanded = macros::expand(src, file, &is_mnemonic).map_err(|e| AsmErrors(vec![e]))?;
+    for l in expanded {
         let mk = |col: usize, msg: String| AsmError {
             file: file.to_string(),
-            line: i + 1,
+            line: l.no,
             col,
-            message: msg,
-            text: text.to_string(),
+            message: format!("{msg}{}", l.from.as_deref().unwrap_or("")),
+            text: l.text.clone(),
         };
-        match lexer::lex(text, &mk) {
-            Ok(toks) => a.lines.push((i + 1, text.to_string(), toks)),
+        match lexer::lex(&l.text, &mk) {
+            Ok(toks) => a.lines.push(Src {
+                no: l.no,
+                text: l.text,
+                toks,
+                from: l.from,
+            }),
             Err(e) => a.errors.push(e),
         }
     }
@@ -160,7 +169,7 @@ pub fn assemble(src: &str, file: &str) -> Result<Image, AsmErrors> {
     for _ in 0..8 {
         let pending = std::mem::take(&mut a.pending_equ);
         for (name, li, toks_from, here) in pending {
-            let toks = a.lines[li].2[toks_from..].to_vec();
+            let toks = a.lines[li].toks[toks_from..].to_vec();
             let c = expr::Ctx {
                 symbols: &a.symbols,
                 here,
@@ -211,16 +220,19 @@ pub fn assemble(src: &str, file: &str) -> Result<Image, AsmErrors> {
             }]));
         }
     }
+    let mut labels = std::mem::take(&mut a.labels);
+    labels.sort_by(|x, y| (x.section as u8, x.addr).cmp(&(y.section as u8, y.addr)));
     Ok(Image {
         entry,
         segments: segs,
         symbols,
+        labels,
     })
 }
 
 struct Asm {
     file: String,
-    lines: Vec<(usize, String, Vec<Token>)>,
+    lines: Vec<Src>,
     symbols: HashMap<String, i64>,
     errors: Vec<AsmError>,
     loc: [i64; 3],
@@ -234,6 +246,19 @@ struct Asm {
     pub(crate) wide: bool,
     /// (name, line index, first token of the expression, `.` there)
     pending_equ: Vec<(String, usize, usize, i64)>,
+    /// The labels defined (pass 1).
+    labels: Vec<Label>,
+}
+
+/// A source line (after macro expansion): its number in the file, its
+/// text, its tokens, and for a line of a macro's body where the macro was
+/// used (appended to its errors).
+#[derive(Clone, Debug)]
+struct Src {
+    no: usize,
+    text: String,
+    toks: Vec<Token>,
+    from: Option<String>,
 }
 
 /// Context of one line for error reporting and operand parsing.
@@ -289,7 +314,7 @@ impl Asm {
     /// constants defined above with `=`; no nesting).
     fn expand_rept(&mut self) -> Result<(), AsmError> {
         let is = |toks: &[Token], d: &str| matches!(toks.first().map(|t| &t.tok), Some(Tok::Ident(n)) if n == d);
-        if !self.lines.iter().any(|l| is(&l.2, ".rept")) {
+        if !self.lines.iter().any(|l| is(&l.toks, ".rept")) {
             return Ok(());
         }
         let lines = std::mem::take(&mut self.lines);
@@ -297,7 +322,12 @@ impl Asm {
         let mut consts: HashMap<String, i64> = HashMap::new();
         let mut k = 0;
         while k < lines.len() {
-            let (no, text, toks) = &lines[k];
+            let Src {
+                no,
+                text,
+                toks,
+                from,
+            } = &lines[k];
             let lc = LineCtx {
                 file: &self.file,
                 line: *no,
@@ -317,8 +347,12 @@ impl Asm {
                     }
                 }
             }
+            let note = |mut e: AsmError| {
+                e.message.push_str(from.as_deref().unwrap_or(""));
+                e
+            };
             if is(toks, ".endr") {
-                return Err(lc.err_at(Some(0), "`.endr` without `.rept`"));
+                return Err(note(lc.err_at(Some(0), "`.endr` without `.rept`")));
             }
             if !is(toks, ".rept") {
                 out.push(lines[k].clone());
@@ -333,7 +367,11 @@ impl Asm {
             let mut p = expr::Parser::new(&toks[1..]);
             let n = match p.expr(&c) {
                 Ok(Some(n)) if (0..=65536).contains(&n) => n,
-                _ => return Err(lc.err_at(Some(1), "`.rept N` needs a count 0..=65536 known here")),
+                _ => {
+                    return Err(note(
+                        lc.err_at(Some(1), "`.rept N` needs a count 0..=65536 known here"),
+                    ))
+                }
             };
             // `.rept N, VAR`: VAR stands for 0, 1, ..., N - 1 in the body.
             let var = match &toks[p.pos + 1..] {
@@ -343,31 +381,32 @@ impl Asm {
                         Some(v.clone())
                     }
                     _ => {
-                        return Err(lc.err_at(
+                        return Err(note(lc.err_at(
                             Some(p.pos + 3),
                             "`.rept N, VAR`: VAR must be a name (not a register or directive)",
-                        ))
+                        )))
                     }
                 },
                 _ => {
-                    return Err(lc.err_at(
+                    return Err(note(lc.err_at(
                         Some(p.pos + 1),
                         "expected `.rept N` or `.rept N, VAR` (VAR counts 0..N-1 in the body)",
-                    ))
+                    )))
                 }
             };
             let end = (k + 1..lines.len())
-                .find(|&j| is(&lines[j].2, ".endr") || is(&lines[j].2, ".rept"));
-            let Some(end) = end.filter(|&j| is(&lines[j].2, ".endr")) else {
-                return Err(lc.err_at(
+                .find(|&j| is(&lines[j].toks, ".endr") || is(&lines[j].toks, ".rept"));
+            let Some(end) = end.filter(|&j| is(&lines[j].toks, ".endr")) else {
+                return Err(note(lc.err_at(
                     Some(0),
                     "`.rept` without `.endr` (nesting is not supported)",
-                ));
+                )));
             };
             for i in 0..n {
-                for (no, text, toks) in &lines[k + 1..end] {
+                for l in &lines[k + 1..end] {
                     let toks = match &var {
-                        Some(v) => toks
+                        Some(v) => l
+                            .toks
                             .iter()
                             .map(|t| match &t.tok {
                                 Tok::Ident(x) if x == v => Token {
@@ -377,9 +416,9 @@ impl Asm {
                                 _ => t.clone(),
                             })
                             .collect(),
-                        None => toks.clone(),
+                        None => l.toks.clone(),
                     };
-                    out.push((*no, text.clone(), toks));
+                    out.push(Src { toks, ..l.clone() });
                 }
             }
             k = end + 1;
@@ -397,7 +436,9 @@ impl Asm {
             if self.errors.len() >= MAX_ERRORS {
                 return;
             }
-            if let Err(e) = self.line(li) {
+            if let Err(mut e) = self.line(li) {
+                e.message
+                    .push_str(self.lines[li].from.as_deref().unwrap_or(""));
                 self.errors.push(e);
             }
         }
@@ -502,7 +543,7 @@ impl Asm {
     fn line(&mut self, li: usize) -> Result<(), AsmError> {
         let (no, text, toks) = {
             let l = &self.lines[li];
-            (l.0, l.1.clone(), l.2.clone())
+            (l.no, l.text.clone(), l.toks.clone())
         };
         let file = self.file.clone();
         let lc = LineCtx {
@@ -518,6 +559,13 @@ impl Asm {
                 (Tok::Ident(name), Tok::P(":")) if !name.starts_with('.') => {
                     let here = self.here();
                     self.define(&lc, i, name, here)?;
+                    if self.pass == 1 && (0..=u32::MAX as i64).contains(&here) {
+                        self.labels.push(Label {
+                            addr: here as u32,
+                            section: self.section,
+                            name: name.clone(),
+                        });
+                    }
                     i += 2;
                 }
                 _ => break,

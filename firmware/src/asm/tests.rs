@@ -425,3 +425,105 @@ fn deep_expressions_are_refused_at_their_column_not_overflowing_the_stack() {
         );
     }
 }
+
+/// `.rept N, VAR`: the body N times, VAR the iteration.
+#[test]
+fn rept_with_a_counter_numbers_its_copies() {
+    let img = assemble(
+        ".ctx\nBASE = 10\n.rept 4, i\nst fb0, [#BASE+i]\n.endr\n.rept 2\nnop\n.endr\n",
+        "t.s",
+    )
+    .unwrap();
+    let got = words(&img, Section::Ctx);
+    let want: Vec<u32> = [10, 11, 12, 13]
+        .iter()
+        .map(|a| one_ctx(&format!("st fb0, [#{a}]")))
+        .chain([one_ctx("nop"), one_ctx("nop")])
+        .collect();
+    assert_eq!(got, want);
+    let e = err(".ctx\n.rept 2, r3\nnop\n.endr\n");
+    assert!(e.message.contains("VAR must be a name"), "{}", e.message);
+    let e = err(".ctx\n.rept 2 3\nnop\n.endr\n");
+    assert!(e.message.contains("`.rept N, VAR`"), "{}", e.message);
+}
+
+/// Macros expand to the same words as their bodies written out, with
+/// parameters, `\()` and unique `\@` labels.
+#[test]
+fn macros_expand_to_their_bodies() {
+    let src = "\
+.macro BCAST k, n
+        li r1, \\k
+        cbcast r1, \\n
+.endm
+.macro LOOP p, reg
+\\p\\()_top\\@:
+        addi \\reg, \\reg, -1
+        bnez \\reg, \\p\\()_top\\@
+.endm
+        .text
+start:  BCAST 5, 2          ; a comment
+        LOOP wait, r3
+        LOOP wait, r4
+";
+    let plain = "\
+        .text
+start:  li r1, 5
+        cbcast r1, 2
+wait_top2:
+        addi r3, r3, -1
+        bnez r3, wait_top2
+wait_top3:
+        addi r4, r4, -1
+        bnez r4, wait_top3
+";
+    let a = assemble(src, "m.s").unwrap_or_else(|e| panic!("{e}"));
+    let b = assemble(plain, "p.s").unwrap();
+    assert_eq!(words(&a, Section::Text), words(&b, Section::Text));
+    // `\@` numbers every use: BCAST was the first.
+    assert_eq!(a.symbol("wait_top3"), b.symbol("wait_top3"));
+}
+
+/// Errors in macros name the line of the body, show it expanded and say
+/// where the macro was used; a bad definition or use names its own line.
+#[test]
+fn macro_errors_are_located() {
+    let src = ".macro M a\n        addi r1, r0, \\a\n.endm\n.text\n        M 1 << 20\n";
+    let e = err(src);
+    assert_eq!(e.line, 2, "{e}");
+    assert!(e.message.contains("out of range"), "{}", e.message);
+    assert!(
+        e.message.contains("in macro `M`, used at line 5"),
+        "{}",
+        e.message
+    );
+    assert!(e.text.contains("addi r1, r0, 1 << 20"), "{}", e.text);
+    let e = err(".macro M a\nnop\n.endm\n.text\nM 1, 2\n");
+    assert_eq!(e.line, 5);
+    assert!(e.message.contains("takes 1 argument"), "{}", e.message);
+    let e = err(".macro M a\nnop\n");
+    assert!(e.message.contains("without `.endm`"), "{}", e.message);
+    let e = err(".endm\n");
+    assert!(e.message.contains("without `.macro`"), "{}", e.message);
+    let e = err(".macro addi a\nnop\n.endm\n");
+    assert!(e.message.contains("not a macro name"), "{}", e.message);
+    let e = err(".macro M a\n  addi r1, r0, \\b\n.endm\n.text\nM 1\n");
+    assert_eq!(e.line, 2);
+    assert!(
+        e.message.contains("`\\b` is not a parameter"),
+        "{}",
+        e.message
+    );
+    let e = err(".macro M\n  M\n.endm\n.text\nM\n");
+    assert!(e.message.contains("use itself"), "{}", e.message);
+    // Macros doubling each other's lines: refused, not run out of memory.
+    let mut src = String::from(".macro M0\nnop\n.endm\n");
+    for i in 1..30 {
+        src += &format!(".macro M{i}\nM{}\nM{}\n.endm\n", i - 1, i - 1);
+    }
+    src += ".ctx\nM29\n";
+    let e = err(&src);
+    assert!(e.message.contains("expand to over"), "{}", e.message);
+    let e = err(".macro M\nnop\n.endm\n.macro M\nnop\n.endm\n");
+    assert!(e.message.contains("defined twice"), "{}", e.message);
+}

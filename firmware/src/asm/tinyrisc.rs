@@ -411,3 +411,12 @@ pub(crate) fn instruction(
     };
     emit(asm, lc, head, i)
 }
+
+/// A TinyRISC instruction or pseudo-instruction's name.
+pub(crate) fn is_mnemonic(w: &str) -> bool {
+    const PSEUDO: [&str; 15] = [
+        "li", "la", "mv", "not", "neg", "subi", "b", "beqz", "bnez", "bgt", "ble", "bgtu", "bleu",
+        "call", "ret",
+    ];
+    PSEUDO.contains(&w) || Opcode::from_mnemonic(w).is_some()
+}

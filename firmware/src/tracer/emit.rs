@@ -396,6 +396,11 @@ impl Code {
         self.lines.push(Line::Raw(text.into()));
         self
     }
+    /// An instruction (or a macro's body line) written out, at the code's
+    /// indentation.
+    pub fn line(&mut self, text: impl Into<String>) -> &mut Self {
+        self.i(text)
+    }
     /// A directive at the code's indentation (`.text`, `.rept N, i`...).
     pub fn directive(&mut self, text: impl Display) -> &mut Self {
         self.lines
@@ -410,6 +415,29 @@ impl Code {
     pub fn extend(&mut self, other: Code) -> &mut Self {
         self.lines.extend(other.lines);
         self
+    }
+
+    /// Define the assembler macro `name` with `params` (comma-separated,
+    /// used as `\\P` in the body) and the documentation `doc`.
+    pub fn define_macro(&mut self, name: &str, params: &str, doc: &str, body: Code) -> &mut Self {
+        self.doc(doc);
+        self.raw(if params.is_empty() {
+            format!(".macro {name}")
+        } else {
+            format!(".macro {name} {params}")
+        });
+        self.lines.extend(body.lines);
+        self.raw(".endm")
+    }
+
+    /// A use of the macro `name` with its arguments.
+    pub fn m(&mut self, name: &str, args: impl Display) -> &mut Self {
+        let args = args.to_string();
+        self.i(if args.is_empty() {
+            name.to_string()
+        } else {
+            format!("{name} {args}")
+        })
     }
 
     r3!(add, sub, and, or, xor, nor, sll, srl, sra, slt, sltu, mul);

@@ -8,7 +8,7 @@ use super::emit::{define, Code, K};
 use super::layout::{Layout, STREAM_BANK};
 use super::memory_map::{format_lines, ram_lines};
 use super::primitives::{self, ChipType, Gen};
-use super::{mem, shading, tiles, traversal, NodeLayout, Numerics, Options, Traversal};
+use super::{mem, shading, tiles, traversal, Numerics, Options, Traversal};
 use crate::scene::Scene;
 
 /// The program of one build.
@@ -294,6 +294,11 @@ fn header(scene: &Scene, lay: &Layout, opt: &Options, nm: &Numerics, tw: u32, th
         "RC RAM (word addresses in every RC)",
         ram_lines(opt.depth),
     );
+    s.push_str("\n; ---- macros ----\n");
+    s.push_str(&tiles::macros(lay).text());
+    if lay.traversal == Traversal::Packet {
+        s.push_str(&traversal::packet::macros().text());
+    }
     s
 }
 
@@ -448,201 +453,13 @@ fn fb(lay: &Layout) -> Vec<String> {
 }
 
 fn nodes(lay: &Layout) -> Vec<String> {
-    let mut v = Vec::new();
+    use super::layout::{packet_nodes, paper_nodes};
+    let types: Vec<&str> = lay.types.iter().map(|t| t.ty.name()).collect();
     match (lay.traversal, lay.stream.is_some()) {
-        (Traversal::Paper, false) if lay.node_layout == NodeLayout::Fig5 => {
-            v.push(define(
-                "N_FLAGS",
-                0,
-                "Fig. 5 node: bit 15 a leaf, bits 1..0 the split axis",
-            ));
-            v.push(define("N_SPLIT", 1, "  the split's position"));
-            v.push(define("N_LEFT", 2, "  the child below (FB address)"));
-            v.push(define("N_RIGHT", 3, "  the child above"));
-            v.push(define(
-                "N_BOUNDS",
-                4,
-                "  the cell, widened by 2 LSB: min.xyz, max.xyz",
-            ));
-            for t in &lay.types {
-                let up = t.ty.name().to_uppercase();
-                v.push(define(
-                    &format!("N_BV_{up}"),
-                    t.bv_offset,
-                    &format!(
-                        "  the {}s under it, a bit each",
-                        t.ty.name().replace('_', " ")
-                    ),
-                ));
-                v.push(define(
-                    &format!("BV_WORDS_{up}"),
-                    t.bv_words,
-                    "  words of that bit vector",
-                ));
-            }
-        }
-        (Traversal::Paper, false) => {
-            v.push(define(
-                "N_FLAGS",
-                0,
-                "compact node: bit 15 a leaf, bits 1..0 the split axis",
-            ));
-            v.push(define("N_SPLIT", 1, "  inner: the split's position"));
-            v.push(define("N_LEFT", 2, "  inner: the child below (FB address)"));
-            v.push(define("N_RIGHT", 3, "  inner: the child above"));
-            v.push(define(
-                "NC_INNER_LISTS",
-                super::layout::COMPACT_INNER_HEAD,
-                "  inner: per type, a count and the slot indices",
-            ));
-            v.push(define(
-                "NC_LEAF_BOUNDS",
-                1,
-                "  leaf: the cell, widened by 2 LSB",
-            ));
-            v.push(define(
-                "NC_LEAF_LISTS",
-                super::layout::COMPACT_LEAF_HEAD,
-                "  leaf: per type, a count and the slot indices",
-            ));
-        }
-        (Traversal::Paper, true) => {
-            v.push(define(
-                "NODE_BYTES",
-                super::layout::NODE_BYTES,
-                "a node record (main memory):",
-            ));
-            v.push(define(
-                "SN_FLAGS",
-                0,
-                "  -32768 a leaf, else the split axis",
-            ));
-            v.push(define("SN_SPLIT", 4, "  the split's position"));
-            v.push(define("SN_LEFT", 8, "  the children (byte addresses)"));
-            v.push(define("SN_RIGHT", 12, ""));
-            v.push(define(
-                "SN_BLOCK",
-                16,
-                "  leaf: its block (bounds, records)",
-            ));
-            v.push(define("SN_BLOCK_WORDS", 20, "  leaf: the block's words"));
-            v.push(define(
-                "SN_LIST",
-                24,
-                "  leaf: its list of mailbox addresses",
-            ));
-            for (j, t) in lay.types.iter().enumerate() {
-                v.push(define(
-                    &format!("SN_COUNT_{}", t.ty.name().to_uppercase()),
-                    28 + 4 * j,
-                    if j == 0 {
-                        "  leaf: objects of each type"
-                    } else {
-                        ""
-                    },
-                ));
-            }
-            v.push(define("SN_OBJECTS", 56, "  leaf: objects in all"));
-            v.push(define(
-                "U_NSTACK",
-                0,
-                "an unordered subtree (USTK): the node stack where it ends",
-            ));
-            v.push(define("U_AXIS", 4, "  its split axis"));
-            v.push(define("U_FRAME", 8, "  bytes"));
-        }
-        (Traversal::Packet, false) => {
-            v.push(define(
-                "PN_FLAGS",
-                0,
-                "packet node: the split axis, or bit 15 a leaf",
-            ));
-            v.push(define(
-                "PN_PARENT_SLOT",
-                1,
-                "  the RAM slot its parent pushed it with",
-            ));
-            v.push(define("PN_SPLIT", 2, "  inner: the split's position"));
-            v.push(define("PN_SLOT", 3, "  inner: the RAM slot of its depth"));
-            v.push(define("PN_LEFT", 4, "  inner: the children (FB addresses)"));
-            v.push(define("PN_RIGHT", 5, ""));
-            v.push(define("PL_OBJECTS", 2, "  leaf: its objects"));
-            v.push(define(
-                "PL_SHARED",
-                3,
-                "  leaf: of those, in other leaves too (a mailbox)",
-            ));
-            v.push(define(
-                "PL_LISTS",
-                super::layout::PK_LEAF_HEAD,
-                "  leaf: per type a count, then an entry per object:",
-            ));
-            v.push(define("LE_RECORD", 0, "    its record (FB address)"));
-            v.push(define("LE_MAILBOX", 1, "    its mailbox index (-1: none)"));
-            v.push(define("LE_WORDS", 2, ""));
-            v.extend(mailbox_fields());
-        }
-        (Traversal::Packet, true) => {
-            v.push(define(
-                "NODE_BYTES",
-                super::layout::NODE_BYTES,
-                "a packet node record (main memory):",
-            ));
-            v.push(define(
-                "PS_FLAGS",
-                0,
-                "  -32768 a leaf or a piece, else the split axis",
-            ));
-            v.push(define(
-                "PS_PARENT_SLOT",
-                4,
-                "  the RAM slot its parent pushed it with",
-            ));
-            v.push(define("PS_SPLIT", 8, "  inner: the split's position"));
-            v.push(define("PS_SLOT", 12, "  inner: the RAM slot of its depth"));
-            v.push(define(
-                "PS_LEFT",
-                16,
-                "  inner: the children (byte addresses)",
-            ));
-            v.push(define("PS_RIGHT", 20, ""));
-            v.push(define(
-                "PS_LIST",
-                8,
-                "  leaf: per object its mailbox's address (0: none)",
-            ));
-            v.push(define("PS_BLOCK", 16, "  leaf: its block of records"));
-            v.push(define("PS_BLOCK_WORDS", 20, "  leaf: the block's words"));
-            v.push(define("PS_NEXT", 24, "  leaf: its next piece (0: none)"));
-            for (j, t) in lay.types.iter().enumerate() {
-                v.push(define(
-                    &format!("PS_COUNT_{}", t.ty.name().to_uppercase()),
-                    28 + 4 * j,
-                    if j == 0 {
-                        "  leaf: objects of each type"
-                    } else {
-                        ""
-                    },
-                ));
-            }
-            v.push(define("PS_OBJECTS", 56, "  leaf: objects in all"));
-            v.push(define("PS_SHARED", 60, "  leaf: of those, with a mailbox"));
-            v.extend(mailbox_fields());
-        }
+        (Traversal::Paper, false) => paper_nodes::header(lay.node_layout, &lay.types),
+        (Traversal::Paper, true) => paper_nodes::streamed_header(&types),
+        (Traversal::Packet, streamed) => packet_nodes::header(streamed, &types),
     }
-    v
-}
-
-fn mailbox_fields() -> Vec<String> {
-    vec![
-        define(
-            "MB_SHIFT",
-            4,
-            "a mailbox (main memory, 16 bytes, MAILBOX + index << MB_SHIFT):",
-        ),
-        define("MB_PASS", 0, "  the pass that last tested the object"),
-        define("MB_RAYS", 4, "  the rays that did (64-bit mask)"),
-    ]
 }
 
 /// TinyRISC's data.

@@ -21,17 +21,106 @@
 
 use super::emit::{at, Code, R0, R1, R2, R3, R4, R5, R6};
 use super::layout::Layout;
-use super::primitives::{kaddr, klen};
+use super::primitives::kaddr;
 
-/// `li r1, kernel; cbcast r1, len`: broadcast a kernel without a stream.
+/// `BCAST k`: broadcast a kernel without a stream.
 fn cb<'a>(t: &'a mut Code, k: &str) -> &'a mut Code {
-    t.li(R1, kaddr(k)).cbcast(R1, klen(k))
+    t.m("BCAST", k)
 }
 
-/// `li r1, kernel; li r2, stream; sbcb r1, r2, len`: broadcast a kernel
-/// with its FB stream.
+/// `BCAST_FB k, stream`: broadcast a kernel with its FB stream.
 fn sb<'a>(t: &'a mut Code, k: &str, stream: &str) -> &'a mut Code {
-    t.li(R1, kaddr(k)).li(R2, stream).sbcb(R1, R2, klen(k))
+    t.m("BCAST_FB", format!("{k}, {stream}"))
+}
+
+/// The macros of the main program and the traversals: broadcasts of a
+/// kernel (its context address and length from its labels), a level's
+/// shading and one light's shadow pass.
+pub fn macros(lay: &Layout) -> Code {
+    let mut t = Code::new();
+    let body = |f: &dyn Fn(&mut Code)| {
+        let mut b = Code::new();
+        f(&mut b);
+        b
+    };
+    t.define_macro(
+        "BCAST",
+        "k",
+        "BCAST k: broadcast kernel k to the array (its contexts, no FB stream). Clobbers r1.",
+        body(&|b| {
+            b.li(R1, "(\\k - CTXBASE) / 4")
+                .cbcast(R1, "(\\k\\()_end - \\k) / 4");
+        }),
+    );
+    t.define_macro(
+        "BCAST_FB",
+        "k, fb",
+        "BCAST_FB k, fb: broadcast kernel k with the FB words from address fb as its stream.\n\
+         Clobbers r1, r2.",
+        body(&|b| {
+            b.li(R1, "(\\k - CTXBASE) / 4")
+                .li(R2, "\\fb")
+                .sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
+        }),
+    );
+    t.define_macro(
+        "BCAST_AT",
+        "k, ra",
+        "BCAST_AT k, ra: broadcast kernel k with the FB words from the address in ra as its\n\
+         stream. Clobbers r1.",
+        body(&|b| {
+            b.li(R1, "(\\k - CTXBASE) / 4")
+                .line("sbcb r1, \\ra, (\\k\\()_end - \\k) / 4");
+        }),
+    );
+    t.define_macro(
+        "BCAST_REC",
+        "k, ra, field",
+        "BCAST_REC k, ra, field: broadcast kernel k with the FB words from `field` of the\n\
+         record (or node) at ra as its stream. Clobbers r1, r2.",
+        body(&|b| {
+            b.li(R1, "(\\k - CTXBASE) / 4")
+                .line("addi r2, \\ra, \\field")
+                .sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
+        }),
+    );
+    t.define_macro(
+        "SHADOW_PASS",
+        "light, shade",
+        "SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream\n\
+         `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.",
+        body(&|b| {
+            b.m("BCAST_FB", "k_light, \\light")
+                .li(R1, 1)
+                .sw(R1, at("MODE", R0))
+                .c("any hit")
+                .jal("trace")
+                .m("BCAST", "k_wake")
+                .m("BCAST_FB", "k_shade, \\shade");
+        }),
+    );
+    t.define_macro(
+        "SHADE_LEVEL",
+        "post",
+        &format!(
+            "SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state\n\
+             (kernel `post`: k_post0 for the eye rays, k_post1 after), then every light's\n\
+             shadow pass ({} light{}).",
+            lay.lights.len(),
+            if lay.lights.len() == 1 { "" } else { "s" }
+        ),
+        body(&|b| {
+            b.sw(R0, at("MODE", R0))
+                .c("closest hit")
+                .jal("trace")
+                .m("BCAST", "k_wake")
+                .m("BCAST_FB", "\\post, FB_POST");
+            for i in 0..lay.lights.len() {
+                b.m("SHADOW_PASS", format!("FB_LIGHT{i}, FB_SHADE{i}"));
+            }
+        }),
+    );
+    t
 }
 
 /// The main program: `_start`, the tile loop, `finish`.
@@ -97,30 +186,20 @@ pub fn main(t: &mut Code, lay: &Layout, depth: u32) {
         .halt();
 }
 
-/// One level's shading: its closest-hit pass, the hit's shading state,
-/// then per light a shadow pass and the Phong terms.
-fn shade_level(t: &mut Code, lay: &Layout, level: u32) {
-    t.comment(format!("level {level}: the rays' closest hits"))
-        .sw(R0, at("MODE", R0))
-        .jal("trace");
-    cb(t, "k_wake");
-    sb(t, if level == 0 { "k_post0" } else { "k_post1" }, "FB_POST").c("the hits' shading state");
-    for i in 0..lay.lights.len() {
-        t.comment(format!(
-            "light {i}: shadow rays, then its Phong terms where lit"
-        ));
-        sb(t, "k_light", &format!("FB_LIGHT{i}"));
-        t.li(R1, 1).sw(R1, at("MODE", R0)).c("any hit").jal("trace");
-        cb(t, "k_wake");
-        sb(t, "k_shade", &format!("FB_SHADE{i}"));
-    }
+/// One level's shading ([`macros`]' `SHADE_LEVEL`).
+fn shade_level(t: &mut Code, level: u32) {
+    t.m(
+        "SHADE_LEVEL",
+        if level == 0 { "k_post0" } else { "k_post1" },
+    )
+    .c(format!("level {level}: trace, shade, every light"));
 }
 
 /// The ray tree, depth first: a level's shading, then its reflected ray's
 /// subtree and, where the scene refracts, its refracted ray's (skipped
 /// when no ray of the tile refracts there).
 fn tree(t: &mut Code, lay: &Layout, level: u32, levels: u32, skips: &mut u32) {
-    shade_level(t, lay, level);
+    shade_level(t, level);
     if level + 1 >= levels {
         return;
     }
@@ -156,9 +235,7 @@ fn output(t: &mut Code) {
         .into_iter()
         .enumerate()
     {
-        t.li(R1, kaddr(&format!("k_out{i}")))
-            .cbcast(R1, 1)
-            .wfb(R4, w);
+        t.m("BCAST", format!("k_out{i}")).wfb(R4, w);
     }
     t.lw(R3, at("CUR_OUT", R0))
         .stfb(R3, R4, "OUT_WORDS")

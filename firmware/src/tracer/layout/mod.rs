@@ -20,8 +20,8 @@
 //! mailboxes go to main memory, and bank 1 is the streaming buffer. The
 //! program's header names every address and field of this image.
 
-mod packet_nodes;
-mod paper_nodes;
+pub mod packet_nodes;
+pub mod paper_nodes;
 
 use crate::scene::{PrimType, Scene, Shape, Vec3};
 use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
@@ -427,11 +427,14 @@ pub fn build_packet(
 }
 
 /// The geometry a primitive's record is written from, computed once for
-/// the fit of the scale shifts and again for the records.
-enum Shape2 {
+/// the fit of the scale shifts and the records.
+enum Geometry {
+    /// Spheres, boxes, polygons: from the shape itself.
     None,
+    /// Rectangles and triangles (one), a cylinder's caps (two).
     Planars(Vec<planar::Planar>),
-    Cone(cone::ConeFit, [planar::Planar; 2]),
+    /// A cone: its fit and caps.
+    Cone(Box<(cone::ConeFit, [planar::Planar; 2])>),
 }
 
 fn build_as(
@@ -445,7 +448,6 @@ fn build_as(
 ) -> Result<Layout, String> {
     // The 32-bit chip: every format gets `xb` more fraction bits.
     let xb = opt.datapath.bits() - 16;
-    let fitter = Fitter { x: xb };
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
     let s = (frac as f64).exp2();
     let err = |line: usize, m: String| {
@@ -456,15 +458,7 @@ fn build_as(
         }
     };
 
-    // Objects by chip type.
-    let mut by: Vec<Vec<usize>> = vec![Vec::new(); ChipType::ALL.len()];
-    let mut slot = vec![(0usize, 0usize); scene.objects.len()];
-    for (i, o) in scene.objects.iter().enumerate() {
-        let t = ChipType::of_object(&o.shape, scene.materials[o.material].t > 0.0);
-        let ti = t as usize;
-        slot[i] = (ti, by[ti].len());
-        by[ti].push(i);
-    }
+    let (by, slot) = by_type(scene);
     // Materials: identical ones are one (an NFF file repeats its `f` line
     // for every object: SPD rings, 841 lines, 7 materials); the kernels
     // shade per distinct material.
@@ -476,95 +470,7 @@ fn build_as(
         ));
     }
 
-    // The geometry of every record, to fit the kernels' scale shifts.
-    let mut geo: Vec<Shape2> = Vec::with_capacity(scene.objects.len());
-    let mut fan = 0usize;
-    for o in &scene.objects {
-        geo.push(match &o.shape {
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-                ..
-            } if o.shape.prim_type() == PrimType::Cone => {
-                let f = cone::ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
-                let caps = f.caps(*base, *base_radius, *apex, *apex_radius, s);
-                Shape2::Cone(f, caps)
-            }
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                ..
-            } => Shape2::Planars(cylinder::caps(*base, *apex, base_radius.abs()).to_vec()),
-            Shape::Rectangle {
-                corner,
-                edge1,
-                edge2,
-            } => Shape2::Planars(vec![planar::Planar::rectangle(
-                *corner,
-                *edge1,
-                *edge2,
-                edge1.cross(*edge2).normalized(),
-            )]),
-            Shape::Triangle { v, .. } => {
-                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-                Shape2::Planars(vec![planar::Planar::triangle(v[0], v[1], v[2], n)])
-            }
-            Shape::Polygon { v, .. } => {
-                fan = fan.max(polygon::edges(v, s).1.len());
-                Shape2::None
-            }
-            Shape::Sphere { .. } | Shape::Box { .. } => Shape2::None,
-        });
-    }
-    let mut m = [0.0f64; 3];
-    for g in &geo {
-        let ps: &[planar::Planar] = match g {
-            Shape2::Planars(p) => p,
-            Shape2::Cone(_, c) => c,
-            Shape2::None => &[],
-        };
-        for p in ps {
-            let k = p.kind.kt_index();
-            m[k] = m[k].max(p.dual_max((14 + xb) as i32 - frac as i32));
-        }
-    }
-    let kt = m.map(|m| fitter.shift(m, 24 + xb));
-    let radii = scene.objects.iter().filter_map(|o| match o.shape {
-        Shape::Sphere { radius, .. } => Some(radius.abs() * s),
-        _ => None,
-    });
-    let (ks_sphere, ep_sphere, sphere_fine) = sphere::fit(radii, &fitter);
-    let cyl_radii = scene.objects.iter().filter_map(|o| match o.shape {
-        Shape::Cone { base_radius, .. } if o.shape.prim_type() == PrimType::Cylinder => {
-            Some(base_radius.abs() * s)
-        }
-        _ => None,
-    });
-    let base_radii = scene.objects.iter().filter_map(|o| match o.shape {
-        Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
-        _ => None,
-    });
-    let (ks_cyl, ep_cyl) = cylinder::fit(cyl_radii, base_radii, &fitter);
-    let cone_fits = geo.iter().filter_map(|g| match g {
-        Shape2::Cone(f, _) => Some(*f),
-        _ => None,
-    });
-    let (ks_cone, ep_cone) = cone::fit(cone_fits, &fitter);
-    let fit = Fit {
-        ks_sphere,
-        ep_sphere,
-        sphere_fine,
-        ks_cyl,
-        ep_cyl,
-        ks_cone,
-        ep_cone,
-        kt,
-        fine_normals,
-    };
-
+    let (geo, fan, fit) = fit_scene(scene, s, frac, xb, fine_normals);
     let mut w = W {
         fb: Vec::new(),
         s,
@@ -577,31 +483,10 @@ fn build_as(
     w.push(w.max());
     let (eye, kd) = camera(&mut w, scene, opt).map_err(|m| err(0, m))?;
 
-    // Post: background, (id, ks) per material.
-    let post = w.fb.len();
-    for x in scene.background.to_array() {
-        w.col(x);
-    }
-    for (i, mt) in mats.iter().enumerate() {
-        w.raw(i as i64);
-        w.col(mt.ks);
-    }
-    // Refraction: per transmitting material `id, T, 1/ior, ior` (the
-    // stream of `k_tset`), only when a refracting object uses one.
     let refract = ChipType::ALL
         .iter()
         .any(|c| c.refracts() && !by[*c as usize].is_empty());
-    let transmit = w.fb.len();
-    let mut transmit_materials = 0;
-    if refract {
-        for (i, mt) in mats.iter().enumerate().filter(|(_, m)| m.t > 0.0) {
-            w.raw(i as i64);
-            w.col(mt.t);
-            w.col(1.0 / mt.ior);
-            w.col(mt.ior);
-            transmit_materials += 1;
-        }
-    }
+    let (post, transmit, transmit_materials) = post_streams(&mut w, scene, &mats, refract);
     let (lights, shades, light_shifted) =
         lights(&mut w, scene, &mats, frac, xb).map_err(|m| err(0, m))?;
     let shines: Vec<(u32, f64)> = mats.iter().map(|m| split_shine(m.shine)).collect();
@@ -622,102 +507,9 @@ fn build_as(
         0
     };
 
-    // Object records, grouped by type.
     let records_start = w.fb.len();
-    let mut types = Vec::new();
-    let mut bv_offset = NODE_HEAD;
-    let mut mailbox_slots = 0;
-    for t in ChipType::ALL {
-        let objs = &by[t as usize];
-        if objs.is_empty() {
-            continue;
-        }
-        let size = t.record_words(&fit, fan);
-        let first = w.fb.len();
-        for &i in objs {
-            let o = &scene.objects[i];
-            let mat = mat_of[o.material];
-            let start = w.fb.len();
-            match (&o.shape, &geo[i]) {
-                (
-                    Shape::Cone {
-                        inside, caps: on, ..
-                    },
-                    Shape2::Cone(cf, caps),
-                ) => cone::write(&mut w, &fit, t.sides(), cf, *inside, *on, caps, i, mat)
-                    .map_err(|m| err(o.line, m))?,
-                (
-                    Shape::Sphere {
-                        center,
-                        radius,
-                        inside,
-                    },
-                    _,
-                ) => sphere::write(&mut w, &fit, fine, *center, *radius, *inside, i, mat),
-                (
-                    Shape::Cone {
-                        base,
-                        base_radius,
-                        apex,
-                        inside,
-                        caps: on,
-                        ..
-                    },
-                    Shape2::Planars(caps),
-                ) => cylinder::write(
-                    &mut w,
-                    &fit,
-                    t.sides(),
-                    *base,
-                    *apex,
-                    *base_radius,
-                    *inside,
-                    *on,
-                    &[caps[0], caps[1]],
-                    i,
-                    mat,
-                ),
-                (Shape::Box { min, max }, _) => aabox::write(&mut w, t.sides(), *min, *max, i, mat),
-                (Shape::Polygon { v, .. }, _) => polygon::write(&mut w, v, size, i, mat),
-                (
-                    Shape::Triangle {
-                        normals: Some(ns), ..
-                    },
-                    Shape2::Planars(p),
-                ) if matches!(t, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) => {
-                    smooth_triangle::write(&mut w, &fit.kt, &p[0], *ns, i, mat)
-                }
-                (_, Shape2::Planars(ps)) => {
-                    for p in ps {
-                        planar::write(&mut w, &fit.kt, p, i, mat);
-                    }
-                }
-                _ => {}
-            }
-            debug_assert_eq!(w.fb.len() - start, size, "{t:?}");
-            if w.fb.len() - start != size {
-                return Err(format!(
-                    "internal: {} record of {} words, expected {size}",
-                    t.name(),
-                    w.fb.len() - start
-                ));
-            }
-        }
-        let bv_words = objs.len().div_ceil(16);
-        types.push(TypeInfo {
-            ty: t,
-            objects: objs.clone(),
-            first,
-            size,
-            bv_offset,
-            bv_words,
-            mailbox: mailbox_slots,
-            fan,
-        });
-        bv_offset += bv_words;
-        mailbox_slots += objs.len();
-    }
-
+    let (types, bv_offset, mailbox_slots) =
+        records(&mut w, scene, &by, &geo, &fit, fan, &mat_of, fine, &err)?;
     let nodes = &image.bsp.nodes;
     let fin = Finish {
         frac,
@@ -969,4 +761,268 @@ mod tests {
             assert!(r > 16384 && r < 32768, "{k}");
         }
     }
+}
+
+/// The geometry every record is written from, and the kernels' scale
+/// shifts fitted to it (`xb`: the datapath's extra bits; `s`: LSBs per
+/// unit of the scene format `frac`). Also the polygons' largest fan.
+fn fit_scene(
+    scene: &Scene,
+    s: f64,
+    frac: u32,
+    xb: u32,
+    fine_normals: bool,
+) -> (Vec<Geometry>, usize, Fit) {
+    let fitter = Fitter { x: xb };
+    let mut geo: Vec<Geometry> = Vec::with_capacity(scene.objects.len());
+    let mut fan = 0usize;
+    for o in &scene.objects {
+        geo.push(match &o.shape {
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+                ..
+            } if o.shape.prim_type() == PrimType::Cone => {
+                let f = cone::ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
+                let caps = f.caps(*base, *base_radius, *apex, *apex_radius, s);
+                Geometry::Cone(Box::new((f, caps)))
+            }
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                ..
+            } => Geometry::Planars(cylinder::caps(*base, *apex, base_radius.abs()).to_vec()),
+            Shape::Rectangle {
+                corner,
+                edge1,
+                edge2,
+            } => Geometry::Planars(vec![planar::Planar::rectangle(
+                *corner,
+                *edge1,
+                *edge2,
+                edge1.cross(*edge2).normalized(),
+            )]),
+            Shape::Triangle { v, .. } => {
+                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+                Geometry::Planars(vec![planar::Planar::triangle(v[0], v[1], v[2], n)])
+            }
+            Shape::Polygon { v, .. } => {
+                fan = fan.max(polygon::edges(v, s).1.len());
+                Geometry::None
+            }
+            Shape::Sphere { .. } | Shape::Box { .. } => Geometry::None,
+        });
+    }
+    let mut m = [0.0f64; 3];
+    for g in &geo {
+        let ps: &[planar::Planar] = match g {
+            Geometry::Planars(p) => p,
+            Geometry::Cone(fc) => &fc.1,
+            Geometry::None => &[],
+        };
+        for p in ps {
+            let k = p.kind.kt_index();
+            m[k] = m[k].max(p.dual_max((14 + xb) as i32 - frac as i32));
+        }
+    }
+    let kt = m.map(|m| fitter.shift(m, 24 + xb));
+    let radii = scene.objects.iter().filter_map(|o| match o.shape {
+        Shape::Sphere { radius, .. } => Some(radius.abs() * s),
+        _ => None,
+    });
+    let (ks_sphere, ep_sphere, sphere_fine) = sphere::fit(radii, &fitter);
+    let cyl_radii = scene.objects.iter().filter_map(|o| match o.shape {
+        Shape::Cone { base_radius, .. } if o.shape.prim_type() == PrimType::Cylinder => {
+            Some(base_radius.abs() * s)
+        }
+        _ => None,
+    });
+    let base_radii = scene.objects.iter().filter_map(|o| match o.shape {
+        Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
+        _ => None,
+    });
+    let (ks_cyl, ep_cyl) = cylinder::fit(cyl_radii, base_radii, &fitter);
+    let cone_fits = geo.iter().filter_map(|g| match g {
+        Geometry::Cone(fc) => Some(fc.0),
+        _ => None,
+    });
+    let (ks_cone, ep_cone) = cone::fit(cone_fits, &fitter);
+    let fit = Fit {
+        ks_sphere,
+        ep_sphere,
+        sphere_fine,
+        ks_cyl,
+        ep_cyl,
+        ks_cone,
+        ep_cone,
+        kt,
+        fine_normals,
+    };
+
+    (geo, fan, fit)
+}
+
+/// The object records, grouped by type in test order, with what the
+/// nodes and kernels need to know of each type. `unrounded`: sphere
+/// records with the unrounded radius's reciprocal (the streamed format).
+#[allow(clippy::too_many_arguments)]
+fn records(
+    w: &mut W,
+    scene: &Scene,
+    by: &[Vec<usize>],
+    geo: &[Geometry],
+    fit: &Fit,
+    fan: usize,
+    mat_of: &[usize],
+    unrounded: bool,
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<(Vec<TypeInfo>, usize, usize), String> {
+    let mut types = Vec::new();
+    let mut bv_offset = NODE_HEAD;
+    let mut mailbox_slots = 0;
+    for t in ChipType::ALL {
+        let objs = &by[t as usize];
+        if objs.is_empty() {
+            continue;
+        }
+        let size = t.record_words(fit, fan);
+        let first = w.fb.len();
+        for &i in objs {
+            let o = &scene.objects[i];
+            let mat = mat_of[o.material];
+            let start = w.fb.len();
+            match (&o.shape, &geo[i]) {
+                (
+                    Shape::Cone {
+                        inside, caps: on, ..
+                    },
+                    Geometry::Cone(fc),
+                ) => cone::write(w, fit, t.sides(), &fc.0, *inside, *on, &fc.1, i, mat)
+                    .map_err(|m| err(o.line, m))?,
+                (
+                    Shape::Sphere {
+                        center,
+                        radius,
+                        inside,
+                    },
+                    _,
+                ) => sphere::write(w, fit, unrounded, *center, *radius, *inside, i, mat),
+                (
+                    Shape::Cone {
+                        base,
+                        base_radius,
+                        apex,
+                        inside,
+                        caps: on,
+                        ..
+                    },
+                    Geometry::Planars(caps),
+                ) => cylinder::write(
+                    w,
+                    fit,
+                    t.sides(),
+                    *base,
+                    *apex,
+                    *base_radius,
+                    *inside,
+                    *on,
+                    &[caps[0], caps[1]],
+                    i,
+                    mat,
+                ),
+                (Shape::Box { min, max }, _) => aabox::write(w, t.sides(), *min, *max, i, mat),
+                (Shape::Polygon { v, .. }, _) => polygon::write(w, v, size, i, mat),
+                (
+                    Shape::Triangle {
+                        normals: Some(ns), ..
+                    },
+                    Geometry::Planars(p),
+                ) if matches!(t, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) => {
+                    smooth_triangle::write(w, &fit.kt, &p[0], *ns, i, mat)
+                }
+                (_, Geometry::Planars(ps)) => {
+                    for p in ps {
+                        planar::write(w, &fit.kt, p, i, mat);
+                    }
+                }
+                _ => {}
+            }
+            debug_assert_eq!(w.fb.len() - start, size, "{t:?}");
+            if w.fb.len() - start != size {
+                return Err(format!(
+                    "internal: {} record of {} words, expected {size}",
+                    t.name(),
+                    w.fb.len() - start
+                ));
+            }
+        }
+        let bv_words = objs.len().div_ceil(16);
+        types.push(TypeInfo {
+            ty: t,
+            objects: objs.clone(),
+            first,
+            size,
+            bv_offset,
+            bv_words,
+            mailbox: mailbox_slots,
+            fan,
+        });
+        bv_offset += bv_words;
+        mailbox_slots += objs.len();
+    }
+
+    Ok((types, bv_offset, mailbox_slots))
+}
+
+/// The scene's objects by chip type (indexed by `ChipType as usize`, in
+/// scene order), and per object its (type, slot among its type).
+#[allow(clippy::type_complexity)]
+fn by_type(scene: &Scene) -> (Vec<Vec<usize>>, Vec<(usize, usize)>) {
+    let mut by: Vec<Vec<usize>> = vec![Vec::new(); ChipType::ALL.len()];
+    let mut slot = vec![(0usize, 0usize); scene.objects.len()];
+    for (i, o) in scene.objects.iter().enumerate() {
+        let t = ChipType::of_object(&o.shape, scene.materials[o.material].t > 0.0);
+        let ti = t as usize;
+        slot[i] = (ti, by[ti].len());
+        by[ti].push(i);
+    }
+    (by, slot)
+}
+
+/// The post-pass stream (background, then `id, ks` per material) and,
+/// where the scene refracts, the refraction stream (`id, T, 1/ior, ior`
+/// per transmitting material, read by `k_tset`): their FB addresses and
+/// the transmitting materials.
+fn post_streams(
+    w: &mut W,
+    scene: &Scene,
+    mats: &[crate::scene::Material],
+    refract: bool,
+) -> (usize, usize, usize) {
+    // Post: background, (id, ks) per material.
+    let post = w.fb.len();
+    for x in scene.background.to_array() {
+        w.col(x);
+    }
+    for (i, mt) in mats.iter().enumerate() {
+        w.raw(i as i64);
+        w.col(mt.ks);
+    }
+    // Refraction: per transmitting material `id, T, 1/ior, ior` (the
+    // stream of `k_tset`), only when a refracting object uses one.
+    let transmit = w.fb.len();
+    let mut transmit_materials = 0;
+    if refract {
+        for (i, mt) in mats.iter().enumerate().filter(|(_, m)| m.t > 0.0) {
+            w.raw(i as i64);
+            w.col(mt.t);
+            w.col(1.0 / mt.ior);
+            w.col(mt.ior);
+            transmit_materials += 1;
+        }
+    }
+    (post, transmit, transmit_materials)
 }

@@ -12,9 +12,11 @@
 use super::super::primitives::{
     aabox, cone, cylinder, planar, polygon, sphere, Body, Fit, Gen, Sides,
 };
+use super::super::{mem, Collapse};
 use super::{
     fb_word_bytes, Finish, Layout, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
 };
+use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};
 
 /// Array cycles a packet spends on an inner node (its kernel and
@@ -82,40 +84,61 @@ fn pk_slot(d: u32) -> i64 {
         + 2 * d.min(super::super::memory_map::ram::P_SLOTS - 1)) as i64
 }
 
-/// The BSP nodes for the packet traversal ([`Traversal::Packet`]): inner
-/// nodes carry their stack slots instead of the objects under them, leaves
-/// per type present a count and the FB addresses of their objects' records;
-/// no mailboxes. Resident when it fits FB set 0, else streamed (node
-/// records in main memory, each leaf's records a block moved into FB bank 1,
-/// a block larger than the bank cut into pieces).
-#[allow(clippy::too_many_arguments)]
-pub(super) fn packet_nodes(
-    mut w: W,
-    fin: Finish,
-    types: Vec<TypeInfo>,
-    nodes: &[crate::bsp::Node],
-    slot: &[(usize, usize)],
-    records_start: usize,
-    streamed: bool,
-    err: &dyn Fn(usize, String) -> String,
-) -> Result<Layout, String> {
-    // The tree the traversal walks: a subtree with at most `collapse`
-    // objects under it is one leaf of those objects (testing them all with
-    // the rays that reach it costs less than walking it).
-    let mut tree: Vec<crate::bsp::Node> = Vec::with_capacity(nodes.len());
+/// The tree the packet traversal walks ([`collapsed`]), and what its
+/// node writers share.
+struct Tree<'a> {
+    nodes: Vec<Node>,
+    /// Per scene object, the number of leaves it is in: an object in one
+    /// leaf only is met once per pass (each node is visited at most once)
+    /// and needs no mailbox.
+    refs: Vec<u32>,
+    types: &'a [TypeInfo],
+    slot: &'a [(usize, usize)],
+}
+
+impl Tree<'_> {
+    /// A leaf's objects of each type, in slot order.
+    fn per_type(&self, n: &Node) -> Vec<Vec<usize>> {
+        self.types
+            .iter()
+            .map(|ti| {
+                n.objects
+                    .iter()
+                    .filter_map(|&o| {
+                        let (t, q) = self.slot[o as usize];
+                        (t == ti.ty as usize).then_some(q)
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    /// The RAM slot a node's parent pushed it with (0 for the root).
+    fn parent_slot(n: &Node) -> i64 {
+        if n.depth == 0 {
+            0
+        } else {
+            pk_slot(n.depth - 1)
+        }
+    }
+
+    /// Objects of `objects` in more than one leaf (with a mailbox).
+    fn shared(&self, objects: impl Iterator<Item = usize>) -> usize {
+        objects.filter(|&o| self.refs[o] > 1).count()
+    }
+}
+
+/// The tree the traversal walks: where the cost model says so (or, with
+/// `Collapse::Objects(c)`, under `c` objects) a subtree is one leaf of the
+/// objects under it (testing them all with the rays that reach it costs
+/// less than walking it). Also the expected cost of the model's tree.
+fn collapsed(nodes: &[Node], fin: &Finish) -> (Vec<Node>, f64) {
     // Expected cost (array cycles) of a packet that reaches node k:
     // walking (a node visit, then each child with the probability that a
     // ray through the cell meets the child's, its surface area over the
     // cell's) or testing everything under it.
-    let test_all =
-        |n: &crate::bsp::Node| -> f64 { n.objects.iter().map(|&o| fin.cost[o as usize]).sum() };
-    let mut keep = vec![true; nodes.len()];
-    fn expect(
-        nodes: &[crate::bsp::Node],
-        k: usize,
-        test_all: &dyn Fn(&crate::bsp::Node) -> f64,
-        keep: &mut [bool],
-    ) -> f64 {
+    let test_all = |n: &Node| -> f64 { n.objects.iter().map(|&o| fin.cost[o as usize]).sum() };
+    fn expect(nodes: &[Node], k: usize, test_all: &dyn Fn(&Node) -> f64, keep: &mut [bool]) -> f64 {
         let n = &nodes[k];
         let all = test_all(n);
         let Some(sp) = n.split else { return all };
@@ -133,10 +156,11 @@ pub(super) fn packet_nodes(
             walk
         }
     }
+    let mut keep = vec![true; nodes.len()];
     let mut model_keep = vec![true; nodes.len()];
     let expected_cost = expect(nodes, 0, &test_all, &mut model_keep);
     let collapse = match fin.collapse {
-        super::super::Collapse::Auto => {
+        Collapse::Auto => {
             keep = model_keep;
             // The root is walked whenever the BSP has one split: the pass's
             // start clips the rays to the root cell, which culls the rays
@@ -145,18 +169,12 @@ pub(super) fn packet_nodes(
             keep[0] = true;
             usize::MAX
         }
-        super::super::Collapse::Objects(c) => c,
+        Collapse::Objects(c) => c,
     };
-    fn walk(
-        nodes: &[crate::bsp::Node],
-        k: usize,
-        collapse: usize,
-        keep: &[bool],
-        out: &mut Vec<crate::bsp::Node>,
-    ) -> u32 {
+    fn walk(nodes: &[Node], k: usize, collapse: usize, keep: &[bool], out: &mut Vec<Node>) -> u32 {
         let n = &nodes[k];
         let at = out.len();
-        out.push(crate::bsp::Node {
+        out.push(Node {
             split: None,
             ..n.clone()
         });
@@ -172,115 +190,132 @@ pub(super) fn packet_nodes(
         }
         at as u32
     }
+    let mut tree = Vec::with_capacity(nodes.len());
     walk(nodes, 0, collapse, &keep, &mut tree);
-    let nodes = &tree[..];
-    // An object in one leaf only is met once per pass (each node is
-    // visited at most once): it needs no mailbox.
+    (tree, expected_cost)
+}
+
+/// The BSP nodes for the packet traversal: inner nodes carry their stack
+/// slots instead of the objects under them, leaves per type present a
+/// count and the FB addresses of their objects' records; the mailboxes in
+/// main memory. Resident when it fits FB set 0, else streamed.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn packet_nodes(
+    w: W,
+    fin: Finish,
+    types: Vec<TypeInfo>,
+    nodes: &[Node],
+    slot: &[(usize, usize)],
+    records_start: usize,
+    streamed: bool,
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<Layout, String> {
+    let (nodes, expected_cost) = collapsed(nodes, &fin);
     let mut refs = vec![0u32; fin.objects];
     for n in nodes.iter().filter(|n| n.split.is_none()) {
         for &o in &n.objects {
             refs[o as usize] += 1;
         }
     }
-    let size = |n: &crate::bsp::Node| match n.split {
+    let tree = Tree {
+        nodes,
+        refs,
+        types: &types,
+        slot,
+    };
+    let size = |n: &Node| match n.split {
         Some(_) => PK_INNER,
         None => PK_LEAF_HEAD + types.len() + 2 * n.objects.len(),
     };
-    let mut node_at = Vec::with_capacity(nodes.len() + 1);
+    let mut node_at = Vec::with_capacity(tree.nodes.len() + 1);
     node_at.push(0usize);
-    for n in nodes {
+    for n in &tree.nodes {
         node_at.push(node_at.last().copied().unwrap_or(0) + size(n));
     }
-    let node_section = node_at[nodes.len()];
+    let node_section = node_at[tree.nodes.len()];
+    let total = w.fb.len() + node_section;
+    let root_leaf = tree.nodes[0].split.is_none();
+    let mut lay = if total <= FB_LIMIT && !streamed {
+        let (fb, root) = resident(w, &tree, &node_at);
+        debug_assert_eq!(fb.len(), total);
+        // The mailboxes (main memory, TinyRISC's), where the streamed
+        // image would start.
+        let mailbox = mem::STREAM as usize;
+        drop(tree);
+        fin.layout(fb, types, root, 0, total, node_section, mailbox, None)
+    } else {
+        let (fb, st) = streamed_image(w, &fin, &tree, records_start, err)?;
+        let mailbox = st.mailbox as usize;
+        drop(tree);
+        fin.layout(
+            fb,
+            types,
+            st.base as usize,
+            NODE_BYTES / 4,
+            total,
+            node_section,
+            mailbox,
+            Some(st),
+        )
+    };
+    lay.root_leaf = root_leaf;
+    lay.expected_cost = expected_cost;
+    Ok(lay)
+}
+
+/// The resident nodes after the records: the FB image and the root's
+/// address.
+fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
     let root = w.fb.len();
-    let total = root + node_section;
-    let parent_slot = |n: &crate::bsp::Node| {
-        if n.depth == 0 {
-            0
-        } else {
-            pk_slot(n.depth - 1)
-        }
-    };
-    // A leaf's objects of each type, in slot order.
-    let per_type = |n: &crate::bsp::Node| -> Vec<Vec<usize>> {
-        types
-            .iter()
-            .map(|ti| {
-                n.objects
-                    .iter()
-                    .filter_map(|&o| {
-                        let (t, q) = slot[o as usize];
-                        (t == ti.ty as usize).then_some(q)
-                    })
-                    .collect()
-            })
-            .collect()
-    };
-    if total <= FB_LIMIT && !streamed {
-        for n in nodes {
-            match n.split {
-                Some(sp) => {
-                    w.raw(sp.axis as i64);
-                    w.raw(parent_slot(n));
-                    w.coord(sp.position);
-                    w.raw(pk_slot(n.depth));
-                    w.raw((root + node_at[sp.children[0] as usize]) as i64);
-                    w.raw((root + node_at[sp.children[1] as usize]) as i64);
-                }
-                None => {
-                    w.word16(0x8000);
-                    w.raw(parent_slot(n));
-                    w.raw(n.objects.len() as i64);
-                    w.raw(n.objects.iter().filter(|&&o| refs[o as usize] > 1).count() as i64);
-                    for (ti, qs) in types.iter().zip(per_type(n)) {
-                        w.raw(qs.len() as i64);
-                        for q in qs {
-                            let o = ti.objects[q];
-                            w.raw((ti.first + q * ti.size) as i64);
-                            w.raw(if refs[o] > 1 { o as i64 } else { -1 });
-                        }
+    for n in &tree.nodes {
+        match n.split {
+            Some(sp) => {
+                w.raw(sp.axis as i64);
+                w.raw(Tree::parent_slot(n));
+                w.coord(sp.position);
+                w.raw(pk_slot(n.depth));
+                w.raw((root + node_at[sp.children[0] as usize]) as i64);
+                w.raw((root + node_at[sp.children[1] as usize]) as i64);
+            }
+            None => {
+                w.word16(0x8000);
+                w.raw(Tree::parent_slot(n));
+                w.raw(n.objects.len() as i64);
+                w.raw(tree.shared(n.objects.iter().map(|&o| o as usize)) as i64);
+                for (ti, qs) in tree.types.iter().zip(tree.per_type(n)) {
+                    w.raw(qs.len() as i64);
+                    for q in qs {
+                        let o = ti.objects[q];
+                        w.raw((ti.first + q * ti.size) as i64);
+                        w.raw(if tree.refs[o] > 1 { o as i64 } else { -1 });
                     }
                 }
             }
         }
-        debug_assert_eq!(w.fb.len(), total);
-        // The mailboxes (main memory, TinyRISC's), where the streamed
-        // image would start.
-        let mailbox = super::super::mem::STREAM as usize;
-        let mut lay = fin.layout(w.fb, types, root, 0, total, node_section, mailbox, None);
-        lay.root_leaf = nodes[0].split.is_none();
-        lay.expected_cost = expected_cost;
-        return Ok(lay);
     }
-    // Streamed: records, nodes and leaf blocks leave the FB.
-    let records = w.fb.split_off(records_start);
-    let split_slot = w.fb.len();
-    w.raw(0); // split
-    w.raw(0); // its slot
-    w.raw(0); // a popped node's parent slot
-    if w.fb.len() > STREAM_BANK {
-        return Err(err(
-            0,
-            format!(
-                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
-                w.fb.len()
-            ),
-        ));
-    }
-    let base = super::super::mem::STREAM as usize;
-    // Leaf pieces: a leaf's records (grouped by type) cut where a block
-    // would exceed FB bank 1; each piece is a node record of its own,
-    // chained from the leaf (word 6).
-    let mut pieces: Vec<Vec<(usize, usize)>> = Vec::new(); // (type index, slot) per piece
-    let mut first_piece = vec![usize::MAX; nodes.len()];
-    for (k, n) in nodes.iter().enumerate() {
+    (w.fb, root)
+}
+
+/// Leaf pieces: a leaf's records (grouped by type) cut where a block would
+/// exceed FB bank 1; each piece is a node record of its own, chained from
+/// the leaf (`PS_NEXT`). Per piece its (type index, slot) pairs, and per
+/// node the index of its first piece (`usize::MAX`: none).
+#[allow(clippy::type_complexity)]
+fn pieces(
+    tree: &Tree,
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<(Vec<Vec<(usize, usize)>>, Vec<usize>), String> {
+    let types = tree.types;
+    let mut pieces: Vec<Vec<(usize, usize)>> = Vec::new();
+    let mut first_piece = vec![usize::MAX; tree.nodes.len()];
+    for (k, n) in tree.nodes.iter().enumerate() {
         if n.split.is_some() || n.objects.is_empty() {
             continue;
         }
         first_piece[k] = pieces.len();
         let mut cur: Vec<(usize, usize)> = Vec::new();
         let mut words = 0usize;
-        for (j, qs) in per_type(n).into_iter().enumerate() {
+        for (j, qs) in tree.per_type(n).into_iter().enumerate() {
             for q in qs {
                 let sz = types[j].size;
                 if sz > STREAM_BANK {
@@ -302,6 +337,45 @@ pub(super) fn packet_nodes(
         }
         pieces.push(cur);
     }
+    Ok((pieces, first_piece))
+}
+
+/// Write a node record (16 words) into the streamed image.
+fn put(img: &mut [u8], rec: usize, f: &[i32; 16]) {
+    for (i, x) in f.iter().enumerate() {
+        img[NODE_BYTES * rec + 4 * i..NODE_BYTES * rec + 4 * i + 4]
+            .copy_from_slice(&x.to_le_bytes());
+    }
+}
+
+/// The streamed image: records, nodes and leaf blocks leave the FB, which
+/// keeps what comes before the records and the split words.
+fn streamed_image(
+    mut w: W,
+    fin: &Finish,
+    tree: &Tree,
+    records_start: usize,
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<(Vec<i32>, Stream), String> {
+    use fields::*;
+    let types = tree.types;
+    let nodes = &tree.nodes;
+    let records = w.fb.split_off(records_start);
+    let split_slot = w.fb.len();
+    w.raw(0); // split
+    w.raw(0); // its slot
+    w.raw(0); // a popped node's parent slot
+    if w.fb.len() > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                w.fb.len()
+            ),
+        ));
+    }
+    let base = mem::STREAM as usize;
+    let (pieces, first_piece) = pieces(tree, err)?;
     let nn = nodes.len();
     let lists_at = NODE_BYTES * (nn + pieces.len());
     let list_bytes: usize = pieces.iter().map(|p| 4 * p.len()).sum();
@@ -310,12 +384,6 @@ pub(super) fn packet_nodes(
     let mut lists: Vec<u32> = Vec::new();
     let mut blocks: Vec<u8> = Vec::new();
     let mut largest = 0usize;
-    let put = |img: &mut Vec<u8>, rec: usize, f: &[i32; 16]| {
-        for (i, x) in f.iter().enumerate() {
-            img[NODE_BYTES * rec + 4 * i..NODE_BYTES * rec + 4 * i + 4]
-                .copy_from_slice(&x.to_le_bytes());
-        }
-    };
     // Piece records: block address and words, next piece, per-type counts.
     let mut piece_rec = vec![[0i32; 16]; pieces.len()];
     for (p, pc) in pieces.iter().enumerate() {
@@ -329,19 +397,16 @@ pub(super) fn packet_nodes(
         }
         largest = largest.max(words.len());
         let f = &mut piece_rec[p];
-        f[0] = -32768;
-        f[2] = (base + lists_at + 4 * lists.len()) as i32;
+        f[word(PS_FLAGS)] = -32768;
+        f[word(PS_LIST)] = (base + lists_at + 4 * lists.len()) as i32;
         for &(j, q) in pc {
             lists.push(types[j].objects[q] as u32);
         }
-        f[4] = (base + blocks_at + blocks.len()) as i32;
-        f[5] = words.len() as i32;
-        f[7..14].copy_from_slice(&counts);
-        f[14] = pc.len() as i32;
-        f[15] = pc
-            .iter()
-            .filter(|&&(j, q)| refs[types[j].objects[q]] > 1)
-            .count() as i32;
+        f[word(PS_BLOCK)] = (base + blocks_at + blocks.len()) as i32;
+        f[word(PS_BLOCK_WORDS)] = words.len() as i32;
+        f[PS_COUNTS as usize / 4..][..7].copy_from_slice(&counts);
+        f[word(PS_OBJECTS)] = pc.len() as i32;
+        f[word(PS_SHARED)] = tree.shared(pc.iter().map(|&(j, q)| types[j].objects[q])) as i32;
         blocks.extend(fb_word_bytes(&words, w.x));
     }
     // Chain the pieces of each leaf (a leaf's pieces are consecutive).
@@ -356,13 +421,13 @@ pub(super) fn packet_nodes(
             .find(|&p| p != usize::MAX)
             .unwrap_or(pieces.len());
         for (p, rec) in piece_rec.iter_mut().enumerate().take(end - 1).skip(first) {
-            rec[6] = (base + NODE_BYTES * (nn + p + 1)) as i32;
+            rec[word(PS_NEXT)] = (base + NODE_BYTES * (nn + p + 1)) as i32;
         }
     }
     // The mailboxes follow the image; the lists hold their addresses.
     let mailbox = (base + blocks_at + blocks.len()).next_multiple_of(PK_MAILBOX_BYTES);
     for (i, o) in lists.iter().enumerate() {
-        let a = if refs[*o as usize] > 1 {
+        let a = if tree.refs[*o as usize] > 1 {
             (mailbox + PK_MAILBOX_BYTES * *o as usize) as u32
         } else {
             0
@@ -371,22 +436,23 @@ pub(super) fn packet_nodes(
     }
     for (k, n) in nodes.iter().enumerate() {
         let mut f = [0i32; 16];
-        f[1] = parent_slot(n) as i32;
+        f[word(PS_PARENT_SLOT)] = Tree::parent_slot(n) as i32;
         match n.split {
             Some(sp) => {
-                f[0] = sp.axis as i32;
-                f[2] = w.sat(sp.position * w.s);
-                f[3] = pk_slot(n.depth) as i32;
-                f[4] = (base + NODE_BYTES * sp.children[0] as usize) as i32;
-                f[5] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
+                f[word(PS_FLAGS)] = sp.axis as i32;
+                f[word(PS_SPLIT)] = w.sat(sp.position * w.s);
+                f[word(PS_SLOT)] = pk_slot(n.depth) as i32;
+                f[word(PS_LEFT)] = (base + NODE_BYTES * sp.children[0] as usize) as i32;
+                f[word(PS_RIGHT)] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
             }
             None => {
-                f[0] = -32768;
+                f[word(PS_FLAGS)] = -32768;
                 if first_piece[k] != usize::MAX {
-                    // The leaf's record is its first piece's.
+                    // The leaf's record is its first piece's (its list,
+                    // block, next piece, counts).
                     let p = piece_rec[first_piece[k]];
-                    f[2] = p[2];
-                    f[4..16].copy_from_slice(&p[4..16]);
+                    f[word(PS_LIST)] = p[word(PS_LIST)];
+                    f[word(PS_BLOCK)..].copy_from_slice(&p[word(PS_BLOCK)..]);
                 }
             }
         }
@@ -397,13 +463,13 @@ pub(super) fn packet_nodes(
     }
     img.extend(blocks);
     let end = mailbox + PK_MAILBOX_BYTES * fin.objects;
-    if end > super::super::mem::STREAM_END as usize {
+    if end > mem::STREAM_END as usize {
         return Err(err(
             0,
             format!(
                 "the streamed scene needs {} bytes of main memory; {} are reserved",
                 end - base,
-                super::super::mem::STREAM_END as usize - base
+                mem::STREAM_END as usize - base
             ),
         ));
     }
@@ -417,18 +483,144 @@ pub(super) fn packet_nodes(
         largest_block: largest,
         extra_pieces: pieces.len() - first_piece.iter().filter(|&&p| p != usize::MAX).count(),
     };
-    let root_leaf = nodes[0].split.is_none();
-    let mut lay = fin.layout(
-        w.fb,
-        types,
-        base,
-        NODE_BYTES / 4,
-        total,
-        node_section,
-        mailbox,
-        Some(st),
+    Ok((w.fb, st))
+}
+
+/// The node fields the packet traversal reads (named in the program's
+/// header): resident nodes in FB words, streamed ones in bytes of a
+/// `NODE_BYTES` record in main memory, and the mailboxes.
+pub mod fields {
+    use crate::tracer::emit::Name;
+
+    pub const PN_FLAGS: Name = Name::new(
+        "PN_FLAGS",
+        0,
+        "packet node: the split axis, or bit 15 a leaf",
     );
-    lay.root_leaf = root_leaf;
-    lay.expected_cost = expected_cost;
-    Ok(lay)
+    pub const PN_PARENT_SLOT: Name = Name::new(
+        "PN_PARENT_SLOT",
+        1,
+        "  the RAM slot its parent pushed it with",
+    );
+    pub const PN_SPLIT: Name = Name::new("PN_SPLIT", 2, "  inner: the split's position");
+    pub const PN_SLOT: Name = Name::new("PN_SLOT", 3, "  inner: the RAM slot of its depth");
+    pub const PN_LEFT: Name = Name::new("PN_LEFT", 4, "  inner: the children (FB addresses)");
+    pub const PN_RIGHT: Name = Name::new("PN_RIGHT", 5, "");
+    pub const PL_OBJECTS: Name = Name::new("PL_OBJECTS", 2, "  leaf: its objects");
+    pub const PL_SHARED: Name = Name::new(
+        "PL_SHARED",
+        3,
+        "  leaf: of those, in other leaves too (a mailbox)",
+    );
+    pub const PL_LISTS: Name = Name::new(
+        "PL_LISTS",
+        4,
+        "  leaf: per type a count, then an entry per object:",
+    );
+    pub const LE_RECORD: Name = Name::new("LE_RECORD", 0, "    its record (FB address)");
+    pub const LE_MAILBOX: Name = Name::new("LE_MAILBOX", 1, "    its mailbox index (-1: none)");
+    pub const LE_WORDS: Name = Name::new("LE_WORDS", 2, "");
+    /// The resident fields, in header order.
+    pub const RESIDENT: &[Name] = &[
+        PN_FLAGS,
+        PN_PARENT_SLOT,
+        PN_SPLIT,
+        PN_SLOT,
+        PN_LEFT,
+        PN_RIGHT,
+        PL_OBJECTS,
+        PL_SHARED,
+        PL_LISTS,
+        LE_RECORD,
+        LE_MAILBOX,
+        LE_WORDS,
+    ];
+
+    pub const PS_FLAGS: Name = Name::new(
+        "PS_FLAGS",
+        0,
+        "  -32768 a leaf or a piece, else the split axis",
+    );
+    pub const PS_PARENT_SLOT: Name = Name::new(
+        "PS_PARENT_SLOT",
+        4,
+        "  the RAM slot its parent pushed it with",
+    );
+    pub const PS_SPLIT: Name = Name::new("PS_SPLIT", 8, "  inner: the split's position");
+    pub const PS_SLOT: Name = Name::new("PS_SLOT", 12, "  inner: the RAM slot of its depth");
+    pub const PS_LEFT: Name = Name::new("PS_LEFT", 16, "  inner: the children (byte addresses)");
+    pub const PS_RIGHT: Name = Name::new("PS_RIGHT", 20, "");
+    pub const PS_LIST: Name = Name::new(
+        "PS_LIST",
+        8,
+        "  leaf: per object its mailbox's address (0: none)",
+    );
+    pub const PS_BLOCK: Name = Name::new("PS_BLOCK", 16, "  leaf: its block of records");
+    pub const PS_BLOCK_WORDS: Name = Name::new("PS_BLOCK_WORDS", 20, "  leaf: the block's words");
+    pub const PS_NEXT: Name = Name::new("PS_NEXT", 24, "  leaf: its next piece (0: none)");
+    /// Per type present (in test order), the leaf's objects of that type:
+    /// `PS_COUNT_type` = `PS_COUNTS + 4 j`.
+    pub const PS_COUNTS: u32 = 28;
+    pub const PS_OBJECTS: Name = Name::new("PS_OBJECTS", 56, "  leaf: objects in all");
+    pub const PS_SHARED: Name = Name::new("PS_SHARED", 60, "  leaf: of those, with a mailbox");
+
+    pub const MB_SHIFT: Name = Name::new(
+        "MB_SHIFT",
+        4,
+        "a mailbox (main memory, 16 bytes, MAILBOX + index << MB_SHIFT):",
+    );
+    pub const MB_PASS: Name = Name::new("MB_PASS", 0, "  the pass that last tested the object");
+    pub const MB_RAYS: Name = Name::new("MB_RAYS", 4, "  the rays that did (64-bit mask)");
+}
+
+/// A streamed node record's word of field `f`.
+fn word(f: crate::tracer::emit::Name) -> usize {
+    f.at() / 4
+}
+
+/// The header lines of the packet traversal's node fields.
+pub fn header(streamed: bool, types: &[&str]) -> Vec<String> {
+    use crate::tracer::emit::define;
+    use fields::*;
+    let mut v: Vec<String> = if streamed {
+        let mut v = vec![define(
+            "NODE_BYTES",
+            NODE_BYTES,
+            "a packet node record (main memory):",
+        )];
+        v.extend(
+            [
+                PS_FLAGS,
+                PS_PARENT_SLOT,
+                PS_SPLIT,
+                PS_SLOT,
+                PS_LEFT,
+                PS_RIGHT,
+                PS_LIST,
+                PS_BLOCK,
+                PS_BLOCK_WORDS,
+                PS_NEXT,
+            ]
+            .iter()
+            .map(|n| n.define()),
+        );
+        for (j, t) in types.iter().enumerate() {
+            v.push(define(
+                &format!("PS_COUNT_{}", t.to_uppercase()),
+                PS_COUNTS as usize + 4 * j,
+                if j == 0 {
+                    "  leaf: objects of each type"
+                } else {
+                    ""
+                },
+            ));
+        }
+        v.push(PS_OBJECTS.define());
+        v.push(PS_SHARED.define());
+        v
+    } else {
+        RESIDENT.iter().map(|n| n.define()).collect()
+    };
+    v.extend([MB_SHIFT, MB_PASS, MB_RAYS].iter().map(|n| n.define()));
+    v
 }

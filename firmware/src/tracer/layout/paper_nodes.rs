@@ -70,129 +70,9 @@ pub(super) fn paper_nodes(
     }
     let node_section = node_at[nodes.len()];
     let root = w.fb.len();
-    let addr = |k: u32| root + node_at[k as usize];
     let total = root + node_section + mailbox_slots;
-    let mut stream = None;
     if total > FB_LIMIT || streamed {
-        // Streamed: only the tables, camera, lights and shading stay in the
-        // FB (bank 0); objects, nodes and mailboxes go to main memory.
-        let records = w.fb.split_off(records_start);
-        let split_slot = w.fb.len();
-        w.raw(0);
-        if w.fb.len() > STREAM_BANK {
-            return Err(err(
-                0,
-                format!(
-                    "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
-                    w.fb.len()
-                ),
-            ));
-        }
-        let base = super::super::mem::STREAM;
-        let nn = nodes.len();
-        let lists_at = NODE_BYTES * nn;
-        let list_bytes: usize = nodes
-            .iter()
-            .filter(|n| n.split.is_none())
-            .map(|n| 4 * n.objects.len())
-            .sum();
-        let blocks_at = lists_at + list_bytes;
-        let mut node_img = vec![0u8; lists_at];
-        let mut lists: Vec<u8> = Vec::with_capacity(list_bytes);
-        let mut blocks: Vec<u8> = Vec::new();
-        let mut largest = 0usize;
-        // Mailbox addresses are known once the blocks are laid out: lay
-        // the blocks out first, patch the lists after.
-        let mut list_objs: Vec<usize> = Vec::new();
-        for (k, n) in nodes.iter().enumerate() {
-            let mut f = [0i32; 16];
-            match n.split {
-                Some(sp) => {
-                    f[0] = sp.axis as i32;
-                    f[1] = w.sat(sp.position * w.s);
-                    f[2] = (base as usize + NODE_BYTES * sp.children[0] as usize) as i32;
-                    f[3] = (base as usize + NODE_BYTES * sp.children[1] as usize) as i32;
-                }
-                None => {
-                    f[0] = -32768;
-                    let list_addr = base as usize + lists_at + 4 * list_objs.len();
-                    let mut words: Vec<i32> = Vec::new();
-                    for v in n.bounds.min.to_array() {
-                        words.push(w.sat((v * w.s).floor() - 2.0));
-                    }
-                    for v in n.bounds.max.to_array() {
-                        words.push(w.sat((v * w.s).ceil() + 2.0));
-                    }
-                    for (j, ti) in types.iter().enumerate() {
-                        let mut cnt = 0;
-                        for &o in &n.objects {
-                            let (t, q) = slot[o as usize];
-                            if t == ti.ty as usize {
-                                let at = ti.first - records_start + q * ti.size;
-                                words.extend_from_slice(&records[at..at + ti.size]);
-                                list_objs.push(o as usize);
-                                cnt += 1;
-                            }
-                        }
-                        f[7 + j] = cnt;
-                    }
-                    if !n.objects.is_empty() {
-                        if words.len() > STREAM_BANK {
-                            return Err(err(
-                                0,
-                                format!(
-                                    "a BSP leaf of {} objects needs {} FB words; FB bank 1 holds {STREAM_BANK}",
-                                    n.objects.len(),
-                                    words.len()
-                                ),
-                            ));
-                        }
-                        largest = largest.max(words.len());
-                        f[4] = (base as usize + blocks_at + blocks.len()) as i32;
-                        f[5] = words.len() as i32;
-                        f[14] = n.objects.len() as i32;
-                        f[6] = list_addr as i32;
-                        blocks.extend(fb_word_bytes(&words, w.x));
-                    }
-                }
-            }
-            for (i, x) in f.iter().enumerate() {
-                node_img[NODE_BYTES * k + 4 * i..NODE_BYTES * k + 4 * i + 4]
-                    .copy_from_slice(&x.to_le_bytes());
-            }
-        }
-        let mb_at = (blocks_at + blocks.len()).next_multiple_of(4);
-        let mailbox = base as usize + mb_at;
-        for &o in &list_objs {
-            lists.extend(((mailbox + 2 * o) as u32).to_le_bytes());
-        }
-        let mut image = node_img;
-        image.extend(lists);
-        image.extend(blocks);
-        image.resize(mb_at, 0);
-        let end = base as usize + mb_at + 2 * fin.objects;
-        if end > super::super::mem::STREAM_END as usize {
-            return Err(err(
-                0,
-                format!(
-                    "the streamed scene needs {} bytes of main memory; {} are reserved",
-                    end - base as usize,
-                    super::super::mem::STREAM_END - base
-                ),
-            ));
-        }
-        stream = Some(Stream {
-            base,
-            image,
-            root: base,
-            mailbox: mailbox as u32,
-            split_slot,
-            nodes: nn,
-            largest_block: largest,
-            extra_pieces: 0,
-        });
-    }
-    if let Some(st) = stream {
+        let st = streamed_image(&mut w, fin.objects, &types, nodes, slot, records_start, err)?;
         let (root, mailbox) = (st.root as usize, st.mailbox as usize);
         return Ok(fin.layout(
             w.fb,
@@ -205,6 +85,169 @@ pub(super) fn paper_nodes(
             Some(st),
         ));
     }
+    resident(&mut w, &types, nodes, slot, node_layout, &node_at);
+    debug_assert_eq!(w.fb.len(), root + node_section);
+    let mailbox = w.fb.len();
+    w.fb.resize(mailbox + mailbox_slots, 0);
+    for t in &mut types {
+        t.mailbox += mailbox;
+    }
+    Ok(fin.layout(
+        w.fb,
+        types,
+        root,
+        node_words,
+        total,
+        node_section,
+        mailbox,
+        None,
+    ))
+}
+
+/// The streamed image of the paper's traversal: only the tables, camera,
+/// lights and shading stay in the FB (bank 0); objects, nodes and
+/// mailboxes go to main memory.
+fn streamed_image(
+    w: &mut W,
+    objects: usize,
+    types: &[TypeInfo],
+    nodes: &[crate::bsp::Node],
+    slot: &[(usize, usize)],
+    records_start: usize,
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<Stream, String> {
+    use fields::*;
+    let word = |f: crate::tracer::emit::Name| f.at() / 4;
+    // Streamed: only the tables, camera, lights and shading stay in the
+    // FB (bank 0); objects, nodes and mailboxes go to main memory.
+    let records = w.fb.split_off(records_start);
+    let split_slot = w.fb.len();
+    w.raw(0);
+    if w.fb.len() > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                w.fb.len()
+            ),
+        ));
+    }
+    let base = super::super::mem::STREAM;
+    let nn = nodes.len();
+    let lists_at = NODE_BYTES * nn;
+    let list_bytes: usize = nodes
+        .iter()
+        .filter(|n| n.split.is_none())
+        .map(|n| 4 * n.objects.len())
+        .sum();
+    let blocks_at = lists_at + list_bytes;
+    let mut node_img = vec![0u8; lists_at];
+    let mut lists: Vec<u8> = Vec::with_capacity(list_bytes);
+    let mut blocks: Vec<u8> = Vec::new();
+    let mut largest = 0usize;
+    // Mailbox addresses are known once the blocks are laid out: lay
+    // the blocks out first, patch the lists after.
+    let mut list_objs: Vec<usize> = Vec::new();
+    for (k, n) in nodes.iter().enumerate() {
+        let mut f = [0i32; 16];
+        match n.split {
+            Some(sp) => {
+                f[word(SN_FLAGS)] = sp.axis as i32;
+                f[word(SN_SPLIT)] = w.sat(sp.position * w.s);
+                f[word(SN_LEFT)] = (base as usize + NODE_BYTES * sp.children[0] as usize) as i32;
+                f[word(SN_RIGHT)] = (base as usize + NODE_BYTES * sp.children[1] as usize) as i32;
+            }
+            None => {
+                f[word(SN_FLAGS)] = -32768;
+                let list_addr = base as usize + lists_at + 4 * list_objs.len();
+                let mut words: Vec<i32> = Vec::new();
+                for v in n.bounds.min.to_array() {
+                    words.push(w.sat((v * w.s).floor() - 2.0));
+                }
+                for v in n.bounds.max.to_array() {
+                    words.push(w.sat((v * w.s).ceil() + 2.0));
+                }
+                for (j, ti) in types.iter().enumerate() {
+                    let mut cnt = 0;
+                    for &o in &n.objects {
+                        let (t, q) = slot[o as usize];
+                        if t == ti.ty as usize {
+                            let at = ti.first - records_start + q * ti.size;
+                            words.extend_from_slice(&records[at..at + ti.size]);
+                            list_objs.push(o as usize);
+                            cnt += 1;
+                        }
+                    }
+                    f[SN_COUNTS as usize / 4 + j] = cnt;
+                }
+                if !n.objects.is_empty() {
+                    if words.len() > STREAM_BANK {
+                        return Err(err(
+                            0,
+                            format!(
+                                "a BSP leaf of {} objects needs {} FB words; FB bank 1 holds {STREAM_BANK}",
+                                n.objects.len(),
+                                words.len()
+                            ),
+                        ));
+                    }
+                    largest = largest.max(words.len());
+                    f[word(SN_BLOCK)] = (base as usize + blocks_at + blocks.len()) as i32;
+                    f[word(SN_BLOCK_WORDS)] = words.len() as i32;
+                    f[word(SN_OBJECTS)] = n.objects.len() as i32;
+                    f[word(SN_LIST)] = list_addr as i32;
+                    blocks.extend(fb_word_bytes(&words, w.x));
+                }
+            }
+        }
+        for (i, x) in f.iter().enumerate() {
+            node_img[NODE_BYTES * k + 4 * i..NODE_BYTES * k + 4 * i + 4]
+                .copy_from_slice(&x.to_le_bytes());
+        }
+    }
+    let mb_at = (blocks_at + blocks.len()).next_multiple_of(4);
+    let mailbox = base as usize + mb_at;
+    for &o in &list_objs {
+        lists.extend(((mailbox + 2 * o) as u32).to_le_bytes());
+    }
+    let mut image = node_img;
+    image.extend(lists);
+    image.extend(blocks);
+    image.resize(mb_at, 0);
+    let end = base as usize + mb_at + 2 * objects;
+    if end > super::super::mem::STREAM_END as usize {
+        return Err(err(
+            0,
+            format!(
+                "the streamed scene needs {} bytes of main memory; {} are reserved",
+                end - base as usize,
+                super::super::mem::STREAM_END - base
+            ),
+        ));
+    }
+    Ok(Stream {
+        base,
+        image,
+        root: base,
+        mailbox: mailbox as u32,
+        split_slot,
+        nodes: nn,
+        largest_block: largest,
+        extra_pieces: 0,
+    })
+}
+
+/// The resident nodes after the records (Fig. 5's or compact).
+fn resident(
+    w: &mut W,
+    types: &[TypeInfo],
+    nodes: &[crate::bsp::Node],
+    slot: &[(usize, usize)],
+    node_layout: NodeLayout,
+    node_at: &[usize],
+) {
+    let root = w.fb.len();
+    let addr = |k: u32| root + node_at[k as usize];
     for n in nodes {
         match n.split {
             Some(sp) => {
@@ -232,7 +275,7 @@ pub(super) fn paper_nodes(
                 w.push((v * w.s).ceil() + 2.0);
             }
         }
-        for ti in &types {
+        for ti in types {
             // The node's objects of this type, ascending (the order the
             // Fig. 6 loop meets them in).
             let ks = n.objects.iter().filter_map(|&o| {
@@ -257,20 +300,137 @@ pub(super) fn paper_nodes(
             }
         }
     }
-    debug_assert_eq!(w.fb.len(), root + node_section);
-    let mailbox = w.fb.len();
-    w.fb.resize(mailbox + mailbox_slots, 0);
-    for t in &mut types {
-        t.mailbox += mailbox;
+}
+
+/// The node fields the paper's traversal reads (named in the program's
+/// header): resident nodes in FB words, streamed ones in bytes of a
+/// `NODE_BYTES` record in main memory.
+pub mod fields {
+    use crate::tracer::emit::Name;
+
+    pub const N_FLAGS: Name = Name::new(
+        "N_FLAGS",
+        0,
+        "node: bit 15 a leaf, bits 1..0 the split axis",
+    );
+    pub const N_SPLIT: Name = Name::new("N_SPLIT", 1, "  inner: the split's position");
+    pub const N_LEFT: Name = Name::new("N_LEFT", 2, "  inner: the child below (FB address)");
+    pub const N_RIGHT: Name = Name::new("N_RIGHT", 3, "  inner: the child above");
+    pub const N_BOUNDS: Name = Name::new(
+        "N_BOUNDS",
+        4,
+        "  Fig. 5: the cell, widened by 2 LSB: min.xyz, max.xyz",
+    );
+    pub const NC_INNER_LISTS: Name = Name::new(
+        "NC_INNER_LISTS",
+        super::COMPACT_INNER_HEAD as u32,
+        "  compact inner: per type, a count and the slot indices",
+    );
+    pub const NC_LEAF_BOUNDS: Name = Name::new(
+        "NC_LEAF_BOUNDS",
+        1,
+        "  compact leaf: the cell, widened by 2 LSB",
+    );
+    pub const NC_LEAF_LISTS: Name = Name::new(
+        "NC_LEAF_LISTS",
+        super::COMPACT_LEAF_HEAD as u32,
+        "  compact leaf: per type, a count and the slot indices",
+    );
+
+    pub const SN_FLAGS: Name = Name::new("SN_FLAGS", 0, "  -32768 a leaf, else the split axis");
+    pub const SN_SPLIT: Name = Name::new("SN_SPLIT", 4, "  the split's position");
+    pub const SN_LEFT: Name = Name::new("SN_LEFT", 8, "  the children (byte addresses)");
+    pub const SN_RIGHT: Name = Name::new("SN_RIGHT", 12, "");
+    pub const SN_BLOCK: Name = Name::new("SN_BLOCK", 16, "  leaf: its block (bounds, records)");
+    pub const SN_BLOCK_WORDS: Name = Name::new("SN_BLOCK_WORDS", 20, "  leaf: the block's words");
+    pub const SN_LIST: Name = Name::new("SN_LIST", 24, "  leaf: its list of mailbox addresses");
+    /// Per type present (in test order), the leaf's objects of that type:
+    /// `SN_COUNT_type` = `SN_COUNTS + 4 j`.
+    pub const SN_COUNTS: u32 = 28;
+    pub const SN_OBJECTS: Name = Name::new("SN_OBJECTS", 56, "  leaf: objects in all");
+    pub const U_NSTACK: Name = Name::new(
+        "U_NSTACK",
+        0,
+        "an unordered subtree (USTK): the node stack where it ends",
+    );
+    pub const U_AXIS: Name = Name::new("U_AXIS", 4, "  its split axis");
+    pub const U_FRAME: Name = Name::new("U_FRAME", 8, "  bytes");
+}
+
+/// The header lines of the resident nodes' fields.
+pub fn header(layout: NodeLayout, types: &[TypeInfo]) -> Vec<String> {
+    use crate::tracer::emit::define;
+    use fields::*;
+    let mut v: Vec<String> = [N_FLAGS, N_SPLIT, N_LEFT, N_RIGHT]
+        .iter()
+        .map(|n| n.define())
+        .collect();
+    match layout {
+        NodeLayout::Fig5 => {
+            v.push(N_BOUNDS.define());
+            for t in types {
+                let up = t.ty.name().to_uppercase();
+                v.push(define(
+                    &format!("N_BV_{up}"),
+                    t.bv_offset,
+                    &format!(
+                        "  the {}s under it, a bit each",
+                        t.ty.name().replace('_', " ")
+                    ),
+                ));
+                v.push(define(
+                    &format!("BV_WORDS_{up}"),
+                    t.bv_words,
+                    "  words of that bit vector",
+                ));
+            }
+        }
+        NodeLayout::Compact => {
+            v.extend(
+                [NC_INNER_LISTS, NC_LEAF_BOUNDS, NC_LEAF_LISTS]
+                    .iter()
+                    .map(|n| n.define()),
+            );
+        }
     }
-    Ok(fin.layout(
-        w.fb,
-        types,
-        root,
-        node_words,
-        total,
-        node_section,
-        mailbox,
-        None,
-    ))
+    v
+}
+
+/// The header lines of the streamed nodes' fields (`types`: the types
+/// present, in test order).
+pub fn streamed_header(types: &[&str]) -> Vec<String> {
+    use crate::tracer::emit::define;
+    use fields::*;
+    let mut v = vec![define(
+        "NODE_BYTES",
+        NODE_BYTES,
+        "a node record (main memory):",
+    )];
+    v.extend(
+        [
+            SN_FLAGS,
+            SN_SPLIT,
+            SN_LEFT,
+            SN_RIGHT,
+            SN_BLOCK,
+            SN_BLOCK_WORDS,
+            SN_LIST,
+        ]
+        .iter()
+        .map(|n| n.define()),
+    );
+    for (j, t) in types.iter().enumerate() {
+        v.push(define(
+            &format!("SN_COUNT_{}", t.to_uppercase()),
+            SN_COUNTS as usize + 4 * j,
+            if j == 0 {
+                "  leaf: objects of each type"
+            } else {
+                ""
+            },
+        ));
+    }
+    v.push(SN_OBJECTS.define());
+    v.extend([U_NSTACK, U_AXIS, U_FRAME].iter().map(|n| n.define()));
+    v
 }

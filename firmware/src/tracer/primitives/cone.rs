@@ -43,11 +43,11 @@
 //! one, a nearly cylindrical one seen from inside): `t` within 3 LSB, the
 //! normal within 0.03.
 
-use super::super::emit::{at, define, Code, K, R1, R2, R3, R7};
-use super::super::math::{divide_q13, normalize, sqrt_q14};
+use super::super::emit::{at, define, Code, K, R3, R7};
+use super::super::math::{divide_q13, normalize, sqrt_q14, Approx};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::{commit_obj_mat, kaddr, klen, perpendicular, self_margin, Body, Fit, Gen, Sides};
+use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
 use crate::scene::Vec3;
 use crate::tracer::layout::{Fitter, W};
 
@@ -271,7 +271,6 @@ pub(crate) fn write(
 /// One run of the cone body kernel.
 pub fn kernel(g: &Gen, body: Body) -> K {
     let nr = g.approx;
-    let ct = ram::CONE_TMP;
     let mut k = K::new();
     k.doc(&format!(
         "{}: the open cone test of one body record (the stream){}.\n\
@@ -290,6 +289,48 @@ pub fn kernel(g: &Gen, body: Body) -> K {
             ", HIT_BACK_OBJ"
         },
     ));
+    bounding_sphere(&mut k);
+    frame(&mut k);
+    quadratic(&mut k, nr);
+    root(&mut k, g, body);
+    height(&mut k);
+    normal(&mut k, nr);
+    commit_obj_mat(&mut k, body);
+    k
+}
+
+/// Broadcast a cone's test (record at r7): the body (both runs for a glass
+/// cone), then the caps where its flag is set. Labels begin with `lbl`.
+pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides) {
+    let cap = planar::kernel_name(Inside::Disc, sides);
+    let nocap = format!("{lbl}_nocap");
+    let caps: [&str; 2] = match sides {
+        Sides::Front => {
+            let k = body_name(Body::Opaque);
+            t.m("BCAST_REC", format!("{k}, r7, CONE_BODY"))
+                .c("the body");
+            ["CONE_CAP0", "CONE_CAP1"]
+        }
+        Sides::Both => {
+            let (f, b) = (body_name(Body::Outer), body_name(Body::Inner));
+            t.m("BCAST_REC", format!("{f}, r7, CONE_BODY"))
+                .c("the body's outside")
+                .m("BCAST_REC", format!("{b}, r7, GCONE_INNER"))
+                .c("its inside");
+            ["GCONE_CAP0", "GCONE_CAP1"]
+        }
+    };
+    t.lfb(R3, at("CONE_CAPS", R7)).beqz(R3, &nocap);
+    for c in caps {
+        t.m("BCAST_REC", format!("{cap}, r7, {c}"));
+    }
+    t.c("the caps");
+    t.label(nocap);
+}
+
+/// The bounding sphere: `b = (M - o).d` into `TMP0`, `w = ((M - o) - b d) / S`
+/// (r8..r10); F where the line meets the sphere (`|w| <= 1/4`).
+fn bounding_sphere(k: &mut K) {
     k.comment("bounding sphere about M: b = (M - o).d, p = (M - o) - b d");
     k.c("sub r8, fb0, r1")
         .c("sub r9, fb0, r2")
@@ -316,6 +357,12 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("cmp.ge r15, #0")
         .note("F: the line meets the bounding sphere")
         .c(format!("st r11, [#{}]", ram::TMP0));
+}
+
+/// The cone's frame: `c q_perp`, `G` (zoomed into [1/8, 1/4) by `2^e`) and `c d_perp`,
+/// `s dz` into `CONE_TMP`, `TMP1`, `TMP2`.
+fn frame(k: &mut K) {
+    let ct = ram::CONE_TMP;
     k.comment(
         "frame: w.ce1 = -c qx, w.ce2 = -c qy, w.a = -qz; d.ce1 = c dx, d.ce2 = c dy, d.a = dz",
     );
@@ -363,6 +410,11 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     for (i, x) in [8, 9, 10, 12, 13, 14].into_iter().enumerate() {
         k.c(format!("st r{x}, [#{}]", ct + i as u32));
     }
+}
+
+/// The quadratic `A tau^2 + 2 B tau + C` (zoomed), times `sg`, its discriminant and
+/// `sqrt(4D)` (r8).
+fn quadratic(k: &mut K, nr: Approx) {
     k.comment("A, -2B, 4C (zoomed: 2^e B, 2^2e C), times sg; 4D = 4B^2 - 4A C");
     k.c("mul out, r8, r8")
         .c("mac out, r9, r9")
@@ -386,7 +438,14 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .note("D")
         .c("(f) cmp.ge r14, #0")
         .c(format!("st r15, [#{}]", ram::TMP3));
-    sqrt_q14(&mut k, 14, 8, [9, 10, 13, 15], nr);
+    sqrt_q14(k, 14, 8, [9, 10, 13, 15], nr);
+}
+
+/// The visible root `tau`, then `t = b + S tau` (r11, `TMP4`) where it is ahead and
+/// nearer than `tbest`.
+fn root(k: &mut K, g: &Gen, body: Body) {
+    let ct = ram::CONE_TMP;
+    let nr = g.approx;
     k.comment("tau' = 2^e tau = X / 2Y: B > 0: -(2B + sqrt 4D) / 2A, else 4C / 2(sqrt 4D - 2B)");
     k.c("movb r9, #0")
         .c("(f) movb r9, #1")
@@ -408,7 +467,7 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("asl r11, r15, #2")
         .c("(f) cmp.lt r10, r11")
         .note("|tau'| < 2");
-    divide_q13(&mut k, 10, 15, 10, [8, 9, 11, 13, 14], nr);
+    divide_q13(k, 10, 15, 10, [8, 9, 11, 13, 14], nr);
     k.c("xor r10, r10, r12").c("sub r10, r10, r12").note("tau'");
     k.comment("tau = tau' / 2^e (rounded); t = b + S tau, S = 2 R");
     k.c(format!("ld r11, [r0 + #{}]", ct + 6))
@@ -429,13 +488,17 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("mac r11, fb0, r13, >>Q13")
         .note("t = b + S tau");
     if body != Body::Opaque {
-        self_margin(&mut k, 12, g.datapath);
+        self_margin(k, 12, g.datapath);
         k.c("(f) cmp.gt r11, r12");
     } else {
         k.c("(f) cmp.gt r11, #0");
     }
     k.c("(f) cmp.lt r11, r7")
         .c(format!("st r11, [#{}]", ram::TMP4));
+}
+
+/// The hit's height within the cone: F kept where `|q_z + tau d_z| <= hh`.
+fn height(k: &mut K) {
     k.comment("height of the hit: |qz + tau dz| <= hh");
     k.c(format!("ld r12, [r0 + #{}]", ram::TMP1))
         .c(format!("ld r14, [r0 + #{}]", ram::TMP2))
@@ -443,6 +506,11 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("msu r12, r13, r14, >>Q14")
         .c("abs r12, r12")
         .c("(f) cmp.ge fb0, r12");
+}
+
+/// The gradient at the hit, normalised, in the scene's axes: `HIT_N`, `tbest`.
+fn normal(k: &mut K, nr: Approx) {
+    let ct = ram::CONE_TMP;
     k.comment("normal: sg (c (c q_perp + tau c d_perp), -s (G + tau s dz)), zoomed, halved");
     for (x, qa, da) in [(8, 3, 0), (9, 4, 1)] {
         k.c(format!("ld r{x}, [r0 + #{}]", ct + qa))
@@ -462,7 +530,7 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("mul r9, r9, r13, >>Q14")
         .c("mul r10, fb0, r11, >>Q14")
         .note("-sg s c rho");
-    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], false, nr);
+    normalize(k, [8, 9, 10], [11, 12, 13, 14, 15], false, nr);
     for x in [11, 12, 13] {
         k.c("mul out, fb0, r8")
             .c("mac out, fb0, r9")
@@ -473,41 +541,4 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     for (i, x) in [11, 12, 13].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    commit_obj_mat(&mut k, body);
-    k
-}
-
-/// Broadcast a cone's test (record at r7): the body (both runs for a glass
-/// cone), then the caps where its flag is set. Labels begin with `lbl`.
-pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides) {
-    let cap = planar::kernel_name(Inside::Disc, sides);
-    let nocap = format!("{lbl}_nocap");
-    let caps: [&str; 2] = match sides {
-        Sides::Front => {
-            let k = body_name(Body::Opaque);
-            t.li(R1, kaddr(k))
-                .addi(R2, R7, "CONE_BODY")
-                .sbcb(R1, R2, klen(k))
-                .c("the body");
-            ["CONE_CAP0", "CONE_CAP1"]
-        }
-        Sides::Both => {
-            let (f, b) = (body_name(Body::Outer), body_name(Body::Inner));
-            t.li(R1, kaddr(f))
-                .addi(R2, R7, "CONE_BODY")
-                .sbcb(R1, R2, klen(f))
-                .c("the body's outside")
-                .li(R1, kaddr(b))
-                .addi(R2, R7, "GCONE_INNER")
-                .sbcb(R1, R2, klen(b))
-                .c("its inside");
-            ["GCONE_CAP0", "GCONE_CAP1"]
-        }
-    };
-    t.lfb(R3, at("CONE_CAPS", R7)).beqz(R3, &nocap);
-    for c in caps {
-        t.li(R1, kaddr(cap)).addi(R2, R7, c).sbcb(R1, R2, klen(cap));
-    }
-    t.c("the caps");
-    t.label(nocap);
 }

@@ -38,11 +38,11 @@
 //! 3 LSB, the normal within 0.03; fine normals beat coarse ones on a thin
 //! cylinder.
 
-use super::super::emit::{at, define, Code, K, R1, R2, R3, R7};
+use super::super::emit::{at, define, Code, K, R3, R7};
 use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::{commit_obj_mat, kaddr, klen, perpendicular, self_margin, Body, Fit, Gen, Sides};
+use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
 use crate::scene::Vec3;
 use crate::tracer::layout::{Fitter, W};
 
@@ -345,6 +345,45 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         self_margin(&mut k, 8, g.datapath);
         k.c("(f) cmp.gt r9, r8");
     }
+    axial_and_normal(&mut k);
+    commit_obj_mat(&mut k, body);
+    k
+}
+
+/// Broadcast a cylinder's test (record at r7): the body (both runs for a
+/// glass cylinder), then the caps where its flag is set. Labels begin
+/// with `lbl`.
+pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides) {
+    let cap = planar::kernel_name(Inside::Disc, sides);
+    let nocap = format!("{lbl}_nocap");
+    let caps: [&str; 2] = match sides {
+        Sides::Front => {
+            let k = body_name(Body::Opaque);
+            t.m("BCAST_REC", format!("{k}, r7, CYL_BODY")).c("the body");
+            ["CYL_CAP0", "CYL_CAP1"]
+        }
+        Sides::Both => {
+            let (f, b) = (body_name(Body::Outer), body_name(Body::Inner));
+            t.m("BCAST_REC", format!("{f}, r7, CYL_BODY"))
+                .c("the body's outside")
+                .m("BCAST_REC", format!("{b}, r7, GCYL_INNER"))
+                .c("its inside");
+            ["GCYL_CAP0", "GCYL_CAP1"]
+        }
+    };
+    t.lfb(R3, at("CYL_CAPS", R7)).beqz(R3, &nocap);
+    for c in caps {
+        t.m("BCAST_REC", format!("{cap}, r7, {c}"));
+    }
+    t.c("the caps");
+    t.label(nocap);
+}
+
+/// After the division (`t` in r9, F the hit so far): the hit's axial
+/// coordinate within `[-2, H + 2]`, then the normal `n2 = -(sg p2 / r +
+/// sqrt(s) d2n)` across the axis, `n = n2.x e1 + n2.y e2` (from `TMP0..TMP4`)
+/// into `HIT_N` and `t` into `tbest` where F.
+fn axial_and_normal(k: &mut K) {
     k.comment("axial coordinate of the hit");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 11 + i;
@@ -378,42 +417,4 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     for (i, x) in [13, 14, 15].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
     }
-    commit_obj_mat(&mut k, body);
-    k
-}
-
-/// Broadcast a cylinder's test (record at r7): the body (both runs for a
-/// glass cylinder), then the caps where its flag is set. Labels begin
-/// with `lbl`.
-pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides) {
-    let cap = planar::kernel_name(Inside::Disc, sides);
-    let nocap = format!("{lbl}_nocap");
-    let caps: [&str; 2] = match sides {
-        Sides::Front => {
-            let k = body_name(Body::Opaque);
-            t.li(R1, kaddr(k))
-                .addi(R2, R7, "CYL_BODY")
-                .sbcb(R1, R2, klen(k))
-                .c("the body");
-            ["CYL_CAP0", "CYL_CAP1"]
-        }
-        Sides::Both => {
-            let (f, b) = (body_name(Body::Outer), body_name(Body::Inner));
-            t.li(R1, kaddr(f))
-                .addi(R2, R7, "CYL_BODY")
-                .sbcb(R1, R2, klen(f))
-                .c("the body's outside")
-                .li(R1, kaddr(b))
-                .addi(R2, R7, "GCYL_INNER")
-                .sbcb(R1, R2, klen(b))
-                .c("its inside");
-            ["GCYL_CAP0", "GCYL_CAP1"]
-        }
-    };
-    t.lfb(R3, at("CYL_CAPS", R7)).beqz(R3, &nocap);
-    for c in caps {
-        t.li(R1, kaddr(cap)).addi(R2, R7, c).sbcb(R1, R2, klen(cap));
-    }
-    t.c("the caps");
-    t.label(nocap);
 }

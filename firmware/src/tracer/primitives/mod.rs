@@ -519,8 +519,7 @@ pub fn klen(n: &str) -> String {
 
 /// Broadcast kernel `n` with the record at r7 as its stream.
 fn one(t: &mut Code, n: &str) {
-    t.li(super::emit::R1, kaddr(n))
-        .sbcb(super::emit::R1, super::emit::R7, klen(n));
+    t.m("BCAST_AT", format!("{n}, r7"));
 }
 
 /// A unit vector perpendicular to the unit vector `a` (the frame of a

@@ -255,9 +255,7 @@ fn tail(sides: Sides) -> K {
 /// edge, the tail. Labels begin with `at`.
 pub fn broadcast(t: &mut Code, at: &str, sides: Sides) {
     let (head, tail) = (head_name(sides), tail_name(sides));
-    t.li(R1, kaddr(head))
-        .addi(R2, R7, "POLY_HEAD")
-        .sbcb(R1, R2, klen(head))
+    t.m("BCAST_REC", format!("{head}, r7, POLY_HEAD"))
         .c("the plane")
         .lfb(R3, super::super::emit::at("POLY_EDGES", R7))
         .c("edges")
@@ -271,7 +269,6 @@ pub fn broadcast(t: &mut Code, at: &str, sides: Sides) {
         .addi(R3, R3, -1)
         .j(format!("{at}_fan"));
     t.label(format!("{at}_tail"))
-        .li(R1, kaddr(tail))
-        .sbcb(R1, R2, klen(tail))
+        .m("BCAST_AT", format!("{tail}, r2"))
         .c("commit where the parity is odd");
 }

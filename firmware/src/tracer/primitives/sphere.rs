@@ -80,6 +80,7 @@ pub(crate) fn fit(radii: impl Iterator<Item = f64> + Clone, f: &Fitter) -> (u32,
 /// Write the record of a sphere (object `id`, material `mat`).
 /// `unrounded`: `invr` of the unrounded radius (the streamed layout's
 /// format; fine records always).
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn write(
     w: &mut W,
     fit: &Fit,

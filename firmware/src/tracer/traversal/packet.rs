@@ -361,8 +361,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         // start for the simulator's count of the rays traced: its RCs are
         // the pass's.)
         t.comment("the tree is one leaf: its objects, tested by the awake rays")
-            .li(R1, kaddr("k_sign0"))
-            .cbcast(R1, 1)
+            .m("BCAST", "k_sign0")
             .li(R14, "NSTACK")
             .li(R5, "ROOT")
             .rcsl(R4)
@@ -374,43 +373,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
             .lw(R11, at("PASS", R0))
             .j("leaf_objects");
     }
-    t.li(R1, kaddr("k_pinit"))
-        .li(R2, "ROOTBOX")
-        .sbcb(R1, R2, klen("k_pinit"))
-        .c("intervals in the root cell, 1/d");
-    for (a, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
-        let lo = axis.to_lowercase();
-        t.li(R1, kaddr(&format!("k_sign{a}")))
-            .cbcast(R1, 1)
-            .rcst(R3)
-            .c(format!(
-                "the awake rays going down along {lo}: none, some, all"
-            ));
-        if a == 0 {
-            t.li(R4, 2).beq(R3, R4, "trace_done").c("no ray awake");
-        }
-        t.li(R8, 0)
-            .beqz(R3, format!("order_{lo}"))
-            .li(R8, 1)
-            .li(R4, 3)
-            .beq(R3, R4, format!("order_{lo}"))
-            .jal("majority")
-            .c("some: r8 = most go down");
-        t.label(format!("order_{lo}"))
-            .li(R1, kaddr(&format!("k_pn{a}b")))
-            .li(R2, f.n("PN_LEFT", "PS_LEFT"))
-            .li(R3, f.n("PN_RIGHT", "PS_RIGHT"))
-            .beqz(R8, format!("order_{lo}_set"))
-            .li(R1, kaddr(&format!("k_pn{a}a")))
-            .li(R2, f.n("PN_RIGHT", "PS_RIGHT"))
-            .li(R3, f.n("PN_LEFT", "PS_LEFT"))
-            .c("most go down: above first");
-        t.label(format!("order_{lo}_set"))
-            .sw(R1, at(format!("NK+AXIS_{axis}"), R0))
-            .sw(R2, at(format!("NF+AXIS_{axis}"), R0))
-            .sw(R3, at(format!("NS+AXIS_{axis}"), R0))
-            .c("node kernel, first and second child");
-    }
+    child_order(t, &f);
     t.li(R14, "NSTACK").li(R5, "ROOT");
     f.load(t, R6, at(flags, R5));
     dispatch_full(t, &f);
@@ -441,21 +404,18 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .beqz(R1, "some_first")
         .bnez(R4, "pop_node")
         .c("no ray awake")
-        .li(R1, kaddr("k_ptake"))
-        .cbcast(R1, klen("k_ptake"))
+        .m("BCAST", "k_ptake")
         .c("none: the second child only")
         .mv(R5, R10);
     f.load(t, R6, at(flags, R5));
     dispatch_full(t, &f);
     t.label("some_first");
     push_second(t, &f);
-    t.li(R1, kaddr("k_psl"))
-        .cbcast(R1, 1)
+    t.m("BCAST", "k_psl")
         .c("the rays not reaching the first sleep");
     dispatch_first(t, &f);
     t.label("all_first")
-        .li(R1, kaddr("k_p2nd"))
-        .cbcast(R1, 1)
+        .m("BCAST", "k_p2nd")
         .rcany(R4)
         .beqz(R4, "visit_first")
         .c("no ray reaches the second");
@@ -466,8 +426,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
     t.label("leaf_done")
         .lw(R1, at("MODE", R0))
         .beqz(R1, "pop_node")
-        .li(R1, kaddr("k_pleafa"))
-        .cbcast(R1, klen("k_pleafa"))
+        .m("BCAST", "k_pleafa")
         .c("any hit: the rays with a hit are done");
     t.label("pop_node")
         .li(R9, "NSTACK")
@@ -535,7 +494,7 @@ fn push_second(t: &mut Code, f: &Fields) {
             .li(R1, kaddr("k_ppush"))
             .sbcb(R1, R2, klen("k_ppush"));
     } else {
-        t.li(R1, kaddr("k_ppush")).sbcb(R1, R12, klen("k_ppush"));
+        t.m("BCAST_AT", "k_ppush, r12");
     }
     t.c("the rays' intervals for the second child")
         .sw(R10, deref(R14))
@@ -547,27 +506,7 @@ fn push_second(t: &mut Code, f: &Fields) {
 /// `{n}_next` when every awake ray (r4, r10) has tested it in this pass
 /// (r11), else the mailbox is updated and the object goes to `{n}_go`.
 fn mailbox_check(t: &mut Code, n: &str) {
-    t.lw(R1, at("MB_PASS", R8))
-        .bne(R1, R11, format!("{n}_fresh"))
-        .c("not tested in this pass yet")
-        .lw(R2, at("MB_RAYS", R8))
-        .lw(R3, at("MB_RAYS+MASK_HI", R8))
-        .or(R1, R2, R4)
-        .bne(R1, R2, format!("{n}_upd"))
-        .or(R1, R3, R10)
-        .beq(R1, R3, format!("{n}_next"))
-        .c("every awake ray has tested it");
-    t.label(format!("{n}_upd"))
-        .or(R2, R2, R4)
-        .or(R3, R3, R10)
-        .sw(R2, at("MB_RAYS", R8))
-        .sw(R3, at("MB_RAYS+MASK_HI", R8))
-        .j(format!("{n}_go"));
-    t.label(format!("{n}_fresh"))
-        .sw(R11, at("MB_PASS", R8))
-        .sw(R4, at("MB_RAYS", R8))
-        .sw(R10, at("MB_RAYS+MASK_HI", R8));
-    t.label(format!("{n}_go")).addi(R13, R13, 1);
+    t.m("MAILBOX_CHECK", n);
 }
 
 /// The leaf (r5): every object not yet tested by every awake ray in this
@@ -728,21 +667,109 @@ fn majority(t: &mut Code) {
 
 /// Popcount of `x` into `x` (SWAR), clobbering `t1`, `t2`.
 fn popcount(t: &mut Code, x: Reg, t1: Reg, t2: Reg) {
-    t.comment(format!("{x} = the number of bits set in {x}"))
-        .srli(t1, x, 1)
-        .li(t2, "0x55555555")
-        .and(t1, t1, t2)
-        .sub(x, x, t1)
-        .li(t2, "0x33333333")
-        .and(t1, x, t2)
-        .srli(x, x, 2)
-        .and(x, x, t2)
-        .add(x, x, t1)
-        .srli(t1, x, 4)
-        .add(x, x, t1)
-        .li(t2, "0x0f0f0f0f")
-        .and(x, x, t2)
-        .li(t2, "0x01010101")
-        .mul(x, x, t2)
-        .srli(x, x, 24);
+    t.m("POPCOUNT", format!("{x}, {t1}, {t2}"));
+}
+
+/// The packet traversal's macros: the mailbox check of a leaf's object and
+/// a population count.
+pub fn macros() -> Code {
+    let mut t = Code::new();
+    let mut b = Code::new();
+    b.lw(R1, at("MB_PASS", R8))
+        .line("bne r1, r11, \\p\\()_fresh")
+        .c("not tested in this pass yet")
+        .lw(R2, at("MB_RAYS", R8))
+        .lw(R3, at("MB_RAYS+MASK_HI", R8))
+        .or(R1, R2, R4)
+        .line("bne r1, r2, \\p\\()_upd")
+        .or(R1, R3, R10)
+        .line("beq r1, r3, \\p\\()_next")
+        .c("every awake ray has tested it");
+    b.label("\\p\\()_upd")
+        .or(R2, R2, R4)
+        .or(R3, R3, R10)
+        .sw(R2, at("MB_RAYS", R8))
+        .sw(R3, at("MB_RAYS+MASK_HI", R8))
+        .line("j \\p\\()_go");
+    b.label("\\p\\()_fresh")
+        .sw(R11, at("MB_PASS", R8))
+        .sw(R4, at("MB_RAYS", R8))
+        .sw(R10, at("MB_RAYS+MASK_HI", R8));
+    b.label("\\p\\()_go")
+        .addi(R13, R13, 1)
+        .c("one more object test");
+    t.define_macro(
+        "MAILBOX_CHECK",
+        "p",
+        "MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,\n\
+         r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the\n\
+         pass and the rays, and on to `p_go` (r13 counts the test). Clobbers r1..r3.",
+        b,
+    );
+    let mut b = Code::new();
+    b.line("srli \\t1, \\x, 1")
+        .line("li \\t2, 0x55555555")
+        .line("and \\t1, \\t1, \\t2")
+        .line("sub \\x, \\x, \\t1")
+        .c("pairs")
+        .line("li \\t2, 0x33333333")
+        .line("and \\t1, \\x, \\t2")
+        .line("srli \\x, \\x, 2")
+        .line("and \\x, \\x, \\t2")
+        .line("add \\x, \\x, \\t1")
+        .c("nibbles")
+        .line("srli \\t1, \\x, 4")
+        .line("add \\x, \\x, \\t1")
+        .line("li \\t2, 0x0f0f0f0f")
+        .line("and \\x, \\x, \\t2")
+        .c("bytes")
+        .line("li \\t2, 0x01010101")
+        .line("mul \\x, \\x, \\t2")
+        .line("srli \\x, \\x, 24")
+        .c("their sum");
+    t.define_macro(
+        "POPCOUNT",
+        "x, t1, t2",
+        "POPCOUNT x, t1, t2: x = the number of bits set in x (SWAR). Clobbers t1, t2.",
+        b,
+    );
+    t
+}
+
+/// The pass's start: `k_pinit`, then per axis the order of the children
+/// the majority of the awake rays meets first (`NK`, `NF`, `NS`); no ray
+/// awake: `trace_done`.
+fn child_order(t: &mut Code, f: &Fields) {
+    t.m("BCAST_FB", "k_pinit, ROOTBOX")
+        .c("intervals in the root cell, 1/d");
+    for (a, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
+        let lo = axis.to_lowercase();
+        t.m("BCAST", format!("k_sign{a}")).rcst(R3).c(format!(
+            "the awake rays going down along {lo}: none, some, all"
+        ));
+        if a == 0 {
+            t.li(R4, 2).beq(R3, R4, "trace_done").c("no ray awake");
+        }
+        t.li(R8, 0)
+            .beqz(R3, format!("order_{lo}"))
+            .li(R8, 1)
+            .li(R4, 3)
+            .beq(R3, R4, format!("order_{lo}"))
+            .jal("majority")
+            .c("some: r8 = most go down");
+        t.label(format!("order_{lo}"))
+            .li(R1, kaddr(&format!("k_pn{a}b")))
+            .li(R2, f.n("PN_LEFT", "PS_LEFT"))
+            .li(R3, f.n("PN_RIGHT", "PS_RIGHT"))
+            .beqz(R8, format!("order_{lo}_set"))
+            .li(R1, kaddr(&format!("k_pn{a}a")))
+            .li(R2, f.n("PN_RIGHT", "PS_RIGHT"))
+            .li(R3, f.n("PN_LEFT", "PS_LEFT"))
+            .c("most go down: above first");
+        t.label(format!("order_{lo}_set"))
+            .sw(R1, at(format!("NK+AXIS_{axis}"), R0))
+            .sw(R2, at(format!("NF+AXIS_{axis}"), R0))
+            .sw(R3, at(format!("NS+AXIS_{axis}"), R0))
+            .c("node kernel, first and second child");
+    }
 }

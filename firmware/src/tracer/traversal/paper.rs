@@ -148,8 +148,7 @@ pub fn pass_start(t: &mut Code) {
         .li(R1, 1);
     t.label("trace_numbered").sw(R1, at("PASS", R0));
     for (a, name) in ["NEG_X", "NEG_Y", "NEG_Z"].into_iter().enumerate() {
-        t.li(R1, kaddr(&format!("k_sign{a}")))
-            .cbcast(R1, klen(&format!("k_sign{a}")))
+        t.m("BCAST", format!("k_sign{a}"))
             .rcfl(R2)
             .rcfh(R3)
             .sw(R2, at(name, R0))
@@ -264,22 +263,21 @@ pub fn trace(t: &mut Code, lay: &Layout) {
     t.jal("test_objects")
         .lw(R1, at("MODE", R0))
         .bnez(R1, "leaf_any_hit")
-        .li(R1, kaddr("k_leafc"))
-        .addi(
-            R2,
-            R5,
-            if compact {
-                "NC_LEAF_BOUNDS"
-            } else {
-                "N_BOUNDS"
-            },
+        .m(
+            "BCAST_REC",
+            format!(
+                "k_leafc, r5, {}",
+                if compact {
+                    "NC_LEAF_BOUNDS"
+                } else {
+                    "N_BOUNDS"
+                }
+            ),
         )
-        .sbcb(R1, R2, klen("k_leafc"))
         .c("the rays with a hit in the cell sleep")
         .j("leaf_done");
     t.label("leaf_any_hit")
-        .li(R1, kaddr("k_leafa"))
-        .cbcast(R1, klen("k_leafa"))
+        .m("BCAST", "k_leafa")
         .c("the rays with a hit sleep");
     t.label("leaf_done").jal("read_awake");
     t.label("pop_node")

@@ -104,8 +104,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
     t.jal("read_awake")
         .li(R9, "USTK")
         .sw(R9, at("UPTR", R0))
-        .li(R1, kaddr("k_uzero"))
-        .cbcast(R1, klen("k_uzero"))
+        .m("BCAST", "k_uzero")
         .li(R14, "NSTACK")
         .li(R5, "ROOT");
     t.label("visit_node")
@@ -194,13 +193,10 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .c("nothing tested")
         .lw(R1, at("MODE", R0))
         .bnez(R1, "leaf_any_hit")
-        .li(R1, kaddr("k_leafcu"))
-        .sbcb(R1, R4, klen("k_leafcu"))
+        .m("BCAST_AT", "k_leafcu, r4")
         .c("the rays with a hit in the cell sleep")
         .j("leaf_done");
-    t.label("leaf_any_hit")
-        .li(R1, kaddr("k_leafa"))
-        .cbcast(R1, klen("k_leafa"));
+    t.label("leaf_any_hit").m("BCAST", "k_leafa");
     t.label("leaf_done").jal("read_awake");
     t.label("pop_node")
         .lw(R9, at("UPTR", R0))
