@@ -191,21 +191,21 @@ SLOT_TMIN = 1           ; slot: near end
 ; SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream
 ; `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.
 .macro SHADOW_PASS light, shade
-        BCAST_FB k_light, \light
+        BCAST_FB k_shadow_rays, \light
         li r1, 1
         sw r1, MODE(r0)                 ; any hit
         jal trace
-        BCAST k_wake
-        BCAST_FB k_shade, \shade
+        BCAST k_wake_tile
+        BCAST_FB k_phong, \shade
 .endm
 
 ; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
-; (kernel `post`: k_post0 for the eye rays, k_post1 after), then every light's
+; (kernel `post`: k_post_eye for the eye rays, k_post after), then every light's
 ; shadow pass (1 light).
 .macro SHADE_LEVEL post
         sw r0, MODE(r0)                 ; closest hit
         jal trace
-        BCAST k_wake
+        BCAST k_wake_tile
         BCAST_FB \post, FB_POST
         SHADOW_PASS FB_LIGHT0, FB_SHADE0
 .endm
@@ -294,12 +294,12 @@ _start:
         ldctxt r1, r2, r3               ; the kernels into context memory
         dwait
         BCAST_FB k_init, 0              ; RSQ, RCP, C_ONE, C_INF from the FB
-        li r1, (k_rows - CTXBASE) / 4
+        li r1, (k_row_index - CTXBASE) / 4
         cbcr r1, r0, 1                  ; row i: r8 = i
-        BCAST k_strow
-        li r1, (k_rows - CTXBASE) / 4
+        BCAST k_store_row
+        li r1, (k_row_index - CTXBASE) / 4
         cbcc r1, r0, 1                  ; column j: r8 = j
-        BCAST k_stcol
+        BCAST k_store_col
         BCAST k_lanes                   ; the RCs outside the tile sleep
         rcany r1                        ; the array done
         rdcyc r1
@@ -324,10 +324,10 @@ tile:
         sfb r3, EYE_PX(r6)
         sfb r4, EYE_PY(r6)              ; the tile's corner into the eye stream
         BCAST_FB k_eye, FB_EYE          ; eye rays
-        SHADE_LEVEL k_post0             ; level 0: trace, shade, every light
-        BCAST k_refl0                   ; level 0's reflected rays
-        SHADE_LEVEL k_post1             ; level 1: trace, shade, every light
-        BCAST k_pop0                    ; their colour added
+        SHADE_LEVEL k_post_eye          ; level 0: trace, shade, every light
+        BCAST k_reflect0                ; level 0's reflected rays
+        SHADE_LEVEL k_post              ; level 1: trace, shade, every light
+        BCAST k_reflected0              ; their colour added
         ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)
         li r4, OUT_BANK0
@@ -335,13 +335,13 @@ tile:
         li r4, OUT_BANK1
 out_bank:
         dwait                           ; the bank's last DMA done
-        BCAST k_out0
+        BCAST k_out_red
         wfb r4, OUT_R
-        BCAST k_out1
+        BCAST k_out_green
         wfb r4, OUT_G
-        BCAST k_out2
+        BCAST k_out_blue
         wfb r4, OUT_B
-        BCAST k_out3
+        BCAST k_out_object
         wfb r4, OUT_ID
         lw r3, CUR_OUT(r0)
         stfb r3, r4, OUT_WORDS          ; DMA to main memory
@@ -373,8 +373,8 @@ trace:
         addi r1, r1, 1
         sw r1, PASS(r0)
         li r13, 0                       ; object tests of the pass
-        BCAST_FB k_pinit, ROOTBOX       ; intervals in the root cell, 1/d
-        BCAST k_sign0
+        BCAST_FB k_pass_start, ROOTBOX  ; intervals in the root cell, 1/d
+        BCAST k_sign_x
         rcst r3                         ; the awake rays going down along x: none, some, all
         li r4, 2
         beq r3, r4, trace_done          ; no ray awake
@@ -385,18 +385,18 @@ trace:
         beq r3, r4, order_x
         jal majority                    ; some: r8 = most go down
 order_x:
-        li r1, (k_pn0b - CTXBASE) / 4
+        li r1, (k_node_x_below_first - CTXBASE) / 4
         li r2, PN_LEFT
         li r3, PN_RIGHT
         beqz r8, order_x_set
-        li r1, (k_pn0a - CTXBASE) / 4
+        li r1, (k_node_x_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
         li r3, PN_LEFT                  ; most go down: above first
 order_x_set:
         sw r1, NK+AXIS_X(r0)
         sw r2, NF+AXIS_X(r0)
         sw r3, NS+AXIS_X(r0)            ; node kernel, first and second child
-        BCAST k_sign1
+        BCAST k_sign_y
         rcst r3                         ; the awake rays going down along y: none, some, all
         li r8, 0
         beqz r3, order_y
@@ -405,18 +405,18 @@ order_x_set:
         beq r3, r4, order_y
         jal majority                    ; some: r8 = most go down
 order_y:
-        li r1, (k_pn1b - CTXBASE) / 4
+        li r1, (k_node_y_below_first - CTXBASE) / 4
         li r2, PN_LEFT
         li r3, PN_RIGHT
         beqz r8, order_y_set
-        li r1, (k_pn1a - CTXBASE) / 4
+        li r1, (k_node_y_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
         li r3, PN_LEFT                  ; most go down: above first
 order_y_set:
         sw r1, NK+AXIS_Y(r0)
         sw r2, NF+AXIS_Y(r0)
         sw r3, NS+AXIS_Y(r0)            ; node kernel, first and second child
-        BCAST k_sign2
+        BCAST k_sign_z
         rcst r3                         ; the awake rays going down along z: none, some, all
         li r8, 0
         beqz r3, order_z
@@ -425,11 +425,11 @@ order_y_set:
         beq r3, r4, order_z
         jal majority                    ; some: r8 = most go down
 order_z:
-        li r1, (k_pn2b - CTXBASE) / 4
+        li r1, (k_node_z_below_first - CTXBASE) / 4
         li r2, PN_LEFT
         li r3, PN_RIGHT
         beqz r8, order_z_set
-        li r1, (k_pn2a - CTXBASE) / 4
+        li r1, (k_node_z_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
         li r3, PN_LEFT                  ; most go down: above first
 order_z_set:
@@ -443,7 +443,7 @@ order_z_set:
         slli r7, r6, 2
         lw r1, NK(r7)
         addi r2, r5, PN_SPLIT
-        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
+        sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
         ; r5 = a node whose kernel runs: read its children, issue the first's kernel
 inner_node:
@@ -464,31 +464,31 @@ inner_node:
         addi r1, r4, -1
         beqz r1, some_first
         bnez r4, pop_node               ; no ray awake
-        BCAST k_ptake                   ; none: the second child only
+        BCAST k_take_second             ; none: the second child only
         mv r5, r10
         lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
         slli r7, r6, 2
         lw r1, NK(r7)
         addi r2, r5, PN_SPLIT
-        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
+        sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
 some_first:
-        BCAST_AT k_ppush, r12           ; the rays' intervals for the second child
+        BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
-        BCAST k_psl                     ; the rays not reaching the first sleep
+        BCAST k_first_or_sleep          ; the rays not reaching the first sleep
         mv r5, r9
         blt r6, r0, leaf
         mv r7, r3
         addi r2, r5, PN_SPLIT
-        sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4 ; the first child's node kernel
+        sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
         j inner_node
 all_first:
-        BCAST k_p2nd
+        BCAST k_second_too
         rcany r4
         beqz r4, visit_first            ; no ray reaches the second
-        BCAST_AT k_ppush, r12           ; the rays' intervals for the second child
+        BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
 visit_first:
@@ -496,7 +496,7 @@ visit_first:
         blt r6, r0, leaf
         mv r7, r3
         addi r2, r5, PN_SPLIT
-        sbcb r11, r2, (k_pn0b_end - k_pn0b) / 4 ; the first child's node kernel
+        sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
         j inner_node
         ; the leaf r5: an object in more than one leaf has a mailbox (the pass that last
         ; tested it and which rays did); it is broadcast unless every awake ray has tested it
@@ -540,7 +540,7 @@ lo_cylinder_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
-        BCAST_REC k_cyl, r7, CYL_BODY   ; the body
+        BCAST_REC k_cylinder, r7, CYL_BODY ; the body
         lfb r3, CYL_CAPS(r7)
         beqz r3, lo_cylinder_nocap
         BCAST_REC k_disc, r7, CYL_CAP0
@@ -553,15 +553,15 @@ lo_cylinder_end:
 leaf_done:
         lw r1, MODE(r0)
         beqz r1, pop_node
-        BCAST k_pleafa                  ; any hit: the rays with a hit are done
+        BCAST k_done_with_hit           ; any hit: the rays with a hit are done
 pop_node:
         li r9, NSTACK
         beq r14, r9, trace_done
         addi r14, r14, -4
         lw r5, (r14)
-        li r1, (k_ppop - CTXBASE) / 4
+        li r1, (k_pop_node - CTXBASE) / 4
         addi r2, r5, PN_PARENT_SLOT
-        sbcb r1, r2, (k_ppop_end - k_ppop) / 4 ; the rays take their intervals for it
+        sbcb r1, r2, (k_pop_node_end - k_pop_node) / 4 ; the rays take their intervals for it
         lfb r6, PN_FLAGS(r5)
         rcany r4
         beqz r4, pop_node               ; no ray needs it
@@ -569,7 +569,7 @@ pop_node:
         slli r7, r6, 2
         lw r1, NK(r7)
         addi r2, r5, PN_SPLIT
-        sbcb r1, r2, (k_pn0b_end - k_pn0b) / 4 ; its node kernel
+        sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
 trace_done:
         lw r1, TESTS(r0)
@@ -605,13 +605,13 @@ majority:
         .ctx
         .org CTXBASE
 
-; k_rows: a group of 8 contexts, one per row (row mode) or column (column mode):
+; k_row_index: a group of 8 contexts, one per row (row mode) or column (column mode):
 ; row i gets r8 = i. Broadcast twice, its results stored to LANE_ROW and LANE_COL.
-k_rows:
+k_row_index:
         .rept 8, i
         movb r8, #i
         .endr
-k_rows_end:
+k_row_index_end:
 
 ; k_init: every RC's RAM from the FB image's start (stream): the RSQ and RCP tables,
 ; 1.0 and the no-hit distance. Out: r0 = 0 in every RC.
@@ -642,34 +642,34 @@ k_lanes:
         (!f) sleep
 k_lanes_end:
 
-; k_wake: every RC of the tile awake again after a pass (the others asleep).
-k_wake:
+; k_wake_tile: every RC of the tile awake again after a pass (the others asleep).
+k_wake_tile:
         wake
         st r0, [#P_ALIVE]
         ld r8, [r0 + #LANE_ACT]
         cmp.eq r8, #0
         (f) sleep
-k_wake_end:
+k_wake_tile_end:
 
-; k_sign0: F = the ray goes down along x (dx < 0).
-k_sign0:
+; k_sign_x: F = the ray goes down along x (dx < 0).
+k_sign_x:
         cmp.lt r4, #0
-k_sign0_end:
+k_sign_x_end:
 
-; k_sign1: F = the ray goes down along y (dy < 0).
-k_sign1:
+; k_sign_y: F = the ray goes down along y (dy < 0).
+k_sign_y:
         cmp.lt r5, #0
-k_sign1_end:
+k_sign_y_end:
 
-; k_sign2: F = the ray goes down along z (dz < 0).
-k_sign2:
+; k_sign_z: F = the ray goes down along z (dz < 0).
+k_sign_z:
         cmp.lt r6, #0
-k_sign2_end:
+k_sign_z_end:
 
-; k_pinit: a pass starts (stream: the root cell widened by P_TOL, per axis min, max).
+; k_pass_start: a pass starts (stream: the root cell widened by P_TOL, per axis min, max).
 ; Out: P_ALIVE = 1, per axis P_Z, P_R (1/d = R >> z) and P_DT (P_TOL / |d|); the interval
 ; (r8, r9) = [0, tbest] clipped to the root cell; the rays that miss it sleep, not alive.
-k_pinit:
+k_pass_start:
         movb r8, #1
         st r8, [#P_ALIVE]
         ld r9, [r0 + #C_ONE]
@@ -787,13 +787,13 @@ k_pinit:
         movb r10, #0
         (!f) st r10, [#P_ALIVE]
         (!f) sleep
-k_pinit_end:
+k_pass_start_end:
 
-; k_pn0b: an inner node split across x, the child below the plane first (stream: the
+; k_node_x_below_first: an inner node split across x, the child below the plane first (stream: the
 ; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
 ; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
 ; Out: F = reaches the first child.
-k_pn0b:
+k_node_x_below_first:
         ld r12, [r0 + #P_Z]
         ld r13, [r0 + #P_R]
         sub r10, fb0, r1
@@ -814,13 +814,13 @@ k_pn0b:
         (!f) cmp.lt r8, r9
         (!f) sleep                      ; neither child
         cmp.lt r8, r9
-k_pn0b_end:
+k_node_x_below_first_end:
 
-; k_pn0a: an inner node split across x, the child above the plane first (stream: the
+; k_node_x_above_first: an inner node split across x, the child above the plane first (stream: the
 ; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
 ; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
 ; Out: F = reaches the first child.
-k_pn0a:
+k_node_x_above_first:
         ld r12, [r0 + #P_Z]
         ld r13, [r0 + #P_R]
         sub r10, fb0, r1
@@ -841,13 +841,13 @@ k_pn0a:
         (!f) cmp.lt r8, r9
         (!f) sleep                      ; neither child
         cmp.lt r8, r9
-k_pn0a_end:
+k_node_x_above_first_end:
 
-; k_pn1b: an inner node split across y, the child below the plane first (stream: the
+; k_node_y_below_first: an inner node split across y, the child below the plane first (stream: the
 ; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
 ; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
 ; Out: F = reaches the first child.
-k_pn1b:
+k_node_y_below_first:
         ld r12, [r0 + #P_Z+1]
         ld r13, [r0 + #P_R+1]
         sub r10, fb0, r2
@@ -868,13 +868,13 @@ k_pn1b:
         (!f) cmp.lt r8, r9
         (!f) sleep                      ; neither child
         cmp.lt r8, r9
-k_pn1b_end:
+k_node_y_below_first_end:
 
-; k_pn1a: an inner node split across y, the child above the plane first (stream: the
+; k_node_y_above_first: an inner node split across y, the child above the plane first (stream: the
 ; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
 ; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
 ; Out: F = reaches the first child.
-k_pn1a:
+k_node_y_above_first:
         ld r12, [r0 + #P_Z+1]
         ld r13, [r0 + #P_R+1]
         sub r10, fb0, r2
@@ -895,13 +895,13 @@ k_pn1a:
         (!f) cmp.lt r8, r9
         (!f) sleep                      ; neither child
         cmp.lt r8, r9
-k_pn1a_end:
+k_node_y_above_first_end:
 
-; k_pn2b: an inner node split across z, the child below the plane first (stream: the
+; k_node_z_below_first: an inner node split across z, the child below the plane first (stream: the
 ; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
 ; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
 ; Out: F = reaches the first child.
-k_pn2b:
+k_node_z_below_first:
         ld r12, [r0 + #P_Z+2]
         ld r13, [r0 + #P_R+2]
         sub r10, fb0, r3
@@ -922,13 +922,13 @@ k_pn2b:
         (!f) cmp.lt r8, r9
         (!f) sleep                      ; neither child
         cmp.lt r8, r9
-k_pn2b_end:
+k_node_z_below_first_end:
 
-; k_pn2a: an inner node split across z, the child above the plane first (stream: the
+; k_node_z_above_first: an inner node split across z, the child above the plane first (stream: the
 ; split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first
 ; child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.
 ; Out: F = reaches the first child.
-k_pn2a:
+k_node_z_above_first:
         ld r12, [r0 + #P_Z+2]
         ld r13, [r0 + #P_R+2]
         sub r10, fb0, r3
@@ -949,37 +949,37 @@ k_pn2a:
         (!f) cmp.lt r8, r9
         (!f) sleep                      ; neither child
         cmp.lt r8, r9
-k_pn2a_end:
+k_node_z_above_first_end:
 
-; k_p2nd: after a node kernel, F = the ray reaches the second child too.
-k_p2nd:
+; k_second_too: after a node kernel, F = the ray reaches the second child too.
+k_second_too:
         cmp.lt r11, r14
-k_p2nd_end:
+k_second_too_end:
 
-; k_psl: the rays that do not reach the first child sleep until the second is popped.
-k_psl:
+; k_first_or_sleep: the rays that do not reach the first child sleep until the second is popped.
+k_first_or_sleep:
         (!f) sleep
-k_psl_end:
+k_first_or_sleep_end:
 
-; k_ptake: only the second child is visited: its interval becomes the current one.
-k_ptake:
+; k_take_second: only the second child is visited: its interval becomes the current one.
+k_take_second:
         mov r8, r11
         mov r9, r14
-k_ptake_end:
+k_take_second_end:
 
-; k_ppush: the second child pushed: every awake ray's interval for it into its slot
+; k_push_second: the second child pushed: every awake ray's interval for it into its slot
 ; (stream: the slot's RAM address).
-k_ppush:
+k_push_second:
         mov r15, fb0
         st r14, [r15]                   ; SLOT_TMAX
         add r15, r15, #1
         st r11, [r15]                   ; SLOT_TMIN
-k_ppush_end:
+k_push_second_end:
 
-; k_ppop: a popped node (stream: its slot's RAM address): every RC wakes and takes its
+; k_pop_node: a popped node (stream: its slot's RAM address): every RC wakes and takes its
 ; interval from the slot, emptied; the rays not alive, or whose interval is empty or
 ; beyond their hit, sleep again. Out: F = awake.
-k_ppop:
+k_pop_node:
         wake
         mov r15, fb0
         ld r9, [r15 + #SLOT_TMAX]
@@ -991,16 +991,16 @@ k_ppop:
         cmp.ne r11, #0
         (f) cmp.lt r8, r9
         (!f) sleep
-k_ppop_end:
+k_pop_node_end:
 
-; k_pleafa: after a leaf, any-hit pass: the rays with a hit are done (not alive) and sleep.
-k_pleafa:
+; k_done_with_hit: after a leaf, any-hit pass: the rays with a hit are done (not alive) and sleep.
+k_done_with_hit:
         ld r8, [r0 + #PASS_T0]
         cmp.lt r7, r8
         movb r9, #0
         (f) st r9, [#P_ALIVE]
         (f) sleep
-k_pleafa_end:
+k_done_with_hit_end:
 
 ; k_eye: the tile's eye rays (stream: px0, py0, eye.xyz, (A, B, C) per axis).
 ; Out: r1..r3 = eye, r4..r6 = normalize(A + i B + j C) for pixel (px0 + col, py0 + row),
@@ -1071,11 +1071,11 @@ k_eye:
         st r8, [#OUT_OBJ]
 k_eye_end:
 
-; k_post0: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; k_post_eye: after a closest-hit pass: the hit's shading state (stream: background.rgb,
 ; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
 ; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
 ; COL = the background where no hit; OUT_OBJ, the eye ray's object.
-k_post0:
+k_post_eye:
         ld r8, [r0 + #C_INF]
         cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
@@ -1117,13 +1117,13 @@ k_post0:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
-k_post0_end:
+k_post_eye_end:
 
-; k_post1: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; k_post: after a closest-hit pass: the hit's shading state (stream: background.rgb,
 ; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
 ; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
 ; COL = the background where no hit.
-k_post1:
+k_post:
         ld r8, [r0 + #C_INF]
         cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
@@ -1161,12 +1161,12 @@ k_post1:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
-k_post1_end:
+k_post_end:
 
-; k_light: the shadow rays towards one light (stream: the light's position).
+; k_shadow_rays: the shadow rays towards one light (stream: the light's position).
 ; In: SH_P, SH_N, SH_D, ACT. Out: r1..r7 the shadow rays (tbest: the light's distance less 2 LSB),
 ; SH_NL, SH_RV, LIT; the RCs with no hit or the light behind the surface sleep.
-k_light:
+k_shadow_rays:
         ld r1, [r0 + #SH_P]
         ld r2, [r0 + #SH_P+1]
         ld r3, [r0 + #SH_P+2]
@@ -1244,12 +1244,12 @@ k_light:
         (f) movb r9, #1
         st r9, [#LIT]
         (!f) sleep
-k_light_end:
+k_shadow_rays_end:
 
-; k_shade: after a shadow pass, the light's Phong terms where it is visible
+; k_phong: after a shadow pass, the light's Phong terms where it is visible
 ; (stream per material: id, [f, 1 - f,] then per channel kd c lc, ks lc).
 ; In: LIT, PASS_T0, r7 (no hit: tbest >= PASS_T0), SH_NL, SH_RV, SH_MAT. Out: COL += kd c lc N.L + ks lc (R.V)^n.
-k_shade:
+k_phong:
         ld r8, [r0 + #LIT]
         cmp.ne r8, #0
         ld r9, [r0 + #PASS_T0]
@@ -1290,41 +1290,41 @@ k_shade:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
-k_shade_end:
+k_phong_end:
 
-; k_out0: the pixel's red into the output register (for wfb).
-k_out0:
+; k_out_red: the pixel's red into the output register (for wfb).
+k_out_red:
         ld out, [r0 + #COL]
-k_out0_end:
+k_out_red_end:
 
-; k_out1: the pixel's green into the output register (for wfb).
-k_out1:
+; k_out_green: the pixel's green into the output register (for wfb).
+k_out_green:
         ld out, [r0 + #COL+1]
-k_out1_end:
+k_out_green_end:
 
-; k_out2: the pixel's blue into the output register (for wfb).
-k_out2:
+; k_out_blue: the pixel's blue into the output register (for wfb).
+k_out_blue:
         ld out, [r0 + #COL+2]
-k_out2_end:
+k_out_blue_end:
 
-; k_out3: the pixel's object id into the output register (for wfb).
-k_out3:
+; k_out_object: the pixel's object id into the output register (for wfb).
+k_out_object:
         ld out, [r0 + #OUT_OBJ]
-k_out3_end:
+k_out_object_end:
 
-; k_strow: r8 (the row or column [`k_rows`] gave) into LANE_ROW.
-k_strow:
+; k_store_row: r8 (the row or column [`k_row_index`] gave) into LANE_ROW.
+k_store_row:
         st r8, [#LANE_ROW]
-k_strow_end:
+k_store_row_end:
 
-; k_stcol: r8 (the row or column [`k_rows`] gave) into LANE_COL.
-k_stcol:
+; k_store_col: r8 (the row or column [`k_row_index`] gave) into LANE_COL.
+k_store_col:
         st r8, [#LANE_COL]
-k_stcol_end:
+k_store_col_end:
 
-; k_refl0: level 0's colour and Ks onto the stack (STACK_L0); the reflected rays
+; k_reflect0: level 0's colour and Ks onto the stack (STACK_L0); the reflected rays
 ; d - 2 (d.N) N from SH_P where Ks > 0, the others sleep. Out: r1..r7 the rays, a new level.
-k_refl0:
+k_reflect0:
         ld r8, [r0 + #SH_KS]
         st r8, [#STACK_L0+FR_KS]
         movb r10, #0
@@ -1368,10 +1368,10 @@ k_refl0:
         cmp.ne r9, #0
         (f) cmp.gt r8, #0               ; F: a hit that reflects
         (!f) sleep
-k_refl0_end:
+k_reflect0_end:
 
-; k_pop0: back from level 0's reflected rays: COL = STACK_L0's colour + Ks COL.
-k_pop0:
+; k_reflected0: back from level 0's reflected rays: COL = STACK_L0's colour + Ks COL.
+k_reflected0:
         ld r10, [r0 + #STACK_L0+FR_KS]
         ld r8, [r0 + #STACK_L0+FR_COL]
         ld r9, [r0 + #COL]
@@ -1388,7 +1388,7 @@ k_pop0:
         mul r9, r9, r10, >>Q12
         adds r9, r8, r9
         st r9, [#COL+2]
-k_pop0_end:
+k_reflected0_end:
 
 ; k_sphere: the sphere test of one record (the stream), for every awake ray.
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F (a nearer hit): r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
@@ -1408,6 +1408,7 @@ k_sphere:
         msu r9, r11, r5, >>Q14-EP_SPHERE
         ldacc r10, <<Q14
         msu r10, r11, r6, >>Q14-EP_SPHERE
+        ; p made perpendicular to d: p -= (p.d) d
         mul out, r8, r4
         mac out, r9, r5
         mac r12, r10, r6, >>Q14
@@ -1442,12 +1443,12 @@ k_sphere:
         srl r13, r10, #RSQ_SHIFT
         ld r13, [r13 + #RSQ]            ; y = 1/sqrt(X) from the table
         ld r14, [r0 + #C_ONE]
-        mul r8, r13, r13, >>Q14
+        mul r8, r13, r13, >>Q14         ; Newton: y += y (1 - X y^2) / 2
         mul r8, r8, r10, >>Q11
         sub r8, r8, r14
         ldacc r13, <<Q15
         msu r13, r13, r8, >>Q15
-        mul r8, r13, r13, >>Q14
+        mul r8, r13, r13, >>Q14         ; Newton: y += y (1 - X y^2) / 2
         mul r8, r8, r10, >>Q11
         sub r8, r8, r14
         ldacc r13, <<Q15
@@ -1483,11 +1484,11 @@ k_sphere:
         (f) st fb0, [#HIT_MAT]
 k_sphere_end:
 
-; k_cyl: the open cylinder test of one body record (the stream).
+; k_cylinder: the open cylinder test of one body record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
 ; Across the axis: d2 = (d.e1, d.e2) normalised, p2 = oc2 - b d2n, s = 1 - |p2/r|^2,
 ; tau = b - sg r sqrt(s), t = tau / |d2|; the axial coordinate within [-2, H+2].
-k_cyl:
+k_cylinder:
         ; oc = B - o, projected on e1, e2
         sub r8, fb0, r1
         sub r9, fb0, r2
@@ -1568,6 +1569,7 @@ k_cyl:
         ldacc r12, <<Q14
         mac out, r15, #1
         msu r12, r13, r9, >>Q14-EP_CYL  ; p2 = oc2 - b d2n
+        ; p made perpendicular to d: p -= (p.d) d
         mul out, r11, r8
         mac r14, r12, r9, >>Q14
         ldacc r11, <<Q14
@@ -1596,12 +1598,12 @@ k_cyl:
         srl r12, r11, #RSQ_SHIFT
         ld r12, [r12 + #RSQ]            ; y = 1/sqrt(X) from the table
         ld r14, [r0 + #C_ONE]
-        mul r8, r12, r12, >>Q14
+        mul r8, r12, r12, >>Q14         ; Newton: y += y (1 - X y^2) / 2
         mul r8, r8, r11, >>Q11
         sub r8, r8, r14
         ldacc r12, <<Q15
         msu r12, r12, r8, >>Q15
-        mul r8, r12, r12, >>Q14
+        mul r8, r12, r12, >>Q14         ; Newton: y += y (1 - X y^2) / 2
         mul r8, r8, r11, >>Q11
         sub r8, r8, r14
         ldacc r12, <<Q15
@@ -1686,7 +1688,7 @@ k_cyl:
         (f) st r15, [#HIT_N+2]
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
-k_cyl_end:
+k_cylinder_end:
 
 ; k_disc: the disc test of one record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.

@@ -171,21 +171,21 @@ SLOT_TMIN = 1           ; slot: near end
 ; SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream
 ; `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.
 .macro SHADOW_PASS light, shade
-        BCAST_FB k_light, \light
+        BCAST_FB k_shadow_rays, \light
         li r1, 1
         sw r1, MODE(r0)                 ; any hit
         jal trace
-        BCAST k_wake
-        BCAST_FB k_shade, \shade
+        BCAST k_wake_tile
+        BCAST_FB k_phong, \shade
 .endm
 
 ; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
-; (kernel `post`: k_post0 for the eye rays, k_post1 after), then every light's
+; (kernel `post`: k_post_eye for the eye rays, k_post after), then every light's
 ; shadow pass (1 light).
 .macro SHADE_LEVEL post
         sw r0, MODE(r0)                 ; closest hit
         jal trace
-        BCAST k_wake
+        BCAST k_wake_tile
         BCAST_FB \post, FB_POST
         SHADOW_PASS FB_LIGHT0, FB_SHADE0
 .endm
@@ -225,12 +225,12 @@ _start:
         ldctxt r1, r2, r3               ; the kernels into context memory
         dwait
         BCAST_FB k_init, 0              ; RSQ, RCP, C_ONE, C_INF from the FB
-        li r1, (k_rows - CTXBASE) / 4
+        li r1, (k_row_index - CTXBASE) / 4
         cbcr r1, r0, 1                  ; row i: r8 = i
-        BCAST k_strow
-        li r1, (k_rows - CTXBASE) / 4
+        BCAST k_store_row
+        li r1, (k_row_index - CTXBASE) / 4
         cbcc r1, r0, 1                  ; column j: r8 = j
-        BCAST k_stcol
+        BCAST k_store_col
         BCAST k_lanes                   ; the RCs outside the tile sleep
         rcany r1                        ; the array done
         rdcyc r1
@@ -255,10 +255,10 @@ tile:
         sfb r3, EYE_PX(r6)
         sfb r4, EYE_PY(r6)              ; the tile's corner into the eye stream
         BCAST_FB k_eye, FB_EYE          ; eye rays
-        SHADE_LEVEL k_post0             ; level 0: trace, shade, every light
-        BCAST k_refl0                   ; level 0's reflected rays
-        SHADE_LEVEL k_post1             ; level 1: trace, shade, every light
-        BCAST k_pop0                    ; their colour added
+        SHADE_LEVEL k_post_eye          ; level 0: trace, shade, every light
+        BCAST k_reflect0                ; level 0's reflected rays
+        SHADE_LEVEL k_post              ; level 1: trace, shade, every light
+        BCAST k_reflected0              ; their colour added
         ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)
         li r4, OUT_BANK0
@@ -266,13 +266,13 @@ tile:
         li r4, OUT_BANK1
 out_bank:
         dwait                           ; the bank's last DMA done
-        BCAST k_out0
+        BCAST k_out_red
         wfb r4, OUT_R
-        BCAST k_out1
+        BCAST k_out_green
         wfb r4, OUT_G
-        BCAST k_out2
+        BCAST k_out_blue
         wfb r4, OUT_B
-        BCAST k_out3
+        BCAST k_out_object
         wfb r4, OUT_ID
         lw r3, CUR_OUT(r0)
         stfb r3, r4, OUT_WORDS          ; DMA to main memory
@@ -308,17 +308,17 @@ trace:
         li r1, 1
 trace_numbered:
         sw r1, PASS(r0)
-        BCAST k_sign0
+        BCAST k_sign_x
         rcfl r2
         rcfh r3
         sw r2, NEG_X(r0)
         sw r3, NEG_X+MASK_HI(r0)        ; the rays going down along this axis
-        BCAST k_sign1
+        BCAST k_sign_y
         rcfl r2
         rcfh r3
         sw r2, NEG_Y(r0)
         sw r3, NEG_Y+MASK_HI(r0)        ; the rays going down along this axis
-        BCAST k_sign2
+        BCAST k_sign_z
         rcfl r2
         rcfh r3
         sw r2, NEG_Z(r0)
@@ -334,20 +334,20 @@ visit_node:
         lfb r6, N_FLAGS(r5)
         blt r6, r0, leaf
         andi r7, r6, 3                  ; the split's axis
-        li r1, (k_cls0 - CTXBASE) / 4
-        li r2, (k_cls1 - CTXBASE) / 4
+        li r1, (k_classify_x - CTXBASE) / 4
+        li r2, (k_classify_y - CTXBASE) / 4
         beqz r7, classify
-        li r1, (k_cls1 - CTXBASE) / 4
-        li r2, (k_cls2 - CTXBASE) / 4
+        li r1, (k_classify_y - CTXBASE) / 4
+        li r2, (k_classify_z - CTXBASE) / 4
         slti r3, r7, 2
         bnez r3, classify
-        li r1, (k_cls2 - CTXBASE) / 4
+        li r1, (k_classify_z - CTXBASE) / 4
 classify:
         addi r2, r5, N_SPLIT
-        sbcb r1, r2, (k_cls0_end - k_cls0) / 4 ; the segments against the plane
+        sbcb r1, r2, (k_classify_x_end - k_classify_x) / 4 ; the segments against the plane
         rcfl r1
         rcfh r2                         ; r1, r2: the rays reaching below
-        li r8, (k_clsr - CTXBASE) / 4
+        li r8, (k_classify_above - CTXBASE) / 4
         cbcast r8, 1
         rcfl r3
         rcfh r4                         ; r3, r4: the rays reaching above
@@ -396,10 +396,10 @@ leaf:
         jal test_objects
         lw r1, MODE(r0)
         bnez r1, leaf_any_hit
-        BCAST_REC k_leafc, r5, N_BOUNDS ; the rays with a hit in the cell sleep
+        BCAST_REC k_leaf_closest, r5, N_BOUNDS ; the rays with a hit in the cell sleep
         j leaf_done
 leaf_any_hit:
-        BCAST k_leafa                   ; the rays with a hit sleep
+        BCAST k_leaf_any                ; the rays with a hit sleep
 leaf_done:
         jal read_awake
 pop_node:
@@ -460,7 +460,7 @@ to_triangle_obj:
         lw r1, TESTS(r0)
         addi r1, r1, 1
         sw r1, TESTS(r0)
-        BCAST_AT k_tri, r7
+        BCAST_AT k_triangle, r7
 to_triangle_next:
         addi r7, r7, TRIANGLE_WORDS
         addi r8, r8, 1
@@ -482,13 +482,13 @@ to_triangle_end:
         .ctx
         .org CTXBASE
 
-; k_rows: a group of 8 contexts, one per row (row mode) or column (column mode):
+; k_row_index: a group of 8 contexts, one per row (row mode) or column (column mode):
 ; row i gets r8 = i. Broadcast twice, its results stored to LANE_ROW and LANE_COL.
-k_rows:
+k_row_index:
         .rept 8, i
         movb r8, #i
         .endr
-k_rows_end:
+k_row_index_end:
 
 ; k_init: every RC's RAM from the FB image's start (stream): the RSQ and RCP tables,
 ; 1.0 and the no-hit distance. Out: r0 = 0 in every RC.
@@ -514,33 +514,33 @@ k_lanes:
         (!f) sleep
 k_lanes_end:
 
-; k_wake: every RC of the tile awake again after a pass (the others asleep).
-k_wake:
+; k_wake_tile: every RC of the tile awake again after a pass (the others asleep).
+k_wake_tile:
         wake
         ld r8, [r0 + #LANE_ACT]
         cmp.eq r8, #0
         (f) sleep
-k_wake_end:
+k_wake_tile_end:
 
-; k_sign0: F = the ray goes down along x (dx < 0).
-k_sign0:
+; k_sign_x: F = the ray goes down along x (dx < 0).
+k_sign_x:
         cmp.lt r4, #0
-k_sign0_end:
+k_sign_x_end:
 
-; k_sign1: F = the ray goes down along y (dy < 0).
-k_sign1:
+; k_sign_y: F = the ray goes down along y (dy < 0).
+k_sign_y:
         cmp.lt r5, #0
-k_sign1_end:
+k_sign_y_end:
 
-; k_sign2: F = the ray goes down along z (dz < 0).
-k_sign2:
+; k_sign_z: F = the ray goes down along z (dz < 0).
+k_sign_z:
         cmp.lt r6, #0
-k_sign2_end:
+k_sign_z_end:
 
-; k_cls0: the segment [o, o + tbest d] against a split plane across x (stream: its
+; k_classify_x: the segment [o, o + tbest d] against a split plane across x (stream: its
 ; position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1
-; (for k_clsr).
-k_cls0:
+; (for k_classify_above).
+k_classify_x:
         ldacc r1, <<Q14
         mac r8, r7, r4, >>Q14           ; o + tbest d
         min r9, r1, r8
@@ -549,12 +549,12 @@ k_cls0:
         add r12, r11, #1
         sub r13, r11, #1
         cmp.le r9, r12
-k_cls0_end:
+k_classify_x_end:
 
-; k_cls1: the segment [o, o + tbest d] against a split plane across y (stream: its
+; k_classify_y: the segment [o, o + tbest d] against a split plane across y (stream: its
 ; position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1
-; (for k_clsr).
-k_cls1:
+; (for k_classify_above).
+k_classify_y:
         ldacc r2, <<Q14
         mac r8, r7, r5, >>Q14           ; o + tbest d
         min r9, r2, r8
@@ -563,12 +563,12 @@ k_cls1:
         add r12, r11, #1
         sub r13, r11, #1
         cmp.le r9, r12
-k_cls1_end:
+k_classify_y_end:
 
-; k_cls2: the segment [o, o + tbest d] against a split plane across z (stream: its
+; k_classify_z: the segment [o, o + tbest d] against a split plane across z (stream: its
 ; position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1
-; (for k_clsr).
-k_cls2:
+; (for k_classify_above).
+k_classify_z:
         ldacc r3, <<Q14
         mac r8, r7, r6, >>Q14           ; o + tbest d
         min r9, r3, r8
@@ -577,16 +577,16 @@ k_cls2:
         add r12, r11, #1
         sub r13, r11, #1
         cmp.le r9, r12
-k_cls2_end:
+k_classify_z_end:
 
-; k_clsr: after k_clsN, F = the segment reaches above the plane.
-k_clsr:
+; k_classify_above: after k_clsN, F = the segment reaches above the plane.
+k_classify_above:
         cmp.ge r10, r13
-k_clsr_end:
+k_classify_above_end:
 
-; k_leafc: after a leaf's objects, closest-hit pass: the rays whose hit lies in the leaf's cell
+; k_leaf_closest: after a leaf's objects, closest-hit pass: the rays whose hit lies in the leaf's cell
 ; (stream: min.xyz, max.xyz) are done and sleep.
-k_leafc:
+k_leaf_closest:
         ld r8, [r0 + #PASS_T0]
         cmp.lt r7, r8                   ; F: a hit in this pass
         ldacc r1, <<Q14
@@ -602,14 +602,14 @@ k_leafc:
         (f) cmp.ge fb0, r10
         (f) cmp.ge fb0, r11             ; F: inside the cell
         (f) sleep
-k_leafc_end:
+k_leaf_closest_end:
 
-; k_leafa: after a leaf's objects, any-hit pass: the rays with a hit are done and sleep.
-k_leafa:
+; k_leaf_any: after a leaf's objects, any-hit pass: the rays with a hit are done and sleep.
+k_leaf_any:
         ld r8, [r0 + #PASS_T0]
         cmp.lt r7, r8
         (f) sleep
-k_leafa_end:
+k_leaf_any_end:
 
 ; k_eye: the tile's eye rays (stream: px0, py0, eye.xyz, (A, B, C) per axis).
 ; Out: r1..r3 = eye, r4..r6 = normalize(A + i B + j C) for pixel (px0 + col, py0 + row),
@@ -680,11 +680,11 @@ k_eye:
         st r8, [#OUT_OBJ]
 k_eye_end:
 
-; k_post0: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; k_post_eye: after a closest-hit pass: the hit's shading state (stream: background.rgb,
 ; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
 ; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
 ; COL = the background where no hit; OUT_OBJ, the eye ray's object.
-k_post0:
+k_post_eye:
         ld r8, [r0 + #C_INF]
         cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
@@ -726,13 +726,13 @@ k_post0:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
-k_post0_end:
+k_post_eye_end:
 
-; k_post1: after a closest-hit pass: the hit's shading state (stream: background.rgb,
+; k_post: after a closest-hit pass: the hit's shading state (stream: background.rgb,
 ; then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.
 ; Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;
 ; COL = the background where no hit.
-k_post1:
+k_post:
         ld r8, [r0 + #C_INF]
         cmp.lt r7, r8                   ; F: a hit
         movb r9, #0
@@ -770,12 +770,12 @@ k_post1:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
-k_post1_end:
+k_post_end:
 
-; k_light: the shadow rays towards one light (stream: a scale shift k, the light's position).
+; k_shadow_rays: the shadow rays towards one light (stream: a scale shift k, the light's position).
 ; In: SH_P, SH_N, SH_D, ACT. Out: r1..r7 the shadow rays (tbest: the light's distance less 2 LSB),
 ; SH_NL, SH_RV, LIT; the RCs with no hit or the light behind the surface sleep.
-k_light:
+k_shadow_rays:
         ld r1, [r0 + #SH_P]
         ld r2, [r0 + #SH_P+1]
         ld r3, [r0 + #SH_P+2]
@@ -861,12 +861,12 @@ k_light:
         (f) movb r9, #1
         st r9, [#LIT]
         (!f) sleep
-k_light_end:
+k_shadow_rays_end:
 
-; k_shade: after a shadow pass, the light's Phong terms where it is visible
+; k_phong: after a shadow pass, the light's Phong terms where it is visible
 ; (stream per material: id, [f, 1 - f,] then per channel kd c lc, ks lc).
 ; In: LIT, PASS_T0, r7 (no hit: tbest >= PASS_T0), SH_NL, SH_RV, SH_MAT. Out: COL += kd c lc N.L + ks lc (R.V)^n.
-k_shade:
+k_phong:
         ld r8, [r0 + #LIT]
         cmp.ne r8, #0
         ld r9, [r0 + #PASS_T0]
@@ -910,41 +910,41 @@ k_shade:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
-k_shade_end:
+k_phong_end:
 
-; k_out0: the pixel's red into the output register (for wfb).
-k_out0:
+; k_out_red: the pixel's red into the output register (for wfb).
+k_out_red:
         ld out, [r0 + #COL]
-k_out0_end:
+k_out_red_end:
 
-; k_out1: the pixel's green into the output register (for wfb).
-k_out1:
+; k_out_green: the pixel's green into the output register (for wfb).
+k_out_green:
         ld out, [r0 + #COL+1]
-k_out1_end:
+k_out_green_end:
 
-; k_out2: the pixel's blue into the output register (for wfb).
-k_out2:
+; k_out_blue: the pixel's blue into the output register (for wfb).
+k_out_blue:
         ld out, [r0 + #COL+2]
-k_out2_end:
+k_out_blue_end:
 
-; k_out3: the pixel's object id into the output register (for wfb).
-k_out3:
+; k_out_object: the pixel's object id into the output register (for wfb).
+k_out_object:
         ld out, [r0 + #OUT_OBJ]
-k_out3_end:
+k_out_object_end:
 
-; k_strow: r8 (the row or column [`k_rows`] gave) into LANE_ROW.
-k_strow:
+; k_store_row: r8 (the row or column [`k_row_index`] gave) into LANE_ROW.
+k_store_row:
         st r8, [#LANE_ROW]
-k_strow_end:
+k_store_row_end:
 
-; k_stcol: r8 (the row or column [`k_rows`] gave) into LANE_COL.
-k_stcol:
+; k_store_col: r8 (the row or column [`k_row_index`] gave) into LANE_COL.
+k_store_col:
         st r8, [#LANE_COL]
-k_stcol_end:
+k_store_col_end:
 
-; k_refl0: level 0's colour and Ks onto the stack (STACK_L0); the reflected rays
+; k_reflect0: level 0's colour and Ks onto the stack (STACK_L0); the reflected rays
 ; d - 2 (d.N) N from SH_P where Ks > 0, the others sleep. Out: r1..r7 the rays, a new level.
-k_refl0:
+k_reflect0:
         ld r8, [r0 + #SH_KS]
         st r8, [#STACK_L0+FR_KS]
         movb r10, #0
@@ -988,10 +988,10 @@ k_refl0:
         cmp.ne r9, #0
         (f) cmp.gt r8, #0               ; F: a hit that reflects
         (!f) sleep
-k_refl0_end:
+k_reflect0_end:
 
-; k_pop0: back from level 0's reflected rays: COL = STACK_L0's colour + Ks COL.
-k_pop0:
+; k_reflected0: back from level 0's reflected rays: COL = STACK_L0's colour + Ks COL.
+k_reflected0:
         ld r10, [r0 + #STACK_L0+FR_KS]
         ld r8, [r0 + #STACK_L0+FR_COL]
         ld r9, [r0 + #COL]
@@ -1008,12 +1008,12 @@ k_pop0:
         mul r9, r9, r10, >>Q12
         adds r9, r8, r9
         st r9, [#COL+2]
-k_pop0_end:
+k_reflected0_end:
 
-; k_tri: the triangle test of one record (the stream).
+; k_triangle: the triangle test of one record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
 ; t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew
-k_tri:
+k_triangle:
         ; den = -n.d, num = -n.(v0 - o)
         mov r8, fb0
         mov r9, fb0
@@ -1087,5 +1087,5 @@ k_tri:
         (f) st fb0, [#HIT_N+2]
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
-k_tri_end:
+k_triangle_end:
 ctx_end:

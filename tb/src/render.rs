@@ -165,28 +165,35 @@ fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
             w.add(a, 0);
         }
     }
+    use tracer::kernel_names as names;
     let start = match fw.layout.traversal {
-        tracer::Traversal::Paper => "k_sign0",
-        tracer::Traversal::Packet if fw.layout.root_leaf => "k_sign0",
-        tracer::Traversal::Packet => "k_pinit",
+        tracer::Traversal::Paper => names::sign(0),
+        tracer::Traversal::Packet if fw.layout.root_leaf => names::sign(0),
+        tracer::Traversal::Packet => names::PASS_START.into(),
     };
-    if let Some(a) = ctx(start) {
+    // Every kernel the census and the test count name must be there.
+    let ctx = |n: &str| {
+        let a = ctx(n);
+        debug_assert!(a.is_some() || !fw.kernels.iter().any(|(k, _)| k == n), "{n}");
+        a
+    };
+    if let Some(a) = ctx(&start) {
         w.add(a, 1);
     }
     // The ray census: the kernels that set up each kind of ray tag the
     // passes that follow ([`RAY_EYE`] ...).
-    if let Some(a) = ctx("k_eye") {
+    if let Some(a) = ctx(names::EYE) {
         w.tag(a, RAY_EYE);
     }
-    if let Some(a) = ctx("k_light") {
+    if let Some(a) = ctx(names::SHADOW) {
         w.tag(a, RAY_SHADOW);
     }
     for l in 0.. {
-        match ctx(&format!("k_refl{l}")) {
+        match ctx(&names::reflect(l)) {
             Some(a) => w.tag(a, RAY_REFLECT),
             None => break,
         }
-        if let Some(a) = ctx(&format!("k_refr{l}")) {
+        if let Some(a) = ctx(&names::refract(l)) {
             w.tag(a, RAY_REFRACT);
         }
     }

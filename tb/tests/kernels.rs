@@ -752,7 +752,7 @@ fn every_kernel_on_the_32_bit_chip() {
     }
 }
 
-/// Snell's law in the RC (`shading::refract_prepare`, which `k_tset0`
+/// Snell's law in the RC (`shading::refract_prepare`, which `k_refract_prepare0`
 /// runs): for 64 random incident directions and normals facing them,
 /// entering (eta = 1/ior) or leaving (eta = ior) a material of index
 /// `ior`, the refracted direction and total internal reflection against
@@ -776,9 +776,8 @@ fn snell_on<W: Word>(ior: f64, seed: u64) -> (usize, f64) {
     let lay = &fw.layout;
     assert!(lay.refract && lay.transmit_materials == 1);
     let img = with_driver(&fw, |t| {
-        t.li(R1, kaddr("k_tset0"))
-            .li(R2, "FB_TRANSMIT")
-            .sbcb(R1, R2, klen("k_tset0"));
+        let k = tracer::kernel_names::refract_prepare(0);
+        t.li(R1, kaddr(&k)).li(R2, "FB_TRANSMIT").sbcb(R1, R2, klen(&k));
     });
     let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
     img.load(&mut chip).unwrap();

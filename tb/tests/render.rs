@@ -104,12 +104,12 @@ fn json_has_every_key_and_sane_figures() {
         .iter()
         .map(|(n, _)| n.as_str())
         .collect();
-    for k in ["k_sphere", "k_cyl", "k_box", "k_rect", "k_tri"] {
+    for k in ["k_sphere", "k_cylinder", "k_box", "k_rectangle", "k_triangle"] {
         assert!(names.contains(&k), "{k} not loaded");
     }
     let jacks = tracer_kernels("jacks-1.nff");
-    assert!(jacks.contains(&"k_sphere".to_string()) && jacks.contains(&"k_cyl".to_string()));
-    assert!(!jacks.contains(&"k_rect".to_string()) && !jacks.contains(&"k_tri".to_string()));
+    assert!(jacks.contains(&"k_sphere".to_string()) && jacks.contains(&"k_cylinder".to_string()));
+    assert!(!jacks.contains(&"k_rectangle".to_string()) && !jacks.contains(&"k_triangle".to_string()));
 }
 
 fn tracer_kernels(name: &str) -> Vec<String> {

@@ -51,7 +51,7 @@ fn an_emitted_firmware_renders_the_same_and_an_edited_one_differs() {
     // root: five contexts fewer per sphere test.
     let at =
         fw.find("k_sphere:").unwrap() + fw[fw.find("k_sphere:").unwrap()..].find("; sqrt").unwrap();
-    let step = "        mul r8, r13, r13, >>Q14\n        mul r8, r8, r10, >>Q11\n        sub r8, r8, r14\n        ldacc r13, <<Q15\n        msu r13, r13, r8, >>Q15\n";
+    let step = "        mul r8, r13, r13, >>Q14         ; Newton: y += y (1 - X y^2) / 2\n        mul r8, r8, r10, >>Q11\n        sub r8, r8, r14\n        ldacc r13, <<Q15\n        msu r13, r13, r8, >>Q15\n";
     let k = at + fw[at..].find(step).unwrap();
     let edited = format!("{}{}", &fw[..k], &fw[k + step.len()..]);
     std::fs::write(d.join("nr1.s"), edited).unwrap();
@@ -70,11 +70,11 @@ fn an_emitted_firmware_renders_the_same_and_an_edited_one_differs() {
     assert_eq!(len(&c) + 5, len(&a));
     // Output green as red: the same cycles, another image.
     let swapped = fw.replacen(
-        "k_out0:\n        ld out, [r0 + #COL]",
-        "k_out0:\n        ld out, [r0 + #COL+1]",
+        "k_out_red:\n        ld out, [r0 + #COL]",
+        "k_out_red:\n        ld out, [r0 + #COL+1]",
         1,
     );
-    assert_ne!(swapped, fw, "k_out0 reads COL");
+    assert_ne!(swapped, fw, "k_out_red reads COL");
     std::fs::write(d.join("swap.s"), swapped).unwrap();
     let e = render(d, "e", &[&s, "--firmware", "swap.s"]);
     assert_eq!(cycles(&e), cycles(&a));

@@ -168,6 +168,7 @@ pub fn sqrt_q14(k: &mut K, s: u8, out: u8, t: [u8; 4], nr: Approx) {
         .c(format!("ld {w}, [r0 + #{}]", ram::C_ONE));
     for _ in 0..nr.newton_steps {
         k.c(format!("mul {o}, {y}, {y}, >>Q14"))
+            .note("Newton: y += y (1 - X y^2) / 2")
             .c(format!("mul {o}, {o}, {x}, >>Q11"))
             .c(format!("sub {o}, {o}, {w}"))
             .c(format!("ldacc {y}, <<Q15"))
@@ -270,6 +271,7 @@ pub fn pow_q14(k: &mut K, base: u8, out: u8, tmp: u8, n: u32) {
 /// hundredth of a radian, which a Phong highlight or a reflection shows.
 pub fn perpendicular_to(k: &mut K, p: &[u8], d: &[u8], t: u8) {
     let n = p.len();
+    k.comment("p made perpendicular to d: p -= (p.d) d");
     for (i, (x, e)) in p.iter().zip(d).enumerate() {
         match i {
             0 => k.c(format!("mul out, r{x}, r{e}")),

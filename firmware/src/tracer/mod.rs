@@ -26,6 +26,7 @@
 //! steps.
 
 pub mod emit;
+pub mod kernel_names;
 pub mod layout;
 pub mod math;
 pub mod memory_map;

@@ -5,6 +5,7 @@
 //! [`super::traversal`]), and the RC kernels in context memory.
 
 use super::emit::{define, Code, K};
+use super::kernel_names as names;
 use super::layout::{Layout, STREAM_BANK};
 use super::memory_map::{format_lines, ram_lines};
 use super::primitives::{self, ChipType, Gen};
@@ -88,13 +89,13 @@ fn kernels(
         traversal::packet::init_ram(&mut init);
     }
     let mut v: Vec<(String, K)> = vec![
-        ("k_rows".into(), shading::rows()),
-        ("k_init".into(), init),
-        ("k_lanes".into(), shading::lanes()),
-        ("k_wake".into(), shading::wake_restore(packet)),
+        (names::ROW_INDEX.into(), shading::rows()),
+        (names::INIT.into(), init),
+        (names::LANES.into(), shading::lanes()),
+        (names::WAKE.into(), shading::wake_restore(packet)),
     ];
     for a in 0..3u8 {
-        v.push((format!("k_sign{a}"), traversal::sign(a)));
+        v.push((names::sign(a), traversal::sign(a)));
     }
     if packet {
         v.extend(traversal::packet::kernels(nm.approx()));
@@ -108,41 +109,41 @@ fn kernels(
             ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle
         )
     });
-    v.push(("k_eye".into(), shading::eye(nm.approx(), lay.refract)));
+    v.push((names::EYE.into(), shading::eye(nm.approx(), lay.refract)));
     v.push((
-        "k_post0".into(),
+        names::POST_EYE.into(),
         shading::post(true, lay.materials, smooth, lay.refract),
     ));
     v.push((
-        "k_post1".into(),
+        names::POST.into(),
         shading::post(false, lay.materials, smooth, lay.refract),
     ));
     v.push((
-        "k_light".into(),
+        names::SHADOW.into(),
         shading::light_setup(nm.approx(), lay.light_shifted),
     ));
-    v.push(("k_shade".into(), shading::shade(&lay.shines)));
+    v.push((names::PHONG.into(), shading::shade(&lay.shines)));
     for i in 0..4 {
-        v.push((format!("k_out{i}"), shading::out_word(i)));
+        v.push((names::out(i).into(), shading::out_word(i)));
     }
     v.push((
-        "k_strow".into(),
-        shading::store_lane("k_strow", super::memory_map::ram::LANE_ROW),
+        names::STORE_ROW.into(),
+        shading::store_lane(names::STORE_ROW, super::memory_map::ram::LANE_ROW),
     ));
     v.push((
-        "k_stcol".into(),
-        shading::store_lane("k_stcol", super::memory_map::ram::LANE_COL),
+        names::STORE_COL.into(),
+        shading::store_lane(names::STORE_COL, super::memory_map::ram::LANE_COL),
     ));
     for l in 0..opt.depth.saturating_sub(1) {
-        v.push((format!("k_refl{l}"), shading::reflect_setup(l, smooth)));
-        v.push((format!("k_pop{l}"), shading::reflect_pop(l)));
+        v.push((names::reflect(l), shading::reflect_setup(l, smooth)));
+        v.push((names::reflected(l), shading::reflect_pop(l)));
         if lay.refract {
             v.push((
-                format!("k_tset{l}"),
+                names::refract_prepare(l),
                 shading::refract_prepare(l, lay.transmit_materials, nm.approx()),
             ));
-            v.push((format!("k_refr{l}"), shading::refract_setup(l)));
-            v.push((format!("k_rpop{l}"), shading::refract_pop(l)));
+            v.push((names::refract(l), shading::refract_setup(l)));
+            v.push((names::refracted(l), shading::refract_pop(l)));
         }
     }
     if lay.stream.is_some() && !packet {

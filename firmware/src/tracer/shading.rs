@@ -11,6 +11,7 @@
 //! and per refracting level (`REFR_Ln`).
 
 use super::emit::K;
+use super::kernel_names as names;
 use super::math::{normalize, pow_q14, sqrt_q14, Approx};
 use super::memory_map::ram;
 use super::primitives::smooth_triangle;
@@ -72,7 +73,7 @@ pub fn init() -> K {
 pub fn rows() -> K {
     let mut k = K::new();
     k.doc(
-        "k_rows: a group of 8 contexts, one per row (row mode) or column (column mode):\n\
+        "k_row_index: a group of 8 contexts, one per row (row mode) or column (column mode):\n\
          row i gets r8 = i. Broadcast twice, its results stored to LANE_ROW and LANE_COL.",
     );
     k.rept(8, "i", |k| {
@@ -85,7 +86,7 @@ pub fn rows() -> K {
 pub fn store_lane(name: &str, at: super::emit::Name) -> K {
     let mut k = K::new();
     k.doc(&format!(
-        "{name}: r8 (the row or column [`k_rows`] gave) into {at}."
+        "{name}: r8 (the row or column [`k_row_index`] gave) into {at}."
     ));
     k.c(format!("st r8, [#{at}]"));
     k
@@ -114,7 +115,7 @@ pub fn lanes() -> K {
 /// `packet`: no ray is alive in a pass until the pass starts.
 pub fn wake_restore(packet: bool) -> K {
     let mut k = K::new();
-    k.doc("k_wake: every RC of the tile awake again after a pass (the others asleep).");
+    k.doc("k_wake_tile: every RC of the tile awake again after a pass (the others asleep).");
     k.c("wake");
     if packet {
         k.c(format!("st r0, [#{}]", ram::P_ALIVE));
@@ -182,11 +183,11 @@ fn new_level_common(k: &mut K) {
 pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
-        "k_post{}: after a closest-hit pass: the hit's shading state (stream: background.rgb,\n\
+        "{}: after a closest-hit pass: the hit's shading state (stream: background.rgb,\n\
          then (material id, ks) per material). In: r1..r7 the rays and their tbest, HIT_*.\n\
          Out: ACT, SH_P (the hit point, EPS_LSB off the surface), SH_N, SH_MAT, SH_KS;\n\
          COL = the background where no hit{}.",
-        if level0 { 0 } else { 1 },
+        if level0 { names::POST_EYE } else { names::POST },
         if level0 {
             "; OUT_OBJ, the eye ray's object"
         } else {
@@ -261,7 +262,7 @@ pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool) -> K {
 pub fn light_setup(nr: Approx, shifted: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
-        "k_light: the shadow rays towards one light (stream: {}the light's position).\n\
+        "k_shadow_rays: the shadow rays towards one light (stream: {}the light's position).\n\
          In: SH_P, SH_N, SH_D, ACT. Out: r1..r7 the shadow rays (tbest: the light's distance less 2 LSB),\n\
          SH_NL, SH_RV, LIT; the RCs with no hit or the light behind the surface sleep.",
         if shifted { "a scale shift k, " } else { "" }
@@ -338,7 +339,7 @@ pub fn light_setup(nr: Approx, shifted: bool) -> K {
 pub fn shade(shines: &[(u32, f64)]) -> K {
     let mut k = K::new();
     k.doc(
-        "k_shade: after a shadow pass, the light's Phong terms where it is visible\n\
+        "k_phong: after a shadow pass, the light's Phong terms where it is visible\n\
          (stream per material: id, [f, 1 - f,] then per channel kd c lc, ks lc).\n\
          In: LIT, PASS_T0, r7 (no hit: tbest >= PASS_T0), SH_NL, SH_RV, SH_MAT. Out: COL += kd c lc N.L + ks lc (R.V)^n.",
     );
@@ -384,8 +385,9 @@ pub fn reflect_setup(level: u32, smooth: bool) -> K {
     let f = format!("STACK_L{level}");
     let mut k = K::new();
     k.doc(&format!(
-        "k_refl{level}: level {level}'s colour and Ks onto the stack ({f}); the reflected rays\n\
-         d - 2 (d.N) N from SH_P where Ks > 0, the others sleep. Out: r1..r7 the rays, a new level."
+        "{}: level {level}'s colour and Ks onto the stack ({f}); the reflected rays\n\
+         d - 2 (d.N) N from SH_P where Ks > 0, the others sleep. Out: r1..r7 the rays, a new level.",
+        names::reflect(level),
     ));
     k.c(format!("ld r8, [r0 + #{}]", ram::SH_KS))
         .c(format!("st r8, [#{}]", word(&f, "FR_KS", 0)))
@@ -459,9 +461,10 @@ pub fn refract_prepare(level: u32, materials: usize, nr: Approx) -> K {
     let rf = format!("REFR_L{level}");
     let mut k = K::new();
     k.doc(&format!(
-        "k_tset{level}: level {level}'s refracted rays by Snell's law, kept in {rf} for after its\n\
+        "{}: level {level}'s refracted rays by Snell's law, kept in {rf} for after its\n\
          reflection (stream per transmitting material: id, T, 1/ior, ior). In: SH_*, ACT.\n\
-         T = eta d + (eta c1 - sqrt(k)) N, c1 = -d.N, k = 1 - eta^2 (1 - c1^2); weight 0 where k <= 0."
+         T = eta d + (eta c1 - sqrt(k)) N, c1 = -d.N, k = 1 - eta^2 (1 - c1^2); weight 0 where k <= 0.",
+        names::refract_prepare(level),
     ));
     k.c(format!("ld r8, [r0 + #{}]", ram::ACT))
         .c(format!("ld r9, [r0 + #{}]", ram::SH_MAT))
@@ -528,8 +531,9 @@ pub fn refract_setup(level: u32) -> K {
     let (f, rf) = (format!("STACK_L{level}"), format!("REFR_L{level}"));
     let mut k = K::new();
     k.doc(&format!(
-        "k_refr{level}: level {level}'s colour so far onto the stack; the refracted rays {rf} traced;\n\
-         the RCs with none sleep. Out: r1..r7 the rays, F = 1 on the awake ones."
+        "{}: level {level}'s colour so far onto the stack; the refracted rays {rf} traced;\n\
+         the RCs with none sleep. Out: r1..r7 the rays, F = 1 on the awake ones.",
+        names::refract(level),
     ));
     k.c("movb r10, #0");
     for c in 0..3 {
@@ -565,7 +569,8 @@ pub fn refract_pop(level: u32) -> K {
     let (f, rf) = (format!("STACK_L{level}"), format!("REFR_L{level}"));
     let mut k = K::new();
     k.doc(&format!(
-        "k_rpop{level}: back from level {level}'s refracted rays: COL = {f}'s colour + T COL."
+        "{}: back from level {level}'s refracted rays: COL = {f}'s colour + T COL.",
+        names::refracted(level),
     ));
     k.c(format!("ld r10, [r0 + #{}]", word(&rf, "RF_T", 0)));
     for c in 0..3 {
@@ -583,7 +588,8 @@ pub fn reflect_pop(level: u32) -> K {
     let f = format!("STACK_L{level}");
     let mut k = K::new();
     k.doc(&format!(
-        "k_pop{level}: back from level {level}'s reflected rays: COL = {f}'s colour + Ks COL."
+        "{}: back from level {level}'s reflected rays: COL = {f}'s colour + Ks COL.",
+        names::reflected(level),
     ));
     k.c(format!("ld r10, [r0 + #{}]", word(&f, "FR_KS", 0)));
     for c in 0..3 {
@@ -605,7 +611,8 @@ pub fn out_word(i: u32) -> K {
         ram::OUT_OBJ + 0
     };
     k.doc(&format!(
-        "k_out{i}: the pixel's {} into the output register (for wfb).",
+        "{}: the pixel's {} into the output register (for wfb).",
+        names::out(i),
         ["red", "green", "blue", "object id"][i as usize]
     ));
     k.c(format!("ld out, [r0 + #{a}]"));

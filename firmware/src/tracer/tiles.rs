@@ -20,6 +20,7 @@
 //! `CUR_OUT`), so that `trace` may use r1..r14.
 
 use super::emit::{at, Code, R0, R1, R2, R3, R4, R5, R6};
+use super::kernel_names as names;
 use super::layout::Layout;
 use super::primitives::kaddr;
 
@@ -90,13 +91,13 @@ pub fn macros(lay: &Layout) -> Code {
         "SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream\n\
          `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.",
         body(&|b| {
-            b.m("BCAST_FB", "k_light, \\light")
+            b.m("BCAST_FB", format!("{}, \\light", names::SHADOW))
                 .li(R1, 1)
                 .sw(R1, at("MODE", R0))
                 .c("any hit")
                 .jal("trace")
-                .m("BCAST", "k_wake")
-                .m("BCAST_FB", "k_shade, \\shade");
+                .m("BCAST", names::WAKE)
+                .m("BCAST_FB", format!("{}, \\shade", names::PHONG));
         }),
     );
     t.define_macro(
@@ -104,7 +105,7 @@ pub fn macros(lay: &Layout) -> Code {
         "post",
         &format!(
             "SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state\n\
-             (kernel `post`: k_post0 for the eye rays, k_post1 after), then every light's\n\
+             (kernel `post`: k_post_eye for the eye rays, k_post after), then every light's\n\
              shadow pass ({} light{}).",
             lay.lights.len(),
             if lay.lights.len() == 1 { "" } else { "s" }
@@ -113,7 +114,7 @@ pub fn macros(lay: &Layout) -> Code {
             b.sw(R0, at("MODE", R0))
                 .c("closest hit")
                 .jal("trace")
-                .m("BCAST", "k_wake")
+                .m("BCAST", names::WAKE)
                 .m("BCAST_FB", "\\post, FB_POST");
             for i in 0..lay.lights.len() {
                 b.m("SHADOW_PASS", format!("FB_LIGHT{i}, FB_SHADE{i}"));
@@ -142,14 +143,16 @@ pub fn main(t: &mut Code, lay: &Layout, depth: u32) {
         .ldctxt(R1, R2, R3)
         .c("the kernels into context memory")
         .dwait();
-    sb(t, "k_init", "0").c("RSQ, RCP, C_ONE, C_INF from the FB");
-    t.li(R1, kaddr("k_rows")).cbcr(R1, R0, 1).c("row i: r8 = i");
-    cb(t, "k_strow");
-    t.li(R1, kaddr("k_rows"))
+    sb(t, names::INIT, "0").c("RSQ, RCP, C_ONE, C_INF from the FB");
+    t.li(R1, kaddr(names::ROW_INDEX))
+        .cbcr(R1, R0, 1)
+        .c("row i: r8 = i");
+    cb(t, names::STORE_ROW);
+    t.li(R1, kaddr(names::ROW_INDEX))
         .cbcc(R1, R0, 1)
         .c("column j: r8 = j");
-    cb(t, "k_stcol");
-    cb(t, "k_lanes").c("the RCs outside the tile sleep");
+    cb(t, names::STORE_COL);
+    cb(t, names::LANES).c("the RCs outside the tile sleep");
     t.rcany(R1)
         .c("the array done")
         .rdcyc(R1)
@@ -175,7 +178,7 @@ pub fn main(t: &mut Code, lay: &Layout, depth: u32) {
         .sfb(R3, at("EYE_PX", R6))
         .sfb(R4, at("EYE_PY", R6))
         .c("the tile's corner into the eye stream");
-    sb(t, "k_eye", "FB_EYE").c("eye rays");
+    sb(t, names::EYE, "FB_EYE").c("eye rays");
     let mut skips = 0;
     tree(t, lay, 0, depth.max(1), &mut skips);
     output(t);
@@ -190,7 +193,11 @@ pub fn main(t: &mut Code, lay: &Layout, depth: u32) {
 fn shade_level(t: &mut Code, level: u32) {
     t.m(
         "SHADE_LEVEL",
-        if level == 0 { "k_post0" } else { "k_post1" },
+        if level == 0 {
+            names::POST_EYE
+        } else {
+            names::POST
+        },
     )
     .c(format!("level {level}: trace, shade, every light"));
 }
@@ -204,21 +211,21 @@ fn tree(t: &mut Code, lay: &Layout, level: u32, levels: u32, skips: &mut u32) {
         return;
     }
     if lay.refract {
-        sb(t, &format!("k_tset{level}"), "FB_TRANSMIT")
+        sb(t, &names::refract_prepare(level), "FB_TRANSMIT")
             .c(format!("level {level}'s refracted rays, for later"));
     }
-    cb(t, &format!("k_refl{level}")).c(format!("level {level}'s reflected rays"));
+    cb(t, &names::reflect(level)).c(format!("level {level}'s reflected rays"));
     tree(t, lay, level + 1, levels, skips);
-    cb(t, &format!("k_pop{level}")).c("their colour added");
+    cb(t, &names::reflected(level)).c("their colour added");
     if lay.refract {
         *skips += 1;
         let skip = format!("no_refraction{}", *skips);
-        cb(t, &format!("k_refr{level}")).c(format!("level {level}'s refracted rays"));
+        cb(t, &names::refract(level)).c(format!("level {level}'s refracted rays"));
         t.rcany(R1).beqz(R1, &skip).c("none in the tile");
         tree(t, lay, level + 1, levels, skips);
         t.label(&skip);
-        cb(t, "k_wake");
-        cb(t, &format!("k_rpop{level}")).c("their colour added");
+        cb(t, names::WAKE);
+        cb(t, &names::refracted(level)).c("their colour added");
     }
 }
 
@@ -235,7 +242,7 @@ fn output(t: &mut Code) {
         .into_iter()
         .enumerate()
     {
-        t.m("BCAST", format!("k_out{i}")).wfb(R4, w);
+        t.m("BCAST", names::out(i as u32)).wfb(R4, w);
     }
     t.lw(R3, at("CUR_OUT", R0))
         .stfb(R3, R4, "OUT_WORDS")

@@ -44,7 +44,7 @@ pub fn words(s: Sides) -> usize {
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
         Sides::Front => "k_box",
-        Sides::Both => "k_gbox",
+        Sides::Both => "k_glass_box",
     }
 }
 

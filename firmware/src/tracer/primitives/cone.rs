@@ -101,8 +101,8 @@ pub fn header(types_sides: &[Sides]) -> Vec<String> {
 fn body_name(b: Body) -> &'static str {
     match b {
         Body::Opaque => "k_cone",
-        Body::Outer => "k_gconef",
-        Body::Inner => "k_gconeb",
+        Body::Outer => "k_glass_cone_out",
+        Body::Inner => "k_glass_cone_in",
     }
 }
 

@@ -106,9 +106,9 @@ pub fn header(fit: &Fit, types_sides: &[Sides]) -> Vec<String> {
 
 fn body_name(b: Body) -> &'static str {
     match b {
-        Body::Opaque => "k_cyl",
-        Body::Outer => "k_gcylf",
-        Body::Inner => "k_gcylb",
+        Body::Opaque => "k_cylinder",
+        Body::Outer => "k_glass_cylinder_out",
+        Body::Inner => "k_glass_cylinder_in",
     }
 }
 

@@ -7,13 +7,13 @@
 //!
 //! | module | chip types | kernels |
 //! |---|---|---|
-//! | [`sphere`] | sphere, glass sphere | `k_sphere`, `k_gsphere` |
-//! | [`cylinder`] | cylinder, glass cylinder (caps: discs) | `k_cyl`; `k_gcylf`, `k_gcylb` |
-//! | [`cone`] | cone, glass cone (caps: discs) | `k_cone`; `k_gconef`, `k_gconeb` |
-//! | [`aabox`] | box, glass box | `k_box`, `k_gbox` |
-//! | [`planar`] | rectangle, triangle, disc (the caps), glass ones | `k_rect`, `k_tri`, `k_disc`, `k_grect`, `k_gtri`, `k_gdisc` |
-//! | [`polygon`] | polygon, glass polygon | `k_polyh`, `k_polye`, `k_polyt`; `k_gpolyh`, `k_gpolyt` |
-//! | [`smooth_triangle`] | triangle with vertex normals (NFF `pp`), glass one | `k_tris`, `k_gtris` |
+//! | [`sphere`] | sphere, glass sphere | `k_sphere`, `k_glass_sphere` |
+//! | [`cylinder`] | cylinder, glass cylinder (caps: discs) | `k_cylinder`; `k_glass_cylinder_out`, `k_glass_cylinder_in` |
+//! | [`cone`] | cone, glass cone (caps: discs) | `k_cone`; `k_glass_cone_out`, `k_glass_cone_in` |
+//! | [`aabox`] | box, glass box | `k_box`, `k_glass_box` |
+//! | [`planar`] | rectangle, triangle, disc (the caps), glass ones | `k_rectangle`, `k_triangle`, `k_disc`, `k_glass_rectangle`, `k_glass_triangle`, `k_glass_disc` |
+//! | [`polygon`] | polygon, glass polygon | `k_polygon_head`, `k_polygon_edge`, `k_polygon_tail`; `k_glass_polygon_head`, `k_glass_polygon_tail` |
+//! | [`smooth_triangle`] | triangle with vertex normals (NFF `pp`), glass one | `k_smooth_triangle`, `k_glass_smooth_triangle` |
 //!
 //! Every kernel reads its object's record from one FB stream (set 0) in
 //! exactly the order its contexts read `fb0`; the writers follow the same
@@ -264,21 +264,21 @@ impl ChipType {
 /// context are the rays tested): the render's count of tests per ray.
 pub const TEST_KERNELS: [&str; 16] = [
     "k_sphere",
-    "k_gsphere",
-    "k_cyl",
+    "k_glass_sphere",
+    "k_cylinder",
     "k_cone",
     "k_box",
-    "k_rect",
-    "k_grect",
-    "k_tri",
-    "k_gtri",
-    "k_tris",
-    "k_polyh",
-    "k_gpolyh",
-    "k_gbox",
-    "k_gcylf",
-    "k_gconef",
-    "k_gtris",
+    "k_rectangle",
+    "k_glass_rectangle",
+    "k_triangle",
+    "k_glass_triangle",
+    "k_smooth_triangle",
+    "k_polygon_head",
+    "k_glass_polygon_head",
+    "k_glass_box",
+    "k_glass_cylinder_out",
+    "k_glass_cone_out",
+    "k_glass_smooth_triangle",
 ];
 
 /// Which faces a kernel accepts.

@@ -74,12 +74,12 @@ impl Inside {
 
 pub fn kernel_name(i: Inside, s: Sides) -> &'static str {
     match (i, s) {
-        (Inside::Rectangle, Sides::Front) => "k_rect",
-        (Inside::Triangle, Sides::Front) => "k_tri",
+        (Inside::Rectangle, Sides::Front) => "k_rectangle",
+        (Inside::Triangle, Sides::Front) => "k_triangle",
         (Inside::Disc, Sides::Front) => "k_disc",
-        (Inside::Rectangle, Sides::Both) => "k_grect",
-        (Inside::Triangle, Sides::Both) => "k_gtri",
-        (Inside::Disc, Sides::Both) => "k_gdisc",
+        (Inside::Rectangle, Sides::Both) => "k_glass_rectangle",
+        (Inside::Triangle, Sides::Both) => "k_glass_triangle",
+        (Inside::Disc, Sides::Both) => "k_glass_disc",
     }
 }
 

@@ -70,19 +70,19 @@ pub fn header() -> Vec<String> {
 
 fn head_name(s: Sides) -> &'static str {
     match s {
-        Sides::Front => "k_polyh",
-        Sides::Both => "k_gpolyh",
+        Sides::Front => "k_polygon_head",
+        Sides::Both => "k_glass_polygon_head",
     }
 }
 
 fn tail_name(s: Sides) -> &'static str {
     match s {
-        Sides::Front => "k_polyt",
-        Sides::Both => "k_gpolyt",
+        Sides::Front => "k_polygon_tail",
+        Sides::Both => "k_glass_polygon_tail",
     }
 }
 
-const EDGE: &str = "k_polye";
+const EDGE: &str = "k_polygon_edge";
 
 /// The kernels of a polygon's test, in load order.
 pub fn kernels(g: &Gen, s: Sides) -> Vec<(&'static str, K)> {
@@ -203,7 +203,7 @@ fn head(g: &Gen, sides: Sides) -> K {
 fn edge() -> K {
     let mut k = K::new();
     k.doc(
-        "k_polye: one edge of the crossing test (stream: xi, yi, yj, s ey, s ex).\n\
+        "k_polygon_edge: one edge of the crossing test (stream: xi, yi, yj, s ey, s ex).\n\
          In: r10, r11 = -px, -py, r8 parity. Out: r8 flipped where the edge crosses the\n\
          point's row to its right: (yi > py) != (yj > py) and s ((xi - px) ey - ex (yi - py)) > 0.",
     );

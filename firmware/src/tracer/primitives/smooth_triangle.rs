@@ -39,8 +39,8 @@ pub const WORDS: usize = planar::WORDS + 9;
 
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
-        Sides::Front => "k_tris",
-        Sides::Both => "k_gtris",
+        Sides::Front => "k_smooth_triangle",
+        Sides::Both => "k_glass_smooth_triangle",
     }
 }
 

@@ -63,7 +63,7 @@ pub fn words(fit: &Fit) -> usize {
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
         Sides::Front => "k_sphere",
-        Sides::Both => "k_gsphere",
+        Sides::Both => "k_glass_sphere",
     }
 }
 

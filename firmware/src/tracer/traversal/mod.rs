@@ -21,12 +21,14 @@ pub mod paper;
 pub mod streamed;
 
 use super::emit::{Code, K, R0, R1, R2};
+use super::kernel_names as names;
 
 /// The sign of the ray direction along `axis` (0, 1, 2) into F.
 pub fn sign(axis: u8) -> K {
     let mut k = K::new();
     k.doc(&format!(
-        "k_sign{axis}: F = the ray goes down along {} (d{} < 0).",
+        "{}: F = the ray goes down along {} (d{} < 0).",
+        names::sign(axis),
         ["x", "y", "z"][axis as usize],
         ["x", "y", "z"][axis as usize]
     ));

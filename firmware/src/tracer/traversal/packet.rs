@@ -7,7 +7,7 @@
 //!
 //! ```text
 //! trace:
-//!   PASS += 1; k_pinit: every awake ray alive, its interval [0, tbest]
+//!   PASS += 1; k_pass_start: every awake ray alive, its interval [0, tbest]
 //!     clipped to the root cell, 1/d per axis
 //!   per axis: the child order the majority of the awake rays meets first
 //!     (NK: the node kernel, NF/NS: the first and second child's field)
@@ -63,6 +63,7 @@ use super::super::layout::Layout;
 use super::super::math::Approx;
 use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen};
+use crate::tracer::kernel_names as names;
 
 /// Widening of every split plane and of the root box in the packet
 /// traversal, in LSB of the scene format.
@@ -82,17 +83,17 @@ fn p_newton(nr: Approx) -> u32 {
 
 /// The packet traversal's kernels, in load order (after the signs).
 pub fn kernels(nr: Approx) -> Vec<(String, K)> {
-    let mut v = vec![("k_pinit".to_string(), pass_start(nr))];
+    let mut v = vec![(names::PASS_START.to_string(), pass_start(nr))];
     for a in 0..3u8 {
-        v.push((format!("k_pn{a}b"), node(a, false)));
-        v.push((format!("k_pn{a}a"), node(a, true)));
+        v.push((names::node(a, false), node(a, false)));
+        v.push((names::node(a, true), node(a, true)));
     }
-    v.push(("k_p2nd".into(), second()));
-    v.push(("k_psl".into(), sleep_first()));
-    v.push(("k_ptake".into(), take()));
-    v.push(("k_ppush".into(), push()));
-    v.push(("k_ppop".into(), pop()));
-    v.push(("k_pleafa".into(), leaf_any()));
+    v.push((names::SECOND_TOO.into(), second()));
+    v.push((names::FIRST_OR_SLEEP.into(), sleep_first()));
+    v.push((names::TAKE_SECOND.into(), take()));
+    v.push((names::PUSH_SECOND.into(), push()));
+    v.push((names::POP_NODE.into(), pop()));
+    v.push((names::DONE_WITH_HIT.into(), leaf_any()));
     v
 }
 
@@ -122,7 +123,7 @@ fn distance(k: &mut K, out: u8, x: &str, o: u8, zr: u8, rr: u8) {
 pub fn pass_start(nr: Approx) -> K {
     let mut k = K::new();
     k.doc(
-        "k_pinit: a pass starts (stream: the root cell widened by P_TOL, per axis min, max).\n\
+        "k_pass_start: a pass starts (stream: the root cell widened by P_TOL, per axis min, max).\n\
          Out: P_ALIVE = 1, per axis P_Z, P_R (1/d = R >> z) and P_DT (P_TOL / |d|); the interval\n\
          (r8, r9) = [0, tbest] clipped to the root cell; the rays that miss it sleep, not alive.",
     );
@@ -192,11 +193,11 @@ pub fn node(axis: u8, first_above: bool) -> K {
     let a = axis as u32;
     let mut k = K::new();
     k.doc(&format!(
-        "k_pn{axis}{}: an inner node split across {}, the child {} the plane first (stream: the\n\
+        "{}: an inner node split across {}, the child {} the plane first (stream: the\n\
          split s). Each awake ray's interval (r8, r9) cut at t(s) widened by P_TOL: the first\n\
          child's into r8, r9, the second's into r11, r14; the rays reaching neither sleep.\n\
          Out: F = reaches the first child.",
-        if first_above { "a" } else { "b" },
+        names::node(axis, first_above),
         ["x", "y", "z"][axis as usize],
         if first_above { "above" } else { "below" }
     ));
@@ -231,7 +232,7 @@ pub fn node(axis: u8, first_above: bool) -> K {
 /// reaches the second too.
 pub fn second() -> K {
     let mut k = K::new();
-    k.doc("k_p2nd: after a node kernel, F = the ray reaches the second child too.");
+    k.doc("k_second_too: after a node kernel, F = the ray reaches the second child too.");
     k.c("cmp.lt r11, r14");
     k
 }
@@ -240,7 +241,7 @@ pub fn second() -> K {
 /// do not reach the first sleep until the second is popped.
 pub fn sleep_first() -> K {
     let mut k = K::new();
-    k.doc("k_psl: the rays that do not reach the first child sleep until the second is popped.");
+    k.doc("k_first_or_sleep: the rays that do not reach the first child sleep until the second is popped.");
     k.c("(!f) sleep");
     k
 }
@@ -249,7 +250,7 @@ pub fn sleep_first() -> K {
 /// address): every awake ray stores its interval for it.
 pub fn push() -> K {
     let mut k = K::new();
-    k.doc("k_ppush: the second child pushed: every awake ray's interval for it into its slot\n(stream: the slot's RAM address).");
+    k.doc("k_push_second: the second child pushed: every awake ray's interval for it into its slot\n(stream: the slot's RAM address).");
     k.c("mov r15, fb0")
         .c("st r14, [r15]")
         .note("SLOT_TMAX")
@@ -263,7 +264,7 @@ pub fn push() -> K {
 /// ray reaches it): its interval becomes the current one.
 pub fn take() -> K {
     let mut k = K::new();
-    k.doc("k_ptake: only the second child is visited: its interval becomes the current one.");
+    k.doc("k_take_second: only the second child is visited: its interval becomes the current one.");
     k.c("mov r8, r11").c("mov r9, r14");
     k
 }
@@ -275,7 +276,7 @@ pub fn take() -> K {
 pub fn pop() -> K {
     let mut k = K::new();
     k.doc(
-        "k_ppop: a popped node (stream: its slot's RAM address): every RC wakes and takes its\n\
+        "k_pop_node: a popped node (stream: its slot's RAM address): every RC wakes and takes its\n\
          interval from the slot, emptied; the rays not alive, or whose interval is empty or\n\
          beyond their hit, sleep again. Out: F = awake.",
     );
@@ -299,7 +300,7 @@ pub fn pop() -> K {
 pub fn leaf_any() -> K {
     let mut k = K::new();
     k.doc(
-        "k_pleafa: after a leaf, any-hit pass: the rays with a hit are done (not alive) and sleep.",
+        "k_done_with_hit: after a leaf, any-hit pass: the rays with a hit are done (not alive) and sleep.",
     );
     k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
         .c("cmp.lt r7, r8")
@@ -357,11 +358,11 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .c("object tests of the pass");
     if lay.root_leaf {
         // The whole tree is one leaf: its objects are tested by the awake
-        // rays, nothing to walk. (`k_sign0` runs only to mark the pass's
+        // rays, nothing to walk. (`k_sign_x` runs only to mark the pass's
         // start for the simulator's count of the rays traced: its RCs are
         // the pass's.)
         t.comment("the tree is one leaf: its objects, tested by the awake rays")
-            .m("BCAST", "k_sign0")
+            .m("BCAST", names::sign(0))
             .li(R14, "NSTACK")
             .li(R5, "ROOT")
             .rcsl(R4)
@@ -404,18 +405,18 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .beqz(R1, "some_first")
         .bnez(R4, "pop_node")
         .c("no ray awake")
-        .m("BCAST", "k_ptake")
+        .m("BCAST", names::TAKE_SECOND)
         .c("none: the second child only")
         .mv(R5, R10);
     f.load(t, R6, at(flags, R5));
     dispatch_full(t, &f);
     t.label("some_first");
     push_second(t, &f);
-    t.m("BCAST", "k_psl")
+    t.m("BCAST", names::FIRST_OR_SLEEP)
         .c("the rays not reaching the first sleep");
     dispatch_first(t, &f);
     t.label("all_first")
-        .m("BCAST", "k_p2nd")
+        .m("BCAST", names::SECOND_TOO)
         .rcany(R4)
         .beqz(R4, "visit_first")
         .c("no ray reaches the second");
@@ -426,14 +427,14 @@ pub fn trace(t: &mut Code, lay: &Layout) {
     t.label("leaf_done")
         .lw(R1, at("MODE", R0))
         .beqz(R1, "pop_node")
-        .m("BCAST", "k_pleafa")
+        .m("BCAST", names::DONE_WITH_HIT)
         .c("any hit: the rays with a hit are done");
     t.label("pop_node")
         .li(R9, "NSTACK")
         .beq(R14, R9, "trace_done")
         .addi(R14, R14, -4)
         .lw(R5, deref(R14))
-        .li(R1, kaddr("k_ppop"));
+        .li(R1, kaddr(names::POP_NODE));
     if streamed {
         t.lw(R2, at("PS_PARENT_SLOT", R5))
             .sfb(R2, at("POP_SLOT", R0))
@@ -441,7 +442,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
     } else {
         t.addi(R2, R5, "PN_PARENT_SLOT");
     }
-    t.sbcb(R1, R2, klen("k_ppop"))
+    t.sbcb(R1, R2, klen(names::POP_NODE))
         .c("the rays take their intervals for it");
     f.load(t, R6, at(flags, R5));
     t.rcany(R4).beqz(R4, "pop_node").c("no ray needs it");
@@ -466,7 +467,7 @@ fn dispatch_full(t: &mut Code, f: &Fields) {
     } else {
         t.addi(R2, R5, "PN_SPLIT");
     }
-    t.sbcb(R1, R2, klen("k_pn0b"))
+    t.sbcb(R1, R2, klen(&names::node(0, false)))
         .c("its node kernel")
         .j("inner_node");
 }
@@ -480,7 +481,7 @@ fn dispatch_first(t: &mut Code, f: &Fields) {
     } else {
         t.addi(R2, R5, "PN_SPLIT");
     }
-    t.sbcb(R11, R2, klen("k_pn0b"))
+    t.sbcb(R11, R2, klen(&names::node(0, false)))
         .c("the first child's node kernel")
         .j("inner_node");
 }
@@ -491,10 +492,10 @@ fn push_second(t: &mut Code, f: &Fields) {
     if f.streamed {
         t.sfb(R12, at("SPLIT_SLOT", R0))
             .li(R2, "SPLIT_SLOT")
-            .li(R1, kaddr("k_ppush"))
-            .sbcb(R1, R2, klen("k_ppush"));
+            .li(R1, kaddr(names::PUSH_SECOND))
+            .sbcb(R1, R2, klen(names::PUSH_SECOND));
     } else {
-        t.m("BCAST_AT", "k_ppush, r12");
+        t.m("BCAST_AT", format!("{}, r12", names::PUSH_SECOND));
     }
     t.c("the rays' intervals for the second child")
         .sw(R10, deref(R14))
@@ -736,15 +737,15 @@ pub fn macros() -> Code {
     t
 }
 
-/// The pass's start: `k_pinit`, then per axis the order of the children
+/// The pass's start: `k_pass_start`, then per axis the order of the children
 /// the majority of the awake rays meets first (`NK`, `NF`, `NS`); no ray
 /// awake: `trace_done`.
 fn child_order(t: &mut Code, f: &Fields) {
-    t.m("BCAST_FB", "k_pinit, ROOTBOX")
+    t.m("BCAST_FB", format!("{}, ROOTBOX", names::PASS_START))
         .c("intervals in the root cell, 1/d");
     for (a, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
         let lo = axis.to_lowercase();
-        t.m("BCAST", format!("k_sign{a}")).rcst(R3).c(format!(
+        t.m("BCAST", names::sign(a as u8)).rcst(R3).c(format!(
             "the awake rays going down along {lo}: none, some, all"
         ));
         if a == 0 {
@@ -758,11 +759,11 @@ fn child_order(t: &mut Code, f: &Fields) {
             .jal("majority")
             .c("some: r8 = most go down");
         t.label(format!("order_{lo}"))
-            .li(R1, kaddr(&format!("k_pn{a}b")))
+            .li(R1, kaddr(&names::node(a as u8, false)))
             .li(R2, f.n("PN_LEFT", "PS_LEFT"))
             .li(R3, f.n("PN_RIGHT", "PS_RIGHT"))
             .beqz(R8, format!("order_{lo}_set"))
-            .li(R1, kaddr(&format!("k_pn{a}a")))
+            .li(R1, kaddr(&names::node(a as u8, true)))
             .li(R2, f.n("PN_RIGHT", "PS_RIGHT"))
             .li(R3, f.n("PN_LEFT", "PS_LEFT"))
             .c("most go down: above first");

@@ -37,15 +37,16 @@ use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen};
 use super::super::NodeLayout;
 use super::read_awake;
+use crate::tracer::kernel_names as names;
 
 /// The paper traversal's kernels, in load order (after the signs).
 pub fn kernels() -> Vec<(String, K)> {
     let mut v: Vec<(String, K)> = (0..3u8)
-        .map(|a| (format!("k_cls{a}"), classify(a)))
+        .map(|a| (names::classify(a), classify(a)))
         .collect();
-    v.push(("k_clsr".into(), classify_above()));
-    v.push(("k_leafc".into(), leaf_closest(false)));
-    v.push(("k_leafa".into(), leaf_any()));
+    v.push((names::CLASSIFY_ABOVE.into(), classify_above()));
+    v.push((names::LEAF_CLOSEST.into(), leaf_closest(false)));
+    v.push((names::LEAF_ANY.into(), leaf_any()));
     v
 }
 
@@ -56,9 +57,10 @@ pub fn classify(axis: u8) -> K {
     let (o, d) = (1 + axis, 4 + axis);
     let mut k = K::new();
     k.doc(&format!(
-        "k_cls{axis}: the segment [o, o + tbest d] against a split plane across {} (stream: its\n\
+        "{}: the segment [o, o + tbest d] against a split plane across {} (stream: its\n\
          position s). Out: F = the segment reaches below s + 1; r10 = its far end, r13 = s - 1\n\
-         (for k_clsr).",
+         (for k_classify_above).",
+        names::classify(axis),
         ["x", "y", "z"][axis as usize]
     ));
     k.c(format!("ldacc r{o}, <<Q14"))
@@ -76,7 +78,7 @@ pub fn classify(axis: u8) -> K {
 /// After [`classify`]: F = the segment reaches above the plane.
 pub fn classify_above() -> K {
     let mut k = K::new();
-    k.doc("k_clsr: after k_clsN, F = the segment reaches above the plane.");
+    k.doc("k_classify_above: after k_clsN, F = the segment reaches above the plane.");
     k.c("cmp.ge r10, r13");
     k
 }
@@ -90,7 +92,7 @@ pub fn leaf_closest(ordered: bool) -> K {
     k.doc(&format!(
         "{}: after a leaf's objects, closest-hit pass: the rays whose hit lies in the leaf's cell\n\
          (stream: min.xyz, max.xyz) are done and sleep{}.",
-        if ordered { "k_leafcu" } else { "k_leafc" },
+        if ordered { names::LEAF_CLOSEST_ORDERED } else { names::LEAF_CLOSEST },
         if ordered {
             ", unless inside an unordered subtree (UNORD > 0)"
         } else {
@@ -124,7 +126,9 @@ pub fn leaf_closest(ordered: bool) -> K {
 /// At a leaf, any-hit (shadow) pass: RCs that found any hit sleep.
 pub fn leaf_any() -> K {
     let mut k = K::new();
-    k.doc("k_leafa: after a leaf's objects, any-hit pass: the rays with a hit are done and sleep.");
+    k.doc(
+        "k_leaf_any: after a leaf's objects, any-hit pass: the rays with a hit are done and sleep.",
+    );
     k.c(format!("ld r8, [r0 + #{}]", ram::PASS_T0))
         .c("cmp.lt r7, r8")
         .c("(f) sleep");
@@ -148,7 +152,7 @@ pub fn pass_start(t: &mut Code) {
         .li(R1, 1);
     t.label("trace_numbered").sw(R1, at("PASS", R0));
     for (a, name) in ["NEG_X", "NEG_Y", "NEG_Z"].into_iter().enumerate() {
-        t.m("BCAST", format!("k_sign{a}"))
+        t.m("BCAST", names::sign(a as u8))
             .rcfl(R2)
             .rcfh(R3)
             .sw(R2, at(name, R0))
@@ -183,22 +187,22 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .blt(R6, R0, "leaf")
         .andi(R7, R6, 3)
         .c("the split's axis")
-        .li(R1, kaddr("k_cls0"))
-        .li(R2, kaddr("k_cls1"))
+        .li(R1, kaddr(&names::classify(0)))
+        .li(R2, kaddr(&names::classify(1)))
         .beqz(R7, "classify")
-        .li(R1, kaddr("k_cls1"))
-        .li(R2, kaddr("k_cls2"))
+        .li(R1, kaddr(&names::classify(1)))
+        .li(R2, kaddr(&names::classify(2)))
         .slti(R3, R7, 2)
         .bnez(R3, "classify")
-        .li(R1, kaddr("k_cls2"));
+        .li(R1, kaddr(&names::classify(2)));
     t.label("classify")
         .addi(R2, R5, "N_SPLIT")
-        .sbcb(R1, R2, klen("k_cls0"))
+        .sbcb(R1, R2, klen(&names::classify(0)))
         .c("the segments against the plane")
         .rcfl(R1)
         .rcfh(R2)
         .c("r1, r2: the rays reaching below")
-        .li(R8, kaddr("k_clsr"))
+        .li(R8, kaddr(names::CLASSIFY_ABOVE))
         .cbcast(R8, 1)
         .rcfl(R3)
         .rcfh(R4)
@@ -266,7 +270,8 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .m(
             "BCAST_REC",
             format!(
-                "k_leafc, r5, {}",
+                "{}, r5, {}",
+                names::LEAF_CLOSEST,
                 if compact {
                     "NC_LEAF_BOUNDS"
                 } else {
@@ -277,7 +282,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .c("the rays with a hit in the cell sleep")
         .j("leaf_done");
     t.label("leaf_any_hit")
-        .m("BCAST", "k_leafa")
+        .m("BCAST", names::LEAF_ANY)
         .c("the rays with a hit sleep");
     t.label("leaf_done").jal("read_awake");
     t.label("pop_node")

@@ -37,17 +37,18 @@ use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen};
 use super::paper::{leaf_closest, pass_start};
 use super::read_awake;
+use crate::tracer::kernel_names as names;
 
 /// The kernels the streamed traversal adds, in load order (after the
 /// shading kernels).
 pub fn kernels() -> Vec<(String, K)> {
     let mut v = vec![
-        ("k_leafcu".to_string(), leaf_closest(true)),
-        ("k_uzero".into(), unordered_clear()),
+        (names::LEAF_CLOSEST_ORDERED.to_string(), leaf_closest(true)),
+        (names::UNORDERED_NONE.into(), unordered_clear()),
     ];
     for a in 0..3u8 {
-        v.push((format!("k_uin{a}"), unordered_count(a, 1)));
-        v.push((format!("k_uout{a}"), unordered_count(a, -1)));
+        v.push((names::unordered_enter(a), unordered_count(a, 1)));
+        v.push((names::unordered_leave(a), unordered_count(a, -1)));
     }
     v
 }
@@ -57,9 +58,13 @@ pub fn kernels() -> Vec<(String, K)> {
 pub fn unordered_count(axis: u8, delta: i32) -> K {
     let mut k = K::new();
     k.doc(&format!(
-        "k_u{}{axis}: {} an unordered subtree split across {} (visited below first): the rays\n\
+        "{}: {} an unordered subtree split across {} (visited below first): the rays\n\
          going down along that axis count it in UNORD.",
-        if delta > 0 { "in" } else { "out" },
+        if delta > 0 {
+            names::unordered_enter(axis)
+        } else {
+            names::unordered_leave(axis)
+        },
         if delta > 0 { "entering" } else { "leaving" },
         ["x", "y", "z"][axis as usize]
     ));
@@ -77,20 +82,19 @@ pub fn unordered_count(axis: u8, delta: i32) -> K {
 /// No unordered subtree at a pass's start.
 pub fn unordered_clear() -> K {
     let mut k = K::new();
-    k.doc("k_uzero: UNORD = 0 at a pass's start.");
+    k.doc("k_unordered_none: UNORD = 0 at a pass's start.");
     k.c("sub r8, r8, r8").c(format!("st r8, [#{}]", ram::UNORD));
     k
 }
 
-/// `li r1` the kernel of `prefix{axis in r7}` (`k_cls`, `k_uin`...), to
-/// `go`.
-fn kernel_of_axis(t: &mut Code, prefix: &str, go: &str) {
-    t.li(R1, kaddr(&format!("{prefix}0")))
+/// `li r1` the kernel `name(axis)` of the axis in r7, then to `go`.
+fn kernel_of_axis(t: &mut Code, name: fn(u8) -> String, go: &str) {
+    t.li(R1, kaddr(&name(0)))
         .beqz(R7, go)
-        .li(R1, kaddr(&format!("{prefix}1")))
+        .li(R1, kaddr(&name(1)))
         .slti(R3, R7, 2)
         .bnez(R3, go)
-        .li(R1, kaddr(&format!("{prefix}2")));
+        .li(R1, kaddr(&name(2)));
 }
 
 /// The streamed `trace`, its `clear_mailbox` and `test_objects`.
@@ -104,7 +108,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
     t.jal("read_awake")
         .li(R9, "USTK")
         .sw(R9, at("UPTR", R0))
-        .m("BCAST", "k_uzero")
+        .m("BCAST", names::UNORDERED_NONE)
         .li(R14, "NSTACK")
         .li(R5, "ROOT");
     t.label("visit_node")
@@ -119,14 +123,14 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .sfb(R1, at("SPLIT", R0))
         .c("the split for the kernel's stream")
         .andi(R7, R6, 3);
-    kernel_of_axis(t, "k_cls", "classify");
+    kernel_of_axis(t, names::classify, "classify");
     t.label("classify")
         .li(R2, "SPLIT")
-        .sbcb(R1, R2, klen("k_cls0"))
+        .sbcb(R1, R2, klen(&names::classify(0)))
         .rcfl(R1)
         .rcfh(R2)
         .c("r1, r2: the rays reaching below")
-        .li(R8, kaddr("k_clsr"))
+        .li(R8, kaddr(names::CLASSIFY_ABOVE))
         .cbcast(R8, 1)
         .rcfl(R3)
         .rcfh(R4)
@@ -172,9 +176,9 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .addi(R9, R9, "U_FRAME")
         .sw(R9, at("UPTR", R0))
         .c("an unordered subtree: where it ends, its axis");
-    kernel_of_axis(t, "k_uin", "mixed_count");
+    kernel_of_axis(t, names::unordered_enter, "mixed_count");
     t.label("mixed_count")
-        .cbcast(R1, klen("k_uin0"))
+        .cbcast(R1, klen(&names::unordered_enter(0)))
         .c("the rays going down count it");
     t.label("positive_first")
         .lw(R9, at("SN_RIGHT", R5))
@@ -193,10 +197,10 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .c("nothing tested")
         .lw(R1, at("MODE", R0))
         .bnez(R1, "leaf_any_hit")
-        .m("BCAST_AT", "k_leafcu, r4")
+        .m("BCAST_AT", format!("{}, r4", names::LEAF_CLOSEST_ORDERED))
         .c("the rays with a hit in the cell sleep")
         .j("leaf_done");
-    t.label("leaf_any_hit").m("BCAST", "k_leafa");
+    t.label("leaf_any_hit").m("BCAST", names::LEAF_ANY);
     t.label("leaf_done").jal("read_awake");
     t.label("pop_node")
         .lw(R9, at("UPTR", R0))
@@ -208,8 +212,9 @@ pub fn trace(t: &mut Code, lay: &Layout) {
         .lw(R7, at("U_AXIS-U_FRAME", R9))
         .addi(R9, R9, "-U_FRAME")
         .sw(R9, at("UPTR", R0));
-    kernel_of_axis(t, "k_uout", "pop_count");
-    t.label("pop_count").cbcast(R1, klen("k_uin0"));
+    kernel_of_axis(t, names::unordered_leave, "pop_count");
+    t.label("pop_count")
+        .cbcast(R1, klen(&names::unordered_enter(0)));
     t.label("pop_stack")
         .li(R9, "NSTACK")
         .beq(R14, R9, "trace_done")
