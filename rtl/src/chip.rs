@@ -28,7 +28,7 @@ use crate::memory::MainMemory;
 use crate::rc::context::Context;
 use crate::rc::{Datapath, Word};
 use crate::tinyrisc::{decode, Command, Machine, RiscTiming, TinyRisc};
-use crate::trace::{Display, Field, Probe, Traced};
+use crate::trace::{Display, Field, LabelKind, Probe, Traced};
 
 /// Every cycle parameter of the chip.
 ///
@@ -808,16 +808,18 @@ impl<W: Word> Traced for Chip<W> {
                     vec![
                         Field::new("", "busy", 1, Display::Bin),
                         Field::new("", "queued", 1, Display::Bin),
-                        Field::new("", "run_ctx", 13, Display::Hex),
+                        Field::new("", "run_ctx", 13, Display::Label(LabelKind::Context)),
                         Field::new("", "step", 14, Display::Hex),
                         Field::new("", "fb0_ptr", 16, Display::Hex),
                         Field::new("", "fb1_ptr", 16, Display::Hex),
                     ]
                 },
                 |v| {
+                    // Idle: the context address all ones (no context:
+                    // the label filter shows `idle`).
                     let (busy, ctx, k, ptr) = match self.bcast.current() {
                         Some((run, k, ptr)) => (1, run.ctx as u64, k as u64, ptr),
-                        None => (0, 0, 0, [0, 0]),
+                        None => (0, (1 << 13) - 1, 0, [0, 0]),
                     };
                     *v = [
                         busy,

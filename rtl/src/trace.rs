@@ -52,6 +52,62 @@ pub enum Display {
     Bin,
     /// Through a translate filter: `text(value)` gives the mnemonic.
     Translate(&'static Filter),
+    /// An address, shown as `label+offset` of the program being run
+    /// ([`TraceConfig::labels`]; hex without them); all ones is `idle`.
+    Label(LabelKind),
+}
+
+impl Display {
+    /// Does GTKWave show it through a filter file (its values are kept)?
+    fn filtered(self) -> bool {
+        matches!(self, Display::Translate(_) | Display::Label(_))
+    }
+}
+
+/// Which labels an address signal is shown by.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LabelKind {
+    /// TinyRISC code: a byte address (the PC).
+    Code,
+    /// Context memory: a context word's index.
+    Context,
+}
+
+impl LabelKind {
+    /// The filter file's name (`<stem>.<name>.txt`).
+    fn filter_name(self) -> &'static str {
+        match self {
+            LabelKind::Code => "code_labels",
+            LabelKind::Context => "context_labels",
+        }
+    }
+}
+
+/// The labels of the program being run, by address: its TinyRISC code
+/// (byte addresses) and its context memory (context indices), each sorted
+/// by address. A waveform shows the PC and the broadcast unit's context
+/// address as `label+offset` of the nearest label at or before it.
+#[derive(Clone, Debug, Default, PartialEq, Eq)]
+pub struct Labels {
+    pub code: Vec<(u32, String)>,
+    pub context: Vec<(u32, String)>,
+}
+
+impl Labels {
+    /// `label+offset` (offset in bytes for code, in contexts for context
+    /// memory; `label` alone at the label), `None` before the first label.
+    pub fn locate(&self, kind: LabelKind, addr: u32) -> Option<String> {
+        let list = match kind {
+            LabelKind::Code => &self.code,
+            LabelKind::Context => &self.context,
+        };
+        let i = list.partition_point(|(a, _)| *a <= addr);
+        let (a, name) = list.get(i.checked_sub(1)?)?;
+        Some(match addr - a {
+            0 => name.clone(),
+            d => format!("{name}+{d}"),
+        })
+    }
 }
 
 /// A translate filter: a name (the file is `<stem>.<name>.txt`) and the
@@ -235,6 +291,10 @@ pub struct TraceConfig {
     /// FST only: bytes of value changes held in memory before they are
     /// compressed into the file as one section ([`FST_SECTION_BYTES`]).
     pub fst_section_bytes: usize,
+    /// The program's labels: the PC and the broadcast unit's context
+    /// address are shown as `label+offset` (filter files beside the
+    /// waveform).
+    pub labels: Option<std::sync::Arc<Labels>>,
 }
 
 /// Whether a waveform path asks for FST (`.fst`) rather than VCD.
@@ -267,6 +327,7 @@ impl TraceConfig {
             budget_cycles: None,
             max_bytes: MAX_TRACE_BYTES,
             fst_section_bytes: FST_SECTION_BYTES,
+            labels: None,
         }
     }
 }
@@ -1836,7 +1897,7 @@ impl Tracer {
             .iter()
             .map(|&i| {
                 let d = t.decls.get(i as usize)?;
-                let filtered = matches!(d.info.display, Display::Translate(_));
+                let filtered = d.info.display.filtered();
                 Some((d.info.id, d.info.width, filtered, i))
             })
             .collect();
@@ -2037,11 +2098,14 @@ impl Tracer {
         let gtkw = vcd_abs.with_extension("gtkw");
         let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
         for d in &self.decls {
-            if let Display::Translate(f) = d.info.display {
-                if !filters.iter().any(|(n, _)| *n == f.name) {
-                    let path = PathBuf::from(format!("{}.{}.txt", stem.display(), f.name));
-                    filters.push((f.name, path));
-                }
+            let name = match d.info.display {
+                Display::Translate(f) => f.name,
+                Display::Label(k) if self.cfg.labels.is_some() => k.filter_name(),
+                _ => continue,
+            };
+            if !filters.iter().any(|(n, _)| *n == name) {
+                let path = PathBuf::from(format!("{}.{}.txt", stem.display(), name));
+                filters.push((name, path));
             }
         }
         Ok(SideFiles {
@@ -2055,6 +2119,38 @@ impl Tracer {
     /// trace (plus the filter's whole table when it is small).
     fn filter_file(&self, name: &str) -> String {
         let mut vals: BTreeSet<(u32, u64)> = BTreeSet::new();
+        // An address through the program's labels.
+        if let Some(labels) = &self.cfg.labels {
+            let mut kind = None;
+            for (i, d) in self.decls.iter().enumerate() {
+                if let Display::Label(k) = d.info.display {
+                    if k.filter_name() == name {
+                        kind = Some(k);
+                        for v in &self.seen[i] {
+                            vals.insert((d.info.width, *v));
+                        }
+                    }
+                }
+            }
+            if let Some(kind) = kind {
+                let mut s = format!(
+                    "# GTKWave translate filter `{name}` written by morphosys: label+offset\n"
+                );
+                for (w, v) in &vals {
+                    let digits = w.div_ceil(4) as usize;
+                    // All ones: no address (the broadcast unit idle).
+                    let text = if *w < 64 && *v == (1u64 << w) - 1 {
+                        Some("idle".to_string())
+                    } else {
+                        labels.locate(kind, *v as u32)
+                    };
+                    if let Some(text) = text {
+                        s.push_str(&format!("{v:0digits$X} {text}\n"));
+                    }
+                }
+                return s;
+            }
+        }
         let mut filter: Option<&Filter> = None;
         for (i, d) in self.decls.iter().enumerate() {
             if let Display::Translate(f) = d.info.display {
@@ -2141,13 +2237,21 @@ impl Tracer {
                     Display::Hex => s.push_str(&format!("@22\n{name}\n")),
                     Display::Signed => s.push_str(&format!("@424\n{name}\n")),
                     Display::Bin => s.push_str(&format!("@28\n{name}\n")),
-                    Display::Translate(f) => {
-                        let k = filters.iter().position(|(n, _)| *n == f.name).unwrap();
-                        s.push_str(&format!(
-                            "^{} {}\n@2022\n{name}\n",
-                            k + 1,
-                            filters[k].1.display()
-                        ));
+                    Display::Translate(_) | Display::Label(_) => {
+                        let fname = match d.info.display {
+                            Display::Translate(f) => f.name,
+                            Display::Label(k) => k.filter_name(),
+                            _ => "",
+                        };
+                        match filters.iter().position(|(n, _)| *n == fname) {
+                            Some(k) => s.push_str(&format!(
+                                "^{} {}\n@2022\n{name}\n",
+                                k + 1,
+                                filters[k].1.display()
+                            )),
+                            // An address without the program's labels.
+                            None => s.push_str(&format!("@22\n{name}\n")),
+                        }
                     }
                 }
             }
@@ -2727,6 +2831,20 @@ impl Chunk<'_> {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn labels_name_an_address_by_the_label_at_or_before_it() {
+        let l = Labels {
+            code: vec![(8, "loop".into()), (20, "done".into())],
+            context: vec![(0, "k_a".into())],
+        };
+        assert_eq!(l.locate(LabelKind::Code, 4), None);
+        assert_eq!(l.locate(LabelKind::Code, 8).as_deref(), Some("loop"));
+        assert_eq!(l.locate(LabelKind::Code, 16).as_deref(), Some("loop+8"));
+        assert_eq!(l.locate(LabelKind::Code, 24).as_deref(), Some("done+4"));
+        assert_eq!(l.locate(LabelKind::Context, 3).as_deref(), Some("k_a+3"));
+    }
+
     use super::*;
     use crate::kernel::{Clocked, Fault, Sim};
 

@@ -183,7 +183,15 @@ pub fn command(a: RunArgs) -> anyhow::Result<()> {
 
 fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyhow::Result<()> {
     let img = load_program(&a.file)?;
-    let trace = a.vcd.clone().map(|p| a.window.config(p));
+    let trace = a.vcd.clone().map(|p| {
+        let mut c = a.window.config(p);
+        // The PC and the broadcast unit's context by the program's labels
+        // (its contexts taken as loaded into context 0 from its `.ctx`).
+        if let Some(base) = img.ctx_base().or((!img.labels.is_empty()).then_some(0)) {
+            c.labels = Some(std::sync::Arc::new(img.trace_labels(base)));
+        }
+        c
+    });
     let t0 = std::time::Instant::now();
     let out = run_image_on::<W>(&img, timing, a.max_cycles, trace)?;
     let secs = t0.elapsed().as_secs_f64();

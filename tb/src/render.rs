@@ -287,7 +287,9 @@ fn run_group<W: Word>(
         .map_err(|f| anyhow!("{f}"))?;
     let mut sim = Sim::new(chip);
     let t0 = std::time::Instant::now();
-    if let Some(cfg) = trace {
+    if let Some(mut cfg) = trace {
+        // The PC and the broadcast unit's context by the program's labels.
+        cfg.labels = Some(std::sync::Arc::new(img.trace_labels(mem::CTX_BASE)));
         let path = cfg.path.clone();
         sim.trace(cfg, "morphosys")
             .map_err(|e| anyhow!("creating {}: {e}", path.display()))?;

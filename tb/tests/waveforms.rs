@@ -240,3 +240,81 @@ fn an_fst_of_many_sections_reads_back_as_its_vcd() {
     let fst = read_back(&dir.path().join("s.fst"));
     assert_same(&vcd, &fst, "dct.s in 256-byte FST sections");
 }
+
+/// A render's waveform names the PC and the broadcast unit's context
+/// address by the firmware's labels: the GTKWave save file shows them
+/// through filter files written beside it, and every value the PC took in
+/// the window is there as the label at or before it plus the offset, which
+/// the assembler's own symbol table of the emitted program confirms.
+#[test]
+fn a_render_waveform_names_the_pc_and_the_context_by_the_firmware_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "render",
+            "--size",
+            "16x16",
+            "--vcd",
+            "w.vcd",
+            "--trace-cycles",
+            "3000",
+            "--emit-asm",
+            "fw.s",
+        ],
+    );
+    assert!(ok, "{err}");
+    let gtkw = std::fs::read_to_string(d.join("w.gtkw")).unwrap();
+    for (filter, signal) in [
+        ("w.code_labels.txt", "morphosys.tinyrisc.pc[31:0]"),
+        ("w.context_labels.txt", "morphosys.broadcast.run_ctx[12:0]"),
+    ] {
+        let at = gtkw
+            .find(signal)
+            .unwrap_or_else(|| panic!("{signal} not in the save file"));
+        assert!(
+            gtkw[..at].rsplit("^").next().unwrap().contains(filter),
+            "{signal} is not shown through {filter}: {gtkw}"
+        );
+    }
+    let img =
+        firmware::asm::assemble(&std::fs::read_to_string(d.join("fw.s")).unwrap(), "fw.s").unwrap();
+    let code = std::fs::read_to_string(d.join("w.code_labels.txt")).unwrap();
+    let pcs = &read_back(&d.join("w.vcd"))["morphosys.tinyrisc.pc"];
+    let mut named = 0;
+    for line in code.lines().filter(|l| !l.starts_with('#')) {
+        let (value, text) = line.split_once(' ').unwrap();
+        let pc = u32::from_str_radix(value, 16).unwrap();
+        let (label, offset) = text.split_once('+').unwrap_or((text, "0"));
+        let at = img
+            .symbol(label)
+            .unwrap_or_else(|| panic!("{label} is no symbol")) as u32;
+        assert_eq!(at + offset.parse::<u32>().unwrap(), pc, "{line}");
+        named += 1;
+    }
+    // Every PC of the window is named (distinct values).
+    let distinct: std::collections::BTreeSet<&String> = pcs.iter().map(|(_, v)| v).collect();
+    assert_eq!(named, distinct.len(), "{code}");
+    assert!(
+        code.contains(" tile\n") || code.contains(" tile+"),
+        "{code}"
+    );
+    let ctx = std::fs::read_to_string(d.join("w.context_labels.txt")).unwrap();
+    assert!(ctx.contains(" k_eye\n"), "{ctx}");
+    let base = img.symbol("CTXBASE").unwrap() as u32;
+    for line in ctx.lines().filter(|l| !l.starts_with('#')) {
+        let (value, text) = line.split_once(' ').unwrap();
+        if text == "idle" {
+            assert_eq!(value, "1FFF", "the broadcast unit idle: all ones");
+            continue;
+        }
+        let (label, offset) = text.split_once('+').unwrap_or((text, "0"));
+        let at = (img.symbol(label).unwrap() as u32 - base) / 4;
+        assert_eq!(
+            at + offset.parse::<u32>().unwrap(),
+            u32::from_str_radix(value, 16).unwrap(),
+            "{line}"
+        );
+    }
+}

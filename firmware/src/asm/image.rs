@@ -133,6 +133,35 @@ impl Image {
         self.symbols.get(name).copied()
     }
 
+    /// The labels a waveform names addresses by: the code labels (byte
+    /// addresses) and the context labels as context-memory indices, the
+    /// context words at main-memory address `ctx_base` being loaded into
+    /// context 0 (the `.ctx` label `k_x: ` at `ctx_base + 4 i` names
+    /// context i).
+    pub fn trace_labels(&self, ctx_base: u32) -> rtl::trace::Labels {
+        rtl::trace::Labels {
+            code: self
+                .labels_in(Section::Text)
+                .map(|l| (l.addr, l.name.clone()))
+                .collect(),
+            context: self
+                .labels_in(Section::Ctx)
+                .filter(|l| l.addr >= ctx_base && (l.addr - ctx_base) % 4 == 0)
+                .map(|l| ((l.addr - ctx_base) / 4, l.name.clone()))
+                .collect(),
+        }
+    }
+
+    /// The lowest address of the `.ctx` segments (where a program that
+    /// loads its contexts whole starts them).
+    pub fn ctx_base(&self) -> Option<u32> {
+        self.segments
+            .iter()
+            .filter(|s| s.section == Section::Ctx)
+            .map(|s| s.addr)
+            .min()
+    }
+
     /// The labels of one section, in address order.
     pub fn labels_in(&self, section: Section) -> impl Iterator<Item = &Label> {
         self.labels.iter().filter(move |l| l.section == section)

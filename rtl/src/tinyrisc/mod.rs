@@ -19,7 +19,7 @@ pub use decode::{Instr, Opcode, INSTR_FILTER};
 pub use execute::{Command, Machine};
 pub use register_file::RegisterFile;
 
-use crate::trace::{Display, Field, Probe, Traced};
+use crate::trace::{Display, Field, LabelKind, Probe, Traced};
 
 /// Cycle cost of each instruction class (see `docs/isa.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -264,7 +264,7 @@ impl Traced for TinyRisc {
         p.block_with(
             &|| {
                 vec![
-                    Field::new("", "pc", 32, Display::Hex),
+                    Field::new("", "pc", 32, Display::Label(LabelKind::Code)),
                     Field::new("", "ir", 32, Display::Translate(&INSTR_FILTER)),
                     Field::new("", "state", 3, Display::Translate(&STATE_FILTER)),
                 ]
