@@ -160,8 +160,8 @@ P_SLOT = 416            ; per BSP depth: the pushed child's interval (tmax, tmin
 ORIG_STACK = 480        ; per recursion level: the object its refracted ray leaves
 STACK_FRAME = 4         ; words of a STACK frame
 REFR_FRAME = 7          ; words of a REFR frame
-STACK_L0 = STACK + 0*STACK_FRAME; the frame of recursion level 0, 1, ...
-REFR_L0 = REFR + 0*REFR_FRAME; the refraction frame of level 0, 1, ...
+STACK_L0 = STACK + 0*STACK_FRAME ; the frame of recursion level 0, 1, ...
+REFR_L0 = REFR + 0*REFR_FRAME ; the refraction frame of level 0, 1, ...
 FR_COL = 0              ; frame: colour so far, 3 words
 FR_KS = 3               ; frame: reflection weight
 RF_O = 0                ; refraction frame: origin, 3 words
@@ -223,6 +223,7 @@ SLOT_TMIN = 1           ; slot: near end
         SHADOW_PASS FB_LIGHT1, FB_SHADE1
         SHADOW_PASS FB_LIGHT2, FB_SHADE2
 .endm
+
 ; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,
 ; r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the
 ; pass and the rays, and on to `p_go` (r13 counts the test). Clobbers r1..r3.
@@ -566,7 +567,7 @@ lo_cylinder_next:
 lo_cylinder_end:
         lfb r9, (r6)
         addi r6, r6, 1
-        beqz r9, lo_box_end             ; boxs in the leaf
+        beqz r9, lo_box_end             ; boxes in the leaf
 lo_box_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)

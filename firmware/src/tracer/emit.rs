@@ -89,8 +89,10 @@ pub fn define(name: &str, value: impl Display, doc: &str) -> String {
     let head = format!("{name} = {value}");
     if doc.is_empty() {
         head
-    } else {
+    } else if head.len() < 24 {
         format!("{head:<24}; {doc}")
+    } else {
+        format!("{head} ; {doc}")
     }
 }
 

@@ -284,3 +284,79 @@ pub fn perpendicular_to(k: &mut K, p: &[u8], d: &[u8], t: u8) {
             .c(format!("msu r{x}, r{t}, r{e}, >>Q14"));
     }
 }
+
+/// Reciprocal square root table of `n` entries (a power of two up to 128):
+/// entry k = 1/sqrt(X) for X = (k + 0.5) 2^(15 - log2 n) in Q.11, Q1.14
+/// (saturated at the bottom, where it is never used).
+pub fn rsq_table(n: usize) -> Vec<i32> {
+    rsq_table_for(n, 0)
+}
+
+/// [`rsq_table`] with `x` extra fraction bits (16 on the 32-bit chip: the
+/// same entries in Q1.30, indexed by X in Q.27).
+pub fn rsq_table_for(n: usize, x: u32) -> Vec<i32> {
+    let w = 32768.0 / n as f64;
+    let one = ((14 + x) as f64).exp2();
+    (0..n)
+        .map(|k| {
+            let v = (k as f64 + 0.5) * w / 2048.0;
+            ((1.0 / v.sqrt()) * one).round().min(word_max(x)) as i32
+        })
+        .collect()
+}
+
+/// Reciprocal table of `n` entries: entry k = 2^29 / d for
+/// d = 2^14 + (k + 0.5) 2^14 / n.
+pub fn rcp_table(n: usize) -> Vec<i32> {
+    rcp_table_for(n, 0)
+}
+
+/// [`rcp_table`] with `x` extra fraction bits: `2^(29 + 2x) / d` for
+/// `d = 2^(14 + x) + (k + 0.5) 2^(14 + x) / n`.
+pub fn rcp_table_for(n: usize, x: u32) -> Vec<i32> {
+    let w = 16384.0 / n as f64;
+    (0..n)
+        .map(|k| {
+            let d = 16384.0 + (k as f64 + 0.5) * w;
+            (((29 + x) as f64).exp2() / d).round().min(word_max(x)) as i32
+        })
+        .collect()
+}
+
+/// The two 128-word table slots at the start of the init stream (RC RAM
+/// `RSQ` and `RCP`): tables of `n` entries, the rest of each slot zero.
+pub fn table_slots(n: usize) -> Vec<i32> {
+    table_slots_for(n, 0)
+}
+
+/// [`table_slots`] with `x` extra fraction bits (the 32-bit chip: 16).
+pub fn table_slots_for(n: usize, x: u32) -> Vec<i32> {
+    let mut v = vec![0i32; 256];
+    v[..n].copy_from_slice(&rsq_table_for(n, x));
+    v[128..128 + n].copy_from_slice(&rcp_table_for(n, x));
+    v
+}
+
+/// The largest word value with `x` extra bits (16-bit: 32767).
+pub(crate) fn word_max(x: u32) -> f64 {
+    ((15 + x) as f64).exp2() - 1.0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The tables against the functions they sample.
+    #[test]
+    fn tables_match_their_definitions() {
+        let rsq = rsq_table(128);
+        for (k, &y) in rsq.iter().enumerate().skip(8) {
+            let x = (k as f64 + 0.5) * 256.0 / 2048.0;
+            assert!((y as f64 / 16384.0 - 1.0 / x.sqrt()).abs() < 1e-4);
+        }
+        let rcp = rcp_table(128);
+        for (k, &r) in rcp.iter().enumerate() {
+            assert!(r > 16384 && r < 32768, "{k}");
+        }
+    }
+}

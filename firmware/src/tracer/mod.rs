@@ -611,7 +611,7 @@ fn build_one(
             )?
         }
     };
-    lay.fb[..256].copy_from_slice(&layout::table_slots_for(
+    lay.fb[..256].copy_from_slice(&math::table_slots_for(
         nm.table_entries as usize,
         opt.datapath.bits() - 16,
     ));

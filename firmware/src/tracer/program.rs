@@ -298,6 +298,7 @@ fn header(scene: &Scene, lay: &Layout, opt: &Options, nm: &Numerics, tw: u32, th
     s.push_str("\n; ---- macros ----\n");
     s.push_str(&tiles::macros(lay).text());
     if lay.traversal == Traversal::Packet {
+        s.push('\n');
         s.push_str(&traversal::packet::macros().text());
     }
     s

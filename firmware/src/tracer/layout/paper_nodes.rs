@@ -373,10 +373,7 @@ pub fn header(layout: NodeLayout, types: &[TypeInfo]) -> Vec<String> {
                 v.push(define(
                     &format!("N_BV_{up}"),
                     t.bv_offset,
-                    &format!(
-                        "  the {}s under it, a bit each",
-                        t.ty.name().replace('_', " ")
-                    ),
+                    &format!("  the {} under it, a bit each", t.ty.plural()),
                 ));
                 v.push(define(
                     &format!("BV_WORDS_{up}"),

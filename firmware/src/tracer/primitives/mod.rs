@@ -133,6 +133,16 @@ impl ChipType {
         }
     }
 
+    /// The plural, in words: "spheres", "glass boxes", "smooth triangles".
+    pub fn plural(self) -> String {
+        let n = self.name().replace('_', " ");
+        if n.ends_with("box") {
+            n + "es"
+        } else {
+            n + "s"
+        }
+    }
+
     /// The chip type of an object: its primitive's, with smooth triangles
     /// and transmitting (two-sided) objects apart.
     pub fn of_object(s: &Shape, transmits: bool) -> ChipType {

@@ -621,7 +621,7 @@ fn leaf(t: &mut Code, lay: &Layout, f: &Fields) {
             t.lfb(R9, deref(R6))
                 .addi(R6, R6, 1)
                 .beqz(R9, format!("{n}_end"))
-                .c(format!("{}s in the leaf", ti.ty.name()));
+                .c(format!("{} in the leaf", ti.ty.plural()));
             t.label(format!("{n}_obj"))
                 .lfb(R7, at("LE_RECORD", R6))
                 .lfb(R8, at("LE_MAILBOX", R6))

@@ -327,7 +327,7 @@ fn test_objects(t: &mut Code, lay: &Layout, compact: bool) {
         if compact {
             // Per type: the count, then that many slot indices k;
             // mailbox = MB + k, record = first + k size.
-            t.comment(format!("{}s: a count, then slot indices", ti.ty.name()))
+            t.comment(format!("{}: a count, then slot indices", ti.ty.plural()))
                 .lfb(R9, deref(R6))
                 .addi(R6, R6, 1)
                 .beqz(R9, format!("{n}_end"))
@@ -347,8 +347,8 @@ fn test_objects(t: &mut Code, lay: &Layout, compact: bool) {
                 .c("r7 = its record");
         } else {
             t.comment(format!(
-                "{}s: the node's bit vector, 16 objects a word",
-                ti.ty.name()
+                "{}: the node's bit vector, 16 objects a word",
+                ti.ty.plural()
             ))
             .addi(R6, R5, format!("N_BV_{up}"))
             .li(R7, format!("FB_{up}"))

@@ -1,581 +1,18 @@
-//! Eric Haines' Standard Procedural Databases (SPD) generators, ported to
-//! Rust from the SPD 3.x C sources (public domain / CC0).
-//!
-//! Each generator writes the NFF text that the C program prints with NFF
-//! output (`-r 1`) and true curved primitives (`-c`): the same entities in
-//! the same order, every number formatted as C's `%g` (6 significant
-//! digits). The arithmetic follows the C code operation by operation (the
-//! same matrix library, the same transform stack, the same random number
-//! generator for `mount`), so the text is identical to the C program's
-//! output; the tests check this against the bundled `scenes/spd/*.nff`
-//! files that the C programs printed.
-//!
-//! [`scene`] parses the generated text with the NFF reader, so a generated
-//! scene and the file written from it are the same [`Scene`].
-//!
-//! Ported: balls, gears, jacks, lattice, mount, rings, shells, tetra, tree.
-//! Not ported: sombrero and teapot (both are tessellated into `pp` patches
-//! by the SPD itself) — see docs/scenes.md.
+//! The SPD scenes, each ported from its C program: balls ("sphereflake"),
+//! tetra, jacks, rings, gears, lattice, shells, mount, tree.
 
-use std::fmt::Write as _;
-
-use super::{nff, Scene, SceneError};
-
-type C3 = [f64; 3];
-type C4 = [f64; 4];
-type Mat = [[f64; 4]; 4];
-
-/// The SPD's `PI` (def.h's 3.141592653589793, the same double).
+use super::spdlib::*;
+use super::{Mat, C3, C4, X_AXIS, Y_AXIS, Z_AXIS};
 use std::f64::consts::PI;
-/// def.h's `EPSILON` and `EPSILON2` (non-Mac values).
-const EPSILON: f64 = 1.0e-8;
-const EPSILON2: f64 = 1.0e-6;
-
-const X_AXIS: usize = 0;
-const Y_AXIS: usize = 1;
-const Z_AXIS: usize = 2;
-
-/// A generator: its name, the SPD's default size, the largest size this
-/// port accepts (to keep files and memory reasonable) and the function.
-struct Generator {
-    name: &'static str,
-    default_size: u32,
-    max_size: u32,
-    run: fn(&mut Lib, u32),
-}
-
-const GENERATORS: &[Generator] = &[
-    Generator {
-        name: "balls",
-        default_size: 4,
-        max_size: 6,
-        run: balls,
-    },
-    Generator {
-        name: "gears",
-        default_size: 4,
-        max_size: 12,
-        run: gears,
-    },
-    Generator {
-        name: "jacks",
-        default_size: 1,
-        max_size: 6,
-        run: jacks,
-    },
-    Generator {
-        name: "lattice",
-        default_size: 12,
-        max_size: 40,
-        run: lattice,
-    },
-    Generator {
-        name: "mount",
-        default_size: 6,
-        // The SPD's hash shifts by 7 - size: larger sizes are undefined in C.
-        max_size: 7,
-        run: mount,
-    },
-    Generator {
-        name: "rings",
-        default_size: 7,
-        max_size: 24,
-        run: rings,
-    },
-    Generator {
-        name: "shells",
-        default_size: 5,
-        max_size: 10,
-        run: shells,
-    },
-    Generator {
-        name: "tetra",
-        default_size: 6,
-        max_size: 9,
-        run: tetra,
-    },
-    Generator {
-        name: "tree",
-        default_size: 11,
-        max_size: 16,
-        run: tree,
-    },
-];
-
-/// Names of the generators, alphabetical.
-pub fn names() -> Vec<&'static str> {
-    GENERATORS.iter().map(|g| g.name).collect()
-}
-
-fn find(name: &str) -> Result<&'static Generator, String> {
-    GENERATORS.iter().find(|g| g.name == name).ok_or_else(|| {
-        format!(
-            "unknown SPD generator '{name}': expected one of {}",
-            names().join(", ")
-        )
-    })
-}
-
-/// The SPD program's default size factor for `name`.
-pub fn default_size(name: &str) -> Result<u32, String> {
-    Ok(find(name)?.default_size)
-}
-
-/// Whether `size` is a size factor `name` takes.
-pub fn check_size(name: &str, size: u32) -> Result<(), String> {
-    let g = find(name)?;
-    if size < 1 || size > g.max_size {
-        return Err(format!(
-            "size {size} for {name}: expected 1 to {} (the SPD default is {})",
-            g.max_size, g.default_size
-        ));
-    }
-    Ok(())
-}
-
-/// The NFF text the SPD program `name` prints at size factor `size`.
-pub fn generate(name: &str, size: u32) -> Result<String, String> {
-    check_size(name, size)?;
-    let g = find(name)?;
-    let mut lib = Lib::new();
-    (g.run)(&mut lib, size);
-    Ok(lib.out)
-}
-
-/// The scene the SPD program `name` describes at size factor `size`,
-/// read back through the NFF reader (source `name-size.nff`).
-pub fn scene(name: &str, size: u32) -> Result<Scene, SceneError> {
-    let file = format!("{name}-{size}.nff");
-    let text = generate(name, size).map_err(|message| SceneError {
-        file: file.clone(),
-        line: 0,
-        col: 0,
-        message,
-    })?;
-    nff::parse(&text, &file)
-}
-
-// ---------------------------------------------------------------------------
-// C's printf("%g")
-
-/// `x` formatted as C's `%g`: 6 significant digits, trailing zeros removed,
-/// exponent form when the exponent is below -4 or at least 6.
-pub fn fmt_g(x: f64) -> String {
-    if x == 0.0 {
-        return if x.is_sign_negative() { "-0" } else { "0" }.into();
-    }
-    if x.is_nan() {
-        return if x.is_sign_negative() { "-nan" } else { "nan" }.into();
-    }
-    if x.is_infinite() {
-        return if x < 0.0 { "-inf" } else { "inf" }.into();
-    }
-    let e = format!("{x:.5e}");
-    let (mant, exp) = e.split_once('e').expect("exponent form");
-    let exp: i32 = exp.parse().expect("exponent");
-    if !(-4..6).contains(&exp) {
-        let sign = if exp < 0 { '-' } else { '+' };
-        format!("{}e{sign}{:02}", strip_zeros(mant), exp.abs())
-    } else {
-        strip_zeros(&format!("{x:.*}", (5 - exp) as usize)).to_string()
-    }
-}
-
-fn strip_zeros(s: &str) -> &str {
-    if s.contains('.') {
-        s.trim_end_matches('0').trim_end_matches('.')
-    } else {
-        s
-    }
-}
-
-// ---------------------------------------------------------------------------
-// libvec.c: vectors and 4x4 matrices (row vectors, `p' = p * M`)
-
-fn dot(a: &[f64], b: &[f64]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: &[f64], b: &[f64]) -> C3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
-/// `lib_normalize_vector`: normalizes in place, returns the length.
-fn normalize(v: &mut [f64]) -> f64 {
-    let d = dot(v, v).sqrt();
-    if d > 0.0 {
-        v[0] /= d;
-        v[1] /= d;
-        v[2] /= d;
-    }
-    d
-}
-
-fn zero_matrix() -> Mat {
-    [[0.0; 4]; 4]
-}
-
-fn identity_matrix() -> Mat {
-    let mut m = zero_matrix();
-    for (i, row) in m.iter_mut().enumerate() {
-        row[i] = 1.0;
-    }
-    m
-}
-
-fn rotate_matrix(axis: usize, angle: f64) -> Mat {
-    let mut mx = zero_matrix();
-    let cosine = angle.cos();
-    let sine = angle.sin();
-    match axis {
-        X_AXIS => {
-            mx[0][0] = 1.0;
-            mx[1][1] = cosine;
-            mx[2][2] = cosine;
-            mx[1][2] = sine;
-            mx[2][1] = -sine;
-        }
-        Y_AXIS => {
-            mx[1][1] = 1.0;
-            mx[0][0] = cosine;
-            mx[2][2] = cosine;
-            mx[2][0] = sine;
-            mx[0][2] = -sine;
-        }
-        _ => {
-            mx[2][2] = 1.0;
-            mx[0][0] = cosine;
-            mx[1][1] = cosine;
-            mx[0][1] = sine;
-            mx[1][0] = -sine;
-        }
-    }
-    mx[3][3] = 1.0;
-    mx
-}
-
-fn axis_rotate_matrix(axis: &[f64], angle: f64) -> Mat {
-    let cosine = angle.cos();
-    let sine = angle.sin();
-    let omc = 1.0 - cosine;
-    let sqr = |a: f64| a * a;
-    let (x, y, z) = (axis[0], axis[1], axis[2]);
-    [
-        [
-            sqr(x) + (1.0 - sqr(x)) * cosine,
-            x * y * omc + z * sine,
-            x * z * omc - y * sine,
-            0.0,
-        ],
-        [
-            x * y * omc - z * sine,
-            sqr(y) + (1.0 - sqr(y)) * cosine,
-            y * z * omc + x * sine,
-            0.0,
-        ],
-        [
-            x * z * omc + y * sine,
-            y * z * omc - x * sine,
-            sqr(z) + (1.0 - sqr(z)) * cosine,
-            0.0,
-        ],
-        [0.0, 0.0, 0.0, 1.0],
-    ]
-}
-
-fn translate_matrix(v: &[f64]) -> Mat {
-    let mut mx = identity_matrix();
-    mx[3][0] = v[0];
-    mx[3][1] = v[1];
-    mx[3][2] = v[2];
-    mx
-}
-
-fn scale_matrix(v: &[f64]) -> Mat {
-    let mut mx = zero_matrix();
-    mx[0][0] = v[0];
-    mx[1][1] = v[1];
-    mx[2][2] = v[2];
-    mx[3][3] = 1.0;
-    mx
-}
-
-fn matrix_multiply(a: &Mat, b: &Mat) -> Mat {
-    let mut r = zero_matrix();
-    for i in 0..4 {
-        for j in 0..4 {
-            r[i][j] = a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j] + a[i][3] * b[3][j];
-        }
-    }
-    r
-}
-
-fn transform_vector(v: &[f64], mx: &Mat) -> C3 {
-    [
-        v[0] * mx[0][0] + v[1] * mx[1][0] + v[2] * mx[2][0],
-        v[0] * mx[0][1] + v[1] * mx[1][1] + v[2] * mx[2][1],
-        v[0] * mx[0][2] + v[1] * mx[1][2] + v[2] * mx[2][2],
-    ]
-}
-
-fn transform_point(v: &[f64], mx: &Mat) -> C3 {
-    [
-        v[0] * mx[0][0] + v[1] * mx[1][0] + v[2] * mx[2][0] + mx[3][0],
-        v[0] * mx[0][1] + v[1] * mx[1][1] + v[2] * mx[2][1] + mx[3][1],
-        v[0] * mx[0][2] + v[1] * mx[1][2] + v[2] * mx[2][2] + mx[3][2],
-    ]
-}
-
-fn transform_coord(v: &C4, mx: &Mat) -> C4 {
-    [
-        v[0] * mx[0][0] + v[1] * mx[1][0] + v[2] * mx[2][0] + v[3] * mx[3][0],
-        v[0] * mx[0][1] + v[1] * mx[1][1] + v[2] * mx[2][1] + v[3] * mx[3][1],
-        v[0] * mx[0][2] + v[1] * mx[1][2] + v[2] * mx[2][2] + v[3] * mx[3][2],
-        v[0] * mx[0][3] + v[1] * mx[1][3] + v[2] * mx[2][3] + v[3] * mx[3][3],
-    ]
-}
-
-/// `lib_gauss_rand`: the SPD's portable Gaussian random number generator
-/// (Numerical Recipes' GASDEV on a small linear congruential generator).
-fn gauss_rand(iseed: i64) -> f64 {
-    const M1: i64 = 134456;
-    const IA1: i64 = 8121;
-    const IC1: i64 = 28411;
-    const RM1: f64 = 1.0 / M1 as f64;
-    let mut ix2 = iseed;
-    let (mut v1, mut r);
-    loop {
-        let ix1 = (IC1 + ix2 * IA1) % M1;
-        ix2 = (IC1 + ix1 * IA1) % M1;
-        v1 = ix1 as f64 * 2.0 * RM1 - 1.0;
-        let v2 = ix2 as f64 * 2.0 * RM1 - 1.0;
-        r = v1 * v1 + v2 * v2;
-        if r < 1.0 {
-            break;
-        }
-    }
-    let fac = (-2.0 * r.ln() / r).sqrt();
-    v1 * fac
-}
-
-// ---------------------------------------------------------------------------
-// libpr*.c / libply.c / libtx.c: NFF output and the transform stack
-
-struct Lib {
-    out: String,
-    tx: Mat,
-    stack: Vec<Mat>,
-}
-
-impl Lib {
-    fn new() -> Self {
-        Lib {
-            out: String::new(),
-            tx: identity_matrix(),
-            stack: Vec::new(),
-        }
-    }
-
-    fn line(&mut self, kw: &str, vals: &[f64]) {
-        self.out.push_str(kw);
-        for v in vals {
-            self.out.push(' ');
-            self.out.push_str(&fmt_g(*v));
-        }
-        self.out.push('\n');
-    }
-
-    fn background(&mut self, c: C3) {
-        self.line("b", &c);
-    }
-
-    #[allow(clippy::too_many_arguments)]
-    fn viewpoint(
-        &mut self,
-        from: C3,
-        at: C3,
-        up: C3,
-        fov: f64,
-        _aspect: f64,
-        hither: f64,
-        resx: u32,
-        resy: u32,
-    ) {
-        self.out.push_str("v\n");
-        self.line("from", &from);
-        self.line("at", &at);
-        self.line("up", &up);
-        self.line("angle", &[fov]);
-        self.line("hither", &[hither]);
-        let _ = writeln!(self.out, "resolution {resx} {resy}");
-    }
-
-    /// `lib_output_light`: an active transform moves the light as a
-    /// vector (no translation), as the SPD does.
-    fn light(&mut self, c: C4) {
-        let mut v = [c[0], c[1], c[2]];
-        if self.tx_active() {
-            v = transform_vector(&v, &self.tx);
-        }
-        self.line("l", &v);
-    }
-
-    /// `lib_output_color`: NFF `f r g b Kd Ks Shine T ior`, the Phong
-    /// exponent derived from the highlight half-angle `ang` (degrees).
-    #[allow(clippy::too_many_arguments)]
-    fn color(
-        &mut self,
-        color: C3,
-        _ka: f64,
-        kd: f64,
-        ks: f64,
-        _ks_spec: f64,
-        ang: f64,
-        kt: f64,
-        ior: f64,
-    ) {
-        let ang_radians = PI * ang / 180.0;
-        let phong_pow = if ang_radians <= 0.0 {
-            100000.0
-        } else if ang_radians >= PI / 2.0 {
-            1.0
-        } else {
-            0.5f64.ln() / ang_radians.cos().ln()
-        };
-        self.line(
-            "f",
-            &[color[0], color[1], color[2], kd, ks, phong_pow, kt, ior],
-        );
-    }
-
-    fn tx_active(&self) -> bool {
-        for i in 0..4 {
-            for j in 0..4 {
-                let id = if i == j { 1.0 } else { 0.0 };
-                if (self.tx[i][j] - id).abs() > EPSILON {
-                    return true;
-                }
-            }
-        }
-        false
-    }
-
-    /// `lib_tx_unwind`'s X scale factor (the length of the first row of
-    /// the normalized 3x3 part); only its absolute value is used.
-    fn tx_scale_x(&self) -> f64 {
-        let mut loc = self.tx;
-        if loc[3][3] != 0.0 {
-            let w = loc[3][3];
-            for row in loc.iter_mut() {
-                for v in row.iter_mut() {
-                    *v /= w;
-                }
-            }
-        }
-        let mut row0 = [loc[0][0], loc[0][1], loc[0][2]];
-        normalize(&mut row0)
-    }
-
-    fn sphere(&mut self, c: C4) {
-        let mut c = c;
-        if self.tx_active() {
-            let s = self.tx_scale_x();
-            let p = transform_point(&c, &self.tx);
-            c = [p[0], p[1], p[2], c[3] * s.abs()];
-        }
-        self.line("s", &c);
-    }
-
-    fn cylcone(&mut self, base: C4, apex: C4) {
-        let (mut base, mut apex) = (base, apex);
-        if self.tx_active() {
-            let s = self.tx_scale_x();
-            let p = transform_point(&base, &self.tx);
-            base = [p[0], p[1], p[2], base[3] * s.abs()];
-            let p = transform_point(&apex, &self.tx);
-            apex = [p[0], p[1], p[2], apex[3] * s.abs()];
-        }
-        self.line(
-            "c",
-            &[
-                base[0], base[1], base[2], base[3], apex[0], apex[1], apex[2], apex[3],
-            ],
-        );
-    }
-
-    /// `lib_output_polygon`: adjacent coincident vertices are merged (in
-    /// the caller's array, as in C), fewer than 3 left means no polygon.
-    fn polygon(&mut self, vert: &mut [C3]) {
-        let mut tot = vert.len();
-        let mut i = 0;
-        while i < tot {
-            let a = vert[i];
-            let b = vert[(i + 1) % tot];
-            let mut x = [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
-            if normalize(&mut x) < EPSILON2 {
-                for j in i..tot - 1 {
-                    vert[j] = vert[j + 1];
-                }
-                tot -= 1;
-            } else {
-                i += 1;
-            }
-        }
-        if tot < 3 {
-            return;
-        }
-        if self.tx_active() {
-            for v in vert.iter_mut().take(tot) {
-                *v = transform_point(v, &self.tx);
-            }
-        }
-        let _ = writeln!(self.out, "p {tot}");
-        for v in vert.iter().take(tot) {
-            self.line_vals(v);
-        }
-    }
-
-    fn line_vals(&mut self, vals: &[f64]) {
-        let s: Vec<String> = vals.iter().map(|v| fmt_g(*v)).collect();
-        self.out.push_str(&s.join(" "));
-        self.out.push('\n');
-    }
-
-    fn tx_push(&mut self) {
-        self.stack.push(self.tx);
-    }
-
-    fn tx_pop(&mut self) {
-        if let Some(m) = self.stack.pop() {
-            self.tx = m;
-        }
-    }
-
-    fn tx_rotate(&mut self, axis: usize, angle: f64) {
-        self.tx = matrix_multiply(&rotate_matrix(axis, angle), &self.tx);
-    }
-
-    fn tx_scale(&mut self, v: C3) {
-        self.tx = matrix_multiply(&scale_matrix(&v), &self.tx);
-    }
-
-    fn tx_translate(&mut self, v: C3) {
-        self.tx = matrix_multiply(&translate_matrix(&v), &self.tx);
-    }
-}
 
 /// The light scale the SPD programs compute: 1 for NFF output.
-const LSCALE_NFF: f64 = 1.0;
+pub(super) const LSCALE_NFF: f64 = 1.0;
 
 // ---------------------------------------------------------------------------
 // balls.c — "sphereflake"
 
-fn balls(lib: &mut Lib, size: u32) {
-    fn create_objset() -> [C4; 9] {
+pub(super) fn balls(lib: &mut Lib, size: u32) {
+    pub(super) fn create_objset() -> [C4; 9] {
         let dist = 1.0 / 2.0f64.sqrt();
         let mut trio_dir: [C4; 3] = [
             [dist, dist, 0.0, 0.0],
@@ -598,7 +35,13 @@ fn balls(lib: &mut Lib, size: u32) {
         objset
     }
 
-    fn output_object(lib: &mut Lib, objset: &[C4; 9], depth: u32, center: C4, direction: C4) {
+    pub(super) fn output_object(
+        lib: &mut Lib,
+        objset: &[C4; 9],
+        depth: u32,
+        center: C4,
+        direction: C4,
+    ) {
         lib.sphere(center);
         if depth > 0 {
             let depth = depth - 1;
@@ -673,8 +116,8 @@ fn balls(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // tetra.c — recursive tetrahedral pyramid
 
-fn tetra(lib: &mut Lib, size: u32) {
-    fn create_tetra(lib: &mut Lib, depth: u32, center: C4) {
+pub(super) fn tetra(lib: &mut Lib, size: u32) {
+    pub(super) fn create_tetra(lib: &mut Lib, depth: u32, center: C4) {
         if depth <= 1 {
             let mut obj_pt = [[0.0; 3]; 4];
             let mut n = 0;
@@ -738,8 +181,8 @@ fn tetra(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // jacks.c — recursive jacks (Alexander Enzmann)
 
-fn jacks(lib: &mut Lib, size: u32) {
-    fn make_jack_obj(lib: &mut Lib) {
+pub(super) fn jacks(lib: &mut Lib, size: u32) {
+    pub(super) fn make_jack_obj(lib: &mut Lib) {
         lib.tx_push();
         lib.tx_scale([0.75, 0.75, 0.75]);
         lib.cylcone([-1.0, 0.0, 0.0, 0.1], [1.0, 0.0, 0.0, 0.1]);
@@ -754,7 +197,7 @@ fn jacks(lib: &mut Lib, size: u32) {
         lib.tx_pop();
     }
 
-    fn make_rec_jack(lib: &mut Lib, depth: u32, max_depth: u32) {
+    pub(super) fn make_rec_jack(lib: &mut Lib, depth: u32, max_depth: u32) {
         make_jack_obj(lib);
         if depth < max_depth {
             for i in [-0.5, 0.5] {
@@ -794,8 +237,8 @@ fn jacks(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // rings.c — pentagonal rings on a dodecahedron, in a pyramid
 
-fn rings(lib: &mut Lib, size: u32) {
-    fn create_dodec(minor_radius: f64) -> [C3; 30] {
+pub(super) fn rings(lib: &mut Lib, size: u32) {
+    pub(super) fn create_dodec(minor_radius: f64) -> [C3; 30] {
         let mut vertex = [[0.0; 3]; 30];
         let scale = 1.0 / (1.0 + minor_radius);
         for (n, v) in vertex.iter_mut().take(5).enumerate() {
@@ -886,14 +329,14 @@ fn rings(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // gears.c — meshing gears with concave faces
 
-fn gears(lib: &mut Lib, size: u32) {
+pub(super) fn gears(lib: &mut Lib, size: u32) {
     const TEETH: usize = 36;
     const OUTER_EDGE_RATIO: f64 = 0.995;
     const INNER_EDGE_RATIO: f64 = 0.9;
     const EDGE_DIFF: f64 = 1.0 - INNER_EDGE_RATIO;
     const DEPTH_RATIO: f64 = 0.1;
 
-    fn create_tooth(
+    pub(super) fn create_tooth(
         gear_angle: f64,
         tooth_angle: f64,
         center: C3,
@@ -912,7 +355,7 @@ fn gears(lib: &mut Lib, size: u32) {
         out[3] = add(transform_vector(&inner, &mx));
     }
 
-    fn create_gear(
+    pub(super) fn create_gear(
         lib: &mut Lib,
         center: C3,
         offset_angle: f64,
@@ -960,7 +403,7 @@ fn gears(lib: &mut Lib, size: u32) {
     }
 
     /// def.h's FRACTION: the part after the decimal point (C int cast).
-    fn fraction(a: f64) -> f64 {
+    pub(super) fn fraction(a: f64) -> f64 {
         a - (a as i32) as f64
     }
 
@@ -1036,7 +479,7 @@ fn gears(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // lattice.c — spheres joined by cylinders in a cubic lattice (Antonio Costa)
 
-fn lattice(lib: &mut Lib, size: u32) {
+pub(super) fn lattice(lib: &mut Lib, size: u32) {
     const RADIUS1: f64 = 1.0 / 4.0;
     const RADIUS2: f64 = 1.0 / 16.0;
     let sf = size as f64;
@@ -1101,7 +544,7 @@ fn lattice(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // shells.c — Pickover's sea shell of spheres
 
-fn shells(lib: &mut Lib, size: u32) {
+pub(super) fn shells(lib: &mut Lib, size: u32) {
     let fgamma = 1.0;
     let alpha = 0.0;
     let beta = -2.0;
@@ -1132,7 +575,7 @@ fn shells(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // mount.c — Carpenter's fractal mountain and four glass spheres
 
-fn mount(lib: &mut Lib, size: u32) {
+pub(super) fn mount(lib: &mut Lib, size: u32) {
     const FRACTAL_DIMENSION: f64 = 2.2;
     const MOUNTAIN_NO: i64 = 21;
     const X_CORNER: f64 = -1.0;
@@ -1141,12 +584,12 @@ fn mount(lib: &mut Lib, size: u32) {
 
     /// The original (repeating) hash, kept as the SPD does for comparable
     /// images.
-    fn hash_rand(a: i64, b: i64, c: u32) -> i64 {
+    pub(super) fn hash_rand(a: i64, b: i64, c: u32) -> i64 {
         let (a, b) = (a as u64, b as u64);
         (((a << (23 - c)) + (b << (15 - c)) + (a << (7 - c))) & 0xffff) as i64
     }
 
-    fn create_spheres(lib: &mut Lib, center: C4) {
+    pub(super) fn create_spheres(lib: &mut Lib, center: C4) {
         let mut axis = [1.0, 1.0, 0.0];
         normalize(&mut axis);
         let angle = (-1.0f64 / 3.0).acos();
@@ -1177,7 +620,7 @@ fn mount(lib: &mut Lib, size: u32) {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn grow_mountain(
+    pub(super) fn grow_mountain(
         lib: &mut Lib,
         m: &M,
         fnum_pts: f64,
@@ -1294,7 +737,7 @@ fn mount(lib: &mut Lib, size: u32) {
 // ---------------------------------------------------------------------------
 // tree.c — Aono & Kunii's tree of cones and spheres
 
-fn tree(lib: &mut Lib, size: u32) {
+pub(super) fn tree(lib: &mut Lib, size: u32) {
     const BR_ANGLE_0: f64 = 40.0;
     const BR_ANGLE_1: f64 = 25.0;
     const BR_CONTR_0: f64 = 0.65;
@@ -1303,7 +746,7 @@ fn tree(lib: &mut Lib, size: u32) {
     const DIV_ANGLE: f64 = 140.0;
     const WIDTH_HEIGHTH_RATIO: f64 = 0.15;
 
-    fn grow_tree(lib: &mut Lib, rst: &[Mat; 2], cur: &Mat, scale: f64, depth: u32) {
+    pub(super) fn grow_tree(lib: &mut Lib, rst: &[Mat; 2], cur: &Mat, scale: f64, depth: u32) {
         let b = transform_point(&[0.0, 0.0, 0.0], cur);
         let base = [b[0], b[1], b[2], scale * WIDTH_HEIGHTH_RATIO];
         let a = transform_point(&[0.0, 0.0, 1.0], cur);
@@ -1367,49 +810,4 @@ fn tree(lib: &mut Lib, size: u32) {
         *r = matrix_multiply(&tr, &st);
     }
     grow_tree(lib, &rst, &identity_matrix(), 1.0, size);
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn percent_g_matches_c() {
-        // Values and their glibc printf("%g") text.
-        let cases = [
-            (0.0, "0"),
-            (-0.0, "-0"),
-            (1.0, "1"),
-            (100000.0, "100000"),
-            (1000000.0, "1e+06"),
-            (0.0001, "0.0001"),
-            (0.00001234, "1.234e-05"),
-            (3.0827, "3.0827"),
-            (-0.7047694, "-0.704769"),
-            (123456.5, "123456"),
-            (123457.5, "123458"),
-            (1.0e-300, "1e-300"),
-            (2.5e10, "2.5e+10"),
-            (0.078, "0.078"),
-        ];
-        for (x, want) in cases {
-            assert_eq!(fmt_g(x), want, "{x}");
-        }
-    }
-
-    #[test]
-    fn bad_names_and_sizes_are_errors() {
-        assert!(generate("nope", 1)
-            .unwrap_err()
-            .contains("unknown SPD generator"));
-        assert!(generate("balls", 0).unwrap_err().contains("size 0"));
-        assert!(generate("balls", 99).unwrap_err().contains("size 99"));
-    }
-
-    #[test]
-    fn gauss_rand_is_deterministic_and_in_range() {
-        let a = gauss_rand(21);
-        assert_eq!(a, gauss_rand(21));
-        assert!(a.is_finite() && a.abs() < 10.0);
-    }
 }
