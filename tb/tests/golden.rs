@@ -121,7 +121,11 @@ fn the_golden_firmware_names_its_numbers() {
             let trimmed = code.trim_start();
             let word = trimmed.split_whitespace().next().unwrap_or("");
             // TinyRISC loads and stores: `OFFSET(rB)` with a named offset or none.
-            if ["lw", "lh", "lhu", "lb", "lbu", "sw", "sh", "sb", "lfb", "sfb"].contains(&word) {
+            if [
+                "lw", "lh", "lhu", "lb", "lbu", "sw", "sh", "sb", "lfb", "sfb",
+            ]
+            .contains(&word)
+            {
                 if let Some(p) = code.find('(') {
                     let off = code[..p].rsplit(',').next().unwrap_or("").trim();
                     if !off.is_empty() && !is_name(off) {
@@ -153,4 +157,52 @@ fn the_golden_firmware_names_its_numbers() {
         }
         assert!(problems.is_empty(), "{}", problems.join("\n"));
     }
+}
+
+/// `docs/tracer.md` reads the default scene's program ("One packet through
+/// the program") in excerpts: each ```asm block is copied from
+/// `firmware/golden/default.s`, runs of lines separated by `...` where
+/// lines are left out. Each run must still be in the file, its lines
+/// consecutive and the runs in the file's order, so the walkthrough cannot
+/// drift from the program it describes.
+#[test]
+fn the_tracer_walkthrough_quotes_the_golden_program() {
+    let doc = std::fs::read_to_string(root().join("docs/tracer.md")).unwrap();
+    let golden = std::fs::read_to_string(root().join("firmware/golden/default.s")).unwrap();
+    let lines: Vec<&str> = golden.lines().collect();
+    let mut blocks = Vec::new();
+    let mut current: Option<(usize, Vec<&str>)> = None;
+    for (k, l) in doc.lines().enumerate() {
+        match (&mut current, l.trim_end()) {
+            (None, "```asm") => current = Some((k + 1, Vec::new())),
+            (Some(_), "```") => blocks.push(current.take().unwrap()),
+            (Some((_, v)), _) => v.push(l),
+            _ => {}
+        }
+    }
+    assert!(
+        blocks.len() >= 8,
+        "docs/tracer.md: {} asm excerpts; the walkthrough has more",
+        blocks.len()
+    );
+    let mut failures = Vec::new();
+    for (line, block) in &blocks {
+        let mut from = 0;
+        for run in block.split(|l| l.trim() == "...") {
+            if run.is_empty() {
+                continue;
+            }
+            match (from..lines.len().saturating_sub(run.len() - 1))
+                .find(|&i| lines[i..i + run.len()] == run[..])
+            {
+                Some(i) => from = i + run.len(),
+                None => failures.push(format!(
+                    "docs/tracer.md:{}: the excerpt's lines from `{}` are not in firmware/golden/default.s (in this order, after the previous run)",
+                    line + 1,
+                    run[0].trim()
+                )),
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
