@@ -110,6 +110,16 @@ impl Labels {
     }
 }
 
+/// An address's text: `label+offset`, or `idle` for all ones (no address:
+/// the broadcast unit idle).
+fn label_text(labels: &Labels, kind: LabelKind, width: u32, v: u64) -> Option<String> {
+    if width < 64 && v == (1u64 << width) - 1 {
+        Some("idle".to_string())
+    } else {
+        labels.locate(kind, v as u32)
+    }
+}
+
 /// A translate filter: a name (the file is `<stem>.<name>.txt`) and the
 /// function that turns a value into text (`None`: leave it as hex).
 pub struct Filter {
@@ -1657,6 +1667,10 @@ struct SideFiles {
     gtkw: PathBuf,
     /// Per translate filter its name and file.
     filters: Vec<(&'static str, PathBuf)>,
+    /// Per label kind shown, Surfer's decoder of it: the kind, the
+    /// signal's width and the file (`.surfer/decoders/<stem>.<name>/`
+    /// beside the waveform, where Surfer started there finds it).
+    decoders: Vec<(LabelKind, u32, PathBuf)>,
 }
 
 fn glob(p: &str, s: &str) -> bool {
@@ -2075,9 +2089,19 @@ impl Tracer {
         for (name, path) in &files.filters {
             filters.push(stage(path, &self.filter_file(name))?);
         }
+        let mut decoders = Vec::new();
+        for (kind, width, path) in &files.decoders {
+            if let Some(dir) = path.parent() {
+                std::fs::create_dir_all(dir)?;
+            }
+            decoders.push(stage(path, &self.surfer_decoder(*kind, *width))?);
+        }
         closing.join()?;
-        // The filter files, the save file, the waveform last.
+        // The filter files and decoders, the save file, the waveform last.
         for (tmp, (_, path)) in filters.into_iter().zip(&files.filters) {
+            tmp.persist(path).map_err(|e| e.error)?;
+        }
+        for (tmp, (_, _, path)) in decoders.into_iter().zip(&files.decoders) {
             tmp.persist(path).map_err(|e| e.error)?;
         }
         save.persist(&files.gtkw).map_err(|e| e.error)?;
@@ -2087,6 +2111,7 @@ impl Tracer {
         done?;
         let mut written = vec![self.cfg.path.clone(), files.gtkw];
         written.extend(files.filters.into_iter().map(|(_, p)| p));
+        written.extend(files.decoders.into_iter().map(|(_, _, p)| p));
         Ok(written)
     }
 
@@ -2097,7 +2122,20 @@ impl Tracer {
         let stem = vcd_abs.with_extension("");
         let gtkw = vcd_abs.with_extension("gtkw");
         let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
+        let mut decoders: Vec<(LabelKind, u32, PathBuf)> = Vec::new();
         for d in &self.decls {
+            if let (Display::Label(k), Some(_)) = (d.info.display, &self.cfg.labels) {
+                if !decoders.iter().any(|(dk, _, _)| *dk == k) {
+                    let dir = vcd_abs.parent().unwrap_or(Path::new("."));
+                    let stem_name = stem.file_name().unwrap_or_default().to_string_lossy();
+                    let name = k.filter_name();
+                    let path = dir
+                        .join(".surfer/decoders")
+                        .join(format!("{stem_name}.{name}"))
+                        .join(format!("{name}.toml"));
+                    decoders.push((k, d.info.width, path));
+                }
+            }
             let name = match d.info.display {
                 Display::Translate(f) => f.name,
                 Display::Label(k) if self.cfg.labels.is_some() => k.filter_name(),
@@ -2112,6 +2150,7 @@ impl Tracer {
             vcd_abs,
             gtkw,
             filters,
+            decoders,
         })
     }
 
@@ -2138,13 +2177,7 @@ impl Tracer {
                 );
                 for (w, v) in &vals {
                     let digits = w.div_ceil(4) as usize;
-                    // All ones: no address (the broadcast unit idle).
-                    let text = if *w < 64 && *v == (1u64 << w) - 1 {
-                        Some("idle".to_string())
-                    } else {
-                        labels.locate(kind, *v as u32)
-                    };
-                    if let Some(text) = text {
+                    if let Some(text) = label_text(labels, kind, *w, *v) {
                         s.push_str(&format!("{v:0digits$X} {text}\n"));
                     }
                 }
@@ -2176,6 +2209,48 @@ impl Tracer {
             if let Some(text) = (f.text)(v) {
                 let digits = w.div_ceil(4) as usize;
                 s.push_str(&format!("{v:0digits$X} {text}\n"));
+            }
+        }
+        s
+    }
+
+    /// Surfer's decoder of the addresses of `kind` (signals `width` bits
+    /// wide) in the TOML format of the `instruction-decoder` crate: one
+    /// exact-match entry per value seen in the trace, named by its
+    /// `label+offset` (the same text as the GTKWave filter's).
+    fn surfer_decoder(&self, kind: LabelKind, width: u32) -> String {
+        let Some(labels) = &self.cfg.labels else {
+            return String::new();
+        };
+        let mut vals: BTreeSet<u64> = BTreeSet::new();
+        for (i, d) in self.decls.iter().enumerate() {
+            if matches!(d.info.display, Display::Label(k) if k == kind) && d.info.width == width {
+                vals.extend(self.seen[i].iter().copied());
+            }
+        }
+        let name = kind.filter_name();
+        let stem = self
+            .cfg
+            .path
+            .file_stem()
+            .unwrap_or_default()
+            .to_string_lossy();
+        let mask = if width >= 64 { !0 } else { (1u64 << width) - 1 };
+        let mut s = format!(
+            "# Surfer decoder written by morphosys beside {}: label+offset of the program run\n\
+             set = \"{stem} {name}\"\nwidth = {width}\n\n\
+             [formats]\nnames = [\"label\"]\nparts = [[\"addr\", {width}, \"u64\"]]\n\n\
+             [types]\nnames = [\"addr\"]\n\n[[types.addr]]\nname = \"addr\"\ntop = {}\nbot = 0\n\n\
+             [label]\ntype = \"addr\"\n\n[label.repr]\ndefault = \"$name$\"\n",
+            self.cfg.path.display(),
+            width - 1
+        );
+        for v in vals {
+            if let Some(text) = label_text(labels, kind, width, v) {
+                let key = text.replace('\\', "\\\\").replace('"', "\\\"");
+                s.push_str(&format!(
+                    "\n[label.instructions.\"{key}\"]\nmask = {mask:#x}\nmatch = {v:#x}\n"
+                ));
             }
         }
         s

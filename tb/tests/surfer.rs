@@ -13,6 +13,7 @@
 //! `$name$` and `%field%` substituted, and the last match kept (formats in
 //! name order, instructions in name order).
 
+mod common;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -441,4 +442,52 @@ unsigned = true
     assert_eq!(d.decode(0x122F_FFFF).as_deref(), Some("go two, -4"));
     assert_eq!(d.decode(0x132F_FFFF).as_deref(), Some("up two, 4194300"));
     assert_eq!(d.decode(0x1400_0000), None);
+}
+
+/// A render's waveform comes with Surfer decoders of the PC and the
+/// broadcast unit's context address (`.surfer/decoders/<stem>.code_labels/`
+/// and `<stem>.context_labels/` beside it): read as the crate reads them,
+/// they name every value the GTKWave filters name, with the same text
+/// (which `waveforms.rs` checks against the assembler's symbols).
+#[test]
+fn a_render_waveform_comes_with_surfer_decoders_of_its_labels() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let (ok, _, err) = common::morphosys(
+        d,
+        &[
+            "render",
+            "--size",
+            "16x16",
+            "--vcd",
+            "w.vcd",
+            "--trace-cycles",
+            "3000",
+        ],
+    );
+    assert!(ok, "{err}");
+    for (name, width) in [("code_labels", 32), ("context_labels", 13)] {
+        let file = d.join(format!(".surfer/decoders/w.{name}/{name}.toml"));
+        let dec = Decoder::parse(
+            &std::fs::read_to_string(&file).unwrap_or_else(|e| panic!("{}: {e}", file.display())),
+        );
+        assert_eq!(dec.width, width, "{name}");
+        let filter = std::fs::read_to_string(d.join(format!("w.{name}.txt"))).unwrap();
+        let mut named = 0;
+        for line in filter.lines().filter(|l| !l.starts_with('#')) {
+            let (value, text) = line.split_once(' ').unwrap();
+            let v = u64::from_str_radix(value, 16).unwrap();
+            assert_eq!(
+                dec.decode_all(v),
+                vec![text.to_string()],
+                "{name}: {value} decodes to one text, the filter's"
+            );
+            named += 1;
+        }
+        assert!(named >= 3, "{name}: {filter}");
+        if name == "code_labels" {
+            // No PC is odd: left as hex.
+            assert!(dec.decode_all(0x7ff).is_empty());
+        }
+    }
 }
