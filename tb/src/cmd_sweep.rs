@@ -540,10 +540,17 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
 fn timing_files(paths: &[PathBuf]) -> Result<Vec<(String, Timing)>> {
     let mut files = Vec::new();
     for p in paths {
-        let name = p.file_stem().map_or_else(
-            || p.display().to_string(),
-            |s| s.to_string_lossy().into_owned(),
-        );
+        // The series' name; a control character (a newline would split a
+        // planned job's line) becomes `_`.
+        let name: String = p
+            .file_stem()
+            .map_or_else(
+                || p.display().to_string(),
+                |s| s.to_string_lossy().into_owned(),
+            )
+            .chars()
+            .map(|c| if c.is_control() { '_' } else { c })
+            .collect();
         files.push((name, crate::timing::load(p)?));
     }
     Ok(files)
@@ -771,6 +778,40 @@ const JOBS_FILE: &str = "jobs.txt";
 /// The M1 chip's timing (instruction issue), the broadcast knob's.
 const M1_TIMING_FILE: &str = "m1-issue.toml";
 
+/// A file name made of `A-Z a-z 0-9 . _ + -` only (others become `_`):
+/// the plan's own copies, named in its job lines.
+fn plain_file_name(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || "._+-".contains(c) {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
+}
+
+/// A path that goes into a job line: refused when it is not UTF-8 or holds
+/// a control character (a newline would end the job's line there and run
+/// the rest as a command of its own).
+fn job_line_path(what: &str, p: &Path) -> Result<String> {
+    let Some(text) = p.to_str() else {
+        anyhow::bail!(
+            "{what} {}: not UTF-8; a plan's job lines name it",
+            p.display()
+        );
+    };
+    if let Some(c) = text.chars().find(|c| c.is_control()) {
+        anyhow::bail!(
+            "{what} {}: holds the control character U+{:04X}; a plan's job lines name it",
+            text.escape_debug(),
+            c as u32
+        );
+    }
+    Ok(text.to_string())
+}
+
 /// A word of a shell command line, quoted when it needs to be.
 fn shell_word(w: &str) -> String {
     if !w.is_empty()
@@ -854,11 +895,18 @@ fn write_plan(
     if pts.is_empty() {
         anyhow::bail!("--plan {}: the sweep asked has no points", dir.display());
     }
+    // Checked before anything is made: the folder and this program go into
+    // every job line.
+    let abs = std::path::absolute(dir).with_context(|| format!("--plan {}", dir.display()))?;
+    job_line_path("--plan", &abs)?;
+    let program = std::env::current_exe().context("the path of this morphosys")?;
+    job_line_path("this morphosys at", &program)?;
     for sub in ["points", "scenes", "timing"] {
         std::fs::create_dir_all(dir.join(sub))
             .with_context(|| format!("--plan {}: cannot create {sub}/ in it", dir.display()))?;
     }
     let dir = &std::fs::canonicalize(dir).with_context(|| format!("--plan {}", dir.display()))?;
+    job_line_path("--plan", dir)?;
     // The plan's own copies of the scenes and timing files: its jobs give
     // the same results whatever happens to the originals.
     let mut refs = Vec::new();
@@ -866,7 +914,7 @@ fn write_plan(
         let fname = sc
             .file
             .file_name()
-            .map_or_else(|| "scene".into(), |f| f.to_string_lossy().into_owned());
+            .map_or_else(|| "scene".into(), |f| plain_file_name(&f.to_string_lossy()));
         let to = dir.join("scenes").join(format!("{i:03}-{fname}"));
         let bytes = match &sc.family {
             Some(f) => firmware::scene::spd::generate(f, sc.size.unwrap_or(1))
@@ -900,7 +948,6 @@ fn write_plan(
         let t = crate::timing::to_toml(&m1.unwrap_or_default());
         write_output(&dir.join(M1_TIMING_FILE), t.as_bytes())?;
     }
-    let program = std::env::current_exe().context("the path of this morphosys")?;
     let mut text = String::new();
     for job in jobs {
         let p = &pts[job.point];

@@ -382,3 +382,107 @@ fn an_in_process_sweep_resumes_from_its_finished_points() {
     assert!(err.contains("3 renders taken from an earlier run"), "{err}");
     assert_eq!(std::fs::read(d.join("out/results.csv")).unwrap(), first);
 }
+
+/// A scene or timing file whose name holds a newline cannot split a job
+/// line (which GNU parallel and the Slurm script run as a shell command):
+/// the plan's copies get plain names, and a `--plan` folder whose path
+/// holds a control character is refused before anything is made.
+#[test]
+fn file_names_cannot_inject_commands_into_a_plan() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let scene = "x\ntouch INJECTED #.nff";
+    let timing = "t\ntouch INJECTED_T #.toml";
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff"),
+        d.join(scene),
+    )
+    .unwrap();
+    let (ok, out, err) = morphosys(d, &["timing"]);
+    assert!(ok, "{err}");
+    std::fs::write(d.join(timing), out).unwrap();
+    let (ok, out, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            scene,
+            "--timing",
+            timing,
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--plan",
+            "plan",
+        ],
+    );
+    assert!(ok, "{err}");
+    let renders: usize = out
+        .split_once("jobs.txt (")
+        .and_then(|(_, r)| r.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    let jobs = std::fs::read_to_string(d.join("plan/jobs.txt")).unwrap();
+    assert_eq!(
+        jobs.lines().count(),
+        renders,
+        "one line per render:\n{jobs}"
+    );
+    let program = std::fs::canonicalize(env!("CARGO_BIN_EXE_morphosys")).unwrap();
+    for line in jobs.lines() {
+        assert!(
+            line.starts_with(&format!("{} render ", program.display())),
+            "{line}"
+        );
+    }
+    // The first two jobs run as written: nothing but renders.
+    std::fs::write(
+        d.join("first.txt"),
+        jobs.lines().take(2).collect::<Vec<_>>().join("\n") + "\n",
+    )
+    .unwrap();
+    if parallel(&d.join("first.txt")).is_some() {
+        assert!(!d.join("INJECTED").exists() && !d.join("plan/INJECTED").exists());
+        assert!(!d.join("INJECTED_T").exists());
+    }
+    // A plan folder with a newline: refused, nothing made.
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            scene,
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--plan",
+            "p\nq",
+        ],
+    );
+    assert!(!ok);
+    assert!(err.contains("--plan") && err.contains("U+000A"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!d.join("p\nq").exists());
+    // Nor a folder whose name is not UTF-8.
+    use std::os::unix::ffi::OsStrExt;
+    let bad = std::ffi::OsStr::from_bytes(b"p\xff");
+    let out = Command::new(env!("CARGO_BIN_EXE_morphosys"))
+        .current_dir(d)
+        .args([
+            "sweep",
+            scene,
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--plan",
+        ])
+        .arg(bad)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("--plan") && err.contains("not UTF-8"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert!(!d.join(bad).exists());
+}
