@@ -154,6 +154,22 @@ impl Stats {
 
 /// The chip, generic over its datapath word: `Chip` (= `Chip<i16>`) is the
 /// paper's 16-bit chip, `Chip<i32>` the 32-bit variant ([`Chip::new_wide`]);
+
+/// Every file a waveform of the chip at `wave` may come with (save file,
+/// the units' translate filters, the firmware's label filters and Surfer
+/// decoders), for checking outputs before a run.
+pub fn waveform_side_files(wave: &std::path::Path) -> Vec<(std::path::PathBuf, String)> {
+    crate::trace::side_files(
+        wave,
+        &[
+            crate::tinyrisc::decode::INSTR_FILTER.name,
+            crate::tinyrisc::STATE_FILTER.name,
+            crate::rc::OP_FILTER.name,
+            crate::rc::CTX_FILTER.name,
+        ],
+    )
+}
+
 /// see `docs/isa.md`, "The 32-bit datapath".
 pub struct Chip<W: Word = i16> {
     pub risc: TinyRisc,

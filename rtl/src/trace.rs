@@ -1661,6 +1661,51 @@ fn stage(path: &Path, text: &str) -> io::Result<tempfile::NamedTempFile> {
     Ok(tmp)
 }
 
+/// A waveform's GTKWave save file: `<stem>.gtkw`.
+fn save_file_path(wave: &Path) -> PathBuf {
+    wave.with_extension("gtkw")
+}
+
+/// A waveform's translate filter `name`: `<stem>.<name>.txt`.
+fn filter_path(wave: &Path, name: &str) -> PathBuf {
+    PathBuf::from(format!("{}.{name}.txt", wave.with_extension("").display()))
+}
+
+/// A waveform's Surfer decoder of the labels `name`:
+/// `.surfer/decoders/<stem>.<name>/<name>.toml` in its folder.
+fn decoder_path(wave: &Path, name: &str) -> PathBuf {
+    let stem = wave.with_extension("");
+    let stem_name = stem.file_name().unwrap_or_default().to_string_lossy();
+    wave.parent()
+        .unwrap_or(Path::new("."))
+        .join(".surfer/decoders")
+        .join(format!("{stem_name}.{name}"))
+        .join(format!("{name}.toml"))
+}
+
+/// Every file that may be written beside a waveform at `wave` whose
+/// signals use the translate filters `filters` (names) and, with labels,
+/// the label kinds: its save file, filter files and Surfer decoders, each
+/// with what it is. Commands check these against their inputs and other
+/// outputs before the work ([`Tracer::finish`] writes those the traced
+/// signals need).
+pub fn side_files(wave: &Path, filters: &[&str]) -> Vec<(PathBuf, String)> {
+    let wave = std::path::absolute(wave).unwrap_or_else(|_| wave.to_path_buf());
+    let mut v = vec![(save_file_path(&wave), "save file".to_string())];
+    for name in filters {
+        v.push((filter_path(&wave, name), format!("filter file `{name}`")));
+    }
+    for k in [LabelKind::Code, LabelKind::Context] {
+        let name = k.filter_name();
+        v.push((filter_path(&wave, name), format!("filter file `{name}`")));
+        v.push((
+            decoder_path(&wave, name),
+            format!("Surfer decoder `{name}`"),
+        ));
+    }
+    v
+}
+
 /// The files written beside a waveform ([`Tracer::side_files`]).
 struct SideFiles {
     vcd_abs: PathBuf,
@@ -2119,21 +2164,13 @@ impl Tracer {
     /// per translate filter.
     fn side_files(&self) -> io::Result<SideFiles> {
         let vcd_abs = std::path::absolute(&self.cfg.path)?;
-        let stem = vcd_abs.with_extension("");
-        let gtkw = vcd_abs.with_extension("gtkw");
+        let gtkw = save_file_path(&vcd_abs);
         let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
         let mut decoders: Vec<(LabelKind, u32, PathBuf)> = Vec::new();
         for d in &self.decls {
             if let (Display::Label(k), Some(_)) = (d.info.display, &self.cfg.labels) {
                 if !decoders.iter().any(|(dk, _, _)| *dk == k) {
-                    let dir = vcd_abs.parent().unwrap_or(Path::new("."));
-                    let stem_name = stem.file_name().unwrap_or_default().to_string_lossy();
-                    let name = k.filter_name();
-                    let path = dir
-                        .join(".surfer/decoders")
-                        .join(format!("{stem_name}.{name}"))
-                        .join(format!("{name}.toml"));
-                    decoders.push((k, d.info.width, path));
+                    decoders.push((k, d.info.width, decoder_path(&vcd_abs, k.filter_name())));
                 }
             }
             let name = match d.info.display {
@@ -2142,8 +2179,7 @@ impl Tracer {
                 _ => continue,
             };
             if !filters.iter().any(|(n, _)| *n == name) {
-                let path = PathBuf::from(format!("{}.{}.txt", stem.display(), name));
-                filters.push((name, path));
+                filters.push((name, filter_path(&vcd_abs, name)));
             }
         }
         Ok(SideFiles {

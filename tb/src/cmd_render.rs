@@ -302,12 +302,14 @@ pub fn command(a: RenderArgs) -> Result<()> {
     for (p, what) in [
         (&a.json, "--json"),
         (&a.hits, "--hits"),
-        (&a.vcd, "--vcd"),
         (&a.emit_asm, "--emit-asm"),
     ] {
         if let Some(p) = p {
             files.output(p, what);
         }
+    }
+    if let Some(v) = &a.vcd {
+        files.waveform(v, "--vcd");
     }
     files.check()?;
     let (width, height) = a.size.unwrap_or((256, 256));

@@ -145,10 +145,11 @@ pub fn command(a: RunArgs) -> anyhow::Result<()> {
     if let Some(t) = &a.timing {
         files.input(t, "--timing");
     }
-    for (p, what) in [(&a.vcd, "--vcd"), (&a.json, "--json")] {
-        if let Some(p) = p {
-            files.output(p, what);
-        }
+    if let Some(p) = &a.json {
+        files.output(p, "--json");
+    }
+    if let Some(p) = &a.vcd {
+        files.waveform(p, "--vcd");
     }
     files.check()?;
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;

@@ -245,6 +245,10 @@ fn is_stream(path: &Path) -> bool {
 pub struct Files {
     inputs: Vec<(PathBuf, String)>,
     outputs: Vec<(PathBuf, String)>,
+    /// Files written beside an output (a waveform's save and filter
+    /// files): neither an input nor another output, but made by the
+    /// writer itself (folders included), so not checked for writability.
+    beside: Vec<(PathBuf, String)>,
 }
 
 impl Files {
@@ -261,6 +265,19 @@ impl Files {
     /// An output file (`what` names its argument).
     pub fn output(&mut self, path: &Path, what: &str) -> &mut Files {
         self.outputs.push((path.to_path_buf(), what.into()));
+        self
+    }
+
+    /// A waveform output (`what` names its argument) and, unless it goes
+    /// to a device, FIFO or standard output, every file the waveform may
+    /// be written with beside it.
+    pub fn waveform(&mut self, path: &Path, what: &str) -> &mut Files {
+        self.output(path, what);
+        if !is_stream(path) && path != Path::new("-") {
+            for (p, kind) in rtl::chip::waveform_side_files(path) {
+                self.beside.push((p, format!("{what}'s {kind}")));
+            }
+        }
         self
     }
 
@@ -292,6 +309,26 @@ impl Files {
             }
             if me == Id::Stdout {
                 STDOUT_TAKEN.store(true, Ordering::Relaxed);
+            }
+        }
+        for (p, what) in &self.beside {
+            let me = id(p);
+            for (q, qwhat) in &self.inputs {
+                if id(q) == me {
+                    anyhow::bail!(
+                        "{what} would be {}: that is the input {qwhat}; refusing to overwrite it",
+                        p.display()
+                    );
+                }
+            }
+            for (q, qwhat) in &self.outputs {
+                if id(q) == me {
+                    anyhow::bail!(
+                        "{what} would be {}, which is also {qwhat} {}: give each output a path of its own",
+                        p.display(),
+                        q.display()
+                    );
+                }
             }
         }
         Ok(())

@@ -196,3 +196,59 @@ fn an_output_over_an_input_or_another_output_is_refused_before_the_work() {
     );
     assert!(!d.path().join("o.png").exists());
 }
+
+/// A waveform's side files (its `.gtkw` save file, translate-filter files
+/// and Surfer label decoders) are outputs too: one that would overwrite an
+/// input, or another output, is refused before the work, and both files
+/// are left as they were.
+#[test]
+fn a_waveforms_side_files_cannot_overwrite_an_input_or_an_output() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene();
+    // The program to render with, named like the waveform's rc_op filter.
+    let (ok, _, err) = morphosys(
+        d,
+        &["render", &s, "--size", "16x16", "--emit-asm", "w.rc_op.txt"],
+    );
+    assert!(ok, "{err}");
+    let program = std::fs::read(d.join("w.rc_op.txt")).unwrap();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "render",
+            &s,
+            "--size",
+            "16x16",
+            "--firmware",
+            "w.rc_op.txt",
+            "--vcd",
+            "w.vcd",
+        ],
+    );
+    assert!(!ok);
+    assert!(err.contains("rc_op") && err.contains("--firmware"), "{err}");
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    assert_eq!(std::fs::read(d.join("w.rc_op.txt")).unwrap(), program);
+    assert!(!d.join("w.vcd").exists());
+    // The JSON named like the save file.
+    std::fs::write(d.join("w.gtkw"), "keep").unwrap();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "render", &s, "--size", "16x16", "--vcd", "w.vcd", "--json", "w.gtkw",
+        ],
+    );
+    assert!(!ok);
+    assert!(err.contains("save file") && err.contains("--json"), "{err}");
+    assert_eq!(std::fs::read_to_string(d.join("w.gtkw")).unwrap(), "keep");
+    // `run` checks the same: a program named like a label filter.
+    std::fs::copy(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/cbcast.s"),
+        d.join("p.code_labels.txt"),
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(d, &["run", "p.code_labels.txt", "--vcd", "p.vcd"]);
+    assert!(!ok);
+    assert!(err.contains("code_labels") && err.contains("FILE"), "{err}");
+}
