@@ -35,6 +35,10 @@ fn parse_scope(s: &str) -> Result<String, String> {
     if s.trim() == "all" {
         return Ok(String::new());
     }
+    // An empty list would be read as every signal (hundreds of MB).
+    if s.split(',').all(|p| p.trim().is_empty()) {
+        return Err("names no scope: give dotted paths such as `tinyrisc,array.rc_r0_c0`, or `all` for every signal".into());
+    }
     rtl::trace::check_scope_patterns(s)?;
     Ok(s.to_string())
 }

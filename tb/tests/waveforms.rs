@@ -216,7 +216,26 @@ fn a_render_traces_what_an_architect_looks_at_first() {
         all.len()
     );
     let gtkw = std::fs::read_to_string(dir.path().join("a.gtkw")).unwrap();
-    assert!(!gtkw.contains("@c00200"), "a group saved closed");
+    assert!(!gtkw.contains("@c00200"), "a group saved closed"); // An empty list of scopes is no list (it once meant every signal).
+    for empty in ["", ",", " , "] {
+        let (ok, _, err) = common::morphosys(
+            dir.path(),
+            &[
+                "render",
+                "--size",
+                "8x8",
+                "--vcd",
+                "e.vcd",
+                "--trace-scope",
+                empty,
+            ],
+        );
+        assert!(
+            !ok && err.contains("--trace-scope") && err.contains("names no scope"),
+            "{err}"
+        );
+        assert!(!dir.path().join("e.vcd").exists());
+    }
 }
 
 /// An FST trace longer than one in-memory section (issue 15: the writer
