@@ -696,16 +696,33 @@ fn main() -> ExitCode {
             Some(u) => {
                 eprintln!(
                     "morphosys: error: {} (see `morphosys {} --help`)",
-                    u.message, u.command
+                    printable(&u.message),
+                    u.command
                 );
                 ExitCode::from(2)
             }
             None => {
-                eprintln!("morphosys: error: {e:#}");
+                eprintln!("morphosys: error: {}", printable(&format!("{e:#}")));
                 ExitCode::FAILURE
             }
         },
     }
+}
+
+/// An error's text as the terminal should get it: a control character
+/// from the input (an escape sequence, a NUL in a scene's token or a file
+/// name) written as `U+001B`, as the assembler writes them; line breaks
+/// and tabs of the message itself kept.
+fn printable(s: &str) -> String {
+    let mut out = String::with_capacity(s.len());
+    for c in s.chars() {
+        if c.is_control() && c != '\n' && c != '\t' {
+            out.push_str(&format!("U+{:04X}", c as u32));
+        } else {
+            out.push(c);
+        }
+    }
+    out
 }
 
 /// Standard output that cannot be written (a full disk) ends the command
@@ -777,6 +794,9 @@ fn usage_error(e: clap::Error) -> ExitCode {
         .find(|a| command.find_subcommand(a.as_str()).is_some())
         .map(|a| format!("{a} "))
         .unwrap_or_default();
-    eprintln!("morphosys: error: {first}{tip} (see `morphosys {sub}--help`)");
+    eprintln!(
+        "morphosys: error: {} (see `morphosys {sub}--help`)",
+        printable(&format!("{first}{tip}"))
+    );
     ExitCode::from(2)
 }

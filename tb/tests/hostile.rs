@@ -189,3 +189,38 @@ fn a_sweep_whose_every_point_fails_is_an_error() {
     );
     assert!(!d.path().join("out/results.csv").exists());
 }
+
+/// A control character in an input reaches the terminal written out
+/// (`U+001B`), never raw: an escape sequence in a scene cannot recolour or
+/// clear the user's terminal, a NUL cannot cut the line.
+#[test]
+fn control_characters_in_errors_are_written_out() {
+    let d = tempfile::tempdir().unwrap();
+    std::fs::write(
+        d.path().join("cc.nff"),
+        "v\nfrom 0 0 5\x1b[31mRED\x00\x07\nat 0 0 0\n",
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(d.path(), &["reference", "cc.nff"]);
+    assert!(!ok);
+    assert!(
+        err.contains("cc.nff:2:") && err.contains("U+001B[31mREDU+0000U+0007"),
+        "{err}"
+    );
+    assert!(
+        !err.trim_end().chars().any(|c| c.is_control()),
+        "raw control characters: {err:?}"
+    );
+    // The same in a TOML scene's error and an argument's.
+    std::fs::write(
+        d.path().join("cc.toml"),
+        "[camera]\nfrom = \"\x1b]0;x\x07\"\n",
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(d.path(), &["reference", "cc.toml"]);
+    assert!(!ok);
+    assert!(!err.trim_end().chars().any(|c| c.is_control()), "{err:?}");
+    let (ok, _, err) = morphosys(d.path(), &["render", "--size", "8x\x1b8"]);
+    assert!(!ok);
+    assert!(!err.trim_end().chars().any(|c| c.is_control()), "{err:?}");
+}
