@@ -904,7 +904,7 @@ impl std::fmt::Display for RunError {
             RunError::Step(e) => write!(f, "{e}"),
             RunError::MaxCycles { cycles, pc, text } => write!(
                 f,
-                "cycle {cycles}: sim: no halt within --max-cycles {cycles} [pc 0x{pc:08x}: `{text}`]"
+                "cycle {cycles}: sim: no halt within {cycles} cycles [pc 0x{pc:08x}: `{text}`]"
             ),
         }
     }

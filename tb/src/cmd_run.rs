@@ -201,6 +201,12 @@ fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyho
     }
     let cycles = match &out.result {
         Ok(c) => *c,
+        Err(e @ RunError::MaxCycles { .. }) => {
+            return Err(anyhow!(
+                "{e}; raise --max-cycles (now {}) to run longer",
+                a.max_cycles
+            ))
+        }
         Err(e) => return Err(anyhow!("{e}")),
     };
     crate::report!(

@@ -174,7 +174,10 @@ fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
     // Every kernel the census and the test count name must be there.
     let ctx = |n: &str| {
         let a = ctx(n);
-        debug_assert!(a.is_some() || !fw.kernels.iter().any(|(k, _)| k == n), "{n}");
+        debug_assert!(
+            a.is_some() || !fw.kernels.iter().any(|(k, _)| k == n),
+            "{n}"
+        );
         a
     };
     if let Some(a) = ctx(&start) {
@@ -338,7 +341,13 @@ fn run_group<W: Word>(
             crate::note!("wrote {}", f.display());
         }
     }
-    result.map_err(|e| anyhow!("the tracer firmware stopped: {e}"))?;
+    result.map_err(|e| match e {
+        rtl::chip::RunError::MaxCycles { .. } => anyhow!(
+            "the tracer firmware stopped: {e}; a render allows {MAX_CYCLES_PER_CHIP} cycles per chip \
+             instance (up to {TILES_PER_CHIP} tiles): a smaller --size, or a faster --timing"
+        ),
+        e => anyhow!("the tracer firmware stopped: {e}"),
+    })?;
     let m = &sim.top.mem;
     let rd = |name: &str| -> Result<u64> { Ok(m.read(sym(img, name)?, 4) as u64) };
     let out = (0..tiles.len())

@@ -224,3 +224,31 @@ fn control_characters_in_errors_are_written_out() {
     assert!(!ok);
     assert!(!err.trim_end().chars().any(|c| c.is_control()), "{err:?}");
 }
+
+/// A render that runs out of its cycle budget says what the budget is and
+/// what to change (it does not take `run`'s --max-cycles); `run` names its
+/// own option.
+#[test]
+fn a_render_out_of_cycles_names_its_own_budget() {
+    let d = tempfile::tempdir().unwrap();
+    let (ok, timing, err) = morphosys(d.path(), &["timing"]);
+    assert!(ok, "{err}");
+    let slow = timing.replace("\nstatus = 2\n", "\nstatus = 1000000\n");
+    assert_ne!(slow, timing, "the timing file has a status field");
+    std::fs::write(d.path().join("slow.toml"), slow).unwrap();
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &["render", "--size", "64x64", "--timing", "slow.toml", "-q"],
+    );
+    assert!(!ok);
+    assert!(
+        err.contains("no halt within 2000000000 cycles")
+            && err.contains("per chip instance")
+            && !err.contains("--max-cycles"),
+        "{err}"
+    );
+    assert_eq!(err.trim().lines().count(), 1, "{err}");
+    std::fs::write(d.path().join("loop.s"), ".text\nl: b l\n").unwrap();
+    let (ok, _, err) = morphosys(d.path(), &["run", "loop.s", "--max-cycles", "500"]);
+    assert!(!ok && err.contains("raise --max-cycles (now 500)"), "{err}");
+}
