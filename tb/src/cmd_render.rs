@@ -260,14 +260,76 @@ fn default_out(scene: &Path) -> PathBuf {
 /// (every JSON is written whole or not at all, so a killed render leaves
 /// none).
 pub fn done_render(path: &Path, argv: &[String]) -> Option<serde_json::Value> {
-    let text = std::fs::read_to_string(path).ok()?;
-    let j = serde_json::from_str::<serde_json::Value>(&text).ok()?;
+    render_json(path, argv).ok()
+}
+
+/// A render's JSON at `path` when it is complete, made with `argv` and
+/// holds only values a render can give; else why not, in a few words.
+pub fn render_json(path: &Path, argv: &[String]) -> Result<serde_json::Value, String> {
+    let text = std::fs::read_to_string(path).map_err(|_| "missing".to_string())?;
+    let j = serde_json::from_str::<serde_json::Value>(&text)
+        .map_err(|_| "not complete JSON (a render that failed or was stopped)".to_string())?;
     let same = j["argv"].as_array().is_some_and(|v| {
         v.iter()
             .map(|x| x.as_str())
             .eq(argv.iter().map(|a| Some(a.as_str())))
     });
-    (same && j["cycles"].is_u64()).then_some(j)
+    if !same {
+        return Err("made with other arguments".into());
+    }
+    if let Some(why) = impossible_value(&j) {
+        return Err(why);
+    }
+    Ok(j)
+}
+
+/// The first value in a render's JSON that no render gives (a file edited
+/// or corrupted by hand), named with its value.
+fn impossible_value(j: &serde_json::Value) -> Option<String> {
+    let Some(cycles) = j["cycles"].as_u64().filter(|&c| c > 0) else {
+        return Some(format!("cycles {} is not a positive integer", j["cycles"]));
+    };
+    let chips = j["chip_instances"].as_u64().unwrap_or(1).max(1);
+    if cycles > chips.saturating_mul(crate::render::MAX_CYCLES_PER_CHIP) {
+        return Some(format!(
+            "cycles {cycles} exceed the budget of {chips} chip instance(s)"
+        ));
+    }
+    let fps = j["fps_at_300mhz"].as_f64();
+    let want = 300e6 / cycles as f64;
+    if fps.is_none_or(|f| (f - want).abs() > 1e-9 * want) {
+        return Some(format!(
+            "fps_at_300mhz {} is not 300 MHz / {cycles} cycles",
+            j["fps_at_300mhz"]
+        ));
+    }
+    for k in [
+        "hit_agreement",
+        "active_rc_fraction",
+        "array_idle_on_control",
+        "eye_misclassified",
+    ] {
+        if let Some(v) = j.get(k).filter(|v| !v.is_null()) {
+            if !v.as_f64().is_some_and(|x| (0.0..=1.0).contains(&x)) {
+                return Some(format!("{k} {v} is not a fraction (0 to 1)"));
+            }
+        }
+    }
+    // PSNR of 8-bit images: 0 dB at the worst; identical images are
+    // written as null (infinite).
+    if let Some(v) = j.get("psnr_db").filter(|v| !v.is_null()) {
+        if !v.as_f64().is_some_and(|x| (0.0..=200.0).contains(&x)) {
+            return Some(format!("psnr_db {v} is not a PSNR of 8-bit images"));
+        }
+    }
+    for k in ["objects_tested_per_ray", "ray_tests_per_ray"] {
+        if let Some(v) = j.get(k).filter(|v| !v.is_null()) {
+            if !v.as_f64().is_some_and(|x| x.is_finite() && x >= 0.0) {
+                return Some(format!("{k} {v} is not a count per ray"));
+            }
+        }
+    }
+    None
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {

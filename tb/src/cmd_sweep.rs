@@ -1028,10 +1028,13 @@ pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
         let p = &pts[job.point];
         let argv = render_argv(pdir, &plan.scene[p.scene].file, &p.cfg, &job.name);
         let json = dir.join("points").join(format!("{}.json", job.name));
-        let j = crate::cmd_render::done_render(&json, &argv);
-        if j.is_none() {
-            missing.push(job.name.clone());
-        }
+        let j = match crate::cmd_render::render_json(&json, &argv) {
+            Ok(j) => Some(j),
+            Err(why) => {
+                missing.push(format!("{} ({why})", job.name));
+                None
+            }
+        };
         measured.push(j);
     }
     let rows: Vec<Row> = pts
@@ -1044,7 +1047,7 @@ pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
         .collect();
     if !missing.is_empty() {
         eprintln!(
-            "{} of {} renders missing, failed or made with other arguments (no complete {}/points/NAME.json): {}",
+            "{} of {} renders left out (no complete {}/points/NAME.json made with the plan's arguments): {}",
             missing.len(),
             jobs.len(),
             dir.display(),

@@ -173,10 +173,7 @@ fn killed_render_leaves_no_complete_json_and_merge_names_it() {
     // The merge names every render it lacks and fails: nothing is done.
     let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan"]);
     assert!(!ok);
-    assert!(
-        err.contains("default-paper,") || err.contains("default-paper\n"),
-        "{err}"
-    );
+    assert!(err.contains("default-paper ("), "{err}");
     assert!(err.contains("no render of the plan is complete"), "{err}");
     assert!(!plan.join("results.csv").exists());
 }
@@ -485,4 +482,80 @@ fn file_names_cannot_inject_commands_into_a_plan() {
     assert!(err.contains("--plan") && err.contains("not UTF-8"), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "{err}");
     assert!(!d.join(bad).exists());
+}
+
+/// A point's JSON holding a value no render gives (edited or corrupted:
+/// a hit agreement of 1e308, a PSNR of -1e308, cycles of u64::MAX) is left
+/// out of the merge and named with the value, never written into
+/// results.csv.
+#[test]
+fn merge_leaves_out_impossible_values_and_names_them() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes/spd/tetra-1.nff")
+        .display()
+        .to_string();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            &scene,
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--plan",
+            "plan",
+        ],
+    );
+    assert!(ok, "{err}");
+    let jobs = std::fs::read_to_string(d.join("plan/jobs.txt")).unwrap();
+    for line in jobs.lines() {
+        let st = Command::new("bash")
+            .args(["-c", line])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(st.success(), "{line}");
+    }
+    let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan", "--out-dir", "good"]);
+    assert!(ok, "{err}");
+    let good = std::fs::read_to_string(d.join("good/results.csv")).unwrap();
+    let mut points: Vec<_> = std::fs::read_dir(d.join("plan/points"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    points.sort();
+    assert!(points.len() >= 3, "{points:?}");
+    let edits: [(&str, serde_json::Value, &str); 3] = [
+        ("hit_agreement", serde_json::json!(1e308), "hit_agreement"),
+        ("psnr_db", serde_json::json!(-1e308), "psnr_db"),
+        ("cycles", serde_json::json!(u64::MAX), "cycles"),
+    ];
+    let mut names = Vec::new();
+    for ((key, value, says), p) in edits.iter().zip(&points) {
+        let mut j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(p).unwrap()).unwrap();
+        j[*key] = value.clone();
+        std::fs::write(p, serde_json::to_string(&j).unwrap()).unwrap();
+        names.push((p.file_stem().unwrap().to_string_lossy().into_owned(), *says));
+    }
+    let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan", "--out-dir", "bad"]);
+    assert!(ok, "{err}");
+    for (name, says) in &names {
+        assert!(err.contains(&format!("{name} ({says}")), "{name}: {err}");
+    }
+    let bad = std::fs::read_to_string(d.join("bad/results.csv")).unwrap();
+    assert_eq!(
+        bad.lines().count() + names.len(),
+        good.lines().count(),
+        "{bad}"
+    );
+    assert!(
+        !bad.contains("1e308") && !bad.contains("18446744073709551615"),
+        "{bad}"
+    );
 }
