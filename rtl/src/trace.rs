@@ -1594,15 +1594,24 @@ fn human_bytes(b: f64) -> String {
 }
 
 /// Temporary files are created 0600; outputs are ordinary files (0644).
-fn readable(f: &File) -> io::Result<()> {
+/// A temporary file in `dir` (named by `b`) that becomes `target`: with
+/// the mode `target` has when it exists, else as any new file (0666 less
+/// the umask), not tempfile's private 0600.
+fn output_tempfile(
+    b: &mut tempfile::Builder,
+    dir: &Path,
+    target: &Path,
+) -> io::Result<tempfile::NamedTempFile> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        f.set_permissions(std::fs::Permissions::from_mode(0o644))?;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
     }
-    #[cfg(not(unix))]
-    let _ = f;
-    Ok(())
+    let tmp = b.tempfile_in(dir)?;
+    if let Ok(m) = std::fs::metadata(target) {
+        tmp.as_file().set_permissions(m.permissions())?;
+    }
+    Ok(tmp)
 }
 
 /// The waveforms being written right now (their temporary files), for a
@@ -1655,8 +1664,7 @@ fn stage(path: &Path, text: &str) -> io::Result<tempfile::NamedTempFile> {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)?;
-    readable(tmp.as_file())?;
+    let mut tmp = output_tempfile(&mut tempfile::Builder::new(), dir, path)?;
     tmp.write_all(text.as_bytes())?;
     Ok(tmp)
 }
@@ -1823,15 +1831,17 @@ impl Tracer {
                     .file_name()
                     .map_or_else(|| "waveform".into(), |n| n.to_string_lossy().into_owned());
                 remove_stale_partials(&dir, &name);
-                let tmp = tempfile::Builder::new()
-                    .prefix(&format!(".{name}.{}.", std::process::id()))
-                    .suffix(".partial")
-                    .tempfile_in(&dir)?;
+                let tmp = output_tempfile(
+                    tempfile::Builder::new()
+                        .prefix(&format!(".{name}.{}.", std::process::id()))
+                        .suffix(".partial"),
+                    &dir,
+                    &target,
+                )?;
                 let (file, tmp_path) = tmp.into_parts();
                 if let Ok(mut v) = PARTIALS.lock() {
                     v.push(tmp_path.to_path_buf());
                 }
-                readable(&file)?;
                 (file, Some(tmp_path), target)
             }
         };

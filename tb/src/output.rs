@@ -181,7 +181,7 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
                 Some(d) if !d.as_os_str().is_empty() => d,
                 _ => Path::new("."),
             };
-            let tmp = tempfile::NamedTempFile::new_in(dir).with_context(what)?;
+            let tmp = new_output_file(dir, &p).with_context(what)?;
             let tmp_path = tmp.path().to_path_buf();
             register_temporary(&tmp_path);
             let done = finish_file(tmp, bytes, &p).with_context(what);
@@ -191,17 +191,31 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
     }
 }
 
-/// Fill the temporary file and rename it onto `p`.
-fn finish_file(mut tmp: tempfile::NamedTempFile, bytes: &[u8], p: &Path) -> std::io::Result<()> {
-    tmp.write_all(bytes)?;
-    // A temporary file is created private (0600); the output is an
-    // ordinary file.
+/// The temporary file in `dir` that becomes the output `p`: with the mode
+/// `p` has when it exists (an overwritten output keeps its permissions),
+/// else as any new file (0666 less the umask), not tempfile's private 0600.
+fn new_output_file(dir: &Path, p: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))?;
+        let mut b = tempfile::Builder::new();
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+        let tmp = b.tempfile_in(dir)?;
+        if let Ok(m) = std::fs::metadata(p) {
+            tmp.as_file().set_permissions(m.permissions())?;
+        }
+        Ok(tmp)
     }
+    #[cfg(not(unix))]
+    {
+        let _ = p;
+        tempfile::NamedTempFile::new_in(dir)
+    }
+}
+
+/// Fill the temporary file and rename it onto `p`.
+fn finish_file(mut tmp: tempfile::NamedTempFile, bytes: &[u8], p: &Path) -> std::io::Result<()> {
+    tmp.write_all(bytes)?;
     tmp.persist(p).map_err(|e| e.error)?;
     Ok(())
 }

@@ -252,3 +252,42 @@ fn a_waveforms_side_files_cannot_overwrite_an_input_or_an_output() {
     assert!(!ok);
     assert!(err.contains("code_labels") && err.contains("FILE"), "{err}");
 }
+
+/// An output keeps the permissions of the file it replaces, and a new one
+/// gets the umask's (issue 32, item 11: every output was made 0644).
+#[test]
+fn outputs_keep_their_mode_and_new_ones_follow_the_umask() {
+    use std::os::unix::fs::PermissionsExt;
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let mode = |f: &str| std::fs::metadata(d.join(f)).unwrap().permissions().mode() & 0o777;
+    let bin = env!("CARGO_BIN_EXE_morphosys");
+    let sh = |cmd: &str| {
+        let st = std::process::Command::new("bash")
+            .current_dir(d)
+            .args(["-c", &format!("umask 077 && '{bin}' {cmd}")])
+            .output()
+            .unwrap();
+        assert!(
+            st.status.success(),
+            "{cmd}: {}",
+            String::from_utf8_lossy(&st.stderr)
+        );
+    };
+    // New files, umask 077: private.
+    sh("spd tetra --size 1 --out t.nff");
+    assert_eq!(mode("t.nff"), 0o600);
+    sh("render t.nff --size 8x8 --out t.png --vcd w.vcd --trace-cycles 50 -q");
+    for f in ["t.png", "w.vcd", "w.gtkw", "w.code_labels.txt"] {
+        assert_eq!(mode(f), 0o600, "{f}");
+    }
+    // Existing files keep their mode, whatever the umask.
+    for f in ["t.nff", "t.png", "w.vcd", "w.gtkw"] {
+        std::fs::set_permissions(d.join(f), std::fs::Permissions::from_mode(0o640)).unwrap();
+    }
+    sh("spd tetra --size 1 --out t.nff");
+    sh("render t.nff --size 8x8 --out t.png --vcd w.vcd --trace-cycles 50 -q");
+    for f in ["t.nff", "t.png", "w.vcd", "w.gtkw"] {
+        assert_eq!(mode(f), 0o640, "{f}");
+    }
+}
