@@ -266,6 +266,16 @@ pub fn done_render(path: &Path, argv: &[String]) -> Option<serde_json::Value> {
 /// A render's JSON at `path` when it is complete, made with `argv` and
 /// holds only values a render can give; else why not, in a few words.
 pub fn render_json(path: &Path, argv: &[String]) -> Result<serde_json::Value, String> {
+    // Only a regular file can hold a finished render: a FIFO or device
+    // would block the read (or never end).
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => {}
+        Ok(_) => return Err("not a regular file".into()),
+        Err(_) => return Err("missing".into()),
+    }
+    if std::fs::metadata(path).is_ok_and(|m| m.len() > 64 << 20) {
+        return Err("larger than any render's JSON".into());
+    }
     let text = std::fs::read_to_string(path).map_err(|_| "missing".to_string())?;
     let j = serde_json::from_str::<serde_json::Value>(&text)
         .map_err(|_| "not complete JSON (a render that failed or was stopped)".to_string())?;

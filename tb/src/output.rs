@@ -36,14 +36,30 @@ fn is_stdout(path: &Path) -> bool {
         .any(|s| path.as_os_str() == *s)
 }
 
+/// A path naming an open descriptor: `/dev/fd/N`, `/dev/stdout`,
+/// `/dev/stderr`, `/proc/self/fd/N`, `/proc/PID/fd/N`.
+fn is_descriptor(path: &Path) -> bool {
+    let s = path.to_string_lossy();
+    if s.starts_with("/dev/fd/") || ["/dev/stdout", "/dev/stderr"].contains(&s.as_ref()) {
+        return true;
+    }
+    let parts: Vec<&str> = s.split('/').collect();
+    // "", "proc", self|PID, "fd", N
+    parts.len() == 5
+        && parts[1] == "proc"
+        && (parts[2] == "self" || parts[2].chars().all(|c| c.is_ascii_digit()))
+        && parts[3] == "fd"
+}
+
 fn target(path: &Path) -> Result<Target> {
     if is_stdout(path) {
         return Ok(Target::Stdout);
     }
     // `/dev/stdout`, `/dev/fd/3`, `/proc/self/fd/1`: a descriptor's file,
     // written through even when it is a regular file (replacing it would
-    // leave the descriptor on the old, unlinked file).
-    if (path.starts_with("/dev") || path.starts_with("/proc")) && path.exists() {
+    // leave the descriptor on the old, unlinked file). Any other regular
+    // file, under /dev or not (`/dev/shm/r.json`), is replaced.
+    if is_descriptor(path) && path.exists() {
         return Ok(Target::Stream(path.to_path_buf()));
     }
     match std::fs::metadata(path) {
@@ -168,8 +184,12 @@ pub fn write(path: &Path, bytes: &[u8]) -> Result<()> {
                 .with_context(what)
         }
         Target::Stream(p) => {
+            // A descriptor's regular file is written from its start, as the
+            // shell's `>` would (a device or FIFO has nothing to truncate).
+            let regular = std::fs::metadata(&p).is_ok_and(|m| m.is_file());
             let mut f = std::fs::OpenOptions::new()
                 .write(true)
+                .truncate(regular)
                 .open(&p)
                 .with_context(what)?;
             f.write_all(bytes)

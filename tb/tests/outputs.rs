@@ -291,3 +291,116 @@ fn outputs_keep_their_mode_and_new_ones_follow_the_umask() {
         assert_eq!(mode(f), 0o640, "{f}");
     }
 }
+
+/// A regular file under /dev (`/dev/shm/...`) is an ordinary output,
+/// replaced whole; a descriptor's regular file (`/dev/fd/N` opened
+/// read-write over a longer file) is written from its start and cut to the
+/// new length. Either way the JSON is exactly the render's (issue 32,
+/// item 4: the old tail stayed after the new JSON).
+#[test]
+fn regular_files_under_dev_and_descriptors_are_written_whole() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene();
+    let long = "x".repeat(20_000);
+    let shm = Path::new("/dev/shm");
+    if shm.is_dir() {
+        let f = shm.join(format!("morphosys-test-{}.json", std::process::id()));
+        std::fs::write(&f, &long).unwrap();
+        let (ok, _, err) = morphosys(
+            d,
+            &[
+                "render",
+                &s,
+                "--size",
+                "8x8",
+                "--out",
+                "/dev/null",
+                "--json",
+                f.to_str().unwrap(),
+            ],
+        );
+        let text = std::fs::read_to_string(&f).unwrap();
+        let _ = std::fs::remove_file(&f);
+        assert!(ok, "{err}");
+        serde_json::from_str::<serde_json::Value>(&text).expect("whole JSON");
+    }
+    std::fs::write(d.join("fd.json"), &long).unwrap();
+    let bin = env!("CARGO_BIN_EXE_morphosys");
+    let st = std::process::Command::new("bash")
+        .current_dir(d)
+        .args([
+            "-c",
+            &format!(
+                "'{bin}' render '{s}' --size 8x8 --out /dev/null --json /dev/fd/4 4<> fd.json"
+            ),
+        ])
+        .output()
+        .unwrap();
+    assert!(
+        st.status.success(),
+        "{}",
+        String::from_utf8_lossy(&st.stderr)
+    );
+    let text = std::fs::read_to_string(d.join("fd.json")).unwrap();
+    serde_json::from_str::<serde_json::Value>(&text).expect("whole JSON through the descriptor");
+}
+
+/// `render --json FIFO --skip-done` renders into the FIFO instead of
+/// blocking on reading it, and `sweep --merge` with a FIFO among its points
+/// names it instead of hanging (issue 32, item 12). Bounded by `timeout`.
+#[test]
+fn a_fifo_where_a_finished_render_is_looked_for_does_not_hang() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene();
+    let bin = env!("CARGO_BIN_EXE_morphosys");
+    let run = |cmd: &str| {
+        std::process::Command::new("bash")
+            .current_dir(d)
+            .args(["-c", cmd])
+            .output()
+            .unwrap()
+    };
+    assert!(run("mkfifo f.json").status.success());
+    let out = run(&format!(
+        "timeout 20 '{bin}' render '{s}' --size 8x8 --out /dev/null --json f.json --skip-done & \
+         timeout 20 cat f.json > got.json; wait $!"
+    ));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let got = std::fs::read_to_string(d.join("got.json")).unwrap();
+    serde_json::from_str::<serde_json::Value>(&got).expect("the render's JSON through the FIFO");
+    // A plan whose points folder holds a FIFO for one render.
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            &s,
+            "--only",
+            "broadcast",
+            "--size",
+            "8x8",
+            "--plan",
+            "plan",
+        ],
+    );
+    assert!(ok, "{err}");
+    let jobs = std::fs::read_to_string(d.join("plan/jobs.txt")).unwrap();
+    let first = jobs.lines().next().unwrap();
+    let name = first
+        .split(" --json ")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .unwrap();
+    assert!(run(&format!("mkfifo '{name}'")).status.success());
+    let out = run(&format!(
+        "timeout 20 '{bin}' sweep --merge plan --out-dir m"
+    ));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_ne!(out.status.code(), Some(124), "the merge hung");
+    assert!(err.contains("not a regular file"), "{err}");
+}
