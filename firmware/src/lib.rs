@@ -4,6 +4,7 @@
 
 pub mod asm;
 pub mod bsp;
+pub mod input;
 pub mod scene;
 pub mod scene_image;
 pub mod tracer;

@@ -276,7 +276,7 @@ pub fn render_json(path: &Path, argv: &[String]) -> Result<serde_json::Value, St
     if std::fs::metadata(path).is_ok_and(|m| m.len() > 64 << 20) {
         return Err("larger than any render's JSON".into());
     }
-    let text = std::fs::read_to_string(path).map_err(|_| "missing".to_string())?;
+    let text = firmware::input::read_to_string(path).map_err(|_| "missing".to_string())?;
     let j = serde_json::from_str::<serde_json::Value>(&text)
         .map_err(|_| "not complete JSON (a render that failed or was stopped)".to_string())?;
     let same = j["argv"].as_array().is_some_and(|v| {
@@ -427,7 +427,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     let program = match &a.firmware {
         Some(p) => Some((
             p.display().to_string(),
-            std::fs::read_to_string(p)
+            firmware::input::read_to_string(p)
                 .with_context(|| format!("{}: cannot read the firmware", p.display()))?,
         )),
         None => None,

@@ -13,7 +13,8 @@ use crate::cli::TraceWindow;
 
 /// Assembly source, or an image written by `morphosys asm -o`.
 pub fn load_program(path: &Path) -> anyhow::Result<Image> {
-    let bytes = std::fs::read(path).with_context(|| format!("reading {}", path.display()))?;
+    let bytes =
+        firmware::input::read(path).with_context(|| format!("reading {}", path.display()))?;
     if Image::is_image(&bytes) {
         return Image::from_bytes(&bytes).map_err(|e| anyhow!("{}: {e}", path.display()));
     }
@@ -155,7 +156,7 @@ pub fn command(a: RunArgs) -> anyhow::Result<()> {
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     // The source's `.datapath` unless --datapath says otherwise (and then
     // they must agree).
-    let source = std::fs::read(&a.file)
+    let source = firmware::input::read(&a.file)
         .ok()
         .filter(|b| !Image::is_image(b))
         .and_then(|b| String::from_utf8(b).ok());

@@ -82,7 +82,8 @@ pub fn hit_map_bytes(width: u32, height: u32, hits: &[u32]) -> Vec<u8> {
 }
 
 pub fn read_hits(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
-    let bytes = std::fs::read(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let bytes =
+        firmware::input::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     let bad = || {
         anyhow::anyhow!(
             "{}: not a hit map (expected 'MSHITS1', size, u32 per pixel)",

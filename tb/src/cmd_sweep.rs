@@ -924,7 +924,7 @@ fn write_plan(
             None if sc.file == crate::cmd_scene::default_scene() && !sc.file.is_file() => {
                 crate::cmd_scene::DEFAULT_SCENE.as_bytes().to_vec()
             }
-            None => std::fs::read(&sc.file)
+            None => firmware::input::read(&sc.file)
                 .with_context(|| format!("{}: cannot read the scene", sc.file.display()))?,
         };
         drop(scene);
@@ -935,7 +935,7 @@ fn write_plan(
     let mut timing = Vec::new();
     for ((name, _), from) in files.iter().zip(&a.timing) {
         let rel = Path::new("timing").join(format!("{name}.toml"));
-        let bytes = std::fs::read(from)
+        let bytes = firmware::input::read(from)
             .with_context(|| format!("{}: cannot read the timing file", from.display()))?;
         write_output(&dir.join(&rel), &bytes)?;
         timing.push(rel);
@@ -1000,7 +1000,7 @@ fn write_plan(
 /// with other arguments are named and left out.
 pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
     let plan_path = dir.join(PLAN_FILE);
-    let text = std::fs::read_to_string(&plan_path).with_context(|| {
+    let text = firmware::input::read_to_string(&plan_path).with_context(|| {
         format!(
             "--merge {}: no plan there (cannot read {PLAN_FILE})",
             dir.display()

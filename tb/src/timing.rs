@@ -271,7 +271,7 @@ pub fn parse(text: &str, name: &str) -> Result<Timing> {
 
 /// Read a timing file.
 pub fn load(path: &Path) -> Result<Timing> {
-    let text = std::fs::read_to_string(path)
+    let text = firmware::input::read_to_string(path)
         .map_err(|e| anyhow!("{}: cannot read the timing file: {e}", path.display()))?;
     parse(&text, &path.display().to_string())
 }

@@ -252,3 +252,47 @@ fn a_render_out_of_cycles_names_its_own_budget() {
     let (ok, _, err) = morphosys(d.path(), &["run", "loop.s", "--max-cycles", "500"]);
     assert!(!ok && err.contains("raise --max-cycles (now 500)"), "{err}");
 }
+
+/// Inputs that are endless streams (`/dev/zero`, a FIFO fed by `yes`) are
+/// read up to the same 64 MB as files and refused there, by every command
+/// that reads one (issue 32, item 5: they were read until memory ran out).
+/// Bounded by `timeout`.
+#[test]
+fn endless_inputs_stop_at_the_input_limit() {
+    let d = tempfile::tempdir().unwrap();
+    let bin = env!("CARGO_BIN_EXE_morphosys");
+    let sh = |cmd: &str| {
+        let out = std::process::Command::new("bash")
+            .current_dir(d.path())
+            .args(["-c", &format!("timeout 60 {cmd}")])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    for args in [
+        "reference /dev/zero",
+        "run /dev/zero",
+        "asm /dev/zero",
+        "render --size 8x8 --firmware /dev/zero",
+        "render --size 8x8 --timing /dev/zero",
+    ] {
+        let (code, err) = sh(&format!("'{bin}' {args}"));
+        assert_eq!(code, Some(1), "{args}: {err}");
+        assert!(
+            err.contains("/dev/zero") && err.contains("more than 64 MB"),
+            "{args}: {err}"
+        );
+        assert_eq!(err.trim().lines().count(), 1, "{args}: {err}");
+    }
+    let (code, err) = sh(&format!(
+        "bash -c 'mkfifo y.nff; (yes > y.nff 2>/dev/null &); '\"'{bin}'\"' reference y.nff'"
+    ));
+    assert_eq!(code, Some(1), "{err}");
+    assert!(
+        err.contains("y.nff") && err.contains("more than 64 MB"),
+        "{err}"
+    );
+}

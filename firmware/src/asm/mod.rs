@@ -104,7 +104,7 @@ const MAX_ERRORS: usize = 50;
 
 /// Assemble a file from disk.
 pub fn assemble_file(path: &std::path::Path) -> Result<Image, String> {
-    let bytes = std::fs::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let bytes = crate::input::read(path).map_err(|e| format!("{}: {e}", path.display()))?;
     if Image::is_image(&bytes) {
         return Err(format!(
             "{}: this is an assembled image (what `morphosys asm -o` writes), not source; `morphosys run` runs it",

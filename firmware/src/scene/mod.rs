@@ -208,7 +208,7 @@ impl Scene {
                 });
             }
         }
-        let text = std::fs::read_to_string(path).map_err(|e| SceneError {
+        let text = crate::input::read_to_string(path).map_err(|e| SceneError {
             file: name.clone(),
             line: 0,
             col: 0,
