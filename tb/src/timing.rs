@@ -174,7 +174,11 @@ pub fn toml_error(e: &toml::de::Error, text: &str, name: &str) -> anyhow::Error 
             let (l, c) = line_col(text, sp.start);
             anyhow!("{name}:{l}:{c}: {msg}")
         }
-        None => anyhow!("{name}: {msg}"),
+        // No position (the parser's nesting limit): the deepest line.
+        None => match firmware::scene::native::deepest_line(text) {
+            0 => anyhow!("{name}: {msg}"),
+            l => anyhow!("{name}:{l}: {msg}"),
+        },
     }
 }
 

@@ -296,3 +296,63 @@ fn endless_inputs_stop_at_the_input_limit() {
         "{err}"
     );
 }
+
+/// Errors that had no location get one, and a file with many errors is
+/// summed up (issue 32, item 9): a TOML nesting past the parser's limit
+/// names its line (scene and timing file), a camera angle too wide for
+/// the chip names the viewpoint's line, and a program cut short shows
+/// three errors and one line for the rest, not 150 lines.
+#[test]
+fn errors_are_located_and_summed_up() {
+    let d = tempfile::tempdir().unwrap();
+    let p = d.path();
+    let deep = format!(
+        "# a scene\n\n[{}]\n",
+        std::iter::repeat_n("a", 100).collect::<Vec<_>>().join(".")
+    );
+    std::fs::write(p.join("deep.toml"), &deep).unwrap();
+    fails_with(p, &["reference", "deep.toml"], &["deep.toml:3:"]);
+    fails_with(
+        p,
+        &["render", "--size", "8x8", "--timing", "deep.toml"],
+        &["deep.toml:3:"],
+    );
+    let wide = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff"),
+    )
+    .unwrap();
+    let v = wide.lines().position(|l| l.starts_with('v')).unwrap() + 1;
+    let wide: String = wide
+        .lines()
+        .map(|l| {
+            if l.starts_with("angle") {
+                "angle 179.9"
+            } else {
+                l
+            }
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    std::fs::write(p.join("wide.nff"), wide).unwrap();
+    fails_with(
+        p,
+        &["render", "wide.nff", "--size", "8x8"],
+        &[&format!("wide.nff:{v}:"), "too wide"],
+    );
+    let golden = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/golden/default.s"),
+    )
+    .unwrap();
+    std::fs::write(p.join("cut.s"), &golden[..20_000]).unwrap();
+    let (ok, _, err) = morphosys(p, &["asm", "cut.s"]);
+    assert!(!ok);
+    assert!(
+        err.lines().count() <= 12,
+        "{} lines: {err}",
+        err.lines().count()
+    );
+    assert!(
+        err.contains("more errors") && err.contains("undefined:"),
+        "{err}"
+    );
+}

@@ -83,13 +83,52 @@ impl std::error::Error for AsmError {}
 #[derive(Clone, Debug)]
 pub struct AsmErrors(pub Vec<AsmError>);
 
+/// Errors shown in full (each with its source line); the rest are
+/// summed up in one line.
+const ERRORS_SHOWN: usize = 3;
+
 impl fmt::Display for AsmErrors {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, e) in self.0.iter().enumerate() {
+        for (i, e) in self.0.iter().take(ERRORS_SHOWN).enumerate() {
             if i > 0 {
                 writeln!(f)?;
             }
             write!(f, "{e}")?;
+        }
+        let rest = &self.0[self.0.len().min(ERRORS_SHOWN)..];
+        if !rest.is_empty() {
+            let mut undefined: Vec<&str> = Vec::new();
+            for name in rest
+                .iter()
+                .filter_map(|e| e.message.strip_prefix("undefined symbol `"))
+                .filter_map(|m| m.split('`').next())
+            {
+                if !undefined.contains(&name) {
+                    undefined.push(name);
+                }
+            }
+            let lines: Vec<usize> = rest.iter().map(|e| e.line).collect();
+            write!(
+                f,
+                "\n... and {} more error{} (lines {}..={})",
+                rest.len(),
+                if rest.len() == 1 { "" } else { "s" },
+                lines.iter().min().unwrap_or(&0),
+                lines.iter().max().unwrap_or(&0)
+            )?;
+            if !undefined.is_empty() {
+                let shown = undefined.len().min(8);
+                write!(
+                    f,
+                    "; undefined: {}{}",
+                    undefined[..shown].join(", "),
+                    if undefined.len() > shown { ", ..." } else { "" }
+                )?;
+                if undefined.len() >= 10 {
+                    write!(f, " (is the file cut short?)")?;
+                }
+            }
+            writeln!(f)?;
         }
         Ok(())
     }

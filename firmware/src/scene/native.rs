@@ -223,6 +223,31 @@ fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
 }
 
 /// Line and column (1-based) of a byte offset.
+/// Where a TOML error the parser gives no position for (its nesting limit:
+/// "recursion limit") most likely is: the first line that nests deepest
+/// (dotted keys, tables, arrays and inline tables, outside strings).
+/// 1-based; 0 for an empty text.
+pub fn deepest_line(text: &str) -> usize {
+    let mut best = (0usize, 0usize);
+    for (k, line) in text.lines().enumerate() {
+        let (mut depth, mut quote) = (0usize, None::<char>);
+        for c in line.chars() {
+            match (quote, c) {
+                (Some(q), c) if c == q => quote = None,
+                (Some(_), _) => {}
+                (None, '"' | '\'') => quote = Some(c),
+                (None, '#') => break,
+                (None, '.' | '[' | '{') => depth += 1,
+                _ => {}
+            }
+        }
+        if depth > best.0 {
+            best = (depth, k + 1);
+        }
+    }
+    best.1
+}
+
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
     Lines::of(text).at(offset)
 }
@@ -271,7 +296,9 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
         });
     }
     let def: File = toml::from_str(text).map_err(|e| {
-        let (line, col) = e.span().map_or((0, 0), |s| line_col(text, s.start));
+        let (line, col) = e
+            .span()
+            .map_or((deepest_line(text), 0), |s| line_col(text, s.start));
         SceneError {
             file: file.into(),
             line,

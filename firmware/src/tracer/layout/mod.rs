@@ -425,7 +425,7 @@ fn build_as(
     w.fb.extend(table_slots_for(128, xb));
     w.push(w.one());
     w.push(w.max());
-    let (eye, kd) = camera(&mut w, scene, opt).map_err(|m| err(0, m))?;
+    let (eye, kd) = camera(&mut w, scene, opt).map_err(|m| err(scene.lines.camera, m))?;
 
     let refract = ChipType::ALL
         .iter()
