@@ -321,6 +321,11 @@ pub const FST_SECTION_BYTES: usize = 64 << 20;
 /// The largest waveform written by default (4 GiB).
 pub const MAX_TRACE_BYTES: u64 = 4 << 30;
 
+/// How many times smaller an FST is than the VCD of the same window, at
+/// the least (measured on render windows: 11 to 19 times); the size
+/// limits, counted in VCD bytes, allow an FST this many times more.
+pub const FST_SMALLER: f64 = 10.0;
+
 /// Estimated VCD bytes per traced signal per cycle: about a quarter of the
 /// signals change in a typical cycle of the tracer, at about 8 bytes a
 /// change (measured on `morphosys run` and `render` traces: 1.5 to 2.5).
@@ -1945,12 +1950,19 @@ impl Tracer {
             (None, None) => None,
         };
         if let Some(c) = cycles {
-            let est = (t.decls.len() + 2) as f64 * c as f64 * BYTES_PER_SIGNAL_CYCLE;
+            let vcd = (t.decls.len() + 2) as f64 * c as f64 * BYTES_PER_SIGNAL_CYCLE;
+            // An FST is written compressed: its estimate is the VCD's over
+            // FST_SMALLER.
+            let (est, kind) = if is_fst(&t.cfg.path) {
+                (vcd / FST_SMALLER, "FST")
+            } else {
+                (vcd, "VCD")
+            };
             if est > t.cfg.max_bytes as f64 {
                 return Err(io::Error::new(
                     io::ErrorKind::InvalidInput,
                     format!(
-                        "tracing {} signals over up to {c} cycles would write about {}, over the {} limit; \
+                        "tracing {} signals over up to {c} cycles would write about {} of {kind}, over the {} limit; \
                          narrow it with --trace-cycles and --trace-scope (e.g. `--trace-scope tinyrisc,array.rc_r0_c0`)",
                         t.decls.len(),
                         human_bytes(est),
@@ -2092,13 +2104,20 @@ impl Tracer {
             self.digits_cycle = self.first_cycle_at(self.digits_below);
         }
         self.bytes += 2 * (self.digits + 2) + 6 + (64 - cycle.leading_zeros()).max(1) as u64 + 6;
-        if self.bytes > self.cfg.max_bytes {
+        // `bytes` counts the VCD text; an FST is at least FST_SMALLER
+        // times smaller.
+        let written = if is_fst(&self.cfg.path) {
+            self.bytes as f64 / FST_SMALLER
+        } else {
+            self.bytes as f64
+        };
+        if written > self.cfg.max_bytes as f64 {
             // An open-ended trace that outgrew the limit stops here, and says so.
             self.truncated_at = Some(cycle + 1);
             let msg = format!(
-                "waveform stopped at cycle {} after {} (limit {}); narrow it with --trace-cycles and --trace-scope",
+                "waveform stopped at cycle {} after about {} (limit {}); narrow it with --trace-cycles and --trace-scope",
                 cycle + 1,
-                human_bytes(self.bytes as f64),
+                human_bytes(written),
                 human_bytes(self.cfg.max_bytes as f64)
             );
             eprintln!("morphosys: warning: {msg}");

@@ -337,3 +337,27 @@ fn a_render_waveform_names_the_pc_and_the_context_by_the_firmware_labels() {
         );
     }
 }
+
+/// The size limit counts an FST as what it is, compressed (issue 32,
+/// item 13: it used the VCD estimate): a window of all signals over 1.5M
+/// cycles is refused as VCD (about 5.5 GB) and taken as FST (about a tenth).
+#[test]
+fn the_size_limit_counts_an_fst_compressed() {
+    let dir = tempfile::tempdir().unwrap();
+    let window = [
+        "render",
+        "--size",
+        "8x8",
+        "--trace-scope",
+        "all",
+        "--trace-cycles",
+        "1500000",
+        "--vcd",
+    ];
+    let (ok, _, err) = common::morphosys(dir.path(), &[&window[..], &["big.vcd"]].concat());
+    assert!(!ok && err.contains("of VCD, over the"), "{err}");
+    assert!(!dir.path().join("big.vcd").exists());
+    let (ok, _, err) = common::morphosys(dir.path(), &[&window[..], &["big.fst"]].concat());
+    assert!(ok, "{err}");
+    assert!(dir.path().join("big.fst").is_file());
+}
