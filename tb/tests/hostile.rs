@@ -356,3 +356,49 @@ fn errors_are_located_and_summed_up() {
         "{err}"
     );
 }
+
+/// A polygon of many short edges is not degenerate (issue 32, item 15: a
+/// 100,000-vertex circle was refused as 'collinear or coincident', its
+/// corners being judged against the scene's size, while a 100,000-vertex
+/// square passed): the reference renders it, and the chip refuses it only
+/// for what its format cannot hold, saying so.
+#[test]
+fn a_polygon_of_many_short_edges_is_not_degenerate() {
+    let d = tempfile::tempdir().unwrap();
+    let n = 100_000;
+    let mut nff = String::from(NFF_HEAD);
+    nff.push_str(&format!("p {n}\n"));
+    for k in 0..n {
+        let a = std::f64::consts::TAU * k as f64 / n as f64;
+        nff.push_str(&format!("{:.9} {:.9} 0\n", a.cos(), a.sin()));
+    }
+    std::fs::write(d.path().join("circle.nff"), nff).unwrap();
+    let (ok, out, err) = morphosys(
+        d.path(),
+        &[
+            "reference",
+            "circle.nff",
+            "--size",
+            "16x16",
+            "--out",
+            "c.png",
+        ],
+    );
+    assert!(ok, "{err}");
+    let hit: usize = out
+        .split(" eye rays (")
+        .nth(1)
+        .and_then(|r| r.split(' ').next())
+        .and_then(|h| h.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(
+        hit > 30,
+        "the disc covers about a fifth of the image: {out}"
+    );
+    let (ok, _, err) = morphosys(d.path(), &["render", "circle.nff", "--size", "16x16"]);
+    assert!(!ok);
+    assert!(
+        !err.contains("degenerate") && err.contains("circle.nff:11:"),
+        "{err}"
+    );
+}
