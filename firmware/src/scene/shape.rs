@@ -431,14 +431,9 @@ impl Shape {
                 if !is_corner(v[0], v[1], v[2], scale) {
                     return Some("polygon's first three vertices are collinear".into());
                 }
-                // The plane by Newell's normal: exact for a polygon of many
-                // short edges, where one corner's cross product is tiny.
-                let newell =
-                    (0..v.len()).fold(Vec3::ZERO, |a, i| a + v[i].cross(v[(i + 1) % v.len()]));
-                if newell.length() <= tiny * scale {
-                    return Some("polygon has collinear (or coincident) vertices".into());
-                }
-                let n = newell.normalized();
+                // The plane of the first corner (what the renderers use);
+                // its direction is accurate even where the corner is small.
+                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
                 let ext = self.bounds().extent().max_abs();
                 for (i, p) in v.iter().enumerate() {
                     if (*p - v[0]).dot(n).abs() > 1e-4 * ext {
