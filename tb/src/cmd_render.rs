@@ -255,17 +255,15 @@ fn default_out(scene: &Path) -> PathBuf {
     PathBuf::from(format!("{stem}-chip.png"))
 }
 
-/// The render JSON in `path` if it is complete and made with the arguments
-/// `argv`: it parses, records those arguments and has the frame's cycles
-/// (every JSON is written whole or not at all, so a killed render leaves
-/// none).
-pub fn done_render(path: &Path, argv: &[String]) -> Option<serde_json::Value> {
-    render_json(path, argv).ok()
-}
-
-/// A render's JSON at `path` when it is complete, made with `argv` and
-/// holds only values a render can give; else why not, in a few words.
-pub fn render_json(path: &Path, argv: &[String]) -> Result<serde_json::Value, String> {
+/// A render's JSON at `path` when it is complete, made with `argv` from
+/// the same `inputs` ([`crate::inputs`]: scene, timing, firmware, build)
+/// and holds only values a render can give; else why not, in a few words
+/// ("made before the scene changed" when only the inputs differ).
+pub fn render_json(
+    path: &Path,
+    argv: &[String],
+    inputs: &serde_json::Value,
+) -> Result<serde_json::Value, String> {
     // Only a regular file can hold a finished render: a FIFO or device
     // would block the read (or never end).
     match std::fs::metadata(path) {
@@ -286,6 +284,9 @@ pub fn render_json(path: &Path, argv: &[String]) -> Result<serde_json::Value, St
     });
     if !same {
         return Err("made with other arguments".into());
+    }
+    if let Some(what) = crate::inputs::changed(&j["inputs"], inputs) {
+        return Err(format!("made before {what} changed"));
     }
     if let Some(why) = impossible_value(&j) {
         return Err(why);
@@ -343,16 +344,31 @@ fn impossible_value(j: &serde_json::Value) -> Option<String> {
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {
+    let scene = load_scene(a.scene.as_deref())?;
+    let timing = crate::timing::load_or_default(a.timing.as_deref())?;
+    let firmware_text = match &a.firmware {
+        Some(p) => Some(
+            firmware::input::read_to_string(p)
+                .with_context(|| format!("{}: cannot read the firmware", p.display()))?,
+        ),
+        None => None,
+    };
+    let inputs = crate::inputs::inputs(&scene, &timing, firmware_text.as_deref());
     if let (true, Some(j)) = (a.skip_done, &a.json) {
-        if done_render(j, &a.argv).is_some() {
-            crate::report!(
-                "{}: already rendered with these arguments (--skip-done)",
-                j.display()
-            );
-            return Ok(());
+        match render_json(j, &a.argv, &inputs) {
+            Ok(_) => {
+                crate::report!(
+                    "{}: already rendered with these arguments and inputs (--skip-done)",
+                    j.display()
+                );
+                return Ok(());
+            }
+            Err(why) if why.starts_with("made before") => {
+                eprintln!("{}: {why}: rendering again", j.display())
+            }
+            Err(_) => {}
         }
     }
-    let scene = load_scene(a.scene.as_deref())?;
     // Every output checked before the frame is rendered.
     let out_path = a
         .out
@@ -422,15 +438,10 @@ pub fn command(a: RenderArgs) -> Result<()> {
         normals: a.normals,
     };
     let mut opt = opt;
-    let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     // --firmware: the file's program on the chip its `.datapath` names.
-    let program = match &a.firmware {
-        Some(p) => Some((
-            p.display().to_string(),
-            firmware::input::read_to_string(p)
-                .with_context(|| format!("{}: cannot read the firmware", p.display()))?,
-        )),
-        None => None,
+    let program = match (&a.firmware, firmware_text) {
+        (Some(p), Some(text)) => Some((p.display().to_string(), text)),
+        _ => None,
     };
     let mut choice = a.datapath;
     if let Some((name, text)) = &program {
@@ -505,6 +516,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     rep.json["argv"] = a.argv.clone().into();
+    rep.json["inputs"] = inputs;
     let out = out_path;
     if let Some(h) = &a.hits {
         write_output(

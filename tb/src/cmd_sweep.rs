@@ -78,6 +78,8 @@ struct Config {
     /// or a timing file's name).
     timing: Timing,
     timing_name: String,
+    /// Which `--timing` file it is (its index), if it is one.
+    timing_file: Option<usize>,
 }
 
 impl From<Knob> for Config {
@@ -89,6 +91,7 @@ impl From<Knob> for Config {
             nm: k.nm,
             timing: Timing::default(),
             timing_name: "default".into(),
+            timing_file: None,
         }
     }
 }
@@ -284,11 +287,12 @@ fn configs(width: u32, height: u32, files: &[(String, Timing)]) -> Vec<Config> {
             })
         });
     }
-    for (name, t) in files {
+    for (i, (name, t)) in files.iter().enumerate() {
         for opt in both {
             v.push(Config {
                 timing: *t,
                 timing_name: name.clone(),
+                timing_file: Some(i),
                 ..Config::from(Knob {
                     knob: "timing",
                     value: name.clone(),
@@ -538,22 +542,58 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
 
 /// The timing files' names (their stems) and timings.
 fn timing_files(paths: &[PathBuf]) -> Result<Vec<(String, Timing)>> {
+    let names = timing_names(paths);
     let mut files = Vec::new();
-    for p in paths {
-        // The series' name; a control character (a newline would split a
-        // planned job's line) becomes `_`.
-        let name: String = p
-            .file_stem()
-            .map_or_else(
-                || p.display().to_string(),
-                |s| s.to_string_lossy().into_owned(),
-            )
-            .chars()
-            .map(|c| if c.is_control() { '_' } else { c })
-            .collect();
+    for (p, name) in paths.iter().zip(names) {
         files.push((name, crate::timing::load(p)?));
     }
     Ok(files)
+}
+
+/// The series' names of the timing files `paths`: each file's stem, or,
+/// where that is not unique (two `t.toml` in different folders) or is a
+/// built-in series' ("default", "M1 issue"), the path as given; every
+/// name distinct. A control character (a newline would split a planned
+/// job's line) becomes `_`.
+fn timing_names(paths: &[PathBuf]) -> Vec<String> {
+    let clean = |s: String| -> String {
+        s.chars()
+            .map(|c| if c.is_control() { '_' } else { c })
+            .collect()
+    };
+    let stem = |p: &PathBuf| {
+        clean(p.file_stem().map_or_else(
+            || p.display().to_string(),
+            |s| s.to_string_lossy().into_owned(),
+        ))
+    };
+    let stems: Vec<String> = paths.iter().map(stem).collect();
+    let mut names: Vec<String> = Vec::new();
+    for (p, s) in paths.iter().zip(&stems) {
+        let shared = stems.iter().filter(|t| *t == s).count() > 1;
+        let mut name = if shared || s == "default" || s == "M1 issue" {
+            clean(p.display().to_string())
+        } else {
+            s.clone()
+        };
+        let base = name.clone();
+        let mut k = 2;
+        while names.contains(&name) || name == "default" || name == "M1 issue" {
+            name = format!("{base} ({k})");
+            k += 1;
+        }
+        names.push(name);
+    }
+    names
+}
+
+/// A timing file's copy in a plan (and its path in the jobs' arguments):
+/// numbered, so that two files of one name stay two.
+fn timing_copy_name(i: usize, name: &str) -> String {
+    format!(
+        "{i:02}-{}.toml",
+        plain_file_name(name.trim_end_matches(".toml"))
+    )
 }
 
 /// The configurations asked: every knob (or, with `--only broadcast`, the
@@ -677,13 +717,21 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     timing: c.timing,
                     ..Default::default()
                 };
-                let measured = if let Some(j) = crate::cmd_render::done_render(&json_path, &argv) {
+                let inputs = crate::inputs::inputs(scene, &c.timing, None);
+                let earlier = crate::cmd_render::render_json(&json_path, &argv, &inputs);
+                if let Err(why) = &earlier {
+                    if why.starts_with("made before") {
+                        bar.suspend(|| eprintln!("{name}: {why}: rendering again"));
+                    }
+                }
+                let measured = if let Ok(j) = earlier {
                     resumed += 1;
                     Ok(j)
                 } else {
                     crate::cmd_render::render_as(scene, &c.opt, &c.nm, &host).and_then(
                         |(_, mut rep)| {
                             rep.json["argv"] = argv.clone().into();
+                            rep.json["inputs"] = inputs.clone();
                             write_output(
                                 &json_path,
                                 (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
@@ -767,8 +815,11 @@ struct Plan {
     /// The knob sweep (`false`: `--only sizes`) and `--only broadcast`.
     knobs: bool,
     broadcast_only: bool,
-    /// Timing files, copied into the plan's folder (paths relative to it).
+    /// Timing files, copied into the plan's folder (paths relative to it),
+    /// and their series' names (a plan without them: the copies' stems).
     timing: Vec<PathBuf>,
+    #[serde(default)]
+    timing_names: Vec<String>,
     /// Every scene, copied or generated into the plan's `scenes/`.
     scene: Vec<SceneRef>,
 }
@@ -860,16 +911,16 @@ fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> Vec<String> 
     arg("--guard-bits", n.guard_bits.to_string());
     arg("--ray-offset-lsb", n.eps_lsb.to_string());
     arg("--normals", n.normals.name().into());
-    match c.timing_name.as_str() {
-        "default" => {}
-        "M1 issue" => arg("--timing", dir.join(M1_TIMING_FILE).display().to_string()),
-        t => arg(
+    match (c.timing_file, c.timing_name.as_str()) {
+        (Some(i), t) => arg(
             "--timing",
             dir.join("timing")
-                .join(format!("{t}.toml"))
+                .join(timing_copy_name(i, t))
                 .display()
                 .to_string(),
         ),
+        (None, "M1 issue") => arg("--timing", dir.join(M1_TIMING_FILE).display().to_string()),
+        (None, _) => {}
     }
     let points = dir.join("points");
     arg(
@@ -933,8 +984,8 @@ fn write_plan(
         refs.push(sc);
     }
     let mut timing = Vec::new();
-    for ((name, _), from) in files.iter().zip(&a.timing) {
-        let rel = Path::new("timing").join(format!("{name}.toml"));
+    for (i, ((name, _), from)) in files.iter().zip(&a.timing).enumerate() {
+        let rel = Path::new("timing").join(timing_copy_name(i, name));
         let bytes = firmware::input::read(from)
             .with_context(|| format!("{}: cannot read the timing file", from.display()))?;
         write_output(&dir.join(&rel), &bytes)?;
@@ -967,6 +1018,7 @@ fn write_plan(
         knobs: a.knobs,
         broadcast_only: a.broadcast_only,
         timing,
+        timing_names: files.iter().map(|(n, _)| n.clone()).collect(),
         scene: refs,
     };
     let toml_text = format!(
@@ -1015,20 +1067,36 @@ pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
     // The jobs' arguments name the plan's folder as it was when planned.
     let pdir = &plan.dir;
     let tfiles: Vec<PathBuf> = plan.timing.iter().map(|t| dir.join(t)).collect();
-    let files = timing_files(&tfiles)?;
+    let mut files = timing_files(&tfiles)?;
+    if plan.timing_names.len() == files.len() {
+        for ((name, _), n) in files.iter_mut().zip(&plan.timing_names) {
+            name.clone_from(n);
+        }
+    }
     let cfgs = if plan.knobs {
         asked_configs(size(&plan.size)?, plan.broadcast_only, &files)
     } else {
         vec![]
     };
     let (pts, jobs) = points(&plan.scene, &cfgs, size(&plan.family_size)?);
+    // The plan's copies of its scenes, read where the folder is now: what
+    // its renders read (their content digests must agree).
+    let mut scenes = Vec::new();
+    for sc in &plan.scene {
+        let name = sc.file.file_name().unwrap_or_default();
+        let local = dir.join("scenes").join(name);
+        let scene = firmware::scene::Scene::load(&local)
+            .with_context(|| format!("--merge {}: the plan's scene copy", dir.display()))?;
+        scenes.push(scene);
+    }
     let mut measured: Vec<Option<serde_json::Value>> = Vec::new();
     let mut missing = Vec::new();
     for job in &jobs {
         let p = &pts[job.point];
         let argv = render_argv(pdir, &plan.scene[p.scene].file, &p.cfg, &job.name);
         let json = dir.join("points").join(format!("{}.json", job.name));
-        let j = match crate::cmd_render::render_json(&json, &argv) {
+        let inputs = crate::inputs::inputs(&scenes[p.scene], &p.cfg.timing, None);
+        let j = match crate::cmd_render::render_json(&json, &argv, &inputs) {
             Ok(j) => Some(j),
             Err(why) => {
                 missing.push(format!("{} ({why})", job.name));

@@ -13,6 +13,7 @@ pub mod cmd_scene;
 pub mod cmd_spd;
 pub mod cmd_sweep;
 pub mod fuzz;
+pub mod inputs;
 pub mod metrics;
 pub mod output;
 pub mod profile;

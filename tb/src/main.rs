@@ -332,8 +332,10 @@ enum Command {
         #[arg(long, value_name = "auto|fine|coarse", default_value = "auto", value_parser = parse_normals)]
         normals: firmware::tracer::Normals,
         /// With --json: when that file already holds a complete render made
-        /// with these same arguments, say so and stop without rendering (a
-        /// rerun of a sweep plan's jobs runs only what is missing).
+        /// with these same arguments from the same scene, timing file,
+        /// firmware and build (their SHA-256 digests, `inputs` in the
+        /// JSON), say so and stop without rendering (a rerun of a sweep
+        /// plan's jobs runs only what is missing).
         #[arg(long, requires = "json")]
         skip_done: bool,
         /// Print (and put in the JSON) where the frame's cycles go: per RC kernel while the array works, per TinyRISC

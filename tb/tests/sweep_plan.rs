@@ -559,3 +559,196 @@ fn merge_leaves_out_impossible_values_and_names_them() {
         "{bad}"
     );
 }
+
+/// A finished render is taken again only when its inputs are unchanged
+/// (issue 32, item 3: the key was the arguments alone): a sweep resumed
+/// after its scene file was replaced renders every point again and says
+/// why; `render --skip-done` does the same; `sweep --merge` leaves out a
+/// point whose scene copy changed since its render.
+#[test]
+fn a_changed_scene_is_rendered_again_not_taken_from_before() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let scenes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd");
+    std::fs::copy(scenes.join("tetra-1.nff"), d.join("s.nff")).unwrap();
+    let sweep = [
+        "sweep",
+        "s.nff",
+        "--only",
+        "broadcast",
+        "--size",
+        "16x16",
+        "--out-dir",
+        "o",
+    ];
+    let (ok, _, err) = morphosys(d, &sweep);
+    assert!(ok, "{err}");
+    let (ok, _, err) = morphosys(d, &sweep);
+    assert!(ok && err.contains("taken from an earlier run"), "{err}");
+    std::fs::copy(scenes.join("jacks-1.nff"), d.join("s.nff")).unwrap();
+    let (ok, _, err) = morphosys(d, &sweep);
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("made before the scene changed: rendering again"),
+        "{err}"
+    );
+    assert!(!err.contains("taken from an earlier run"), "{err}");
+    let csv = std::fs::read_to_string(d.join("o/results.csv")).unwrap();
+    let row = csv.lines().nth(1).unwrap();
+    assert!(
+        row.starts_with("s.nff,9,"),
+        "jacks-1 has 9 primitives: {row}"
+    );
+    // render --skip-done.
+    let render = [
+        "render",
+        "s.nff",
+        "--size",
+        "8x8",
+        "--json",
+        "r.json",
+        "--skip-done",
+    ];
+    let (ok, _, err) = morphosys(d, &render);
+    assert!(ok, "{err}");
+    let (ok, out, err) = morphosys(d, &render);
+    assert!(ok && (out + &err).contains("already rendered"), "{err}");
+    std::fs::copy(scenes.join("tetra-1.nff"), d.join("s.nff")).unwrap();
+    let (ok, _, err) = morphosys(d, &render);
+    assert!(ok && err.contains("made before the scene changed"), "{err}");
+    // A plan whose scene copy changes after its renders.
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            "s.nff",
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--plan",
+            "plan",
+        ],
+    );
+    assert!(ok, "{err}");
+    for line in std::fs::read_to_string(d.join("plan/jobs.txt"))
+        .unwrap()
+        .lines()
+    {
+        let st = Command::new("bash")
+            .args(["-c", line])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(st.success(), "{line}");
+    }
+    let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan", "--out-dir", "m1"]);
+    assert!(ok && !err.contains("left out"), "{err}");
+    let copy = std::fs::read_dir(d.join("plan/scenes"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    std::fs::copy(scenes.join("jacks-1.nff"), &copy).unwrap();
+    let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan", "--out-dir", "m2"]);
+    assert!(!ok, "nothing of the plan is valid any more: {err}");
+    assert!(err.contains("made before the scene changed"), "{err}");
+}
+
+/// Timing files are told apart by more than their file names (issue 32,
+/// item 2): two `t.toml` in different folders make two series with their
+/// own figures, a file named `default.toml` is not the default chip, and a
+/// plan of them merges to what the sweep gives in one process.
+#[test]
+fn timing_files_of_one_name_stay_apart() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let (ok, base, err) = morphosys(d, &["timing"]);
+    assert!(ok, "{err}");
+    std::fs::create_dir_all(d.join("a")).unwrap();
+    std::fs::create_dir_all(d.join("b")).unwrap();
+    std::fs::write(d.join("a/t.toml"), &base).unwrap();
+    let slower = |n: &str| base.replace("\nstatus = 2\n", &format!("\nstatus = {n}\n"));
+    std::fs::write(d.join("b/t.toml"), slower("40")).unwrap();
+    std::fs::write(d.join("default.toml"), slower("80")).unwrap();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes/spd/tetra-1.nff")
+        .display()
+        .to_string();
+    let args = |out: &[&'static str]| {
+        let mut v: Vec<String> = [
+            "sweep",
+            &scene,
+            "--timing",
+            "a/t.toml",
+            "b/t.toml",
+            "default.toml",
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        v.extend(out.iter().map(|s| s.to_string()));
+        v
+    };
+    let run = |v: Vec<String>| {
+        let v: Vec<&str> = v.iter().map(String::as_str).collect();
+        morphosys(d, &v)
+    };
+    let (ok, _, err) = run(args(&["--out-dir", "o"]));
+    assert!(ok, "{err}");
+    let csv = std::fs::read_to_string(d.join("o/results.csv")).unwrap();
+    let cycles = |series: &str| -> Vec<u64> {
+        let head: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+        let (kv, kc) = (
+            head.iter().position(|h| *h == "value").unwrap(),
+            head.iter().position(|h| *h == "cycles").unwrap(),
+        );
+        csv.lines()
+            .skip(1)
+            .map(|l| l.split(',').collect::<Vec<_>>())
+            .filter(|f| f[kv] == series)
+            .map(|f| f[kc].parse().unwrap())
+            .collect()
+    };
+    let (a, b, def) = (
+        cycles("a/t.toml"),
+        cycles("b/t.toml"),
+        cycles("default.toml"),
+    );
+    assert_eq!((a.len(), b.len(), def.len()), (2, 2, 2), "{csv}");
+    assert!(
+        b.iter().zip(&a).all(|(b, a)| b > a),
+        "b is slower than a: {csv}"
+    );
+    assert!(
+        def.iter().zip(&b).all(|(d, b)| d > b),
+        "default.toml is slower still: {csv}"
+    );
+    // The same as a plan: its jobs run one by one, then merged.
+    let (ok, _, err) = run(args(&["--plan", "plan"]));
+    assert!(ok, "{err}");
+    for line in std::fs::read_to_string(d.join("plan/jobs.txt"))
+        .unwrap()
+        .lines()
+    {
+        let st = Command::new("bash")
+            .args(["-c", line])
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(st.success(), "{line}");
+    }
+    let (ok, _, err) = morphosys(d, &["sweep", "--merge", "plan", "--out-dir", "m"]);
+    assert!(ok, "{err}");
+    assert_eq!(
+        std::fs::read_to_string(d.join("m/results.csv")).unwrap(),
+        csv
+    );
+}
