@@ -188,6 +188,7 @@ pub fn render_built(
         "scene": scene.source,
         "warnings": warnings,
         "cycles": chip.cycles,
+        "firmware_cycles": chip.firmware_cycles,
         "fps_at_300mhz": chip.fps_at(300_000_000),
         "width": opt.width,
         "height": opt.height,
@@ -513,6 +514,21 @@ pub fn command(a: RenderArgs) -> Result<()> {
     };
     if let Some(p) = &chip.profile {
         rep.json["profile"] = profile_json(p);
+    }
+    if let Some(why) = chip.firmware_count_disagrees() {
+        let w = firmware::scene::Warning {
+            feature: "cycle-count".into(),
+            file: program
+                .as_ref()
+                .map_or_else(|| "the tracer firmware".into(), |(n, _)| n.clone()),
+            line: 0,
+            count: 0,
+            message: why,
+        };
+        eprintln!("{w}");
+        if let Some(list) = rep.json["warnings"].as_array_mut() {
+            list.push(serde_json::to_value(&w)?);
+        }
     }
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     rep.json["argv"] = a.argv.clone().into();

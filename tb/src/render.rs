@@ -34,9 +34,16 @@ pub struct ChipRender {
     pub rgb8: Vec<u8>,
     /// Per pixel the object the eye ray hit ([`NO_HIT`] for none).
     pub hits: Vec<u32>,
-    /// Frame cycles (start-up once plus every tile loop).
+    /// Frame cycles by the simulator's count: every chip instance from
+    /// reset to `halt`, its start-up (reset to the first `tile`) counted
+    /// once.
     pub cycles: u64,
+    /// The first chip instance's cycles from reset to the first `tile`.
     pub startup_cycles: u64,
+    /// The same frame by the firmware's own count (its `T_START` of the
+    /// first instance plus every instance's `T_END - T_START`), which the
+    /// program can get wrong: see [`ChipRender::firmware_count_disagrees`].
+    pub firmware_cycles: u64,
     pub stats: Stats,
     pub object_tests: u64,
     pub passes: u64,
@@ -66,6 +73,20 @@ pub struct RenderSettings {
 }
 
 impl ChipRender {
+    /// When the firmware's own count of the frame
+    /// ([`ChipRender::firmware_cycles`]) differs from the simulator's by
+    /// more than 1%: a sentence saying so. (The tracer's reads the counter
+    /// a few instructions from where the simulator splits start-up and
+    /// tile loop and from `halt`: a handful of cycles per chip instance.)
+    pub fn firmware_count_disagrees(&self) -> Option<String> {
+        let (sim, fw) = (self.cycles, self.firmware_cycles);
+        (sim.abs_diff(fw) as f64 > 0.01 * sim as f64).then(|| {
+            format!(
+                "the firmware's own count of the frame (T_START, T_END) is {fw} cycles, \
+                 the simulator counted {sim}: the figures are the simulator's"
+            )
+        })
+    }
     pub fn fps_at(&self, clock_hz: u64) -> f64 {
         if self.cycles == 0 {
             0.0
@@ -478,7 +499,7 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<Probe> {
     };
     for (gi, r) in runs.into_iter().enumerate() {
         let g = r?;
-        p.cycles += g.end.saturating_sub(g.start);
+        p.cycles += g.stats.cycles - g.startup.cycles;
         for (k, out) in g.out.iter().enumerate() {
             let (x0, y0) = groups[gi][k];
             for lane in 0..64u32 {
@@ -729,7 +750,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     let mut rgb8 = vec![0u8; (w * h * 3) as usize];
     let mut hits = vec![NO_HIT; (w * h) as usize];
     let mut stats = Stats::default();
-    let (mut cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
+    let (mut fw_cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
     let mut chip_seconds = 0.0;
     let mut profile = None;
     for (gi, r) in results.into_iter().enumerate() {
@@ -741,9 +762,10 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             });
         }
         if gi == 0 {
-            startup = g.start;
+            startup = g.startup.cycles;
+            fw_cycles = g.start;
         }
-        cycles += g.end.saturating_sub(g.start);
+        fw_cycles += g.end.saturating_sub(g.start);
         chip_seconds += g.seconds;
         tests += g.tests;
         passes += g.passes;
@@ -776,8 +798,9 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         height: h,
         rgb8,
         hits,
-        cycles: startup + cycles,
+        cycles: stats.cycles,
         startup_cycles: startup,
+        firmware_cycles: fw_cycles,
         stats,
         object_tests: tests,
         passes,

@@ -35,9 +35,11 @@ fn opts(w: u32, h: u32, traversal: Traversal) -> Options {
     }
 }
 
-/// The cycle counts published before the packet traversal existed
-/// (README, docs/tracer.md): the paper's traversal must keep them, with
-/// the kernels as they were then (`--normals coarse`).
+/// The cycle counts published for the paper's traversal (README,
+/// docs/tracer.md), with the kernels as they were then (`--normals
+/// coarse`): the firmware's own count of the frame (its `rdcyc` around the
+/// tile loop) must keep them, and the simulator's count, which the render
+/// reports, stays within a few cycles per chip instance of it.
 #[test]
 fn paper_traversal_keeps_its_cycle_counts() {
     let coarse = Numerics {
@@ -57,7 +59,12 @@ fn paper_traversal_keeps_its_cycle_counts() {
             None,
         )
         .unwrap();
-        assert_eq!(r.cycles, cycles, "{name}");
+        assert_eq!(r.firmware_cycles, cycles, "{name}");
+        assert!(
+            r.cycles.abs_diff(cycles) <= 16 * r.chips as u64,
+            "{name}: the simulator counted {}",
+            r.cycles
+        );
     }
 }
 

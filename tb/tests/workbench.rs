@@ -305,3 +305,78 @@ fn a_one_scene_knob_sweep_writes_no_scaling_chart() {
     };
     assert!(cycles("normals", "coarse") < cycles("paper", "fine"));
 }
+
+/// A frame's cycles are the simulator's count, whatever the program
+/// writes into `T_START` and `T_END`: a program that writes
+/// `T_END = T_START + 100` reports the cycles the chip ran, and one that
+/// halts before its tile loop reports the start-up it ran; both warn
+/// that the firmware's own count disagrees, on the terminal and in the
+/// JSON. The honest program's own count (the counter read by `rdcyc`)
+/// stays within a few cycles per chip instance of the simulator's.
+#[test]
+fn the_cycles_are_the_simulators_not_the_firmwares() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    let s = scene("tetra-1.nff");
+    let a = render(d, "a", &[&s, "--emit-asm", "fw.s"]);
+    let honest = cycles(&a);
+    let own = a["firmware_cycles"].as_u64().unwrap();
+    let chips = a["chip_instances"].as_u64().unwrap();
+    assert!(honest.abs_diff(own) <= 16 * chips, "{honest} vs {own}");
+    let warned = |j: &serde_json::Value| {
+        j["warnings"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|w| w["feature"] == "cycle-count")
+    };
+    assert!(!warned(&a));
+    let fw = std::fs::read_to_string(d.join("fw.s")).unwrap();
+    let end = "        rdcyc r1\n        sw r1, T_END(r0)\n";
+    assert!(fw.contains(end), "the tracer stores its counter in T_END");
+    let faked = fw.replacen(
+        end,
+        "        lw r1, T_START(r0)\n        addi r1, r1, 100\n        sw r1, T_END(r0)\n",
+        1,
+    );
+    std::fs::write(d.join("fake.s"), faked).unwrap();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "render",
+            &s,
+            "--size",
+            "32x32",
+            "--firmware",
+            "fake.s",
+            "--out",
+            "f.png",
+            "--json",
+            "f.json",
+        ],
+    );
+    assert!(ok, "{err}");
+    let f: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(d.join("f.json")).unwrap()).unwrap();
+    // One instruction more than the honest program, no fewer cycles.
+    assert!(
+        cycles(&f) >= honest && cycles(&f) <= honest + 8,
+        "{} against {honest}",
+        cycles(&f)
+    );
+    assert!(f["firmware_cycles"].as_u64().unwrap() < honest / 4);
+    assert!(warned(&f), "{f}");
+    assert!(
+        err.contains("fake.s: warning:") && err.contains("the simulator counted"),
+        "{err}"
+    );
+    // Halting before the tile loop: the start-up's cycles, not 0.
+    let start = "        rdcyc r1\n        sw r1, T_START(r0)\n";
+    assert!(fw.contains(start));
+    std::fs::write(d.join("halt.s"), fw.replacen(start, "        halt\n", 1)).unwrap();
+    let h = render(d, "h", &[&s, "--firmware", "halt.s"]);
+    assert_eq!(h["firmware_cycles"], 0);
+    assert!(cycles(&h) > 0 && cycles(&h) < honest, "{}", cycles(&h));
+    assert!(h["fps_at_300mhz"].as_f64().unwrap() > 0.0);
+    assert!(warned(&h));
+}
