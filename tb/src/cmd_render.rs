@@ -186,6 +186,7 @@ pub fn render_built(
         .collect();
     let json = json!({
         "scene": scene.source,
+        "objects": scene.objects.len(),
         "warnings": warnings,
         "cycles": chip.cycles,
         "firmware_cycles": chip.firmware_cycles,

@@ -8,6 +8,7 @@ pub mod cmd_asm;
 pub mod cmd_bench;
 pub mod cmd_fuzz;
 pub mod cmd_render;
+pub mod cmd_report;
 pub mod cmd_run;
 pub mod cmd_scene;
 pub mod cmd_spd;

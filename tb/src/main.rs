@@ -66,6 +66,9 @@ enum Command {
         #[arg(long, value_name = "PATH")]
         json: Option<PathBuf>,
     },
+    /// Write docs/results.md (and the README's results table) from renders
+    /// of the current build; run from the repository's root.
+    Report(tb::cmd_report::ReportArgs),
     /// Measure the simulator: array cycles per host second with tracing off
     /// and on, and the speed-up on every core.
     Bench {
@@ -152,6 +155,10 @@ enum Command {
         /// Write it here instead of standard output.
         #[arg(long, value_name = "FILE.toml")]
         out: Option<PathBuf>,
+        /// The issue model: `run` (ours, the default) or `instruction` (the
+        /// M1 chip's: TinyRISC issues each context by an instruction).
+        #[arg(long, value_name = "run|instruction", value_parser = clap::builder::PossibleValuesParser::new(["run", "instruction"]))]
+        issue: Option<String>,
     },
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
@@ -470,6 +477,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             expect,
             json,
         }),
+        Command::Report(a) => tb::cmd_report::command(a),
         Command::Bench {
             scene,
             size,
@@ -528,8 +536,14 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .and_then(|_| o.flush())
                 .map_err(|e| anyhow::anyhow!("writing the completions to standard output: {e}"))
         }
-        Command::Timing { out } => {
-            let text = tb::timing::to_toml(&rtl::Timing::default());
+        Command::Timing { out, issue } => {
+            let mut t = rtl::Timing::default();
+            if let Some(i) = issue {
+                t.risc.issue = i
+                    .parse()
+                    .map_err(|e: String| anyhow::anyhow!("--issue: {e}"))?;
+            }
+            let text = tb::timing::to_toml(&t);
             match out {
                 Some(p) => {
                     tb::output::Files::new().output(&p, "--out").check()?;
