@@ -4,8 +4,6 @@
 //! --merge` take a finished render only when its arguments and these are
 //! unchanged, and say so when one changed.
 
-use std::sync::OnceLock;
-
 use sha2::{Digest, Sha256};
 
 /// The SHA-256 of `bytes`, in hex.
@@ -29,15 +27,11 @@ pub fn timing_digest(t: &rtl::Timing) -> String {
     digest(format!("{t:?}").as_bytes())
 }
 
-/// This program's own bytes (computed once): a render made by another
-/// build is not taken for one of this build.
+/// This build: the SHA-256 of the sources its results depend on (the
+/// chip, the firmware generator, this crate and the lock file; `build.rs`),
+/// so a render made by another build is not taken for one of this build.
 pub fn build_digest() -> &'static str {
-    static BUILD: OnceLock<String> = OnceLock::new();
-    BUILD.get_or_init(|| {
-        std::env::current_exe()
-            .and_then(std::fs::read)
-            .map_or_else(|_| "unknown".to_string(), |b| digest(&b))
-    })
+    env!("MORPHOSYS_SOURCE_DIGEST")
 }
 
 /// The `inputs` a render's JSON records.
