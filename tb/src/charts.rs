@@ -454,8 +454,7 @@ mod tests {
             .filter(|&(x, y)| img.get_pixel(x, y).0.iter().all(|&v| v < 100))
             .count();
         assert!(dark > 200, "title text not rendered ({dark} dark pixels)");
-        // What the chart promises, read back from the SVG (issue 17, item
-        // 7): the x ticks at the measured ways, the hollow marker drawn
+        // What the chart promises, read back from the SVG: the x ticks at the measured ways, the hollow marker drawn
         // hollow and the others filled.
         // (y position, text) of every text element; the x axis's tick
         // labels are the ones on the row of the "64".

@@ -231,7 +231,7 @@ fn closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
     drop(child.stdout.take());
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
-    // A reader that went away ends the command quietly (issue 18, item 4).
+    // A reader that went away ends the command quietly.
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(err.is_empty(), "{err}");
     if let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") {
@@ -251,7 +251,7 @@ fn closed_stdout_ends_quietly_and_a_full_one_is_an_error() {
 }
 
 /// A usage error names the argument on one line and exits 2, whether clap
-/// or a value range catches it (issue 17: missing arguments were cut from
+/// or a value range catches it (missing arguments were cut from
 /// the message, and --ways / --depth errors exited 1).
 #[test]
 fn usage_errors_name_the_argument_and_exit_2() {
@@ -335,7 +335,7 @@ fn usage_errors_name_the_argument_and_exit_2() {
     }
 }
 
-/// Output paths are checked before the work (issue 17: a render into a
+/// Output paths are checked before the work (a render into a
 /// missing folder ran the whole frame, then failed): one line naming the
 /// argument, no output, at once.
 #[test]
@@ -368,7 +368,7 @@ fn output_paths_are_checked_before_the_work() {
 }
 
 /// `bench` traces into temporary files it deletes: it does not announce
-/// them (issue 17: a dozen "wrote /tmp/.tmpXXX/bench0.vcd" lines).
+/// them (a dozen "wrote /tmp/.tmpXXX/bench0.vcd" lines).
 #[test]
 fn bench_does_not_announce_its_temporary_waveforms() {
     let dir = tempfile::tempdir().unwrap();
@@ -379,7 +379,7 @@ fn bench_does_not_announce_its_temporary_waveforms() {
         !err.contains("wrote") && !out.contains("wrote"),
         "{out}{err}"
     );
-    // Honest figures (issue 15, items 2 and 6): the host, the statistic
+    // Honest figures: the host, the statistic
     // and the traced slowdown.
     let (ok, out, err) = morphosys(
         dir.path(),
@@ -406,7 +406,7 @@ fn bench_does_not_announce_its_temporary_waveforms() {
 
 /// `render --hits` and `reference --hits` make the hit maps `compare --hits`
 /// reads, and `render` and `reference` share their default depth, so their
-/// default images compare as they are (issue 17, items 1 and 6).
+/// default images compare as they are.
 #[test]
 fn chip_and_reference_hit_maps_and_depths_compare() {
     let d = tempfile::tempdir().unwrap();
@@ -508,7 +508,7 @@ fn run_reports_pass_and_failure_by_its_exit_status() {
     assert!(err.contains("0xBAD") && err.contains("r2 = 7"), "{err}");
 }
 
-/// Shell completions and `--quiet` (issue 17, item 5).
+/// Shell completions and `--quiet`.
 #[test]
 fn completions_parse_and_quiet_is_quiet() {
     let d = tempfile::tempdir().unwrap();
@@ -541,7 +541,7 @@ fn completions_parse_and_quiet_is_quiet() {
 }
 
 /// The default scene is built into the binary: `render` and `reference`
-/// work from any folder (issue 17, item 5).
+/// work from any folder.
 #[test]
 fn the_default_scene_is_built_in() {
     let d = tempfile::tempdir().unwrap();
@@ -553,7 +553,7 @@ fn the_default_scene_is_built_in() {
     assert!(d.path().join("default-reference.png").exists());
 }
 
-/// The same value names for the same concept (issue 17, items 2 and 8):
+/// The same value names for the same concept:
 /// `compile` takes render's `--layout fig5|compact` and `--split
 /// median|sah`, says so in words, and refuses the old names with the valid
 /// ones.
@@ -585,7 +585,7 @@ fn compile_speaks_renders_names() {
     );
 }
 
-/// JSON from every command that measures (issue 17, item 5): `tb rc` and
+/// JSON from every command that measures: `tb rc` and
 /// `fuzz` too.
 #[test]
 fn testbench_and_fuzz_write_json() {

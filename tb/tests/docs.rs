@@ -1,4 +1,4 @@
-//! Every command README.md and docs/*.md show runs as written (issue 17).
+//! Every command README.md and docs/*.md show runs as written.
 //!
 //! The commands are read out of the Markdown itself: each line of a ```sh
 //! block (its `# comment` removed) and each inline code span that begins

@@ -57,7 +57,7 @@ fn regression_corpus() {
     assert!(n >= 10, "corpus has {n} inputs");
 }
 
-/// The seeds are embedded (issue 18, item 11: run outside the source tree
+/// The seeds are embedded (run outside the source tree
 /// the fuzzer used to find no seeds and fuzz nothing, silently): every
 /// conformance program is among them, and `morphosys fuzz` run from an
 /// empty folder accepts some inputs of every target.
@@ -96,7 +96,7 @@ fn seeds_are_embedded_and_complete() {
 }
 
 /// The structure-aware generator reaches what mutations of the seeds do
-/// not (issue 18, item 5): expressions thousands deep, absurd counts and
+/// not: expressions thousands deep, absurd counts and
 /// files of megabytes; and every such input is handled (no finding).
 #[test]
 fn structured_inputs_reach_deep_nesting_absurd_counts_and_large_files() {

@@ -1,4 +1,4 @@
-//! The smaller findings of the adversarial pass (issue 18, item 12), one
+//! The smaller findings of the adversarial pass, one
 //! regression test each: every bad input gets one located line and a
 //! non-zero exit, and valid input written oddly is read.
 
@@ -255,7 +255,7 @@ fn a_render_out_of_cycles_names_its_own_budget() {
 
 /// Inputs that are endless streams (`/dev/zero`, a FIFO fed by `yes`) are
 /// read up to the same 64 MB as files and refused there, by every command
-/// that reads one (issue 32, item 5: they were read until memory ran out).
+/// that reads one (they were read until memory ran out).
 /// Bounded by `timeout`.
 #[test]
 fn endless_inputs_stop_at_the_input_limit() {
@@ -298,7 +298,7 @@ fn endless_inputs_stop_at_the_input_limit() {
 }
 
 /// Errors that had no location get one, and a file with many errors is
-/// summed up (issue 32, item 9): a TOML nesting past the parser's limit
+/// summed up: a TOML nesting past the parser's limit
 /// names its line (scene and timing file), a camera angle too wide for
 /// the chip names the viewpoint's line, and a program cut short shows
 /// three errors and one line for the rest, not 150 lines.
@@ -357,7 +357,7 @@ fn errors_are_located_and_summed_up() {
     );
 }
 
-/// A polygon of many short edges is not degenerate (issue 32, item 15: a
+/// A polygon of many short edges is not degenerate (a
 /// 100,000-vertex circle was refused as 'collinear or coincident', its
 /// corners being judged against the scene's size, while a 100,000-vertex
 /// square passed): the reference renders it, and the chip refuses it only

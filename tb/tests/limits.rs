@@ -75,7 +75,7 @@ fn runaway_firmware_stops_at_the_cycle_budget_with_cycle_and_pc() {
     assert!(err.contains("cycle 5000") && err.contains("pc 0x"), "{err}");
 }
 
-/// One image-size limit everywhere (issue 18, item 8; issue 17, item 2):
+/// One image-size limit everywhere:
 /// `--size` on every command and a scene's own resolution.
 #[test]
 fn every_image_size_has_the_same_limit_and_an_estimate() {
@@ -162,7 +162,7 @@ fn counts_past_the_image_fields_are_refused_at_the_first_object_past_them() {
 }
 
 /// Scenes too large are refused while being read, before they can take the
-/// machine's memory (issue 18, item 2: 1.89 M spheres aborted on a failed
+/// machine's memory (1.89 M spheres aborted on a failed
 /// 6 GB allocation): under a 2 GB address-space cap, one located line.
 #[test]
 fn huge_scenes_are_refused_while_read_within_bounded_memory() {

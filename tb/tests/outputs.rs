@@ -1,4 +1,4 @@
-//! Output files under hostile or careless use (issue 18, item 1): devices
+//! Output files under hostile or careless use: devices
 //! and FIFOs are written through, never replaced; symbolic links are
 //! followed and kept; standard output is `-`; an output that is an input or
 //! another output is refused before any work.
@@ -254,7 +254,7 @@ fn a_waveforms_side_files_cannot_overwrite_an_input_or_an_output() {
 }
 
 /// An output keeps the permissions of the file it replaces, and a new one
-/// gets the umask's (issue 32, item 11: every output was made 0644).
+/// gets the umask's (every output was made 0644).
 #[test]
 fn outputs_keep_their_mode_and_new_ones_follow_the_umask() {
     use std::os::unix::fs::PermissionsExt;
@@ -295,8 +295,8 @@ fn outputs_keep_their_mode_and_new_ones_follow_the_umask() {
 /// A regular file under /dev (`/dev/shm/...`) is an ordinary output,
 /// replaced whole; a descriptor's regular file (`/dev/fd/N` opened
 /// read-write over a longer file) is written from its start and cut to the
-/// new length. Either way the JSON is exactly the render's (issue 32,
-/// item 4: the old tail stayed after the new JSON).
+/// new length. Either way the JSON is exactly the render's, with
+/// no old tail after the new JSON.
 #[test]
 fn regular_files_under_dev_and_descriptors_are_written_whole() {
     let dir = tempfile::tempdir().unwrap();
@@ -348,7 +348,7 @@ fn regular_files_under_dev_and_descriptors_are_written_whole() {
 
 /// `render --json FIFO --skip-done` renders into the FIFO instead of
 /// blocking on reading it, and `sweep --merge` with a FIFO among its points
-/// names it instead of hanging (issue 32, item 12). Bounded by `timeout`.
+/// names it instead of hanging. Bounded by `timeout`.
 #[test]
 fn a_fifo_where_a_finished_render_is_looked_for_does_not_hang() {
     let dir = tempfile::tempdir().unwrap();

@@ -1,4 +1,4 @@
-//! Interrupted runs leave nothing behind (issue 18, item 7): SIGINT or
+//! Interrupted runs leave nothing behind: SIGINT or
 //! SIGTERM removes the partial waveform and the temporary folders; a
 //! partial file left by a run killed outright (SIGKILL) is removed by the
 //! next run writing the same waveform.

@@ -1,7 +1,7 @@
 //! Every size-1 SPD scene the chip can render, traced on the simulated chip
 //! at 48x48 and measured against the f64
 //! reference renderer: PSNR >= 30 dB
-//! and eye-ray hit agreement >= 99% (issue 5's targets, the same for every
+//! and eye-ray hit agreement >= 99% (the same targets for every
 //! scene, none tuned to one).
 //!
 //! mount-1's glass spheres (T 0.9) are not refracted on the chip; at

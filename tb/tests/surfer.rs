@@ -1,4 +1,4 @@
-//! Surfer's instruction decoders (issue 15, item 4): the TOML files under
+//! Surfer's instruction decoders: the TOML files under
 //! `waves/.surfer/decoders/` are the ones `tb/src/surfer.rs` generates
 //! from the opcode tables, and they decode every word of the conformance
 //! programs and of the tracer's golden firmware (and a few hundred

@@ -1,4 +1,4 @@
-//! Sweeps past one process (issue 16): `sweep --plan` writes one
+//! Sweeps past one process: `sweep --plan` writes one
 //! `morphosys render` per distinct render, GNU parallel runs them, `sweep
 //! --merge` writes the table and charts, byte for byte those of the same
 //! sweep run in one process; reruns skip what is done, and a killed job
@@ -348,7 +348,7 @@ fn plan_and_merge_refuse_bad_input_with_one_line() {
     assert_eq!(err.trim().lines().count(), 1, "{err}");
 }
 
-/// An interrupted in-process sweep resumes (issue 18, item 7): every
+/// An interrupted in-process sweep resumes: every
 /// render's JSON is kept under OUT/points as it finishes, and a rerun takes
 /// those made with the same arguments instead of rendering them again.
 #[test]
@@ -561,7 +561,7 @@ fn merge_leaves_out_impossible_values_and_names_them() {
 }
 
 /// A finished render is taken again only when its inputs are unchanged
-/// (issue 32, item 3: the key was the arguments alone): a sweep resumed
+/// (the key was the arguments alone): a sweep resumed
 /// after its scene file was replaced renders every point again and says
 /// why; `render --skip-done` does the same; `sweep --merge` leaves out a
 /// point whose scene copy changed since its render.
@@ -657,8 +657,7 @@ fn a_changed_scene_is_rendered_again_not_taken_from_before() {
     assert!(err.contains("made before the scene changed"), "{err}");
 }
 
-/// Timing files are told apart by more than their file names (issue 32,
-/// item 2): two `t.toml` in different folders make two series with their
+/// Timing files are told apart by more than their file names: two `t.toml` in different folders make two series with their
 /// own figures, a file named `default.toml` is not the default chip, and a
 /// plan of them merges to what the sweep gives in one process.
 #[test]

@@ -1,4 +1,4 @@
-//! FST waveforms (issue 15, item 3): a `--vcd` path ending in `.fst` writes
+//! FST waveforms: a `--vcd` path ending in `.fst` writes
 //! FST (GTKWave's and Surfer's compressed format) through the `fst-writer`
 //! crate. Each test writes the same window as VCD and as FST and reads both
 //! back with the `wellen` crate (the reader Surfer uses): the same signals
@@ -162,7 +162,7 @@ fn an_fst_waveform_into_a_pipe_is_refused_before_the_run() {
     assert_eq!(err.lines().count(), 1, "{err}");
 }
 
-/// A render's waveform reads well by default (issue 15, item 5): the
+/// A render's waveform reads well by default: the
 /// control path, the array's masks and one RC, every group open in the
 /// save file; `--trace-scope all` records every signal.
 #[test]
@@ -238,7 +238,7 @@ fn a_render_traces_what_an_architect_looks_at_first() {
     }
 }
 
-/// An FST trace longer than one in-memory section (issue 15: the writer
+/// An FST trace longer than one in-memory section (the writer
 /// thread once flushed a section in the middle of a time step, which the
 /// FST writer refuses with a panic): with sections of 256 bytes, a run of
 /// dct.s is written in many sections and still reads back as its VCD.
@@ -338,8 +338,8 @@ fn a_render_waveform_names_the_pc_and_the_context_by_the_firmware_labels() {
     }
 }
 
-/// The size limit counts an FST as what it is, compressed (issue 32,
-/// item 13: it used the VCD estimate): a window of all signals over 1.5M
+/// The size limit counts an FST as what it is, compressed
+/// (not by the VCD estimate): a window of all signals over 1.5M
 /// cycles is refused as VCD (about 5.5 GB) and taken as FST (about a tenth).
 #[test]
 fn the_size_limit_counts_an_fst_compressed() {

@@ -1,4 +1,4 @@
-//! Whitted on the chip (issue 13): what the chip cannot render as the
+//! Whitted on the chip: what the chip cannot render as the
 //! scene asks is named in a warning (stderr and the JSON's `warnings`),
 //! degenerate polygons are skipped by both renderers alike, and the chip's
 //! ray census agrees with the f64 reference's independent count.

@@ -242,8 +242,8 @@ fn the_sweep_charts_the_issue_models_and_timing_files() {
     assert!(d.join("sw/timing.png").is_file());
 }
 
-/// A knob sweep of one scene draws no one-point scaling chart (issue 17:
-/// `sweep --only knobs` wrote a `scaling.png` of a single point); with two
+/// A knob sweep of one scene draws no one-point scaling chart (`sweep
+/// --only knobs` once wrote a `scaling.png` of a single point); with two
 /// scenes it draws one with both.
 #[test]
 fn a_one_scene_knob_sweep_writes_no_scaling_chart() {
