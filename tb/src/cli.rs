@@ -157,3 +157,50 @@ impl std::fmt::Display for UsageError {
 }
 
 impl std::error::Error for UsageError {}
+
+/// `--table-entries`: the table sizes that fit a 128-word slot of an RC's RAM.
+pub fn parse_table_entries(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n) if firmware::tracer::math::TABLE_SIZES.contains(&n) => Ok(n),
+        _ => Err(format!(
+            "expected 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM), found '{s}'"
+        )),
+    }
+}
+
+pub fn parse_normals(s: &str) -> Result<firmware::tracer::Normals, String> {
+    s.parse()
+}
+
+pub fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
+    s.parse()
+}
+
+/// `--ways`: 4, 8, 16, 32 or 64 rays in flight (a tile of 2x2 .. 8x8).
+pub fn parse_ways(s: &str) -> Result<u32, String> {
+    match s.parse::<u32>() {
+        Ok(n @ (4 | 8 | 16 | 32 | 64)) => Ok(n),
+        _ => Err(format!("expected 4, 8, 16, 32 or 64, found '{s}'")),
+    }
+}
+
+pub fn parse_depth(s: &str) -> Result<u32, String> {
+    if s == "auto" {
+        return Ok(0);
+    }
+    match s.parse::<u32>() {
+        Ok(d) if (1..=firmware::scene_image::MAX_BSP_DEPTH).contains(&d) => Ok(d),
+        _ => Err(format!(
+            "expected auto or a depth 1..={}",
+            firmware::scene_image::MAX_BSP_DEPTH
+        )),
+    }
+}
+
+pub fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, String> {
+    s.parse()
+}
+
+pub fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
+    s.parse()
+}

@@ -31,12 +31,21 @@ use serde_json::json;
 
 use crate::cmd_scene::{load_scene, write_output};
 
+#[derive(clap::Args, Debug)]
 pub struct BenchArgs {
+    /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
+    /// Image size of the throughput workload (each side 1..=4096).
+    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size, default_value = "128x128")]
     pub size: (u32, u32),
+    /// Runs per configuration; the fastest counts.
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = crate::cli::parse_count::<u32>)]
     pub repeat: u32,
+    /// Write the figures as JSON here.
+    #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
-    /// The chip's timing (`--timing FILE.toml`).
+    /// The chip's timing from a TOML file (`morphosys timing`).
+    #[arg(long, value_name = "FILE.toml")]
     pub timing: Option<PathBuf>,
 }
 

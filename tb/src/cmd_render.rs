@@ -9,55 +9,130 @@ use firmware::bsp::BspParams;
 use firmware::tracer::Options;
 use serde_json::json;
 
-use crate::cli::TraceWindow;
 use crate::cmd_scene::{load_scene, png_bytes, write_output};
 use crate::metrics;
 use crate::reference;
 
+#[derive(clap::Args, Debug)]
 pub struct RenderArgs {
+    /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
+    /// Image size WIDTHxHEIGHT, each side 1..=4096 (default 256x256).
+    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Rays traced in parallel: 4, 8, 16, 32 or 64.
+    #[arg(long, value_name = "N", default_value_t = 64, value_parser = crate::cli::parse_ways)]
     pub ways: u32,
+    /// Maximum ray depth 1..=8; the eye ray is depth 1 (default: the
+    /// paper's recursion level 2; the SPD's is 5).
+    #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
     pub depth: u32,
+    /// Write the image here (default: <scene>-chip.png).
+    #[arg(long, value_name = "PNG")]
     pub out: Option<PathBuf>,
+    /// Write the figures as JSON here.
+    #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
-    /// The chip's hit map (`compare --hits`).
+    /// Write the chip's hit map here (the object each pixel's eye ray
+    /// hit), for `compare --hits` against `reference --hits`.
+    #[arg(long, value_name = "PATH")]
     pub hits: Option<PathBuf>,
+    /// Write the waveform of the first chip instance here: VCD, or FST
+    /// where the path ends in `.fst` (GTKWave save file and filters
+    /// beside it).
+    #[arg(long, value_name = "PATH")]
     pub vcd: Option<PathBuf>,
-    pub window: TraceWindow,
+    #[command(flatten)]
+    pub window: crate::cli::TraceWindow,
+    /// Write the generated firmware (assembly source) here.
+    #[arg(long, value_name = "FILE.s")]
     pub emit_asm: Option<PathBuf>,
+    /// Maximum BSP depth: a number (1..=32) or auto (the paper's 15 for
+    /// the paper's traversal; for the packet traversal 15 for a median
+    /// tree and 8 + 1.3 log2(objects) for an SAH tree).
+    #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_depth)]
     pub max_depth: u32,
+    /// Maximum objects per BSP leaf.
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::parse_count::<usize>)]
     pub max_leaf: usize,
-    /// BSP split rule: "median" or "sah".
+    /// BSP split rule: median (the paper's spatial median, axes in turn),
+    /// sah (surface area heuristic) or auto (median for the paper's
+    /// traversal; for the packet traversal the cheaper of the two trees
+    /// by its cost model).
+    #[arg(long, value_name = "auto|median|sah", default_value = "auto", value_parser = ["auto", "median", "sah"])]
     pub split: String,
+    /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
+    /// or compact (index lists); the same image either way.
+    #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = crate::cli::parse_layout)]
     pub layout: firmware::tracer::NodeLayout,
+    /// BSP traversal: paper (the paper's: where the rays disagree, test
+    /// every object under the node) or packet (per-ray intervals; a
+    /// child is visited only by the rays that reach it).
+    #[arg(long, value_name = "packet|paper", default_value = "packet", value_parser = crate::cli::parse_traversal)]
     pub traversal: firmware::tracer::Traversal,
+    /// Packet traversal: which BSP subtrees to walk as one leaf of all
+    /// their objects: auto (where that costs less than walking them, by
+    /// the cells' surface areas and the kernels' lengths) or N (those
+    /// with at most N objects; 0: none).
+    #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_collapse)]
     pub collapse: firmware::tracer::Collapse,
+    /// RC datapath width in bits: 16 (the paper's chip), 32 (the
+    /// variant the paper announces; every format gets 16 more fraction
+    /// bits), or auto: 16 unless the 16-bit chip cannot hold the scene or
+    /// renders a probe of the frame (1/16 of the tiles) under 30 dB or
+    /// 99% hit agreement against the reference where 32 bits do better.
+    #[arg(long, value_name = "auto|16|32", value_parser = crate::cli::parse_datapath_choice, default_value = "auto")]
     pub datapath: crate::cli::DatapathChoice,
-    /// Newton-Raphson steps after each table lookup.
+    /// Newton-Raphson steps after each reciprocal / square-root table
+    /// lookup (0..=3).
+    #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=3))]
     pub newton_steps: u32,
-    /// Entries of the reciprocal and reciprocal square root tables.
+    /// Entries of the reciprocal and reciprocal square-root tables in
+    /// every RC's RAM: 16, 32, 64 or 128.
+    #[arg(long, value_name = "N", default_value_t = 128, value_parser = crate::cli::parse_table_entries)]
     pub table_entries: u32,
-    /// Guard bits of the coordinate format (2..=4).
+    /// Guard bits of the coordinate format above the scene's largest
+    /// object or eye coordinate (2..=4; more: a coarser format).
+    #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=4))]
     pub guard_bits: u32,
-    /// Offset of spawned rays along the normal, in LSBs.
+    /// Offset of spawned (shadow, reflected, refracted) rays along the
+    /// normal, in LSBs of the coordinate format (0..=64).
+    #[arg(long, value_name = "N", default_value_t = firmware::tracer::shading::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
     pub ray_offset_lsb: i32,
-    /// `--normals` ([`firmware::tracer::Normals`]).
+    /// Normals of spheres and cylinders: fine (the eye moved onto the
+    /// coordinate format's grid with the whole scene, and the
+    /// perpendicular vector formed from unrounded centres and axes and
+    /// kept perpendicular to the ray: 9 more cycles per sphere test, 19
+    /// per cylinder test), coarse (the kernels as first written, with
+    /// which the comparison with the paper was made) or auto (fine on
+    /// the 16-bit chip, coarse on the 32-bit one)
+    #[arg(long, value_name = "auto|fine|coarse", default_value = "auto", value_parser = crate::cli::parse_normals)]
     pub normals: firmware::tracer::Normals,
-    /// Stop at once when `json` already holds a complete render made with
-    /// the same `argv`.
+    /// With --json: when that file already holds a complete render made
+    /// with these same arguments from the same scene, timing file,
+    /// firmware and build (their SHA-256 digests, `inputs` in the
+    /// JSON), say so and stop without rendering (a rerun of a sweep
+    /// plan's jobs runs only what is missing).
+    #[arg(long, requires = "json")]
     pub skip_done: bool,
-    /// The command line's arguments (after the program's name), recorded in
-    /// the JSON for `skip_done` and `sweep --merge`.
-    pub argv: Vec<String>,
-    /// Profile every chip instance (cycles per kernel and per TinyRISC
-    /// label).
+    /// Print (and put in the JSON) where the frame's cycles go: per RC kernel while the array works, per TinyRISC
+    /// label while it waits (steps every cycle: several times slower).
+    #[arg(long)]
     pub profile: bool,
-    /// The chip's timing from a TOML file (`morphosys timing`).
+    /// The chip's timing from a TOML file (any subset of the fields
+    /// `morphosys timing` prints; the rest keep their defaults).
+    #[arg(long, value_name = "FILE.toml")]
     pub timing: Option<PathBuf>,
-    /// Render with this program (an `--emit-asm` file, maybe edited)
-    /// instead of the generated one; the data image is built as usual.
+    /// Render with the program assembled from this file (what
+    /// `--emit-asm` writes, edited or not) instead of the generated
+    /// one; the scene's data image is built as usual, with the same
+    /// options the file was emitted with.
+    #[arg(long, value_name = "FILE.s")]
     pub firmware: Option<PathBuf>,
+    /// The command line's arguments (after the program's name), recorded in
+    /// the JSON for `--skip-done` and `sweep --merge`.
+    #[arg(skip)]
+    pub argv: Vec<String>,
 }
 
 fn profile_json(p: &crate::profile::Profile) -> serde_json::Value {

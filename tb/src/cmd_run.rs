@@ -9,8 +9,6 @@ use rtl::chip::{run_to_halt, RunError};
 use rtl::rc::{Datapath, Word};
 use rtl::{Chip, Sim, Stats, Timing};
 
-use crate::cli::TraceWindow;
-
 /// Assembly source, or an image written by `morphosys asm -o`.
 pub fn load_program(path: &Path) -> anyhow::Result<Image> {
     let bytes =
@@ -100,16 +98,35 @@ pub fn print_stats(s: &Stats) {
 }
 
 /// Arguments of `morphosys run`.
+#[derive(clap::Args, Debug)]
 pub struct RunArgs {
     pub file: PathBuf,
+    /// Stop with an error after this many cycles.
+    #[arg(long, value_name = "N", default_value_t = 100_000_000)]
     pub max_cycles: u64,
+    /// Write the waveform here: VCD, or FST where the path ends in `.fst`
+    /// (GTKWave save file and filters beside it).
+    #[arg(long, value_name = "PATH")]
     pub vcd: Option<PathBuf>,
-    pub window: TraceWindow,
-    /// `None`: the source's `.datapath`, else 16.
-    pub datapath: Option<Datapath>,
+    #[command(flatten)]
+    pub window: crate::cli::TraceWindow,
+    /// RC datapath width in bits: 16 (the paper's chip) or 32 (default:
+    /// the source's `.datapath`, else 16).
+    #[arg(long, value_name = "16|32", value_parser = crate::cli::parse_datapath)]
+    pub datapath: Option<rtl::rc::Datapath>,
+    /// The chip's timing from a TOML file (any subset of the fields
+    /// `morphosys timing` prints; the rest keep their defaults).
+    #[arg(long, value_name = "FILE.toml")]
     pub timing: Option<PathBuf>,
-    /// (register, value) every one of which must hold after the halt.
+    /// After the halt, TinyRISC register REG must hold VALUE (e.g.
+    /// `r3=38`, `r1=0x1`); repeatable. Any mismatch exits 1. Without
+    /// it, a halt with r1 = 0xBAD (the conformance programs' failure
+    /// code, docs/isa.md) exits 1.
+    #[arg(long, value_name = "REG=VALUE", value_parser = crate::cmd_run::parse_expect)]
     pub expect: Vec<(u8, u32)>,
+    /// Write the cycles, the registers (decimal and hex) and the
+    /// statistics as JSON here.
+    #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
 }
 

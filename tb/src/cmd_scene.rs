@@ -162,13 +162,30 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 /// Arguments of `morphosys reference`.
+#[derive(clap::Args, Debug)]
 pub struct ReferenceArgs {
+    /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
+    /// Image size WIDTHxHEIGHT, each side 1..=4096 (default: the scene's resolution).
+    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Maximum ray depth 1..=8; the eye ray is depth 1 (default 2, the
+    /// paper's recursion level, as `render` and `sweep`, so their images
+    /// compare as they are; `--spd-stats`: 5, the SPD's).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
     pub depth: Option<u32>,
+    /// Write the image here (default: <scene>-reference.png).
+    #[arg(long, value_name = "PNG")]
     pub out: Option<PathBuf>,
+    /// Write ray counts and timing as JSON here.
+    #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+    /// Write the per-pixel hit map (which object each eye ray hit) here.
+    #[arg(long, value_name = "PATH")]
     pub hits: Option<PathBuf>,
+    /// Count rays as the SPD prescribes: 512x512, rays through pixel
+    /// corners (513x513 eye rays), depth 5.
+    #[arg(long)]
     pub spd_stats: bool,
 }
 
@@ -266,18 +283,42 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
 }
 
 /// Arguments of `morphosys compile`.
+#[derive(clap::Args, Debug)]
 pub struct CompileArgs {
+    /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
+    /// Write the report as JSON here.
+    #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+    /// Write the memory image (16-bit little-endian words) here.
+    #[arg(long, value_name = "FILE.img")]
     pub out: Option<PathBuf>,
+    /// BSP split rule: median (the paper's spatial median, axes in turn)
+    /// or sah (surface area heuristic); `--sah` is short for `--split sah`.
+    #[arg(long, value_name = "median|sah", default_value = "median", value_parser = ["median", "sah"])]
+    pub split: String,
+    #[arg(long, hide = true)]
     pub sah: bool,
+    /// Maximum BSP depth (1..=32).
+    #[arg(long, value_name = "N", default_value_t = 15, value_parser = clap::value_parser!(u32).range(1..=firmware::scene_image::MAX_BSP_DEPTH as i64))]
     pub max_depth: u32,
+    /// Maximum objects per BSP leaf.
+    #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::parse_count::<usize>)]
     pub max_leaf: usize,
-    pub layout: Option<Layout>,
+    /// How BSP nodes name their objects: fig5 (the paper's bit
+    /// vectors) or compact (index lists), as `render --layout`
+    /// (default: the smaller).
+    #[arg(long, value_name = "fig5|compact", value_parser = crate::cli::parse_layout)]
+    pub layout: Option<firmware::tracer::NodeLayout>,
 }
 
 /// `morphosys compile`: the fixed-point scene image and its report.
 pub fn compile_cmd(a: CompileArgs) -> Result<()> {
+    let sah = a.sah || a.split == "sah";
+    let layout = a.layout.map(|l| match l {
+        firmware::tracer::NodeLayout::Compact => Layout::IndexLists,
+        firmware::tracer::NodeLayout::Fig5 => Layout::BitVectors,
+    });
     let mut files = crate::output::Files::new();
     files.input(&a.scene.clone().unwrap_or_else(default_scene), "SCENE");
     for (p, what) in [(&a.out, "--out"), (&a.json, "--json")] {
@@ -291,14 +332,14 @@ pub fn compile_cmd(a: CompileArgs) -> Result<()> {
         bsp: BspParams {
             max_depth: a.max_depth,
             max_leaf: a.max_leaf,
-            rule: if a.sah {
+            rule: if sah {
                 SplitRule::Sah
             } else {
                 SplitRule::Median
             },
             snap: 0.0,
         },
-        layout: a.layout,
+        layout,
         ..CompileOptions::default()
     };
     let img = compile(&scene, &opt)?;

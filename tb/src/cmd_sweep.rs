@@ -30,6 +30,88 @@ use rtl::Timing;
 use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
 use crate::cmd_scene::{load_scene, write_output};
 
+/// `morphosys sweep` as the command line gives it.
+#[derive(clap::Args, Debug)]
+pub struct SweepCli {
+    /// Scene files (default: scenes/default.toml).
+    pub scenes: Vec<PathBuf>,
+    /// Where results.csv and the charts go (with --merge: default the
+    /// plan's folder).
+    #[arg(long, value_name = "DIR", required_unless_present_any = ["plan", "merge"])]
+    pub out_dir: Option<PathBuf>,
+    /// Render nothing: write DIR/jobs.txt, one self-contained `morphosys
+    /// render ... --json DIR/points/NAME.json` per distinct render of the
+    /// sweep (for GNU parallel or a Slurm job array; a rerun skips the
+    /// renders already done), and DIR/sweep.toml, what was asked. Every
+    /// size of the size sweep is planned (--size-seconds does not apply).
+    #[arg(long, value_name = "PLAN", conflicts_with_all = ["out_dir", "size_seconds", "merge"])]
+    pub plan: Option<PathBuf>,
+    /// Merge a plan's renders: results.csv and the charts, as the sweep
+    /// run here would write them; missing or failed renders are named
+    /// and left out.
+    #[arg(long, value_name = "PLAN", conflicts_with_all = ["scenes", "size", "only", "families", "max_size", "family_size", "size_seconds", "timing"])]
+    pub merge: Option<PathBuf>,
+    /// Image size (each side 1..=4096).
+    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size, default_value = "256x256")]
+    pub size: (u32, u32),
+    /// Run only one part: `knobs` (every knob on SCENES), `sizes` (the
+    /// SPD families at sizes 1..=--max-size, both traversals) or
+    /// `broadcast` (both traversals on SCENES under both issue models).
+    #[arg(long, value_name = "knobs|sizes|broadcast", value_parser = ["knobs", "sizes", "broadcast"])]
+    pub only: Option<String>,
+    /// SPD generators of the size sweep, comma-separated.
+    #[arg(
+        long,
+        value_name = "NAMES",
+        value_delimiter = ',',
+        default_value = "balls,tetra,rings,gears,lattice",
+        value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names())
+    )]
+    pub families: Vec<String>,
+    /// Largest SPD size factor of the size sweep.
+    #[arg(long, value_name = "N", default_value_t = 4, value_parser = crate::cli::parse_count::<u32>)]
+    pub max_size: u32,
+    /// Image size of the size sweep (streamed scenes of thousands of
+    /// objects take minutes of host time at 256x256).
+    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size, default_value = "64x64")]
+    pub family_size: (u32, u32),
+    /// Skip a family's larger sizes (with a traversal) once one of its
+    /// renders took longer than this many host seconds.
+    #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = crate::cli::parse_seconds)]
+    pub size_seconds: f64,
+    /// Timing files: the paper's configuration and the packet
+    /// traversal on each scene under each (the `timing` knob, one
+    /// series each in timing.png).
+    #[arg(long, value_name = "FILE.toml", num_args = 1..)]
+    pub timing: Vec<PathBuf>,
+}
+
+/// `morphosys sweep`: merge a plan's renders (`--merge`), or run or plan
+/// the sweep the arguments ask for.
+pub fn run(a: SweepCli) -> Result<()> {
+    if let Some(dir) = &a.merge {
+        return merge(dir, a.out_dir.as_deref().unwrap_or(dir));
+    }
+    let only = a.only.as_deref();
+    command(SweepArgs {
+        scenes: a.scenes,
+        out_dir: a.out_dir.unwrap_or_default(),
+        plan: a.plan,
+        size: a.size,
+        knobs: only != Some("sizes"),
+        families: if only.is_some() && only != Some("sizes") {
+            vec![]
+        } else {
+            a.families
+        },
+        broadcast_only: only == Some("broadcast"),
+        max_size: a.max_size,
+        family_size: a.family_size,
+        size_seconds: a.size_seconds,
+        timing: a.timing,
+    })
+}
+
 pub struct SweepArgs {
     pub scenes: Vec<PathBuf>,
     pub out_dir: PathBuf,
