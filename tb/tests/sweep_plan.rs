@@ -9,30 +9,26 @@ use common::morphosys;
 use std::path::Path;
 use std::process::{Command, Stdio};
 
-/// GNU parallel on `jobs` with 2 job slots: its output, or None where it is
-/// not installed outside CI (CI installs it, `.ci/run`).
-fn parallel(jobs: &Path) -> Option<String> {
-    let run = Command::new("parallel")
+/// GNU parallel on `jobs` with 2 job slots: its output. The tests that
+/// call it are ignored by default (`cargo test -- --ignored` runs them;
+/// `.ci/run` does, after installing GNU parallel) and fail without it.
+fn parallel(jobs: &Path) -> String {
+    let out = Command::new("parallel")
         .args(["--jobs", "2"])
         .stdin(std::fs::File::open(jobs).unwrap())
-        .output();
-    match run {
-        Ok(out) => {
-            assert!(
-                out.status.success(),
-                "parallel: {}",
-                String::from_utf8_lossy(&out.stderr)
-            );
-            Some(String::from_utf8_lossy(&out.stdout).into_owned())
-        }
-        Err(_) if std::env::var_os("CI").is_none() => {
-            eprintln!("GNU parallel not installed (apt-get install parallel); test skipped");
-            None
-        }
-        Err(e) => panic!("GNU parallel must be installed in CI: {e}"),
-    }
+        .output()
+        .unwrap_or_else(|e| {
+            panic!("GNU parallel is not installed (apt-get install parallel): {e}")
+        });
+    assert!(
+        out.status.success(),
+        "parallel: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stdout).into_owned()
 }
 
+#[ignore = "needs GNU parallel (Debian package parallel); .ci/run installs it and runs the ignored tests"]
 #[test]
 fn planned_sweep_on_gnu_parallel_merges_to_the_in_process_sweep() {
     let tmp = tempfile::tempdir().unwrap();
@@ -70,9 +66,7 @@ fn planned_sweep_on_gnu_parallel_merges_to_the_in_process_sweep() {
         assert!(l.contains(" render ") && l.contains("/points/") && l.ends_with("--skip-done"));
     }
     assert!(jobs.contains("--timing") && jobs.contains("slowload.toml"));
-    let Some(_) = parallel(&plan.join("jobs.txt")) else {
-        return;
-    };
+    parallel(&plan.join("jobs.txt"));
     let (ok, out, err) = morphosys(d, &["sweep", "--merge", "plan"]);
     assert!(ok, "merge: {err}");
     assert!(err.is_empty() || !err.contains("missing"), "{err}");
@@ -105,7 +99,7 @@ fn planned_sweep_on_gnu_parallel_merges_to_the_in_process_sweep() {
     }
 
     // A rerun of the plan renders nothing.
-    let out = parallel(&plan.join("jobs.txt")).unwrap();
+    let out = parallel(&plan.join("jobs.txt"));
     assert_eq!(
         out.matches("already rendered with these arguments").count(),
         lines.len(),
@@ -146,18 +140,35 @@ fn killed_render_leaves_no_complete_json_and_merge_names_it() {
     let plan = d.join("plan");
     let jobs = std::fs::read_to_string(plan.join("jobs.txt")).unwrap();
     let first = jobs.lines().next().unwrap();
-    // Kill the first render a second into its frame.
+    // Kill the first render inside its frame: once it has used 0.1 s of
+    // CPU time (a 1024x1024 frame takes seconds of it on any machine),
+    // whatever the wall clock says.
     let mut child = Command::new("sh")
         .args(["-c", &format!("exec {first}")])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .unwrap();
-    std::thread::sleep(std::time::Duration::from_secs(1));
-    assert!(
-        child.try_wait().unwrap().is_none(),
-        "the render ended within a second"
-    );
+    let cpu_ticks = |pid: u32| -> u64 {
+        let stat = std::fs::read_to_string(format!("/proc/{pid}/stat")).unwrap_or_default();
+        // Fields after the command's closing parenthesis: utime and stime
+        // are the 12th and 13th.
+        let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+        let f: Vec<u64> = rest
+            .split_whitespace()
+            .map(|x| x.parse().unwrap_or(0))
+            .collect();
+        f.get(11).copied().unwrap_or(0) + f.get(12).copied().unwrap_or(0)
+    };
+    let tick = unsafe { libc::sysconf(libc::_SC_CLK_TCK) }.max(1) as u64;
+    while cpu_ticks(child.id()) < tick / 10 {
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the render ended before it used 0.1 s of CPU time"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(child.try_wait().unwrap().is_none(), "the render ended");
     child.kill().unwrap();
     child.wait().unwrap();
     // Nothing under points/ parses as a render's report.
@@ -200,34 +211,38 @@ fn cluster_script(name: &str) -> std::path::PathBuf {
         .join(name)
 }
 
-/// Whether this machine can run a Slurm of its own: root, and the Debian
-/// packages slurm-wlm and munge (CI has both, `.ci/run`).
-fn slurm_possible() -> bool {
+/// Checks that this machine can run a Slurm of its own: root, and the
+/// Debian packages slurm-wlm and munge (`.ci/run` installs them and runs
+/// the ignored tests).
+fn require_slurm() {
     let root = Command::new("id")
         .arg("-u")
         .output()
         .is_ok_and(|o| String::from_utf8_lossy(&o.stdout).trim() == "0");
-    let tools = ["munged", "slurmctld", "slurmd", "sbatch"].iter().all(|t| {
-        Command::new("sh")
-            .args(["-c", &format!("command -v {t}")])
-            .output()
-            .is_ok_and(|o| o.status.success())
-    });
-    match (root && tools, std::env::var_os("CI").is_some()) {
-        (true, _) => true,
-        (false, false) => {
-            eprintln!("not root or no slurm-wlm/munge: the Slurm array test is skipped");
-            false
-        }
-        (false, true) => panic!("CI runs the Slurm test: it needs root, slurm-wlm and munge"),
-    }
+    let missing: Vec<&str> = ["munged", "slurmctld", "slurmd", "sbatch"]
+        .into_iter()
+        .filter(|t| {
+            !Command::new("sh")
+                .args(["-c", &format!("command -v {t}")])
+                .output()
+                .is_ok_and(|o| o.status.success())
+        })
+        .collect();
+    assert!(
+        root,
+        "the Slurm test needs root (it starts slurmctld and munged)"
+    );
+    assert!(
+        missing.is_empty(),
+        "the Slurm test needs slurm-wlm and munge: {} not found",
+        missing.join(", ")
+    );
 }
 
 #[test]
+#[ignore = "needs root, slurm-wlm and munge; .ci/run installs them and runs the ignored tests"]
 fn planned_sweep_on_a_slurm_job_array_merges_to_the_in_process_sweep() {
-    if !slurm_possible() {
-        return;
-    }
+    require_slurm();
     let tmp = tempfile::tempdir().unwrap();
     let d = tmp.path();
     let sweep = ["sweep", "--only", "broadcast", "--size", "16x16"];
@@ -438,10 +453,20 @@ fn file_names_cannot_inject_commands_into_a_plan() {
         jobs.lines().take(2).collect::<Vec<_>>().join("\n") + "\n",
     )
     .unwrap();
-    if parallel(&d.join("first.txt")).is_some() {
-        assert!(!d.join("INJECTED").exists() && !d.join("plan/INJECTED").exists());
-        assert!(!d.join("INJECTED_T").exists());
+    // As the Slurm script runs a line (`bash -c "$line"`); GNU parallel's
+    // own reading of them: hostile_names_run_as_renders_under_gnu_parallel.
+    for line in jobs.lines().take(2) {
+        let st = Command::new("bash")
+            .args(["-c", line])
+            .current_dir(d)
+            .stdout(Stdio::null())
+            .stderr(Stdio::null())
+            .status()
+            .unwrap();
+        assert!(st.success(), "{line}");
     }
+    assert!(!d.join("INJECTED").exists() && !d.join("plan/INJECTED").exists());
+    assert!(!d.join("INJECTED_T").exists());
     // A plan folder with a newline: refused, nothing made.
     let (ok, _, err) = morphosys(
         d,
@@ -749,5 +774,63 @@ fn timing_files_of_one_name_stay_apart() {
     assert_eq!(
         std::fs::read_to_string(d.join("m/results.csv")).unwrap(),
         csv
+    );
+}
+
+/// The plan's job lines for a scene and a timing file whose names hold a
+/// newline and a command run under GNU parallel as renders and nothing
+/// else (parallel reads lines and its own replacement strings).
+#[test]
+#[ignore = "needs GNU parallel (Debian package parallel); .ci/run installs it and runs the ignored tests"]
+fn hostile_names_run_as_renders_under_gnu_parallel() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let scene = "x\ntouch INJECTED #{}.nff";
+    let timing = "t\ntouch INJECTED_T #{1}.toml";
+    std::fs::copy(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff"),
+        d.join(scene),
+    )
+    .unwrap();
+    let (ok, out, err) = morphosys(d, &["timing"]);
+    assert!(ok, "{err}");
+    std::fs::write(d.join(timing), out).unwrap();
+    let (ok, _, err) = morphosys(
+        d,
+        &[
+            "sweep",
+            scene,
+            "--timing",
+            timing,
+            "--only",
+            "broadcast",
+            "--size",
+            "16x16",
+            "--plan",
+            "plan",
+        ],
+    );
+    assert!(ok, "{err}");
+    let jobs = std::fs::read_to_string(d.join("plan/jobs.txt")).unwrap();
+    std::fs::write(
+        d.join("first.txt"),
+        jobs.lines().take(2).collect::<Vec<_>>().join("\n") + "\n",
+    )
+    .unwrap();
+    parallel(&d.join("first.txt"));
+    assert!(!d.join("INJECTED").exists() && !d.join("plan/INJECTED").exists());
+    assert!(!d.join("INJECTED_T").exists());
+    assert_eq!(
+        std::fs::read_dir(d.join("plan/points"))
+            .unwrap()
+            .filter(|e| e
+                .as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "json"))
+            .count(),
+        2,
+        "the two lines made their two renders"
     );
 }
