@@ -47,6 +47,11 @@ pub struct BenchArgs {
     /// The chip's timing from a TOML file (`morphosys timing`).
     #[arg(long, value_name = "FILE.toml")]
     pub timing: Option<PathBuf>,
+    /// Step every cycle through the plain register-transfer model (one
+    /// eval and commit per cycle) instead of the fast paths: slower, and
+    /// the same cycles, states and waveform.
+    #[arg(long)]
+    pub plain: bool,
 }
 
 fn pool(threads: usize) -> Result<rayon::ThreadPool> {
@@ -57,6 +62,7 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 }
 
 pub fn command(a: BenchArgs) -> Result<()> {
+    rtl::chip::set_plain(a.plain);
     if let Some(j) = &a.json {
         crate::output::Files::new()
             .input(
@@ -172,7 +178,10 @@ pub fn command(a: BenchArgs) -> Result<()> {
     // same in both runs): the chip instance alone, from the waveform's
     // creation to its end.
     let traced_slowdown_chip = traced_chip / untraced_small_chip;
-    println!("host                           {cpu}, {cores} threads; each figure the fastest of {repeat} runs, taken in turn");
+    println!(
+        "host                           {cpu}, {cores} threads; each figure the fastest of {repeat} runs, taken in turn{}",
+        if a.plain { "; the plain model (--plain)" } else { "" }
+    );
     println!(
         "workload                       {} at {width}x{height}, 64 ways: {cycles} chip cycles",
         scene.source

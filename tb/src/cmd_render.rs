@@ -129,6 +129,11 @@ pub struct RenderArgs {
     /// options the file was emitted with.
     #[arg(long, value_name = "FILE.s")]
     pub firmware: Option<PathBuf>,
+    /// Step every cycle through the plain register-transfer model (one
+    /// eval and commit per cycle) instead of the fast paths: slower, and
+    /// the same cycles, states and waveform.
+    #[arg(long)]
+    pub plain: bool,
     /// The command line's arguments (after the program's name), recorded in
     /// the JSON for `--skip-done` and `sweep --merge`.
     #[arg(skip)]
@@ -421,6 +426,7 @@ fn impossible_value(j: &serde_json::Value) -> Option<String> {
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {
+    rtl::chip::set_plain(a.plain);
     let scene = load_scene(a.scene.as_deref())?;
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     let firmware_text = match &a.firmware {
@@ -608,6 +614,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     rep.json["datapath_choice"] = serde_json::Value::String(datapath_reason.clone());
     rep.json["argv"] = a.argv.clone().into();
+    rep.json["stepping"] = if a.plain { "plain" } else { "fast" }.into();
     rep.json["inputs"] = inputs;
     let out = out_path;
     if let Some(h) = &a.hits {

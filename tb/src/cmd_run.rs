@@ -128,6 +128,11 @@ pub struct RunArgs {
     /// statistics as JSON here.
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
+    /// Step every cycle through the plain register-transfer model (one
+    /// eval and commit per cycle) instead of the fast paths: slower, and
+    /// the same cycles, states and waveform.
+    #[arg(long)]
+    pub plain: bool,
 }
 
 /// The failure code of the conformance programs: a halt with r1 = 0xBAD
@@ -158,6 +163,7 @@ pub fn parse_expect(s: &str) -> Result<(u8, u32), String> {
 }
 
 pub fn command(a: RunArgs) -> anyhow::Result<()> {
+    rtl::chip::set_plain(a.plain);
     let mut files = crate::output::Files::new();
     files.input(&a.file, "FILE");
     if let Some(t) = &a.timing {

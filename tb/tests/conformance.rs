@@ -297,3 +297,92 @@ fn the_stall_fast_path_traces_the_same_waveform() {
     }
     assert!(stalled >= 10, "only {stalled} programs stall");
 }
+
+/// Every conformance program, `wide.s` included, on both datapaths: run
+/// to its halt through the fast paths (`rtl::chip::run_to_halt`) and
+/// through the plain model alone (`rtl::chip::run_to_halt_plain`, what
+/// `--plain` runs), each with a waveform of every signal. The outcome (the
+/// cycles, or the same error), the statistics, TinyRISC's and the RCs'
+/// registers, outputs, flags, the FB and main memory, and the waveform
+/// byte for byte must be the same.
+#[test]
+fn fast_paths_equal_the_plain_model_on_both_datapaths() {
+    fn both<W: rtl::rc::Word>(name: &str, img: &firmware::asm::Image, dir: &std::path::Path) {
+        let run = |plain: bool| {
+            let vcd = dir.join(if plain { "plain.vcd" } else { "fast.vcd" });
+            let mut chip = rtl::Chip::<W>::build(Timing::default(), tb::cmd_run::DEFAULT_MEMORY);
+            img.load(&mut chip).unwrap();
+            let mut sim = rtl::Sim::new(chip);
+            // Every signal (an empty scope filter).
+            sim.trace(rtl::trace::TraceConfig::new(&vcd), "morphosys")
+                .unwrap();
+            let r = if plain {
+                rtl::chip::run_to_halt_plain(&mut sim, 300_000)
+            } else {
+                rtl::chip::run_to_halt(&mut sim, 300_000)
+            };
+            sim.finish_trace().unwrap();
+            (
+                sim,
+                r.map_err(|e| e.to_string()),
+                std::fs::read(&vcd).unwrap(),
+            )
+        };
+        let (fast, fr, fw) = run(false);
+        let (plain, pr, pw) = run(true);
+        let bits = W::BITS;
+        assert_eq!(fr, pr, "{name} ({bits}-bit): outcome");
+        let (f, s) = (&fast.top, &plain.top);
+        assert_eq!(f.stats(), s.stats(), "{name} ({bits}-bit): statistics");
+        for k in 0..16 {
+            assert_eq!(
+                f.risc.regs.read(k),
+                s.risc.regs.read(k),
+                "{name}: TinyRISC r{k}"
+            );
+            assert_eq!(
+                f.array.rc.regs.read(k),
+                s.array.rc.regs.read(k),
+                "{name}: RC r{k}"
+            );
+        }
+        assert_eq!(
+            f.array.rc.out, s.array.rc.out,
+            "{name} ({bits}-bit): RC outputs"
+        );
+        assert_eq!(
+            f.array.rc.acc, s.array.rc.acc,
+            "{name} ({bits}-bit): accumulators"
+        );
+        for a in 0..=0xFFFFu16 {
+            assert_eq!(
+                f.fb.read(a),
+                s.fb.read(a),
+                "{name} ({bits}-bit): FB word {a:#x}"
+            );
+        }
+        let n = f.mem.size();
+        assert!(
+            f.mem.bytes(0, n) == s.mem.bytes(0, n),
+            "{name} ({bits}-bit): main memory"
+        );
+        assert!(fw.len() > 1000, "{name}: a waveform of {} bytes", fw.len());
+        assert!(fw == pw, "{name} ({bits}-bit): the waveforms differ");
+    }
+    let tmp = tempfile::tempdir().unwrap();
+    let mut names: Vec<String> = std::fs::read_dir(dir())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".s"))
+        .collect();
+    names.sort();
+    assert!(
+        names.iter().any(|n| n == "wide.s") && names.len() >= 18,
+        "{names:?}"
+    );
+    for name in &names {
+        let img = load_program(&dir().join(name)).unwrap();
+        both::<i16>(name, &img, tmp.path());
+        both::<i32>(name, &img, tmp.path());
+    }
+}

@@ -104,12 +104,20 @@ fn json_has_every_key_and_sane_figures() {
         .iter()
         .map(|(n, _)| n.as_str())
         .collect();
-    for k in ["k_sphere", "k_cylinder", "k_box", "k_rectangle", "k_triangle"] {
+    for k in [
+        "k_sphere",
+        "k_cylinder",
+        "k_box",
+        "k_rectangle",
+        "k_triangle",
+    ] {
         assert!(names.contains(&k), "{k} not loaded");
     }
     let jacks = tracer_kernels("jacks-1.nff");
     assert!(jacks.contains(&"k_sphere".to_string()) && jacks.contains(&"k_cylinder".to_string()));
-    assert!(!jacks.contains(&"k_rectangle".to_string()) && !jacks.contains(&"k_triangle".to_string()));
+    assert!(
+        !jacks.contains(&"k_rectangle".to_string()) && !jacks.contains(&"k_triangle".to_string())
+    );
 }
 
 fn tracer_kernels(name: &str) -> Vec<String> {
@@ -569,7 +577,8 @@ fn every_table_size_reaches_every_kernel() {
             table_entries,
             ..Numerics::default()
         };
-        let (_, rep) = tb::cmd_render::render_with(&scene, &opts(64, 64), &nm, false, None).unwrap();
+        let (_, rep) =
+            tb::cmd_render::render_with(&scene, &opts(64, 64), &nm, false, None).unwrap();
         rep.json["psnr_db"].as_f64().unwrap()
     };
     let full = psnr(128);
@@ -579,6 +588,86 @@ fn every_table_size_reaches_every_kernel() {
         assert!(
             p >= full - 1.5,
             "tree-1 with {n}-entry tables: {p:.2} dB against {full:.2} dB with 128"
+        );
+    }
+}
+
+/// `morphosys render --plain` steps every cycle through the plain model:
+/// the default scene and jacks-1 at 32x32 under both traversals, and
+/// jacks-1 on the 32-bit chip, give the fast paths' image, hit map, every
+/// JSON figure but host time, and a waveform window byte for byte.
+#[test]
+fn render_plain_equals_the_fast_paths() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let cases: [(&str, &[&str]); 5] = [
+        ("default.toml", &["--traversal", "packet"]),
+        ("default.toml", &["--traversal", "paper"]),
+        ("jacks-1.nff", &["--traversal", "packet"]),
+        ("jacks-1.nff", &["--traversal", "paper"]),
+        ("jacks-1.nff", &["--datapath", "32"]),
+    ];
+    for (scene, extra) in cases {
+        let s = scene_path(scene);
+        let s = s.to_str().unwrap();
+        let mut outs = Vec::new();
+        for mode in ["fast", "plain"] {
+            let (png, json, hits, vcd) = (
+                format!("{mode}.png"),
+                format!("{mode}.json"),
+                format!("{mode}.hits"),
+                format!("{mode}.vcd"),
+            );
+            let mut args = vec![
+                "render",
+                s,
+                "--size",
+                "32x32",
+                "--out",
+                &png,
+                "--json",
+                &json,
+                "--hits",
+                &hits,
+                "--vcd",
+                &vcd,
+                "--trace-from",
+                "3000",
+                "--trace-cycles",
+                "4000",
+            ];
+            args.extend_from_slice(extra);
+            if mode == "plain" {
+                args.push("--plain");
+            }
+            let (ok, _, err) = morphosys(d, &args);
+            assert!(ok, "{scene} {extra:?} {mode}: {err}");
+            let mut j: serde_json::Value =
+                serde_json::from_slice(&std::fs::read(d.join(&json)).unwrap()).unwrap();
+            assert_eq!(j["stepping"], mode);
+            for k in [
+                "host_seconds",
+                "array_cycles_per_host_second",
+                "argv",
+                "stepping",
+            ] {
+                j.as_object_mut().unwrap().remove(k);
+            }
+            outs.push((
+                std::fs::read(d.join(&png)).unwrap(),
+                std::fs::read(d.join(&hits)).unwrap(),
+                j,
+                std::fs::read(d.join(&vcd)).unwrap(),
+            ));
+        }
+        let (f, p) = (&outs[0], &outs[1]);
+        assert!(f.2["cycles"].as_u64().unwrap() > 10_000);
+        assert_eq!(f.2, p.2, "{scene} {extra:?}: JSON");
+        assert!(f.0 == p.0, "{scene} {extra:?}: image");
+        assert!(f.1 == p.1, "{scene} {extra:?}: hit map");
+        assert!(
+            f.3.len() > 10_000 && f.3 == p.3,
+            "{scene} {extra:?}: waveform"
         );
     }
 }

@@ -30,6 +30,9 @@ use crate::rc::{Datapath, Word};
 use crate::tinyrisc::{decode, Command, Machine, RiscTiming, TinyRisc};
 use crate::trace::{Display, Field, LabelKind, Probe, Traced};
 
+mod fast;
+pub use fast::{run_to_halt16, run_to_halt32};
+
 /// Every cycle parameter of the chip.
 ///
 /// Fixed by the architecture (not parameters): the array executes one
@@ -355,284 +358,6 @@ impl<W: Word> Chip<W> {
         }
     }
 
-    /// The fast path of a stall: while TinyRISC retries an instruction
-    /// that waits for the array or the DMA (`rcany`, `wfb`, `dwait`, a full
-    /// broadcast queue...), only the broadcast unit, the array and the DMA
-    /// change, so their cycles are run without evaluating TinyRISC. Exactly
-    /// the cycles [`Clocked::eval`] + [`Clocked::commit`] would give (the
-    /// stall counters included); stops when the wait is over, the
-    /// instruction word changed (a DMA store into the program), or after
-    /// `limit` cycles. Returns the cycles run.
-    #[inline]
-    pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        self.run_stalled_sampled(limit, |_| true)
-    }
-
-    /// The untraced fast path, tried by the cycle loop before a plain
-    /// cycle. While the DMA is idle (main memory, the FB and the context
-    /// memory then change only by TinyRISC's own writes) whole cycles run
-    /// in [`Chip::run_local`]; otherwise stalled cycles run in
-    /// [`Chip::run_stalled`]. Exactly the cycles [`Clocked::eval`] +
-    /// [`Clocked::commit`] would give (tested against plain stepping on
-    /// every conformance program); returns the cycles run (0: step one
-    /// cycle).
-    #[inline(always)]
-    pub fn run_fast(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        if self.dma.idle() {
-            return self.run_local(limit);
-        }
-        self.run_stalled(limit)
-    }
-
-    /// [`Chip::run_fast`] with a waveform: `sample` is called between
-    /// each cycle's evaluation and its commit (`false`: stop before the
-    /// commit). While the DMA is idle the cycles run in
-    /// [`Chip::run_local`]'s loops, sampled one by one (multi-cycle
-    /// instructions' busy cycles evaluated one at a time); otherwise in
-    /// [`Chip::run_stalled_sampled`].
-    #[inline(always)]
-    pub fn run_fast_sampled(
-        &mut self,
-        limit: u64,
-        sample: &mut dyn FnMut(&Self) -> bool,
-    ) -> (u64, Result<(), Fault>) {
-        if self.dma.idle() {
-            return self.run_local_sampled(limit, sample);
-        }
-        self.run_stalled_sampled(limit, sample)
-    }
-
-    /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
-    /// fault, or `limit`; three kinds, each with less to do than a plain
-    /// cycle:
-    ///
-    /// * TinyRISC waits for the array while a run streams: the broadcast
-    ///   unit and the array cycle alone, the stall counted at the end (a
-    ///   stalled evaluation changes nothing, and nothing can change the
-    ///   waiting instruction's word);
-    /// * the array is idle and nothing is queued: TinyRISC alone, and its
-    ///   multi-cycle instructions' busy cycles pass at once;
-    /// * both work: TinyRISC, then the broadcast unit and the array (its
-    ///   evaluation and clock edge in one call), in the order of
-    ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
-    #[inline(never)]
-    fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        self.local_cycles::<false, _>(limit, &mut |_: &Self| true)
-    }
-
-    /// [`Chip::run_local`] sampled cycle by cycle (see
-    /// [`Chip::run_fast_sampled`]).
-    #[inline(never)]
-    fn run_local_sampled(
-        &mut self,
-        limit: u64,
-        sample: &mut dyn FnMut(&Self) -> bool,
-    ) -> (u64, Result<(), Fault>) {
-        self.local_cycles::<true, _>(limit, sample)
-    }
-
-    /// The loops of [`Chip::run_local`]; when `SAMPLED`, `sample` is
-    /// called between every cycle's evaluation and its commit, and busy
-    /// cycles are evaluated one by one.
-    #[inline(always)]
-    fn local_cycles<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
-        &mut self,
-        limit: u64,
-        sample: &mut S,
-    ) -> (u64, Result<(), Fault>) {
-        use crate::tinyrisc::{State, Wait};
-        let mut n = 0;
-        // A stall evaluated before this call may wait on a word the DMA
-        // has just rewritten: then it is evaluated again.
-        let mut word_ok = self.mem.word(self.risc.pc) == Some(self.risc.ir);
-        // The cycle before was one of TinyRISC alone, in this loop.
-        let mut alone = false;
-        while n < limit && !self.risc.halted() {
-            let alone_before = std::mem::take(&mut alone);
-            if self.bcast.idle() {
-                // TinyRISC alone.
-                let busy = self.risc.busy();
-                if !SAMPLED && busy > 0 {
-                    let b = (busy as u64).min(limit - n);
-                    self.risc.skip_busy(b as u32);
-                    self.idle_control += b;
-                    self.cycles += b;
-                    n += b;
-                    continue;
-                }
-                if let Err(f) = self.eval_risc() {
-                    return (n, Err(f));
-                }
-                word_ok = true;
-                self.array.idle();
-                if SAMPLED {
-                    // Nothing but TinyRISC works in this cycle and did in
-                    // the one before: the broadcast unit and the DMA were
-                    // idle in both, nothing issued a run or a transfer
-                    // between them (either ends TinyRISC's time alone),
-                    // and the array, idle in both, was neither evaluated
-                    // nor clocked since the last sample.
-                    self.quiet = alone_before;
-                    let go_on = sample(self);
-                    self.quiet = false;
-                    if !go_on {
-                        break;
-                    }
-                }
-                alone = true;
-                if self.risc.state != State::StallDma {
-                    self.idle_control += 1;
-                }
-            } else if word_ok
-                && self.risc.state == State::StallArray
-                && match self.risc.wait {
-                    Wait::ArrayIdle => true,
-                    Wait::Issue => !self.bcast.can_issue(),
-                    _ => false,
-                }
-            {
-                // The array streams while TinyRISC waits.
-                let (k, r, stopped) = self.stream::<SAMPLED, S>(limit - n, sample);
-                n += k;
-                if r.is_err() {
-                    return (n, r);
-                }
-                if SAMPLED && stopped {
-                    break; // by the waveform
-                }
-                continue;
-            } else {
-                // Both.
-                if let Err(f) = self.eval_risc() {
-                    return (n, Err(f));
-                }
-                word_ok = true;
-                match self.stream_one::<SAMPLED, S>(sample) {
-                    Ok(Some(k)) => {
-                        self.array_busy += 1;
-                        self.active_rc += k;
-                    }
-                    Ok(None) => break,
-                    Err(f) => return (n, Err(f)),
-                }
-            }
-            let cmd = self.risc.cmd;
-            self.apply(cmd);
-            self.risc.commit();
-            self.cycles += 1;
-            n += 1;
-            if matches!(cmd, Command::Dma(_)) {
-                break;
-            }
-        }
-        (n, Ok(()))
-    }
-
-    /// The array streams while TinyRISC waits for it (the stall of the
-    /// last evaluation, `Wait::ArrayIdle` or `Wait::Issue`) and the DMA is
-    /// idle: until the wait is over, `limit`, or (`SAMPLED`) `sample`
-    /// stops it (the third value: whether it did).
-    #[inline(always)]
-    fn stream<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
-        &mut self,
-        limit: u64,
-        sample: &mut S,
-    ) -> (u64, Result<(), Fault>, bool) {
-        use crate::tinyrisc::Wait;
-        let wait = self.risc.wait;
-        let mut n = 0;
-        let mut active = 0u64;
-        let mut err = None;
-        let mut stopped = false;
-        while n < limit
-            && match wait {
-                Wait::ArrayIdle => !self.bcast.idle(),
-                _ => !self.bcast.can_issue(),
-            }
-        {
-            if !SAMPLED {
-                let (k, a, r) = self.bcast.stream_simd(
-                    &self.ctx_mem,
-                    &self.fb,
-                    &mut self.array,
-                    limit - n,
-                    wait != Wait::ArrayIdle,
-                    self.watch
-                        .any
-                        .then_some(|ctx, rcs| self.watch.count(ctx, rcs)),
-                );
-                n += k;
-                active += a;
-                if let Err(f) = r {
-                    err = Some(self.locate(f));
-                    break;
-                }
-                if k > 0 {
-                    continue;
-                }
-            }
-            // TinyRISC waits through the whole stream, neither evaluated
-            // nor clocked: after the stream's first cycle it shows what
-            // it showed in the cycle before.
-            if SAMPLED {
-                self.risc_quiet = n > 0;
-            }
-            let r = self.stream_cycle::<SAMPLED, S>(sample);
-            if SAMPLED {
-                self.risc_quiet = false;
-            }
-            match r {
-                Ok(Some(k)) => active += k as u64,
-                Ok(None) => {
-                    stopped = true;
-                    break;
-                }
-                Err(f) => {
-                    err = Some(f);
-                    break;
-                }
-            }
-            n += 1;
-        }
-        self.array_busy += n;
-        self.active_rc += active;
-        self.risc.add_stalled(n);
-        self.cycles += n;
-        match err {
-            None => (n, Ok(()), stopped),
-            Some(f) => (n, Err(f), stopped),
-        }
-    }
-
-    /// One cycle of the broadcast unit and the array with the DMA idle:
-    /// [`Broadcast::stream_simd`]'s when it runs it (untraced), else
-    /// [`Chip::stream_cycle`]'s.
-    #[inline(always)]
-    fn stream_one<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
-        &mut self,
-        sample: &mut S,
-    ) -> Result<Option<u64>, Fault> {
-        if !SAMPLED {
-            let (k, a, r) = self.bcast.stream_simd(
-                &self.ctx_mem,
-                &self.fb,
-                &mut self.array,
-                1,
-                false,
-                self.watch
-                    .any
-                    .then_some(|ctx, rcs| self.watch.count(ctx, rcs)),
-            );
-            if let Err(f) = r {
-                return Err(self.locate(f));
-            }
-            if k == 1 {
-                return Ok(Some(a));
-            }
-        }
-        Ok(self.stream_cycle::<SAMPLED, S>(sample)?.map(u64::from))
-    }
-
     /// TinyRISC's evaluation of the cycle, through its view of the chip.
     #[inline(always)]
     fn eval_risc(&mut self) -> Result<(), Fault> {
@@ -645,39 +370,6 @@ impl<W: Word> Chip<W> {
             cycles: self.cycles,
         };
         self.risc.eval(&view).map_err(|f| self.locate(f))
-    }
-
-    /// One cycle of the broadcast unit and the array with the DMA idle,
-    /// evaluation and clock edge (the run's statistics to the caller):
-    /// the RCs that executed; `None` when (`SAMPLED`) `sample`, called
-    /// between the two, stopped it before the clock edge.
-    #[inline(always)]
-    fn stream_cycle<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
-        &mut self,
-        sample: &mut S,
-    ) -> Result<Option<u32>, Fault> {
-        if let Err(f) = self
-            .bcast
-            .eval(&self.ctx_mem, &self.fb, 0, 0, &mut self.array)
-        {
-            return Err(self.locate(f));
-        }
-        if SAMPLED {
-            if let Err(f) = self.array.eval() {
-                return Err(self.locate(f));
-            }
-            if !sample(self) {
-                return Ok(None);
-            }
-            self.array.commit();
-        } else if let Err(f) = self.array.step() {
-            return Err(self.locate(f));
-        }
-        if self.watch.any {
-            self.count_watched();
-        }
-        self.bcast.commit();
-        Ok(Some(self.array.active_now))
     }
 
     /// TinyRISC's write at the clock edge.
@@ -695,49 +387,6 @@ impl<W: Word> Chip<W> {
             Command::Dma(req) => self.dma.start(req, self.risc.pc),
             Command::Run(run) => self.bcast.issue(run),
         }
-    }
-
-    /// [`Chip::run_stalled`], calling `sample` between each cycle's
-    /// evaluation and its commit (a waveform samples the cycle; `false`
-    /// stops before the commit).
-    #[inline(always)]
-    pub fn run_stalled_sampled(
-        &mut self,
-        limit: u64,
-        mut sample: impl FnMut(&Self) -> bool,
-    ) -> (u64, Result<(), Fault>) {
-        use crate::tinyrisc::{State, Wait};
-        let mut n = 0;
-        while n < limit
-            && matches!(self.risc.state, State::StallArray | State::StallDma)
-            && match self.risc.wait {
-                Wait::ArrayIdle => !self.bcast.idle(),
-                Wait::Issue => !self.bcast.can_issue(),
-                Wait::Dma => !self.dma.idle(),
-                Wait::None => false,
-            }
-            && self.mem.read(self.risc.pc, 4) == self.risc.ir
-        {
-            if let Err(f) = self.bcast.eval(
-                &self.ctx_mem,
-                &self.fb,
-                self.dma.owned_fb_banks(),
-                self.dma.owned_ctx_banks(),
-                &mut self.array,
-            ) {
-                return (n, Err(self.locate(f)));
-            }
-            if let Err(f) = self.array.eval() {
-                return (n, Err(self.locate(f)));
-            }
-            if !sample(self) {
-                break;
-            }
-            // TinyRISC's stalled eval left no command and no write-back.
-            self.commit();
-            n += 1;
-        }
-        (n, Ok(()))
     }
 
     #[cold]
@@ -912,13 +561,50 @@ impl std::fmt::Display for RunError {
 
 impl std::error::Error for RunError {}
 
+/// Runs to `halt` step by step through the plain model instead of the
+/// fast paths, for every run of this process ([`set_plain`]).
+static PLAIN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
+
+/// Make [`run_to_halt`] step every cycle through the plain model: one
+/// [`Clocked::eval`] and [`Clocked::commit`] per cycle (`Sim::step`), no
+/// fast path. Slower, and the same cycles, states, statistics and
+/// waveforms (`--plain` on `render`, `run` and `bench`).
+pub fn set_plain(plain: bool) {
+    PLAIN.store(plain, std::sync::atomic::Ordering::Relaxed);
+}
+
+/// Whether [`run_to_halt`] steps through the plain model ([`set_plain`]).
+pub fn plain() -> bool {
+    PLAIN.load(std::sync::atomic::Ordering::Relaxed)
+}
+
+/// Run to `halt` through the plain model alone, one [`Sim::step`] a cycle:
+/// what the fast paths of [`run_to_halt`] are held to.
+pub fn run_to_halt_plain<W: Word>(
+    sim: &mut Sim<Chip<W>>,
+    max_cycles: u64,
+) -> Result<u64, RunError> {
+    while !sim.top.halted() {
+        if sim.cycle() >= max_cycles {
+            return Err(no_halt(sim));
+        }
+        sim.step().map_err(RunError::Step)?;
+    }
+    Ok(sim.cycle())
+}
+
 /// Run to `halt`; returns the cycles used (the halt's cycle included).
+/// Through the fast paths ([`fast`]) unless [`set_plain`] asked for the
+/// plain model.
 ///
 /// Both datapaths run through a copy of the loop compiled in this crate
 /// ([`run_to_halt16`], [`run_to_halt32`]), not instantiated in the caller's:
 /// the cycle loop of the 16-bit chip is then compiled as it was before the
 /// 32-bit variant existed (measured: 5% faster than a caller's instance).
 pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
+    if plain() {
+        return run_to_halt_plain(sim, max_cycles);
+    }
     let any: &mut dyn std::any::Any = sim;
     if let Some(s) = any.downcast_mut::<Sim<Chip<i16>>>() {
         return run_to_halt16(s, max_cycles);
@@ -927,56 +613,6 @@ pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u
         return run_to_halt32(s, max_cycles);
     }
     unreachable!("Word is implemented by i16 and i32 only")
-}
-
-/// [`run_to_halt`] for the 16-bit chip.
-pub fn run_to_halt16(sim: &mut Sim<Chip<i16>>, max_cycles: u64) -> Result<u64, RunError> {
-    run_loop(sim, max_cycles)
-}
-
-/// [`run_to_halt`] for the 32-bit chip.
-pub fn run_to_halt32(sim: &mut Sim<Chip<i32>>, max_cycles: u64) -> Result<u64, RunError> {
-    run_loop(sim, max_cycles)
-}
-
-fn run_loop<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
-    if sim.tracing() {
-        return run_loop_traced(sim, max_cycles);
-    }
-    cycles::<W, false>(sim, max_cycles)
-}
-
-/// [`run_loop`] with a waveform: out of line, so that the untraced loop's
-/// code is what it was before tracing could take the fast path (the
-/// inliner had left the cycle's parts out of line: 8% slower).
-#[inline(never)]
-fn run_loop_traced<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
-    cycles::<W, true>(sim, max_cycles)
-}
-
-/// The cycle loop, stalled cycles through the fast path (sampled when
-/// `TRACED`).
-#[inline(always)]
-fn cycles<W: Word, const TRACED: bool>(
-    sim: &mut Sim<Chip<W>>,
-    max_cycles: u64,
-) -> Result<u64, RunError> {
-    while !sim.top.halted() {
-        if sim.cycle() >= max_cycles {
-            return Err(no_halt(sim));
-        }
-        let limit = max_cycles - sim.cycle();
-        let stalled = if TRACED {
-            sim.fast_forward_sampled(|c, sample| c.run_fast_sampled(limit, sample))
-        } else {
-            sim.fast_forward(|c| c.run_fast(limit))
-        };
-        if stalled.map_err(RunError::Step)? > 0 {
-            continue;
-        }
-        sim.step().map_err(RunError::Step)?;
-    }
-    Ok(sim.cycle())
 }
 
 #[cold]
