@@ -5,7 +5,9 @@
 //! reference, or the compiler refuses the scene with a message saying what
 //! the number format cannot represent.
 //!
-//! Run with `--nocapture` to see the measured figures.
+//! Run with `--nocapture` to see the measured figures. The floors sit about
+//! 3 dB under what the chip measures (deterministic: any fall of that
+//! size is a regression, not noise).
 
 use firmware::scene::{native, Scene};
 use firmware::tracer::Options;
@@ -114,7 +116,7 @@ fn grazing_rays_at_sphere_silhouettes() {
             + FLOOR
             + &sphere("[0.0, 0.0, 1.0]", 1.0)),
     );
-    close(&run("grazing rays", &s), 25.0, 0.95);
+    close(&run("grazing rays", &s), 63.0, 0.999);
 }
 
 #[test]
@@ -132,7 +134,7 @@ fn ray_directions_with_zero_components() {
     // Measured: 60.0 dB, format Q5.10. (With a coarser Q6.9 an earlier
     // firmware shaded a one-pixel sliver of the box's side face, seen almost
     // edge-on, with the top face's normal: 24.6 dB at 32x32.)
-    close(&run("zero direction components", &s), 25.0, 0.97);
+    close(&run("zero direction components", &s), 58.0, 0.999);
 }
 
 #[test]
@@ -164,11 +166,8 @@ fn huge_floor_beside_small_spheres() {
             + &sphere("[0.0, 0.0, 0.5]", 0.5)
             + &sphere("[1.2, 0.0, 0.3]", 0.3)),
     );
-    match run("huge floor, small spheres", &s) {
-        // Either rendered (reported above) or refused with the reason.
-        Outcome::Rendered { hits, .. } => assert!(hits > 0.5, "hit agreement {hits}"),
-        Outcome::Refused(m) => assert!(m.contains("LSB") || m.contains("Q"), "{m}"),
-    }
+    // Representable (Q10.5): rendered, close to the reference.
+    close(&run("huge floor, small spheres", &s), 46.0, 0.999);
 }
 
 #[test]
@@ -189,10 +188,7 @@ fn near_coplanar_triangles() {
             + &tri(0.5, "red")
             + &tri(0.502, "white")),
     );
-    match run("near-coplanar triangles", &s) {
-        Outcome::Rendered { hits, .. } => assert!(hits > 0.6, "hit agreement {hits}"),
-        Outcome::Refused(m) => assert!(m.contains("LSB") || m.contains("degenerate"), "{m}"),
-    }
+    close(&run("near-coplanar triangles", &s), 61.0, 0.999);
 }
 
 #[test]
@@ -206,7 +202,7 @@ fn light_just_above_a_surface() {
             + FLOOR
             + &sphere("[1.5, 1.5, 0.5]", 0.5)),
     );
-    close(&run("light just above the floor", &s), 20.0, 0.95);
+    close(&run("light just above the floor", &s), 56.0, 0.999);
 }
 
 #[test]
@@ -221,10 +217,7 @@ fn camera_inside_an_object() {
             + &sphere("[0.0, 0.0, 1.0]", 1.5)
             + &sphere("[0.0, 3.0, 0.5]", 0.5)),
     );
-    match run("camera inside a sphere", &s) {
-        Outcome::Rendered { hits, .. } => assert!(hits > 0.8, "hit agreement {hits}"),
-        Outcome::Refused(m) => panic!("refused: {m}"),
-    }
+    close(&run("camera inside a sphere", &s), 40.0, 0.995);
 }
 
 #[test]
@@ -239,11 +232,6 @@ fn distances_that_overflow_16_bits() {
             + &sphere("[0.0, 0.0, 1.0]", 1.0)
             + &sphere("[0.0, 1000.0, 1.0]", 20.0)),
     );
-    match run("distances beyond 16 bits", &s) {
-        Outcome::Rendered { hits, .. } => assert!(hits > 0.9, "hit agreement {hits}"),
-        Outcome::Refused(m) => assert!(
-            m.contains("LSB") || m.contains("16") || m.contains("Q"),
-            "{m}"
-        ),
-    }
+    // The compiler picks a format for the bounds (Q12.3) and renders.
+    close(&run("distances beyond 16 bits", &s), 47.0, 0.999);
 }
