@@ -4,7 +4,7 @@
 
 use firmware::bsp::{BspParams, SplitRule};
 use firmware::scene::{native, Aabb, Scene, Shape, Vec3};
-use firmware::scene_image::{compile, CompileOptions, Layout, MAGIC, NO_CHILD};
+use firmware::scene_image::{compile, CompileOptions, NodeFormat, MAGIC, NO_CHILD};
 
 const HEAD: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nup = [0, 1, 0]\nangle = 45\n\
                     [[light]]\nposition = [1, 2, 3]\n[material.m]\ncolor = [1, 0.5, 0.25]\nkd = 0.75\nks = 0.25\nshine = 20\n";
@@ -58,7 +58,7 @@ fn small_scene_by_hand() {
     // Three objects <= 5 per leaf: the root is a leaf; Fig. 5 node: flags,
     // plane, two children, then one bit vector per type present, object 0
     // in the most significant bit.
-    assert_eq!(r.layout, Layout::BitVectors);
+    assert_eq!(r.layout, NodeFormat::BitVectors);
     let n = addr(w, 38);
     assert_eq!(
         &w[n..n + 6],
@@ -185,7 +185,7 @@ fn grid_scene(n: usize) -> Scene {
 fn bit_vector_membership_matches_planes() {
     let s = grid_scene(60);
     let img = compile(&s, &CompileOptions::default()).unwrap();
-    assert_eq!(img.report.layout, Layout::BitVectors);
+    assert_eq!(img.report.layout, NodeFormat::BitVectors);
     assert!(img.report.bsp.nodes > 7);
     check_membership(&s, &img);
     let sah = CompileOptions {
@@ -204,7 +204,7 @@ fn thousands_of_objects_choose_index_lists() {
     let img = compile(&s, &CompileOptions::default()).unwrap();
     assert_eq!(
         img.report.layout,
-        Layout::IndexLists,
+        NodeFormat::IndexLists,
         "{}",
         img.report.layout_reason
     );
@@ -214,7 +214,7 @@ fn thousands_of_objects_choose_index_lists() {
     check_membership(&s, &img);
     // Forcing bit vectors gives the same membership.
     let forced = CompileOptions {
-        layout: Some(Layout::BitVectors),
+        layout: Some(NodeFormat::BitVectors),
         ..CompileOptions::default()
     };
     check_membership(&s, &compile(&s, &forced).unwrap());
@@ -249,7 +249,7 @@ fn spd_scenes_compile() {
     assert_eq!(r.format, "Q5.10");
     assert!((r.smallest_feature_lsb - 0.00617284 * 1024.0).abs() < 1e-9);
     assert!(r.max_quantization_error <= 0.5 / 1024.0);
-    assert_eq!(r.layout, Layout::IndexLists);
+    assert_eq!(r.layout, NodeFormat::IndexLists);
     assert!(r.bsp.max_depth <= 15);
     check_membership(&balls, &img);
 }

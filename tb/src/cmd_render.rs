@@ -220,11 +220,11 @@ pub fn render_as(
     nm: &firmware::tracer::Numerics,
     host: &crate::render::RenderSettings,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
-    render_built(scene, opt, nm, host, None)
+    render_and_measure(scene, opt, nm, host, None)
 }
 
 /// [`render_as`] with the firmware already built (`None`: built here).
-pub fn render_built(
+pub fn render_and_measure(
     scene: &firmware::scene::Scene,
     opt: &Options,
     nm: &firmware::tracer::Numerics,
@@ -576,7 +576,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         }
         c
     });
-    let (chip, mut rep) = render_built(
+    let (chip, mut rep) = render_and_measure(
         &scene,
         &opt,
         &nm,

@@ -7,7 +7,7 @@ use std::time::Instant;
 use anyhow::{bail, Context, Result};
 use firmware::bsp::{BspParams, SplitRule};
 use firmware::scene::Scene;
-use firmware::scene_image::{compile, CompileOptions, Layout};
+use firmware::scene_image::{compile, CompileOptions, NodeFormat};
 use serde_json::json;
 
 use crate::metrics;
@@ -316,8 +316,8 @@ pub struct CompileArgs {
 pub fn compile_cmd(a: CompileArgs) -> Result<()> {
     let sah = a.sah || a.split == "sah";
     let layout = a.layout.map(|l| match l {
-        firmware::tracer::NodeLayout::Compact => Layout::IndexLists,
-        firmware::tracer::NodeLayout::Fig5 => Layout::BitVectors,
+        firmware::tracer::NodeLayout::Compact => NodeFormat::IndexLists,
+        firmware::tracer::NodeLayout::Fig5 => NodeFormat::BitVectors,
     });
     let mut files = crate::output::Files::new();
     files.input(&a.scene.clone().unwrap_or_else(default_scene), "SCENE");

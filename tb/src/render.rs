@@ -450,7 +450,7 @@ pub const PROBE_STRIDE: u32 = 4;
 /// A render of the probe's tiles: their cycles, and their pixels (row by
 /// row within each tile, tiles in order) with the colours and hit objects.
 #[derive(Clone, Debug)]
-pub struct Probe {
+pub struct ProbeRender {
     pub cycles: u64,
     pub pixels: Vec<(u32, u32)>,
     pub rgb8: Vec<u8>,
@@ -461,7 +461,7 @@ pub struct Probe {
 }
 
 /// Run the probe's tiles of `opt`'s frame on the chip with `fw`.
-pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<Probe> {
+pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRender> {
     let (tw, th) = (fw.tile_w, fw.tile_h);
     let (nx, ny) = (opt.width.div_ceil(tw), opt.height.div_ceil(th));
     let pick = |n: u32| -> Vec<u32> {
@@ -490,7 +490,7 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<Probe> {
             Datapath::W32 => run_group::<i32>(&img, fw, g, None, false, timing, false),
         })
         .collect();
-    let mut p = Probe {
+    let mut p = ProbeRender {
         cycles: 0,
         pixels: Vec::new(),
         rgb8: Vec::new(),
@@ -548,13 +548,13 @@ pub fn choose_firmware_probed(
     opt: &Options,
     nm: &Numerics,
     timing: &Timing,
-) -> Result<(Firmware, Option<Probe>)> {
+) -> Result<(Firmware, Option<ProbeRender>)> {
     let cands = tracer::resolve_bsp(opt, scene.objects.len());
     if cands.len() < 2 {
         let fw = tracer::build_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
         return Ok((fw, None));
     }
-    let mut tried: Vec<(Probe, f64, Firmware)> = Vec::new();
+    let mut tried: Vec<(ProbeRender, f64, Firmware)> = Vec::new();
     let mut reference: Option<(Vec<u8>, Vec<u32>)> = None;
     let mut first_err = None;
     for bsp in cands {
@@ -575,7 +575,7 @@ pub fn choose_firmware_probed(
         tried.push((p, if psnr.is_finite() { psnr } else { 99.0 }, fw));
     }
     let best_psnr = tried.iter().map(|t| t.1).fold(f64::NEG_INFINITY, f64::max);
-    let mut pick: Option<(Probe, f64, Firmware)> = None;
+    let mut pick: Option<(ProbeRender, f64, Firmware)> = None;
     for t in tried {
         if t.1 >= best_psnr - TREE_PSNR_SLACK
             && pick.as_ref().is_none_or(|(b, _, _)| t.0.cycles < b.cycles)

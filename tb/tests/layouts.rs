@@ -153,7 +153,7 @@ fn both_node_images_name_exactly_the_bsp_objects() {
     let image = firmware::scene_image::compile(
         &scene,
         &firmware::scene_image::CompileOptions {
-            layout: Some(firmware::scene_image::Layout::BitVectors),
+            layout: Some(firmware::scene_image::NodeFormat::BitVectors),
             guard_bits: 2,
             ..Default::default()
         },

@@ -83,7 +83,7 @@ pub fn record_words(t: PrimType) -> usize {
 /// Which node layout.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
-pub enum Layout {
+pub enum NodeFormat {
     /// Fig. 5: one membership bit vector per primitive type in every node.
     BitVectors,
     /// Per node, a range of a shared list of object references.
@@ -95,7 +95,7 @@ pub enum Layout {
 pub struct CompileOptions {
     pub bsp: BspParams,
     /// None: the smaller of the two.
-    pub layout: Option<Layout>,
+    pub layout: Option<NodeFormat>,
     /// Bits of headroom above the largest coordinate.
     pub guard_bits: u32,
     /// Refuse a scene whose smallest feature is below this many LSBs.
@@ -386,7 +386,7 @@ fn build_bsp(scene: &Scene, opt: &CompileOptions, q: QFormat) -> Result<Bsp, Sce
 
 /// The node layout, why, and both layouts' sizes.
 struct LayoutChoice {
-    layout: Layout,
+    layout: NodeFormat,
     reason: String,
     /// Bit-vector words in one Fig. 5 node.
     bv_per_node: usize,
@@ -429,7 +429,7 @@ fn choose_layout(
     let il_words = (max_per_type <= 1 << LIST_INDEX_BITS)
         .then(|| bsp.nodes.len() * 8 + bsp.stats().leaf_references);
     let (layout, reason) = match (opt.layout, il_words) {
-        (Some(Layout::IndexLists), None) => {
+        (Some(NodeFormat::IndexLists), None) => {
             return Err(error(
                 scene,
                 0,
@@ -438,11 +438,11 @@ fn choose_layout(
         }
         (Some(l), _) => (l, "chosen by option".to_string()),
         (None, Some(il)) if il < bv_words => (
-            Layout::IndexLists,
+            NodeFormat::IndexLists,
             format!("index lists ({il} words) are smaller than bit vectors ({bv_words} words, {bv_per_node} per node)"),
         ),
         (None, _) => (
-            Layout::BitVectors,
+            NodeFormat::BitVectors,
             format!("bit vectors ({bv_words} words, {bv_per_node} per node) are no larger than index lists"),
         ),
     };

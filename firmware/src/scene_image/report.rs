@@ -3,7 +3,7 @@
 
 use crate::bsp::{BspParams, BspStats};
 
-use super::Layout;
+use super::NodeFormat;
 
 /// The triangle-only version of a scene, for comparison.
 #[derive(Clone, Debug, serde::Serialize)]
@@ -34,7 +34,7 @@ pub struct Report {
     pub type_counts: Vec<(String, usize)>,
     pub bsp: BspStats,
     pub bsp_params: BspParams,
-    pub layout: Layout,
+    pub layout: NodeFormat,
     pub layout_reason: String,
     pub bitvector_layout_words: Option<usize>,
     pub index_list_layout_words: Option<usize>,
@@ -98,8 +98,8 @@ impl Report {
         s += &format!(
             "layout: {}: {}\n",
             match self.layout {
-                Layout::BitVectors => "fig5 (bit vectors)",
-                Layout::IndexLists => "compact (index lists)",
+                NodeFormat::BitVectors => "fig5 (bit vectors)",
+                NodeFormat::IndexLists => "compact (index lists)",
             },
             self.layout_reason
         );

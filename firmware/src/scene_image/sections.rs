@@ -7,7 +7,7 @@ use crate::scene::{PrimType, Scene, SceneError, Shape, Vec3};
 
 use super::fit::dequantized;
 use super::{
-    membership_words, record_words, CompileOptions, Groups, Layout, LayoutChoice, QFormat,
+    membership_words, record_words, CompileOptions, Groups, NodeFormat, LayoutChoice, QFormat,
     HEADER_WORDS, LIST_INDEX_BITS, MAGIC, NO_CHILD, Q_MATERIAL, Q_UNIT, VERSION,
 };
 
@@ -75,14 +75,14 @@ pub(super) fn header(w: &mut Writer, scene: &Scene, g: &Groups, bsp: &Bsp, l: &L
     w.words[1] = VERSION;
     w.words[2] = w.q.frac as u16;
     w.words[3] = match l.layout {
-        Layout::BitVectors => 0,
-        Layout::IndexLists => 1,
+        NodeFormat::BitVectors => 0,
+        NodeFormat::IndexLists => 1,
     };
     w.words[4] = bsp.nodes.len() as u16;
     w.words[5] = 0; // root node index
     w.words[6] = match l.layout {
-        Layout::BitVectors => 4 + l.bv_per_node,
-        Layout::IndexLists => 8,
+        NodeFormat::BitVectors => 4 + l.bv_per_node,
+        NodeFormat::IndexLists => 8,
     } as u16;
     w.words[7] = scene.lights.len() as u16;
     w.words[8] = scene.materials.len() as u16;
@@ -272,12 +272,12 @@ fn record(w: &mut Writer, t: PrimType, shape: &Shape, material: usize) -> Option
 
 /// The BSP nodes in the chosen layout (and, for index lists, the shared
 /// list after them). Returns the words written, lists included.
-pub(super) fn nodes(w: &mut Writer, bsp: &Bsp, g: &Groups, layout: Layout) -> usize {
+pub(super) fn nodes(w: &mut Writer, bsp: &Bsp, g: &Groups, layout: NodeFormat) -> usize {
     let at_nodes = w.words.len();
     w.addr(A_NODES, at_nodes);
     let slot = |i: u32| g.object_slots[i as usize];
     match layout {
-        Layout::BitVectors => {
+        NodeFormat::BitVectors => {
             for n in &bsp.nodes {
                 node_head(w, n);
                 for t in &g.present {
@@ -293,7 +293,7 @@ pub(super) fn nodes(w: &mut Writer, bsp: &Bsp, g: &Groups, layout: Layout) -> us
             }
             w.addr(A_LISTS, 0);
         }
-        Layout::IndexLists => {
+        NodeFormat::IndexLists => {
             let (ranges, list) = index_lists(bsp, &slot);
             for (k, n) in bsp.nodes.iter().enumerate() {
                 node_head(w, n);

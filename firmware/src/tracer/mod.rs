@@ -351,7 +351,7 @@ pub struct Firmware {
     /// Names of the kernels loaded (types present only) and their lengths.
     pub kernels: Vec<(String, usize)>,
     /// Where everything is in the FB image, and the kernels' scale shifts.
-    pub layout: layout::Layout,
+    pub layout: layout::FbImage,
     /// The BSP built (the options' automatic choices resolved).
     pub bsp: BspParams,
 }
@@ -548,7 +548,7 @@ fn build_one(
     }
     let copt = CompileOptions {
         bsp: opt.bsp,
-        layout: Some(crate::scene_image::Layout::BitVectors),
+        layout: Some(crate::scene_image::NodeFormat::BitVectors),
         guard_bits: nm.guard_bits,
         target_extra_frac: opt.datapath.bits() - 16,
         ..CompileOptions::default()

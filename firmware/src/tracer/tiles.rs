@@ -21,7 +21,7 @@
 
 use super::emit::{at, Code, R0, R1, R2, R3, R4, R5, R6};
 use super::kernel_names as names;
-use super::layout::Layout;
+use super::layout::FbImage;
 use super::primitives::kaddr;
 
 /// `BCAST k`: broadcast a kernel without a stream.
@@ -37,7 +37,7 @@ fn sb<'a>(t: &'a mut Code, k: &str, stream: &str) -> &'a mut Code {
 /// The macros of the main program and the traversals: broadcasts of a
 /// kernel (its context address and length from its labels), a level's
 /// shading and one light's shadow pass.
-pub fn macros(lay: &Layout) -> Code {
+pub fn macros(lay: &FbImage) -> Code {
     let mut t = Code::new();
     let body = |f: &dyn Fn(&mut Code)| {
         let mut b = Code::new();
@@ -125,7 +125,7 @@ pub fn macros(lay: &Layout) -> Code {
 }
 
 /// The main program: `_start`, the tile loop, `finish`.
-pub fn main(t: &mut Code, lay: &Layout, depth: u32) {
+pub fn main(t: &mut Code, lay: &FbImage, depth: u32) {
     t.doc(
         "_start: the FB image and the contexts in by DMA, every RC's RAM tables and lane words,\n\
          then the tile loop; T_START, T_END: the cycle counter around it.",
@@ -205,7 +205,7 @@ fn shade_level(t: &mut Code, level: u32) {
 /// The ray tree, depth first: a level's shading, then its reflected ray's
 /// subtree and, where the scene refracts, its refracted ray's (skipped
 /// when no ray of the tile refracts there).
-fn tree(t: &mut Code, lay: &Layout, level: u32, levels: u32, skips: &mut u32) {
+fn tree(t: &mut Code, lay: &FbImage, level: u32, levels: u32, skips: &mut u32) {
     shade_level(t, level);
     if level + 1 >= levels {
         return;

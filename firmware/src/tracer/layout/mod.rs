@@ -56,7 +56,7 @@ pub struct TypeInfo {
 
 /// The laid-out image and everything the generator needs to know of it.
 #[derive(Clone, Debug)]
-pub struct Layout {
+pub struct FbImage {
     /// FB words as values: 16-bit on the 16-bit chip; on the 32-bit chip
     /// numeric words use the whole word and the others (flags, addresses,
     /// bit vectors, counts) are the 16-bit words sign-extended.
@@ -328,7 +328,7 @@ pub fn build(
     guard_bits: u32,
     fine_normals: bool,
     force_stream: bool,
-) -> Result<Layout, String> {
+) -> Result<FbImage, String> {
     if !force_stream {
         let lay = build_as(scene, image, opt, guard_bits, fine_normals, false, false)?;
         if lay.stream.is_none() {
@@ -365,7 +365,7 @@ pub fn build_packet(
     fine_normals: bool,
     force_stream: bool,
     fine: bool,
-) -> Result<Layout, String> {
+) -> Result<FbImage, String> {
     let g = if fine { guard_bits.min(1) } else { guard_bits };
     build_as(scene, image, opt, g, fine_normals, fine, force_stream)
 }
@@ -389,7 +389,7 @@ fn build_as(
     fine_normals: bool,
     fine: bool,
     streamed: bool,
-) -> Result<Layout, String> {
+) -> Result<FbImage, String> {
     // The 32-bit chip: every format gets `xb` more fraction bits.
     let xb = opt.datapath.bits() - 16;
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
@@ -616,7 +616,7 @@ fn lights(
     Ok((lights, shades, light_shifted))
 }
 
-/// What every node format's [`Layout`] shares (the part laid out before
+/// What every node format's [`FbImage`] shares (the part laid out before
 /// the BSP nodes).
 pub(super) struct Finish {
     frac: u32,
@@ -654,8 +654,8 @@ impl Finish {
         resident_node_words: usize,
         mailbox: usize,
         stream: Option<Stream>,
-    ) -> Layout {
-        Layout {
+    ) -> FbImage {
+        FbImage {
             fb,
             frac: self.frac,
             eye: self.eye,

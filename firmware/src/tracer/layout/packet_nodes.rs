@@ -14,7 +14,7 @@ use super::super::primitives::{
 };
 use super::super::{mem, Collapse};
 use super::{
-    fb_word_bytes, Finish, Layout, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
+    fb_word_bytes, Finish, FbImage, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
 };
 use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};
@@ -209,7 +209,7 @@ pub(super) fn packet_nodes(
     records_start: usize,
     streamed: bool,
     err: &dyn Fn(usize, String) -> String,
-) -> Result<Layout, String> {
+) -> Result<FbImage, String> {
     let (nodes, expected_cost) = collapsed(nodes, &fin);
     let mut refs = vec![0u32; fin.objects];
     for n in nodes.iter().filter(|n| n.split.is_none()) {

@@ -18,7 +18,7 @@
 
 use super::super::NodeLayout;
 use super::{
-    fb_word_bytes, Finish, Layout, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
+    fb_word_bytes, Finish, FbImage, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
 };
 
 /// Head words of a Fig. 5 node: flags, split, left, right, cell bounds.
@@ -52,7 +52,7 @@ pub(super) fn paper_nodes(
     bv_offset: usize,
     mailbox_slots: usize,
     err: &dyn Fn(usize, String) -> String,
-) -> Result<Layout, String> {
+) -> Result<FbImage, String> {
     // BSP nodes: Fig. 5 (fixed size) or compact (head, then per type a
     // count and the slot indices).
     let node_words = match node_layout {

@@ -59,7 +59,7 @@
 use super::super::emit::{
     at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
-use super::super::layout::Layout;
+use super::super::layout::FbImage;
 use super::super::math::Approx;
 use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen};
@@ -335,7 +335,7 @@ impl Fields {
 }
 
 /// The packet `trace`, its leaf loop and `majority`.
-pub fn trace(t: &mut Code, lay: &Layout) {
+pub fn trace(t: &mut Code, lay: &FbImage) {
     let streamed = lay.stream.is_some();
     let f = Fields { streamed };
     let flags = f.n("PN_FLAGS", "PS_FLAGS");
@@ -512,7 +512,7 @@ fn mailbox_check(t: &mut Code, n: &str) {
 
 /// The leaf (r5): every object not yet tested by every awake ray in this
 /// pass, by type.
-fn leaf(t: &mut Code, lay: &Layout, f: &Fields) {
+fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
     t.comment("the leaf r5: an object in more than one leaf has a mailbox (the pass that last")
         .comment(
             "tested it and which rays did); it is broadcast unless every awake ray has tested it",

@@ -32,7 +32,7 @@
 use super::super::emit::{
     at, deref, Code, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
-use super::super::layout::Layout;
+use super::super::layout::FbImage;
 use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen};
 use super::super::NodeLayout;
@@ -163,7 +163,7 @@ pub fn pass_start(t: &mut Code) {
 
 /// The paper's `trace` for a resident scene, its `test_objects` (Fig. 6)
 /// and helpers.
-pub fn trace(t: &mut Code, lay: &Layout) {
+pub fn trace(t: &mut Code, lay: &FbImage) {
     let compact = lay.node_layout == NodeLayout::Compact;
     t.doc(&format!(
         "trace: one ray pass, the paper's traversal. In: the rays in r1..r7 of every RC, MODE\n\
@@ -313,7 +313,7 @@ fn clear_mailbox(t: &mut Code) {
 }
 
 /// `test_objects`: Fig. 6, per type present.
-fn test_objects(t: &mut Code, lay: &Layout, compact: bool) {
+fn test_objects(t: &mut Code, lay: &FbImage, compact: bool) {
     t.doc(&format!(
         "test_objects: every object of the node (r5{}) not yet tested in this pass (its mailbox\n\
          holds PASS) is broadcast with its type's kernels, type by type (object test reordering).\n\

@@ -32,7 +32,7 @@
 use super::super::emit::{
     at, deref, Code, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
-use super::super::layout::Layout;
+use super::super::layout::FbImage;
 use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen};
 use super::paper::{leaf_closest, pass_start};
@@ -98,7 +98,7 @@ fn kernel_of_axis(t: &mut Code, name: fn(u8) -> String, go: &str) {
 }
 
 /// The streamed `trace`, its `clear_mailbox` and `test_objects`.
-pub fn trace(t: &mut Code, lay: &Layout) {
+pub fn trace(t: &mut Code, lay: &FbImage) {
     t.doc(
         "trace: one ray pass, the paper's traversal of a streamed scene. In: the rays in r1..r7\n\
          of every RC, MODE (0: closest hit, 1: any hit). Out: the hits in HIT_*, r7.\n\
@@ -240,7 +240,7 @@ pub fn trace(t: &mut Code, lay: &Layout) {
 }
 
 /// `test_objects` of a streamed leaf.
-fn test_objects(t: &mut Code, lay: &Layout) {
+fn test_objects(t: &mut Code, lay: &FbImage) {
     t.doc(
         "test_objects: the leaf r5's objects not yet tested in this pass, type by type, from its\n\
          block in SBANK (moved there by DMA unless it is the last one loaded, CUR_BLK).\n\
