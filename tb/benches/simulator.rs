@@ -26,12 +26,13 @@ fn render_one_chip_instance(b: Bencher) {
         .build()
         .unwrap();
     let cycles = pool.install(|| {
-        tb::render::render_chip(&scene, &opt, false, None)
+        tb::render::render_chip(&scene, &opt, &Default::default())
             .unwrap()
             .cycles
     });
-    b.counter(ItemsCount::new(cycles))
-        .bench(|| pool.install(|| tb::render::render_chip(&scene, &opt, false, None).unwrap()));
+    b.counter(ItemsCount::new(cycles)).bench(|| {
+        pool.install(|| tb::render::render_chip(&scene, &opt, &Default::default()).unwrap())
+    });
 }
 
 /// The RC datapath alone: one context of each kind on 64 lanes (eval and

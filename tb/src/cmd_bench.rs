@@ -143,10 +143,9 @@ pub fn command(a: BenchArgs) -> Result<()> {
             };
             let t0 = Instant::now();
             let r = p.install(|| {
-                crate::render::render_chip_as(
+                crate::render::render_chip(
                     &scene,
                     opt,
-                    &Default::default(),
                     &crate::render::RenderSettings {
                         trace: cfg,
                         timing,

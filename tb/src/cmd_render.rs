@@ -182,60 +182,29 @@ pub struct RenderReport {
 /// Cycles a render traces when `--trace-cycles` is not given.
 pub const DEFAULT_TRACE_CYCLES: u64 = 100_000;
 
-/// Render and measure; no files written.
+/// Render on the chip and measure against the reference; no files
+/// written.
 pub fn render(
     scene: &firmware::scene::Scene,
     opt: &Options,
-    progress: bool,
-    trace: Option<rtl::trace::TraceConfig>,
+    settings: &crate::render::RenderSettings,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
-    render_with(scene, opt, &Default::default(), progress, trace)
+    render_and_measure(scene, opt, settings, None)
 }
 
-/// [`render`] with the numeric knobs of the firmware (Newton steps, guard
-/// bits of the coordinate format, ray offset).
-pub fn render_with(
-    scene: &firmware::scene::Scene,
-    opt: &Options,
-    nm: &firmware::tracer::Numerics,
-    progress: bool,
-    trace: Option<rtl::trace::TraceConfig>,
-) -> Result<(crate::render::ChipRender, RenderReport)> {
-    render_as(
-        scene,
-        opt,
-        nm,
-        &crate::render::RenderSettings {
-            progress,
-            trace,
-            ..Default::default()
-        },
-    )
-}
-
-/// [`render_with`] with the host's settings (progress, waveform, profile).
-pub fn render_as(
-    scene: &firmware::scene::Scene,
-    opt: &Options,
-    nm: &firmware::tracer::Numerics,
-    host: &crate::render::RenderSettings,
-) -> Result<(crate::render::ChipRender, RenderReport)> {
-    render_and_measure(scene, opt, nm, host, None)
-}
-
-/// [`render_as`] with the firmware already built (`None`: built here).
+/// [`render`] with the firmware already built (`None`: built here).
 pub fn render_and_measure(
     scene: &firmware::scene::Scene,
     opt: &Options,
-    nm: &firmware::tracer::Numerics,
     host: &crate::render::RenderSettings,
     built: Option<firmware::tracer::Firmware>,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
     let progress = host.progress;
+    let nm = host.numerics;
     let t0 = Instant::now();
     let chip = match built {
         Some(fw) => crate::render::render_built(fw, opt, host)?,
-        None => crate::render::render_chip_as(scene, opt, nm, host)?,
+        None => crate::render::render_chip(scene, opt, host)?,
     };
     let host = t0.elapsed().as_secs_f64();
     let refimg = reference::render(
@@ -579,8 +548,9 @@ pub fn command(a: RenderArgs) -> Result<()> {
     let (chip, mut rep) = render_and_measure(
         &scene,
         &opt,
-        &nm,
         &crate::render::RenderSettings {
+            numerics: nm,
+            streamed: false,
             progress: true,
             trace,
             profile: a.profile,

@@ -802,6 +802,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
                 let argv = render_argv(&a.out_dir, &sc.file, c, name);
                 let json_path = points_dir.join(format!("{name}.json"));
                 let host = crate::render::RenderSettings {
+                    numerics: c.nm,
                     timing: c.timing,
                     ..Default::default()
                 };
@@ -816,17 +817,15 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     resumed += 1;
                     Ok(j)
                 } else {
-                    crate::cmd_render::render_as(scene, &c.opt, &c.nm, &host).and_then(
-                        |(_, mut rep)| {
-                            rep.json["argv"] = argv.clone().into();
-                            rep.json["inputs"] = inputs.clone();
-                            write_output(
-                                &json_path,
-                                (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
-                            )?;
-                            Ok(rep.json)
-                        },
-                    )
+                    crate::cmd_render::render(scene, &c.opt, &host).and_then(|(_, mut rep)| {
+                        rep.json["argv"] = argv.clone().into();
+                        rep.json["inputs"] = inputs.clone();
+                        write_output(
+                            &json_path,
+                            (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
+                        )?;
+                        Ok(rep.json)
+                    })
                 };
                 match measured {
                     Ok(json) => {

@@ -59,9 +59,17 @@ pub struct ChipRender {
     pub chip_seconds: f64,
 }
 
-/// How the host runs a render (not part of the chip or the firmware).
+/// Everything a render takes besides the scene and the tracer's options:
+/// the firmware's numeric knobs, the chip's timing, and how the host runs
+/// it (progress, waveform, profile).
 #[derive(Clone, Debug, Default)]
 pub struct RenderSettings {
+    /// The firmware's numeric knobs (Newton-Raphson steps, table entries,
+    /// guard bits, ray offset, normals).
+    pub numerics: Numerics,
+    /// Stream the scene from main memory (leaf blocks moved into FB bank 1
+    /// by DMA) even where it fits the FB.
+    pub streamed: bool,
     pub progress: bool,
     pub trace: Option<rtl::trace::TraceConfig>,
     /// Charge every cycle of the tile loops to a kernel or a TinyRISC
@@ -400,46 +408,13 @@ fn run_group<W: Word>(
 }
 
 /// Render `scene` on the simulated chip.
-pub fn render_chip(
-    scene: &Scene,
-    opt: &Options,
-    progress: bool,
-    trace: Option<rtl::trace::TraceConfig>,
-) -> Result<ChipRender> {
-    render_chip_with(scene, opt, &Numerics::default(), progress, trace)
-}
-
-/// Render with explicit numerical knobs of the firmware (Newton steps,
-/// guard bits, ray offset).
-pub fn render_chip_with(
-    scene: &Scene,
-    opt: &Options,
-    nm: &Numerics,
-    progress: bool,
-    trace: Option<rtl::trace::TraceConfig>,
-) -> Result<ChipRender> {
-    let fw = choose_firmware(scene, opt, nm, &Timing::default())?;
-    render_firmware(
-        fw,
-        opt,
-        &RenderSettings {
-            progress,
-            trace,
-            ..Default::default()
-        },
-    )
-}
-
-/// [`render_chip_with`] with the host's settings (progress, waveform,
-/// profile).
-pub fn render_chip_as(
-    scene: &Scene,
-    opt: &Options,
-    nm: &Numerics,
-    host: &RenderSettings,
-) -> Result<ChipRender> {
-    let fw = choose_firmware(scene, opt, nm, &host.timing)?;
-    render_firmware(fw, opt, host)
+pub fn render_chip(scene: &Scene, opt: &Options, settings: &RenderSettings) -> Result<ChipRender> {
+    let fw = if settings.streamed {
+        tracer::build_streamed_with(scene, opt, &settings.numerics).map_err(|e| anyhow!("{e}"))?
+    } else {
+        choose_firmware(scene, opt, &settings.numerics, &settings.timing)?
+    };
+    render_firmware(fw, opt, settings)
 }
 
 /// Every `PROBE_STRIDE`-th tile row and column (1/16 of the tiles) make
@@ -590,25 +565,6 @@ pub fn choose_firmware_probed(
             first_err.unwrap_or_else(|| "internal: no BSP to build".into())
         )),
     }
-}
-
-/// Render with the streamed layout (scene in main memory, leaf blocks moved
-/// into FB bank 1 by DMA) even if the scene fits the FB.
-pub fn render_chip_streamed(
-    scene: &Scene,
-    opt: &Options,
-    nm: &Numerics,
-    progress: bool,
-) -> Result<ChipRender> {
-    let fw = tracer::build_streamed_with(scene, opt, nm).map_err(|e| anyhow!("{e}"))?;
-    render_firmware(
-        fw,
-        opt,
-        &RenderSettings {
-            progress,
-            ..Default::default()
-        },
-    )
 }
 
 /// The lines of a generated firmware's header that name the options it

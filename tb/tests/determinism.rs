@@ -29,7 +29,17 @@ fn renders_are_bit_identical_for_1_and_2_threads() {
         let mut cfg = TraceConfig::new(dir.path().join(format!("t{threads}.vcd")));
         cfg.first = 1000;
         cfg.count = Some(2000);
-        let (chip, rep) = in_pool(threads, || render(&scene, &opt, false, Some(cfg)).unwrap());
+        let (chip, rep) = in_pool(threads, || {
+            render(
+                &scene,
+                &opt,
+                &tb::render::RenderSettings {
+                    trace: Some(cfg),
+                    ..Default::default()
+                },
+            )
+            .unwrap()
+        });
         let mut j = rep.json.clone();
         let o = j.as_object_mut().unwrap();
         o.remove("host_seconds");

@@ -95,7 +95,7 @@ fn same_image(name: &str, scene: &Scene, w: u32, h: u32) {
     let r8 = reference.to_rgb8();
     let mut renders = Vec::new();
     for l in NodeLayout::ALL {
-        let c = tb::render::render_chip(scene, &opts(w, h, l), false, None).unwrap();
+        let c = tb::render::render_chip(scene, &opts(w, h, l), &Default::default()).unwrap();
         assert!(
             c.firmware.layout.stream.is_none(),
             "{name} must be resident"

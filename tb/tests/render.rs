@@ -38,7 +38,7 @@ fn opts(w: u32, h: u32) -> Options {
 
 fn check_quality(name: &str, w: u32, h: u32, min_psnr: f64, min_hits: f64) {
     let scene = load(name);
-    let (_, rep) = render(&scene, &opts(w, h), false, None).unwrap();
+    let (_, rep) = render(&scene, &opts(w, h), &Default::default()).unwrap();
     let j = &rep.json;
     let psnr = j["psnr_db"].as_f64().unwrap();
     let hits = j["hit_agreement"].as_f64().unwrap();
@@ -71,7 +71,7 @@ fn tetra_matches_the_reference() {
 #[test]
 fn json_has_every_key_and_sane_figures() {
     let scene = load("default.toml");
-    let (chip, rep) = render(&scene, &opts(24, 16), false, None).unwrap();
+    let (chip, rep) = render(&scene, &opts(24, 16), &Default::default()).unwrap();
     let j = &rep.json;
     for k in [
         "cycles",
@@ -135,7 +135,9 @@ fn image_and_cycles_do_not_depend_on_host_threads() {
             .unwrap();
         // 40x40 = 25 tiles; with TILES_PER_CHIP 32 use a size spanning two
         // chip instances.
-        pool.install(|| tb::render::render_chip(&scene, &opts(72, 64), false, None).unwrap())
+        pool.install(|| {
+            tb::render::render_chip(&scene, &opts(72, 64), &Default::default()).unwrap()
+        })
     };
     let (a, b) = (run(1), run(2));
     assert!(a.chips >= 2);
@@ -154,7 +156,7 @@ fn every_number_of_ways_gives_the_same_image_and_more_ways_are_faster() {
             ways,
             ..opts(16, 16)
         };
-        let c = tb::render::render_chip(&scene, &o, false, None).unwrap();
+        let c = tb::render::render_chip(&scene, &o, &Default::default()).unwrap();
         if let Some((img, cycles)) = &prev {
             assert_eq!(&c.rgb8, img, "{ways} ways: another image");
             assert!(c.cycles < *cycles, "{ways} ways not faster");
@@ -172,7 +174,7 @@ fn bad_options_are_errors_not_panics() {
             depth,
             ..opts(8, 8)
         };
-        let e = tb::render::render_chip(&scene, &o, false, None).unwrap_err();
+        let e = tb::render::render_chip(&scene, &o, &Default::default()).unwrap_err();
         assert!(e.to_string().contains("--"), "{e}");
     }
 }
@@ -261,7 +263,15 @@ fn numerical_knobs_render_and_trade_accuracy() {
     )
     .to_rgb8();
     let psnr = |nm: Numerics| {
-        let c = tb::render::render_chip_with(&scene, &opts(32, 32), &nm, false, None).unwrap();
+        let c = tb::render::render_chip(
+            &scene,
+            &opts(32, 32),
+            &tb::render::RenderSettings {
+                numerics: nm,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         tb::metrics::psnr(&c.rgb8, &reference)
     };
     let best = psnr(Numerics::default());
@@ -279,7 +289,15 @@ fn numerical_knobs_render_and_trade_accuracy() {
         newton_steps: 9,
         ..Numerics::default()
     };
-    assert!(tb::render::render_chip_with(&scene, &opts(8, 8), &bad, false, None).is_err());
+    assert!(tb::render::render_chip(
+        &scene,
+        &opts(8, 8),
+        &tb::render::RenderSettings {
+            numerics: bad,
+            ..Default::default()
+        }
+    )
+    .is_err());
 }
 
 /// A scene that does not fit the FB is streamed from main memory (leaf
@@ -297,7 +315,6 @@ fn large_scene_is_streamed_and_matches_the_reference() {
 
 #[test]
 fn streamed_layout_matches_the_resident_one_on_a_small_scene() {
-    use firmware::tracer::Numerics;
     let scene = load("jacks-1.nff");
     let o = opts(24, 24);
     let reference = tb::reference::render(
@@ -310,9 +327,16 @@ fn streamed_layout_matches_the_resident_one_on_a_small_scene() {
             progress: false,
         },
     );
-    let resident = tb::render::render_chip(&scene, &o, false, None).unwrap();
-    let streamed =
-        tb::render::render_chip_streamed(&scene, &o, &Numerics::default(), false).unwrap();
+    let resident = tb::render::render_chip(&scene, &o, &Default::default()).unwrap();
+    let streamed = tb::render::render_chip(
+        &scene,
+        &o,
+        &tb::render::RenderSettings {
+            streamed: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!(resident.firmware.layout.stream.is_none());
     assert!(streamed.firmware.layout.stream.is_some());
     let r8 = reference.to_rgb8();
@@ -346,8 +370,8 @@ fn the_32_bit_chip_renders_the_small_scenes_closer_to_the_reference() {
             datapath: Datapath::W32,
             ..o16
         };
-        let (_, r16) = render(&scene, &o16, false, None).unwrap();
-        let (c32, r32) = render(&scene, &o32, false, None).unwrap();
+        let (_, r16) = render(&scene, &o16, &Default::default()).unwrap();
+        let (c32, r32) = render(&scene, &o32, &Default::default()).unwrap();
         assert_eq!(c32.firmware.datapath, Datapath::W32);
         let f = |r: &tb::cmd_render::RenderReport, k: &str| r.json[k].as_f64().unwrap();
         let (p16, p32) = (f(&r16, "psnr_db"), f(&r32, "psnr_db"));
@@ -366,7 +390,7 @@ fn the_32_bit_chip_renders_the_small_scenes_closer_to_the_reference() {
 /// blocks moved by DMA).
 #[test]
 fn streamed_layout_on_the_32_bit_chip() {
-    use firmware::tracer::{Datapath, Numerics};
+    use firmware::tracer::Datapath;
     let scene = load("jacks-1.nff");
     let o = Options {
         datapath: Datapath::W32,
@@ -382,8 +406,15 @@ fn streamed_layout_on_the_32_bit_chip() {
             progress: false,
         },
     );
-    let streamed =
-        tb::render::render_chip_streamed(&scene, &o, &Numerics::default(), false).unwrap();
+    let streamed = tb::render::render_chip(
+        &scene,
+        &o,
+        &tb::render::RenderSettings {
+            streamed: true,
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!(streamed.firmware.layout.stream.is_some());
     let p = tb::metrics::psnr(&streamed.rgb8, &reference.to_rgb8());
     let h = tb::metrics::hit_agreement(&streamed.hits, &reference.hits);
@@ -455,7 +486,7 @@ fn large_scene_on_the_32_bit_chip() {
         datapath: Datapath::W32,
         ..opts(16, 16)
     };
-    let (chip, rep) = render(&scene, &o, false, None).unwrap();
+    let (chip, rep) = render(&scene, &o, &Default::default()).unwrap();
     assert!(chip.firmware.layout.stream.is_some());
     let psnr = rep.json["psnr_db"].as_f64().unwrap();
     let hits = rep.json["hit_agreement"].as_f64().unwrap();
@@ -471,7 +502,7 @@ fn a_far_light_keeps_the_fine_format() {
     let mut scene = load("tetra-1.nff");
     scene.lights[0].position = scene.lights[0].position * 22.0;
     assert!(scene.lights[0].position.max_abs() > 390.0);
-    let (chip, rep) = render(&scene, &opts(32, 32), false, None).unwrap();
+    let (chip, rep) = render(&scene, &opts(32, 32), &Default::default()).unwrap();
     assert!(chip.firmware.layout.light_shifted);
     assert_eq!(rep.json["format"], "Q4.11", "the light set the format");
     let psnr = rep.json["psnr_db"].as_f64().unwrap();
@@ -488,7 +519,7 @@ fn a_far_light_keeps_the_fine_format() {
 #[test]
 fn all_seven_chip_types_resident_compact_and_streamed() {
     use firmware::scene::{Object, Shape, Vec3};
-    use firmware::tracer::{NodeLayout, Numerics};
+    use firmware::tracer::NodeLayout;
     let mut scene = load("default.toml");
     scene.objects.push(Object {
         shape: Shape::Cone {
@@ -535,16 +566,23 @@ fn all_seven_chip_types_resident_compact_and_streamed() {
     let runs = [
         (
             "fig5",
-            tb::render::render_chip(&scene, &opts(w, h), false, None).unwrap(),
+            tb::render::render_chip(&scene, &opts(w, h), &Default::default()).unwrap(),
         ),
         (
             "compact",
-            tb::render::render_chip(&scene, &compact, false, None).unwrap(),
+            tb::render::render_chip(&scene, &compact, &Default::default()).unwrap(),
         ),
         (
             "streamed",
-            tb::render::render_chip_streamed(&scene, &opts(w, h), &Numerics::default(), false)
-                .unwrap(),
+            tb::render::render_chip(
+                &scene,
+                &opts(w, h),
+                &tb::render::RenderSettings {
+                    streamed: true,
+                    ..Default::default()
+                },
+            )
+            .unwrap(),
         ),
     ];
     for (name, r) in &runs {
@@ -577,8 +615,15 @@ fn every_table_size_reaches_every_kernel() {
             table_entries,
             ..Numerics::default()
         };
-        let (_, rep) =
-            tb::cmd_render::render_with(&scene, &opts(64, 64), &nm, false, None).unwrap();
+        let (_, rep) = tb::cmd_render::render(
+            &scene,
+            &opts(64, 64),
+            &tb::render::RenderSettings {
+                numerics: nm,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         rep.json["psnr_db"].as_f64().unwrap()
     };
     let full = psnr(128);

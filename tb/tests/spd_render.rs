@@ -36,7 +36,7 @@ fn check_on(name: &str, datapath: rtl::rc::Datapath) {
         datapath,
         ..Options::default()
     };
-    let (_, rep) = render(&scene, &opt, false, None).unwrap();
+    let (_, rep) = render(&scene, &opt, &Default::default()).unwrap();
     let j = &rep.json;
     let psnr = j["psnr_db"].as_f64().unwrap();
     let hits = j["hit_agreement"].as_f64().unwrap();

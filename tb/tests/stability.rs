@@ -44,7 +44,7 @@ fn run(name: &str, s: &Scene) -> Outcome {
         height: 32,
         ..Options::default()
     };
-    match render(s, &opt, false, None) {
+    match render(s, &opt, &Default::default()) {
         Ok((_, rep)) => {
             let j = &rep.json;
             let o = Outcome::Rendered {

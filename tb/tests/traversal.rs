@@ -7,7 +7,7 @@ use std::path::PathBuf;
 use firmware::scene::Scene;
 use firmware::tracer::{Numerics, Options, Traversal};
 use tb::reference::{self, shapes, NO_HIT};
-use tb::render::{render_chip, render_chip_with};
+use tb::render::{render_chip, RenderSettings};
 
 fn scene_path(name: &str) -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -51,12 +51,13 @@ fn paper_traversal_keeps_its_cycle_counts() {
         ("tetra-1.nff", 1_234_920),
         ("default.toml", 8_529_730),
     ] {
-        let r = render_chip_with(
+        let r = render_chip(
             &load(name),
             &opts(256, 256, Traversal::Paper),
-            &coarse,
-            false,
-            None,
+            &RenderSettings {
+                numerics: coarse,
+                ..Default::default()
+            },
         )
         .unwrap();
         assert_eq!(r.firmware_cycles, cycles, "{name}");
@@ -74,8 +75,8 @@ fn paper_traversal_keeps_its_cycle_counts() {
 /// in different orders, and the first of two equal `t` wins).
 fn same_hits_up_to_ties(name: &str, w: u32, h: u32) {
     let scene = load(name);
-    let paper = render_chip(&scene, &opts(w, h, Traversal::Paper), false, None).unwrap();
-    let packet = render_chip(&scene, &opts(w, h, Traversal::Packet), false, None).unwrap();
+    let paper = render_chip(&scene, &opts(w, h, Traversal::Paper), &Default::default()).unwrap();
+    let packet = render_chip(&scene, &opts(w, h, Traversal::Packet), &Default::default()).unwrap();
     let lsb = (-(packet.firmware.frac as f64)).exp2();
     let mut differ = 0;
     for j in 0..h {
@@ -164,8 +165,8 @@ fn rays_that_miss_a_subtree_do_not_test_it() {
     let path = dir.path().join("rows.nff");
     std::fs::write(&path, nff).unwrap();
     let scene = Scene::load(&path).unwrap();
-    let paper = render_chip(&scene, &opts(8, 8, Traversal::Paper), false, None).unwrap();
-    let packet = render_chip(&scene, &opts(8, 8, Traversal::Packet), false, None).unwrap();
+    let paper = render_chip(&scene, &opts(8, 8, Traversal::Paper), &Default::default()).unwrap();
+    let packet = render_chip(&scene, &opts(8, 8, Traversal::Packet), &Default::default()).unwrap();
     let (a, b) = (paper.tests_per_ray(), packet.tests_per_ray());
     let (ba, bb) = (
         paper.objects_tested_per_ray(),
@@ -194,8 +195,8 @@ fn same_hits_on_shells_on_the_32_bit_chip() {
         datapath: firmware::tracer::Datapath::W32,
         ..opts(48, 48, t)
     };
-    let paper = render_chip(&scene, &o(Traversal::Paper), false, None).unwrap();
-    let packet = render_chip(&scene, &o(Traversal::Packet), false, None).unwrap();
+    let paper = render_chip(&scene, &o(Traversal::Paper), &Default::default()).unwrap();
+    let packet = render_chip(&scene, &o(Traversal::Packet), &Default::default()).unwrap();
     let differ = paper
         .hits
         .iter()
@@ -210,22 +211,25 @@ fn same_hits_on_shells_on_the_32_bit_chip() {
 /// bank 1): both traversals find the same hits up to ties there too.
 #[test]
 fn streamed_traversals_find_the_same_hits() {
-    use firmware::tracer::Numerics;
     for name in ["default.toml", "jacks-1.nff", "rings-1.nff"] {
         let scene = load(name);
         let (w, h) = (32, 32);
-        let paper = tb::render::render_chip_streamed(
+        let paper = tb::render::render_chip(
             &scene,
             &opts(w, h, Traversal::Paper),
-            &Numerics::default(),
-            false,
+            &RenderSettings {
+                streamed: true,
+                ..Default::default()
+            },
         )
         .unwrap();
-        let packet = tb::render::render_chip_streamed(
+        let packet = tb::render::render_chip(
             &scene,
             &opts(w, h, Traversal::Packet),
-            &Numerics::default(),
-            false,
+            &RenderSettings {
+                streamed: true,
+                ..Default::default()
+            },
         )
         .unwrap();
         assert!(packet.firmware.layout.stream.is_some());
@@ -266,7 +270,7 @@ fn a_leaf_larger_than_the_bank_is_streamed_in_pieces() {
     let scene = Scene::load(&path).unwrap();
     let mut o = opts(8, 8, Traversal::Packet);
     o.bsp.max_depth = 1;
-    let (chip, rep) = tb::cmd_render::render(&scene, &o, false, None).unwrap();
+    let (chip, rep) = tb::cmd_render::render(&scene, &o, &Default::default()).unwrap();
     let st = chip.firmware.layout.stream.as_ref().expect("streamed");
     assert!(st.extra_pieces >= 2, "{} extra pieces", st.extra_pieces);
     assert!(st.largest_block <= firmware::tracer::layout::STREAM_BANK);
