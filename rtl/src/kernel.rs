@@ -111,7 +111,8 @@ impl<T: Clocked + Traced> Sim<T> {
             });
         }
         if let Some(t) = &mut self.tracer {
-            t.sample(self.cycle, &self.top).map_err(StepError::Trace)?;
+            t.sample(self.cycle, &self.top, 0)
+                .map_err(StepError::Trace)?;
         }
         self.top.commit();
         self.cycle += 1;
@@ -150,13 +151,15 @@ impl<T: Clocked + Traced> Sim<T> {
     /// commit).
     pub fn fast_forward_sampled(
         &mut self,
-        f: impl FnOnce(&mut T, &mut dyn FnMut(&T) -> bool) -> (u64, Result<(), Fault>),
+        f: impl FnOnce(&mut T, &mut dyn FnMut(&T, u8) -> bool) -> (u64, Result<(), Fault>),
     ) -> Result<u64, StepError> {
         let mut cycle = self.cycle;
         let mut err = None;
         let (n, r) = match &mut self.tracer {
-            None => f(&mut self.top, &mut |_| true),
-            Some(t) => f(&mut self.top, &mut |top: &T| match t.sample(cycle, top) {
+            None => f(&mut self.top, &mut |_, _| true),
+            Some(t) => f(&mut self.top, &mut |top: &T, unchanged| match t
+                .sample(cycle, top, unchanged)
+            {
                 Ok(()) => {
                     cycle += 1;
                     true

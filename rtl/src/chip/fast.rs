@@ -19,7 +19,7 @@ impl<W: Word> Chip<W> {
     /// `limit` cycles. Returns the cycles run.
     #[inline]
     pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        self.run_stalled_sampled(limit, |_| true)
+        self.run_stalled_sampled(limit, |_, _| true)
     }
 
     /// The untraced fast path, tried by the cycle loop before a plain
@@ -48,7 +48,7 @@ impl<W: Word> Chip<W> {
     pub fn run_fast_sampled(
         &mut self,
         limit: u64,
-        sample: &mut dyn FnMut(&Self) -> bool,
+        sample: &mut dyn FnMut(&Self, u8) -> bool,
     ) -> (u64, Result<(), Fault>) {
         if self.dma.idle() {
             return self.run_local_sampled(limit, sample);
@@ -71,7 +71,7 @@ impl<W: Word> Chip<W> {
     ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
     #[inline(never)]
     fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        self.local_cycles::<false, _>(limit, &mut |_: &Self| true)
+        self.local_cycles::<false, _>(limit, &mut |_: &Self, _| true)
     }
 
     /// [`Chip::run_local`] sampled cycle by cycle (see
@@ -80,7 +80,7 @@ impl<W: Word> Chip<W> {
     fn run_local_sampled(
         &mut self,
         limit: u64,
-        sample: &mut dyn FnMut(&Self) -> bool,
+        sample: &mut dyn FnMut(&Self, u8) -> bool,
     ) -> (u64, Result<(), Fault>) {
         self.local_cycles::<true, _>(limit, sample)
     }
@@ -89,7 +89,7 @@ impl<W: Word> Chip<W> {
     /// called between every cycle's evaluation and its commit, and busy
     /// cycles are evaluated one by one.
     #[inline(always)]
-    fn local_cycles<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+    fn local_cycles<const SAMPLED: bool, S: FnMut(&Self, u8) -> bool + ?Sized>(
         &mut self,
         limit: u64,
         sample: &mut S,
@@ -126,9 +126,14 @@ impl<W: Word> Chip<W> {
                     // between them (either ends TinyRISC's time alone),
                     // and the array, idle in both, was neither evaluated
                     // nor clocked since the last sample.
-                    self.quiet = alone_before;
-                    let go_on = sample(self);
-                    self.quiet = false;
+                    let go_on = sample(
+                        self,
+                        if alone_before {
+                            super::UNCHANGED_ARRAY_SIDE
+                        } else {
+                            0
+                        },
+                    );
                     if !go_on {
                         break;
                     }
@@ -187,7 +192,7 @@ impl<W: Word> Chip<W> {
     /// idle: until the wait is over, `limit`, or (`SAMPLED`) `sample`
     /// stops it (the third value: whether it did).
     #[inline(always)]
-    fn stream<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+    fn stream<const SAMPLED: bool, S: FnMut(&Self, u8) -> bool + ?Sized>(
         &mut self,
         limit: u64,
         sample: &mut S,
@@ -228,13 +233,8 @@ impl<W: Word> Chip<W> {
             // TinyRISC waits through the whole stream, neither evaluated
             // nor clocked: after the stream's first cycle it shows what
             // it showed in the cycle before.
-            if SAMPLED {
-                self.risc_quiet = n > 0;
-            }
-            let r = self.stream_cycle::<SAMPLED, S>(sample);
-            if SAMPLED {
-                self.risc_quiet = false;
-            }
+            let unchanged = if n > 0 { super::UNCHANGED_RISC } else { 0 };
+            let r = self.stream_cycle::<SAMPLED, S>(sample, unchanged);
             match r {
                 Ok(Some(k)) => active += k as u64,
                 Ok(None) => {
@@ -262,7 +262,7 @@ impl<W: Word> Chip<W> {
     /// [`Broadcast::stream_simd`]'s when it runs it (untraced), else
     /// [`Chip::stream_cycle`]'s.
     #[inline(always)]
-    fn stream_one<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+    fn stream_one<const SAMPLED: bool, S: FnMut(&Self, u8) -> bool + ?Sized>(
         &mut self,
         sample: &mut S,
     ) -> Result<Option<u64>, Fault> {
@@ -284,7 +284,7 @@ impl<W: Word> Chip<W> {
                 return Ok(Some(a));
             }
         }
-        Ok(self.stream_cycle::<SAMPLED, S>(sample)?.map(u64::from))
+        Ok(self.stream_cycle::<SAMPLED, S>(sample, 0)?.map(u64::from))
     }
 
     /// One cycle of the broadcast unit and the array with the DMA idle,
@@ -292,9 +292,10 @@ impl<W: Word> Chip<W> {
     /// the RCs that executed; `None` when (`SAMPLED`) `sample`, called
     /// between the two, stopped it before the clock edge.
     #[inline(always)]
-    fn stream_cycle<const SAMPLED: bool, S: FnMut(&Self) -> bool + ?Sized>(
+    fn stream_cycle<const SAMPLED: bool, S: FnMut(&Self, u8) -> bool + ?Sized>(
         &mut self,
         sample: &mut S,
+        unchanged: u8,
     ) -> Result<Option<u32>, Fault> {
         if let Err(f) = self
             .bcast
@@ -306,7 +307,7 @@ impl<W: Word> Chip<W> {
             if let Err(f) = self.array.eval() {
                 return Err(self.locate(f));
             }
-            if !sample(self) {
+            if !sample(self, unchanged) {
                 return Ok(None);
             }
             self.array.commit();
@@ -327,7 +328,7 @@ impl<W: Word> Chip<W> {
     pub fn run_stalled_sampled(
         &mut self,
         limit: u64,
-        mut sample: impl FnMut(&Self) -> bool,
+        mut sample: impl FnMut(&Self, u8) -> bool,
     ) -> (u64, Result<(), Fault>) {
         use crate::tinyrisc::{State, Wait};
         let mut n = 0;
@@ -353,7 +354,7 @@ impl<W: Word> Chip<W> {
             if let Err(f) = self.array.eval() {
                 return (n, Err(self.locate(f)));
             }
-            if !sample(self) {
+            if !sample(self, 0) {
                 break;
             }
             // TinyRISC's stalled eval left no command and no write-back.

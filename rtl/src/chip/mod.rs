@@ -189,17 +189,17 @@ pub struct Chip<W: Word = i16> {
     idle_control: u64,
     /// Runs counted for the statistics ([`Watch`]).
     pub watch: Watch,
-    /// Set only while a waveform samples a cycle in which TinyRISC alone
-    /// worked, as it did in the cycle before: the broadcast unit, the
-    /// DMA and the array then show what they showed in that cycle (none
-    /// of them changed; see [`Chip::local_cycles`]), and the waveform
-    /// skips them.
-    quiet: bool,
-    /// Set only while a waveform samples a cycle of a stream after its
-    /// first: TinyRISC, waiting, shows what it showed in the cycle before
-    /// (see [`Chip::stream`]).
-    risc_quiet: bool,
 }
+
+/// The parts of the chip's walk ([`Traced::trace`]) a fast loop reports
+/// unchanged with a sample ([`crate::trace::Probe::unchanged`]): TinyRISC,
+/// which waits through a stream after its first cycle, neither evaluated
+/// nor clocked ([`Chip::stream`])...
+pub const UNCHANGED_RISC: u8 = 1;
+/// ... and the broadcast unit, the DMA and the array, in a cycle in which
+/// TinyRISC alone worked, as it did in the cycle before
+/// ([`Chip::local_cycles`]).
+pub const UNCHANGED_ARRAY_SIDE: u8 = 2;
 
 /// TinyRISC's view of the chip.
 struct View<'a, W: Word> {
@@ -315,8 +315,6 @@ impl<W: Word> Chip<W> {
             active_rc: 0,
             idle_control: 0,
             watch: Watch::default(),
-            quiet: false,
-            risc_quiet: false,
         }
     }
 
@@ -455,16 +453,17 @@ impl<W: Word> Traced for Chip<W> {
         // entered at all.
         const SCOPES: [&str; 4] = ["tinyrisc", "broadcast", "dma", "array"];
         let on = p.open_scopes(4, &mut |i| SCOPES[i].to_string());
-        // TinyRISC, unchanged while it waits for a stream (`risc_quiet`).
-        if p.section(self.risc_quiet) {
+        // TinyRISC, unchanged while it waits for a stream.
+        let unchanged = p.unchanged();
+        if p.section(unchanged & UNCHANGED_RISC != 0) {
             if on & 1 != 0 && p.scope(format_args!("tinyrisc")) {
                 self.risc.trace(p);
                 p.end();
             }
             p.end_section();
         }
-        // The rest, unchanged while TinyRISC works alone (`quiet`).
-        if !p.section(self.quiet) {
+        // The rest, unchanged while TinyRISC works alone.
+        if !p.section(unchanged & UNCHANGED_ARRAY_SIDE != 0) {
             return;
         }
         if on & 2 != 0 && p.scope(format_args!("broadcast")) {

@@ -213,6 +213,14 @@ pub trait Probe {
         fill(&mut v);
         self.block(fields, &v);
     }
+    /// The parts of the traced module its simulation reports unchanged
+    /// since the last sample (bit k: the module's part k, as it numbers
+    /// them): the fast loops know which blocks they did not evaluate and
+    /// pass that with each sample ([`crate::kernel::Sim`]). A module asks
+    /// here rather than keeping waveform state of its own.
+    fn unchanged(&self) -> u8 {
+        0
+    }
     /// A part of the walk, up to the matching [`Probe::end_section`],
     /// that reports (when `unchanged`) the values it reported in the last
     /// cycle sampled. `false`: the probe skips it (the caller does not

@@ -89,6 +89,8 @@ pub(super) struct Sampler<'a> {
     pub(super) at: Progress,
     /// A block reported that was not declared.
     pub(super) undeclared: bool,
+    /// [`Probe::unchanged`] of this sample.
+    pub(super) unchanged: u8,
 }
 
 impl Sampler<'_> {
@@ -113,6 +115,11 @@ impl Sampler<'_> {
 }
 
 impl Probe for Sampler<'_> {
+    #[inline]
+    fn unchanged(&self) -> u8 {
+        self.unchanged
+    }
+
     fn block_versioned(
         &mut self,
         version: u64,

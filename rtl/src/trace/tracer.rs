@@ -416,7 +416,7 @@ impl Tracer {
     /// walk's narrower stores to reach the cache (a store the processor
     /// cannot forward to a wider load).
     #[inline(never)]
-    pub fn sample<T: Traced>(&mut self, cycle: u64, top: &T) -> io::Result<()> {
+    pub fn sample<T: Traced>(&mut self, cycle: u64, top: &T, unchanged: u8) -> io::Result<()> {
         if let Some(c) = self.pending.take() {
             self.write_cycle(c)?;
         }
@@ -435,6 +435,7 @@ impl Tracer {
             first: self.first_sample,
             at: Progress::default(),
             undeclared: false,
+            unchanged,
         };
         top.trace(&mut s);
         let (slots, undeclared) = (s.at.slots, s.undeclared);
