@@ -82,7 +82,7 @@ const COLORS: [RGBColor; 8] = [
 
 /// Points not dominated in both coordinates (larger is better in both),
 /// sorted by x.
-pub fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
+pub(crate) fn pareto_front(points: &[(f64, f64)]) -> Vec<(f64, f64)> {
     let mut f: Vec<(f64, f64)> = points
         .iter()
         .copied()
@@ -118,7 +118,7 @@ fn tick(v: f64) -> String {
 /// The ticks of a logarithmic axis over `lo..hi`: powers of two over up
 /// to eight octaves (4, 8, .. 64 ways), 1-2-5 steps over up to three
 /// decades, powers of ten beyond.
-pub fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
+pub(crate) fn log_ticks(lo: f64, hi: f64) -> Vec<f64> {
     if !(lo > 0.0 && hi > lo) {
         return vec![];
     }

@@ -27,7 +27,7 @@ pub struct TraceWindow {
 /// The signals a render's waveform records unless `--trace-scope` says
 /// otherwise: the control path and one RC, 52 signals of the 1,842
 /// (`--trace-scope all` records every one).
-pub const RENDER_SCOPE: &str = "tinyrisc.pc,tinyrisc.ir,tinyrisc.state,broadcast,dma,\
+pub(crate) const RENDER_SCOPE: &str = "tinyrisc.pc,tinyrisc.ir,tinyrisc.state,broadcast,dma,\
 array.active,array.mode,array.active_rcs,array.ctx,array.op,array.awake,array.flag_f,\
 array.fb0,array.fb1,array.rc_r0_c0";
 
@@ -58,7 +58,7 @@ impl TraceWindow {
 }
 
 /// Where a waveform with no `--trace-cycles` stops (with a warning).
-pub const OPEN_WINDOW_MAX_BYTES: u64 = 256 << 20;
+pub(crate) const OPEN_WINDOW_MAX_BYTES: u64 = 256 << 20;
 
 #[cfg(test)]
 mod tests {
@@ -78,7 +78,7 @@ mod tests {
 }
 
 /// `--datapath 16|32`: the RC datapath width of the simulated chip.
-pub fn parse_datapath(s: &str) -> Result<rtl::rc::Datapath, String> {
+pub(crate) fn parse_datapath(s: &str) -> Result<rtl::rc::Datapath, String> {
     s.trim()
         .parse::<u32>()
         .ok()
@@ -106,10 +106,10 @@ pub enum DatapathChoice {
 /// whose smallest parts are 8.6 LSB of its format, renders at 41.6 dB on
 /// the 16-bit chip, while SPD rings at its default size (cylinders of 38
 /// LSB) reaches 29 dB there and 59 dB on the 32-bit chip.
-pub const AUTO_MIN_PSNR: f64 = 30.0;
-pub const AUTO_MIN_HITS: f64 = 0.99;
+pub(crate) const AUTO_MIN_PSNR: f64 = 30.0;
+pub(crate) const AUTO_MIN_HITS: f64 = 0.99;
 
-pub fn parse_datapath_choice(s: &str) -> Result<DatapathChoice, String> {
+pub(crate) fn parse_datapath_choice(s: &str) -> Result<DatapathChoice, String> {
     if s.trim() == "auto" {
         return Ok(DatapathChoice::Auto);
     }
@@ -133,7 +133,7 @@ where
 }
 
 /// A number of seconds above zero.
-pub fn parse_seconds(s: &str) -> Result<f64, String> {
+pub(crate) fn parse_seconds(s: &str) -> Result<f64, String> {
     match s.parse::<f64>() {
         Ok(x) if x > 0.0 && x.is_finite() => Ok(x),
         _ => Err(format!("expected a number of seconds above 0, found '{s}'")),
@@ -159,7 +159,7 @@ impl std::fmt::Display for UsageError {
 impl std::error::Error for UsageError {}
 
 /// `--table-entries`: the table sizes that fit a 128-word slot of an RC's RAM.
-pub fn parse_table_entries(s: &str) -> Result<u32, String> {
+pub(crate) fn parse_table_entries(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
         Ok(n) if firmware::tracer::math::TABLE_SIZES.contains(&n) => Ok(n),
         _ => Err(format!(
@@ -168,23 +168,23 @@ pub fn parse_table_entries(s: &str) -> Result<u32, String> {
     }
 }
 
-pub fn parse_normals(s: &str) -> Result<firmware::tracer::Normals, String> {
+pub(crate) fn parse_normals(s: &str) -> Result<firmware::tracer::Normals, String> {
     s.parse()
 }
 
-pub fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
+pub(crate) fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
     s.parse()
 }
 
 /// `--ways`: 4, 8, 16, 32 or 64 rays in flight (a tile of 2x2 .. 8x8).
-pub fn parse_ways(s: &str) -> Result<u32, String> {
+pub(crate) fn parse_ways(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
         Ok(n @ (4 | 8 | 16 | 32 | 64)) => Ok(n),
         _ => Err(format!("expected 4, 8, 16, 32 or 64, found '{s}'")),
     }
 }
 
-pub fn parse_depth(s: &str) -> Result<u32, String> {
+pub(crate) fn parse_depth(s: &str) -> Result<u32, String> {
     if s == "auto" {
         return Ok(0);
     }
@@ -197,10 +197,10 @@ pub fn parse_depth(s: &str) -> Result<u32, String> {
     }
 }
 
-pub fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, String> {
+pub(crate) fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, String> {
     s.parse()
 }
 
-pub fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
+pub(crate) fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
     s.parse()
 }

@@ -180,7 +180,7 @@ pub struct RenderReport {
 }
 
 /// Cycles a render traces when `--trace-cycles` is not given.
-pub const DEFAULT_TRACE_CYCLES: u64 = 100_000;
+pub(crate) const DEFAULT_TRACE_CYCLES: u64 = 100_000;
 
 /// Render on the chip and measure against the reference; no files
 /// written.
@@ -193,7 +193,7 @@ pub fn render(
 }
 
 /// [`render`] with the firmware already built (`None`: built here).
-pub fn render_and_measure(
+pub(crate) fn render_and_measure(
     scene: &firmware::scene::Scene,
     opt: &Options,
     host: &crate::render::RenderSettings,
@@ -310,7 +310,7 @@ fn default_out(scene: &Path) -> PathBuf {
 /// the same `inputs` ([`crate::inputs`]: scene, timing, firmware, build)
 /// and holds only values a render can give; else why not, in a few words
 /// ("made before the scene changed" when only the inputs differ).
-pub fn render_json(
+pub(crate) fn render_json(
     path: &Path,
     argv: &[String],
     inputs: &serde_json::Value,

@@ -221,7 +221,7 @@ pub fn sections() -> Vec<Section> {
 }
 
 /// Renders as `morphosys render` processes, each once.
-pub struct Runner {
+pub(crate) struct Runner {
     bin: PathBuf,
     dir: tempfile::TempDir,
     done: HashMap<Vec<String>, Value>,

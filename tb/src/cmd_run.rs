@@ -82,7 +82,7 @@ pub fn run_image_on<W: Word>(
     Ok(Outcome { sim, result, files })
 }
 
-pub fn print_stats(s: &Stats) {
+pub(crate) fn print_stats(s: &Stats) {
     crate::report!("cycles               {}", s.cycles);
     crate::report!("tinyrisc issued      {}", s.risc_instructions);
     crate::report!("array busy cycles    {}", s.array_busy_cycles);
@@ -137,10 +137,10 @@ pub struct RunArgs {
 
 /// The failure code of the conformance programs: a halt with r1 = 0xBAD
 /// (and r2 = the number of the failed check).
-pub const FAIL_CODE: u32 = 0xBAD;
+pub(crate) const FAIL_CODE: u32 = 0xBAD;
 
 /// `--expect REG=VALUE`: `r0`..`r15` and a decimal or `0x` hex value.
-pub fn parse_expect(s: &str) -> Result<(u8, u32), String> {
+pub(crate) fn parse_expect(s: &str) -> Result<(u8, u32), String> {
     let (r, v) = s
         .split_once('=')
         .ok_or_else(|| format!("expected REG=VALUE (e.g. r3=38), found '{s}'"))?;

@@ -22,7 +22,7 @@ pub fn default_scene() -> PathBuf {
 /// The default scene, built into the binary: `morphosys render` works from
 /// any folder (a `scenes/default.toml` in the current folder is used
 /// instead, so an edited copy wins).
-pub const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
+pub(crate) const DEFAULT_SCENE: &str = include_str!("../../scenes/default.toml");
 
 /// Load a scene (or the default one), errors as `file:line:col: ...`.
 pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
@@ -44,7 +44,7 @@ pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
 }
 
 /// Encode 8-bit RGB as PNG.
-pub fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>> {
+pub(crate) fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>> {
     use image::ImageEncoder;
     let mut out = Vec::new();
     image::codecs::png::PngEncoder::new(&mut out)
@@ -54,7 +54,7 @@ pub fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>> {
 }
 
 /// Read a PNG (any colour type) as 8-bit RGB.
-pub fn read_png(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
+pub(crate) fn read_png(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
     let img = image::ImageReader::open(path)
         .with_context(|| format!("cannot open {}", path.display()))?
         .with_guessed_format()
@@ -67,13 +67,13 @@ pub fn read_png(path: &Path) -> Result<(u32, u32, Vec<u8>)> {
 
 /// Hit map file: `MSHITS1\n<w> <h>\n` then one little-endian u32 per
 /// pixel (object index, 0xFFFFFFFF for none).
-pub fn hits_bytes(img: &Image) -> Vec<u8> {
+pub(crate) fn hits_bytes(img: &Image) -> Vec<u8> {
     hit_map_bytes(img.width, img.height, &img.hits)
 }
 
 /// A hit map: `MSHITS1`, the size, then the object hit by each pixel's eye
 /// ray (u32, little-endian, row by row; `u32::MAX` for none).
-pub fn hit_map_bytes(width: u32, height: u32, hits: &[u32]) -> Vec<u8> {
+pub(crate) fn hit_map_bytes(width: u32, height: u32, hits: &[u32]) -> Vec<u8> {
     let mut out = format!("MSHITS1\n{width} {height}\n").into_bytes();
     for h in hits {
         out.extend_from_slice(&h.to_le_bytes());
@@ -81,7 +81,7 @@ pub fn hit_map_bytes(width: u32, height: u32, hits: &[u32]) -> Vec<u8> {
     out
 }
 
-pub fn read_hits(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
+pub(crate) fn read_hits(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
     let bytes =
         firmware::input::read(path).with_context(|| format!("cannot read {}", path.display()))?;
     let bad = || {
@@ -113,14 +113,14 @@ pub fn read_hits(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
 /// Parse `WxH`.
 /// The largest image side any command renders (host memory grows with the
 /// pixels: about 40 bytes each, 670 MB at 4096x4096).
-pub const MAX_SIDE: u64 = 4096;
+pub(crate) const MAX_SIDE: u64 = 4096;
 
 /// `w` x `h` if each side is 1..=[`MAX_SIDE`]; otherwise what the request
 /// would cost: about 40 bytes of host memory per pixel (images, hit maps,
 /// f64 colours) and, on the chip, about 140 cycles per pixel for the
 /// default scene (9.08 M cycles at 256x256) simulated at about 15 M cycles
 /// per host second.
-pub fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
+pub(crate) fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
     if (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h) {
         return Ok((w as u32, h as u32));
     }
@@ -148,7 +148,7 @@ pub fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
 }
 
 /// `--size WIDTHxHEIGHT`, each side 1..=[`MAX_SIDE`].
-pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 256x256, found '{s}'"))?;

@@ -7,7 +7,7 @@
 use sha2::{Digest, Sha256};
 
 /// The SHA-256 of `bytes`, in hex.
-pub fn digest(bytes: &[u8]) -> String {
+pub(crate) fn digest(bytes: &[u8]) -> String {
     Sha256::digest(bytes)
         .iter()
         .map(|b| format!("{b:02x}"))
@@ -16,21 +16,21 @@ pub fn digest(bytes: &[u8]) -> String {
 
 /// A scene's content, wherever its file is (the name left out: a plan's
 /// folder may move between its renders and its merge).
-pub fn scene_digest(scene: &firmware::scene::Scene) -> String {
+pub(crate) fn scene_digest(scene: &firmware::scene::Scene) -> String {
     let mut s = scene.clone();
     s.source.clear();
     digest(format!("{s:?}").as_bytes())
 }
 
 /// A chip timing's values.
-pub fn timing_digest(t: &rtl::Timing) -> String {
+pub(crate) fn timing_digest(t: &rtl::Timing) -> String {
     digest(format!("{t:?}").as_bytes())
 }
 
 /// This build: the SHA-256 of the sources its results depend on (the
 /// chip, the firmware generator, this crate and the lock file; `build.rs`),
 /// so a render made by another build is not taken for one of this build.
-pub fn build_digest() -> &'static str {
+pub(crate) fn build_digest() -> &'static str {
     env!("MORPHOSYS_SOURCE_DIGEST")
 }
 

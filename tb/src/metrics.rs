@@ -23,7 +23,7 @@ pub fn psnr(a: &[u8], b: &[u8]) -> f64 {
 
 /// Share (0..=1) of pixels whose largest channel difference exceeds
 /// `threshold` (in 8-bit steps).
-pub fn share_off(a: &[u8], b: &[u8], threshold: u8) -> f64 {
+pub(crate) fn share_off(a: &[u8], b: &[u8], threshold: u8) -> f64 {
     assert_eq!(a.len(), b.len(), "images differ in size");
     let n = a.len() / 3;
     if n == 0 {

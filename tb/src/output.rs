@@ -92,14 +92,14 @@ fn target(path: &Path) -> Result<Target> {
 static TEMPS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
 
 /// Note a temporary file or folder to remove if the run is interrupted.
-pub fn register_temporary(p: &Path) {
+pub(crate) fn register_temporary(p: &Path) {
     if let Ok(mut v) = TEMPS.lock() {
         v.push(p.to_path_buf());
     }
 }
 
 /// It is gone (renamed into place or removed): forget it.
-pub fn forget_temporary(p: &Path) {
+pub(crate) fn forget_temporary(p: &Path) {
     if let Ok(mut v) = TEMPS.lock() {
         v.retain(|q| q != p);
     }
@@ -134,7 +134,7 @@ pub fn quiet() -> bool {
 }
 
 /// A progress bar of `len` steps, hidden under `--quiet`.
-pub fn progress_bar(len: u64) -> indicatif::ProgressBar {
+pub(crate) fn progress_bar(len: u64) -> indicatif::ProgressBar {
     if quiet() {
         indicatif::ProgressBar::hidden()
     } else {
@@ -157,7 +157,7 @@ static STDOUT_TAKEN: AtomicBool = AtomicBool::new(false);
 
 /// Whether an output of this command is standard output (`-`), so its
 /// report must go to standard error.
-pub fn stdout_taken() -> bool {
+pub(crate) fn stdout_taken() -> bool {
     STDOUT_TAKEN.load(Ordering::Relaxed)
 }
 
@@ -372,7 +372,7 @@ impl Files {
 /// Check before the work that `path` can be written: a regular file's
 /// folder exists and takes a new file (a temporary one, removed at once); a
 /// device or FIFO is writable by us. `what` names the argument.
-pub fn check_writable(path: &Path, what: &str) -> Result<()> {
+pub(crate) fn check_writable(path: &Path, what: &str) -> Result<()> {
     match target(path).with_context(|| format!("{what} {}", path.display()))? {
         Target::Stdout => Ok(()),
         Target::Stream(p) => {

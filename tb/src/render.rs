@@ -24,7 +24,7 @@ use crate::reference::NO_HIT;
 /// Tiles per chip instance.
 pub const TILES_PER_CHIP: usize = 32;
 /// Cycle budget of one chip instance.
-pub const MAX_CYCLES_PER_CHIP: u64 = 2_000_000_000;
+pub(crate) const MAX_CYCLES_PER_CHIP: u64 = 2_000_000_000;
 
 /// The chip's image and figures.
 #[derive(Clone, Debug)]
@@ -234,10 +234,10 @@ fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
 
 /// Tags of the simulator's ray census ([`rtl::chip::Watch::tag`]): the
 /// kind of the rays of a pass.
-pub const RAY_EYE: usize = 0;
-pub const RAY_SHADOW: usize = 1;
-pub const RAY_REFLECT: usize = 2;
-pub const RAY_REFRACT: usize = 3;
+pub(crate) const RAY_EYE: usize = 0;
+pub(crate) const RAY_SHADOW: usize = 1;
+pub(crate) const RAY_REFLECT: usize = 2;
+pub(crate) const RAY_REFRACT: usize = 3;
 
 struct Group {
     start: u64,
@@ -420,7 +420,7 @@ pub fn render_chip(scene: &Scene, opt: &Options, settings: &RenderSettings) -> R
 /// Every `PROBE_STRIDE`-th tile row and column (1/16 of the tiles) make
 /// the probe by which [`choose_firmware`] compares BSP trees and
 /// `render --datapath auto` the chips.
-pub const PROBE_STRIDE: u32 = 4;
+pub(crate) const PROBE_STRIDE: u32 = 4;
 
 /// A render of the probe's tiles: their cycles, and their pixels (row by
 /// row within each tile, tiles in order) with the colours and hit objects.
@@ -515,10 +515,10 @@ pub fn choose_firmware(
 }
 
 /// See [`choose_firmware`].
-pub const TREE_PSNR_SLACK: f64 = 0.25;
+pub(crate) const TREE_PSNR_SLACK: f64 = 0.25;
 
 /// [`choose_firmware`], with the chosen firmware's probe when one ran.
-pub fn choose_firmware_probed(
+pub(crate) fn choose_firmware_probed(
     scene: &Scene,
     opt: &Options,
     nm: &Numerics,
@@ -580,7 +580,7 @@ fn header(source: &str) -> Vec<&str> {
 }
 
 /// The `.datapath` a firmware source declares (16 without the directive).
-pub fn source_datapath(source: &str) -> Datapath {
+pub(crate) fn source_datapath(source: &str) -> Datapath {
     source
         .lines()
         .map(|l| l.split(';').next().unwrap_or("").trim())
@@ -596,7 +596,7 @@ pub fn source_datapath(source: &str) -> Datapath {
 /// when it does not assemble (file:line:col), was generated for other
 /// options (its header or the data image's addresses differ), or does not
 /// fit below the data the host loads.
-pub fn firmware_from_source(mut fw: Firmware, text: &str, name: &str) -> Result<Firmware> {
+pub(crate) fn firmware_from_source(mut fw: Firmware, text: &str, name: &str) -> Result<Firmware> {
     let img = asm::assemble(text, name).map_err(|e| anyhow!("{e}"))?;
     let (want, got) = (header(&fw.source), header(text));
     if want != got {
@@ -659,7 +659,7 @@ pub fn firmware_from_source(mut fw: Firmware, text: &str, name: &str) -> Result<
 
 /// Render with a firmware already built (for example by
 /// [`choose_firmware`]).
-pub fn render_built(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
+pub(crate) fn render_built(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
     render_firmware(fw, opt, host)
 }
 

@@ -84,7 +84,7 @@ tb/tests/surfer.rs checks it.\n# Regenerate: UPDATE_GOLDEN=1 cargo test -p morph
 /// `rtl::tinyrisc::decode::Instr`'s disassembly writes it, except the
 /// branch target, written `.+4+(OFFSET)` (OFFSET: the byte offset from the
 /// next instruction) where the disassembler writes the sum (`.+12`, `.-4`).
-pub fn tinyrisc_toml() -> String {
+pub(crate) fn tinyrisc_toml() -> String {
     let mut s = String::from(HEADER);
     s.push_str("set = \"MorphoSys TinyRISC\"\nwidth = 32\n");
     let mut formats: Vec<Fmt> = Vec::new();
@@ -285,7 +285,7 @@ pub fn tinyrisc_toml() -> String {
 /// disassembly writes it (the 32-bit chip's decoding, which the waveforms'
 /// translate filter uses too: bit 10 of the register form is bit 5 of the
 /// shift).
-pub fn context_toml() -> String {
+pub(crate) fn context_toml() -> String {
     let mut s = String::from(HEADER);
     s.push_str("set = \"MorphoSys RC context\"\nwidth = 32\n");
     const OP: u32 = 0xFC00_0000;

@@ -137,7 +137,7 @@ pub fn to_toml(t: &Timing) -> String {
 }
 
 /// `t` as JSON (the render report's `timing`).
-pub fn to_json(t: &Timing) -> serde_json::Value {
+pub(crate) fn to_json(t: &Timing) -> serde_json::Value {
     let mut top = serde_json::Map::new();
     for f in FIELDS {
         let v: serde_json::Value = match (f.table, f.key) {
@@ -167,7 +167,7 @@ fn line_col(text: &str, offset: usize) -> (usize, usize) {
 }
 
 /// A TOML error as one line, `name:line:col: message`.
-pub fn toml_error(e: &toml::de::Error, text: &str, name: &str) -> anyhow::Error {
+pub(crate) fn toml_error(e: &toml::de::Error, text: &str, name: &str) -> anyhow::Error {
     let msg = e.message().trim_end();
     match e.span() {
         Some(sp) => {
@@ -281,7 +281,7 @@ pub fn load(path: &Path) -> Result<Timing> {
 }
 
 /// `--timing FILE`, or the defaults.
-pub fn load_or_default(path: Option<&Path>) -> Result<Timing> {
+pub(crate) fn load_or_default(path: Option<&Path>) -> Result<Timing> {
     path.map_or_else(|| Ok(Timing::default()), load)
 }
 

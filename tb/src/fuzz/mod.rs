@@ -231,7 +231,7 @@ pub fn seeds(t: Target) -> Vec<Vec<u8>> {
 }
 
 /// One mutation of `x` (possibly spliced with `other`).
-pub fn mutate(g: &mut Rng, x: &[u8], other: &[u8]) -> Vec<u8> {
+pub(crate) fn mutate(g: &mut Rng, x: &[u8], other: &[u8]) -> Vec<u8> {
     let mut v = x.to_vec();
     let rounds = 1 + g.below(4);
     for _ in 0..rounds {

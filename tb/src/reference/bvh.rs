@@ -18,7 +18,7 @@ struct Node {
 }
 
 /// The hierarchy; `two_sided[i]` marks transmitting objects.
-pub struct Bvh {
+pub(crate) struct Bvh {
     nodes: Vec<Node>,
     order: Vec<u32>,
     two_sided: Vec<bool>,

@@ -312,7 +312,7 @@ pub fn eye_ray(scene: &Scene, w: u32, h: u32, i: u32, j: u32) -> Ray {
 
 /// The 8-bit colour and hit object of the listed pixels of a `w` x `h`
 /// image, traced as [`render`] traces them (without `corners`).
-pub fn render_pixels(
+pub(crate) fn render_pixels(
     scene: &Scene,
     w: u32,
     h: u32,

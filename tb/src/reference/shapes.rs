@@ -211,7 +211,7 @@ pub fn cone(
 }
 
 /// Axis-aligned box, visible from outside (slab method).
-pub fn aabox(
+pub(crate) fn aabox(
     min: Vec3,
     max: Vec3,
     r: &Ray,

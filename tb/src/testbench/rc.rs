@@ -25,7 +25,7 @@ pub struct Stim {
 }
 
 /// The device under test and its stimulus, as one clocked module.
-pub struct RcBench {
+pub(crate) struct RcBench {
     pub rc: RcArray<1>,
     pub stims: Vec<Stim>,
     pub pc: usize,
