@@ -34,12 +34,12 @@ pub enum Mode {
     Col = 2,
 }
 
-pub const ROW_MASK: Mask = 0xFF;
-pub const COL_MASK: Mask = 0x0101_0101_0101_0101;
+pub(crate) const ROW_MASK: Mask = 0xFF;
+pub(crate) const COL_MASK: Mask = 0x0101_0101_0101_0101;
 
 /// Lanes of row `i` (mode Row) or column `i` (mode Col).
 #[inline(always)]
-pub fn group_mask(mode: Mode, i: usize) -> Mask {
+pub(crate) fn group_mask(mode: Mode, i: usize) -> Mask {
     match mode {
         Mode::Row => ROW_MASK << (8 * i),
         _ => COL_MASK << i,

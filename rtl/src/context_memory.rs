@@ -18,7 +18,7 @@
 use crate::rc::context::{Context, DecodeError};
 
 pub const WORDS: usize = 8192;
-pub const BANK_WORDS: usize = 4096;
+pub(crate) const BANK_WORDS: usize = 4096;
 
 #[inline(always)]
 pub const fn bank(addr: u16) -> usize {

@@ -15,8 +15,7 @@
 //!   against the banks the DMA owns ([`crate::dma::Dma::owned_fb_banks`])
 //!   and faults on a conflict.
 
-pub const SET_WORDS: usize = 1 << 15;
-pub const BANK_WORDS: usize = 1 << 14;
+pub(crate) const BANK_WORDS: usize = 1 << 14;
 pub const WORDS: usize = 1 << 16;
 
 use crate::rc::Word;
@@ -77,7 +76,7 @@ mod tests {
         assert_eq!((set(0x4000), bank(0x4000)), (0, 1));
         assert_eq!((set(0x8000), bank(0x8000)), (1, 2));
         assert_eq!((set(0xFFFF), bank(0xFFFF)), (1, 3));
-        assert_eq!(SET_WORDS * 2, WORDS);
+        assert_eq!(BANK_WORDS * 4, WORDS);
         let mut fb = FrameBuffer::<i16>::default();
         fb.write(0xC001, -7);
         assert_eq!(fb.read(0xC001), -7);

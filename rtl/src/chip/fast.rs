@@ -366,12 +366,12 @@ impl<W: Word> Chip<W> {
 }
 
 /// [`run_to_halt`] for the 16-bit chip.
-pub fn run_to_halt16(sim: &mut Sim<Chip<i16>>, max_cycles: u64) -> Result<u64, RunError> {
+pub(crate) fn run_to_halt16(sim: &mut Sim<Chip<i16>>, max_cycles: u64) -> Result<u64, RunError> {
     run_loop(sim, max_cycles)
 }
 
 /// [`run_to_halt`] for the 32-bit chip.
-pub fn run_to_halt32(sim: &mut Sim<Chip<i32>>, max_cycles: u64) -> Result<u64, RunError> {
+pub(crate) fn run_to_halt32(sim: &mut Sim<Chip<i32>>, max_cycles: u64) -> Result<u64, RunError> {
     run_loop(sim, max_cycles)
 }
 

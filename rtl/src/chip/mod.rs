@@ -31,7 +31,7 @@ use crate::tinyrisc::{decode, Command, Machine, RiscTiming, TinyRisc};
 use crate::trace::{Display, Field, LabelKind, Probe, Traced};
 
 mod fast;
-pub use fast::{run_to_halt16, run_to_halt32};
+pub(crate) use fast::{run_to_halt16, run_to_halt32};
 
 /// Every cycle parameter of the chip.
 ///
@@ -195,11 +195,11 @@ pub struct Chip<W: Word = i16> {
 /// unchanged with a sample ([`crate::trace::Probe::unchanged`]): TinyRISC,
 /// which waits through a stream after its first cycle, neither evaluated
 /// nor clocked ([`Chip::stream`])...
-pub const UNCHANGED_RISC: u8 = 1;
+pub(crate) const UNCHANGED_RISC: u8 = 1;
 /// ... and the broadcast unit, the DMA and the array, in a cycle in which
 /// TinyRISC alone worked, as it did in the cycle before
 /// ([`Chip::local_cycles`]).
-pub const UNCHANGED_ARRAY_SIDE: u8 = 2;
+pub(crate) const UNCHANGED_ARRAY_SIDE: u8 = 2;
 
 /// TinyRISC's view of the chip.
 struct View<'a, W: Word> {

@@ -18,7 +18,7 @@ pub const fn full(n: usize) -> Mask {
 
 /// `dst[i] = src[i]` for every lane `i` in `mask`.
 #[inline(always)]
-pub fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, src: &[T; N]) {
+pub(crate) fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, src: &[T; N]) {
     if mask == full(N) {
         *dst = *src;
     } else if mask != 0 {
@@ -33,7 +33,7 @@ pub fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, s
 /// table ([`Word::expand8`]) and blended with bit operations, which
 /// vectorises.
 #[inline(always)]
-pub fn select_word<W: Word, const N: usize>(dst: &mut [W; N], mask: Mask, src: &[W; N]) {
+pub(crate) fn select_word<W: Word, const N: usize>(dst: &mut [W; N], mask: Mask, src: &[W; N]) {
     if mask == full(N) {
         *dst = *src;
     } else if mask != 0 {
@@ -65,12 +65,6 @@ pub fn blend<W: Word, const N: usize>(dst: &mut [W; N], m: &[W; N], src: &[W; N]
     for i in 0..N {
         dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
     }
-}
-
-/// [`select_word`] for 16-bit lanes.
-#[inline(always)]
-pub fn select16<const N: usize>(dst: &mut [i16; N], mask: Mask, src: &[i16; N]) {
-    select_word(dst, mask, src)
 }
 
 /// A signed lane type whose sign bits can be gathered into a mask.
@@ -151,7 +145,7 @@ sign_bits!(i64, 8, _mm512_movepi64_mask, _mm512_movm_epi64);
 
 /// One bool per lane from a mask.
 #[inline(always)]
-pub fn unpack<const N: usize>(mask: Mask) -> [bool; N] {
+pub(crate) fn unpack<const N: usize>(mask: Mask) -> [bool; N] {
     let mut m = [false; N];
     for (i, b) in m.iter_mut().enumerate() {
         *b = mask >> i & 1 != 0;
@@ -162,7 +156,7 @@ pub fn unpack<const N: usize>(mask: Mask) -> [bool; N] {
 /// Pack one bool per lane into a mask. Eight lanes at a time: the eight
 /// 0/1 bytes of a little-endian u64 gathered into one byte by a multiply.
 #[inline(always)]
-pub fn pack_bools<const N: usize>(b: &[bool; N]) -> Mask {
+pub(crate) fn pack_bools<const N: usize>(b: &[bool; N]) -> Mask {
     let mut m = 0u64;
     let chunks = N / 8;
     for c in 0..chunks {
@@ -232,7 +226,7 @@ mod tests {
             assert_eq!(pack_bools(&b), x);
             let mut d = [7i16; 64];
             let src: [i16; 64] = std::array::from_fn(|i| i as i16 - 20);
-            select16(&mut d, x, &src);
+            select_word(&mut d, x, &src);
             for i in 0..64 {
                 assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
             }

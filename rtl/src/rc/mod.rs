@@ -106,12 +106,12 @@ fn ctx_text(v: u64) -> Option<String> {
 }
 
 /// Translate filter: opcode field to mnemonic.
-pub static OP_FILTER: Filter = Filter {
+pub(crate) static OP_FILTER: Filter = Filter {
     name: "rc_op",
     text: op_text,
 };
 /// Translate filter: context word to its disassembly.
-pub static CTX_FILTER: Filter = Filter {
+pub(crate) static CTX_FILTER: Filter = Filter {
     name: "rc_ctx",
     text: ctx_text,
 };

@@ -8,7 +8,7 @@
 use super::lanes::{blend, select_word, Mask};
 use super::word::Word;
 
-pub const REGS: usize = 16;
+pub(crate) const REGS: usize = 16;
 
 pub struct RegisterFile<const N: usize, W: Word = i16> {
     pub(crate) r: [[W; N]; REGS],

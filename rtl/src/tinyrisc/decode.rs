@@ -163,8 +163,8 @@ impl Opcode {
 
 pub const IMM18_MIN: i32 = -(1 << 17);
 pub const IMM18_MAX: i32 = (1 << 17) - 1;
-pub const UIMM18_MAX: i32 = (1 << 18) - 1;
-pub const IMM14_MAX: i32 = (1 << 14) - 1;
+pub(crate) const UIMM18_MAX: i32 = (1 << 18) - 1;
+pub(crate) const IMM14_MAX: i32 = (1 << 14) - 1;
 
 /// A decoded instruction. `imm` holds the value the format gives it:
 /// sign- or zero-extended immediate, the branch word offset, the jump
@@ -368,7 +368,7 @@ fn instr_text(v: u64) -> Option<String> {
 }
 
 /// Translate filter for waveforms: instruction word to its disassembly.
-pub static INSTR_FILTER: crate::trace::Filter = crate::trace::Filter {
+pub(crate) static INSTR_FILTER: crate::trace::Filter = crate::trace::Filter {
     name: "tinyrisc_instr",
     text: instr_text,
 };

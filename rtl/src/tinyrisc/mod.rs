@@ -15,7 +15,8 @@ pub mod decode;
 pub mod execute;
 pub mod register_file;
 
-pub use decode::{Instr, Opcode, INSTR_FILTER};
+pub(crate) use decode::INSTR_FILTER;
+pub use decode::{Instr, Opcode};
 pub use execute::{Command, Machine};
 pub use register_file::RegisterFile;
 
@@ -254,7 +255,7 @@ fn state_text(v: u64) -> Option<String> {
     )
 }
 
-pub static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
+pub(crate) static STATE_FILTER: crate::trace::Filter = crate::trace::Filter {
     name: "tinyrisc_state",
     text: state_text,
 };

@@ -91,7 +91,7 @@ pub(super) fn decoder_path(wave: &Path, name: &str) -> PathBuf {
 /// with what it is. Commands check these against their inputs and other
 /// outputs before the work ([`Tracer::finish`] writes those the traced
 /// signals need).
-pub fn side_files(wave: &Path, filters: &[&str]) -> Vec<(PathBuf, String)> {
+pub(crate) fn side_files(wave: &Path, filters: &[&str]) -> Vec<(PathBuf, String)> {
     let wave = std::path::absolute(wave).unwrap_or_else(|_| wave.to_path_buf());
     let mut v = vec![(save_file_path(&wave), "save file".to_string())];
     for name in filters {

@@ -47,7 +47,8 @@ mod sampler;
 mod sink;
 mod tracer;
 
-pub use self::files::{check_scope_patterns, partial_files, side_files};
+pub(crate) use self::files::side_files;
+pub use self::files::{check_scope_patterns, partial_files};
 pub use self::tracer::Tracer;
 
 #[cfg(test)]
@@ -326,7 +327,7 @@ pub struct TraceConfig {
 }
 
 /// Whether a waveform path asks for FST (`.fst`) rather than VCD.
-pub fn is_fst(path: &Path) -> bool {
+pub(crate) fn is_fst(path: &Path) -> bool {
     path.extension()
         .is_some_and(|e| e.eq_ignore_ascii_case("fst"))
 }
@@ -334,7 +335,7 @@ pub fn is_fst(path: &Path) -> bool {
 /// Value changes an FST writer holds in memory before it writes them out
 /// as one compressed section (the default of
 /// [`TraceConfig::fst_section_bytes`]).
-pub const FST_SECTION_BYTES: usize = 64 << 20;
+pub(crate) const FST_SECTION_BYTES: usize = 64 << 20;
 
 /// The largest waveform written by default (4 GiB).
 pub const MAX_TRACE_BYTES: u64 = 4 << 30;
@@ -342,12 +343,12 @@ pub const MAX_TRACE_BYTES: u64 = 4 << 30;
 /// How many times smaller an FST is than the VCD of the same window, at
 /// the least (measured on render windows: 11 to 19 times); the size
 /// limits, counted in VCD bytes, allow an FST this many times more.
-pub const FST_SMALLER: f64 = 10.0;
+pub(crate) const FST_SMALLER: f64 = 10.0;
 
 /// Estimated VCD bytes per traced signal per cycle: about a quarter of the
 /// signals change in a typical cycle of the tracer, at about 8 bytes a
 /// change (measured on `morphosys run` and `render` traces: 1.5 to 2.5).
-pub const BYTES_PER_SIGNAL_CYCLE: f64 = 2.0;
+pub(crate) const BYTES_PER_SIGNAL_CYCLE: f64 = 2.0;
 
 impl TraceConfig {
     pub fn new(path: impl Into<PathBuf>) -> TraceConfig {
