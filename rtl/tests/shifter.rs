@@ -1,52 +1,86 @@
-//! The barrel shifter for every amount, against i64 arithmetic and the
-//! `fixed` crate's shifts.
+//! The barrel shifter for every amount on both datapaths, against i128
+//! arithmetic, and the `fixed` crate's shifts on the 16-bit RC.
 
 mod common;
 use common::*;
 use fixed::types::{I4F12, I8F8};
 use proptest::prelude::*;
+use proptest::test_runner::TestCaseError;
 use rtl::rc::context::Op;
+
+/// Every amount 0 to twice the word's width less one: logical shifts by
+/// the width or more give 0, `sra` the sign fill (floor division by 2^n),
+/// `asl` the exact product saturated.
+fn every_amount<W: TestWord>(a: &[W; L]) -> Result<(), TestCaseError> {
+    let mut rc = rc_w::<W>();
+    let bits = W::BITS as i128;
+    for n in 0..2 * bits {
+        let amt = [W::of(n); L];
+        let sll = binop_w(&mut rc, Op::Sll, a, &amt);
+        let srl = binop_w(&mut rc, Op::Srl, a, &amt);
+        let sra = binop_w(&mut rc, Op::Sra, a, &amt);
+        let asl = binop_w(&mut rc, Op::Asl, a, &amt);
+        for i in 0..L {
+            let x = a[i].get();
+            let u = unsigned_w::<W>(x);
+            let mask = (1i128 << bits) - 1;
+            let want_sll = if n >= bits { 0 } else { (u << n) & mask };
+            let want_srl = if n >= bits { 0 } else { u >> n };
+            prop_assert_eq!(
+                unsigned_w::<W>(sll[i].get()),
+                want_sll,
+                "sll {} by {}",
+                x,
+                n
+            );
+            prop_assert_eq!(
+                unsigned_w::<W>(srl[i].get()),
+                want_srl,
+                "srl {} by {}",
+                x,
+                n
+            );
+            prop_assert_eq!(sra[i].get(), x.div_euclid(1i128 << n), "sra {} by {}", x, n);
+            let exact = x * (1i128 << n);
+            prop_assert_eq!(asl[i].get(), clamp_w::<W>(exact), "asl {} by {}", x, n);
+            prop_assert_eq!(bit(rc.flags.v, i), clamp_w::<W>(exact) != exact);
+        }
+    }
+    Ok(())
+}
+
+/// Only the low bits of B are the amount: five on the 16-bit RC, six on
+/// the 32-bit one.
+fn amount_is_b_mod_twice_the_width<W: TestWord>(
+    a: &[W; L],
+    b: &[W; L],
+) -> Result<(), TestCaseError> {
+    let mut rc = rc_w::<W>();
+    let r = binop_w(&mut rc, Op::Sra, a, b);
+    for i in 0..L {
+        let n = unsigned_w::<W>(b[i].get()) & (2 * W::BITS as i128 - 1);
+        prop_assert_eq!(r[i].get(), a[i].get().div_euclid(1i128 << n));
+    }
+    Ok(())
+}
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(128))]
 
     #[test]
-    fn every_amount(a in lanes()) {
-        let mut rc = rc();
-        for n in 0..=31i16 {
-            let amt = [n; L];
-            let sll = binop(&mut rc, Op::Sll, &a, &amt);
-            let srl = binop(&mut rc, Op::Srl, &a, &amt);
-            let sra = binop(&mut rc, Op::Sra, &a, &amt);
-            let asl = binop(&mut rc, Op::Asl, &a, &amt);
-            for i in 0..L {
-                let x = a[i] as i64;
-                let u = x.rem_euclid(1 << 16);
-                let n = n as i64;
-                // Logical: the 16-bit pattern shifted in a 64-bit register.
-                let want_sll = if n >= 16 { 0 } else { (u << n) & 0xFFFF };
-                let want_srl = if n >= 16 { 0 } else { u >> n };
-                prop_assert_eq!(sll[i] as u16 as i64, want_sll, "sll {} by {}", x, n);
-                prop_assert_eq!(srl[i] as u16 as i64, want_srl, "srl {} by {}", x, n);
-                // Arithmetic right: floor division by 2^n.
-                prop_assert_eq!(sra[i] as i64, x.div_euclid(1i64 << n), "sra {} by {}", x, n);
-                // Arithmetic left: the exact product, saturated.
-                let exact = x * (1i64 << n);
-                prop_assert_eq!(asl[i] as i64, clamp16(exact), "asl {} by {}", x, n);
-                prop_assert_eq!(bit(rc.flags.v, i), clamp16(exact) != exact);
-            }
-        }
+    fn every_amount_16(a in lanes_w::<i16>()) { every_amount(&a)?; }
+
+    #[test]
+    fn every_amount_32(a in lanes_w::<i32>()) { every_amount(&a)?; }
+
+    #[test]
+    fn amount_is_b_mod_32_on_16_bits(a in lanes_w::<i16>(), b in lanes_w::<i16>()) {
+        amount_is_b_mod_twice_the_width(&a, &b)?;
     }
 
-    /// Only the low five bits of B are the amount.
     #[test]
-    fn amount_is_b_mod_32(a in lanes(), b in lanes()) {
-        let mut rc = rc();
-        let r = binop(&mut rc, Op::Sra, &a, &b);
-        for i in 0..L {
-            let n = (b[i] as u16 & 31) as i64;
-            prop_assert_eq!(r[i] as i64, (a[i] as i64).div_euclid(1i64 << n));
-        }
+    fn amount_is_b_mod_64_on_32_bits(a in lanes_w::<i32>(), b in lanes_w::<i32>()) {
+        amount_is_b_mod_twice_the_width(&a, &b)?;
     }
 
     /// As fixed-point operations: `sra` is the `fixed` crate's `>>` and `asl`
