@@ -233,6 +233,7 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(e),
     };
     tb::output::set_quiet(cli.quiet);
+    rtl::trace::set_partial_files(tb::output::PARTIAL_FILES);
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that went away (`morphosys spd balls | head`) ends the

@@ -105,10 +105,10 @@ pub(crate) fn forget_temporary(p: &Path) {
     }
 }
 
-/// Remove every temporary file and folder of the run and every partial
-/// waveform: called on SIGINT, SIGTERM and SIGHUP before exiting.
+/// Remove every temporary file and folder of the run, partial waveforms
+/// included: called on SIGINT, SIGTERM and SIGHUP before exiting.
 pub fn remove_temporaries() {
-    let mut all = rtl::trace::partial_files();
+    let mut all = Vec::new();
     if let Ok(v) = TEMPS.lock() {
         all.extend(v.iter().cloned());
     }
@@ -117,6 +117,42 @@ pub fn remove_temporaries() {
             let _ = std::fs::remove_dir_all(&p);
         } else {
             let _ = std::fs::remove_file(&p);
+        }
+    }
+}
+
+/// What the tracer does with a waveform's temporary file
+/// ([`rtl::trace::set_partial_files`], set by `main`): listed with the
+/// run's other temporaries, and those a killed run left removed.
+pub const PARTIAL_FILES: rtl::trace::PartialFiles = rtl::trace::PartialFiles {
+    clean_stale: remove_stale_partials,
+    created: register_temporary,
+    done: forget_temporary,
+};
+
+/// A waveform's temporary file is `.<name>.<pid>.<random>.partial` beside
+/// it (the tracer makes it). Those of `name` in `dir` left by a process
+/// that no longer runs (killed outright, with no chance to clean up) are
+/// removed.
+pub(crate) fn remove_stale_partials(dir: &Path, name: &str) {
+    let proc_fs = Path::new("/proc/self").exists();
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let prefix = format!(".{name}.");
+    for e in entries.flatten() {
+        let f = e.file_name().to_string_lossy().into_owned();
+        let Some(rest) = f
+            .strip_prefix(&prefix)
+            .and_then(|r| r.strip_suffix(".partial"))
+        else {
+            continue;
+        };
+        let Some(pid) = rest.split('.').next().and_then(|p| p.parse::<u32>().ok()) else {
+            continue;
+        };
+        if proc_fs && pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
+            let _ = std::fs::remove_file(e.path());
         }
     }
 }

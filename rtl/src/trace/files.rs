@@ -1,6 +1,6 @@
-//! The files around a waveform: partial files removed on interruption,
-//! the GTKWave save file, translate filters and Surfer decoders beside it,
-//! and the scope patterns of `--trace-scope`.
+//! The files around a waveform: the hooks through which the program
+//! tracks its temporary file, the GTKWave save file, translate filters and
+//! Surfer decoders beside it, and the scope patterns of `--trace-scope`.
 
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -8,46 +8,47 @@ use std::path::{Path, PathBuf};
 use super::tracer::*;
 use super::*;
 
-/// The waveforms being written right now (their temporary files), for a
-/// signal handler to remove: [`partial_files`].
-pub(super) static PARTIALS: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
-
-/// The temporary files of the waveforms being written now: what an
-/// interrupted run must remove (the `morphosys` command does so on SIGINT,
-/// SIGTERM and SIGHUP).
-pub fn partial_files() -> Vec<PathBuf> {
-    PARTIALS.lock().map(|v| v.clone()).unwrap_or_default()
+/// What the program around the tracer does with a waveform's temporary
+/// file (`.<name>.<pid>.<random>.partial` beside the waveform, renamed onto
+/// it when finished): the `morphosys` command keeps the list its signal
+/// handler empties and removes what a killed run left
+/// (`tb::output::PARTIAL_FILES`). Without it ([`set_partial_files`] never
+/// called, as in a library's tests) the tracer only makes and renames the
+/// file.
+#[derive(Clone, Copy)]
+pub struct PartialFiles {
+    /// Before a waveform named `name` is begun in `dir`: remove the
+    /// temporary files of it that a run killed outright left.
+    pub clean_stale: fn(dir: &Path, name: &str),
+    /// The tracer made this temporary file: remove it if the run is
+    /// interrupted.
+    pub created: fn(&Path),
+    /// Renamed into place or removed: nothing is left to clean.
+    pub done: fn(&Path),
 }
 
-pub(super) fn forget_partial(p: &Path) {
-    if let Ok(mut v) = PARTIALS.lock() {
-        v.retain(|q| q != p);
+static PARTIAL_FILES: std::sync::OnceLock<PartialFiles> = std::sync::OnceLock::new();
+
+/// Tell the tracer what to do with its temporary files (once per process).
+pub fn set_partial_files(p: PartialFiles) {
+    let _ = PARTIAL_FILES.set(p);
+}
+
+pub(super) fn clean_stale_partials(dir: &Path, name: &str) {
+    if let Some(p) = PARTIAL_FILES.get() {
+        (p.clean_stale)(dir, name);
     }
 }
 
-/// A waveform's temporary file is `.<name>.<pid>.<random>.partial` beside
-/// it. Those of `target` left by a process that no longer runs (killed
-/// outright, with no chance to clean up) are removed.
-pub(super) fn remove_stale_partials(dir: &Path, name: &str) {
-    let proc_fs = Path::new("/proc/self").exists();
-    let Ok(entries) = std::fs::read_dir(dir) else {
-        return;
-    };
-    let prefix = format!(".{name}.");
-    for e in entries.flatten() {
-        let f = e.file_name().to_string_lossy().into_owned();
-        let Some(rest) = f
-            .strip_prefix(&prefix)
-            .and_then(|r| r.strip_suffix(".partial"))
-        else {
-            continue;
-        };
-        let Some(pid) = rest.split('.').next().and_then(|p| p.parse::<u32>().ok()) else {
-            continue;
-        };
-        if proc_fs && pid != std::process::id() && !Path::new(&format!("/proc/{pid}")).exists() {
-            let _ = std::fs::remove_file(e.path());
-        }
+pub(super) fn partial_created(path: &Path) {
+    if let Some(p) = PARTIAL_FILES.get() {
+        (p.created)(path);
+    }
+}
+
+pub(super) fn forget_partial(path: &Path) {
+    if let Some(p) = PARTIAL_FILES.get() {
+        (p.done)(path);
     }
 }
 

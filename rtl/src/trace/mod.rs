@@ -48,7 +48,7 @@ mod sink;
 mod tracer;
 
 pub(crate) use self::files::side_files;
-pub use self::files::{check_scope_patterns, partial_files};
+pub use self::files::{check_scope_patterns, set_partial_files, PartialFiles};
 pub use self::tracer::Tracer;
 
 #[cfg(test)]

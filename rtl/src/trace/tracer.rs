@@ -204,7 +204,7 @@ impl Tracer {
                 let name = target
                     .file_name()
                     .map_or_else(|| "waveform".into(), |n| n.to_string_lossy().into_owned());
-                remove_stale_partials(&dir, &name);
+                clean_stale_partials(&dir, &name);
                 let tmp = output_tempfile(
                     tempfile::Builder::new()
                         .prefix(&format!(".{name}.{}.", std::process::id()))
@@ -213,9 +213,7 @@ impl Tracer {
                     &target,
                 )?;
                 let (file, tmp_path) = tmp.into_parts();
-                if let Ok(mut v) = PARTIALS.lock() {
-                    v.push(tmp_path.to_path_buf());
-                }
+                partial_created(&tmp_path);
                 (file, Some(tmp_path), target)
             }
         };
