@@ -29,3 +29,17 @@ pub fn command(file: PathBuf, out: Option<PathBuf>) -> anyhow::Result<()> {
     }
     Ok(())
 }
+
+/// `morphosys asm` arguments.
+#[derive(clap::Args, Debug)]
+pub struct AsmArgs {
+    pub file: PathBuf,
+    /// Write the assembled image here.
+    #[arg(short, long, value_name = "FILE.img")]
+    pub out: Option<PathBuf>,
+}
+
+/// `morphosys asm`.
+pub fn run(a: AsmArgs) -> anyhow::Result<()> {
+    command(a.file, a.out)
+}

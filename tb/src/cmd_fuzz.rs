@@ -91,3 +91,29 @@ pub fn command(
     }
     Ok(())
 }
+
+/// `morphosys fuzz` arguments.
+#[derive(clap::Args, Debug)]
+pub struct FuzzArgs {
+    /// Targets (default: all).
+    #[arg(value_enum)]
+    pub targets: Vec<crate::fuzz::Target>,
+    /// Inputs per target.
+    #[arg(long, value_name = "N", default_value_t = 100_000, value_parser = crate::cli::parse_count::<u64>)]
+    pub count: u64,
+    /// Random seed (runs are reproducible).
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    pub seed: u64,
+    /// Save the inputs of findings under DIR/<target>/.
+    #[arg(long, value_name = "DIR")]
+    pub save: Option<PathBuf>,
+    /// Write the figures per target (inputs, accepted, rejected,
+    /// findings, inputs per second, slowest input) as JSON here.
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+/// `morphosys fuzz`.
+pub fn run(a: FuzzArgs) -> anyhow::Result<()> {
+    command(a.targets, a.count, a.seed, a.save, a.json)
+}

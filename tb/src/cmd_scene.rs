@@ -427,3 +427,25 @@ pub fn compare(
     }
     Ok(())
 }
+
+/// `morphosys compare` arguments.
+#[derive(clap::Args, Debug)]
+pub struct CompareArgs {
+    pub a: PathBuf,
+    pub b: PathBuf,
+    /// A pixel is "off" when a channel differs by more than this.
+    #[arg(long, value_name = "N", default_value_t = 8)]
+    pub threshold: u8,
+    /// Hit maps of A and B (from `reference --hits`).
+    #[arg(long, num_args = 2, value_names = ["HITS_A", "HITS_B"])]
+    pub hits: Option<Vec<PathBuf>>,
+    /// Write the figures as JSON here.
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
+
+/// `morphosys compare`.
+pub fn compare_cmd(a: CompareArgs) -> Result<()> {
+    let hits = a.hits.map(|h| (h[0].clone(), h[1].clone()));
+    compare(&a.a, &a.b, a.threshold, hits, a.json)
+}

@@ -51,3 +51,21 @@ pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()
     }
     Ok(())
 }
+
+/// `morphosys spd` arguments.
+#[derive(clap::Args, Debug)]
+pub struct SpdArgs {
+    #[arg(value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names()))]
+    pub name: String,
+    /// SPD size factor (default: the SPD program's default).
+    #[arg(long, value_name = "N", value_parser = crate::cli::parse_count::<u32>)]
+    pub size: Option<u32>,
+    /// Write the NFF here (default: stdout).
+    #[arg(long, value_name = "FILE.nff")]
+    pub out: Option<PathBuf>,
+}
+
+/// `morphosys spd`.
+pub fn run(a: SpdArgs) -> Result<()> {
+    command(&a.name, a.size, a.out)
+}

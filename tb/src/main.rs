@@ -3,7 +3,6 @@
 //! Every subcommand lives in its own module of the `tb` library; this file
 //! only parses arguments and reports errors as one line with a non-zero exit.
 
-use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{CommandFactory, Parser, Subcommand};
@@ -28,12 +27,7 @@ struct Cli {
 enum Command {
     /// Assemble TinyRISC code and RC contexts; with -o write the image,
     /// without print the listing.
-    Asm {
-        file: PathBuf,
-        /// Write the assembled image here.
-        #[arg(short, long, value_name = "FILE.img")]
-        out: Option<PathBuf>,
-    },
+    Asm(tb::cmd_asm::AsmArgs),
     /// Run a program (assembly source or image) on the chip to its halt and
     /// print the cycles used.
     Run(tb::cmd_run::RunArgs),
@@ -55,35 +49,10 @@ enum Command {
     },
     /// Print the chip's default timing as a TOML file, every field with
     /// where its value comes from; edit a copy and pass it with --timing.
-    Timing {
-        /// Write it here instead of standard output.
-        #[arg(long, value_name = "FILE.toml")]
-        out: Option<PathBuf>,
-        /// The issue model: `run` (ours, the default) or `instruction` (the
-        /// M1 chip's: TinyRISC issues each context by an instruction).
-        #[arg(long, value_name = "run|instruction", value_parser = clap::builder::PossibleValuesParser::new(["run", "instruction"]))]
-        issue: Option<String>,
-    },
+    Timing(tb::timing::TimingArgs),
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
-    Fuzz {
-        /// Targets (default: all).
-        #[arg(value_enum)]
-        targets: Vec<tb::fuzz::Target>,
-        /// Inputs per target.
-        #[arg(long, value_name = "N", default_value_t = 100_000, value_parser = tb::cli::parse_count::<u64>)]
-        count: u64,
-        /// Random seed (runs are reproducible).
-        #[arg(long, value_name = "N", default_value_t = 1)]
-        seed: u64,
-        /// Save the inputs of findings under DIR/<target>/.
-        #[arg(long, value_name = "DIR")]
-        save: Option<PathBuf>,
-        /// Write the figures per target (inputs, accepted, rejected,
-        /// findings, inputs per second, slowest input) as JSON here.
-        #[arg(long, value_name = "PATH")]
-        json: Option<PathBuf>,
-    },
+    Fuzz(tb::cmd_fuzz::FuzzArgs),
     /// Run a testbench: drive a block of the chip, check it against a
     /// reference model, write its waveform.
     Tb {
@@ -101,55 +70,22 @@ enum Command {
     Render(tb::cmd_render::RenderArgs),
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
-    Compare {
-        a: PathBuf,
-        b: PathBuf,
-        /// A pixel is "off" when a channel differs by more than this.
-        #[arg(long, value_name = "N", default_value_t = 8)]
-        threshold: u8,
-        /// Hit maps of A and B (from `reference --hits`).
-        #[arg(long, num_args = 2, value_names = ["HITS_A", "HITS_B"])]
-        hits: Option<Vec<PathBuf>>,
-        /// Write the figures as JSON here.
-        #[arg(long, value_name = "PATH")]
-        json: Option<PathBuf>,
-    },
+    Compare(tb::cmd_scene::CompareArgs),
     /// Generate one of Eric Haines' Standard Procedural Databases in NFF
     /// (balls, gears, jacks, lattice, mount, rings, shells, tetra, tree).
-    Spd {
-        #[arg(value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names()))]
-        name: String,
-        /// SPD size factor (default: the SPD program's default).
-        #[arg(long, value_name = "N", value_parser = tb::cli::parse_count::<u32>)]
-        size: Option<u32>,
-        /// Write the NFF here (default: stdout).
-        #[arg(long, value_name = "FILE.nff")]
-        out: Option<PathBuf>,
-    },
+    Spd(tb::cmd_spd::SpdArgs),
 }
 
 #[derive(Subcommand)]
 enum Bench {
     /// One Reconfigurable Cell: every ALU, shifter, multiplier, register-file
     /// and RAM operation, checked against an independent reference model.
-    Rc {
-        /// Write the waveform here: VCD, or FST where the path ends in
-        /// `.fst` (a GTKWave `.gtkw` save file and the translate filters go
-        /// beside it).
-        #[arg(long, value_name = "PATH")]
-        vcd: Option<PathBuf>,
-        #[command(flatten)]
-        window: tb::cli::TraceWindow,
-        /// Write the result (cycles, contexts, values checked, mismatches)
-        /// as JSON here.
-        #[arg(long, value_name = "PATH")]
-        json: Option<PathBuf>,
-    },
+    Rc(tb::testbench::rc::RcArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
     match cli.command {
-        Command::Asm { file, out } => tb::cmd_asm::command(file, out),
+        Command::Asm(a) => tb::cmd_asm::run(a),
         Command::Run(a) => tb::cmd_run::command(a),
         Command::Report(a) => tb::cmd_report::command(a),
         Command::Bench(a) => tb::cmd_bench::command(a),
@@ -165,39 +101,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
                 .and_then(|_| o.flush())
                 .map_err(|e| anyhow::anyhow!("writing the completions to standard output: {e}"))
         }
-        Command::Timing { out, issue } => {
-            let mut t = rtl::Timing::default();
-            if let Some(i) = issue {
-                t.risc.issue = i
-                    .parse()
-                    .map_err(|e: String| anyhow::anyhow!("--issue: {e}"))?;
-            }
-            let text = tb::timing::to_toml(&t);
-            match out {
-                Some(p) => {
-                    tb::output::Files::new().output(&p, "--out").check()?;
-                    tb::cmd_scene::write_output(&p, text.as_bytes())?;
-                    tb::note!("wrote {}", p.display());
-                    Ok(())
-                }
-                None => {
-                    use std::io::Write;
-                    let mut o = std::io::stdout().lock();
-                    o.write_all(text.as_bytes())
-                        .and_then(|_| o.flush())
-                        .map_err(|e| anyhow::anyhow!("writing the timing to standard output: {e}"))
-                }
-            }
-        }
-        Command::Fuzz {
-            targets,
-            count,
-            seed,
-            save,
-            json,
-        } => tb::cmd_fuzz::command(targets, count, seed, save, json),
+        Command::Timing(a) => tb::timing::command(a),
+        Command::Fuzz(a) => tb::cmd_fuzz::run(a),
         Command::Tb { bench } => match bench {
-            Bench::Rc { vcd, window, json } => tb::testbench::rc::command(vcd, window, json),
+            Bench::Rc(a) => tb::testbench::rc::command(a.vcd, a.window, a.json),
         },
         Command::Reference(a) => tb::cmd_scene::reference(a),
         Command::Compile(a) => tb::cmd_scene::compile_cmd(a),
@@ -205,17 +112,8 @@ fn run(cli: Cli) -> anyhow::Result<()> {
             argv: std::env::args().skip(1).collect(),
             ..a
         }),
-        Command::Compare {
-            a,
-            b,
-            threshold,
-            hits,
-            json,
-        } => {
-            let hits = hits.map(|h| (h[0].clone(), h[1].clone()));
-            tb::cmd_scene::compare(&a, &b, threshold, hits, json)
-        }
-        Command::Spd { name, size, out } => tb::cmd_spd::command(&name, size, out),
+        Command::Compare(a) => tb::cmd_scene::compare_cmd(a),
+        Command::Spd(a) => tb::cmd_spd::run(a),
     }
 }
 

@@ -331,3 +331,42 @@ mod tests {
         );
     }
 }
+
+/// `morphosys timing` arguments.
+#[derive(clap::Args, Debug)]
+pub struct TimingArgs {
+    /// Write it here instead of standard output.
+    #[arg(long, value_name = "FILE.toml")]
+    pub out: Option<std::path::PathBuf>,
+    /// The issue model: `run` (ours, the default) or `instruction` (the
+    /// M1 chip's: TinyRISC issues each context by an instruction).
+    #[arg(long, value_name = "run|instruction", value_parser = clap::builder::PossibleValuesParser::new(["run", "instruction"]))]
+    pub issue: Option<String>,
+}
+
+/// `morphosys timing`: the chip's timing as TOML, every field with where
+/// its value comes from.
+pub fn command(a: TimingArgs) -> Result<()> {
+    let mut t = Timing::default();
+    if let Some(i) = a.issue {
+        t.risc.issue = i
+            .parse()
+            .map_err(|e: String| anyhow::anyhow!("--issue: {e}"))?;
+    }
+    let text = to_toml(&t);
+    match a.out {
+        Some(p) => {
+            crate::output::Files::new().output(&p, "--out").check()?;
+            crate::cmd_scene::write_output(&p, text.as_bytes())?;
+            crate::note!("wrote {}", p.display());
+            Ok(())
+        }
+        None => {
+            use std::io::Write;
+            let mut o = std::io::stdout().lock();
+            o.write_all(text.as_bytes())
+                .and_then(|_| o.flush())
+                .map_err(|e| anyhow::anyhow!("writing the timing to standard output: {e}"))
+        }
+    }
+}

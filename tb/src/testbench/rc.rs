@@ -404,3 +404,19 @@ pub fn command(
     println!("  PASS");
     Ok(())
 }
+
+/// `morphosys tb rc` arguments.
+#[derive(clap::Args, Debug)]
+pub struct RcArgs {
+    /// Write the waveform here: VCD, or FST where the path ends in
+    /// `.fst` (a GTKWave `.gtkw` save file and the translate filters go
+    /// beside it).
+    #[arg(long, value_name = "PATH")]
+    pub vcd: Option<PathBuf>,
+    #[command(flatten)]
+    pub window: crate::cli::TraceWindow,
+    /// Write the result (cycles, contexts, values checked, mismatches)
+    /// as JSON here.
+    #[arg(long, value_name = "PATH")]
+    pub json: Option<PathBuf>,
+}
