@@ -393,7 +393,7 @@ pub fn write(stem: &Path, c: &Chart) -> anyhow::Result<[PathBuf; 2]> {
         c,
     )?;
     let svg_path = stem.with_extension("svg");
-    crate::cmd_scene::write_output(&svg_path, svg.as_bytes())?;
+    crate::output::write(&svg_path, svg.as_bytes())?;
     let mut buf = vec![0u8; (w * h * 3) as usize];
     draw(
         BitMapBackend::with_buffer(&mut buf, (w, h)).into_drawing_area(),
@@ -403,7 +403,7 @@ pub fn write(stem: &Path, c: &Chart) -> anyhow::Result<[PathBuf; 2]> {
     let mut png = Vec::new();
     img.write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)?;
     let png_path = stem.with_extension("png");
-    crate::cmd_scene::write_output(&png_path, &png)?;
+    crate::output::write(&png_path, &png)?;
     Ok([svg_path, png_path])
 }
 

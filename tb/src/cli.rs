@@ -204,3 +204,53 @@ pub(crate) fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, Stri
 pub(crate) fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
     s.parse()
 }
+
+/// The largest image side any command renders (host memory grows with the
+/// pixels: about 40 bytes each, 670 MB at 4096x4096).
+pub(crate) const MAX_SIDE: u64 = 4096;
+
+/// `w` x `h` if each side is 1..=[`MAX_SIDE`]; otherwise what the request
+/// would cost: about 40 bytes of host memory per pixel (images, hit maps,
+/// f64 colours) and, on the chip, about 140 cycles per pixel for the
+/// default scene (9.08 M cycles at 256x256) simulated at about 15 M cycles
+/// per host second.
+pub(crate) fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
+    if (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h) {
+        return Ok((w as u32, h as u32));
+    }
+    if w == 0 || h == 0 {
+        return Err(format!("{w}x{h}: each side must be 1..={MAX_SIDE}"));
+    }
+    let px = w as f64 * h as f64;
+    let mb = px * 40.0 / 1e6;
+    let secs = px * 140.0 / 15e6;
+    let mem = if mb >= 1000.0 {
+        format!("{:.0} GB", mb / 1000.0)
+    } else {
+        format!("{mb:.0} MB")
+    };
+    let time = if secs >= 7200.0 {
+        format!("{:.0} hours", secs / 3600.0)
+    } else if secs >= 120.0 {
+        format!("{:.0} minutes", secs / 60.0)
+    } else {
+        format!("{secs:.0} seconds")
+    };
+    Err(format!(
+        "{w}x{h} is too large: each side must be 1..={MAX_SIDE} (this would need about {mem} of memory and, on the simulated chip, about {time} of host time)"
+    ))
+}
+
+/// `--size WIDTHxHEIGHT`, each side 1..=[`MAX_SIDE`].
+pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 256x256, found '{s}'"))?;
+    let n = |v: &str| v.trim().parse::<u64>().ok();
+    match (n(w), n(h)) {
+        (Some(w), Some(h)) => check_size(w, h),
+        _ => Err(format!(
+            "expected WIDTHxHEIGHT with each between 1 and {MAX_SIDE}, found '{s}'"
+        )),
+    }
+}

@@ -29,14 +29,14 @@ use firmware::bsp::BspParams;
 use firmware::tracer::Options;
 use serde_json::json;
 
-use crate::cmd_scene::{load_scene, write_output};
+use crate::cmd_scene::load_scene;
 
 #[derive(clap::Args, Debug)]
 pub struct BenchArgs {
     /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
     /// Image size of the throughput workload (each side 1..=4096).
-    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size, default_value = "128x128")]
+    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size, default_value = "128x128")]
     pub size: (u32, u32),
     /// Runs per configuration; the fastest counts.
     #[arg(long, value_name = "N", default_value_t = 3, value_parser = crate::cli::parse_count::<u32>)]
@@ -219,7 +219,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "host_seconds_traced": traced,
             "host_seconds_untraced_small": untraced_small,
         });
-        write_output(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        crate::output::write(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
         crate::note!("wrote {}", p.display());
     }
     Ok(())

@@ -9,7 +9,7 @@ use firmware::bsp::BspParams;
 use firmware::tracer::Options;
 use serde_json::json;
 
-use crate::cmd_scene::{load_scene, png_bytes, write_output};
+use crate::cmd_scene::{load_scene, png_bytes};
 use crate::metrics;
 use crate::reference;
 
@@ -18,7 +18,7 @@ pub struct RenderArgs {
     /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
     /// Image size WIDTHxHEIGHT, each side 1..=4096 (default 256x256).
-    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size)]
     pub size: Option<(u32, u32)>,
     /// Rays traced in parallel: 4, 8, 16, 32 or 64.
     #[arg(long, value_name = "N", default_value_t = 64, value_parser = crate::cli::parse_ways)]
@@ -523,7 +523,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         eprintln!("{w}");
     }
     if let Some(p) = &a.emit_asm {
-        write_output(p, built.source.as_bytes())?;
+        crate::output::write(p, built.source.as_bytes())?;
         crate::note!("wrote {}", p.display());
     }
     let trace = a.vcd.map(|p| {
@@ -588,13 +588,13 @@ pub fn command(a: RenderArgs) -> Result<()> {
     rep.json["inputs"] = inputs;
     let out = out_path;
     if let Some(h) = &a.hits {
-        write_output(
+        crate::output::write(
             h,
             &crate::cmd_scene::hit_map_bytes(width, height, &chip.hits),
         )?;
         crate::note!("wrote {}", h.display());
     }
-    write_output(&out, &png_bytes(width, height, &chip.rgb8)?)
+    crate::output::write(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;
     crate::note!("wrote {}", out.display());
     let j = &rep.json;
@@ -703,7 +703,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     }
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(j)?;
-        write_output(p, text.as_bytes())?;
+        crate::output::write(p, text.as_bytes())?;
         crate::note!("wrote {}", p.display());
     }
     Ok(())

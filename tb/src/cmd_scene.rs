@@ -37,12 +37,6 @@ pub fn load_scene(path: Option<&Path>) -> Result<Scene> {
     Ok(scene)
 }
 
-/// Write an output file: atomically for a regular file, through for a
-/// device or FIFO, the target of a symbolic link ([`crate::output::write`]).
-pub fn write_output(path: &Path, bytes: &[u8]) -> Result<()> {
-    crate::output::write(path, bytes)
-}
-
 /// Encode 8-bit RGB as PNG.
 pub(crate) fn png_bytes(width: u32, height: u32, rgb: &[u8]) -> Result<Vec<u8>> {
     use image::ImageEncoder;
@@ -110,64 +104,13 @@ pub(crate) fn read_hits(path: &Path) -> Result<(u32, u32, Vec<u32>)> {
     ))
 }
 
-/// Parse `WxH`.
-/// The largest image side any command renders (host memory grows with the
-/// pixels: about 40 bytes each, 670 MB at 4096x4096).
-pub(crate) const MAX_SIDE: u64 = 4096;
-
-/// `w` x `h` if each side is 1..=[`MAX_SIDE`]; otherwise what the request
-/// would cost: about 40 bytes of host memory per pixel (images, hit maps,
-/// f64 colours) and, on the chip, about 140 cycles per pixel for the
-/// default scene (9.08 M cycles at 256x256) simulated at about 15 M cycles
-/// per host second.
-pub(crate) fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
-    if (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h) {
-        return Ok((w as u32, h as u32));
-    }
-    if w == 0 || h == 0 {
-        return Err(format!("{w}x{h}: each side must be 1..={MAX_SIDE}"));
-    }
-    let px = w as f64 * h as f64;
-    let mb = px * 40.0 / 1e6;
-    let secs = px * 140.0 / 15e6;
-    let mem = if mb >= 1000.0 {
-        format!("{:.0} GB", mb / 1000.0)
-    } else {
-        format!("{mb:.0} MB")
-    };
-    let time = if secs >= 7200.0 {
-        format!("{:.0} hours", secs / 3600.0)
-    } else if secs >= 120.0 {
-        format!("{:.0} minutes", secs / 60.0)
-    } else {
-        format!("{secs:.0} seconds")
-    };
-    Err(format!(
-        "{w}x{h} is too large: each side must be 1..={MAX_SIDE} (this would need about {mem} of memory and, on the simulated chip, about {time} of host time)"
-    ))
-}
-
-/// `--size WIDTHxHEIGHT`, each side 1..=[`MAX_SIDE`].
-pub(crate) fn parse_size(s: &str) -> Result<(u32, u32), String> {
-    let (w, h) = s
-        .split_once(['x', 'X'])
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, e.g. 256x256, found '{s}'"))?;
-    let n = |v: &str| v.trim().parse::<u64>().ok();
-    match (n(w), n(h)) {
-        (Some(w), Some(h)) => check_size(w, h),
-        _ => Err(format!(
-            "expected WIDTHxHEIGHT with each between 1 and {MAX_SIDE}, found '{s}'"
-        )),
-    }
-}
-
 /// Arguments of `morphosys reference`.
 #[derive(clap::Args, Debug)]
 pub struct ReferenceArgs {
     /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
     /// Image size WIDTHxHEIGHT, each side 1..=4096 (default: the scene's resolution).
-    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size)]
+    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size)]
     pub size: Option<(u32, u32)>,
     /// Maximum ray depth 1..=8; the eye ray is depth 1 (default 2, the
     /// paper's recursion level, as `render` and `sweep`, so their images
@@ -202,7 +145,7 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
             Some(s) => s,
             None => {
                 let (w, h) = scene.camera.resolution;
-                check_size(w.into(), h.into()).map_err(|e| {
+                crate::cli::check_size(w.into(), h.into()).map_err(|e| {
                     anyhow::anyhow!("{}: the scene's resolution {e}; give --size", scene.source)
                 })?
             }
@@ -255,11 +198,11 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
         s.shadow_rays
     );
     if let Some(out) = &out {
-        write_output(out, &png_bytes(img.width, img.height, &img.to_rgb8())?)?;
+        crate::output::write(out, &png_bytes(img.width, img.height, &img.to_rgb8())?)?;
         crate::note!("wrote {}", out.display());
     }
     if let Some(path) = &a.hits {
-        write_output(path, &hits_bytes(&img))?;
+        crate::output::write(path, &hits_bytes(&img))?;
         crate::note!("wrote {}", path.display());
     }
     if let Some(path) = &a.json {
@@ -277,7 +220,7 @@ pub fn reference(a: ReferenceArgs) -> Result<()> {
             "shadow_rays": s.shadow_rays,
             "image": out.as_ref().map(|p| p.display().to_string()),
         });
-        write_output(path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        crate::output::write(path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
     }
     Ok(())
 }
@@ -345,7 +288,7 @@ pub fn compile_cmd(a: CompileArgs) -> Result<()> {
     let img = compile(&scene, &opt)?;
     crate::report!("{}", img.report.text().trim_end());
     if let Some(path) = &a.out {
-        write_output(path, &img.to_le_bytes())?;
+        crate::output::write(path, &img.to_le_bytes())?;
         crate::report!(
             "wrote {} ({} words, little-endian)",
             path.display(),
@@ -353,7 +296,7 @@ pub fn compile_cmd(a: CompileArgs) -> Result<()> {
         );
     }
     if let Some(path) = &a.json {
-        write_output(
+        crate::output::write(
             path,
             (serde_json::to_string_pretty(&img.report)? + "\n").as_bytes(),
         )?;
@@ -423,7 +366,7 @@ pub fn compare(
             "share_off": off,
             "hit_agreement": agreement,
         });
-        write_output(&path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
+        crate::output::write(&path, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
     }
     Ok(())
 }

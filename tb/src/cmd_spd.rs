@@ -7,8 +7,6 @@ use std::path::PathBuf;
 use anyhow::{anyhow, Result};
 use firmware::scene::{spd, PrimType};
 
-use crate::cmd_scene::write_output;
-
 /// Generate `name` at `size` (default: the SPD program's default size) and
 /// write it to `out`, or to stdout without `out`.
 pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()> {
@@ -30,7 +28,7 @@ pub fn command(name: &str, size: Option<u32>, out: Option<PathBuf>) -> Result<()
     let text = spd::generate(name, size).map_err(|e| anyhow!(e))?;
     match out {
         Some(path) => {
-            write_output(&path, text.as_bytes())?;
+            crate::output::write(&path, text.as_bytes())?;
             let scene = firmware::scene::nff::parse(&text, &path.display().to_string())?;
             let c = scene.type_counts();
             let parts: Vec<String> = PrimType::ALL

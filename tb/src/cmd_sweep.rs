@@ -27,7 +27,7 @@ use firmware::tracer::{Datapath, NodeLayout, Numerics, Options, Traversal};
 use rtl::tinyrisc::IssueModel;
 use rtl::Timing;
 
-use crate::cmd_scene::{load_scene, write_output};
+use crate::cmd_scene::load_scene;
 
 mod plan;
 mod plots;
@@ -58,7 +58,7 @@ pub struct SweepCli {
     #[arg(long, value_name = "PLAN", conflicts_with_all = ["scenes", "size", "only", "families", "max_size", "family_size", "size_seconds", "timing"])]
     pub merge: Option<PathBuf>,
     /// Image size (each side 1..=4096).
-    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size, default_value = "256x256")]
+    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size, default_value = "256x256")]
     pub size: (u32, u32),
     /// Run only one part: `knobs` (every knob on SCENES), `sizes` (the
     /// SPD families at sizes 1..=--max-size, both traversals) or
@@ -79,7 +79,7 @@ pub struct SweepCli {
     pub max_size: u32,
     /// Image size of the size sweep (streamed scenes of thousands of
     /// objects take minutes of host time at 256x256).
-    #[arg(long, value_name = "WxH", value_parser = crate::cmd_scene::parse_size, default_value = "64x64")]
+    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size, default_value = "64x64")]
     pub family_size: (u32, u32),
     /// Skip a family's larger sizes (with a traversal) once one of its
     /// renders took longer than this many host seconds.
@@ -820,7 +820,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
                     crate::cmd_render::render(scene, &c.opt, &host).and_then(|(_, mut rep)| {
                         rep.json["argv"] = argv.clone().into();
                         rep.json["inputs"] = inputs.clone();
-                        write_output(
+                        crate::output::write(
                             &json_path,
                             (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
                         )?;
@@ -876,7 +876,7 @@ fn write_results(rows: &[Row], dir: &Path) -> Result<()> {
         w.serialize(r)?;
     }
     let csv_path = dir.join("results.csv");
-    write_output(&csv_path, &w.into_inner().context("csv")?)?;
+    crate::output::write(&csv_path, &w.into_inner().context("csv")?)?;
     crate::note!("wrote {}", csv_path.display());
     for p in charts_for(rows, dir)? {
         crate::note!("wrote {}", p.display());

@@ -659,7 +659,11 @@ pub(crate) fn firmware_from_source(mut fw: Firmware, text: &str, name: &str) -> 
 
 /// Render with a firmware already built (for example by
 /// [`choose_firmware`]).
-pub(crate) fn render_built(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
+pub(crate) fn render_built(
+    fw: Firmware,
+    opt: &Options,
+    host: &RenderSettings,
+) -> Result<ChipRender> {
     render_firmware(fw, opt, host)
 }
 

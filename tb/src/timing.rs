@@ -357,7 +357,7 @@ pub fn command(a: TimingArgs) -> Result<()> {
     match a.out {
         Some(p) => {
             crate::output::Files::new().output(&p, "--out").check()?;
-            crate::cmd_scene::write_output(&p, text.as_bytes())?;
+            crate::output::write(&p, text.as_bytes())?;
             crate::note!("wrote {}", p.display());
             Ok(())
         }

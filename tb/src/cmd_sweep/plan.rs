@@ -2,7 +2,6 @@
 //! `sweep.toml`, what was asked) and `sweep --merge` (the table and charts
 //! from the plan's renders).
 
-use crate::cmd_scene::write_output;
 use anyhow::{Context as _, Result};
 use firmware::bsp::SplitRule;
 use rtl::Timing;
@@ -189,7 +188,7 @@ pub(super) fn write_plan(
                 .with_context(|| format!("{}: cannot read the scene", sc.file.display()))?,
         };
         drop(scene);
-        write_output(&to, &bytes)?;
+        crate::output::write(&to, &bytes)?;
         sc.file = to;
         refs.push(sc);
     }
@@ -198,7 +197,7 @@ pub(super) fn write_plan(
         let rel = Path::new("timing").join(timing_copy_name(i, name));
         let bytes = firmware::input::read(from)
             .with_context(|| format!("{}: cannot read the timing file", from.display()))?;
-        write_output(&dir.join(&rel), &bytes)?;
+        crate::output::write(&dir.join(&rel), &bytes)?;
         timing.push(rel);
     }
     if pts.iter().any(|p| p.cfg.timing_name == "M1 issue") {
@@ -207,7 +206,7 @@ pub(super) fn write_plan(
             .find(|p| p.cfg.timing_name == "M1 issue")
             .map(|p| p.cfg.timing);
         let t = crate::timing::to_toml(&m1.unwrap_or_default());
-        write_output(&dir.join(M1_TIMING_FILE), t.as_bytes())?;
+        crate::output::write(&dir.join(M1_TIMING_FILE), t.as_bytes())?;
     }
     let mut text = String::new();
     for job in jobs {
@@ -237,8 +236,8 @@ pub(super) fn write_plan(
         dir.display(),
         toml::to_string(&plan).context("sweep.toml")?
     );
-    write_output(&dir.join(PLAN_FILE), toml_text.as_bytes())?;
-    write_output(&dir.join(JOBS_FILE), text.as_bytes())?;
+    crate::output::write(&dir.join(PLAN_FILE), toml_text.as_bytes())?;
+    crate::output::write(&dir.join(JOBS_FILE), text.as_bytes())?;
     println!(
         "wrote {} ({} renders for {} points) and {}",
         dir.join(JOBS_FILE).display(),
@@ -271,7 +270,7 @@ pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
     let plan: Plan = toml::from_str(&text)
         .map_err(|e| crate::timing::toml_error(&e, &text, &plan_path.display().to_string()))?;
     let size = |s: &str| {
-        crate::cmd_scene::parse_size(s)
+        crate::cli::parse_size(s)
             .map_err(|e| anyhow::anyhow!("{}: size {s}: {e}", plan_path.display()))
     };
     // The jobs' arguments name the plan's folder as it was when planned.
