@@ -757,10 +757,12 @@ pub fn command(a: SweepArgs) -> Result<()> {
     let points_dir = a.out_dir.join("points");
     std::fs::create_dir_all(&points_dir)
         .with_context(|| format!("cannot create {}", points_dir.display()))?;
-    let mut resumed = 0;
-
+    let resumed = std::sync::atomic::AtomicUsize::new(0);
     let mut rows: Vec<Row> = Vec::new();
-    let mut skipped = 0;
+    let skipped = std::sync::atomic::AtomicUsize::new(0);
+    let count = |n: &std::sync::atomic::AtomicUsize| {
+        n.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    };
     let bar = crate::output::progress_bar(pts.len() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
@@ -773,10 +775,84 @@ pub fn command(a: SweepArgs) -> Result<()> {
     // took more than --size-seconds of host time (sizes grow about 8x in
     // objects).
     let mut slow: BTreeMap<(String, &str), f64> = BTreeMap::new();
-    for p in &pts {
+    // One point's render: taken from an earlier run's JSON when its
+    // arguments and inputs are the same, else rendered and its JSON kept.
+    let measure = |p: &Point| -> Result<serde_json::Value> {
         let (sc, scene) = &scenes[p.scene];
         let c = &p.cfg;
-        bar.inc(1);
+        let name = &jobs[p.job].name;
+        let argv = render_argv(&a.out_dir, &sc.file, c, name);
+        let json_path = points_dir.join(format!("{name}.json"));
+        let host = crate::render::RenderSettings {
+            numerics: c.nm,
+            timing: c.timing,
+            ..Default::default()
+        };
+        let inputs = crate::inputs::inputs(scene, &c.timing, None);
+        let earlier = crate::cmd_render::render_json(&json_path, &argv, &inputs);
+        if let Err(why) = &earlier {
+            if why.starts_with("made before") {
+                bar.suspend(|| eprintln!("{name}: {why}: rendering again"));
+            }
+        }
+        if let Ok(j) = earlier {
+            count(&resumed);
+            return Ok(j);
+        }
+        crate::cmd_render::render(scene, &c.opt, &host).and_then(|(_, mut rep)| {
+            rep.json["argv"] = argv.clone().into();
+            rep.json["inputs"] = inputs.clone();
+            crate::output::write(
+                &json_path,
+                (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
+            )?;
+            Ok(rep.json)
+        })
+    };
+    // The knob sweep's renders do not depend on each other: they run
+    // concurrently on the thread pool (each render's chip instances share
+    // it), and the table takes them in its own order, so it is the one a
+    // render after another gives. The size sweep runs in order below: a
+    // family's next size depends on how long the last one took.
+    {
+        use rayon::prelude::*;
+        let mut per_job = vec![0u64; jobs.len()];
+        for p in &pts {
+            per_job[p.job] += 1;
+        }
+        let knob_jobs: Vec<usize> = (0..jobs.len())
+            .filter(|&k| pts[jobs[k].point].cfg.knob != SCENE_SIZE)
+            .collect();
+        let measured: Vec<(usize, Option<serde_json::Value>)> = knob_jobs
+            .par_iter()
+            .map(|&k| {
+                let p = &pts[jobs[k].point];
+                let r = match measure(p) {
+                    Ok(j) => Some(j),
+                    Err(e) => {
+                        let sc = &scenes[p.scene].0;
+                        bar.suspend(|| {
+                            eprintln!(
+                                "skipped {} with {}={}: {e:#}",
+                                sc.name, p.cfg.knob, p.cfg.value
+                            )
+                        });
+                        count(&skipped);
+                        None
+                    }
+                };
+                bar.inc(per_job[k]);
+                (k, r)
+            })
+            .collect();
+        done.extend(measured);
+    }
+    for p in &pts {
+        let sc = &scenes[p.scene].0;
+        let c = &p.cfg;
+        if c.knob == SCENE_SIZE {
+            bar.inc(1);
+        }
         let j = match done.get(&p.job) {
             Some(Some(j)) => j.clone(),
             Some(None) => continue,
@@ -792,41 +868,13 @@ pub fn command(a: SweepArgs) -> Result<()> {
                                 a.size_seconds
                             )
                         });
-                        skipped += 1;
+                        count(&skipped);
                         done.insert(p.job, None);
                         continue;
                     }
                 }
                 bar.set_message(format!("{} {}={}", sc.name, c.knob, c.value));
-                let name = &jobs[p.job].name;
-                let argv = render_argv(&a.out_dir, &sc.file, c, name);
-                let json_path = points_dir.join(format!("{name}.json"));
-                let host = crate::render::RenderSettings {
-                    numerics: c.nm,
-                    timing: c.timing,
-                    ..Default::default()
-                };
-                let inputs = crate::inputs::inputs(scene, &c.timing, None);
-                let earlier = crate::cmd_render::render_json(&json_path, &argv, &inputs);
-                if let Err(why) = &earlier {
-                    if why.starts_with("made before") {
-                        bar.suspend(|| eprintln!("{name}: {why}: rendering again"));
-                    }
-                }
-                let measured = if let Ok(j) = earlier {
-                    resumed += 1;
-                    Ok(j)
-                } else {
-                    crate::cmd_render::render(scene, &c.opt, &host).and_then(|(_, mut rep)| {
-                        rep.json["argv"] = argv.clone().into();
-                        rep.json["inputs"] = inputs.clone();
-                        crate::output::write(
-                            &json_path,
-                            (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
-                        )?;
-                        Ok(rep.json)
-                    })
-                };
+                let measured = measure(p);
                 match measured {
                     Ok(json) => {
                         let t = json["host_seconds"].as_f64().unwrap_or(0.0);
@@ -844,7 +892,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
                         bar.suspend(|| {
                             eprintln!("skipped {} with {}={}: {e:#}", sc.name, c.knob, c.value)
                         });
-                        skipped += 1;
+                        count(&skipped);
                         done.insert(p.job, None);
                         continue;
                     }
@@ -854,6 +902,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
         rows.push(point_row(&refs, p, &j));
     }
     bar.finish_and_clear();
+    let (resumed, skipped) = (resumed.into_inner(), skipped.into_inner());
     if resumed > 0 {
         eprintln!(
             "{resumed} renders taken from an earlier run ({}/NAME.json, same arguments)",

@@ -54,3 +54,45 @@ fn renders_are_bit_identical_for_1_and_2_threads() {
     assert!(a.3.len() > 10_000, "the waveform has content");
     assert!(a.3 == b.3, "waveforms differ");
 }
+
+/// The in-process sweep renders its knob points concurrently: on 1 and on
+/// 2 threads its table and charts are byte for byte the same.
+#[test]
+fn a_sweep_is_bit_identical_for_1_and_2_threads() {
+    let d = tempfile::tempdir().unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let tetra = root.join("scenes/spd/tetra-1.nff");
+    let jacks = root.join("scenes/spd/jacks-1.nff");
+    for threads in ["1", "2"] {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_morphosys"))
+            .current_dir(d.path())
+            .env("RAYON_NUM_THREADS", threads)
+            .args(["--quiet", "sweep"])
+            .arg(&tetra)
+            .arg(&jacks)
+            .args(["--size", "16x16", "--family-size", "8x8", "--max-size", "1"])
+            .args(["--families", "tetra", "--out-dir", threads])
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let mut compared = 0;
+    for e in std::fs::read_dir(d.path().join("1")).unwrap() {
+        let name = e.unwrap().file_name();
+        let a = d.path().join("1").join(&name);
+        if a.is_dir() {
+            continue;
+        }
+        let b = d.path().join("2").join(&name);
+        assert!(
+            std::fs::read(&a).unwrap() == std::fs::read(&b).unwrap(),
+            "{name:?} differs between 1 and 2 threads"
+        );
+        compared += 1;
+    }
+    assert!(compared >= 5, "only {compared} files");
+}
