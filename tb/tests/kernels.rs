@@ -59,7 +59,10 @@ fn with_driver(fw: &Firmware, body: impl FnOnce(&mut Code)) -> asm::Image {
         .sbcb(R1, R2, klen("k_init"))
         .rcany(R1);
     t.label("wait")
-        .lw(R1, firmware::tracer::emit::at("GO", firmware::tracer::emit::R0))
+        .lw(
+            R1,
+            firmware::tracer::emit::at("GO", firmware::tracer::emit::R0),
+        )
         .beqz(R1, "wait");
     body(&mut t);
     t.rcany(R1).halt().directive(".entry driver");
@@ -132,7 +135,11 @@ fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(
     // Rays that leave no object (two-sided planar kernels skip the one
     // their rays leave).
     for i in 0..64 {
-        sim.top.array.rc.ram.write(i, ram::ORIG_OBJ.at(), W::wrap(-1));
+        sim.top
+            .array
+            .rc
+            .ram
+            .write(i, ram::ORIG_OBJ.at(), W::wrap(-1));
     }
     let go = img.symbol("GO").unwrap() as u32;
     sim.top.mem.write(go, 4, 1);
@@ -777,7 +784,9 @@ fn snell_on<W: Word>(ior: f64, seed: u64) -> (usize, f64) {
     assert!(lay.refract && lay.transmit_materials == 1);
     let img = with_driver(&fw, |t| {
         let k = tracer::kernel_names::refract_prepare(0);
-        t.li(R1, kaddr(&k)).li(R2, "FB_TRANSMIT").sbcb(R1, R2, klen(&k));
+        t.li(R1, kaddr(&k))
+            .li(R2, "FB_TRANSMIT")
+            .sbcb(R1, R2, klen(&k));
     });
     let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
     img.load(&mut chip).unwrap();

@@ -7,7 +7,7 @@ use crate::scene::{PrimType, Scene, SceneError, Shape, Vec3};
 
 use super::fit::dequantized;
 use super::{
-    membership_words, record_words, CompileOptions, Groups, NodeFormat, LayoutChoice, QFormat,
+    membership_words, record_words, CompileOptions, Groups, LayoutChoice, NodeFormat, QFormat,
     HEADER_WORDS, LIST_INDEX_BITS, MAGIC, NO_CHILD, Q_MATERIAL, Q_UNIT, VERSION,
 };
 

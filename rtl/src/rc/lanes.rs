@@ -18,7 +18,11 @@ pub const fn full(n: usize) -> Mask {
 
 /// `dst[i] = src[i]` for every lane `i` in `mask`.
 #[inline(always)]
-pub(crate) fn select<T: Copy + Default, const N: usize>(dst: &mut [T; N], mask: Mask, src: &[T; N]) {
+pub(crate) fn select<T: Copy + Default, const N: usize>(
+    dst: &mut [T; N],
+    mask: Mask,
+    src: &[T; N],
+) {
     if mask == full(N) {
         *dst = *src;
     } else if mask != 0 {

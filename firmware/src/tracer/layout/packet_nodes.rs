@@ -14,7 +14,7 @@ use super::super::primitives::{
 };
 use super::super::{mem, Collapse};
 use super::{
-    fb_word_bytes, Finish, FbImage, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
+    fb_word_bytes, FbImage, Finish, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
 };
 use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};

@@ -18,7 +18,7 @@
 
 use super::super::NodeLayout;
 use super::{
-    fb_word_bytes, Finish, FbImage, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
+    fb_word_bytes, FbImage, Finish, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
 };
 
 /// Head words of a Fig. 5 node: flags, split, left, right, cell bounds.
