@@ -395,16 +395,10 @@ fn an_in_process_sweep_resumes_from_its_finished_points() {
     assert_eq!(std::fs::read(d.join("out/results.csv")).unwrap(), first);
 }
 
-/// A scene or timing file whose name holds a newline cannot split a job
-/// line (which GNU parallel and the Slurm script run as a shell command):
-/// the plan's copies get plain names, and a `--plan` folder whose path
-/// holds a control character is refused before anything is made.
-#[test]
-fn file_names_cannot_inject_commands_into_a_plan() {
-    let tmp = tempfile::tempdir().unwrap();
-    let d = tmp.path();
-    let scene = "x\ntouch INJECTED #.nff";
-    let timing = "t\ntouch INJECTED_T #.toml";
+/// In `d`: tetra-1 copied to `scene` and the default timing to `timing`
+/// (names that may hold newlines and commands), planned as a broadcast
+/// sweep into `d/plan`; the sweep's standard output.
+fn hostile_plan(d: &Path, scene: &str, timing: &str) -> String {
     std::fs::copy(
         std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff"),
         d.join(scene),
@@ -429,6 +423,20 @@ fn file_names_cannot_inject_commands_into_a_plan() {
         ],
     );
     assert!(ok, "{err}");
+    out
+}
+
+/// A scene or timing file whose name holds a newline cannot split a job
+/// line (which GNU parallel and the Slurm script run as a shell command):
+/// the plan's copies get plain names, and a `--plan` folder whose path
+/// holds a control character is refused before anything is made.
+#[test]
+fn file_names_cannot_inject_commands_into_a_plan() {
+    let tmp = tempfile::tempdir().unwrap();
+    let d = tmp.path();
+    let scene = "x\ntouch INJECTED #.nff";
+    let timing = "t\ntouch INJECTED_T #.toml";
+    let out = hostile_plan(d, scene, timing);
     let renders: usize = out
         .split_once("jobs.txt (")
         .and_then(|(_, r)| r.split(' ').next())
@@ -787,30 +795,7 @@ fn hostile_names_run_as_renders_under_gnu_parallel() {
     let d = tmp.path();
     let scene = "x\ntouch INJECTED #{}.nff";
     let timing = "t\ntouch INJECTED_T #{1}.toml";
-    std::fs::copy(
-        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff"),
-        d.join(scene),
-    )
-    .unwrap();
-    let (ok, out, err) = morphosys(d, &["timing"]);
-    assert!(ok, "{err}");
-    std::fs::write(d.join(timing), out).unwrap();
-    let (ok, _, err) = morphosys(
-        d,
-        &[
-            "sweep",
-            scene,
-            "--timing",
-            timing,
-            "--only",
-            "broadcast",
-            "--size",
-            "16x16",
-            "--plan",
-            "plan",
-        ],
-    );
-    assert!(ok, "{err}");
+    hostile_plan(d, scene, timing);
     let jobs = std::fs::read_to_string(d.join("plan/jobs.txt")).unwrap();
     std::fs::write(
         d.join("first.txt"),

@@ -81,15 +81,43 @@ fn check_with_fst2vcd(fst: &Path, want: &Changes) {
     assert_same(want, &read_back(&back), "fst2vcd's VCD");
 }
 
-#[test]
-fn a_program_traced_as_fst_reads_back_as_its_vcd() {
-    let dir = tempfile::tempdir().unwrap();
+/// `dct.vcd` and `dct.fst` in `dir`: the same run of the DCT conformance
+/// program, traced in both formats.
+fn trace_program(dir: &Path) {
     let program = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
     let program = program.to_str().unwrap();
     for name in ["dct.vcd", "dct.fst"] {
-        let (ok, _, err) = morphosys(dir.path(), &["run", program, "--vcd", name]);
+        let (ok, _, err) = morphosys(dir, &["run", program, "--vcd", name]);
         assert!(ok, "{name}: {err}");
     }
+}
+
+/// `r.vcd` and `r.fst` in `dir`: the same window (cycles 2000 to 5000) of a
+/// 16x16 render of the default scene.
+fn trace_render_window(dir: &Path) {
+    for name in ["r.vcd", "r.fst"] {
+        let (ok, _, err) = morphosys(
+            dir,
+            &[
+                "render",
+                "--size",
+                "16x16",
+                "--vcd",
+                name,
+                "--trace-from",
+                "2000",
+                "--trace-cycles",
+                "3000",
+            ],
+        );
+        assert!(ok, "{name}: {err}");
+    }
+}
+
+#[test]
+fn a_program_traced_as_fst_reads_back_as_its_vcd() {
+    let dir = tempfile::tempdir().unwrap();
+    trace_program(dir.path());
     let vcd = read_back(&dir.path().join("dct.vcd"));
     let fst = read_back(&dir.path().join("dct.fst"));
     assert_same(&vcd, &fst, "run dct.s");
@@ -104,31 +132,10 @@ fn a_program_traced_as_fst_reads_back_as_its_vcd() {
 #[ignore = "needs GTKWave's fst2vcd (Debian package gtkwave); .ci/run installs it and runs the ignored tests"]
 fn gtkwaves_fst2vcd_converts_our_fst_to_our_vcd() {
     let dir = tempfile::tempdir().unwrap();
-    let program = Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/conformance/dct.s");
-    let program = program.to_str().unwrap();
-    for name in ["dct.vcd", "dct.fst"] {
-        let (ok, _, err) = morphosys(dir.path(), &["run", program, "--vcd", name]);
-        assert!(ok, "{name}: {err}");
-    }
+    trace_program(dir.path());
     let vcd = read_back(&dir.path().join("dct.vcd"));
     check_with_fst2vcd(&dir.path().join("dct.fst"), &vcd);
-    for name in ["r.vcd", "r.fst"] {
-        let (ok, _, err) = morphosys(
-            dir.path(),
-            &[
-                "render",
-                "--size",
-                "16x16",
-                "--vcd",
-                name,
-                "--trace-from",
-                "2000",
-                "--trace-cycles",
-                "3000",
-            ],
-        );
-        assert!(ok, "{name}: {err}");
-    }
+    trace_render_window(dir.path());
     let vcd = read_back(&dir.path().join("r.vcd"));
     check_with_fst2vcd(&dir.path().join("r.fst"), &vcd);
 }
@@ -136,23 +143,7 @@ fn gtkwaves_fst2vcd_converts_our_fst_to_our_vcd() {
 #[test]
 fn a_render_window_traced_as_fst_reads_back_as_its_vcd_and_is_smaller() {
     let dir = tempfile::tempdir().unwrap();
-    for name in ["r.vcd", "r.fst"] {
-        let (ok, _, err) = morphosys(
-            dir.path(),
-            &[
-                "render",
-                "--size",
-                "16x16",
-                "--vcd",
-                name,
-                "--trace-from",
-                "2000",
-                "--trace-cycles",
-                "3000",
-            ],
-        );
-        assert!(ok, "{name}: {err}");
-    }
+    trace_render_window(dir.path());
     let vcd_path = dir.path().join("r.vcd");
     let fst_path = dir.path().join("r.fst");
     let vcd = read_back(&vcd_path);

@@ -10,8 +10,7 @@ use super::*;
 pub(super) fn headline(r: &mut Runner) -> Result<String> {
     let mut rows = Vec::new();
     for s in SMALL {
-        let p = r.render(s, &["--traversal", "paper"])?;
-        let k = r.render(s, &[])?;
+        let (p, k) = both_traversals(r, s)?;
         rows.push(vec![
             format!("`{}`", short(s)),
             thousands(u(&k, "objects")),
@@ -41,11 +40,18 @@ pub(super) fn headline(r: &mut Runner) -> Result<String> {
     )
 }
 
+/// `scene` rendered with the paper's traversal and with the default one.
+fn both_traversals(r: &mut Runner, scene: &str) -> Result<(Value, Value)> {
+    Ok((
+        r.render(scene, &["--traversal", "paper"])?,
+        r.render(scene, &[])?,
+    ))
+}
+
 pub(super) fn traversal(r: &mut Runner) -> Result<String> {
     let mut rows = Vec::new();
     for s in SMALL {
-        let p = r.render(s, &["--traversal", "paper"])?;
-        let k = r.render(s, &[])?;
+        let (p, k) = both_traversals(r, s)?;
         rows.push(vec![
             format!("`{}`", short(s)),
             thousands(u(&p, "cycles")),
