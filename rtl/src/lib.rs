@@ -8,6 +8,7 @@
 //! * [`fb`], [`context_memory`], [`memory`], [`dma`]: the memories and the DMA.
 //! * [`tinyrisc`]: the control processor.
 //! * [`chip`]: the top module, its [`chip::Timing`] and [`chip::Stats`].
+//! * [`simd`]: the instruction set the per-cycle path runs on, chosen at run time.
 
 // Lane loops index several per-lane arrays by the lane number on purpose:
 // that is the form the compiler vectorises.
@@ -23,6 +24,7 @@ pub mod interconnect;
 pub mod kernel;
 pub mod memory;
 pub mod rc;
+pub mod simd;
 pub mod tinyrisc;
 pub mod trace;
 

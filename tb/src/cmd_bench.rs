@@ -181,6 +181,17 @@ pub fn command(a: BenchArgs) -> Result<()> {
         "host                           {cpu}, {cores} threads; each figure the fastest of {repeat} runs, taken in turn{}",
         if a.plain { "; the plain model (--plain)" } else { "" }
     );
+    let simd = rtl::simd::level();
+    println!(
+        "simd path                      {} ({}; the widest this CPU has: {})",
+        simd.name(),
+        if std::env::var_os(rtl::simd::ENV).is_some_and(|v| !v.is_empty()) {
+            "forced by MORPHOSYS_SIMD"
+        } else {
+            "chosen at run time"
+        },
+        rtl::simd::Simd::best().name()
+    );
     println!(
         "workload                       {} at {width}x{height}, 64 ways: {cycles} chip cycles",
         scene.source
@@ -214,6 +225,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "repeat": repeat,
             "statistic": format!("fastest of {repeat} runs, the measurements taken in turn"),
             "host_cpu": cpu,
+            "simd": simd.name(),
             "traced_slowdown": traced_slowdown,
             "traced_slowdown_chip": traced_slowdown_chip,
             "host_seconds_traced": traced,

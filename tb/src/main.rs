@@ -132,6 +132,11 @@ fn main() -> ExitCode {
     };
     tb::output::set_quiet(cli.quiet);
     rtl::trace::set_partial_files(tb::output::PARTIAL_FILES);
+    // The instruction set of the per-cycle path: checked before any work.
+    if let Err(e) = rtl::simd::Simd::from_env().and_then(rtl::simd::set) {
+        eprintln!("morphosys: error: {}", printable(&e));
+        return ExitCode::from(2);
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that went away (`morphosys spd balls | head`) ends the

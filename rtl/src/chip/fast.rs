@@ -9,6 +9,7 @@
 use super::*;
 
 impl<W: Word> Chip<W> {
+    crate::simd::versions! {
     /// The fast path of a stall: while TinyRISC retries an instruction
     /// that waits for the array or the DMA (`rcany`, `wfb`, `dwait`, a full
     /// broadcast queue...), only the broadcast unit, the array and the DMA
@@ -17,9 +18,9 @@ impl<W: Word> Chip<W> {
     /// stall counters included); stops when the wait is over, the
     /// instruction word changed (a DMA store into the program), or after
     /// `limit` cycles. Returns the cycles run.
-    #[inline]
-    pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        self.run_stalled_sampled(limit, |_, _| true)
+    pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>);
+        versions run_stalled_portable run_stalled_avx2 run_stalled_avx512;
+        { self.run_stalled_sampled(limit, |_, _| true) }
     }
 
     /// The untraced fast path, tried by the cycle loop before a plain
@@ -56,6 +57,7 @@ impl<W: Word> Chip<W> {
         self.run_stalled_sampled(limit, sample)
     }
 
+    crate::simd::versions! {
     /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
     /// fault, or `limit`; three kinds, each with less to do than a plain
     /// cycle:
@@ -69,20 +71,21 @@ impl<W: Word> Chip<W> {
     /// * both work: TinyRISC, then the broadcast unit and the array (its
     ///   evaluation and clock edge in one call), in the order of
     ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
-    #[inline(never)]
-    fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>) {
-        self.local_cycles::<false, _>(limit, &mut |_: &Self, _| true)
+    fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>);
+        versions run_local_portable run_local_avx2 run_local_avx512;
+        { self.local_cycles::<false, _>(limit, &mut |_: &Self, _| true) }
     }
 
-    /// [`Chip::run_local`] sampled cycle by cycle (see
-    /// [`Chip::run_fast_sampled`]).
-    #[inline(never)]
-    fn run_local_sampled(
-        &mut self,
-        limit: u64,
-        sample: &mut dyn FnMut(&Self, u8) -> bool,
-    ) -> (u64, Result<(), Fault>) {
-        self.local_cycles::<true, _>(limit, sample)
+    crate::simd::versions! {
+        /// [`Chip::run_local`] sampled cycle by cycle (see
+        /// [`Chip::run_fast_sampled`]).
+        fn run_local_sampled(
+            &mut self,
+            limit: u64,
+            sample: &mut dyn FnMut(&Self, u8) -> bool,
+        ) -> (u64, Result<(), Fault>);
+        versions run_local_sampled_portable run_local_sampled_avx2 run_local_sampled_avx512;
+        { self.local_cycles::<true, _>(limit, sample) }
     }
 
     /// The loops of [`Chip::run_local`]; when `SAMPLED`, `sample` is

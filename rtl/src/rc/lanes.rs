@@ -74,16 +74,16 @@ pub fn blend<W: Word, const N: usize>(dst: &mut [W; N], m: &[W; N], src: &[W; N]
 /// A signed lane type whose sign bits can be gathered into a mask.
 pub trait SignBits: Copy + Default {
     /// The mask of the lanes of `x` whose sign bit is set (bit `i`: lane
-    /// `i`). With AVX-512 (a build for a CPU that has it) one instruction
-    /// per 512-bit register; otherwise through bools.
+    /// `i`). On the AVX-512 path ([`crate::simd::avx512`]) one
+    /// instruction per 512-bit register; otherwise through bools.
     fn sign_mask<const N: usize>(x: &[Self; N]) -> Mask;
     /// [`SignBits::sign_mask`] without AVX-512 (what other CPUs run).
     fn sign_mask_portable<const N: usize>(x: &[Self; N]) -> Mask;
     /// -1 if `b`, else 0 (a lane of a flag vector for [`SignBits::sign_mask`]).
     fn flag(b: bool) -> Self;
     /// The inverse of [`SignBits::sign_mask`]: lane `i` is -1 where bit
-    /// `i` of `mask` is set, else 0. With AVX-512 one instruction per
-    /// 512-bit register; otherwise `None` (the caller's table does it).
+    /// `i` of `mask` is set, else 0. On the AVX-512 path one instruction
+    /// per 512-bit register; otherwise `None` (the caller's table does it).
     fn from_mask<const N: usize>(mask: Mask) -> Option<[Self; N]>;
 }
 
@@ -92,8 +92,8 @@ macro_rules! sign_bits {
         impl SignBits for $t {
             #[inline(always)]
             fn sign_mask<const N: usize>(x: &[$t; N]) -> Mask {
-                #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
-                if N <= 64 && N % $per == 0 {
+                #[cfg(target_arch = "x86_64")]
+                if crate::simd::avx512() && N <= 64 && N % $per == 0 {
                     use std::arch::x86_64::{_mm512_loadu_si512, $movemask};
                     let mut m = 0u64;
                     for k in 0..N / $per {
@@ -123,8 +123,8 @@ macro_rules! sign_bits {
             #[inline(always)]
             #[allow(unused_variables)]
             fn from_mask<const N: usize>(mask: Mask) -> Option<[$t; N]> {
-                #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
-                if N == 64 {
+                #[cfg(target_arch = "x86_64")]
+                if crate::simd::avx512() && N == 64 {
                     use std::arch::x86_64::{_mm512_storeu_si512, $movm};
                     let mut x = [0 as $t; N];
                     for k in 0..64 / $per {
@@ -181,7 +181,7 @@ pub(crate) fn pack_bools<const N: usize>(b: &[bool; N]) -> Mask {
 mod tests {
     use super::*;
 
-    /// Both ways of packing sign bits (AVX-512 where the build has it, and
+    /// Both ways of packing sign bits (AVX-512 on the AVX-512 path, and
     /// the portable one other CPUs run) against the bits one by one.
     #[test]
     fn sign_masks_of_every_lane_width() {
@@ -244,8 +244,8 @@ mod tests {
             for i in 0..64 {
                 assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
             }
-            // Masks expanded to 0 / -1 lanes of every width (by AVX-512
-            // where the build has it, else by table), against the bits.
+            // Masks expanded to 0 / -1 lanes of every width (by AVX-512 on
+            // the AVX-512 path, else by table), against the bits.
             let e16 = expand::<i16, 64>(x);
             let e32 = expand::<i32, 64>(x);
             let e8 = expand::<i16, 8>(x);

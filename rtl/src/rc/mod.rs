@@ -359,13 +359,12 @@ fn cmp_mask<W: Word, const N: usize>(
 
 impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
     fn eval(&mut self) -> Result<(), Fault> {
-        self.exec::<false>()
+        self.eval_lanes()
     }
 
     fn commit(&mut self) {
         if self.en != 0 {
-            self.write_back(self.pend);
-            self.sleep_wake();
+            self.commit_lanes();
         }
     }
 }
@@ -395,13 +394,33 @@ const P_ST: Pending = Pending {
 };
 
 impl<const N: usize, W: Word> RcArray<N, W> {
+    crate::simd::versions! {
     /// [`Clocked::eval`] and [`Clocked::commit`] in one call (nothing
     /// samples between the two): each operation's clock edge is written
     /// in its own arm, knowing what it writes (no branch on the pending
     /// updates).
-    #[inline(never)]
-    pub fn step(&mut self) -> Result<(), Fault> {
-        self.exec::<true>()
+    pub fn step(&mut self) -> Result<(), Fault>;
+        versions step_portable step_avx2 step_avx512;
+        { self.exec::<true>() }
+    }
+
+    crate::simd::versions! {
+        /// [`Clocked::eval`]: the evaluation alone (the clock edge left
+        /// pending for [`Clocked::commit`]).
+        fn eval_lanes(&mut self) -> Result<(), Fault>;
+        versions eval_portable eval_avx2 eval_avx512;
+        { self.exec::<false>() }
+    }
+
+    crate::simd::versions! {
+        /// [`Clocked::commit`] of the enabled lanes: the pending updates'
+        /// clock edge.
+        fn commit_lanes(&mut self) -> ();
+        versions commit_portable commit_avx2 commit_avx512;
+        {
+            self.write_back(self.pend);
+            self.sleep_wake();
+        }
     }
 
     /// The evaluation; with `STEP` the clock edge too.

@@ -104,33 +104,37 @@ pub(super) fn bin8(b: u8) -> u64 {
 #[inline(always)]
 pub(super) fn binary(dst: &mut [u8], v: u64, bits: usize) {
     let dst = &mut dst[..64];
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
-    {
-        use std::arch::x86_64::*;
-        let digits = (v << (64 - bits)).reverse_bits();
-        // SAFETY: a store of 64 bytes into the 64 of `dst`.
-        unsafe {
-            let ascii = _mm512_mask_blend_epi8(
-                digits,
-                _mm512_set1_epi8(b'0' as i8),
-                _mm512_set1_epi8(b'1' as i8),
-            );
-            _mm512_storeu_si512(dst.as_mut_ptr().cast(), ascii);
-        }
+    #[cfg(target_arch = "x86_64")]
+    if crate::simd::avx512() {
+        // SAFETY: the AVX-512 path runs only on a CPU that has it.
+        unsafe { binary_avx512(dst, v, bits) };
+        return;
     }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512bw")))]
-    {
-        binary_portable(dst, v, bits);
+    binary_portable(dst, v, bits);
+}
+
+/// [`binary`] with AVX-512.
+#[cfg(target_arch = "x86_64")]
+#[inline]
+#[target_feature(enable = "avx512f,avx512bw")]
+fn binary_avx512(dst: &mut [u8], v: u64, bits: usize) {
+    use std::arch::x86_64::*;
+    let dst = &mut dst[..64];
+    let digits = (v << (64 - bits)).reverse_bits();
+    // SAFETY: a store of 64 bytes into the 64 of `dst`.
+    unsafe {
+        let ascii = _mm512_mask_blend_epi8(
+            digits,
+            _mm512_set1_epi8(b'0' as i8),
+            _mm512_set1_epi8(b'1' as i8),
+        );
+        _mm512_storeu_si512(dst.as_mut_ptr().cast(), ascii);
     }
 }
 
 /// [`binary`] 8 digits at a time: the top byte's digits shifted down to
 /// its significant ones, then whole bytes (the bytes stored past the
 /// digits are overwritten by the next ones, or lie in the 64).
-#[cfg_attr(
-    all(target_arch = "x86_64", target_feature = "avx512bw"),
-    allow(dead_code)
-)]
 #[inline(always)]
 pub(super) fn binary_portable(dst: &mut [u8], v: u64, bits: usize) {
     let bytes = bits.div_ceil(8);

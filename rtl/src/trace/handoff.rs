@@ -204,37 +204,45 @@ pub(super) fn queue_cycle(batch: &mut Vec<u64>, c: u64) {
 /// one batch of its own that stays in its caches, and the copies the
 /// writing thread reads never come back to it.
 pub(super) fn copy_streaming(dst: &mut Vec<u64>, src: &[u64]) {
-    #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-    {
-        use std::arch::x86_64::*;
-        dst.reserve(src.len());
-        let len = dst.len();
-        let out = dst.spare_capacity_mut().as_mut_ptr().cast::<u64>();
-        // Words before the first 64-byte boundary, stored plainly.
-        let head = (out.align_offset(64)).min(src.len());
-        let lines = (src.len() - head) / 8;
-        // SAFETY: every store lies inside the `src.len()` words of spare
-        // capacity reserved above (`head + 8 * lines` <= `src.len()`), the
-        // streaming ones at 64-byte boundaries (`align_offset`; should it
-        // not know, `head` takes every word); all `src.len()` words after
-        // `len` are written before `set_len`; the fence orders the
-        // streaming stores before the batch is handed over.
-        unsafe {
-            for k in 0..head {
-                out.add(k).write(src[k]);
-            }
-            for k in 0..lines {
-                let at = head + 8 * k;
-                let v = _mm512_loadu_si512(src.as_ptr().add(at).cast());
-                _mm512_stream_si512(out.add(at).cast(), v);
-            }
-            for k in head + 8 * lines..src.len() {
-                out.add(k).write(src[k]);
-            }
-            _mm_sfence();
-            dst.set_len(len + src.len());
-        }
+    #[cfg(target_arch = "x86_64")]
+    if crate::simd::avx512() {
+        // SAFETY: the AVX-512 path runs only on a CPU that has it.
+        unsafe { copy_streaming_avx512(dst, src) };
+        return;
     }
-    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
     dst.extend_from_slice(src);
+}
+
+/// [`copy_streaming`] with AVX-512.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f")]
+fn copy_streaming_avx512(dst: &mut Vec<u64>, src: &[u64]) {
+    use std::arch::x86_64::*;
+    dst.reserve(src.len());
+    let len = dst.len();
+    let out = dst.spare_capacity_mut().as_mut_ptr().cast::<u64>();
+    // Words before the first 64-byte boundary, stored plainly.
+    let head = (out.align_offset(64)).min(src.len());
+    let lines = (src.len() - head) / 8;
+    // SAFETY: every store lies inside the `src.len()` words of spare
+    // capacity reserved above (`head + 8 * lines` <= `src.len()`), the
+    // streaming ones at 64-byte boundaries (`align_offset`; should it
+    // not know, `head` takes every word); all `src.len()` words after
+    // `len` are written before `set_len`; the fence orders the
+    // streaming stores before the batch is handed over.
+    unsafe {
+        for k in 0..head {
+            out.add(k).write(src[k]);
+        }
+        for k in 0..lines {
+            let at = head + 8 * k;
+            let v = _mm512_loadu_si512(src.as_ptr().add(at).cast());
+            _mm512_stream_si512(out.add(at).cast(), v);
+        }
+        for k in head + 8 * lines..src.len() {
+            out.add(k).write(src[k]);
+        }
+        _mm_sfence();
+        dst.set_len(len + src.len());
+    }
 }

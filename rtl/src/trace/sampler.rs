@@ -397,10 +397,13 @@ impl Tracer {
         self.slot_decl.push(NOT_TRACED);
     }
 
+    crate::simd::versions! {
     /// Write the values of the cycle's walk that changed (all traced
     /// ones the first time): per chunk of 64 calls, the mask of those that
     /// changed and their values queued as one message ([`MSG_CHUNK`]).
-    pub(super) fn write_changes(&mut self) {
+    pub(super) fn write_changes(&mut self) -> ();
+        versions write_changes_portable write_changes_avx2 write_changes_avx512;
+    {
         let first = std::mem::take(&mut self.first_sample);
         let padded = self.n_slots.next_multiple_of(64);
         let hot = self.hot.get_mut(self.hot_at..).unwrap_or_default();
@@ -428,6 +431,7 @@ impl Tracer {
             self.bytes += chunk.changes(&mut self.batch, j as u64, first, groups);
             j += 1;
         }
+    }
     }
 }
 
@@ -468,74 +472,61 @@ impl Chunk<'_> {
     /// less than one at a time.
     #[inline(always)]
     pub(super) fn changes(self, batch: &mut Vec<u64>, j: u64, first: bool, groups: usize) -> u64 {
-        #[cfg(all(
-            target_arch = "x86_64",
-            target_feature = "avx512f",
-            target_feature = "avx512bw"
-        ))]
-        {
-            use std::arch::x86_64::*;
-            let Chunk { c, m, l, cost } = self;
-            let len = batch.len();
-            let spare = batch.spare_capacity_mut();
-            // Reserved: the message, the mask and 64 values, the last 8
-            // stored whole.
-            assert!(spare.len() >= 66, "the batch keeps room for a chunk");
-            let dst = spare.as_mut_ptr().cast::<u64>();
-            let mut n = 2;
-            let mut bits = 0u64;
-            // SAFETY: every load and store of the 8 groups lies inside the
-            // 64 words of `c`, `m` or `l`, or inside the batch's spare
-            // capacity (`n` <= 58 before a store of 8 words, 66 checked
-            // above); the first `n` words after `len` are all written
-            // before `set_len`.
-            unsafe {
-                for g in 0..groups.min(8) {
-                    let mg = _mm512_loadu_si512(m.as_ptr().add(8 * g).cast());
-                    let v = _mm512_and_si512(_mm512_loadu_si512(c.as_ptr().add(8 * g).cast()), mg);
-                    let k = if first {
-                        _mm512_test_epi64_mask(mg, mg)
-                    } else {
-                        _mm512_cmpneq_epi64_mask(
-                            v,
-                            _mm512_loadu_si512(l.as_ptr().add(8 * g).cast()),
-                        )
-                    };
-                    _mm512_mask_storeu_epi64(l.as_mut_ptr().add(8 * g).cast(), k, v);
-                    _mm512_storeu_si512(dst.add(n).cast(), _mm512_maskz_compress_epi64(k, v));
-                    n += k.count_ones() as usize;
-                    bits |= u64::from(k) << (8 * g);
-                }
-                if bits == 0 {
-                    return 0;
-                }
-                dst.write(MSG_CHUNK << 48 | j);
-                dst.add(1).write(bits);
-                batch.set_len(len + n);
-                let costs = _mm512_maskz_mov_epi8(bits, _mm512_loadu_si512(cost.as_ptr().cast()));
-                _mm512_reduce_add_epi64(_mm512_sad_epu8(costs, _mm512_setzero_si512())) as u64
-            }
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::avx512() {
+            // SAFETY: the AVX-512 path runs only on a CPU that has it.
+            return unsafe { self.changes_avx512(batch, j, first, groups) };
         }
-        #[cfg(not(all(
-            target_arch = "x86_64",
-            target_feature = "avx512f",
-            target_feature = "avx512bw"
-        )))]
-        {
-            let _ = groups;
-            self.changes_portable(batch, j, first)
+        let _ = groups;
+        self.changes_portable(batch, j, first)
+    }
+
+    /// [`Chunk::changes`] with AVX-512.
+    #[cfg(target_arch = "x86_64")]
+    #[inline]
+    #[target_feature(enable = "avx512f,avx512bw")]
+    fn changes_avx512(self, batch: &mut Vec<u64>, j: u64, first: bool, groups: usize) -> u64 {
+        use std::arch::x86_64::*;
+        let Chunk { c, m, l, cost } = self;
+        let len = batch.len();
+        let spare = batch.spare_capacity_mut();
+        // Reserved: the message, the mask and 64 values, the last 8
+        // stored whole.
+        assert!(spare.len() >= 66, "the batch keeps room for a chunk");
+        let dst = spare.as_mut_ptr().cast::<u64>();
+        let mut n = 2;
+        let mut bits = 0u64;
+        // SAFETY: every load and store of the 8 groups lies inside the
+        // 64 words of `c`, `m` or `l`, or inside the batch's spare
+        // capacity (`n` <= 58 before a store of 8 words, 66 checked
+        // above); the first `n` words after `len` are all written
+        // before `set_len`.
+        unsafe {
+            for g in 0..groups.min(8) {
+                let mg = _mm512_loadu_si512(m.as_ptr().add(8 * g).cast());
+                let v = _mm512_and_si512(_mm512_loadu_si512(c.as_ptr().add(8 * g).cast()), mg);
+                let k = if first {
+                    _mm512_test_epi64_mask(mg, mg)
+                } else {
+                    _mm512_cmpneq_epi64_mask(v, _mm512_loadu_si512(l.as_ptr().add(8 * g).cast()))
+                };
+                _mm512_mask_storeu_epi64(l.as_mut_ptr().add(8 * g).cast(), k, v);
+                _mm512_storeu_si512(dst.add(n).cast(), _mm512_maskz_compress_epi64(k, v));
+                n += k.count_ones() as usize;
+                bits |= u64::from(k) << (8 * g);
+            }
+            if bits == 0 {
+                return 0;
+            }
+            dst.write(MSG_CHUNK << 48 | j);
+            dst.add(1).write(bits);
+            batch.set_len(len + n);
+            let costs = _mm512_maskz_mov_epi8(bits, _mm512_loadu_si512(cost.as_ptr().cast()));
+            _mm512_reduce_add_epi64(_mm512_sad_epu8(costs, _mm512_setzero_si512())) as u64
         }
     }
 
     /// [`Chunk::changes`] one change at a time (what other CPUs run).
-    #[cfg_attr(
-        all(
-            target_arch = "x86_64",
-            target_feature = "avx512f",
-            target_feature = "avx512bw"
-        ),
-        allow(dead_code)
-    )]
     #[inline(always)]
     pub(super) fn changes_portable(self, batch: &mut Vec<u64>, j: u64, first: bool) -> u64 {
         let Chunk { c, m, l, cost } = self;

@@ -449,21 +449,24 @@ pub(super) fn changes<'a>(
     })
 }
 
+crate::simd::versions! {
 /// The writing thread's loop over a batch for a VCD (the general loop of
 /// [`Sink::threaded`] matches the sink and the handle at every message):
 /// `ids` per signal call its code, width, whether it has a translate
 /// filter and its signal's index (untraced: [`NOT_TRACED`]); `edges` the
 /// clock, the falling edge still to write, and the codes of `clk` and
 /// `cycle`.
-#[inline(never)]
 pub(super) fn vcd_batch(
     out: &mut BufWriter<File>,
     body: &mut VcdBody,
     batch: &[u64],
     ids: &[(u32, u32, bool, u32)],
     seen: &mut Seen,
-    (clock, fall, clk, cycle): (&mut Clock, &mut Option<u64>, u32, u32),
-) -> io::Result<()> {
+    edges: (&mut Clock, &mut Option<u64>, u32, u32),
+) -> io::Result<()>;
+    versions vcd_batch_portable vcd_batch_avx2 vcd_batch_avx512;
+{
+    let (clock, fall, clk, cycle) = edges;
     let mut k = 0;
     while k < batch.len() {
         let m = batch[k];
@@ -501,4 +504,5 @@ pub(super) fn vcd_batch(
         body.flush(out, false)?;
     }
     Ok(())
+}
 }
