@@ -117,9 +117,8 @@ impl Bsp {
         object_bounds: &[Aabb],
         bounds: Aabb,
         params: BspParams,
-        meets: &dyn Fn(u32, &Aabb) -> bool,
+        meets: &(dyn Fn(u32, &Aabb) -> bool + Sync),
     ) -> Bsp {
-        let mut nodes = Vec::new();
         let all: Vec<u32> = (0..object_bounds.len() as u32).collect();
         let mut params = params;
         if params.max_depth == 0 {
@@ -130,7 +129,7 @@ impl Bsp {
             p: &params,
             meets,
         };
-        build(&mut nodes, &ctx, bounds, all, 0, 0);
+        let nodes = build(&ctx, bounds, all, 0, 0);
         Bsp { nodes, params }
     }
 
@@ -187,8 +186,13 @@ fn child_box(b: Aabb, axis: usize, pos: f64, above: bool) -> Aabb {
 struct Ctx<'a> {
     ob: &'a [Aabb],
     p: &'a BspParams,
-    meets: &'a dyn Fn(u32, &Aabb) -> bool,
+    meets: &'a (dyn Fn(u32, &Aabb) -> bool + Sync),
 }
+
+/// Nodes of at least this many objects sort them into their children on
+/// several threads, and build the two subtrees side by side (the tree is
+/// the same on any number of threads).
+const PARALLEL_OBJECTS: usize = 128;
 
 /// Splits in a row that separated nothing (both children kept every
 /// object) after which a node becomes a leaf: one per axis, so a cell
@@ -196,71 +200,96 @@ struct Ctx<'a> {
 /// split down to `max_depth` for nothing.
 const FUTILE_SPLITS: u32 = 3;
 
-fn build(
-    nodes: &mut Vec<Node>,
-    cx: &Ctx,
-    bounds: Aabb,
-    objects: Vec<u32>,
-    depth: u32,
-    futile: u32,
-) -> u32 {
+/// The subtree of the node of box `bounds` holding `objects`, in
+/// depth-first pre-order (its root first, children numbered within it).
+fn build(cx: &Ctx, bounds: Aabb, objects: Vec<u32>, depth: u32, futile: u32) -> Vec<Node> {
+    use rayon::prelude::*;
     let (ob, p) = (cx.ob, cx.p);
-    let at = nodes.len() as u32;
-    nodes.push(Node {
-        bounds,
-        depth,
-        objects,
-        split: None,
-    });
-    let objects = &nodes[at as usize].objects;
+    let leaf = |objects| {
+        vec![Node {
+            bounds,
+            depth,
+            objects,
+            split: None,
+        }]
+    };
     if objects.len() <= p.max_leaf || depth >= p.max_depth || futile >= FUTILE_SPLITS {
-        return at;
+        return leaf(objects);
     }
     let choice = match p.rule {
         SplitRule::Median | SplitRule::Auto => {
             let axis = (depth % 3) as usize;
             Some((axis, bounds.center().axis(axis)))
         }
-        SplitRule::Sah => sah_split(ob, objects, bounds),
+        SplitRule::Sah => sah_split(ob, &objects, bounds),
     };
     let Some((axis, mut pos)) = choice else {
-        return at;
+        return leaf(objects);
     };
     if p.snap > 0.0 {
         pos = (pos / p.snap).round() * p.snap;
     }
     let (lo, hi) = (bounds.min.axis(axis), bounds.max.axis(axis));
     if !(pos > lo && pos < hi) {
-        return at; // the box is too thin to split (at the snapped precision)
+        return leaf(objects); // the box is too thin to split (at the snapped precision)
     }
     let (bl, bh) = (
         child_box(bounds, axis, pos, false),
         child_box(bounds, axis, pos, true),
     );
-    let below: Vec<u32> = objects
-        .iter()
-        .copied()
-        .filter(|&i| ob[i as usize].min.axis(axis) <= pos && (cx.meets)(i, &bl))
-        .collect();
-    let above: Vec<u32> = objects
-        .iter()
-        .copied()
-        .filter(|&i| ob[i as usize].max.axis(axis) >= pos && (cx.meets)(i, &bh))
-        .collect();
+    let is_below = |&i: &u32| ob[i as usize].min.axis(axis) <= pos && (cx.meets)(i, &bl);
+    let is_above = |&i: &u32| ob[i as usize].max.axis(axis) >= pos && (cx.meets)(i, &bh);
     let n = objects.len();
+    let parallel = n >= PARALLEL_OBJECTS;
+    let (below, above): (Vec<u32>, Vec<u32>) = if parallel {
+        rayon::join(
+            || objects.par_iter().copied().filter(is_below).collect(),
+            || objects.par_iter().copied().filter(is_above).collect(),
+        )
+    } else {
+        (
+            objects.iter().copied().filter(is_below).collect(),
+            objects.iter().copied().filter(is_above).collect(),
+        )
+    };
     let futile = if below.len() == n && above.len() == n {
         futile + 1
     } else {
         0
     };
-    let l = build(nodes, cx, bl, below, depth + 1, futile);
-    let r = build(nodes, cx, bh, above, depth + 1, futile);
-    nodes[at as usize].split = Some(Split {
-        axis: axis as u8,
-        position: pos,
-        children: [l, r],
+    let (l, r) = if parallel {
+        rayon::join(
+            || build(cx, bl, below, depth + 1, futile),
+            || build(cx, bh, above, depth + 1, futile),
+        )
+    } else {
+        (
+            build(cx, bl, below, depth + 1, futile),
+            build(cx, bh, above, depth + 1, futile),
+        )
+    };
+    // Below's subtree right after this node, above's after it.
+    let r_at = 1 + l.len() as u32;
+    let mut nodes = Vec::with_capacity(1 + l.len() + r.len());
+    nodes.push(Node {
+        bounds,
+        depth,
+        objects,
+        split: Some(Split {
+            axis: axis as u8,
+            position: pos,
+            children: [1, r_at],
+        }),
     });
-    at
+    for (sub, at) in [(l, 1), (r, r_at)] {
+        nodes.extend(sub.into_iter().map(|mut node| {
+            if let Some(s) = &mut node.split {
+                s.children = s.children.map(|c| c + at);
+            }
+            node
+        }));
+    }
+    nodes
 }
 
 /// The cheapest SAH plane, or None when a leaf is cheaper.
@@ -393,6 +422,57 @@ mod tests {
         // 5 objects: the root is already a leaf.
         let t = Bsp::build(&ob[..5], cube([0.0, 0.0, 0.0], 1.0), BspParams::default());
         assert_eq!(t.nodes.len(), 1);
+    }
+
+    /// A tree big enough to be built on several threads is the same on 1
+    /// and 4, numbered in pre-order, and keeps every object under the
+    /// root in the leaves its box meets.
+    #[test]
+    fn the_same_tree_on_any_number_of_threads() {
+        let mut x = 7u64;
+        let mut next = || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64 * 18.0 - 9.0
+        };
+        let ob: Vec<Aabb> = (0..700)
+            .map(|_| cube([next(), next(), next()], 0.05 + next().abs() / 40.0))
+            .collect();
+        let world = cube([0.0, 0.0, 0.0], 10.0);
+        for rule in [SplitRule::Median, SplitRule::Sah] {
+            let params = BspParams {
+                rule,
+                max_depth: 20,
+                ..BspParams::default()
+            };
+            let on = |threads| {
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap()
+                    .install(|| Bsp::build(&ob, world, params))
+            };
+            let (one, four) = (on(1), on(4));
+            assert!(one.nodes.len() > 100, "{rule:?}: {} nodes", one.nodes.len());
+            assert!(one.nodes == four.nodes, "{rule:?}: the trees differ");
+            for (i, n) in one.nodes.iter().enumerate() {
+                if let Some(s) = n.split {
+                    assert_eq!(s.children[0] as usize, i + 1);
+                    assert!(s.children[1] as usize > i + 1);
+                    assert_eq!(one.nodes[s.children[0] as usize].depth, n.depth + 1);
+                    assert_eq!(one.nodes[s.children[1] as usize].depth, n.depth + 1);
+                }
+            }
+            // Each object is in the leaf holding its box's centre.
+            for (k, b) in ob.iter().enumerate() {
+                let leaf = one.leaf_at(b.center().to_array());
+                assert!(
+                    one.nodes[leaf as usize].objects.contains(&(k as u32)),
+                    "object {k}"
+                );
+            }
+        }
     }
 
     #[test]

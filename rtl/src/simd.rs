@@ -160,7 +160,7 @@ pub fn set(simd: Simd) -> Result<(), String> {
 /// versions (out of line, each built for its instruction set) and the
 /// named function itself, which calls the version [`level`] gives.
 ///
-/// ```ignore
+/// ```text
 /// simd::versions! {
 ///     /// Doc.
 ///     pub fn step(&mut self) -> R; versions step_portable step_avx2 step_avx512;

@@ -15,7 +15,14 @@
 //!   and assembly and the image's assembly, the same in both runs, left
 //!   out);
 //! * the speed-up of rendering a 256x256 frame on every core (independent
-//!   chip instances on groups of tiles) over one core.
+//!   chip instances on groups of tiles) over one core, and the schedule
+//!   model's prediction of it on this machine's thread count, 16 and 64
+//!   cores from the frame's work items measured on one thread
+//!   ([`crate::schedule`]).
+//!
+//! The workload runs the paper's traversal by default (the simulator's
+//! workload since the first bench); `--traversal packet` runs what
+//! `render` runs.
 //!
 //! Each configuration runs `--repeat` times, the configurations in turn
 //! (one run of each per round); the best (least disturbed) run of each
@@ -47,6 +54,12 @@ pub struct BenchArgs {
     /// The chip's timing from a TOML file (`morphosys timing`).
     #[arg(long, value_name = "FILE.toml")]
     pub timing: Option<PathBuf>,
+    /// BSP traversal of the workload: paper (the paper's tracer and its
+    /// median BSP, the simulator's workload since the first bench) or
+    /// packet (what `render` runs by default, its BSP chosen as `render`
+    /// chooses it).
+    #[arg(long, value_name = "paper|packet", default_value = "paper", value_parser = crate::cli::parse_traversal)]
+    pub traversal: firmware::tracer::Traversal,
     /// Step every cycle through the plain register-transfer model (one
     /// eval and commit per cycle) instead of the fast paths: slower, and
     /// the same cycles, states and waveform.
@@ -79,16 +92,24 @@ pub fn command(a: BenchArgs) -> Result<()> {
     let (width, height) = a.size;
     // The paper's configuration (its traversal and BSP): the workload the
     // simulator's speed has been measured on since the first bench.
-    let opt = Options {
-        width,
-        height,
-        ways: 64,
-        depth: 2,
-        bsp: BspParams::default(),
-        layout: Default::default(),
-        datapath: Default::default(),
-        traversal: firmware::tracer::Traversal::Paper,
-        collapse: Default::default(),
+    let opt = match a.traversal {
+        firmware::tracer::Traversal::Paper => Options {
+            width,
+            height,
+            ways: 64,
+            depth: 2,
+            bsp: BspParams::default(),
+            layout: Default::default(),
+            datapath: Default::default(),
+            traversal: firmware::tracer::Traversal::Paper,
+            collapse: Default::default(),
+        },
+        firmware::tracer::Traversal::Packet => Options {
+            width,
+            height,
+            traversal: firmware::tracer::Traversal::Packet,
+            ..Options::default()
+        },
     };
     let repeat = a.repeat.max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
@@ -129,6 +150,14 @@ pub fn command(a: BenchArgs) -> Result<()> {
     // once measured 3.6x its untraced one where the runs around it gave
     // 2.7-2.8x).
     let mut best = [(0u64, f64::INFINITY, f64::INFINITY); 5];
+    // The schedule model's measurements: the work items (chip instances)
+    // of the fastest 256x256 frame on one thread and the rest of its chip
+    // render (the serial part), and the fastest chip render (the
+    // firmware's generation and probe aside) on one thread and on every
+    // core.
+    let mut items: Vec<f64> = Vec::new();
+    let mut serial = 0.0;
+    let mut chip_render = [f64::INFINITY; 2];
     for k in 0..repeat {
         for (&(opt, threads, trace), b) in runs.iter().zip(&mut best) {
             let cfg = trace.then(|| {
@@ -154,6 +183,14 @@ pub fn command(a: BenchArgs) -> Result<()> {
                 )
             })?;
             let s = t0.elapsed().as_secs_f64();
+            if opt.width == 256 {
+                let k = (threads > 1) as usize;
+                if threads == 1 && r.render_seconds < chip_render[0] {
+                    serial = (r.render_seconds - r.instance_seconds.iter().sum::<f64>()).max(0.0);
+                    items = r.instance_seconds.clone();
+                }
+                chip_render[k] = chip_render[k].min(r.render_seconds);
+            }
             *b = (r.cycles, b.1.min(s), b.2.min(r.chip_seconds));
         }
     }
@@ -204,10 +241,29 @@ pub fn command(a: BenchArgs) -> Result<()> {
         "tracing on, 1 thread           {:.2} M array cycles per host second at 64x32 ({traced:.3} s against {untraced_small:.3} s untraced, {traced_slowdown:.1}x; the chip instance alone {traced_chip:.4} s against {untraced_small_chip:.4} s, {traced_slowdown_chip:.1}x; VCD of tinyrisc, broadcast, rc_r0_c0)",
         on / 1e6
     );
+    let model = |n: usize| crate::schedule::speedup(serial, &items, n);
+    let chip_speedup = chip_render[0] / chip_render[1];
     println!(
-        "{cores} threads                      256x256 ({big_cycles} chip cycles, 32 chip instances): {all:.3} s against {big_one:.3} s, speed-up {speedup:.2}x"
+        "{cores} threads                      256x256 ({big_cycles} chip cycles, {} chip instances): {all:.3} s against {big_one:.3} s, speed-up {speedup:.2}x; the chip render alone {:.3} s against {:.3} s, {chip_speedup:.2}x (the schedule model: {:.2}x)",
+        items.len(),
+        chip_render[1],
+        chip_render[0],
+        model(cores)
+    );
+    let (shortest, longest) = items.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
+        (lo.min(t), hi.max(t))
+    });
+    println!(
+        "schedule model                 the 256x256 chip render on one thread: {} work items (chip instances) of {shortest:.4} to {longest:.4} s and {serial:.4} s serial; predicted speed-up {:.1}x on 16 cores, {:.1}x on 64",
+        items.len(),
+        model(16),
+        model(64)
     );
     if let Some(p) = &a.json {
+        let predicted: serde_json::Map<String, serde_json::Value> = [cores, 16, 64]
+            .into_iter()
+            .map(|n| (n.to_string(), json!(model(n))))
+            .collect();
         let v = json!({
             "scene": scene.source,
             "width": width,
@@ -230,6 +286,16 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "traced_slowdown_chip": traced_slowdown_chip,
             "host_seconds_traced": traced,
             "host_seconds_untraced_small": untraced_small,
+            "traversal": opt.traversal.name(),
+            "schedule": {
+                "model": "the chip render of the 256x256 frame: its serial part, then its work items (chip instances) in order, each taken by the first free thread",
+                "chip_render_seconds_1_thread": chip_render[0],
+                "chip_render_seconds_all_threads": chip_render[1],
+                "chip_render_speedup": chip_speedup,
+                "serial_seconds": serial,
+                "item_seconds": items,
+                "predicted_speedup": predicted,
+            },
         });
         crate::output::write(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
         crate::note!("wrote {}", p.display());

@@ -20,6 +20,7 @@ pub mod output;
 pub mod profile;
 pub mod reference;
 pub mod render;
+pub mod schedule;
 pub mod surfer;
 pub mod testbench;
 pub mod timing;

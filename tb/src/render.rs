@@ -57,6 +57,15 @@ pub struct ChipRender {
     /// waveform's creation, if any, to its end (the frame's setup, the
     /// firmware and the image's assembly, aside).
     pub chip_seconds: f64,
+    /// The host seconds of each chip instance's whole work (building and
+    /// loading the chip, running it, reading its pixels back), in tile
+    /// order: the work items the host's threads share (`bench`'s schedule
+    /// model).
+    pub instance_seconds: Vec<f64>,
+    /// Host seconds of the chip render: from assembling the firmware to
+    /// the assembled image (the firmware's generation and any probe
+    /// before it aside); the instances and its serial part.
+    pub render_seconds: f64,
 }
 
 /// Everything a render takes besides the scene and the tracer's options:
@@ -668,6 +677,7 @@ pub(crate) fn render_built(
 }
 
 fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
+    let t0 = std::time::Instant::now();
     let progress = host.progress;
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
@@ -692,10 +702,13 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         ProgressBar::hidden()
     };
     let first_trace = host.trace.clone();
-    let results: Vec<Result<Group>> = groups
+    // Each chip instance with the host seconds of all its work (building
+    // the chip and loading it, running it, reading its pixels back).
+    let results: Vec<(Result<Group>, f64)> = groups
         .par_iter()
         .enumerate()
         .map(|(gi, g)| {
+            let t0 = std::time::Instant::now();
             let t = if gi == 0 { first_trace.clone() } else { None };
             let p = host.profile;
             let r = match fw.datapath {
@@ -703,7 +716,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
                 Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p, &host.timing, progress),
             };
             bar.inc(g.len() as u64);
-            r
+            (r, t0.elapsed().as_secs_f64())
         })
         .collect();
     bar.finish_and_clear();
@@ -712,9 +725,11 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     let mut stats = Stats::default();
     let (mut fw_cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
     let mut chip_seconds = 0.0;
+    let mut instance_seconds = Vec::with_capacity(groups.len());
     let mut profile = None;
-    for (gi, r) in results.into_iter().enumerate() {
+    for (gi, (r, item_seconds)) in results.into_iter().enumerate() {
         let mut g = r?;
+        instance_seconds.push(item_seconds);
         if let Some(p) = g.profile.take() {
             profile = Some(match profile {
                 None => p,
@@ -769,5 +784,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         firmware: fw,
         profile,
         chip_seconds,
+        instance_seconds,
+        render_seconds: t0.elapsed().as_secs_f64(),
     })
 }

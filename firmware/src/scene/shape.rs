@@ -468,7 +468,20 @@ fn is_corner(a: Vec3, b: Vec3, c: Vec3, scale: f64) -> bool {
 /// of centre `c` and half-extent `h`: false only when an axis separates
 /// them (the box's axes are covered by the bounding-box test before).
 fn sat_planar(v: &[Vec3], c: Vec3, h: Vec3) -> bool {
-    let p: Vec<Vec3> = v.iter().map(|&x| x - c).collect();
+    // The vertices relative to the box's centre; on the stack for all but
+    // polygons of many vertices (the BSP build calls this for every object
+    // and cell it may meet).
+    let mut near = [Vec3::ZERO; 16];
+    let far: Vec<Vec3>;
+    let p: &[Vec3] = if v.len() <= near.len() {
+        for (d, &x) in near.iter_mut().zip(v) {
+            *d = x - c;
+        }
+        &near[..v.len()]
+    } else {
+        far = v.iter().map(|&x| x - c).collect();
+        &far
+    };
     let separates = |ax: Vec3| {
         let r = h.x * ax.x.abs() + h.y * ax.y.abs() + h.z * ax.z.abs();
         let (lo, hi) = p
