@@ -60,6 +60,19 @@ pub struct BenchArgs {
     /// chooses it).
     #[arg(long, value_name = "paper|packet", default_value = "paper", value_parser = crate::cli::parse_traversal)]
     pub traversal: firmware::tracer::Traversal,
+    /// Also run `morphosys sweep` of these scenes (comma-separated; its
+    /// knobs and its size sweep of the SPD families) on one thread and on
+    /// every core, and give the schedule model's prediction for it
+    /// (minutes).
+    #[arg(long, value_name = "SCENES", value_delimiter = ',')]
+    pub sweep: Vec<PathBuf>,
+    /// Image size of `--sweep`'s knob renders (the sweep's `--size`).
+    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size, default_value = "256x256")]
+    pub sweep_size: (u32, u32),
+    /// Largest SPD size of `--sweep`'s size sweep (the sweep's
+    /// `--max-size`).
+    #[arg(long, value_name = "N", default_value_t = 4, value_parser = crate::cli::parse_count::<u32>)]
+    pub sweep_max_size: u32,
     /// Step every cycle through the plain register-transfer model (one
     /// eval and commit per cycle) instead of the fast paths: slower, and
     /// the same cycles, states and waveform.
@@ -88,6 +101,10 @@ pub fn command(a: BenchArgs) -> Result<()> {
             .check()?;
     }
     let scene = load_scene(a.scene.as_deref())?;
+    // `--sweep`'s scenes, checked before minutes of work.
+    for s in &a.sweep {
+        load_scene(Some(s))?;
+    }
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     let (width, height) = a.size;
     // The paper's configuration (its traversal and BSP): the workload the
@@ -259,6 +276,11 @@ pub fn command(a: BenchArgs) -> Result<()> {
         model(16),
         model(64)
     );
+    let sweep = if a.sweep.is_empty() {
+        serde_json::Value::Null
+    } else {
+        sweep_model(&a, tmp.path(), [&one_thread, &every_core], cores)?
+    };
     if let Some(p) = &a.json {
         let predicted: serde_json::Map<String, serde_json::Value> = [cores, 16, 64]
             .into_iter()
@@ -296,9 +318,93 @@ pub fn command(a: BenchArgs) -> Result<()> {
                 "item_seconds": items,
                 "predicted_speedup": predicted,
             },
+            "sweep": sweep,
         });
         crate::output::write(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
         crate::note!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// `--sweep`: the sweep of `a.sweep` on one thread (its renders' work
+/// recorded) and on every core; prints and returns the measured speed-up
+/// and the schedule model's.
+fn sweep_model(
+    a: &BenchArgs,
+    tmp: &std::path::Path,
+    pools: [&rayon::ThreadPool; 2],
+    cores: usize,
+) -> Result<serde_json::Value> {
+    use std::sync::{Arc, Mutex};
+    let mut seconds = [0.0; 2];
+    let mut work = Vec::new();
+    for (k, pool) in pools.into_iter().enumerate() {
+        let recorded = Arc::new(Mutex::new(Vec::new()));
+        let args = crate::cmd_sweep::SweepArgs {
+            scenes: a.sweep.clone(),
+            out_dir: tmp.join(format!("sweep-{k}")),
+            size: a.sweep_size,
+            knobs: true,
+            families: crate::cmd_sweep::FAMILIES
+                .split(',')
+                .map(String::from)
+                .collect(),
+            max_size: a.sweep_max_size,
+            family_size: (64, 64),
+            size_seconds: 60.0,
+            timing: Vec::new(),
+            broadcast_only: false,
+            plan: None,
+            work: Some(recorded.clone()),
+        };
+        let t0 = Instant::now();
+        pool.install(|| crate::cmd_sweep::command(args))?;
+        seconds[k] = t0.elapsed().as_secs_f64();
+        if k == 0 {
+            work = std::mem::take(&mut *recorded.lock().map_err(|_| anyhow::anyhow!("poisoned"))?);
+        }
+    }
+    let rendered: f64 = work
+        .iter()
+        .map(|w| w.prep + w.items.iter().sum::<f64>())
+        .sum();
+    let serial = (seconds[0] - rendered).max(0.0);
+    let model = |n: usize| crate::schedule::sweep_speedup(serial, &work, n);
+    let measured = seconds[0] / seconds[1];
+    let names: Vec<String> = a.sweep.iter().map(|p| p.display().to_string()).collect();
+    println!(
+        "sweep                          {} at {}x{} and the SPD families at sizes 1..={} (64x64): {} renders, {:.1} s on 1 thread, {:.1} s on {cores}: speed-up {measured:.2}x (the schedule model: {:.2}x); predicted {:.1}x on 16 cores, {:.1}x on 64",
+        names.join(", "),
+        a.sweep_size.0,
+        a.sweep_size.1,
+        a.sweep_max_size,
+        work.len(),
+        seconds[0],
+        seconds[1],
+        model(cores),
+        model(16),
+        model(64)
+    );
+    let predicted: serde_json::Map<String, serde_json::Value> = [cores, 16, 64]
+        .into_iter()
+        .map(|n| (n.to_string(), json!(model(n))))
+        .collect();
+    Ok(json!({
+        "scenes": names,
+        "size": format!("{}x{}", a.sweep_size.0, a.sweep_size.1),
+        "max_size": a.sweep_max_size,
+        "renders": work.len(),
+        "host_seconds_1_thread": seconds[0],
+        "host_seconds_all_threads": seconds[1],
+        "speedup": measured,
+        "model": "each render's preparation, then its chip instances, a size-sweep family's renders one after the other; each free thread takes the item ready longest",
+        "serial_seconds": serial,
+        "renders_work": work.iter().map(|w| json!({
+            "task": w.task,
+            "step": w.step,
+            "prep_seconds": w.prep,
+            "item_seconds": w.items,
+        })).collect::<Vec<_>>(),
+        "predicted_speedup": predicted,
+    }))
 }

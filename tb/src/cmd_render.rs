@@ -263,6 +263,10 @@ pub(crate) fn render_and_measure(
         "rays_traced": chip.stats.watched_rcs[1],
         "ray_object_tests": chip.stats.watched_rcs[0],
         "host_seconds": host,
+        // The chip instances' host seconds summed over the threads: about
+        // the chip render's time on one thread, whatever else runs beside
+        // it (the sweep's --size-seconds).
+        "host_chip_seconds": chip.instance_seconds.iter().sum::<f64>(),
         "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
         "startup_cycles": chip.startup_cycles,
         "tiles": chip.tiles,

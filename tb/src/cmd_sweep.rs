@@ -70,7 +70,7 @@ pub struct SweepCli {
         long,
         value_name = "NAMES",
         value_delimiter = ',',
-        default_value = "balls,tetra,rings,gears,lattice",
+        default_value = FAMILIES,
         value_parser = clap::builder::PossibleValuesParser::new(firmware::scene::spd::names())
     )]
     pub families: Vec<String>,
@@ -82,7 +82,9 @@ pub struct SweepCli {
     #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size, default_value = "64x64")]
     pub family_size: (u32, u32),
     /// Skip a family's larger sizes (with a traversal) once one of its
-    /// renders took longer than this many host seconds.
+    /// renders' chip instances took longer than this many host seconds
+    /// (summed over the threads: about one thread's time, whatever runs
+    /// beside it).
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = crate::cli::parse_seconds)]
     pub size_seconds: f64,
     /// Timing files: the paper's configuration and the packet
@@ -115,6 +117,7 @@ pub fn run(a: SweepCli) -> Result<()> {
         family_size: a.family_size,
         size_seconds: a.size_seconds,
         timing: a.timing,
+        work: None,
     })
 }
 
@@ -129,8 +132,8 @@ pub struct SweepArgs {
     pub families: Vec<String>,
     pub max_size: u32,
     pub family_size: (u32, u32),
-    /// A family's larger sizes are skipped once a render took longer than
-    /// this (host seconds).
+    /// A family's larger sizes are skipped once a render's chip instances
+    /// took longer than this (host seconds, summed over the threads).
     pub size_seconds: f64,
     /// Timing files: both traversals on each scene under each.
     pub timing: Vec<PathBuf>,
@@ -141,7 +144,13 @@ pub struct SweepArgs {
     /// `morphosys render` per distinct render, and `sweep.toml`), for
     /// GNU parallel or a Slurm job array, then `sweep --merge`.
     pub plan: Option<PathBuf>,
+    /// Where each render's work is recorded, when asked (`bench --sweep`'s
+    /// schedule model).
+    pub work: Option<std::sync::Arc<std::sync::Mutex<Vec<crate::schedule::RenderWork>>>>,
 }
+
+/// The SPD generators of the size sweep unless asked otherwise.
+pub const FAMILIES: &str = "balls,tetra,rings,gears,lattice";
 
 /// Knob name of the rows of the scene-size sweep.
 const SCENE_SIZE: &str = "scene_size";
@@ -769,15 +778,14 @@ pub fn command(a: SweepArgs) -> Result<()> {
             .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
             .progress_chars("=> "),
     );
-    // The measured renders by job; a job that failed is None.
+    // The measured renders by job; a job that failed or was skipped is
+    // None.
     let mut done: BTreeMap<usize, Option<serde_json::Value>> = BTreeMap::new();
-    // The size sweep: a family's next size is skipped once a render of it
-    // took more than --size-seconds of host time (sizes grow about 8x in
-    // objects).
-    let mut slow: BTreeMap<(String, &str), f64> = BTreeMap::new();
     // One point's render: taken from an earlier run's JSON when its
     // arguments and inputs are the same, else rendered and its JSON kept.
-    let measure = |p: &Point| -> Result<serde_json::Value> {
+    // `task` and `step` place it in the sweep's schedule (`a.work`).
+    let measure = |p: &Point, task: usize, step: usize| -> Result<serde_json::Value> {
+        let t0 = std::time::Instant::now();
         let (sc, scene) = &scenes[p.scene];
         let c = &p.cfg;
         let name = &jobs[p.job].name;
@@ -799,107 +807,124 @@ pub fn command(a: SweepArgs) -> Result<()> {
             count(&resumed);
             return Ok(j);
         }
-        crate::cmd_render::render(scene, &c.opt, &host).and_then(|(_, mut rep)| {
+        crate::cmd_render::render(scene, &c.opt, &host).and_then(|(chip, mut rep)| {
             rep.json["argv"] = argv.clone().into();
             rep.json["inputs"] = inputs.clone();
             crate::output::write(
                 &json_path,
                 (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
             )?;
+            if let Some(w) = &a.work {
+                let items = chip.instance_seconds;
+                let all = t0.elapsed().as_secs_f64();
+                let prep = (all - items.iter().sum::<f64>()).max(0.0);
+                if let Ok(mut w) = w.lock() {
+                    w.push(crate::schedule::RenderWork {
+                        task,
+                        step,
+                        prep,
+                        items,
+                    });
+                }
+            }
             Ok(rep.json)
         })
     };
-    // The knob sweep's renders do not depend on each other: they run
-    // concurrently on the thread pool (each render's chip instances share
-    // it), and the table takes them in its own order, so it is the one a
-    // render after another gives. The size sweep runs in order below: a
-    // family's next size depends on how long the last one took.
+    let mut per_job = vec![0u64; jobs.len()];
+    for p in &pts {
+        per_job[p.job] += 1;
+    }
+    // What runs: each render of the knob sweep on its own, and each chain
+    // of the size sweep (a family with one traversal, its sizes in order)
+    // as one task that renders one size after the other and stops once a
+    // render's chip instances took longer than --size-seconds (summed over
+    // the threads, so about one thread's time, whatever runs beside it).
+    // The tasks run concurrently on the thread pool, the chains first
+    // (each render's chip instances share the pool), and the table takes
+    // the renders in its own order: it is the one a render after another
+    // gives.
+    let mut chains: Vec<((String, &str), Vec<usize>)> = Vec::new();
+    let mut knob_jobs: Vec<usize> = Vec::new();
+    for (k, job) in jobs.iter().enumerate() {
+        let p = &pts[job.point];
+        let sc = &scenes[p.scene].0;
+        match sc.family.as_ref().filter(|_| p.cfg.knob == SCENE_SIZE) {
+            Some(fam) => {
+                let key = (fam.clone(), p.cfg.opt.traversal.name());
+                match chains.iter_mut().find(|c| c.0 == key) {
+                    Some(c) => c.1.push(k),
+                    None => chains.push((key, vec![k])),
+                }
+            }
+            None => knob_jobs.push(k),
+        }
+    }
+    let tasks: Vec<Vec<usize>> = chains
+        .into_iter()
+        .map(|c| c.1)
+        .chain(knob_jobs.into_iter().map(|k| vec![k]))
+        .collect();
     {
         use rayon::prelude::*;
-        let mut per_job = vec![0u64; jobs.len()];
-        for p in &pts {
-            per_job[p.job] += 1;
-        }
-        let knob_jobs: Vec<usize> = (0..jobs.len())
-            .filter(|&k| pts[jobs[k].point].cfg.knob != SCENE_SIZE)
-            .collect();
-        let measured: Vec<(usize, Option<serde_json::Value>)> = knob_jobs
+        let measured: Vec<Vec<(usize, Option<serde_json::Value>)>> = tasks
             .par_iter()
-            .map(|&k| {
-                let p = &pts[jobs[k].point];
-                let r = match measure(p) {
-                    Ok(j) => Some(j),
-                    Err(e) => {
-                        let sc = &scenes[p.scene].0;
+            .enumerate()
+            .map(|(task, chain)| {
+                let mut out = Vec::new();
+                // A size that took longer than --size-seconds: (size, seconds).
+                let mut slow: Option<(u32, f64)> = None;
+                for (step, &k) in chain.iter().enumerate() {
+                    let p = &pts[jobs[k].point];
+                    let sc = &scenes[p.scene].0;
+                    let c = &p.cfg;
+                    if let Some((size, t)) = slow {
                         bar.suspend(|| {
                             eprintln!(
-                                "skipped {} with {}={}: {e:#}",
-                                sc.name, p.cfg.knob, p.cfg.value
-                            )
-                        });
-                        count(&skipped);
-                        None
-                    }
-                };
-                bar.inc(per_job[k]);
-                (k, r)
-            })
-            .collect();
-        done.extend(measured);
-    }
-    for p in &pts {
-        let sc = &scenes[p.scene].0;
-        let c = &p.cfg;
-        if c.knob == SCENE_SIZE {
-            bar.inc(1);
-        }
-        let j = match done.get(&p.job) {
-            Some(Some(j)) => j.clone(),
-            Some(None) => continue,
-            None => {
-                let traversal = c.opt.traversal.name();
-                if let Some(fam) = sc.family.as_ref().filter(|_| c.knob == SCENE_SIZE) {
-                    if let Some(t) = slow.get(&(fam.clone(), traversal)) {
-                        bar.suspend(|| {
-                            eprintln!(
-                                "skipped {} with the {traversal} traversal: size {} took {t:.0} s (--size-seconds {})",
+                                "skipped {} with the {} traversal: size {size} took {t:.0} s (--size-seconds {})",
                                 sc.name,
-                                sc.size.unwrap_or(1) - 1,
+                                c.opt.traversal.name(),
                                 a.size_seconds
                             )
                         });
                         count(&skipped);
-                        done.insert(p.job, None);
+                        bar.inc(per_job[k]);
+                        out.push((k, None));
                         continue;
                     }
-                }
-                bar.set_message(format!("{} {}={}", sc.name, c.knob, c.value));
-                let measured = measure(p);
-                match measured {
-                    Ok(json) => {
-                        let t = json["host_seconds"].as_f64().unwrap_or(0.0);
-                        if let Some(fam) = &sc.family {
-                            if t > a.size_seconds {
-                                slow.insert((fam.clone(), traversal), t);
-                            }
+                    let r = match measure(p, task, step) {
+                        Ok(j) => Some(j),
+                        Err(e) => {
+                            // A configuration the chip cannot run (for
+                            // example a BSP too large for the FB) is
+                            // reported and skipped.
+                            bar.suspend(|| {
+                                eprintln!("skipped {} with {}={}: {e:#}", sc.name, c.knob, c.value)
+                            });
+                            count(&skipped);
+                            None
                         }
-                        done.insert(p.job, Some(json.clone()));
-                        json
+                    };
+                    if let (Some(j), Some(_)) = (&r, &sc.family) {
+                        let t = j["host_chip_seconds"]
+                            .as_f64()
+                            .or_else(|| j["host_seconds"].as_f64())
+                            .unwrap_or(0.0);
+                        if c.knob == SCENE_SIZE && t > a.size_seconds {
+                            slow = Some((sc.size.unwrap_or(0), t));
+                        }
                     }
-                    Err(e) => {
-                        // A configuration the chip cannot run (for example a
-                        // BSP too large for the FB) is reported and skipped.
-                        bar.suspend(|| {
-                            eprintln!("skipped {} with {}={}: {e:#}", sc.name, c.knob, c.value)
-                        });
-                        count(&skipped);
-                        done.insert(p.job, None);
-                        continue;
-                    }
+                    bar.inc(per_job[k]);
+                    out.push((k, r));
                 }
-            }
-        };
-        rows.push(point_row(&refs, p, &j));
+                out
+            })
+            .collect();
+        done.extend(measured.into_iter().flatten());
+    }
+    for p in &pts {
+        if let Some(Some(j)) = done.get(&p.job) {
+            rows.push(point_row(&refs, p, j));
+        }
     }
     bar.finish_and_clear();
     let (resumed, skipped) = (resumed.into_inner(), skipped.into_inner());

@@ -404,6 +404,90 @@ fn bench_does_not_announce_its_temporary_waveforms() {
     );
 }
 
+/// `bench`'s schedule model: the frame's work items, and with `--sweep`
+/// one record per render the sweep makes (counted against the sweep's own
+/// points), its predictions between 1 and the thread count.
+#[test]
+fn bench_predicts_a_frame_and_a_sweep_from_their_work_items() {
+    let dir = tempfile::tempdir().unwrap();
+    let tetra = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../scenes/spd/tetra-1.nff")
+        .display()
+        .to_string();
+    let small = ["--sweep-size", "16x16", "--sweep-max-size", "1"];
+    let mut args = vec![
+        "bench", "--size", "16x16", "--repeat", "1", "--json", "b.json", "-q",
+    ];
+    args.extend(["--sweep", &tetra]);
+    args.extend(small);
+    let (ok, out, err) = morphosys(dir.path(), &args);
+    assert!(ok, "{out}{err}");
+    assert!(
+        out.contains("schedule model") && out.contains("sweep "),
+        "{out}"
+    );
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("b.json")).unwrap()).unwrap();
+    let s = &j["schedule"];
+    assert_eq!(s["item_seconds"].as_array().unwrap().len(), 32, "{s}");
+    let sw = &j["sweep"];
+    for (sched, most) in [(s, 64.0), (sw, 64.0)] {
+        for n in ["16", "64"] {
+            let p = sched["predicted_speedup"][n].as_f64().unwrap();
+            assert!((1.0..=most).contains(&p), "{n}: {p}");
+        }
+    }
+    // The same sweep run by `sweep` writes one JSON per render.
+    let (ok, out, err) = morphosys(
+        dir.path(),
+        &[
+            "sweep",
+            &tetra,
+            "--out-dir",
+            "sw",
+            "-q",
+            "--size",
+            "16x16",
+            "--max-size",
+            "1",
+        ],
+    );
+    assert!(ok, "{out}{err}");
+    let renders = std::fs::read_dir(dir.path().join("sw/points"))
+        .unwrap()
+        .filter(|e| {
+            e.as_ref()
+                .unwrap()
+                .path()
+                .extension()
+                .is_some_and(|x| x == "json")
+        })
+        .count();
+    assert_eq!(sw["renders"], renders, "{sw}");
+    // Its work and serial part add up to its time on one thread.
+    let work: f64 = sw["renders_work"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|w| {
+            w["prep_seconds"].as_f64().unwrap()
+                + w["item_seconds"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .map(|t| t.as_f64().unwrap())
+                    .sum::<f64>()
+        })
+        .sum();
+    let one = sw["host_seconds_1_thread"].as_f64().unwrap();
+    assert!(
+        (work + sw["serial_seconds"].as_f64().unwrap() - one).abs() < 1e-6 * one.max(1.0) + 1e-9
+    );
+    // A bad scene stops it before any work.
+    let (ok, _, err) = morphosys(dir.path(), &["bench", "--sweep", "nothere.nff"]);
+    assert!(!ok && err.contains("nothere.nff"), "{err}");
+}
+
 /// `render --hits` and `reference --hits` make the hit maps `compare --hits`
 /// reads, and `render` and `reference` share their default depth, so their
 /// default images compare as they are.

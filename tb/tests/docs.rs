@@ -77,6 +77,14 @@ const SPECIAL: &[(&str, &str, Special)] = &[
         ),
     ),
     (
+        "docs/performance.md",
+        "morphosys bench --repeat 1 --sweep scenes/default.toml,scenes/spd/jacks-1.nff,scenes/spd/tetra-1.nff",
+        Special::RunAs(
+            "morphosys bench --repeat 1 --size 16x16 --sweep scenes/default.toml,scenes/spd/jacks-1.nff,scenes/spd/tetra-1.nff --sweep-size 16x16 --sweep-max-size 1",
+            "the measured sweep takes minutes; the same sweep at 16x16 and size 1",
+        ),
+    ),
+    (
         "README.md",
         "cargo run --release --bin morphosys -- render",
         Special::RunAs(

@@ -692,6 +692,7 @@ fn render_plain_equals_the_fast_paths() {
             assert_eq!(j["stepping"], mode);
             for k in [
                 "host_seconds",
+                "host_chip_seconds",
                 "array_cycles_per_host_second",
                 "argv",
                 "stepping",
