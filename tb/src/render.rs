@@ -541,16 +541,24 @@ pub(crate) fn choose_firmware_probed(
     let mut tried: Vec<(ProbeRender, f64, Firmware)> = Vec::new();
     let mut reference: Option<(Vec<u8>, Vec<u32>)> = None;
     let mut first_err = None;
-    for bsp in cands {
-        let o = Options { bsp, ..*opt };
-        let fw = match tracer::build_with(scene, &o, nm) {
-            Ok(fw) => fw,
+    // The candidates built and probed side by side (each probe's chip
+    // instances and each tree's build share the thread pool), taken in
+    // their order.
+    let built: Vec<std::result::Result<Result<(Firmware, ProbeRender)>, String>> = cands
+        .par_iter()
+        .map(|&bsp| {
+            let o = Options { bsp, ..*opt };
+            tracer::build_with(scene, &o, nm).map(|fw| probe(&fw, opt, timing).map(|p| (fw, p)))
+        })
+        .collect();
+    for b in built {
+        let (fw, mut p) = match b {
+            Ok(probed) => probed?,
             Err(e) => {
                 first_err.get_or_insert(e);
                 continue;
             }
         };
-        let mut p = probe(&fw, opt, timing)?;
         let (r8, rh) = reference.get_or_insert_with(|| {
             crate::reference::render_pixels(scene, opt.width, opt.height, opt.depth, &p.pixels)
         });
