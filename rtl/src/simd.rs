@@ -161,9 +161,10 @@ pub fn set(simd: Simd) -> Result<(), String> {
 /// named function itself, which calls the version [`level`] gives.
 ///
 /// ```text
-/// simd::versions! {
+/// crate::simd::versions! {
 ///     /// Doc.
-///     pub fn step(&mut self) -> R; versions step_portable step_avx2 step_avx512;
+///     pub fn step(&mut self) -> Result<(), Fault>;
+///     versions step_portable step_avx2 step_avx512;
 ///     { self.exec::<true>() }
 /// }
 /// ```

@@ -10,15 +10,15 @@ use super::*;
 
 impl<W: Word> Chip<W> {
     crate::simd::versions! {
-    /// The fast path of a stall: while TinyRISC retries an instruction
-    /// that waits for the array or the DMA (`rcany`, `wfb`, `dwait`, a full
-    /// broadcast queue...), only the broadcast unit, the array and the DMA
-    /// change, so their cycles are run without evaluating TinyRISC. Exactly
-    /// the cycles [`Clocked::eval`] + [`Clocked::commit`] would give (the
-    /// stall counters included); stops when the wait is over, the
-    /// instruction word changed (a DMA store into the program), or after
-    /// `limit` cycles. Returns the cycles run.
-    pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>);
+        /// The fast path of a stall: while TinyRISC retries an instruction
+        /// that waits for the array or the DMA (`rcany`, `wfb`, `dwait`, a full
+        /// broadcast queue...), only the broadcast unit, the array and the DMA
+        /// change, so their cycles are run without evaluating TinyRISC. Exactly
+        /// the cycles [`Clocked::eval`] + [`Clocked::commit`] would give (the
+        /// stall counters included); stops when the wait is over, the
+        /// instruction word changed (a DMA store into the program), or after
+        /// `limit` cycles. Returns the cycles run.
+        pub fn run_stalled(&mut self, limit: u64) -> (u64, Result<(), Fault>);
         versions run_stalled_portable run_stalled_avx2 run_stalled_avx512;
         { self.run_stalled_sampled(limit, |_, _| true) }
     }
@@ -58,20 +58,20 @@ impl<W: Word> Chip<W> {
     }
 
     crate::simd::versions! {
-    /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
-    /// fault, or `limit`; three kinds, each with less to do than a plain
-    /// cycle:
-    ///
-    /// * TinyRISC waits for the array while a run streams: the broadcast
-    ///   unit and the array cycle alone, the stall counted at the end (a
-    ///   stalled evaluation changes nothing, and nothing can change the
-    ///   waiting instruction's word);
-    /// * the array is idle and nothing is queued: TinyRISC alone, and its
-    ///   multi-cycle instructions' busy cycles pass at once;
-    /// * both work: TinyRISC, then the broadcast unit and the array (its
-    ///   evaluation and clock edge in one call), in the order of
-    ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
-    fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>);
+        /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
+        /// fault, or `limit`; three kinds, each with less to do than a plain
+        /// cycle:
+        ///
+        /// * TinyRISC waits for the array while a run streams: the broadcast
+        ///   unit and the array cycle alone, the stall counted at the end (a
+        ///   stalled evaluation changes nothing, and nothing can change the
+        ///   waiting instruction's word);
+        /// * the array is idle and nothing is queued: TinyRISC alone, and its
+        ///   multi-cycle instructions' busy cycles pass at once;
+        /// * both work: TinyRISC, then the broadcast unit and the array (its
+        ///   evaluation and clock edge in one call), in the order of
+        ///   [`Clocked::eval`] and [`Clocked::commit`], without the DMA.
+        fn run_local(&mut self, limit: u64) -> (u64, Result<(), Fault>);
         versions run_local_portable run_local_avx2 run_local_avx512;
         { self.local_cycles::<false, _>(limit, &mut |_: &Self, _| true) }
     }

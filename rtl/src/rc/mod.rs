@@ -395,11 +395,11 @@ const P_ST: Pending = Pending {
 
 impl<const N: usize, W: Word> RcArray<N, W> {
     crate::simd::versions! {
-    /// [`Clocked::eval`] and [`Clocked::commit`] in one call (nothing
-    /// samples between the two): each operation's clock edge is written
-    /// in its own arm, knowing what it writes (no branch on the pending
-    /// updates).
-    pub fn step(&mut self) -> Result<(), Fault>;
+        /// [`Clocked::eval`] and [`Clocked::commit`] in one call (nothing
+        /// samples between the two): each operation's clock edge is written
+        /// in its own arm, knowing what it writes (no branch on the pending
+        /// updates).
+        pub fn step(&mut self) -> Result<(), Fault>;
         versions step_portable step_avx2 step_avx512;
         { self.exec::<true>() }
     }

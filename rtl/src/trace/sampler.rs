@@ -398,39 +398,39 @@ impl Tracer {
     }
 
     crate::simd::versions! {
-    /// Write the values of the cycle's walk that changed (all traced
-    /// ones the first time): per chunk of 64 calls, the mask of those that
-    /// changed and their values queued as one message ([`MSG_CHUNK`]).
-    pub(super) fn write_changes(&mut self) -> ();
+        /// Write the values of the cycle's walk that changed (all traced
+        /// ones the first time): per chunk of 64 calls, the mask of those that
+        /// changed and their values queued as one message ([`MSG_CHUNK`]).
+        pub(super) fn write_changes(&mut self) -> ();
         versions write_changes_portable write_changes_avx2 write_changes_avx512;
-    {
-        let first = std::mem::take(&mut self.first_sample);
-        let padded = self.n_slots.next_multiple_of(64);
-        let hot = self.hot.get_mut(self.hot_at..).unwrap_or_default();
-        let (cur, rest) = hot.split_at_mut(padded.min(hot.len()));
-        let (masks, lasts) = rest.split_at_mut(padded.min(rest.len()));
-        let (cur, _) = cur.as_chunks::<64>();
-        let (masks, _) = masks.as_chunks::<64>();
-        let (lasts, _) = lasts.as_chunks_mut::<64>();
-        let (costs, _) = self.costs.as_chunks::<64>();
-        // Indexed, not zipped: the zip's length (the least of four) took
-        // a chain of vector instructions in front of every sample.
-        let mut left = self.n_slots;
-        let mut j = 0;
-        while left > 0 {
-            // The groups of 8 calls that hold declared ones (the padding
-            // after the last holds none).
-            let groups = left.min(64).div_ceil(8);
-            left = left.saturating_sub(64);
-            let chunk = Chunk {
-                c: &cur[j],
-                m: &masks[j],
-                l: &mut lasts[j],
-                cost: &costs[j],
-            };
-            self.bytes += chunk.changes(&mut self.batch, j as u64, first, groups);
-            j += 1;
-        }
+        {
+            let first = std::mem::take(&mut self.first_sample);
+            let padded = self.n_slots.next_multiple_of(64);
+            let hot = self.hot.get_mut(self.hot_at..).unwrap_or_default();
+            let (cur, rest) = hot.split_at_mut(padded.min(hot.len()));
+            let (masks, lasts) = rest.split_at_mut(padded.min(rest.len()));
+            let (cur, _) = cur.as_chunks::<64>();
+            let (masks, _) = masks.as_chunks::<64>();
+            let (lasts, _) = lasts.as_chunks_mut::<64>();
+            let (costs, _) = self.costs.as_chunks::<64>();
+            // Indexed, not zipped: the zip's length (the least of four) took
+            // a chain of vector instructions in front of every sample.
+            let mut left = self.n_slots;
+            let mut j = 0;
+            while left > 0 {
+                // The groups of 8 calls that hold declared ones (the padding
+                // after the last holds none).
+                let groups = left.min(64).div_ceil(8);
+                left = left.saturating_sub(64);
+                let chunk = Chunk {
+                    c: &cur[j],
+                    m: &masks[j],
+                    l: &mut lasts[j],
+                    cost: &costs[j],
+                };
+                self.bytes += chunk.changes(&mut self.batch, j as u64, first, groups);
+                j += 1;
+            }
     }
     }
 }

@@ -450,59 +450,59 @@ pub(super) fn changes<'a>(
 }
 
 crate::simd::versions! {
-/// The writing thread's loop over a batch for a VCD (the general loop of
-/// [`Sink::threaded`] matches the sink and the handle at every message):
-/// `ids` per signal call its code, width, whether it has a translate
-/// filter and its signal's index (untraced: [`NOT_TRACED`]); `edges` the
-/// clock, the falling edge still to write, and the codes of `clk` and
-/// `cycle`.
-pub(super) fn vcd_batch(
-    out: &mut BufWriter<File>,
-    body: &mut VcdBody,
-    batch: &[u64],
-    ids: &[(u32, u32, bool, u32)],
-    seen: &mut Seen,
-    edges: (&mut Clock, &mut Option<u64>, u32, u32),
-) -> io::Result<()>;
+    /// The writing thread's loop over a batch for a VCD (the general loop of
+    /// [`Sink::threaded`] matches the sink and the handle at every message):
+    /// `ids` per signal call its code, width, whether it has a translate
+    /// filter and its signal's index (untraced: [`NOT_TRACED`]); `edges` the
+    /// clock, the falling edge still to write, and the codes of `clk` and
+    /// `cycle`.
+    pub(super) fn vcd_batch(
+        out: &mut BufWriter<File>,
+        body: &mut VcdBody,
+        batch: &[u64],
+        ids: &[(u32, u32, bool, u32)],
+        seen: &mut Seen,
+        edges: (&mut Clock, &mut Option<u64>, u32, u32),
+    ) -> io::Result<()>;
     versions vcd_batch_portable vcd_batch_avx2 vcd_batch_avx512;
-{
-    let (clock, fall, clk, cycle) = edges;
-    let mut k = 0;
-    while k < batch.len() {
-        let m = batch[k];
-        k += 1;
-        let (tag, mut v) = (m >> 48, m & MSG_VALUE);
-        if tag == MSG_CHUNK {
-            let Some(&bits) = batch.get(k) else {
-                return Err(io::Error::other("a change message cut short"));
-            };
+    {
+        let (clock, fall, clk, cycle) = edges;
+        let mut k = 0;
+        while k < batch.len() {
+            let m = batch[k];
             k += 1;
-            for (s, v) in changes(v, bits, batch, &mut k) {
-                let Some(&(id, w, filtered, i)) = ids.get(s).filter(|d| d.3 != NOT_TRACED) else {
-                    return Err(io::Error::other("a change of a signal not declared"));
+            let (tag, mut v) = (m >> 48, m & MSG_VALUE);
+            if tag == MSG_CHUNK {
+                let Some(&bits) = batch.get(k) else {
+                    return Err(io::Error::other("a change message cut short"));
                 };
-                if filtered {
-                    seen.add(i as usize, v);
+                k += 1;
+                for (s, v) in changes(v, bits, batch, &mut k) {
+                    let Some(&(id, w, filtered, i)) = ids.get(s).filter(|d| d.3 != NOT_TRACED) else {
+                        return Err(io::Error::other("a change of a signal not declared"));
+                    };
+                    if filtered {
+                        seen.add(i as usize, v);
+                    }
+                    body.change(id, w, v);
+                    body.flush(out, false)?;
                 }
-                body.change(id, w, v);
-                body.flush(out, false)?;
+                continue;
             }
-            continue;
+            if tag == MSG_LONG {
+                v = batch.get(k).copied().unwrap_or(0);
+                k += 1;
+            }
+            let (rise, f) = clock.edges(v);
+            if let Some(t) = fall.replace(f) {
+                body.timestamp(t);
+                body.change(clk, 1, 0);
+            }
+            body.timestamp(rise);
+            body.change(clk, 1, 1);
+            body.change(cycle, 64, v);
+            body.flush(out, false)?;
         }
-        if tag == MSG_LONG {
-            v = batch.get(k).copied().unwrap_or(0);
-            k += 1;
-        }
-        let (rise, f) = clock.edges(v);
-        if let Some(t) = fall.replace(f) {
-            body.timestamp(t);
-            body.change(clk, 1, 0);
-        }
-        body.timestamp(rise);
-        body.change(clk, 1, 1);
-        body.change(cycle, 64, v);
-        body.flush(out, false)?;
-    }
-    Ok(())
+        Ok(())
 }
 }
