@@ -12,6 +12,10 @@ use clap::{CommandFactory, Parser, Subcommand};
     name = "morphosys",
     version,
     about = "Cycle-level model of the MorphoSys reconfigurable SIMD processor and its BSP ray tracer",
+    after_help = "Environment: RAYON_NUM_THREADS=N sets the host threads (default: every core; \
+the outputs are the same on any number); MORPHOSYS_SIMD=portable|avx2|avx512 forces the \
+instruction set of the simulator's per-cycle path (default: the widest the CPU has; the \
+same bits on every path).",
     propagate_version = true
 )]
 struct Cli {
@@ -35,7 +39,8 @@ enum Command {
     /// of the current build; run from the repository's root.
     Report(tb::cmd_report::ReportArgs),
     /// Measure the simulator: array cycles per host second with tracing off
-    /// and on, and the speed-up on every core.
+    /// and on, the speed-up on every core, and what 16 and 64 cores would
+    /// give (the schedule model).
     Bench(tb::cmd_bench::BenchArgs),
     /// Render scenes under many configurations (ways, recursion, BSP depth,
     /// leaf size, split rule) and chart frame rate against image quality.
