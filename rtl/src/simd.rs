@@ -193,21 +193,8 @@ macro_rules! versions {
                 _ => $self.$portable($($arg),*),
             }
         }
-
-        #[inline(never)]
-        fn $portable(&mut $self $(, $arg: $ty)*) -> $ret $body
-
-        #[cfg(target_arch = "x86_64")]
-        #[inline(never)]
-        #[target_feature(enable = "avx2,bmi1,bmi2,fma,lzcnt,movbe,popcnt")]
-        fn $avx2(&mut $self $(, $arg: $ty)*) -> $ret $body
-
-        #[cfg(target_arch = "x86_64")]
-        #[inline(never)]
-        #[target_feature(
-            enable = "avx2,bmi1,bmi2,fma,lzcnt,movbe,popcnt,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
-        )]
-        fn $avx512(&mut $self $(, $arg: $ty)*) -> $ret $body
+        $crate::simd::versions!(@bodies [&mut $self $(, $arg: $ty)*] -> $ret;
+            $portable $avx2 $avx512; $body);
     };
     // A free function.
     (
@@ -228,21 +215,25 @@ macro_rules! versions {
                 _ => $portable($($arg),*),
             }
         }
-
+        $crate::simd::versions!(@bodies [$($arg: $ty),*] -> $ret;
+            $portable $avx2 $avx512; $body);
+    };
+    // The three versions of one body, each out of line.
+    (@bodies [$($params:tt)*] -> $ret:ty; $portable:ident $avx2:ident $avx512:ident; $body:block) => {
         #[inline(never)]
-        fn $portable($($arg: $ty),*) -> $ret $body
+        fn $portable($($params)*) -> $ret $body
 
         #[cfg(target_arch = "x86_64")]
         #[inline(never)]
         #[target_feature(enable = "avx2,bmi1,bmi2,fma,lzcnt,movbe,popcnt")]
-        fn $avx2($($arg: $ty),*) -> $ret $body
+        fn $avx2($($params)*) -> $ret $body
 
         #[cfg(target_arch = "x86_64")]
         #[inline(never)]
         #[target_feature(
             enable = "avx2,bmi1,bmi2,fma,lzcnt,movbe,popcnt,avx512f,avx512bw,avx512cd,avx512dq,avx512vl"
         )]
-        fn $avx512($($arg: $ty),*) -> $ret $body
+        fn $avx512($($params)*) -> $ret $body
     };
 }
 pub(crate) use versions;

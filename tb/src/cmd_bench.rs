@@ -176,7 +176,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
     let mut serial = 0.0;
     let mut chip_render = [f64::INFINITY; 2];
     for k in 0..repeat {
-        for (&(opt, threads, trace), b) in runs.iter().zip(&mut best) {
+        for (run, (&(opt, threads, trace), b)) in runs.iter().zip(&mut best).enumerate() {
             let cfg = trace.then(|| {
                 let mut c = rtl::trace::TraceConfig::new(tmp.path().join(format!("bench{k}.vcd")));
                 c.scope = "tinyrisc,broadcast,array.rc_r0_c0".into();
@@ -200,9 +200,11 @@ pub fn command(a: BenchArgs) -> Result<()> {
                 )
             })?;
             let s = t0.elapsed().as_secs_f64();
-            if opt.width == 256 {
-                let k = (threads > 1) as usize;
-                if threads == 1 && r.render_seconds < chip_render[0] {
+            // Runs 3 and 4: the 256x256 frame on one thread and on every
+            // core.
+            if run >= 3 {
+                let k = run - 3;
+                if k == 0 && r.render_seconds < chip_render[0] {
                     serial = (r.render_seconds - r.instance_seconds.iter().sum::<f64>()).max(0.0);
                     items = r.instance_seconds.clone();
                 }
@@ -282,10 +284,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
         sweep_model(&a, tmp.path(), [&one_thread, &every_core], cores)?
     };
     if let Some(p) = &a.json {
-        let predicted: serde_json::Map<String, serde_json::Value> = [cores, 16, 64]
-            .into_iter()
-            .map(|n| (n.to_string(), json!(model(n))))
-            .collect();
+        let predicted = predictions(cores, model);
         let v = json!({
             "scene": scene.source,
             "width": width,
@@ -385,10 +384,7 @@ fn sweep_model(
         model(16),
         model(64)
     );
-    let predicted: serde_json::Map<String, serde_json::Value> = [cores, 16, 64]
-        .into_iter()
-        .map(|n| (n.to_string(), json!(model(n))))
-        .collect();
+    let predicted = predictions(cores, model);
     Ok(json!({
         "scenes": names,
         "size": format!("{}x{}", a.sweep_size.0, a.sweep_size.1),
@@ -407,4 +403,16 @@ fn sweep_model(
         })).collect::<Vec<_>>(),
         "predicted_speedup": predicted,
     }))
+}
+
+/// A model's predicted speed-ups on this machine's threads, 16 and 64, by
+/// thread count (the JSON's `predicted_speedup`).
+fn predictions(
+    cores: usize,
+    model: impl Fn(usize) -> f64,
+) -> serde_json::Map<String, serde_json::Value> {
+    [cores, 16, 64]
+        .into_iter()
+        .map(|n| (n.to_string(), json!(model(n))))
+        .collect()
 }
