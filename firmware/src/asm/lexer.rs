@@ -28,8 +28,10 @@ const PUNCT: &[&str] = &[
 /// Split a line into tokens; comments (`;` or `//` to the end of the line)
 /// are dropped.
 pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Token>, AsmError> {
-    let chars: Vec<char> = line.chars().collect();
-    let mut out = Vec::new();
+    // (One allocation: a line has at most as many characters as bytes.)
+    let mut chars: Vec<char> = Vec::with_capacity(line.len());
+    chars.extend(line.chars());
+    let mut out = Vec::with_capacity(8);
     let mut i = 0;
     while i < chars.len() {
         let c = chars[i];
@@ -55,8 +57,10 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
             {
                 i += 1;
             }
+            let mut id = String::with_capacity(i - s);
+            id.extend(&chars[s..i]);
             out.push(Token {
-                tok: Tok::Ident(chars[s..i].iter().collect()),
+                tok: Tok::Ident(id),
                 col,
             });
             continue;
@@ -66,15 +70,23 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
             while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
                 i += 1;
             }
-            let text: String = chars[s..i].iter().filter(|c| **c != '_').collect();
-            let lower = text.to_ascii_lowercase();
-            let v = if let Some(h) = lower.strip_prefix("0x") {
-                i64::from_str_radix(h, 16)
-            } else if let Some(b) = lower.strip_prefix("0b") {
-                i64::from_str_radix(b, 2)
-            } else {
-                lower.parse::<i64>()
+            // `_` separates digit groups anywhere; then `0x` or `0b` (any
+            // case) and at least one digit of the radix.
+            let digits: Vec<char> = chars[s..i].iter().filter(|c| **c != '_').copied().collect();
+            let (radix, body) = match digits.as_slice() {
+                ['0', 'x' | 'X', rest @ ..] => (16, rest),
+                ['0', 'b' | 'B', rest @ ..] => (2, rest),
+                d => (10, d),
             };
+            let mut v: Result<i64, ()> = if body.is_empty() { Err(()) } else { Ok(0) };
+            for ch in body {
+                v = v.and_then(|acc| {
+                    let d = ch.to_digit(radix).ok_or(())?;
+                    acc.checked_mul(radix as i64)
+                        .and_then(|x| x.checked_add(d as i64))
+                        .ok_or(())
+                });
+            }
             match v {
                 Ok(v) => out.push(Token {
                     tok: Tok::Int(v),
@@ -135,8 +147,12 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
             });
             continue;
         }
-        let rest: String = chars[i..chars.len().min(i + 2)].iter().collect();
-        match PUNCT.iter().find(|p| rest.starts_with(**p)) {
+        let next = chars.get(i + 1).copied();
+        let punct = PUNCT.iter().find(|p| {
+            let mut pc = p.chars();
+            pc.next() == Some(c) && pc.next().is_none_or(|second| Some(second) == next)
+        });
+        match punct {
             Some(p) => {
                 out.push(Token {
                     tok: Tok::P(p),

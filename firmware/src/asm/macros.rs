@@ -221,13 +221,13 @@ pub(crate) fn expand(
     // Uses, depth first.
     let mut result = Vec::with_capacity(out.len());
     for l in out {
-        expand_line(&l, &macros, &mut result, &mut uses, 0, file)?;
+        expand_line(l, &macros, &mut result, &mut uses, 0, file)?;
     }
     Ok(result)
 }
 
 fn expand_line(
-    l: &Expanded,
+    l: Expanded,
     macros: &HashMap<String, Macro>,
     out: &mut Vec<Expanded>,
     uses: &mut usize,
@@ -238,7 +238,7 @@ fn expand_line(
     let (labels, rest) = labels(c);
     let name = rest.split_whitespace().next().unwrap_or("");
     let Some(m) = macros.get(name) else {
-        out.push(l.clone());
+        out.push(l);
         return Ok(());
     };
     if out.len() >= MAX_LINES {
@@ -344,7 +344,7 @@ fn expand_line(
             text: s,
             from: Some(from.clone()),
         };
-        expand_line(&e, macros, out, uses, depth + 1, file)?;
+        expand_line(e, macros, out, uses, depth + 1, file)?;
     }
     Ok(())
 }

@@ -292,7 +292,7 @@ struct Asm {
 /// A source line (after macro expansion): its number in the file, its
 /// text, its tokens, and for a line of a macro's body where the macro was
 /// used (appended to its errors).
-#[derive(Clone, Debug)]
+#[derive(Clone, Debug, Default)]
 struct Src {
     no: usize,
     text: String,
@@ -356,8 +356,8 @@ impl Asm {
         if !self.lines.iter().any(|l| is(&l.toks, ".rept")) {
             return Ok(());
         }
-        let lines = std::mem::take(&mut self.lines);
-        let mut out = Vec::new();
+        let mut lines = std::mem::take(&mut self.lines);
+        let mut out = Vec::with_capacity(lines.len());
         let mut consts: HashMap<String, i64> = HashMap::new();
         let mut k = 0;
         while k < lines.len() {
@@ -394,7 +394,7 @@ impl Asm {
                 return Err(note(lc.err_at(Some(0), "`.endr` without `.rept`")));
             }
             if !is(toks, ".rept") {
-                out.push(lines[k].clone());
+                out.push(std::mem::take(&mut lines[k]));
                 k += 1;
                 continue;
             }
@@ -457,7 +457,12 @@ impl Asm {
                             .collect(),
                         None => l.toks.clone(),
                     };
-                    out.push(Src { toks, ..l.clone() });
+                    out.push(Src {
+                        no: l.no,
+                        text: l.text.clone(),
+                        toks,
+                        from: l.from.clone(),
+                    });
                 }
             }
             k = end + 1;
@@ -471,16 +476,21 @@ impl Asm {
         self.loc = [TEXT_ORIGIN, DATA_ORIGIN, CTX_ORIGIN];
         self.section = Section::Text;
         self.wide = false;
-        for li in 0..self.lines.len() {
+        // The lines out of `self` while a pass reads them (no line is
+        // changed by a pass), so that each is read in place.
+        let lines = std::mem::take(&mut self.lines);
+        let file = std::mem::take(&mut self.file);
+        for (li, l) in lines.iter().enumerate() {
             if self.errors.len() >= MAX_ERRORS {
-                return;
+                break;
             }
-            if let Err(mut e) = self.line(li) {
-                e.message
-                    .push_str(self.lines[li].from.as_deref().unwrap_or(""));
+            if let Err(mut e) = self.line(&file, li, l) {
+                e.message.push_str(l.from.as_deref().unwrap_or(""));
                 self.errors.push(e);
             }
         }
+        self.lines = lines;
+        self.file = file;
     }
 
     fn here(&self) -> i64 {
@@ -579,17 +589,13 @@ impl Asm {
         self.loc[self.section as usize] = here + bytes.len() as i64;
     }
 
-    fn line(&mut self, li: usize) -> Result<(), AsmError> {
-        let (no, text, toks) = {
-            let l = &self.lines[li];
-            (l.no, l.text.clone(), l.toks.clone())
-        };
-        let file = self.file.clone();
+    fn line(&mut self, file: &str, li: usize, l: &Src) -> Result<(), AsmError> {
+        let (no, text, toks) = (l.no, &l.text, &l.toks);
         let lc = LineCtx {
-            file: &file,
+            file,
             line: no,
-            text: &text,
-            toks: &toks,
+            text,
+            toks,
         };
         let mut i = 0;
         // labels
