@@ -11,8 +11,8 @@ fn main() {
     divan::main();
 }
 
-/// One 64x32 tile group of the default scene on one chip instance (the
-/// unit of work the renderer hands to a host thread), tracing off.
+/// A 64x32 frame of the default scene (32 tiles, one work item on the
+/// bench's one thread), tracing off.
 #[divan::bench(sample_count = 10)]
 fn render_one_chip_instance(b: Bencher) {
     let scene = tb::cmd_scene::load_scene(None).unwrap();

@@ -9,7 +9,7 @@ pub struct TraceWindow {
     #[arg(long, value_name = "CYCLE", default_value_t = 0)]
     pub trace_from: u64,
     /// Number of cycles to trace (default: to the end of the run, and for
-    /// `render` the first 100,000 cycles of the first chip instance). A
+    /// `render` the first 100,000 cycles of the chip on the first 32 tiles). A
     /// window left open stops at 256 MB of waveform, with a warning; one
     /// asked for is refused up front when its estimate passes 4 GB.
     #[arg(long, value_name = "CYCLES", value_parser = parse_count::<u64>)]

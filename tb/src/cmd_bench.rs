@@ -4,21 +4,19 @@
 //! small size, rendered on the simulated chip. Measured:
 //!
 //! * tracing off, one host thread: simulated chip (array) cycles per host
-//!   second over a frame of `--size` (default 128x128: several chip
-//!   instances, so start-up is amortised), the figure the project's goal is
-//!   stated in;
+//!   second over a frame of `--size` (default 128x128: 256 tiles, so the
+//!   start-up is amortised), the figure the project's goal is stated in;
 //! * tracing on (a VCD of TinyRISC, the broadcast unit and one RC, the kind
 //!   of trace a user asks for), one host thread, against the same frame
 //!   untraced: the whole render (`traced_slowdown`, what a user waits
-//!   for) and the chip instance alone, from the waveform's creation to its
+//!   for) and the chip alone, from the waveform's creation to its
 //!   end (`traced_slowdown_chip`: the frame's setup, firmware generation
 //!   and assembly and the image's assembly, the same in both runs, left
 //!   out);
-//! * the speed-up of rendering a 256x256 frame on every core (independent
-//!   chip instances on groups of tiles) over one core, and the schedule
-//!   model's prediction of it on this machine's thread count, 16 and 64
-//!   cores from the frame's work items measured on one thread
-//!   ([`crate::schedule`]).
+//! * the speed-up of rendering a 256x256 frame on every core (its tiles
+//!   as work items, a chip each) over one core, and the schedule model's
+//!   prediction of it on this machine's thread count, 16 and 64 cores from
+//!   the frame's tiles measured on one thread ([`crate::schedule`]).
 //!
 //! The workload runs the paper's traversal by default (the simulator's
 //! workload since the first bench); `--traversal packet` runs what
@@ -133,11 +131,9 @@ pub fn command(a: BenchArgs) -> Result<()> {
     let tmp = tempfile::tempdir().context("cannot create a temporary directory")?;
     crate::output::register_temporary(tmp.path());
 
-    // Throughput: a frame of several chip instances run one after another on
-    // one thread (start-up amortised). Tracing on: the first instance of a
+    // Throughput: a frame on one thread (start-up amortised). Tracing on: a
     // smaller frame, all of it traced, against the same frame untraced.
-    // Speed-up: a 256x256 frame (32 instances) on every core against one
-    // core.
+    // Speed-up: a 256x256 frame on every core against one core.
     let traced_opt = Options {
         width: 64,
         height: 32,
@@ -160,19 +156,19 @@ pub fn command(a: BenchArgs) -> Result<()> {
     let one_thread = pool(1)?;
     let every_core = pool(cores)?;
     // Each measurement: (chip cycles, best host seconds, best host seconds
-    // of the chip instances alone). The measurements are taken in turn,
+    // of the chips alone). The measurements are taken in turn,
     // one run of each per round, so that the two sides of a ratio see the
     // same phases of the host: one after the other, a slow spell of the
     // machine could fall on all the repeats of one side (a traced frame
     // once measured 3.6x its untraced one where the runs around it gave
     // 2.7-2.8x).
     let mut best = [(0u64, f64::INFINITY, f64::INFINITY); 5];
-    // The schedule model's measurements: the work items (chip instances)
+    // The schedule model's measurements: the tiles and an item's own work
     // of the fastest 256x256 frame on one thread and the rest of its chip
     // render (the serial part), and the fastest chip render (the
     // firmware's generation and probe aside) on one thread and on every
     // core.
-    let mut items: Vec<f64> = Vec::new();
+    let mut frame = crate::schedule::FrameWork::default();
     let mut serial = 0.0;
     let mut chip_render = [f64::INFINITY; 2];
     for k in 0..repeat {
@@ -205,8 +201,8 @@ pub fn command(a: BenchArgs) -> Result<()> {
             if run >= 3 {
                 let k = run - 3;
                 if k == 0 && r.render_seconds < chip_render[0] {
-                    serial = (r.render_seconds - r.instance_seconds.iter().sum::<f64>()).max(0.0);
-                    items = r.instance_seconds.clone();
+                    serial = (r.render_seconds - r.item_seconds.iter().sum::<f64>()).max(0.0);
+                    frame = r.work();
                 }
                 chip_render[k] = chip_render[k].min(r.render_seconds);
             }
@@ -230,8 +226,8 @@ pub fn command(a: BenchArgs) -> Result<()> {
         .unwrap_or_else(|| std::env::consts::ARCH.to_string());
     let traced_slowdown = traced / untraced_small;
     // The same without the frame's setup and the image's assembly (the
-    // same in both runs): the chip instance alone, from the waveform's
-    // creation to its end.
+    // same in both runs): the chip alone, from the waveform's creation to
+    // its end.
     let traced_slowdown_chip = traced_chip / untraced_small_chip;
     println!(
         "host                           {cpu}, {cores} threads; each figure the fastest of {repeat} runs, taken in turn{}",
@@ -257,26 +253,34 @@ pub fn command(a: BenchArgs) -> Result<()> {
         off / 1e6
     );
     println!(
-        "tracing on, 1 thread           {:.2} M array cycles per host second at 64x32 ({traced:.3} s against {untraced_small:.3} s untraced, {traced_slowdown:.1}x; the chip instance alone {traced_chip:.4} s against {untraced_small_chip:.4} s, {traced_slowdown_chip:.1}x; VCD of tinyrisc, broadcast, rc_r0_c0)",
+        "tracing on, 1 thread           {:.2} M array cycles per host second at 64x32 ({traced:.3} s against {untraced_small:.3} s untraced, {traced_slowdown:.1}x; the chip alone {traced_chip:.4} s against {untraced_small_chip:.4} s, {traced_slowdown_chip:.1}x; VCD of tinyrisc, broadcast, rc_r0_c0)",
         on / 1e6
     );
-    let model = |n: usize| crate::schedule::speedup(serial, &items, n);
+    let model = |n: usize| crate::schedule::frame_speedup(serial, &frame, n);
     let chip_speedup = chip_render[0] / chip_render[1];
     println!(
-        "{cores} threads                      256x256 ({big_cycles} chip cycles, {} chip instances): {all:.3} s against {big_one:.3} s, speed-up {speedup:.2}x; the chip render alone {:.3} s against {:.3} s, {chip_speedup:.2}x (the schedule model: {:.2}x)",
-        items.len(),
+        "{cores} threads                      256x256 ({big_cycles} chip cycles, {} work items): {all:.3} s against {big_one:.3} s, speed-up {speedup:.2}x; the chip render alone {:.3} s against {:.3} s, {chip_speedup:.2}x (the schedule model: {:.2}x)",
+        frame.items(cores).len(),
         chip_render[1],
         chip_render[0],
         model(cores)
     );
-    let (shortest, longest) = items.iter().fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
-        (lo.min(t), hi.max(t))
-    });
+    let (shortest, longest) = frame
+        .tiles
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
+            (lo.min(t), hi.max(t))
+        });
     println!(
-        "schedule model                 the 256x256 chip render on one thread: {} work items (chip instances) of {shortest:.4} to {longest:.4} s and {serial:.4} s serial; predicted speed-up {:.1}x on 16 cores, {:.1}x on 64",
-        items.len(),
+        "schedule model                 the 256x256 chip render on one thread: {} tiles of {:.2} to {:.2} ms, {:.2} ms a work item's own, {serial:.4} s serial; predicted speed-up {:.1}x on 16 cores ({} items), {:.1}x on 64 ({} items)",
+        frame.tiles.len(),
+        shortest * 1e3,
+        longest * 1e3,
+        frame.item * 1e3,
         model(16),
-        model(64)
+        frame.items(16).len(),
+        model(64),
+        frame.items(64).len()
     );
     let sweep = if a.sweep.is_empty() {
         serde_json::Value::Null
@@ -309,12 +313,13 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "host_seconds_untraced_small": untraced_small,
             "traversal": opt.traversal.name(),
             "schedule": {
-                "model": "the chip render of the 256x256 frame: its serial part, then its work items (chip instances) in order, each taken by the first free thread",
+                "model": "the chip render of the 256x256 frame: its serial part, then its tiles cut into the work items N threads run (each an item's own work, its tiles and a warm-up tile), in order, each taken by the first free thread",
                 "chip_render_seconds_1_thread": chip_render[0],
                 "chip_render_seconds_all_threads": chip_render[1],
                 "chip_render_speedup": chip_speedup,
                 "serial_seconds": serial,
-                "item_seconds": items,
+                "tile_seconds": frame.tiles,
+                "item_own_seconds": frame.item,
                 "predicted_speedup": predicted,
             },
             "sweep": sweep,
@@ -363,12 +368,14 @@ fn sweep_model(
             work = std::mem::take(&mut *recorded.lock().map_err(|_| anyhow::anyhow!("poisoned"))?);
         }
     }
-    let rendered: f64 = work
+    let on = |n: usize| work.iter().map(|w| w.on(n)).collect::<Vec<_>>();
+    let one = on(1);
+    let rendered: f64 = one
         .iter()
         .map(|w| w.prep + w.items.iter().sum::<f64>())
         .sum();
     let serial = (seconds[0] - rendered).max(0.0);
-    let model = |n: usize| crate::schedule::sweep_speedup(serial, &work, n);
+    let model = |n: usize| crate::schedule::sweep_speedup(serial, &one, &on(n), n);
     let measured = seconds[0] / seconds[1];
     let names: Vec<String> = a.sweep.iter().map(|p| p.display().to_string()).collect();
     println!(
@@ -393,13 +400,14 @@ fn sweep_model(
         "host_seconds_1_thread": seconds[0],
         "host_seconds_all_threads": seconds[1],
         "speedup": measured,
-        "model": "each render's preparation, then its chip instances, a size-sweep family's renders one after the other; each free thread takes the item ready longest",
+        "model": "each render's preparation, then its work items as N threads cut its tiles, a size-sweep family's renders one after the other; each free thread takes the item ready longest",
         "serial_seconds": serial,
         "renders_work": work.iter().map(|w| json!({
             "task": w.task,
             "step": w.step,
             "prep_seconds": w.prep,
-            "item_seconds": w.items,
+            "tile_seconds": w.frame.tiles,
+            "item_own_seconds": w.frame.item,
         })).collect::<Vec<_>>(),
         "predicted_speedup": predicted,
     }))

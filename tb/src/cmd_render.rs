@@ -37,7 +37,7 @@ pub struct RenderArgs {
     /// hit), for `compare --hits` against `reference --hits`.
     #[arg(long, value_name = "PATH")]
     pub hits: Option<PathBuf>,
-    /// Write the waveform of the first chip instance here: VCD, or FST
+    /// Write the waveform of the chip on the frame's first 32 tiles here: VCD, or FST
     /// where the path ends in `.fst` (GTKWave save file and filters
     /// beside it).
     #[arg(long, value_name = "PATH")]
@@ -157,7 +157,7 @@ fn print_profile(p: &crate::profile::Profile) {
     let pct = |c: u64| 100.0 * c as f64 / p.cycles.max(1) as f64;
     let busy: u64 = p.kernels.iter().map(|x| x.1).sum();
     println!(
-        "profile                  every chip instance's tile loop: {} cycles; array busy {:.1}%, idle {:.1}%",
+        "profile                  the tile loop: {} cycles; array busy {:.1}%, idle {:.1}%",
         p.cycles,
         pct(busy),
         pct(p.cycles - busy)
@@ -263,14 +263,13 @@ pub(crate) fn render_and_measure(
         "rays_traced": chip.stats.watched_rcs[1],
         "ray_object_tests": chip.stats.watched_rcs[0],
         "host_seconds": host,
-        // The chip instances' host seconds summed over the threads: about
+        // The work items' host seconds summed over the threads: about
         // the chip render's time on one thread, whatever else runs beside
         // it (the sweep's --size-seconds).
-        "host_chip_seconds": chip.instance_seconds.iter().sum::<f64>(),
+        "host_chip_seconds": chip.item_seconds.iter().sum::<f64>(),
         "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
         "startup_cycles": chip.startup_cycles,
         "tiles": chip.tiles,
-        "chip_instances": chip.chips,
         "passes": chip.passes,
         "object_tests": chip.object_tests,
         "array_busy_cycles": chip.stats.array_busy_cycles,
@@ -355,10 +354,10 @@ fn impossible_value(j: &serde_json::Value) -> Option<String> {
     let Some(cycles) = j["cycles"].as_u64().filter(|&c| c > 0) else {
         return Some(format!("cycles {} is not a positive integer", j["cycles"]));
     };
-    let chips = j["chip_instances"].as_u64().unwrap_or(1).max(1);
-    if cycles > chips.saturating_mul(crate::render::MAX_CYCLES_PER_CHIP) {
+    let tiles = j["tiles"].as_u64().unwrap_or(1).max(1);
+    if cycles > (tiles + 1).saturating_mul(crate::render::MAX_CYCLES_PER_TILE) {
         return Some(format!(
-            "cycles {cycles} exceed the budget of {chips} chip instance(s)"
+            "cycles {cycles} exceed the budget of {tiles} tile(s) and the start-up"
         ));
     }
     let fps = j["fps_at_300mhz"].as_f64();
@@ -536,13 +535,13 @@ pub fn command(a: RenderArgs) -> Result<()> {
             c.scope = crate::cli::RENDER_SCOPE.to_string();
         }
         // A frame runs for millions of cycles: without --trace-cycles the
-        // waveform covers a window of the first chip instance, not the whole
+        // waveform covers a window of the first work item's chip, not the whole
         // frame (whose size would be refused anyway).
         if c.count.is_none() {
             c.count = Some(DEFAULT_TRACE_CYCLES);
             c.max_bytes = rtl::trace::MAX_TRACE_BYTES;
             eprintln!(
-                "tracing cycles {}..{} of the first chip instance (--trace-from / --trace-cycles to change)",
+                "tracing cycles {}..{} of the chip on the first 32 tiles (--trace-from / --trace-cycles to change)",
                 c.first,
                 c.first + DEFAULT_TRACE_CYCLES
             );
@@ -559,6 +558,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             trace,
             profile: a.profile,
             timing,
+            item_tiles: None,
         },
         Some(built),
     )?;

@@ -200,8 +200,7 @@ pub fn sections() -> Vec<Section> {
             about: "The paper's traversal with the kernels the comparison with the paper was \
                     made with (`--normals coarse`). `firmware` is the program's own count \
                     (`rdcyc` around the tile loop), which `tb/tests/traversal.rs` holds for the \
-                    first three scenes; `cycles` is the simulator's, a few cycles per chip \
-                    instance apart.",
+                    first three scenes; `cycles` is the simulator's, a few cycles apart.",
             checked: true,
             write: published,
         },

@@ -82,7 +82,7 @@ pub struct SweepCli {
     #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size, default_value = "64x64")]
     pub family_size: (u32, u32),
     /// Skip a family's larger sizes (with a traversal) once one of its
-    /// renders' chip instances took longer than this many host seconds
+    /// renders' chips took longer than this many host seconds
     /// (summed over the threads: about one thread's time, whatever runs
     /// beside it).
     #[arg(long, value_name = "SECONDS", default_value_t = 60.0, value_parser = crate::cli::parse_seconds)]
@@ -132,7 +132,7 @@ pub struct SweepArgs {
     pub families: Vec<String>,
     pub max_size: u32,
     pub family_size: (u32, u32),
-    /// A family's larger sizes are skipped once a render's chip instances
+    /// A family's larger sizes are skipped once a render's chips
     /// took longer than this (host seconds, summed over the threads).
     pub size_seconds: f64,
     /// Timing files: both traversals on each scene under each.
@@ -146,7 +146,7 @@ pub struct SweepArgs {
     pub plan: Option<PathBuf>,
     /// Where each render's work is recorded, when asked (`bench --sweep`'s
     /// schedule model).
-    pub work: Option<std::sync::Arc<std::sync::Mutex<Vec<crate::schedule::RenderWork>>>>,
+    pub work: Option<std::sync::Arc<std::sync::Mutex<Vec<crate::schedule::RecordedRender>>>>,
 }
 
 /// The SPD generators of the size sweep unless asked otherwise.
@@ -815,15 +815,14 @@ pub fn command(a: SweepArgs) -> Result<()> {
                 (serde_json::to_string_pretty(&rep.json)? + "\n").as_bytes(),
             )?;
             if let Some(w) = &a.work {
-                let items = chip.instance_seconds;
                 let all = t0.elapsed().as_secs_f64();
-                let prep = (all - items.iter().sum::<f64>()).max(0.0);
+                let prep = (all - chip.item_seconds.iter().sum::<f64>()).max(0.0);
                 if let Ok(mut w) = w.lock() {
-                    w.push(crate::schedule::RenderWork {
+                    w.push(crate::schedule::RecordedRender {
                         task,
                         step,
                         prep,
-                        items,
+                        frame: chip.work(),
                     });
                 }
             }
@@ -837,10 +836,10 @@ pub fn command(a: SweepArgs) -> Result<()> {
     // What runs: each render of the knob sweep on its own, and each chain
     // of the size sweep (a family with one traversal, its sizes in order)
     // as one task that renders one size after the other and stops once a
-    // render's chip instances took longer than --size-seconds (summed over
+    // render's chips took longer than --size-seconds (summed over
     // the threads, so about one thread's time, whatever runs beside it).
     // The tasks run concurrently on the thread pool, the chains first
-    // (each render's chip instances share the pool), and the table takes
+    // (each render's work items share the pool), and the table takes
     // the renders in its own order: it is the one a render after another
     // gives.
     let mut chains: Vec<((String, &str), Vec<usize>)> = Vec::new();

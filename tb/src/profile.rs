@@ -1,8 +1,8 @@
-//! Where a chip instance's cycles go, for firmware authors: every cycle of
-//! the tile loop is charged to the RC kernel the array executes in it or,
-//! when the array idles, to the TinyRISC code (the label before its PC)
-//! that keeps it waiting. `morphosys render --profile` prints the table
-//! for the whole frame (every chip instance's tile loop).
+//! Where a frame's cycles go, for firmware authors: every cycle of the
+//! tile loop is charged to the RC kernel the array executes in it or, when
+//! the array idles, to the TinyRISC code (the label before its PC) that
+//! keeps it waiting. `morphosys render --profile` prints the table for the
+//! whole frame (the sum of its work items' tiles).
 
 use std::collections::BTreeMap;
 
@@ -20,7 +20,7 @@ pub struct Profile {
 }
 
 impl Profile {
-    /// The sum of two profiles (two chip instances).
+    /// The sum of two profiles (two work items of a frame).
     pub fn merge(a: Profile, b: Profile) -> Profile {
         let add = |x: Vec<(String, u64)>, y: Vec<(String, u64)>| {
             let mut m: BTreeMap<String, u64> = BTreeMap::new();
@@ -74,18 +74,34 @@ impl Names {
     }
 }
 
-/// Step `sim` to its halt (at most `max_cycles`), charging every cycle.
+/// Step `sim` to its halt (an error past `max_cycles`), charging every cycle;
+/// with `stop` `(pc, n)`, only until TinyRISC's PC comes to `pc` for the
+/// `n`-th time (an arrival: the PC is `pc` and was not in the cycle
+/// before), that cycle not run.
 pub fn run<W: Word>(
     sim: &mut Sim<Chip<W>>,
     names: &Names,
     max_cycles: u64,
+    stop: Option<(u32, u32)>,
 ) -> Result<Profile, rtl::chip::RunError> {
     let mut k: BTreeMap<&str, u64> = BTreeMap::new();
     let mut c: BTreeMap<&str, u64> = BTreeMap::new();
     let mut cycles = 0u64;
+    let mut arrivals = 0;
+    let mut was_at = stop.is_some_and(|(pc, _)| sim.top.risc.pc == pc);
     while !sim.top.halted() {
         if sim.cycle() >= max_cycles {
-            break;
+            return Err(rtl::chip::over_budget(sim));
+        }
+        if let Some((pc, n)) = stop {
+            let at = sim.top.risc.pc == pc;
+            if at && !was_at {
+                arrivals += 1;
+                if arrivals == n {
+                    break;
+                }
+            }
+            was_at = at;
         }
         match sim.top.bcast.current() {
             Some((run, step, _)) => {

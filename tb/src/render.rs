@@ -1,13 +1,15 @@
 //! Rendering on the simulated chip: compile the scene, generate and
-//! assemble the tracer firmware, run independent chip instances over
-//! groups of tiles (rayon), read the pixels back from main memory.
+//! assemble the tracer firmware, run it on one chip over the frame's tiles,
+//! read the pixels back from main memory.
 //!
-//! Determinism: the tiles are cut into groups of a fixed size whatever the
-//! number of host threads, each group runs on its own fresh chip, and the
-//! results are placed by tile; the image and every figure are identical for
-//! any thread count. Cycle count of a frame: the start-up of one chip
-//! (loading the FB, the contexts and the RC tables) plus the tile loops of
-//! every group, as if one chip rendered every tile in sequence.
+//! The frame is one chip's work: its start-up (loading the FB, the
+//! contexts and the RC tables), then every tile in order. The host cuts
+//! the tile list into work items sized by its thread count
+//! ([`work_items`]) and runs each on a fresh chip (rayon), which first
+//! runs the tile before the item's own (a warm-up) so that each tile is
+//! counted exactly as in the one chip ([`run_item`]); the pixels are placed
+//! by tile. The image and every figure are identical for any thread
+//! count.
 
 use anyhow::{anyhow, Result};
 use firmware::asm::{self, Image};
@@ -21,11 +23,6 @@ use rtl::{Chip, Sim, Stats, Timing};
 
 use crate::reference::NO_HIT;
 
-/// Tiles per chip instance.
-pub const TILES_PER_CHIP: usize = 32;
-/// Cycle budget of one chip instance.
-pub(crate) const MAX_CYCLES_PER_CHIP: u64 = 2_000_000_000;
-
 /// The chip's image and figures.
 #[derive(Clone, Debug)]
 pub struct ChipRender {
@@ -34,34 +31,36 @@ pub struct ChipRender {
     pub rgb8: Vec<u8>,
     /// Per pixel the object the eye ray hit ([`NO_HIT`] for none).
     pub hits: Vec<u32>,
-    /// Frame cycles by the simulator's count: every chip instance from
-    /// reset to `halt`, its start-up (reset to the first `tile`) counted
-    /// once.
+    /// Frame cycles by the simulator's count: the chip from reset to
+    /// `halt`.
     pub cycles: u64,
-    /// The first chip instance's cycles from reset to the first `tile`.
+    /// The chip's cycles from reset to the first `tile` (the start-up).
     pub startup_cycles: u64,
-    /// The same frame by the firmware's own count (its `T_START` of the
-    /// first instance plus every instance's `T_END - T_START`), which the
-    /// program can get wrong: see [`ChipRender::firmware_count_disagrees`].
+    /// The same frame by the firmware's own count (its `T_END`, which it
+    /// reads from the cycle counter before `halt`), which the program can
+    /// get wrong: see [`ChipRender::firmware_count_disagrees`].
     pub firmware_cycles: u64,
     pub stats: Stats,
     pub object_tests: u64,
     pub passes: u64,
     pub tiles: usize,
-    pub chips: usize,
     pub firmware: Firmware,
-    /// With [`RenderSettings::profile`]: where the tile loops' cycles went
-    /// (every chip instance).
+    /// With [`RenderSettings::profile`]: where the tile loop's cycles went.
     pub profile: Option<crate::profile::Profile>,
-    /// Host seconds the chip instances ran, summed over them: from the
+    /// Host seconds the work items' chips ran, summed over them: from the
     /// waveform's creation, if any, to its end (the frame's setup, the
     /// firmware and the image's assembly, aside).
     pub chip_seconds: f64,
-    /// The host seconds of each chip instance's whole work (building and
-    /// loading the chip, running it, reading its pixels back), in tile
-    /// order: the work items the host's threads share (`bench`'s schedule
-    /// model).
-    pub instance_seconds: Vec<f64>,
+    /// The host seconds of each work item's whole work (building and
+    /// loading its chip, running it, reading its pixels back), in tile
+    /// order: what the host's threads shared.
+    pub item_seconds: Vec<f64>,
+    /// The host seconds of each tile (in the chip's order) within its
+    /// item, and an item's mean seconds apart from its tiles: the frame as
+    /// `bench`'s schedule model cuts it for any thread count
+    /// ([`ChipRender::work`]).
+    pub tile_seconds: Vec<f64>,
+    pub item_own_seconds: f64,
     /// Host seconds of the chip render: from assembling the firmware to
     /// the assembled image (the firmware's generation and any probe
     /// before it aside); the instances and its serial part.
@@ -87,6 +86,9 @@ pub struct RenderSettings {
     pub profile: bool,
     /// The chip's timing (`--timing FILE.toml`).
     pub timing: Timing,
+    /// Tiles per host work item ([`work_items`]; `None`: sized by the
+    /// thread count). Any size gives the same frame.
+    pub item_tiles: Option<usize>,
 }
 
 impl ChipRender {
@@ -94,7 +96,7 @@ impl ChipRender {
     /// ([`ChipRender::firmware_cycles`]) differs from the simulator's by
     /// more than 1%: a sentence saying so. (The tracer's reads the counter
     /// a few instructions from where the simulator splits start-up and
-    /// tile loop and from `halt`: a handful of cycles per chip instance.)
+    /// tile loop and from `halt`: a handful of cycles.)
     pub fn firmware_count_disagrees(&self) -> Option<String> {
         let (sim, fw) = (self.cycles, self.firmware_cycles);
         (sim.abs_diff(fw) as f64 > 0.01 * sim as f64).then(|| {
@@ -103,6 +105,13 @@ impl ChipRender {
                  the simulator counted {sim}: the figures are the simulator's"
             )
         })
+    }
+    /// The chip render's host work ([`crate::schedule::FrameWork`]).
+    pub fn work(&self) -> crate::schedule::FrameWork {
+        crate::schedule::FrameWork {
+            tiles: self.tile_seconds.clone(),
+            item: self.item_own_seconds,
+        }
     }
     pub fn fps_at(&self, clock_hz: u64) -> f64 {
         if self.cycles == 0 {
@@ -248,16 +257,35 @@ pub(crate) const RAY_SHADOW: usize = 1;
 pub(crate) const RAY_REFLECT: usize = 2;
 pub(crate) const RAY_REFRACT: usize = 3;
 
+/// One work item's share of a frame: its own tiles' statistics and
+/// output, counted as one chip rendering the frame's whole tile list would
+/// count them ([`run_item`]).
 struct Group {
-    start: u64,
-    end: u64,
+    /// Statistics at the first arrival at `tile` (the chip's start-up).
+    startup: Stats,
+    /// Statistics of its own tiles: from the arrival at its first tile to
+    /// the arrival at the tile after its last, or to `halt` for the frame's
+    /// last item.
+    counted: Stats,
+    /// The firmware's object tests and passes over the same span.
     tests: u64,
     passes: u64,
-    stats: Stats,
-    /// Statistics at the start of the tile loop.
-    startup: Stats,
-    /// Per tile, the 256 output words.
+    /// The chip halted within the item's span (always for the frame's
+    /// last item; for another, the program ended the frame early).
+    halted: bool,
+    /// When it did, the firmware's `T_END` less the cycle counter at the
+    /// span's start: the end of the firmware's own count of the frame
+    /// ([`ChipRender::firmware_cycles`]); or, where `T_END` is below that
+    /// counter (not a reading taken at the end), `T_END` itself.
+    t_end_tail: u64,
+    t_end_raw: Option<u64>,
+    /// Per own tile, the 256 output words.
     out: Vec<Vec<i32>>,
+    /// Host seconds of each own tile (reading its pixels back included),
+    /// and of the item's own work (building and loading the chip, the
+    /// start-up, the run from the last tile to `halt`).
+    tile_seconds: Vec<f64>,
+    own_seconds: f64,
     profile: Option<crate::profile::Profile>,
     /// Host seconds from the waveform's creation to its end.
     seconds: f64,
@@ -269,45 +297,124 @@ fn sym(img: &Image, name: &str) -> Result<u32> {
         .ok_or_else(|| anyhow!("internal: firmware symbol {name} missing"))
 }
 
-fn run_group<W: Word>(
+/// Tiles of the waveform's work item: a render with `--trace` records
+/// the chip on the frame's first `TRACED_TILES` tiles (one item, whatever
+/// the thread count).
+pub const TRACED_TILES: usize = 32;
+/// Work items per host thread ([`work_items`]): enough that a thread done
+/// early takes another while the rest finish, few enough that the
+/// warm-up tiles stay a small share.
+const ITEMS_PER_THREAD: usize = 8;
+/// The fewest tiles a work item is cut to (about: the tiles are shared
+/// evenly).
+const MIN_ITEM_TILES: usize = 8;
+/// Cycle budget of one tile on the chip (and of the start-up).
+pub(crate) const MAX_CYCLES_PER_TILE: u64 = 62_500_000;
+
+/// The frame's `tiles` (in the chip's order) cut into work items for
+/// `threads` host threads: one item on one thread, else about
+/// [`ITEMS_PER_THREAD`] per thread of at least [`MIN_ITEM_TILES`] tiles,
+/// contiguous and in order; with `traced`, the first [`TRACED_TILES`] are
+/// one item of their own. Any cut gives the same frame ([`run_item`]).
+pub(crate) fn work_items(
+    tiles: usize,
+    threads: usize,
+    traced: bool,
+) -> Vec<std::ops::Range<usize>> {
+    let first = if traced { tiles.min(TRACED_TILES) } else { 0 };
+    let mut items = Vec::new();
+    if first > 0 {
+        items.push(0..first);
+    }
+    let rest = tiles - first;
+    if rest > 0 {
+        let n = if threads <= 1 {
+            1
+        } else {
+            (threads * ITEMS_PER_THREAD).min(rest.div_ceil(MIN_ITEM_TILES))
+        };
+        let n = n.max(1);
+        items.extend((0..n).map(|i| first + i * rest / n..first + (i + 1) * rest / n));
+    }
+    items
+}
+
+/// Run the work item `own` of the frame's tile list `tiles` on a fresh
+/// chip, counted as one chip running the whole list would count it.
+///
+/// The chip runs the item's tiles after the tile before them (a warm-up,
+/// not counted), from its first arrival at the tile loop's `tile` label:
+/// what carries from one tile to the next (the output DMA of the tile
+/// before, which the next one's start waits on or overlaps, the transfers
+/// of a streamed scene still draining, and the output bank, which
+/// alternates by tile: the host sets `TL_BANK` as one chip has it at the
+/// warm-up tile) is then as in one chip, and nothing carries further (the
+/// tile's rays, passes and leaf blocks are its own, and no RC's work
+/// depends on the hit records an earlier tile left: the tracer's shading
+/// reads only its pass's). Its own tiles count from the arrival at the first to the
+/// arrival at the tile after the last (where the list ends here, one chip
+/// would go on to the next tile), or to `halt` for the frame's last item.
+/// `tb/tests/render.rs` holds whole frames cut at every tile against one
+/// item on each traversal, resident and streamed.
+#[allow(clippy::too_many_arguments)]
+fn run_item<W: Word>(
     img: &Image,
     fw: &Firmware,
     tiles: &[(u32, u32)],
+    own: std::ops::Range<usize>,
     trace: Option<rtl::trace::TraceConfig>,
     profile: bool,
     timing: &Timing,
     say_files: bool,
 ) -> Result<Group> {
+    let t_item = std::time::Instant::now();
+    let warm = own.start > 0;
+    let list = &tiles[own.start - warm as usize..own.end];
+    let last = own.end == tiles.len();
     // Main memory as large as the program touches (its segments, the tile
     // list, the output tiles and the streamed scene image), not the
-    // 16 MiB default: a fresh instance per group must not zero-fill memory
+    // 16 MiB default: a fresh instance per item must not zero-fill memory
     // nobody reads.
     let wb = fw.fb_word_bytes();
+    // What lies above `mem::OUTPUT`: the streamed scene image and its
+    // mailboxes, the packet traversal's mailboxes.
+    let above = fw
+        .layout
+        .stream
+        .as_ref()
+        // the image, then the mailboxes (a half-word per object)
+        .map(|st| {
+            (st.base as usize + st.image.len()).max(st.mailbox as usize + 2 * fw.layout.objects)
+        })
+        .into_iter()
+        .chain(
+            // the packet traversal's mailboxes (main memory, resident or
+            // streamed)
+            (fw.layout.traversal == tracer::Traversal::Packet)
+                .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
+        )
+        .max()
+        .unwrap_or(0);
+    // The tiles' pixels: at `mem::OUTPUT`, or past that data where an
+    // item's tiles would reach it (each tile's address is in the list).
+    let out_bytes = list.len() * fw.out_tile_bytes() as usize;
+    let output = if above > mem::OUTPUT as usize
+        && mem::OUTPUT as usize + out_bytes > mem::STREAM as usize
+    {
+        above.next_multiple_of(1 << 12) as u32
+    } else {
+        mem::OUTPUT
+    };
     let ends = img
         .segments
         .iter()
         .map(|s| s.addr as usize + s.data.len())
         .chain([
             mem::FB_IMAGE as usize + wb as usize * fw.fb.len(),
-            mem::TILE_LIST as usize + 4 + 12 * tiles.len(),
-            (mem::OUTPUT + tiles.len() as u32 * fw.out_tile_bytes()) as usize,
-        ])
-        .chain(
-            fw.layout
-                .stream
-                .as_ref()
-                // the image, then the mailboxes (a half-word per object)
-                .map(|st| {
-                    (st.base as usize + st.image.len())
-                        .max(st.mailbox as usize + 2 * fw.layout.objects)
-                }),
-        )
-        .chain(
-            // the packet traversal's mailboxes (main memory, resident or
-            // streamed)
-            (fw.layout.traversal == tracer::Traversal::Packet)
-                .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
-        );
+            mem::TILE_LIST as usize + 4 + 12 * list.len(),
+            output as usize + out_bytes,
+            above,
+        ]);
     let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
     let mut chip = Chip::<W>::build(*timing, mem_bytes);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
@@ -317,15 +424,16 @@ fn run_group<W: Word>(
     if let Some(st) = &fw.layout.stream {
         chip.load(st.base, &st.image).map_err(|f| anyhow!("{f}"))?;
     }
-    let mut list = Vec::with_capacity(4 + 12 * tiles.len());
-    list.extend((tiles.len() as u32).to_le_bytes());
-    for (k, (x, y)) in tiles.iter().enumerate() {
-        list.extend(x.to_le_bytes());
-        list.extend(y.to_le_bytes());
-        list.extend((mem::OUTPUT + k as u32 * fw.out_tile_bytes()).to_le_bytes());
+    // The tile list, in chunks of what fits below `mem::OUTPUT`: the next
+    // chunk goes in when the program has taken the last tile of one
+    // ([`feed`]).
+    let mut fed = feed(&mut chip, list, 0, output, fw.out_tile_bytes())?;
+    // The tracer's output banks alternate by tile (`TL_BANK`, 0 at the
+    // first): the list's first tile takes the bank it has in one chip.
+    if let Some(bank) = img.symbol("TL_BANK") {
+        let first = (own.start - warm as usize) as u32;
+        chip.mem.write(bank as u32, 4, first % 2);
     }
-    chip.load(mem::TILE_LIST, &list)
-        .map_err(|f| anyhow!("{f}"))?;
     let mut sim = Sim::new(chip);
     let t0 = std::time::Instant::now();
     if let Some(mut cfg) = trace {
@@ -335,38 +443,116 @@ fn run_group<W: Word>(
         sim.trace(cfg, "morphosys")
             .map_err(|e| anyhow!("creating {}: {e}", path.display()))?;
     }
-    // Start-up (FB and context loads, RC tables) ends where the tile loop
-    // begins: its statistics are taken apart so that a frame counts one
-    // start-up whatever the number of chip instances.
     let tile_pc = sym(img, "tile")?;
+    let m = |sim: &Sim<Chip<W>>, name: &str| -> Result<u64> {
+        Ok(sim.top.mem.read(sym(img, name)?, 4) as u64)
+    };
+    let names = profile.then(|| crate::profile::Names::new(img, mem::CTX_BASE));
+    let mut prof: Option<crate::profile::Profile> = None;
+    // The spans the chip runs: the start-up (to the first arrival at
+    // `tile`), the warm-up tile, the own tiles (each to the next arrival),
+    // and `halt`; each within its own cycle budget, an error naming it.
     let mut startup = Stats::default();
-    let mut result = Ok(0);
-    while !sim.top.halted() {
-        if sim.top.risc.pc == tile_pc {
+    let mut from = Stats::default();
+    let mut to: Option<Stats> = None;
+    let mut halted = false;
+    let (mut tests, mut passes, mut t_end_tail) = (0, 0, 0);
+    let mut t_end_raw = None;
+    let (mut tests0, mut passes0) = (0, 0);
+    let mut tile_seconds = Vec::with_capacity(own.len());
+    // The item's own work: building and loading the chip, the start-up,
+    // the run from the last tile to `halt`.
+    let mut own_seconds = 0.0;
+    let mut result: Result<()> = Ok(());
+    let spans = 1 + warm as usize + own.len();
+    own_seconds += t_item.elapsed().as_secs_f64();
+    for k in 0..spans {
+        // The frame's tile this span runs (none for the start-up).
+        let tile = (k > 0).then(|| own.start - warm as usize + k - 1);
+        let counting = k > warm as usize;
+        let begun = sim.cycle();
+        let t_span = std::time::Instant::now();
+        let r = advance(
+            &mut sim,
+            tile_pc,
+            k > 0,
+            names.as_ref().filter(|_| counting),
+            &mut prof,
+        );
+        let span_seconds = t_span.elapsed().as_secs_f64();
+        if counting {
+            tile_seconds.push(span_seconds);
+        } else if k == 0 {
+            own_seconds += span_seconds;
+        }
+        if let Err(e) = r {
+            result = Err(span_error(
+                e,
+                tile.map(|t| (t, tiles[t])),
+                sim.cycle() - begun,
+            ));
+            break;
+        }
+        if k == 0 {
             startup = sim.top.stats();
+        }
+        if k == warm as usize {
+            from = sim.top.stats();
+            (tests0, passes0) = (m(&sim, "TESTS")?, m(&sim, "PASSES")?);
+        }
+        if sim.top.halted() {
+            halted = true;
             break;
         }
-        if sim.cycle() >= MAX_CYCLES_PER_CHIP {
-            break;
-        }
-        if let Err(e) = sim.step() {
-            result = Err(rtl::chip::RunError::Step(e));
-            break;
+        if fed < list.len() && m(&sim, "TL_CNT")? == 0 {
+            // At `tile` with the chunk taken: the next one, and the
+            // program's list state pointed at it (as a longer list would
+            // have it, at no cycle).
+            let n = feed(&mut sim.top, list, fed, output, fw.out_tile_bytes())?;
+            let at = |name: &str| sym(img, name);
+            sim.top.mem.write(at("TL_PTR")?, 4, mem::TILE_LIST + 4);
+            sim.top.mem.write(at("TL_CNT")?, 4, (n - fed) as u32);
+            fed = n;
         }
     }
-    let mut prof = None;
     if result.is_ok() {
-        if profile {
-            let names = crate::profile::Names::new(img, mem::CTX_BASE);
-            match crate::profile::run(&mut sim, &names, MAX_CYCLES_PER_CHIP) {
-                Ok(p) => {
-                    result = Ok(p.cycles);
-                    prof = Some(p);
+        to = Some(sim.top.stats());
+        tests = m(&sim, "TESTS")?.wrapping_sub(tests0) & 0xffff_ffff;
+        passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
+        if !halted {
+            // On to `halt`: counted for the frame's last item (one chip
+            // ends there too), not for the others (one chip goes on to
+            // the next tile; this one's last pixels are still on their way
+            // out by DMA).
+            let t = (last && own.end > 0).then(|| own.end - 1);
+            let n = if last { names.as_ref() } else { None };
+            let begun = sim.cycle();
+            let t_end = std::time::Instant::now();
+            let r = advance(&mut sim, u32::MAX, false, n, &mut prof);
+            own_seconds += t_end.elapsed().as_secs_f64();
+            match r {
+                Ok(_) => {
+                    if last {
+                        to = Some(sim.top.stats());
+                        tests = m(&sim, "TESTS")?.wrapping_sub(tests0) & 0xffff_ffff;
+                        passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
+                        halted = true;
+                    }
                 }
-                Err(e) => result = Err(e),
+                Err(e) => {
+                    result = Err(span_error(e, t.map(|t| (t, tiles[t])), sim.cycle() - begun))
+                }
             }
-        } else {
-            result = run_to_halt(&mut sim, MAX_CYCLES_PER_CHIP);
+        }
+        if halted {
+            // T_END as a reading of the counter after the span's start (as
+            // the tracer's is: then exactly one chip's reading); a value
+            // below it, not the counter at the end (a program's own
+            // arithmetic on its start-up's reading, the same in every
+            // item), is kept as it is ([`Group::t_end_tail`]).
+            let t_end = m(&sim, "T_END")?;
+            t_end_tail = t_end.wrapping_sub(from.cycles & 0xffff_ffff) as u32 as u64;
+            t_end_raw = (t_end < from.cycles & 0xffff_ffff).then_some(t_end);
         }
     }
     let files = sim
@@ -379,21 +565,18 @@ fn run_group<W: Word>(
             crate::note!("wrote {}", f.display());
         }
     }
-    result.map_err(|e| match e {
-        rtl::chip::RunError::MaxCycles { .. } => anyhow!(
-            "the tracer firmware stopped: {e}; a render allows {MAX_CYCLES_PER_CHIP} cycles per chip \
-             instance (up to {TILES_PER_CHIP} tiles): a smaller --size, or a faster --timing"
-        ),
-        e => anyhow!("the tracer firmware stopped: {e}"),
-    })?;
-    let m = &sim.top.mem;
-    let rd = |name: &str| -> Result<u64> { Ok(m.read(sym(img, name)?, 4) as u64) };
-    let out = (0..tiles.len())
+    result?;
+    tile_seconds.resize(own.len(), 0.0);
+    let mut counted = to.unwrap_or_default();
+    sub_stats(&mut counted, &from);
+    let mem = &sim.top.mem;
+    let t_out = std::time::Instant::now();
+    let out: Vec<Vec<i32>> = (warm as usize..list.len())
         .map(|k| {
-            let base = mem::OUTPUT + k as u32 * fw.out_tile_bytes();
+            let base = output + k as u32 * fw.out_tile_bytes();
             (0..256)
                 .map(|i| {
-                    let v = m.read(base + wb * i, wb);
+                    let v = mem.read(base + wb * i, wb);
                     if wb == 2 {
                         v as u16 as i16 as i32
                     } else {
@@ -403,17 +586,122 @@ fn run_group<W: Word>(
                 .collect()
         })
         .collect();
+    // Reading a tile's pixels back is that tile's work.
+    let per_tile = t_out.elapsed().as_secs_f64() / own.len().max(1) as f64;
+    tile_seconds.iter_mut().for_each(|t| *t += per_tile);
     Ok(Group {
-        start: rd("T_START")?,
-        end: rd("T_END")?,
-        tests: rd("TESTS")?,
-        passes: rd("PASSES")?,
-        stats: sim.top.stats(),
         startup,
+        counted,
+        tests,
+        passes,
+        halted,
+        t_end_tail,
+        t_end_raw,
         out,
+        tile_seconds,
+        own_seconds,
         profile: prof,
         seconds,
     })
+}
+
+/// Tile-list entries a chip's list holds (below `mem::OUTPUT`, 12 bytes
+/// each after the count).
+const LIST_CHUNK: usize = ((mem::OUTPUT - mem::TILE_LIST - 4) / 12) as usize;
+
+/// Write the tile list's chunk from `list[from]` (count, then per tile its
+/// corner and its pixels' address, `output` plus the tile's place in
+/// `list`); returns where the next chunk starts.
+fn feed<W: Word>(
+    chip: &mut Chip<W>,
+    list: &[(u32, u32)],
+    from: usize,
+    output: u32,
+    tile_bytes: u32,
+) -> Result<usize> {
+    let to = list.len().min(from + LIST_CHUNK);
+    let mut bytes = Vec::with_capacity(4 + 12 * (to - from));
+    bytes.extend(((to - from) as u32).to_le_bytes());
+    for (k, (x, y)) in list.iter().enumerate().take(to).skip(from) {
+        bytes.extend(x.to_le_bytes());
+        bytes.extend(y.to_le_bytes());
+        bytes.extend((output + k as u32 * tile_bytes).to_le_bytes());
+    }
+    chip.load(mem::TILE_LIST, &bytes)
+        .map_err(|f| anyhow!("{f}"))?;
+    Ok(to)
+}
+
+/// The firmware's `PASS_WRAP` when a frame run as several `items` made as
+/// many passes or more (so that one chip would have wrapped its pass
+/// numbers where the items did not count them).
+fn wraps(
+    img: &Image,
+    items: &[std::ops::Range<usize>],
+    results: &[(Result<Group>, f64)],
+) -> Option<u64> {
+    let wrap = img.symbol("PASS_WRAP")? as u64;
+    let passes: u64 = results
+        .iter()
+        .filter_map(|(r, _)| r.as_ref().ok())
+        .map(|g| g.passes)
+        .sum();
+    (items.len() > 1 && passes >= wrap).then_some(wrap)
+}
+
+/// Run the chip to the next arrival at `pc` (the PC comes to it; with
+/// `leave`, first out of a stay there) or to `halt` (`pc` `u32::MAX`:
+/// there), within [`MAX_CYCLES_PER_TILE`] cycles; with `names`, each cycle
+/// charged to `prof`. Returns whether it arrived (else it halted).
+fn advance<W: Word>(
+    sim: &mut Sim<Chip<W>>,
+    pc: u32,
+    leave: bool,
+    names: Option<&crate::profile::Names>,
+    prof: &mut Option<crate::profile::Profile>,
+) -> std::result::Result<bool, rtl::chip::RunError> {
+    let budget = sim.cycle() + MAX_CYCLES_PER_TILE;
+    if let Some(names) = names {
+        let p = crate::profile::run(sim, names, budget, Some((pc, 1)).filter(|_| pc != u32::MAX))?;
+        *prof = Some(match prof.take() {
+            None => p,
+            Some(q) => crate::profile::Profile::merge(q, p),
+        });
+        return Ok(!sim.top.halted());
+    }
+    if pc == u32::MAX {
+        return run_to_halt(sim, budget).map(|_| false);
+    }
+    if leave {
+        while !sim.top.halted() && sim.top.risc.pc == pc {
+            if sim.cycle() >= budget {
+                return Err(rtl::chip::over_budget(sim));
+            }
+            sim.step().map_err(rtl::chip::RunError::Step)?;
+        }
+    }
+    rtl::chip::run_to_pc(sim, pc, budget)
+}
+
+/// A chip's error in a span of its work item, named by the frame's tile
+/// (`None`: the start-up) and the cycle within it, `at` (not the chip's
+/// own count, which depends on where the frame was cut).
+fn span_error(e: rtl::chip::RunError, tile: Option<(usize, (u32, u32))>, at: u64) -> anyhow::Error {
+    let span = match tile {
+        None => "the start-up (before the tile loop)".to_string(),
+        Some((k, (x, y))) => format!("tile {k} (pixels from ({x}, {y}))"),
+    };
+    match e {
+        rtl::chip::RunError::MaxCycles { pc, text, .. } => anyhow!(
+            "the tracer firmware stopped: {span} took more than {MAX_CYCLES_PER_TILE} cycles \
+             [pc 0x{pc:08x}: `{text}`]; a render allows that many per tile and for the start-up: \
+             a smaller scene, or a faster --timing"
+        ),
+        rtl::chip::RunError::Step(rtl::kernel::StepError::Fault { fault, .. }) => {
+            anyhow!("the tracer firmware stopped in {span}, at its cycle {at}: {fault}")
+        }
+        rtl::chip::RunError::Step(e) => anyhow!("the tracer firmware stopped in {span}: {e}"),
+    }
 }
 
 /// Render `scene` on the simulated chip.
@@ -466,15 +754,31 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
     }
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
-    let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
-    let runs: Vec<Result<Group>> = groups
-        .par_iter()
-        .with_max_len(1)
-        .map(|g| match fw.datapath {
-            Datapath::W16 => run_group::<i16>(&img, fw, g, None, false, timing, false),
-            Datapath::W32 => run_group::<i32>(&img, fw, g, None, false, timing, false),
-        })
-        .collect();
+    let run = |items: &[std::ops::Range<usize>]| {
+        items
+            .par_iter()
+            .with_max_len(1)
+            .map(|own| {
+                let own = own.clone();
+                let r = match fw.datapath {
+                    Datapath::W16 => {
+                        run_item::<i16>(&img, fw, &tiles, own, None, false, timing, false)
+                    }
+                    Datapath::W32 => {
+                        run_item::<i32>(&img, fw, &tiles, own, None, false, timing, false)
+                    }
+                };
+                (r, 0.0)
+            })
+            .collect::<Vec<(Result<Group>, f64)>>()
+    };
+    let mut items = work_items(tiles.len(), rayon::current_num_threads(), false);
+    let mut runs = run(&items);
+    // As for a frame ([`wraps`]).
+    if wraps(&img, &items, &runs).is_some() {
+        items = std::iter::once(0..tiles.len()).collect();
+        runs = run(&items);
+    }
     let mut p = ProbeRender {
         cycles: 0,
         pixels: Vec::new(),
@@ -482,11 +786,17 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
         hits: Vec::new(),
         reference: None,
     };
-    for (gi, r) in runs.into_iter().enumerate() {
-        let g = r?;
-        p.cycles += g.stats.cycles - g.startup.cycles;
+    let mut ended = false;
+    for (own, (r, _)) in items.iter().zip(runs) {
+        let mut g = r?;
+        if ended {
+            g.out.iter_mut().for_each(|o| o.fill(0));
+        } else {
+            p.cycles += g.counted.cycles;
+            ended = g.halted;
+        }
         for (k, out) in g.out.iter().enumerate() {
-            let (x0, y0) = groups[gi][k];
+            let (x0, y0) = tiles[own.start + k];
             for lane in 0..64u32 {
                 let (row, col) = (lane / 8, lane % 8);
                 let (x, y) = (x0 + col, y0 + row);
@@ -698,8 +1008,20 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             tiles.push((tx * tw, ty * th));
         }
     }
-    let groups: Vec<&[(u32, u32)]> = tiles.chunks(TILES_PER_CHIP).collect();
-    let bar = if progress && groups.len() > 1 {
+    let mut items = match host.item_tiles {
+        Some(n) => {
+            let n = n.max(1);
+            (0..tiles.len().div_ceil(n))
+                .map(|i| i * n..(i + 1).saturating_mul(n).min(tiles.len()))
+                .collect()
+        }
+        None => work_items(
+            tiles.len(),
+            rayon::current_num_threads(),
+            host.trace.is_some(),
+        ),
+    };
+    let bar = if progress && tiles.len() > 1 {
         let b = crate::output::progress_bar(tiles.len() as u64);
         b.set_style(
             ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} tiles, {eta} left")
@@ -710,59 +1032,88 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     } else {
         ProgressBar::hidden()
     };
-    let first_trace = host.trace.clone();
-    // Each chip instance with the host seconds of all its work (building
-    // the chip and loading it, running it, reading its pixels back); one
-    // task each, so that a thread that is done takes the next instance
-    // rather than half of a run of them (2 threads: gears-2's chip render
-    // 1.93x-1.98x one thread's against 1.78x-1.87x).
-    let results: Vec<(Result<Group>, f64)> = groups
-        .par_iter()
-        .with_max_len(1)
-        .enumerate()
-        .map(|(gi, g)| {
-            let t0 = std::time::Instant::now();
-            let t = if gi == 0 { first_trace.clone() } else { None };
-            let p = host.profile;
-            let r = match fw.datapath {
-                Datapath::W16 => run_group::<i16>(&img, &fw, g, t, p, &host.timing, progress),
-                Datapath::W32 => run_group::<i32>(&img, &fw, g, t, p, &host.timing, progress),
-            };
-            bar.inc(g.len() as u64);
-            (r, t0.elapsed().as_secs_f64())
-        })
-        .collect();
+    // Each work item with the host seconds of all its work (building the
+    // chip and loading it, running it, reading its pixels back); one task
+    // each, so that a thread that is done takes the next item rather than
+    // half of a run of them.
+    let run = |items: &[std::ops::Range<usize>], trace: Option<rtl::trace::TraceConfig>| {
+        items
+            .par_iter()
+            .with_max_len(1)
+            .enumerate()
+            .map(|(gi, own)| {
+                let t0 = std::time::Instant::now();
+                let t = if gi == 0 { trace.clone() } else { None };
+                let p = host.profile;
+                let (tm, own) = (&host.timing, own.clone());
+                let n = own.len() as u64;
+                let r = match fw.datapath {
+                    Datapath::W16 => run_item::<i16>(&img, &fw, &tiles, own, t, p, tm, progress),
+                    Datapath::W32 => run_item::<i32>(&img, &fw, &tiles, own, t, p, tm, progress),
+                };
+                bar.inc(n);
+                (r, t0.elapsed().as_secs_f64())
+            })
+            .collect::<Vec<(Result<Group>, f64)>>()
+    };
+    let mut results = run(&items, host.trace.clone());
+    // A frame whose passes reach the firmware's `PASS_WRAP` (the paper's
+    // traversal: 16-bit pass numbers in the mailboxes, cleared when they
+    // wrap) clears its mailboxes where one chip's count of passes says, which
+    // items that count their own passes cannot know: it runs again as one
+    // item (its waveform, if any, kept from the first run).
+    if let Some(wrap) = wraps(&img, &items, &results) {
+        crate::note!(
+            "the frame's {wrap} passes or more wrap the firmware's pass numbers: run again on one chip"
+        );
+        bar.set_position(0);
+        items = std::iter::once(0..tiles.len()).collect();
+        results = run(&items, None);
+    }
     bar.finish_and_clear();
     let mut rgb8 = vec![0u8; (w * h * 3) as usize];
     let mut hits = vec![NO_HIT; (w * h) as usize];
     let mut stats = Stats::default();
     let (mut fw_cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
     let mut chip_seconds = 0.0;
-    let mut instance_seconds = Vec::with_capacity(groups.len());
+    let mut item_seconds_all = Vec::with_capacity(items.len());
+    let mut tile_seconds = Vec::with_capacity(tiles.len());
+    let mut own_seconds = 0.0;
     let mut profile = None;
+    let mut ended = false;
     for (gi, (r, item_seconds)) in results.into_iter().enumerate() {
         let mut g = r?;
-        instance_seconds.push(item_seconds);
-        if let Some(p) = g.profile.take() {
+        item_seconds_all.push(item_seconds);
+        tile_seconds.extend(&g.tile_seconds);
+        own_seconds += g.own_seconds;
+        if let Some(p) = g.profile.take().filter(|_| !ended) {
             profile = Some(match profile {
                 None => p,
                 Some(q) => crate::profile::Profile::merge(q, p),
             });
         }
+        chip_seconds += g.seconds;
         if gi == 0 {
             startup = g.startup.cycles;
-            fw_cycles = g.start;
+            add_stats(&mut stats, &g.startup);
         }
-        fw_cycles += g.end.saturating_sub(g.start);
-        chip_seconds += g.seconds;
-        tests += g.tests;
-        passes += g.passes;
-        add_stats(&mut stats, &g.stats);
-        if gi > 0 {
-            sub_stats(&mut stats, &g.startup);
+        if ended {
+            // One chip halted before these tiles: their output words are
+            // the zeros of main memory.
+            g.out.iter_mut().for_each(|o| o.fill(0));
+        } else {
+            if g.halted {
+                // The firmware's `T_END` as one chip's counter reads it
+                // (taken as a reading of the counter, as the tracer's is).
+                fw_cycles = g.t_end_raw.unwrap_or(stats.cycles + g.t_end_tail);
+                ended = true;
+            }
+            tests += g.tests;
+            passes += g.passes;
+            add_stats(&mut stats, &g.counted);
         }
         for (k, out) in g.out.iter().enumerate() {
-            let (x0, y0) = groups[gi][k];
+            let (x0, y0) = tiles[items[gi].start + k];
             for lane in 0..64u32 {
                 let (row, col) = (lane / 8, lane % 8);
                 if row >= th || col >= tw {
@@ -793,11 +1144,12 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         object_tests: tests,
         passes,
         tiles: tiles.len(),
-        chips: groups.len(),
         firmware: fw,
         profile,
         chip_seconds,
-        instance_seconds,
+        item_own_seconds: own_seconds / item_seconds_all.len().max(1) as f64,
+        item_seconds: item_seconds_all,
+        tile_seconds,
         render_seconds: t0.elapsed().as_secs_f64(),
     })
 }

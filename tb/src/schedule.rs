@@ -2,9 +2,13 @@
 //! more cores than this one, from its work items measured here.
 //!
 //! A render is a serial part (building the firmware and the scene image,
-//! assembling, putting the image together) and independent work items (its
-//! chip instances), which the host's threads take from a work-stealing
-//! pool. The model takes the items in order, each by the first thread to
+//! assembling, putting the image together) and independent work items
+//! (runs of its tiles, a chip each), which the host's threads take from a
+//! work-stealing pool. The items depend on the thread count
+//! ([`crate::render::work_items`]): the model cuts the frame as `n` threads
+//! would from the host seconds of each tile and of an item's own work
+//! (building and loading its chip, its start-up), measured on one thread
+//! ([`FrameWork`]). The model takes the items in order, each by the first thread to
 //! be free (list scheduling, which a work-stealing pool approaches), so
 //! the items' makespan on `n` threads is at least the longest item and at
 //! least their sum over `n`; the predicted time is the serial part plus
@@ -43,12 +47,69 @@ pub fn speedup(serial: f64, items: &[f64], workers: usize) -> f64 {
     }
 }
 
+/// A frame's chip render as measured: the host seconds of each tile (in
+/// the chip's order) and of a work item's own work apart from its tiles.
+#[derive(Clone, Debug, Default)]
+pub struct FrameWork {
+    pub tiles: Vec<f64>,
+    pub item: f64,
+}
+
+impl FrameWork {
+    /// The work items `workers` threads run the frame as, in order: each
+    /// the item's own work, its tiles and the warm-up tile before them.
+    pub fn items(&self, workers: usize) -> Vec<f64> {
+        crate::render::work_items(self.tiles.len(), workers, false)
+            .into_iter()
+            .map(|own| {
+                let warm = own.start.checked_sub(1).map_or(0.0, |k| self.tiles[k]);
+                self.item + warm + self.tiles[own].iter().sum::<f64>()
+            })
+            .collect()
+    }
+}
+
+/// The predicted speed-up on `workers` threads of a frame's chip render:
+/// `serial` seconds of one thread, then the frame's items on `workers`
+/// threads, against its one item on one thread.
+pub fn frame_speedup(serial: f64, frame: &FrameWork, workers: usize) -> f64 {
+    let one = serial + frame.items(1).iter().sum::<f64>();
+    let many = serial + makespan(&frame.items(workers), workers);
+    if many > 0.0 {
+        one / many
+    } else {
+        1.0
+    }
+}
+
+/// A render of a sweep as measured on one thread: its task and place in it
+/// ([`RenderWork`]), its preparation, and its chip render.
+#[derive(Clone, Debug)]
+pub struct RecordedRender {
+    pub task: usize,
+    pub step: usize,
+    pub prep: f64,
+    pub frame: FrameWork,
+}
+
+impl RecordedRender {
+    /// The render as `workers` threads run it.
+    pub fn on(&self, workers: usize) -> RenderWork {
+        RenderWork {
+            task: self.task,
+            step: self.step,
+            prep: self.prep,
+            items: self.frame.items(workers),
+        }
+    }
+}
+
 /// One render of a sweep as the schedule model sees it: the task it
 /// belongs to (a render of the knob sweep, or a chain of the size sweep
 /// whose renders run one after the other), its place in that task, its
-/// preparation (all but its chip instances: the firmware, the probe, the
-/// reference and the metrics; taken as one thread's work) and its chip
-/// instances (host seconds each).
+/// preparation (all but its chip render's items: the firmware, the probe,
+/// the reference and the metrics; taken as one thread's work) and its work
+/// items (host seconds each).
 #[derive(Clone, Debug)]
 pub struct RenderWork {
     pub task: usize,
@@ -58,12 +119,12 @@ pub struct RenderWork {
 }
 
 /// The time the renders of `work` take on `workers` threads: every task
-/// starts at once; a render's preparation is one item, its chip instances
+/// starts at once; a render's preparation is one item, its work items
 /// are ready when it ends, and the next render of its task when the last
 /// of them ends. Each thread, when free, takes of the ready items the one
 /// with the longest path of work still behind it in its task (critical
 /// path first, as the sweep starts its size-sweep chains first and a
-/// thread runs the instances of its own render before others'; ties in
+/// thread runs the items of its own render before others'; ties in
 /// the order of the tasks); with none ready, the first to become ready.
 pub fn sweep_makespan(work: &[RenderWork], workers: usize) -> f64 {
     let ns = |t: f64| (t.max(0.0) * 1e9).round() as u64;
@@ -80,7 +141,7 @@ pub fn sweep_makespan(work: &[RenderWork], workers: usize) -> f64 {
     }
     let longest = |w: &RenderWork| w.items.iter().map(|&t| ns(t)).max().unwrap_or(0);
     // The work behind each render of a task: the later renders' preparation
-    // and longest instance.
+    // and longest item.
     let behind: Vec<Vec<u64>> = tasks
         .iter()
         .map(|renders| {
@@ -92,7 +153,7 @@ pub fn sweep_makespan(work: &[RenderWork], workers: usize) -> f64 {
             b
         })
         .collect();
-    // Released items: (ready at, priority, task, render, instance or None
+    // Released items: (ready at, priority, task, render, item or None
     // for the preparation).
     let mut ready: Vec<(u64, u64, usize, usize, Option<usize>)> = Vec::new();
     let release = |ready: &mut Vec<_>, at: u64, t: usize, r: usize, item: Option<usize>| {
@@ -109,7 +170,7 @@ pub fn sweep_makespan(work: &[RenderWork], workers: usize) -> f64 {
             release(&mut ready, 0, t, 0, None);
         }
     }
-    // Per render: instances not yet taken, and when the last taken ends.
+    // Per render: items not yet taken, and when the last taken ends.
     let mut left: Vec<Vec<(usize, u64)>> = tasks
         .iter()
         .map(|r| r.iter().map(|w| (w.items.len(), 0)).collect())
@@ -168,14 +229,15 @@ pub fn sweep_makespan(work: &[RenderWork], workers: usize) -> f64 {
 
 /// The predicted speed-up of a sweep on `workers` threads against one:
 /// `serial` seconds of its own (loading scenes, the table and charts) and
-/// its renders' work ([`sweep_makespan`]).
-pub fn sweep_speedup(serial: f64, work: &[RenderWork], workers: usize) -> f64 {
+/// its renders' work, as one thread and as `workers` threads run them
+/// ([`sweep_makespan`]).
+pub fn sweep_speedup(serial: f64, one: &[RenderWork], many: &[RenderWork], workers: usize) -> f64 {
     let one: f64 = serial
-        + work
+        + one
             .iter()
             .map(|w| w.prep + w.items.iter().sum::<f64>())
             .sum::<f64>();
-    let many = serial + sweep_makespan(work, workers);
+    let many = serial + sweep_makespan(many, workers);
     if many > 0.0 {
         one / many
     } else {
@@ -227,6 +289,25 @@ mod tests {
         assert_eq!(speedup(0.0, &[1.0; 4], 1), 1.0);
     }
 
+    #[test]
+    fn a_frame_cut_as_the_threads_would_by_hand() {
+        // 64 tiles of 1 s, 0.5 s of an item's own work.
+        let f = FrameWork {
+            tiles: vec![1.0; 64],
+            item: 0.5,
+        };
+        assert_eq!(f.items(1), vec![64.5]);
+        // Two threads: 8 items of 8 tiles, all but the first after a
+        // warm-up tile.
+        let two = f.items(2);
+        assert_eq!(two.len(), 8);
+        assert_eq!(two[0], 8.5);
+        assert!(two[1..].iter().all(|&t| t == 9.5));
+        // 8.5 | 9.5, then each thread three more: 37 and 38.
+        assert_eq!(frame_speedup(0.0, &f, 2), 64.5 / 38.0);
+        assert_eq!(frame_speedup(1.0, &f, 1), 1.0);
+    }
+
     fn render(task: usize, step: usize, prep: f64, items: &[f64]) -> RenderWork {
         RenderWork {
             task,
@@ -238,9 +319,9 @@ mod tests {
 
     #[test]
     fn a_sweep_by_hand() {
-        // A chain of two renders (preparation 1, instances 2 and 2; then
-        // preparation 1, one instance of 3) and a knob render
-        // (preparation 1, instances 1 and 1).
+        // A chain of two renders (preparation 1, items 2 and 2; then
+        // preparation 1, one item of 3) and a knob render
+        // (preparation 1, items 1 and 1).
         let work = [
             render(0, 0, 1.0, &[2.0, 2.0]),
             render(0, 1, 1.0, &[3.0]),
@@ -248,16 +329,16 @@ mod tests {
         ];
         // One thread: everything one after the other, 12.
         assert_eq!(sweep_makespan(&work, 1), 12.0);
-        // Two threads: both preparations 0-1; the chain's instances 1-3
+        // Two threads: both preparations 0-1; the chain's items 1-3
         // on both (the longest path behind them); at 3 the chain's second
-        // preparation (3-4) and a knob instance (3-4); the chain's last
-        // instance 4-7 beside the other knob instance 4-5.
+        // preparation (3-4) and a knob item (3-4); the chain's last
+        // item 4-7 beside the other knob item 4-5.
         assert_eq!(sweep_makespan(&work, 2), 7.0);
-        // Taken first come, first served, the knob's instances would have
+        // Taken first come, first served, the knob's items would have
         // gone before the chain's second preparation: 4-5, then 5-8.
         // Many threads: the chain is the critical path, 1 + 2 + 1 + 3.
         assert_eq!(sweep_makespan(&work, 16), 7.0);
-        assert_eq!(sweep_speedup(0.0, &work, 16), 12.0 / 7.0);
+        assert_eq!(sweep_speedup(0.0, &work, &work, 16), 12.0 / 7.0);
         // Steps given out of order are taken in order.
         let swapped = [work[1].clone(), work[0].clone(), work[2].clone()];
         assert_eq!(sweep_makespan(&swapped, 16), 7.0);
@@ -265,7 +346,7 @@ mod tests {
 
     /// Knob renders alone are independent: on one thread the sum, and
     /// never shorter than the longest render's preparation plus its
-    /// longest instance, nor than the work over the threads.
+    /// longest item, nor than the work over the threads.
     #[test]
     fn independent_renders_within_bounds() {
         let mut x = 99u64;

@@ -394,7 +394,7 @@ fn bench_does_not_announce_its_temporary_waveforms() {
     assert_eq!(j["repeat"], 2);
     assert!(!j["host_cpu"].as_str().unwrap().is_empty());
     assert!(j["traced_slowdown"].as_f64().unwrap() > 1.0, "{j}");
-    // The same for the chip instance alone (the frame's setup aside), and
+    // The same for the chip alone (the frame's setup aside), and
     // the two frames' times it comes from.
     assert!(j["traced_slowdown_chip"].as_f64().unwrap() > 0.0, "{j}");
     assert!(j["host_seconds_traced"].as_f64().unwrap() > 0.0, "{j}");
@@ -429,7 +429,8 @@ fn bench_predicts_a_frame_and_a_sweep_from_their_work_items() {
     let j: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("b.json")).unwrap()).unwrap();
     let s = &j["schedule"];
-    assert_eq!(s["item_seconds"].as_array().unwrap().len(), 32, "{s}");
+    // 256x256: 1024 tiles of 8x8 pixels.
+    assert_eq!(s["tile_seconds"].as_array().unwrap().len(), 1024, "{s}");
     let sw = &j["sweep"];
     for (sched, most) in [(s, 64.0), (sw, 64.0)] {
         for n in ["16", "64"] {
@@ -470,8 +471,11 @@ fn bench_predicts_a_frame_and_a_sweep_from_their_work_items() {
         .unwrap()
         .iter()
         .map(|w| {
+            // On one thread a render is one work item: its own work and
+            // its tiles.
             w["prep_seconds"].as_f64().unwrap()
-                + w["item_seconds"]
+                + w["item_own_seconds"].as_f64().unwrap()
+                + w["tile_seconds"]
                     .as_array()
                     .unwrap()
                     .iter()

@@ -17,7 +17,7 @@ fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
 #[test]
 fn renders_are_bit_identical_for_1_and_2_threads() {
     let scene = load_scene(None).unwrap();
-    // 64x64: 64 tiles, two chip instances, so two threads really split it.
+    // 64x64: 64 tiles, several work items on two threads.
     let opt = Options {
         width: 64,
         height: 64,

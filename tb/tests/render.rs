@@ -133,18 +133,101 @@ fn image_and_cycles_do_not_depend_on_host_threads() {
             .num_threads(threads)
             .build()
             .unwrap();
-        // 40x40 = 25 tiles; with TILES_PER_CHIP 32 use a size spanning two
-        // chip instances.
+        // 9 x 8 tiles: one work item on one thread, 9 on two.
         pool.install(|| {
             tb::render::render_chip(&scene, &opts(72, 64), &Default::default()).unwrap()
         })
     };
     let (a, b) = (run(1), run(2));
-    assert!(a.chips >= 2);
+    assert_eq!(a.item_seconds.len(), 1);
+    assert!(b.item_seconds.len() >= 2);
     assert_eq!(a.rgb8, b.rgb8);
     assert_eq!(a.hits, b.hits);
     assert_eq!(a.cycles, b.cycles);
+    assert_eq!(a.firmware_cycles, b.firmware_cycles);
     assert_eq!(a.stats, b.stats);
+}
+
+/// A frame cut into work items of one tile each (every one after its
+/// warm-up tile on a fresh chip) is the frame of one chip running every
+/// tile: the same image, cycles and every statistic, on both traversals,
+/// both datapaths, a streamed scene, and scenes whose RCs keep hit records
+/// from tile to tile (refraction: mount, gears).
+#[test]
+fn a_frame_cut_at_every_tile_is_one_chips_frame() {
+    use firmware::tracer::{Datapath, Traversal};
+    let cases: [(&str, Traversal, Datapath, bool); 8] = [
+        ("default.toml", Traversal::Packet, Datapath::W16, false),
+        ("default.toml", Traversal::Paper, Datapath::W16, false),
+        ("default.toml", Traversal::Packet, Datapath::W32, false),
+        ("mount-1.nff", Traversal::Packet, Datapath::W16, false),
+        ("mount-1.nff", Traversal::Paper, Datapath::W16, false),
+        ("gears-1.nff", Traversal::Packet, Datapath::W16, false),
+        ("tetra-1.nff", Traversal::Packet, Datapath::W16, true),
+        ("jacks-1.nff", Traversal::Paper, Datapath::W16, true),
+    ];
+    for (name, traversal, datapath, streamed) in cases {
+        let scene = load(name);
+        let o = Options {
+            traversal,
+            datapath,
+            ..opts(40, 24)
+        };
+        let render = |item_tiles| {
+            let s = tb::render::RenderSettings {
+                streamed,
+                item_tiles,
+                ..Default::default()
+            };
+            tb::render::render_chip(&scene, &o, &s).unwrap()
+        };
+        let (one, cut) = (render(Some(usize::MAX)), render(Some(1)));
+        let what = format!("{name} {traversal:?} {datapath:?} streamed {streamed}");
+        assert_eq!(cut.item_seconds.len(), 15, "{what}");
+        assert_eq!(one.rgb8, cut.rgb8, "{what}");
+        assert_eq!(one.hits, cut.hits, "{what}");
+        assert_eq!(one.stats, cut.stats, "{what}");
+        assert_eq!(one.firmware_cycles, cut.firmware_cycles, "{what}");
+        assert_eq!(
+            (one.object_tests, one.passes),
+            (cut.object_tests, cut.passes),
+            "{what}"
+        );
+    }
+}
+
+/// A frame of more tiles than a chip's tile list holds (4 ways at
+/// 216x216: 11,664 tiles of 2x2 pixels) runs as one item with its list fed
+/// in chunks, and is the frame cut into items of 1,000 tiles; under the
+/// paper's traversal its 93,312 passes wrap the 16-bit pass numbers (the
+/// mailboxes cleared where one chip's count says), and the frame cut for
+/// two threads runs again as one item: the same either way.
+#[test]
+fn long_tile_lists_and_wrapping_pass_numbers_keep_the_frame() {
+    use firmware::tracer::Traversal;
+    let scene = load("default.toml");
+    for traversal in [Traversal::Packet, Traversal::Paper] {
+        let o = Options {
+            traversal,
+            ways: 4,
+            ..opts(216, 216)
+        };
+        let render = |item_tiles| {
+            let s = tb::render::RenderSettings {
+                item_tiles,
+                ..Default::default()
+            };
+            tb::render::render_chip(&scene, &o, &s).unwrap()
+        };
+        let (one, cut) = (render(Some(usize::MAX)), render(Some(1000)));
+        assert_eq!(one.tiles, 11_664);
+        assert_eq!(one.rgb8, cut.rgb8, "{traversal:?}");
+        assert_eq!(one.hits, cut.hits, "{traversal:?}");
+        assert_eq!(one.stats, cut.stats, "{traversal:?}");
+        assert_eq!(one.firmware_cycles, cut.firmware_cycles, "{traversal:?}");
+        let again = cut.item_seconds.len() == 1;
+        assert_eq!(again, traversal == Traversal::Paper, "{traversal:?}");
+    }
 }
 
 #[test]

@@ -135,7 +135,10 @@ fn kernels(
         shading::store_lane(names::STORE_COL, super::memory_map::ram::LANE_COL),
     ));
     for l in 0..opt.depth.saturating_sub(1) {
-        v.push((names::reflect(l), shading::reflect_setup(l, smooth)));
+        v.push((
+            names::reflect(l),
+            shading::reflect_setup(l, smooth, lay.refract),
+        ));
         v.push((names::reflected(l), shading::reflect_pop(l)));
         if lay.refract {
             v.push((

@@ -129,7 +129,8 @@ pub fn wake_restore(packet: bool) -> K {
 /// Eye rays. Stream: `px0, py0, from.xyz, (A, B, C) per axis`: the
 /// direction through pixel (i, j) is `A + i B + j C` with A in Q2.13 and
 /// B, C scaled by 2^KD; normalised in the RC. `refract`: eye rays leave
-/// no object (`ORIG_OBJ` = -1).
+/// no object (`ORIG_OBJ` = -1) and have no back hit yet
+/// (`HIT_BACK_OBJ` = -1, [`back_hit_none`]).
 pub fn eye(nr: Approx, refract: bool) -> K {
     let mut k = K::new();
     k.doc(
@@ -156,7 +157,9 @@ pub fn eye(nr: Approx, refract: bool) -> K {
     new_level_common(&mut k);
     k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::OUT_OBJ));
     if refract {
-        k.c(format!("st r8, [#{}]", ram::ORIG_OBJ));
+        k.c(format!("st r8, [#{}]", ram::ORIG_OBJ))
+            .c(format!("st r8, [#{}]", ram::HIT_BACK_OBJ))
+            .note("no back hit yet in this pass");
     }
     k
 }
@@ -235,11 +238,18 @@ pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool) -> K {
         smooth_triangle::shading_normal(&mut k);
     }
     if refract {
+        // A missed ray's HIT_* hold what an earlier hit in the RC left
+        // (the frame's earlier tiles): the back-hit test only where this
+        // pass hit, so that no RC's work depends on them.
         k.comment("a back hit? the rays this hit spawns leave its object");
-        k.c(format!("ld r8, [r0 + #{}]", ram::HIT_BACK_OBJ))
+        k.c(format!("ld r8, [r0 + #{}]", ram::ACT))
+            .c("cmp.ne r8, #0")
+            .note("F: a hit")
+            .c(format!("ld r8, [r0 + #{}]", ram::HIT_BACK_OBJ))
             .c(format!("ld r9, [r0 + #{}]", ram::HIT_OBJ))
             .c("movb r10, #0")
-            .c("cmp.eq r8, r9")
+            .c("(f) cmp.eq r8, r9")
+            .note("F: on its object's back")
             .c("(f) movb r10, #1")
             .c(format!("st r10, [#{}]", ram::SH_BACK))
             .c(format!("ld r8, [r0 + #{}]", ram::ACT))
@@ -381,7 +391,7 @@ pub fn shade(shines: &[(u32, f64)]) -> K {
 /// direction about the shading normal would go below the surface
 /// (`r.Ng <= 0`), the mirror direction about the geometric normal
 /// `SH_NG`, as the reference does.
-pub fn reflect_setup(level: u32, smooth: bool) -> K {
+pub fn reflect_setup(level: u32, smooth: bool, refract: bool) -> K {
     let f = format!("STACK_L{level}");
     let mut k = K::new();
     k.doc(&format!(
@@ -440,6 +450,9 @@ pub fn reflect_setup(level: u32, smooth: bool) -> K {
     for (i, d) in [4, 5, 6].into_iter().enumerate() {
         k.c(format!("st r{d}, [#{}]", ram::SH_D + i as u32));
     }
+    if refract {
+        back_hit_none(&mut k);
+    }
     k.c(format!("ld r9, [r0 + #{}]", ram::ACT))
         .c(format!("ld r8, [r0 + #{}]", ram::SH_KS))
         .c("cmp.ne r9, #0")
@@ -447,6 +460,16 @@ pub fn reflect_setup(level: u32, smooth: bool) -> K {
         .note("F: a hit that reflects")
         .c("(!f) sleep");
     k
+}
+
+/// `HIT_BACK_OBJ = -1` at a closest-hit pass's set-up (a scene with
+/// transmitting objects): the pass's own back hits only, in every RC, so
+/// that the hit's shading ([`post`]) does not depend on what the RC's
+/// earlier passes (or tiles) left. Clobbers r8.
+fn back_hit_none(k: &mut K) {
+    k.c("movb r8, #-1")
+        .c(format!("st r8, [#{}]", ram::HIT_BACK_OBJ))
+        .note("no back hit yet in this pass");
 }
 
 /// Refraction set-up of recursion level `level` (before its reflection):
@@ -555,6 +578,7 @@ pub fn refract_setup(level: u32) -> K {
     for (i, d) in [4, 5, 6].into_iter().enumerate() {
         k.c(format!("st r{d}, [#{}]", ram::SH_D + i as u32));
     }
+    back_hit_none(&mut k);
     k.c(format!("ld r8, [r0 + #{}]", ram::ORIG_STACK + level))
         .c(format!("st r8, [#{}]", ram::ORIG_OBJ))
         .c(format!("ld r8, [r0 + #{}]", word(&rf, "RF_T", 0)))

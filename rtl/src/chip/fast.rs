@@ -104,7 +104,7 @@ impl<W: Word> Chip<W> {
         let mut word_ok = self.mem.word(self.risc.pc) == Some(self.risc.ir);
         // The cycle before was one of TinyRISC alone, in this loop.
         let mut alone = false;
-        while n < limit && !self.risc.halted() {
+        while n < limit && !self.risc.halted() && self.risc.pc != self.stop_pc {
             let alone_before = std::mem::take(&mut alone);
             if self.bcast.idle() {
                 // TinyRISC alone.
@@ -400,9 +400,9 @@ fn cycles<W: Word, const TRACED: bool>(
     sim: &mut Sim<Chip<W>>,
     max_cycles: u64,
 ) -> Result<u64, RunError> {
-    while !sim.top.halted() {
+    while !sim.top.halted() && sim.top.risc.pc != sim.top.stop_pc {
         if sim.cycle() >= max_cycles {
-            return Err(no_halt(sim));
+            return Err(over_budget(sim));
         }
         let limit = max_cycles - sim.cycle();
         let stalled = if TRACED {

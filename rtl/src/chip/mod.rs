@@ -189,7 +189,14 @@ pub struct Chip<W: Word = i16> {
     idle_control: u64,
     /// Runs counted for the statistics ([`Watch`]).
     pub watch: Watch,
+    /// The fast loops stop before a cycle in which TinyRISC's PC is this
+    /// ([`run_to_pc`]; `NO_STOP`: never).
+    stop_pc: u32,
 }
+
+/// [`Chip::stop_pc`] when no run stops at a PC (no instruction is fetched
+/// from an unaligned address).
+const NO_STOP: u32 = u32::MAX;
 
 /// The parts of the chip's walk ([`Traced::trace`]) a fast loop reports
 /// unchanged with a sample ([`crate::trace::Probe::unchanged`]): TinyRISC,
@@ -315,6 +322,7 @@ impl<W: Word> Chip<W> {
             active_rc: 0,
             idle_control: 0,
             watch: Watch::default(),
+            stop_pc: NO_STOP,
         }
     }
 
@@ -585,11 +593,40 @@ pub fn run_to_halt_plain<W: Word>(
 ) -> Result<u64, RunError> {
     while !sim.top.halted() {
         if sim.cycle() >= max_cycles {
-            return Err(no_halt(sim));
+            return Err(over_budget(sim));
         }
         sim.step().map_err(RunError::Step)?;
     }
     Ok(sim.cycle())
+}
+
+/// Run until TinyRISC's PC is `pc` before a cycle (that cycle not run;
+/// at once when it already is) or it halts; returns whether it stopped at
+/// `pc`. Through the fast paths unless [`set_plain`] asked for the plain
+/// model: the same cycles, states and statistics as stepping
+/// ([`Sim::step`]) until the PC is `pc`.
+pub fn run_to_pc<W: Word>(
+    sim: &mut Sim<Chip<W>>,
+    pc: u32,
+    max_cycles: u64,
+) -> Result<bool, RunError> {
+    if plain() {
+        while !sim.top.halted() {
+            if sim.top.risc.pc == pc {
+                return Ok(true);
+            }
+            if sim.cycle() >= max_cycles {
+                return Err(over_budget(sim));
+            }
+            sim.step().map_err(RunError::Step)?;
+        }
+        return Ok(false);
+    }
+    sim.top.stop_pc = pc;
+    let r = run_to_halt(sim, max_cycles);
+    sim.top.stop_pc = NO_STOP;
+    r?;
+    Ok(!sim.top.halted() && sim.top.risc.pc == pc)
 }
 
 /// Run to `halt`; returns the cycles used (the halt's cycle included).
@@ -614,8 +651,10 @@ pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u
     unreachable!("Word is implemented by i16 and i32 only")
 }
 
+/// The error of a run stopped by its cycle budget, with TinyRISC's PC
+/// and the instruction there.
 #[cold]
-fn no_halt<W: Word>(sim: &Sim<Chip<W>>) -> RunError {
+pub fn over_budget<W: Word>(sim: &Sim<Chip<W>>) -> RunError {
     let pc = sim.top.risc.pc;
     let text = if sim.top.mem.check(pc, 4).is_ok() {
         decode::disassemble(sim.top.mem.read(pc, 4))
