@@ -281,6 +281,8 @@ struct Group {
     t_end_raw: Option<u64>,
     /// Per own tile, the 256 output words.
     out: Vec<Vec<i32>>,
+    /// Per own tile, the passes the firmware counted.
+    tile_passes: Vec<u64>,
     /// Host seconds of each own tile (reading its pixels back included),
     /// and of the item's own work (building and loading the chip, the
     /// start-up, the run from the last tile to `halt`).
@@ -307,7 +309,7 @@ pub const TRACED_TILES: usize = 32;
 const ITEMS_PER_THREAD: usize = 8;
 /// The fewest tiles a work item is cut to (about: the tiles are shared
 /// evenly).
-const MIN_ITEM_TILES: usize = 8;
+const MIN_ITEM_TILES: usize = 16;
 /// Cycle budget of one tile on the chip (and of the start-up).
 pub(crate) const MAX_CYCLES_PER_TILE: u64 = 62_500_000;
 
@@ -362,6 +364,7 @@ fn run_item<W: Word>(
     fw: &Firmware,
     tiles: &[(u32, u32)],
     own: std::ops::Range<usize>,
+    pass_seed: Option<u32>,
     trace: Option<rtl::trace::TraceConfig>,
     profile: bool,
     timing: &Timing,
@@ -434,6 +437,11 @@ fn run_item<W: Word>(
         let first = (own.start - warm as usize) as u32;
         chip.mem.write(bank as u32, 4, first % 2);
     }
+    // The pass number one chip has before the list's first tile, where it
+    // matters ([`pass_seeds`]).
+    if let Some(seed) = pass_seed {
+        chip.mem.write(sym(img, "PASS")?, 4, seed);
+    }
     let mut sim = Sim::new(chip);
     let t0 = std::time::Instant::now();
     if let Some(mut cfg) = trace {
@@ -459,6 +467,8 @@ fn run_item<W: Word>(
     let (mut tests, mut passes, mut t_end_tail) = (0, 0, 0);
     let mut t_end_raw = None;
     let (mut tests0, mut passes0) = (0, 0);
+    // Each own tile's passes (the firmware's count).
+    let (mut tile_passes, mut last_passes) = (Vec::with_capacity(own.len()), 0);
     let mut tile_seconds = Vec::with_capacity(own.len());
     // The item's own work: building and loading the chip, the start-up,
     // the run from the last tile to `halt`.
@@ -499,6 +509,12 @@ fn run_item<W: Word>(
         if k == warm as usize {
             from = sim.top.stats();
             (tests0, passes0) = (m(&sim, "TESTS")?, m(&sim, "PASSES")?);
+            last_passes = passes0;
+        }
+        if counting {
+            let p = m(&sim, "PASSES")?;
+            tile_passes.push(p.wrapping_sub(last_passes) & 0xffff_ffff);
+            last_passes = p;
         }
         if sim.top.halted() {
             halted = true;
@@ -567,6 +583,7 @@ fn run_item<W: Word>(
     }
     result?;
     tile_seconds.resize(own.len(), 0.0);
+    tile_passes.resize(own.len(), 0);
     let mut counted = to.unwrap_or_default();
     sub_stats(&mut counted, &from);
     let mem = &sim.top.mem;
@@ -600,6 +617,7 @@ fn run_item<W: Word>(
         out,
         tile_seconds,
         own_seconds,
+        tile_passes,
         profile: prof,
         seconds,
     })
@@ -632,21 +650,57 @@ fn feed<W: Word>(
     Ok(to)
 }
 
-/// The firmware's `PASS_WRAP` when a frame run as several `items` made as
-/// many passes or more (so that one chip would have wrapped its pass
-/// numbers where the items did not count them).
-fn wraps(
+/// The items to run again, each with the pass number one chip has before
+/// its list's first tile: those in which one chip's pass numbers wrap.
+///
+/// The paper's traversal numbers its passes in 16 bits for its mailboxes
+/// (`PASS`): a pass that would reach `PASS_WRAP` clears them and takes the
+/// number one. A chip that starts with the mailboxes clear and the number
+/// one chip has at the same tile runs as that chip does (every mailbox then
+/// holds an older pass's number in both); an item that wraps nowhere runs
+/// so from any start, and the others run again from one chip's number,
+/// known once every tile's passes are (extra host work only for frames of
+/// 32,767 passes or more).
+fn pass_seeds(
     img: &Image,
     items: &[std::ops::Range<usize>],
     results: &[(Result<Group>, f64)],
-) -> Option<u64> {
-    let wrap = img.symbol("PASS_WRAP")? as u64;
-    let passes: u64 = results
+) -> Vec<(usize, u32)> {
+    let Some(wrap) = img.symbol("PASS_WRAP").map(|w| w as u64) else {
+        return Vec::new();
+    };
+    // Passes before each tile (one chip's count), as far as the items ran.
+    let mut before = vec![0u64];
+    for (r, _) in results {
+        match r {
+            Ok(g) => {
+                for p in &g.tile_passes {
+                    before.push(before[before.len() - 1] + p);
+                }
+            }
+            Err(_) => return Vec::new(),
+        }
+    }
+    // One chip's pass number after `n` passes.
+    let number = |n: u64| {
+        if n < wrap {
+            n
+        } else {
+            (n - wrap) % (wrap - 1) + 1
+        }
+    };
+    // Whether one of passes n + 1 ..= m wraps: the number reaches `wrap`.
+    let wraps_in = |n: u64, m: u64| number(n) + (m - n) >= wrap;
+    items
         .iter()
-        .filter_map(|(r, _)| r.as_ref().ok())
-        .map(|g| g.passes)
-        .sum();
-    (items.len() > 1 && passes >= wrap).then_some(wrap)
+        .enumerate()
+        .filter_map(|(i, own)| {
+            let first = own.start.saturating_sub(1);
+            let (n, m) = (*before.get(first)?, *before.get(own.end)?);
+            // (An item from the frame's first tile starts as one chip.)
+            (n > 0 && wraps_in(n, m)).then(|| (i, number(n) as u32))
+        })
+        .collect()
 }
 
 /// Run the chip to the next arrival at `pc` (the PC comes to it; with
@@ -754,30 +808,36 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
     }
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
-    let run = |items: &[std::ops::Range<usize>]| {
-        items
-            .par_iter()
+    let run = |jobs: &[(std::ops::Range<usize>, Option<u32>)]| {
+        jobs.par_iter()
             .with_max_len(1)
-            .map(|own| {
-                let own = own.clone();
+            .map(|(own, seed)| {
+                let (own, seed) = (own.clone(), *seed);
                 let r = match fw.datapath {
                     Datapath::W16 => {
-                        run_item::<i16>(&img, fw, &tiles, own, None, false, timing, false)
+                        run_item::<i16>(&img, fw, &tiles, own, seed, None, false, timing, false)
                     }
                     Datapath::W32 => {
-                        run_item::<i32>(&img, fw, &tiles, own, None, false, timing, false)
+                        run_item::<i32>(&img, fw, &tiles, own, seed, None, false, timing, false)
                     }
                 };
                 (r, 0.0)
             })
             .collect::<Vec<(Result<Group>, f64)>>()
     };
-    let mut items = work_items(tiles.len(), rayon::current_num_threads(), false);
-    let mut runs = run(&items);
-    // As for a frame ([`wraps`]).
-    if wraps(&img, &items, &runs).is_some() {
-        items = std::iter::once(0..tiles.len()).collect();
-        runs = run(&items);
+    let items = work_items(tiles.len(), rayon::current_num_threads(), false);
+    let jobs: Vec<_> = items.iter().map(|r| (r.clone(), None)).collect();
+    let mut runs = run(&jobs);
+    // As for a frame ([`pass_seeds`]).
+    let again = pass_seeds(&img, &items, &runs);
+    if !again.is_empty() {
+        let jobs: Vec<_> = again
+            .iter()
+            .map(|&(i, seed)| (items[i].clone(), Some(seed)))
+            .collect();
+        for ((i, _), r) in again.iter().zip(run(&jobs)) {
+            runs[*i] = r;
+        }
     }
     let mut p = ProbeRender {
         cycles: 0,
@@ -1008,7 +1068,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             tiles.push((tx * tw, ty * th));
         }
     }
-    let mut items = match host.item_tiles {
+    let items = match host.item_tiles {
         Some(n) => {
             let n = n.max(1);
             (0..tiles.len().div_ceil(n))
@@ -1036,39 +1096,40 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     // chip and loading it, running it, reading its pixels back); one task
     // each, so that a thread that is done takes the next item rather than
     // half of a run of them.
-    let run = |items: &[std::ops::Range<usize>], trace: Option<rtl::trace::TraceConfig>| {
-        items
-            .par_iter()
+    // (item index, pass seed)
+    let run = |jobs: &[(usize, Option<u32>)]| {
+        jobs.par_iter()
             .with_max_len(1)
-            .enumerate()
-            .map(|(gi, own)| {
+            .map(|&(gi, seed)| {
                 let t0 = std::time::Instant::now();
-                let t = if gi == 0 { trace.clone() } else { None };
+                let t = if gi == 0 { host.trace.clone() } else { None };
                 let p = host.profile;
-                let (tm, own) = (&host.timing, own.clone());
+                let (tm, own) = (&host.timing, items[gi].clone());
                 let n = own.len() as u64;
                 let r = match fw.datapath {
-                    Datapath::W16 => run_item::<i16>(&img, &fw, &tiles, own, t, p, tm, progress),
-                    Datapath::W32 => run_item::<i32>(&img, &fw, &tiles, own, t, p, tm, progress),
+                    Datapath::W16 => {
+                        run_item::<i16>(&img, &fw, &tiles, own, seed, t, p, tm, progress)
+                    }
+                    Datapath::W32 => {
+                        run_item::<i32>(&img, &fw, &tiles, own, seed, t, p, tm, progress)
+                    }
                 };
                 bar.inc(n);
                 (r, t0.elapsed().as_secs_f64())
             })
             .collect::<Vec<(Result<Group>, f64)>>()
     };
-    let mut results = run(&items, host.trace.clone());
-    // A frame whose passes reach the firmware's `PASS_WRAP` (the paper's
-    // traversal: 16-bit pass numbers in the mailboxes, cleared when they
-    // wrap) clears its mailboxes where one chip's count of passes says, which
-    // items that count their own passes cannot know: it runs again as one
-    // item (its waveform, if any, kept from the first run).
-    if let Some(wrap) = wraps(&img, &items, &results) {
-        crate::note!(
-            "the frame's {wrap} passes or more wrap the firmware's pass numbers: run again on one chip"
-        );
-        bar.set_position(0);
-        items = std::iter::once(0..tiles.len()).collect();
-        results = run(&items, None);
+    let jobs: Vec<_> = (0..items.len()).map(|i| (i, None)).collect();
+    let mut results = run(&jobs);
+    // The items in which one chip's pass numbers wrap run again from the
+    // pass number one chip has there ([`pass_seeds`]).
+    let again = pass_seeds(&img, &items, &results);
+    if !again.is_empty() {
+        let jobs: Vec<_> = again.iter().map(|&(i, seed)| (i, Some(seed))).collect();
+        for ((i, _), r) in again.iter().zip(run(&jobs)) {
+            let seconds = results[*i].1 + r.1;
+            results[*i] = (r.0, seconds);
+        }
     }
     bar.finish_and_clear();
     let mut rgb8 = vec![0u8; (w * h * 3) as usize];

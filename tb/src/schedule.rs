@@ -297,14 +297,12 @@ mod tests {
             item: 0.5,
         };
         assert_eq!(f.items(1), vec![64.5]);
-        // Two threads: 8 items of 8 tiles, all but the first after a
-        // warm-up tile.
+        // Two threads: 4 items of 16 tiles (at least 16 tiles an item), all
+        // but the first after a warm-up tile.
         let two = f.items(2);
-        assert_eq!(two.len(), 8);
-        assert_eq!(two[0], 8.5);
-        assert!(two[1..].iter().all(|&t| t == 9.5));
-        // 8.5 | 9.5, then each thread three more: 37 and 38.
-        assert_eq!(frame_speedup(0.0, &f, 2), 64.5 / 38.0);
+        assert_eq!(two, vec![16.5, 17.5, 17.5, 17.5]);
+        // 16.5 | 17.5, then one more each: 34 and 35.
+        assert_eq!(frame_speedup(0.0, &f, 2), 64.5 / 35.0);
         assert_eq!(frame_speedup(1.0, &f, 1), 1.0);
     }
 
