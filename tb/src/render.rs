@@ -353,11 +353,12 @@ pub(crate) fn work_items(
 /// warm-up tile) is then as in one chip, and nothing carries further (the
 /// tile's rays, passes and leaf blocks are its own, and no RC's work
 /// depends on the hit records an earlier tile left: the tracer's shading
-/// reads only its pass's). Its own tiles count from the arrival at the first to the
-/// arrival at the tile after the last (where the list ends here, one chip
-/// would go on to the next tile), or to `halt` for the frame's last item.
-/// `tb/tests/render.rs` holds whole frames cut at every tile against one
-/// item on each traversal, resident and streamed.
+/// reads only its pass's), but for the paper's pass numbers
+/// ([`pass_seeds`]: `pass_seed`). Its own tiles count from the arrival at
+/// the first to the arrival at the tile after the last (where the list
+/// ends here, one chip would go on to the next tile), or to `halt` for the
+/// frame's last item. `tb/tests/render.rs` holds whole frames cut at every
+/// tile against one item on each traversal, resident and streamed.
 #[allow(clippy::too_many_arguments)]
 fn run_item<W: Word>(
     img: &Image,
@@ -414,7 +415,7 @@ fn run_item<W: Word>(
         .map(|s| s.addr as usize + s.data.len())
         .chain([
             mem::FB_IMAGE as usize + wb as usize * fw.fb.len(),
-            mem::TILE_LIST as usize + 4 + 12 * list.len(),
+            mem::TILE_LIST as usize + 4 + 12 * list.len().min(LIST_CHUNK),
             output as usize + out_bytes,
             above,
         ]);
