@@ -127,8 +127,11 @@ pub fn level() -> Simd {
 pub fn avx512() -> bool {
     #[cfg(all(target_arch = "x86_64", target_feature = "avx512bw"))]
     return true;
+    // The path's number alone, inlined into every caller (no call to
+    // choose it: the versions' dispatch, through `level`, has chosen it
+    // before any of them runs; unchosen reads as not AVX-512).
     #[cfg(all(target_arch = "x86_64", not(target_feature = "avx512bw")))]
-    return level() == Simd::Avx512;
+    return LEVEL.load(Ordering::Relaxed) == 3;
     #[cfg(not(target_arch = "x86_64"))]
     return false;
 }
