@@ -303,21 +303,19 @@ fn sym(img: &Image, name: &str) -> Result<u32> {
 /// the chip on the frame's first `TRACED_TILES` tiles (one item, whatever
 /// the thread count).
 pub const TRACED_TILES: usize = 32;
-/// Work items per host thread ([`work_items`]): enough that a thread done
-/// early takes another while the rest finish, few enough that the
-/// warm-up tiles stay a small share.
-const ITEMS_PER_THREAD: usize = 8;
-/// The fewest tiles a work item is cut to (about: the tiles are shared
-/// evenly).
+/// The fewest tiles a work item is cut to (but the frame's last): its
+/// warm-up tile and its chip's set-up stay a small share.
 const MIN_ITEM_TILES: usize = 16;
 /// Cycle budget of one tile on the chip (and of the start-up).
 pub(crate) const MAX_CYCLES_PER_TILE: u64 = 62_500_000;
 
 /// The frame's `tiles` (in the chip's order) cut into work items for
-/// `threads` host threads: one item on one thread, else about
-/// [`ITEMS_PER_THREAD`] per thread of at least [`MIN_ITEM_TILES`] tiles,
-/// contiguous and in order; with `traced`, the first [`TRACED_TILES`] are
-/// one item of their own. Any cut gives the same frame ([`run_item`]).
+/// `threads` host threads, taken in order by the first thread free
+/// ([`in_order`]): one item on one thread, else each item the tiles left
+/// over the thread count (at least [`MIN_ITEM_TILES`]), large ones first
+/// and small ones to even the threads out at the end (guided
+/// self-scheduling); with `traced`, the first [`TRACED_TILES`] are one
+/// item of their own. Any cut gives the same frame ([`run_item`]).
 pub(crate) fn work_items(
     tiles: usize,
     threads: usize,
@@ -328,17 +326,48 @@ pub(crate) fn work_items(
     if first > 0 {
         items.push(0..first);
     }
-    let rest = tiles - first;
-    if rest > 0 {
+    let mut at = first;
+    while at < tiles {
+        let left = tiles - at;
         let n = if threads <= 1 {
-            1
+            left
         } else {
-            (threads * ITEMS_PER_THREAD).min(rest.div_ceil(MIN_ITEM_TILES))
+            (left / threads).max(MIN_ITEM_TILES).min(left)
         };
-        let n = n.max(1);
-        items.extend((0..n).map(|i| first + i * rest / n..first + (i + 1) * rest / n));
+        items.push(at..at + n);
+        at += n;
     }
     items
+}
+
+/// `f` of `0..n` on the thread pool, each index taken in order by the first
+/// thread free (a work-stealing pool would start a second thread in the
+/// middle of the list); the results in index order.
+fn in_order<T: Send>(n: usize, f: impl Fn(usize) -> T + Sync) -> Vec<T> {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    let next = AtomicUsize::new(0);
+    let out: Vec<std::sync::Mutex<Option<T>>> =
+        (0..n).map(|_| std::sync::Mutex::new(None)).collect();
+    let take = || loop {
+        let k = next.fetch_add(1, Ordering::Relaxed);
+        if k >= n {
+            break;
+        }
+        let v = f(k);
+        if let Ok(mut slot) = out[k].lock() {
+            *slot = Some(v);
+        }
+    };
+    let workers = rayon::current_num_threads().min(n);
+    rayon::scope(|s| {
+        for _ in 1..workers {
+            s.spawn(|_| take());
+        }
+        take();
+    });
+    out.into_iter()
+        .filter_map(|m| m.into_inner().ok().flatten())
+        .collect()
 }
 
 /// Run the work item `own` of the frame's tile list `tiles` on a fresh
@@ -810,21 +839,18 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
     let run = |jobs: &[(std::ops::Range<usize>, Option<u32>)]| {
-        jobs.par_iter()
-            .with_max_len(1)
-            .map(|(own, seed)| {
-                let (own, seed) = (own.clone(), *seed);
-                let r = match fw.datapath {
-                    Datapath::W16 => {
-                        run_item::<i16>(&img, fw, &tiles, own, seed, None, false, timing, false)
-                    }
-                    Datapath::W32 => {
-                        run_item::<i32>(&img, fw, &tiles, own, seed, None, false, timing, false)
-                    }
-                };
-                (r, 0.0)
-            })
-            .collect::<Vec<(Result<Group>, f64)>>()
+        in_order(jobs.len(), |k| {
+            let (own, seed) = (jobs[k].0.clone(), jobs[k].1);
+            let r = match fw.datapath {
+                Datapath::W16 => {
+                    run_item::<i16>(&img, fw, &tiles, own, seed, None, false, timing, false)
+                }
+                Datapath::W32 => {
+                    run_item::<i32>(&img, fw, &tiles, own, seed, None, false, timing, false)
+                }
+            };
+            (r, 0.0)
+        })
     };
     let items = work_items(tiles.len(), rayon::current_num_threads(), false);
     let jobs: Vec<_> = items.iter().map(|r| (r.clone(), None)).collect();
@@ -1094,31 +1120,24 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         ProgressBar::hidden()
     };
     // Each work item with the host seconds of all its work (building the
-    // chip and loading it, running it, reading its pixels back); one task
-    // each, so that a thread that is done takes the next item rather than
-    // half of a run of them.
+    // chip and loading it, running it, reading its pixels back), taken in
+    // order by the first thread free.
     // (item index, pass seed)
     let run = |jobs: &[(usize, Option<u32>)]| {
-        jobs.par_iter()
-            .with_max_len(1)
-            .map(|&(gi, seed)| {
-                let t0 = std::time::Instant::now();
-                let t = if gi == 0 { host.trace.clone() } else { None };
-                let p = host.profile;
-                let (tm, own) = (&host.timing, items[gi].clone());
-                let n = own.len() as u64;
-                let r = match fw.datapath {
-                    Datapath::W16 => {
-                        run_item::<i16>(&img, &fw, &tiles, own, seed, t, p, tm, progress)
-                    }
-                    Datapath::W32 => {
-                        run_item::<i32>(&img, &fw, &tiles, own, seed, t, p, tm, progress)
-                    }
-                };
-                bar.inc(n);
-                (r, t0.elapsed().as_secs_f64())
-            })
-            .collect::<Vec<(Result<Group>, f64)>>()
+        in_order(jobs.len(), |k| {
+            let (gi, seed) = jobs[k];
+            let t0 = std::time::Instant::now();
+            let t = if gi == 0 { host.trace.clone() } else { None };
+            let p = host.profile;
+            let (tm, own) = (&host.timing, items[gi].clone());
+            let n = own.len() as u64;
+            let r = match fw.datapath {
+                Datapath::W16 => run_item::<i16>(&img, &fw, &tiles, own, seed, t, p, tm, progress),
+                Datapath::W32 => run_item::<i32>(&img, &fw, &tiles, own, seed, t, p, tm, progress),
+            };
+            bar.inc(n);
+            (r, t0.elapsed().as_secs_f64())
+        })
     };
     let jobs: Vec<_> = (0..items.len()).map(|i| (i, None)).collect();
     let mut results = run(&jobs);

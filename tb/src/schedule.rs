@@ -3,14 +3,14 @@
 //!
 //! A render is a serial part (building the firmware and the scene image,
 //! assembling, putting the image together) and independent work items
-//! (runs of its tiles, a chip each), which the host's threads take from a
-//! work-stealing pool. The items depend on the thread count
-//! ([`crate::render::work_items`]): the model cuts the frame as `n` threads
-//! would from the host seconds of each tile and of an item's own work
-//! (building and loading its chip, its start-up), measured on one thread
-//! ([`FrameWork`]). The model takes the items in order, each by the first thread to
-//! be free (list scheduling, which a work-stealing pool approaches), so
-//! the items' makespan on `n` threads is at least the longest item and at
+//! (runs of its tiles, a chip each), which the host's threads take in
+//! order, each by the first thread free. The items depend on the thread
+//! count ([`crate::render::work_items`]): the model cuts the frame as `n`
+//! threads would from the host seconds of each tile and of an item's own
+//! work (building and loading its chip, its start-up), measured on one
+//! thread ([`FrameWork`]), and takes the items in order, each by the first
+//! thread to be free (list scheduling, as the render runs them), so the
+//! items' makespan on `n` threads is at least the longest item and at
 //! least their sum over `n`; the predicted time is the serial part plus
 //! that makespan. On this machine the model's prediction for its own
 //! thread count is printed beside the measured figure, which checks it.
@@ -297,11 +297,11 @@ mod tests {
             item: 0.5,
         };
         assert_eq!(f.items(1), vec![64.5]);
-        // Two threads: 4 items of 16 tiles (at least 16 tiles an item), all
-        // but the first after a warm-up tile.
+        // Two threads: each item the tiles left over two, at least 16 (32,
+        // 16, 16), all but the first after a warm-up tile.
         let two = f.items(2);
-        assert_eq!(two, vec![16.5, 17.5, 17.5, 17.5]);
-        // 16.5 | 17.5, then one more each: 34 and 35.
+        assert_eq!(two, vec![32.5, 17.5, 17.5]);
+        // 32.5 | 17.5, then the second thread's next: 35.
         assert_eq!(frame_speedup(0.0, &f, 2), 64.5 / 35.0);
         assert_eq!(frame_speedup(1.0, &f, 1), 1.0);
     }
