@@ -75,31 +75,26 @@ impl Names {
 }
 
 /// Step `sim` to its halt (an error past `max_cycles`), charging every cycle;
-/// with `stop` `(pc, n)`, only until TinyRISC's PC comes to `pc` for the
-/// `n`-th time (an arrival: the PC is `pc` and was not in the cycle
-/// before), that cycle not run.
+/// with `stop`, only until TinyRISC's PC comes to it (an arrival: the PC
+/// is `stop` and was not in the cycle before), that cycle not run.
 pub fn run<W: Word>(
     sim: &mut Sim<Chip<W>>,
     names: &Names,
     max_cycles: u64,
-    stop: Option<(u32, u32)>,
+    stop: Option<u32>,
 ) -> Result<Profile, rtl::chip::RunError> {
     let mut k: BTreeMap<&str, u64> = BTreeMap::new();
     let mut c: BTreeMap<&str, u64> = BTreeMap::new();
     let mut cycles = 0u64;
-    let mut arrivals = 0;
-    let mut was_at = stop.is_some_and(|(pc, _)| sim.top.risc.pc == pc);
+    let mut was_at = stop.is_some_and(|pc| sim.top.risc.pc == pc);
     while !sim.top.halted() {
         if sim.cycle() >= max_cycles {
             return Err(rtl::chip::over_budget(sim));
         }
-        if let Some((pc, n)) = stop {
+        if let Some(pc) = stop {
             let at = sim.top.risc.pc == pc;
             if at && !was_at {
-                arrivals += 1;
-                if arrivals == n {
-                    break;
-                }
+                break;
             }
             was_at = at;
         }

@@ -680,6 +680,28 @@ fn feed<W: Word>(
     Ok(to)
 }
 
+/// `run` (item index, pass seed) of every one of `items`, taken in order by
+/// the first thread free ([`in_order`]); then the items in which one chip's
+/// pass numbers wrap again, from the number one chip has there
+/// ([`pass_seeds`]), their host seconds added to the first run's.
+fn run_items(
+    img: &Image,
+    items: &[std::ops::Range<usize>],
+    run: impl Fn(usize, Option<u32>) -> (Result<Group>, f64) + Sync,
+) -> Vec<(Result<Group>, f64)> {
+    let mut results = in_order(items.len(), |i| run(i, None));
+    let again = pass_seeds(img, items, &results);
+    for (i, r) in in_order(again.len(), |k| run(again[k].0, Some(again[k].1)))
+        .into_iter()
+        .enumerate()
+    {
+        let i = again[i].0;
+        let seconds = results[i].1 + r.1;
+        results[i] = (r.0, seconds);
+    }
+    results
+}
+
 /// The items to run again, each with the pass number one chip has before
 /// its list's first tile: those in which one chip's pass numbers wrap.
 ///
@@ -746,7 +768,7 @@ fn advance<W: Word>(
 ) -> std::result::Result<bool, rtl::chip::RunError> {
     let budget = sim.cycle() + MAX_CYCLES_PER_TILE;
     if let Some(names) = names {
-        let p = crate::profile::run(sim, names, budget, Some((pc, 1)).filter(|_| pc != u32::MAX))?;
+        let p = crate::profile::run(sim, names, budget, Some(pc).filter(|&pc| pc != u32::MAX))?;
         *prof = Some(match prof.take() {
             None => p,
             Some(q) => crate::profile::Profile::merge(q, p),
@@ -838,34 +860,19 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
     }
     let img = asm::assemble(&fw.source, "tracer.s")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
-    let run = |jobs: &[(std::ops::Range<usize>, Option<u32>)]| {
-        in_order(jobs.len(), |k| {
-            let (own, seed) = (jobs[k].0.clone(), jobs[k].1);
-            let r = match fw.datapath {
-                Datapath::W16 => {
-                    run_item::<i16>(&img, fw, &tiles, own, seed, None, false, timing, false)
-                }
-                Datapath::W32 => {
-                    run_item::<i32>(&img, fw, &tiles, own, seed, None, false, timing, false)
-                }
-            };
-            (r, 0.0)
-        })
-    };
     let items = work_items(tiles.len(), rayon::current_num_threads(), false);
-    let jobs: Vec<_> = items.iter().map(|r| (r.clone(), None)).collect();
-    let mut runs = run(&jobs);
-    // As for a frame ([`pass_seeds`]).
-    let again = pass_seeds(&img, &items, &runs);
-    if !again.is_empty() {
-        let jobs: Vec<_> = again
-            .iter()
-            .map(|&(i, seed)| (items[i].clone(), Some(seed)))
-            .collect();
-        for ((i, _), r) in again.iter().zip(run(&jobs)) {
-            runs[*i] = r;
-        }
-    }
+    let runs = run_items(&img, &items, |gi, seed| {
+        let own = items[gi].clone();
+        let r = match fw.datapath {
+            Datapath::W16 => {
+                run_item::<i16>(&img, fw, &tiles, own, seed, None, false, timing, false)
+            }
+            Datapath::W32 => {
+                run_item::<i32>(&img, fw, &tiles, own, seed, None, false, timing, false)
+            }
+        };
+        (r, 0.0)
+    });
     let mut p = ProbeRender {
         cycles: 0,
         pixels: Vec::new(),
@@ -1120,37 +1127,20 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         ProgressBar::hidden()
     };
     // Each work item with the host seconds of all its work (building the
-    // chip and loading it, running it, reading its pixels back), taken in
-    // order by the first thread free.
-    // (item index, pass seed)
-    let run = |jobs: &[(usize, Option<u32>)]| {
-        in_order(jobs.len(), |k| {
-            let (gi, seed) = jobs[k];
-            let t0 = std::time::Instant::now();
-            let t = if gi == 0 { host.trace.clone() } else { None };
-            let p = host.profile;
-            let (tm, own) = (&host.timing, items[gi].clone());
-            let n = own.len() as u64;
-            let r = match fw.datapath {
-                Datapath::W16 => run_item::<i16>(&img, &fw, &tiles, own, seed, t, p, tm, progress),
-                Datapath::W32 => run_item::<i32>(&img, &fw, &tiles, own, seed, t, p, tm, progress),
-            };
-            bar.inc(n);
-            (r, t0.elapsed().as_secs_f64())
-        })
-    };
-    let jobs: Vec<_> = (0..items.len()).map(|i| (i, None)).collect();
-    let mut results = run(&jobs);
-    // The items in which one chip's pass numbers wrap run again from the
-    // pass number one chip has there ([`pass_seeds`]).
-    let again = pass_seeds(&img, &items, &results);
-    if !again.is_empty() {
-        let jobs: Vec<_> = again.iter().map(|&(i, seed)| (i, Some(seed))).collect();
-        for ((i, _), r) in again.iter().zip(run(&jobs)) {
-            let seconds = results[*i].1 + r.1;
-            results[*i] = (r.0, seconds);
-        }
-    }
+    // chip and loading it, running it, reading its pixels back).
+    let results = run_items(&img, &items, |gi, seed| {
+        let t0 = std::time::Instant::now();
+        let t = if gi == 0 { host.trace.clone() } else { None };
+        let p = host.profile;
+        let (tm, own) = (&host.timing, items[gi].clone());
+        let n = own.len() as u64;
+        let r = match fw.datapath {
+            Datapath::W16 => run_item::<i16>(&img, &fw, &tiles, own, seed, t, p, tm, progress),
+            Datapath::W32 => run_item::<i32>(&img, &fw, &tiles, own, seed, t, p, tm, progress),
+        };
+        bar.inc(n);
+        (r, t0.elapsed().as_secs_f64())
+    });
     bar.finish_and_clear();
     let mut rgb8 = vec![0u8; (w * h * 3) as usize];
     let mut hits = vec![NO_HIT; (w * h) as usize];

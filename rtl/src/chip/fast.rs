@@ -59,7 +59,8 @@ impl<W: Word> Chip<W> {
 
     crate::simd::versions! {
         /// Cycles while the DMA is idle, until it starts, TinyRISC halts, a
-        /// fault, or `limit`; three kinds, each with less to do than a plain
+        /// fault, `limit`, or before a cycle at the stop PC of
+        /// [`run_to_pc`]; three kinds, each with less to do than a plain
         /// cycle:
         ///
         /// * TinyRISC waits for the array while a run streams: the broadcast
