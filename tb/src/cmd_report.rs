@@ -127,9 +127,13 @@ pub fn sections() -> Vec<Section> {
             title: "The 16-bit and the 32-bit chip",
             about: "The same firmware on the paper's 16-bit datapath and on the 32-bit one the \
                     paper announces for the next chip (`docs/isa.md`, section 1a): 16 more \
-                    fraction bits, the same context word, TinyRISC and timing. The model charges \
-                    a 32-bit operation one cycle like a 16-bit one; what it would cost in \
-                    silicon is not modelled.",
+                    fraction bits, the same context word, TinyRISC and timing, in the same \
+                    cycles. What the 16 more bits cost in silicon comes from the RC in Verilog \
+                    synthesized by Yosys (`morphosys cost`, `docs/silicon.md`): the 32-bit RC's \
+                    longest path sets an estimated clock (300 MHz for the 16-bit RC, scaled by \
+                    path depth), and its array of 64 RCs with their RAM has more transistors; \
+                    the last frame-rate column divides the frame rate at the estimated clock \
+                    by the array's transistors in millions. Relative estimates, not a sign-off.",
             checked: true,
             write: datapath,
         },
@@ -494,7 +498,7 @@ fn f(j: &Value, k: &str) -> f64 {
 }
 
 /// 12,345,678
-fn thousands(n: u64) -> String {
+pub(crate) fn thousands(n: u64) -> String {
     let s = n.to_string();
     let mut out = String::new();
     for (i, c) in s.chars().enumerate() {

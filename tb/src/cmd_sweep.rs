@@ -12,6 +12,10 @@
 //!   with the Pareto front; the datapath-width series (the paper's
 //!   configuration on the 16-bit chip and on the 32-bit variant) has hollow
 //!   markers for the 32-bit chip;
+//! * `pareto_cost.{svg,png}`: the same points with the silicon's price on
+//!   the speed axis: frames/s at each datapath's estimated clock per
+//!   million transistors of its array (`morphosys cost`), so that the
+//!   32-bit chip's larger, slower RCs count;
 //! * `scaling.{svg,png}`: chip cycles per frame against primitive count,
 //!   over SPD families generated at sizes 1 to `--max-size` (balls and
 //!   tetra by default, at a smaller image, 64x64), one series per family
@@ -427,6 +431,15 @@ struct Row {
     format: String,
     cycles: u64,
     fps_at_300mhz: f64,
+    /// What the configuration's silicon costs (`morphosys cost`): the
+    /// clock its RC's path depth allows (300 MHz for the 16-bit RC), the
+    /// frame rate at that clock, the transistors of the array's 64 RCs
+    /// with their RAM, and frames/s per million of those transistors at
+    /// the estimated clock.
+    clock_mhz_estimate: f64,
+    fps_at_estimated_clock: f64,
+    array_transistors: u64,
+    fps_per_m_transistors: f64,
     psnr_db: f64,
     hit_agreement: f64,
     active_rc_fraction: f64,
@@ -593,6 +606,10 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
     let (opt, nm) = (&c.opt, &c.nm);
     let f = |n: &str| j[n].as_f64().unwrap_or(f64::NAN);
     let s = |n: &str| j[n].as_str().unwrap_or("?").to_string();
+    let cost = crate::cost::Synthesis::committed();
+    let clock = cost.clock_mhz(opt.datapath);
+    let fps_at_clock = f("fps_at_300mhz") * clock / crate::cost::CLOCK_MHZ_16;
+    let array = cost.array_transistors(opt.datapath);
     Row {
         scene: scene.into(),
         primitives,
@@ -619,6 +636,10 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
         format: s("format"),
         cycles: j["cycles"].as_u64().unwrap_or(0),
         fps_at_300mhz: f("fps_at_300mhz"),
+        clock_mhz_estimate: clock,
+        fps_at_estimated_clock: fps_at_clock,
+        array_transistors: array,
+        fps_per_m_transistors: fps_at_clock / (array as f64 / 1e6),
         psnr_db: f("psnr_db"),
         hit_agreement: f("hit_agreement"),
         active_rc_fraction: f("active_rc_fraction"),

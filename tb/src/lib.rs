@@ -13,6 +13,7 @@ pub mod cmd_run;
 pub mod cmd_scene;
 pub mod cmd_spd;
 pub mod cmd_sweep;
+pub mod cost;
 pub mod fuzz;
 pub mod inputs;
 pub mod metrics;

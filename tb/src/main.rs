@@ -43,7 +43,11 @@ enum Command {
     /// give (the schedule model).
     Bench(tb::cmd_bench::BenchArgs),
     /// Render scenes under many configurations (ways, recursion, BSP depth,
-    /// leaf size, split rule) and chart frame rate against image quality.
+    /// leaf size, split rule, datapath) and chart frame rate against image
+    /// quality, also with the silicon's cost on the speed axis (frames/s
+    /// at each datapath's estimated clock per million array transistors,
+    /// from `morphosys cost`; results.csv: clock_mhz_estimate,
+    /// array_transistors, fps_per_m_transistors).
     Sweep(tb::cmd_sweep::SweepCli),
     /// Print a shell completion script: `morphosys completions bash >
     /// ~/.local/share/bash-completion/completions/morphosys` (zsh: into a
@@ -58,6 +62,11 @@ enum Command {
     /// Fuzz the scene parsers, the assembler and the program loader with
     /// mutated and random inputs; any panic or unlocated error is a finding.
     Fuzz(tb::cmd_fuzz::FuzzArgs),
+    /// What the RC costs in silicon: the Verilog RC (rtl/verilog/)
+    /// synthesized by Yosys per unit at 16 and 32 bits: cells, transistors,
+    /// path depth, the array's area and a clock estimate (from the
+    /// committed results; --synthesize runs Yosys).
+    Cost(tb::cost::CostArgs),
     /// Run a testbench: drive a block of the chip, check it against a
     /// reference model, write its waveform.
     Tb {
@@ -86,6 +95,11 @@ enum Bench {
     /// One Reconfigurable Cell: every ALU, shifter, multiplier, register-file
     /// and RAM operation, checked against an independent reference model.
     Rc(tb::testbench::rc::RcArgs),
+    /// The RC in Verilog (rtl/verilog/) against the Rust RC, cycle for
+    /// cycle under Verilator: the RC testbench's stream and random context
+    /// streams, both widths; the first difference is printed with the cycle,
+    /// the context and both states.
+    Cosim(tb::testbench::cosim::CosimArgs),
 }
 
 fn run(cli: Cli) -> anyhow::Result<()> {
@@ -108,8 +122,10 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }
         Command::Timing(a) => tb::timing::command(a),
         Command::Fuzz(a) => tb::cmd_fuzz::run(a),
+        Command::Cost(a) => tb::cost::command(a),
         Command::Tb { bench } => match bench {
             Bench::Rc(a) => tb::testbench::rc::command(a.vcd, a.window, a.json),
+            Bench::Cosim(a) => tb::testbench::cosim::command(a),
         },
         Command::Reference(a) => tb::cmd_scene::reference(a),
         Command::Compile(a) => tb::cmd_scene::compile_cmd(a),

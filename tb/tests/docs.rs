@@ -49,6 +49,21 @@ enum Special {
 /// (document, command as written, what to do).
 const SPECIAL: &[(&str, &str, Special)] = &[
     (
+        "README.md",
+        "morphosys tb cosim",
+        Special::CoveredBy("cosim.rs", "the_verilog_rc_is_the_rust_rc_cycle_for_cycle"),
+    ),
+    (
+        "docs/silicon.md",
+        "morphosys tb cosim",
+        Special::CoveredBy("cosim.rs", "the_verilog_rc_is_the_rust_rc_cycle_for_cycle"),
+    ),
+    (
+        "docs/silicon.md",
+        "morphosys cost --synthesize",
+        Special::CoveredBy("cost.rs", "the_committed_synthesis_is_what_yosys_gives"),
+    ),
+    (
         "docs/testing.md",
         "cargo test --workspace -- --ignored",
         Special::Skip("the tests .ci/run runs after this one, where their tools are installed"),
@@ -685,6 +700,7 @@ const DOCUMENTS: &[&str] = &[
     "docs/testing.md",
     "docs/cluster.md",
     "docs/performance.md",
+    "docs/silicon.md",
 ];
 
 #[test]
@@ -736,6 +752,11 @@ fn waveforms_commands_run_as_written() {
 #[test]
 fn testing_commands_run_as_written() {
     check_document("docs/testing.md");
+}
+
+#[test]
+fn silicon_commands_run_as_written() {
+    check_document("docs/silicon.md");
 }
 
 /// Every document is checked, and every exception still names a command a

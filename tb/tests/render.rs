@@ -557,6 +557,31 @@ fn sweep_has_the_datapath_width_series() {
         .filter(|r| &r[col("knob")] != "datapath")
         .all(|r| &r[col("datapath_bits")] == "16"));
     assert!(dir.path().join("sw/pareto.png").is_file());
+    // The silicon's cost: the array's transistors and the estimated clock
+    // of each width, from the committed synthesis read here as JSON.
+    let cost: serde_json::Value = serde_json::from_str(tb::cost::COMMITTED).unwrap();
+    let unit = |name: &str, bits: u64| {
+        cost["units"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|u| u["unit"] == name && u["datapath_bits"] == bits)
+            .unwrap()
+            .clone()
+    };
+    for (r, bits) in [(&r16, 16u64), (&r32, 32)] {
+        let rc = unit("rc", bits);
+        let array = 64 * (rc["transistors"].as_u64().unwrap() + 512 * bits * 6);
+        assert_eq!(r[col("array_transistors")], array.to_string());
+        let clock = 300.0 * unit("rc", 16)["path_depth"].as_f64().unwrap()
+            / rc["path_depth"].as_f64().unwrap();
+        let got = r[col("clock_mhz_estimate")].parse::<f64>().unwrap();
+        assert!((got - clock).abs() < 1e-9, "{got} {clock}");
+        let fps = r[col("fps_at_300mhz")].parse::<f64>().unwrap();
+        let per = r[col("fps_per_m_transistors")].parse::<f64>().unwrap();
+        assert!((per - fps * clock / 300.0 / (array as f64 / 1e6)).abs() < 1e-6 * per);
+    }
+    assert!(dir.path().join("sw/pareto_cost.png").is_file());
 }
 
 /// balls-4 (7,382 objects, streamed) on the 32-bit chip: its smallest

@@ -135,16 +135,26 @@ pub(super) fn large(r: &mut Runner) -> Result<String> {
 }
 
 pub(super) fn datapath(r: &mut Runner) -> Result<String> {
+    let cost = crate::cost::Synthesis::committed();
     let mut rows = Vec::new();
     for s in PAPER_SCENES {
         for bits in ["16", "32"] {
             let j = r.render(s, &["--datapath", bits])?;
+            let dp = rtl::rc::Datapath::from_bits(bits.parse()?).expect("16 or 32");
+            let clock = cost.clock_mhz(dp);
+            let at_clock = f(&j, "fps_at_300mhz") * clock / crate::cost::CLOCK_MHZ_16;
             rows.push(vec![
                 format!("`{}`", short(s)),
                 bits.into(),
                 j["format"].as_str().unwrap_or("?").into(),
                 thousands(u(&j, "cycles")),
                 fps(&j),
+                format!("{clock:.0}"),
+                sig3(at_clock),
+                format!(
+                    "{:.2}",
+                    at_clock / (cost.array_transistors(dp) as f64 / 1e6)
+                ),
                 psnr(&j),
                 hits(&j),
             ]);
@@ -157,7 +167,10 @@ pub(super) fn datapath(r: &mut Runner) -> Result<String> {
             "bits",
             "format",
             "cycles",
-            "frames/s",
+            "frames/s at 300 MHz",
+            "clock est. (MHz)",
+            "frames/s at that clock",
+            "per M array transistors",
             "PSNR (dB)",
             "hits",
         ],
@@ -418,6 +431,7 @@ pub(super) fn published(r: &mut Runner) -> Result<String> {
 /// The charts `sweep` draws, as this document shows them.
 pub(super) const CHARTS: &[(&str, &str)] = &[
     ("pareto", "PSNR against frames/s, one knob at a time, each scene's Pareto front; the triangles mark the paper's configuration, the hollow markers the 32-bit chip"),
+    ("pareto_cost", "The same points with the silicon's price on the speed axis: frames/s at each datapath's estimated clock per million transistors of its array (`morphosys cost`); the 32-bit chip's points (hollow) move left by its larger, slower RCs"),
     ("fig8", "Frames/s against rays in parallel (the paper's Fig. 8), with the paper's 13.3 frames/s at 64 ways"),
     ("fig8_active", "Active RCs per ray lane against ways (set-up contexts run on all 64 RCs before the unused ones sleep)"),
     ("scaling", "Cycles per frame against objects, SPD families at sizes 1 to 4 (64x64), both traversals; the legend gives each series' fitted log-log slope"),

@@ -154,6 +154,47 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             log_y: false,
         },
     )?);
+    // The same points with the silicon's price on the speed axis.
+    let cost = crate::cost::Synthesis::committed();
+    let (w16, w32) = (
+        firmware::tracer::Datapath::W16,
+        firmware::tracer::Datapath::W32,
+    );
+    let priced: Vec<Series> = scenes
+        .iter()
+        .map(|s| {
+            let mine: Vec<&Row> = rows.iter().filter(|r| r.scene == *s).collect();
+            Series {
+                name: short(s),
+                points: mine
+                    .iter()
+                    .map(|r| (r.fps_per_m_transistors, r.psnr_db))
+                    .collect(),
+                style: SeriesStyle {
+                    hollow: mine.iter().map(|r| r.datapath_bits == 32).collect(),
+                    ..SeriesStyle::default()
+                },
+            }
+        })
+        .collect();
+    out.extend(charts::write(
+        &dir.join("pareto_cost"),
+        &Chart {
+            title: format!(
+                "Speed for the silicon against accuracy (hollow: 32-bit, {:.1}x area, {:.0} MHz est.)",
+                cost.array_transistors(w32) as f64 / cost.array_transistors(w16) as f64,
+                cost.clock_mhz(w32)
+            ),
+            x_label: "frames/s at the estimated clock per million array transistors".into(),
+            y_label: "PSNR against the f64 reference (dB)".into(),
+            series: priced,
+            marks: vec![],
+            lines: false,
+            log_x: true,
+            pareto: true,
+            log_y: false,
+        },
+    )?);
     // Coarse against fine normals: PSNR against cycles per scene, the
     // arrow's tail the kernels as first written.
     let normals: Vec<Series> = scenes
