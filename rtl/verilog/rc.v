@@ -38,8 +38,10 @@ module rc #(
     output wire [W-1:0]  ram_wdata
 `ifdef COSIM
     ,
-    input  wire [8:0]    peek_addr,
-    output wire [W-1:0]  peek
+    input  wire [8:0]    peek_addr,  // test bench: a RAM word
+    output wire [W-1:0]  peek,
+    input  wire [3:0]    peek_reg,   // and a register
+    output wire [W-1:0]  peek_reg_q
 `endif
 );
 `include "rc_isa.vh"
@@ -126,6 +128,9 @@ module rc #(
     rc_register_file #(.W(W)) regfile (
         .clk(clk), .ra(ra), .rb(rb), .a(rf_a), .b(rf_b),
         .we(ex & has_result & we), .rd(rd), .d(res), .state(regs)
+`ifdef COSIM
+        , .peek_k(peek_reg), .peek_q(peek_reg_q)
+`endif
     );
 
     rc_flags flags (

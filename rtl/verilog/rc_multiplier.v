@@ -45,12 +45,13 @@ module rc_multiplier #(
     wire         acc_ovf = ~(acc[A-1] ^ q[A-1]) & (acc[A-1] ^ sum[A-1]);
     wire [A-1:0] acc_sat = acc_ovf ? (acc[A-1] ? AMIN : AMAX) : sum;
 
-    // ldacc: a * 2^sh in 3W bits is exact (sh < 2W), then clamped.
-    wire [5:0]            lsh = sh & SMASK;
-    wire signed [3*W-1:0] ld_wide = $signed({{(2*W){a[W-1]}}, a}) <<< lsh;
-    wire [A-1:0] ld = ld_wide > $signed({{W{1'b0}}, AMAX}) ? AMAX
-                    : ld_wide < $signed({{W{1'b1}}, AMIN}) ? AMIN
-                    : ld_wide[A-1:0];
+    // ldacc: a * 2^sh saturates where shifting back does not give a
+    // again (sh < 2W: the shift field is masked to the accumulator).
+    wire [5:0]   lsh = sh & SMASK;
+    wire [A-1:0] a_ext = {{W{a[W-1]}}, a};
+    wire [A-1:0] ld_up = a_ext << lsh;
+    wire         ld_fits = ($signed(ld_up) >>> lsh) == $signed(a_ext);
+    wire [A-1:0] ld = ld_fits ? ld_up : a[W-1] ? AMIN : AMAX;
 
     reg [A-1:0] acc_d;
     always @* begin

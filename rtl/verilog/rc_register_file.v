@@ -14,6 +14,11 @@ module rc_register_file #(
     input  wire [3:0]    rd,
     input  wire [W-1:0]  d,
     output wire [16*W-1:0] state
+`ifdef COSIM
+    ,
+    input  wire [3:0]    peek_k,    // a third read port for the test bench
+    output wire [W-1:0]  peek_q
+`endif
 );
     reg [W-1:0] r [0:15];
 
@@ -30,6 +35,9 @@ module rc_register_file #(
         end
     endgenerate
 
+`ifdef COSIM
+    assign peek_q = r[peek_k];
+`endif
 `ifndef SYNTHESIS
     integer i;
     initial for (i = 0; i < 16; i = i + 1) r[i] = {W{1'b0}};

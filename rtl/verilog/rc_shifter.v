@@ -1,7 +1,7 @@
 // The RC's barrel shifter (rtl/src/rc/shifter.rs). The amount is operand
 // B's low 5 bits (W = 16) or 6 bits (W = 32); shifts by W or more give 0
 // (sll, srl) or the sign fill (sra). asl multiplies by 2^n and saturates,
-// V = saturated.
+// V = saturated. Nothing is wider than the word.
 module rc_shifter #(
     parameter W = 16
 ) (
@@ -27,20 +27,20 @@ module rc_shifter #(
     wire          big = n >= WN;                           // the whole word out
     wire [AW-1:0] n_sra = big ? WN1 : n;
 
-    // asl: a * 2^min(n, W) in 2W + 1 bits is exact (|a| <= 2^(W-1)); a
-    // non-zero a shifted by W or more saturates either way.
-    wire [AW-1:0]      n_asl = big ? WN : n;
-    wire signed [2*W:0] wide = $signed({{(W+1){a[W-1]}}, a}) <<< n_asl;
-    wire over  = wide > $signed({{(W+1){1'b0}}, MAX});
-    wire under = wide < $signed({{(W+1){1'b1}}, MIN});
-    assign v_out = over | under;
+    // asl: a * 2^n saturates where shifting back does not give a again
+    // (a bit unlike the sign left the word); a non-zero a shifted by W or
+    // more always does, towards its sign.
+    wire [W-1:0] up = a << n;
+    wire         fits = ~big & (($signed(up) >>> n) == $signed(a));
+    wire         sat = (a != {W{1'b0}}) & ~fits;
+    assign v_out = sat;
 
     always @* begin
         case (op)
             OP_SLL:  res = big ? {W{1'b0}} : a << n;
             OP_SRL:  res = big ? {W{1'b0}} : a >> n;
             OP_SRA:  res = $signed(a) >>> n_sra;
-            default: res = over ? MAX : under ? MIN : wide[W-1:0];   // asl
+            default: res = ~sat ? up : a[W-1] ? MIN : MAX;             // asl
         endcase
     end
 endmodule

@@ -40,9 +40,14 @@ fn the_committed_results_hold_together() {
         assert_eq!(rc.flip_flops, 16 * w + w + 2 * w + 4, "{dp}");
         assert_eq!(s.unit("rc_register_file", dp).unwrap().flip_flops, 16 * w);
         assert_eq!(s.unit("rc_multiplier", dp).unwrap().flip_flops, 2 * w);
+        let ic = s.unit("rc_interconnect", dp).unwrap();
+        assert_eq!(
+            ic.flip_flops, 0,
+            "the interconnect is wires and multiplexers"
+        );
         assert_eq!(
             s.array_transistors(dp),
-            64 * (rc.transistors + 512 * w * 6),
+            64 * (rc.transistors + 512 * w * 6) + ic.transistors,
             "{dp}"
         );
     }
@@ -69,7 +74,7 @@ fn cost_prints_the_table_and_writes_json() {
     assert!(ok, "{err}");
     for what in [
         "multiplier + accumulator (rc_multiplier)",
-        "array of 64 RCs",
+        "array: 64 RCs with RAM, interconnect",
         "clock estimate",
         "not a sign-off",
     ] {

@@ -60,6 +60,21 @@ const SPECIAL: &[(&str, &str, Special)] = &[
     ),
     (
         "docs/silicon.md",
+        "morphosys tb cosim --bench",
+        Special::Skip("a measurement of Verilator against this model (minutes of Verilator builds); the co-simulation it builds runs in cosim.rs"),
+    ),
+    (
+        "docs/performance.md",
+        "morphosys tb cosim --random 0 --array 0 --bench",
+        Special::Skip("a measurement of Verilator against this model (minutes of Verilator builds); the co-simulation it builds runs in cosim.rs"),
+    ),
+    (
+        "docs/performance.md",
+        "morphosys bench --repeat 3",
+        Special::RunAs("morphosys bench --repeat 1", "a measurement, not a check: run once"),
+    ),
+    (
+        "docs/silicon.md",
         "morphosys cost --synthesize",
         Special::CoveredBy("cost.rs", "the_committed_synthesis_is_what_yosys_gives"),
     ),

@@ -569,12 +569,20 @@ fn sweep_has_the_datapath_width_series() {
             .unwrap()
             .clone()
     };
+    let depth = |bits: u64| {
+        unit("rc", bits)["path_depth"].as_f64().unwrap()
+            + unit("rc_interconnect", bits)["path_depth"]
+                .as_f64()
+                .unwrap()
+    };
     for (r, bits) in [(&r16, 16u64), (&r32, 32)] {
         let rc = unit("rc", bits);
-        let array = 64 * (rc["transistors"].as_u64().unwrap() + 512 * bits * 6);
+        let array = 64 * (rc["transistors"].as_u64().unwrap() + 512 * bits * 6)
+            + unit("rc_interconnect", bits)["transistors"]
+                .as_u64()
+                .unwrap();
         assert_eq!(r[col("array_transistors")], array.to_string());
-        let clock = 300.0 * unit("rc", 16)["path_depth"].as_f64().unwrap()
-            / rc["path_depth"].as_f64().unwrap();
+        let clock = 300.0 * depth(16) / depth(bits);
         let got = r[col("clock_mhz_estimate")].parse::<f64>().unwrap();
         assert!((got - clock).abs() < 1e-9, "{got} {clock}");
         let fps = r[col("fps_at_300mhz")].parse::<f64>().unwrap();

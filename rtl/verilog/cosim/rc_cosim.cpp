@@ -16,20 +16,11 @@
 
 #include "Vrc.h"
 #include "verilated.h"
+#include "bits.h"
 
 #ifndef RC_W
 #error "RC_W (16 or 32) must be defined"
 #endif
-
-template <typename T>
-static uint64_t field(const T& words, int bit, int width) {
-    uint64_t v = 0;
-    for (int i = 0; i < width; ++i) {
-        int b = bit + i;
-        v |= (uint64_t)((words[b / 32] >> (b % 32)) & 1u) << i;
-    }
-    return v;
-}
 
 int main(int argc, char** argv) {
     auto context = std::make_unique<VerilatedContext>();

@@ -17,10 +17,11 @@
 
 use std::io::{BufReader, Read, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Command, Stdio};
+use std::process::{Child, ChildStdout, Command, Stdio};
 use std::time::Instant;
 
 use anyhow::{bail, Context as _};
+use rtl::array::{Array, Mode};
 use rtl::rc::context::{ASrc, BSrc, Context, Guard, Op, ALL_OPS};
 use rtl::rc::{Datapath, LaneNames, RcArray, Word};
 
@@ -58,18 +59,6 @@ pub fn testbench_stream() -> Vec<Step> {
 pub fn random_stream(dp: Datapath, n: usize, seed: u64) -> Vec<Step> {
     let bits = dp.bits();
     let mut g = Rng(seed | 1);
-    let val = |g: &mut Rng| -> i64 {
-        let min = -(1i64 << (bits - 1));
-        let max = (1i64 << (bits - 1)) - 1;
-        match g.below(6) {
-            0 | 1 => [min, -1, 0, 1, max, min + 1, max - 1][g.below(7) as usize],
-            2 => g.below(81) as i64 - 40,
-            _ => {
-                let x = g.next() as i64;
-                x >> (64 - bits)
-            }
-        }
-    };
     let mut s = Vec::with_capacity(n);
     let mut asleep = false;
     for _ in 0..n {
@@ -77,7 +66,7 @@ pub fn random_stream(dp: Datapath, n: usize, seed: u64) -> Vec<Step> {
         if g.chance(2) {
             s.push(Step {
                 ctx: g.next() as u32,
-                ext: val(&mut g),
+                ext: value(&mut g, bits),
                 lane_en,
             });
             continue;
@@ -89,7 +78,6 @@ pub fn random_stream(dp: Datapath, n: usize, seed: u64) -> Vec<Step> {
         if asleep && g.below(4) == 0 {
             op = Op::Wake;
         }
-        let guard = [Guard::Always, Guard::Always, Guard::IfF, Guard::IfNotF][g.below(4) as usize];
         let asrc = match g.below(10) {
             0..=3 => ASrc::Reg,
             4 | 5 => ASrc::Out,
@@ -98,44 +86,15 @@ pub fn random_stream(dp: Datapath, n: usize, seed: u64) -> Vec<Step> {
             8 => ASrc::QCol,
             _ => ASrc::Fb,
         };
-        let b = if g.chance(50) {
-            BSrc::Reg(g.below(16) as u8)
-        } else {
-            BSrc::Imm(g.below(2048) as i16 - 1024)
-        };
-        let mut ctx = Context {
-            op,
-            guard,
-            we: g.below(4) != 0,
-            rd: g.below(16) as u8,
-            asrc,
-            ra: g.below(16) as u8,
-            b,
-            shift: 0,
-            trunc: false,
-        };
-        if matches!(b, BSrc::Reg(_)) {
-            ctx.shift = g.below(2 * bits as u64) as u8;
-            ctx.trunc = g.chance(50);
-        }
-        let mut ext = val(&mut g);
-        match op {
-            Op::Ld if !g.chance(20) => {
-                ctx.asrc = ASrc::Fb;
-                ctx.ra = 0;
-                ext = g.below(256) as i64;
-                ctx.b = BSrc::Imm(g.below(256) as i16);
-                ctx.shift = 0;
-                ctx.trunc = false;
+        let ra = g.below(16) as u8;
+        let mut ctx = context(&mut g, bits, op, asrc, ra);
+        let mut ext = value(&mut g, bits);
+        if matches!(op, Op::Ld | Op::St) && !g.chance(20) {
+            if let Some(x) = address_in_range(&mut g, &mut ctx) {
+                ext = x;
             }
-            Op::St if !g.chance(20) => {
-                ctx.b = BSrc::Imm(g.below(512) as i16);
-                ctx.shift = 0;
-                ctx.trunc = false;
-            }
-            _ => {}
         }
-        if op == Op::Sleep && guard == Guard::Always && lane_en {
+        if op == Op::Sleep && ctx.guard == Guard::Always && lane_en {
             asleep = true;
         }
         if op == Op::Wake {
@@ -148,6 +107,59 @@ pub fn random_stream(dp: Datapath, n: usize, seed: u64) -> Vec<Step> {
         });
     }
     s
+}
+
+/// A datum of `bits` bits: at the word's edges, small, or any.
+fn value(g: &mut Rng, bits: u32) -> i64 {
+    let min = -(1i64 << (bits - 1));
+    let max = (1i64 << (bits - 1)) - 1;
+    match g.below(6) {
+        0 | 1 => [min, -1, 0, 1, max, min + 1, max - 1][g.below(7) as usize],
+        2 => g.below(81) as i64 - 40,
+        _ => (g.next() as i64) >> (64 - bits),
+    }
+}
+
+/// A context of `op` with operand A from `asrc` / `ra`, and at random its
+/// guard, destination, operand B and multiplier shift (up to 2 `bits`).
+fn context(g: &mut Rng, bits: u32, op: Op, asrc: ASrc, ra: u8) -> Context {
+    let guard = [Guard::Always, Guard::Always, Guard::IfF, Guard::IfNotF][g.below(4) as usize];
+    let b = if g.chance(50) {
+        BSrc::Reg(g.below(16) as u8)
+    } else {
+        BSrc::Imm(g.below(2048) as i16 - 1024)
+    };
+    let mut ctx = Context {
+        op,
+        guard,
+        we: g.below(4) != 0,
+        rd: g.below(16) as u8,
+        asrc,
+        ra,
+        b,
+        shift: 0,
+        trunc: false,
+    };
+    if matches!(b, BSrc::Reg(_)) {
+        ctx.shift = g.below(2 * bits as u64) as u8;
+        ctx.trunc = g.chance(50);
+    }
+    ctx
+}
+
+/// Make a `ld` / `st` address a valid one: `ld rd, [fbK + #i]` with the
+/// FB datum returned (0..255 each), `st A, [#i]`.
+fn address_in_range(g: &mut Rng, ctx: &mut Context) -> Option<i64> {
+    ctx.shift = 0;
+    ctx.trunc = false;
+    if ctx.op == Op::St {
+        ctx.b = BSrc::Imm(g.below(512) as i16);
+        return None;
+    }
+    ctx.asrc = ASrc::Fb;
+    ctx.ra = g.below(2) as u8;
+    ctx.b = BSrc::Imm(g.below(256) as i16);
+    Some(g.below(256) as i64)
 }
 
 /// Where the Verilog sources are: `MORPHOSYS_VERILOG`, else the source
@@ -173,17 +185,49 @@ pub const RC_FILES: &[&str] = &[
     "rc_flags.v",
 ];
 
-/// Build the Verilator harness of the RC of width `dp` from the Verilog
-/// in `src` ([`verilog_dir`]) under `dir`; returns the program. Verilator
-/// and make rebuild what changed.
-pub fn build(dp: Datapath, src: &Path, dir: &Path) -> anyhow::Result<PathBuf> {
+/// What a Verilator harness simulates.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Top {
+    /// One RC (`rc.v`, harness `cosim/rc_cosim.cpp`).
+    Rc,
+    /// The 8x8 array with its interconnect (`rc_array.v`, harness
+    /// `cosim/rc_array_cosim.cpp`).
+    Array,
+}
+
+impl Top {
+    fn module(self) -> &'static str {
+        match self {
+            Top::Rc => "rc",
+            Top::Array => "rc_array",
+        }
+    }
+    /// Every source of the harness, relative to the Verilog folder.
+    pub fn files(self) -> Vec<&'static str> {
+        let mut f = match self {
+            Top::Rc => vec![],
+            Top::Array => vec!["rc_array.v", "rc_interconnect.v"],
+        };
+        f.extend(RC_FILES);
+        f.push(match self {
+            Top::Rc => "cosim/rc_cosim.cpp",
+            Top::Array => "cosim/rc_array_cosim.cpp",
+        });
+        f
+    }
+}
+
+/// Build the Verilator harness of `top` at width `dp` from the Verilog in
+/// `src` ([`verilog_dir`]) under `dir`; returns the program. Verilator and
+/// make rebuild what changed.
+pub fn build(top: Top, dp: Datapath, src: &Path, dir: &Path) -> anyhow::Result<PathBuf> {
     let src = src.canonicalize().with_context(|| {
         format!(
             "the Verilog sources are not at {} (set MORPHOSYS_VERILOG)",
             src.display()
         )
     })?;
-    let obj = dir.join(format!("rc_w{}", dp.bits()));
+    let obj = dir.join(format!("{}_w{}", top.module(), dp.bits()));
     std::fs::create_dir_all(&obj).with_context(|| format!("cannot make {}", obj.display()))?;
     let obj = obj.canonicalize()?;
     // Make's dependency files name the sources: a build from other
@@ -196,19 +240,21 @@ pub fn build(dp: Datapath, src: &Path, dir: &Path) -> anyhow::Result<PathBuf> {
             .with_context(|| format!("cannot write {}", stamp.display()))?;
     }
     let w = dp.bits();
+    let program = format!("{}_cosim", top.module());
     let mut cmd = Command::new("verilator");
     cmd.args(["--cc", "--exe", "--build", "-j", "2", "-O3", "-Wall"])
         .arg(format!("-GW={w}"))
         .arg("-DCOSIM")
-        .args(["-CFLAGS", &format!("-O2 -DRC_W={w}")])
+        .args(["-CFLAGS", &format!("-DRC_W={w}")])
+        // the model's code at -O2 (Verilator's makefile builds it at -Os)
+        .args(["-MAKEFLAGS", "OPT_FAST=-O2 OPT_SLOW=-O1"])
         .arg("-Mdir")
         .arg(obj.join("obj"))
-        .args(["--top-module", "rc", "-o", "rc_cosim"])
+        .args(["--top-module", top.module(), "-o", &program])
         .arg(format!("-I{}", src.display()));
-    for f in RC_FILES {
+    for f in top.files() {
         cmd.arg(src.join(f));
     }
-    cmd.arg(src.join("cosim/rc_cosim.cpp"));
     let out = match cmd.output() {
         Ok(o) => o,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => bail!(
@@ -221,9 +267,13 @@ pub fn build(dp: Datapath, src: &Path, dir: &Path) -> anyhow::Result<PathBuf> {
             + &String::from_utf8_lossy(&out.stdout);
         let tail: Vec<&str> = text.lines().rev().take(30).collect();
         let tail: Vec<&str> = tail.into_iter().rev().collect();
-        bail!("verilator failed on the {w}-bit RC:\n{}", tail.join("\n"));
+        bail!(
+            "verilator failed on the {w}-bit {}:\n{}",
+            top.module(),
+            tail.join("\n")
+        );
     }
-    Ok(obj.join("obj/rc_cosim"))
+    Ok(obj.join("obj").join(program))
 }
 
 /// What a co-simulation compared.
@@ -341,6 +391,52 @@ impl State {
     }
 }
 
+/// A running Verilator harness: a thread writes the stream to its
+/// standard input while the states are read from its standard output.
+struct Harness {
+    child: Child,
+    writer: std::thread::JoinHandle<std::io::Result<()>>,
+    out: BufReader<ChildStdout>,
+}
+
+impl Harness {
+    fn start(program: &Path, input: Vec<u8>) -> anyhow::Result<Harness> {
+        let mut child = Command::new(program)
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .with_context(|| format!("cannot run {}", program.display()))?;
+        let mut stdin = child.stdin.take().expect("piped");
+        let writer = std::thread::spawn(move || stdin.write_all(&input));
+        let out = BufReader::with_capacity(1 << 16, child.stdout.take().expect("piped"));
+        Ok(Harness { child, writer, out })
+    }
+
+    fn read_exact(&mut self, buf: &mut [u8]) -> std::io::Result<()> {
+        self.out.read_exact(buf)
+    }
+
+    /// Stop it early (a difference found).
+    fn stop(mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        let _ = self.writer.join();
+    }
+
+    /// Its stream written and its exit a success.
+    fn finish(mut self) -> anyhow::Result<()> {
+        self.writer
+            .join()
+            .expect("writer thread")
+            .context("writing the stream to the Verilog harness")?;
+        let status = self.child.wait()?;
+        if !status.success() {
+            bail!("the Verilog harness exited with {status}");
+        }
+        Ok(())
+    }
+}
+
 /// Run `steps` through the harness `program` (from [`build`]) and the
 /// Rust RC of width `dp`, comparing after every cycle.
 pub fn run(dp: Datapath, program: &Path, steps: &[Step]) -> anyhow::Result<Report> {
@@ -352,20 +448,13 @@ pub fn run(dp: Datapath, program: &Path, steps: &[Step]) -> anyhow::Result<Repor
 
 fn run_w<W: Word>(program: &Path, steps: &[Step]) -> anyhow::Result<Report> {
     let t0 = Instant::now();
-    let mut child = Command::new(program)
-        .stdin(Stdio::piped())
-        .stdout(Stdio::piped())
-        .spawn()
-        .with_context(|| format!("cannot run {}", program.display()))?;
     let mut input = Vec::with_capacity(steps.len() * 16);
     for s in steps {
         input.extend_from_slice(&s.ctx.to_le_bytes());
         input.extend_from_slice(&(s.lane_en as u32).to_le_bytes());
         input.extend_from_slice(&(s.ext as u64).to_le_bytes());
     }
-    let mut stdin = child.stdin.take().expect("piped");
-    let writer = std::thread::spawn(move || stdin.write_all(&input));
-    let mut from = BufReader::with_capacity(1 << 16, child.stdout.take().expect("piped"));
+    let mut from = Harness::start(program, input)?;
 
     let bits = W::BITS;
     let word = |x: W| x.to_i64() as u64 & mask(bits);
@@ -425,9 +514,7 @@ fn run_w<W: Word>(program: &Path, steps: &[Step]) -> anyhow::Result<Report> {
                 v.show(),
                 rust.show()
             ));
-            let _ = child.kill();
-            let _ = child.wait();
-            let _ = writer.join();
+            from.stop();
             report.seconds = t0.elapsed().as_secs_f64();
             return Ok(report);
         }
@@ -446,16 +533,329 @@ fn run_w<W: Word>(program: &Path, steps: &[Step]) -> anyhow::Result<Report> {
             ));
         }
     }
-    writer
-        .join()
-        .expect("writer thread")
-        .context("writing the stream to the Verilog harness")?;
-    let status = child.wait()?;
-    if !status.success() {
-        bail!("the Verilog harness exited with {status}");
-    }
+    from.finish()?;
     report.seconds = t0.elapsed().as_secs_f64();
     Ok(report)
+}
+
+/// One cycle of the array's stream: whether a context runs, the broadcast
+/// mode, the 8 context words (SIMD: word 0) and the two FB data.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ArrayStep {
+    pub active: bool,
+    pub mode: Mode,
+    pub words: [u32; 8],
+    pub fb: [i64; 2],
+}
+
+/// `n` random cycles of the array from `seed`: one cycle in five in row
+/// or column mode, any legal operation with every interconnect source
+/// (neighbours, short and express lanes, FB data) often, RAM addresses in
+/// range, and in each cycle one lane index per lane bus (two rows of a
+/// row-mode group asking one vertical lane for different drivers is a
+/// fault of the chip, not a cycle to compare).
+///
+/// With `simd_only` every cycle is SIMD (as nearly every cycle of the ray
+/// tracer is; `tb cosim --bench` times that).
+pub fn array_stream(dp: Datapath, n: usize, seed: u64, simd_only: bool) -> Vec<ArrayStep> {
+    let bits = dp.bits();
+    let mut g = Rng(seed | 1);
+    let mut s = Vec::with_capacity(n);
+    for _ in 0..n {
+        let mode = match g.below(10) {
+            _ if simd_only => Mode::Simd,
+            0 => Mode::Row,
+            1 => Mode::Col,
+            _ => Mode::Simd,
+        };
+        let (kx, kq) = (g.below(8) as u8, g.below(4) as u8);
+        let mut fb = [value(&mut g, bits), value(&mut g, bits)];
+        let mut words = [0u32; 8];
+        for w in words.iter_mut() {
+            let mut op = ALL_OPS[g.below(ALL_OPS.len() as u64) as usize];
+            // Sleep seldom and wake often: the array stays mostly awake.
+            if op == Op::Sleep && g.below(4) != 0 {
+                op = Op::Wake;
+            }
+            let asrc = [
+                ASrc::Reg,
+                ASrc::Out,
+                ASrc::Nbr,
+                ASrc::QRow,
+                ASrc::QCol,
+                ASrc::XRow,
+                ASrc::XCol,
+                ASrc::Fb,
+            ][g.below(8) as usize];
+            let ra = match asrc {
+                ASrc::Nbr => g.below(4) as u8,
+                ASrc::QRow | ASrc::QCol => kq,
+                ASrc::XRow | ASrc::XCol => kx,
+                ASrc::Fb => g.below(2) as u8,
+                _ => g.below(16) as u8,
+            };
+            let mut ctx = context(&mut g, bits, op, asrc, ra);
+            if matches!(op, Op::Ld | Op::St) {
+                if let Some(x) = address_in_range(&mut g, &mut ctx) {
+                    // both sets small: the group's other loads read them too
+                    fb = [x, g.below(256) as i64];
+                }
+            }
+            *w = ctx.encode();
+        }
+        s.push(ArrayStep {
+            active: !g.chance(5),
+            mode,
+            words,
+            fb,
+        });
+    }
+    s
+}
+
+/// Run `steps` through the array harness `program` (from [`build`] with
+/// [`Top::Array`]) and the Rust array of width `dp`, comparing every RC's
+/// `out`, the flag masks and the RCs executed after every cycle, and every
+/// register, accumulator and RAM word at the end.
+pub fn run_array(dp: Datapath, program: &Path, steps: &[ArrayStep]) -> anyhow::Result<Report> {
+    match dp {
+        Datapath::W16 => run_array_w::<i16>(program, steps),
+        Datapath::W32 => run_array_w::<i32>(program, steps),
+    }
+}
+
+fn array_input(steps: &[ArrayStep]) -> Vec<u8> {
+    let mut input = Vec::with_capacity(steps.len() * 56);
+    for s in steps {
+        let control = s.active as u32 | (s.mode as u32) << 1;
+        input.extend_from_slice(&control.to_le_bytes());
+        for w in s.words {
+            input.extend_from_slice(&w.to_le_bytes());
+        }
+        input.extend_from_slice(&0u32.to_le_bytes());
+        input.extend_from_slice(&(s.fb[0] as u64).to_le_bytes());
+        input.extend_from_slice(&(s.fb[1] as u64).to_le_bytes());
+    }
+    input
+}
+
+/// A cycle's contexts, decoded (as the chip's context memory holds them).
+fn decode_step(s: &ArrayStep, wide: bool) -> anyhow::Result<[Context; 8]> {
+    let mut ctx = [Context::NOP; 8];
+    for (c, &w) in ctx.iter_mut().zip(&s.words) {
+        *c = Context::decode_for(w, wide).map_err(|e| anyhow::anyhow!("word 0x{w:08x}: {e}"))?;
+    }
+    Ok(ctx)
+}
+
+/// One cycle of the Rust array, its contexts decoded.
+#[inline]
+fn array_cycle<W: Word>(a: &mut Array<W>, s: &ArrayStep, ctx: &[Context; 8]) -> anyhow::Result<()> {
+    let fb = [W::wrap(s.fb[0]), W::wrap(s.fb[1])];
+    if !s.active {
+        a.idle();
+        return Ok(());
+    }
+    if s.mode == Mode::Simd {
+        a.drive_simd(s.words[0], &ctx[0], fb);
+    } else {
+        a.drive_group(s.mode, s.words, *ctx, fb);
+    }
+    a.step()
+        .map_err(|e| anyhow::anyhow!("the Rust array faulted: {e}"))
+}
+
+fn run_array_w<W: Word>(program: &Path, steps: &[ArrayStep]) -> anyhow::Result<Report> {
+    let t0 = Instant::now();
+    let mut from = Harness::start(program, array_input(steps))?;
+    let word = |x: W| x.to_i64() as u64 & mask(W::BITS);
+    let mut a: Array<W> = Array::new();
+    let mut report = Report::default();
+    let mut rec = [0u8; 70 * 8];
+    for (i, s) in steps.iter().enumerate() {
+        let ctx = decode_step(s, W::BITS == 32)?;
+        array_cycle(&mut a, s, &ctx).with_context(|| format!("cycle {i}"))?;
+        from.read_exact(&mut rec)
+            .with_context(|| format!("the Verilog harness stopped before cycle {i}"))?;
+        let v = |k: usize| u64::from_le_bytes(rec[8 * k..8 * k + 8].try_into().unwrap());
+        report.cycles += 1;
+        report.values += 64 + 6;
+        let executed = if s.active { a.active_now as u64 } else { 0 };
+        report.executed += executed;
+        let mut d = Vec::new();
+        for k in 0..64 {
+            let r = word(a.rc.out[k]);
+            if v(k) != r {
+                d.push(format!(
+                    "{}: out Verilog 0x{:x}, Rust 0x{r:x}",
+                    LaneNames::Grid.name(k),
+                    v(k)
+                ));
+            }
+        }
+        let f = &a.rc.flags;
+        for (name, k, r) in [
+            ("F", 64, f.f),
+            ("C", 65, f.c),
+            ("V", 66, f.v),
+            ("sleep", 67, f.sleep),
+        ] {
+            if v(k) != r {
+                d.push(format!("{name} mask: Verilog {:016x}, Rust {r:016x}", v(k)));
+            }
+        }
+        if v(68).count_ones() as u64 != executed {
+            d.push(format!(
+                "RCs executed: Verilog {}, Rust {executed}",
+                v(68).count_ones()
+            ));
+        }
+        if v(69) != 0 {
+            d.push(format!("Verilog faults {:016x}", v(69)));
+        }
+        if !d.is_empty() {
+            let words: Vec<String> = match s.mode {
+                Mode::Simd => vec![describe(s.words[0], W::BITS == 32)],
+                _ => s
+                    .words
+                    .iter()
+                    .map(|&w| describe(w, W::BITS == 32))
+                    .collect(),
+            };
+            report.mismatch = Some(format!(
+                "first difference at cycle {i}: {:?} mode, {}, fb {:?}{}\n  {}",
+                s.mode,
+                words.join(" | "),
+                s.fb,
+                if s.active { "" } else { " (idle)" },
+                d.join("\n  ")
+            ));
+            from.stop();
+            report.seconds = t0.elapsed().as_secs_f64();
+            return Ok(report);
+        }
+    }
+    // The whole state: registers, accumulators, RAM.
+    let mut rest = vec![0u8; (64 * 16 + 64 + 512 * 64) * 8];
+    from.read_exact(&mut rest)
+        .context("the Verilog harness stopped before its final state")?;
+    let v = |k: usize| u64::from_le_bytes(rest[8 * k..8 * k + 8].try_into().unwrap());
+    let mut diff = None;
+    for i in 0..64 {
+        for r in 0..16u8 {
+            let got = word(a.rc.regs.read(r)[i]);
+            let k = i * 16 + r as usize;
+            if v(k) != got && diff.is_none() {
+                diff = Some(format!(
+                    "{} r{r} at the end: Verilog 0x{:x}, Rust 0x{got:x}",
+                    LaneNames::Grid.name(i),
+                    v(k)
+                ));
+            }
+        }
+        let acc = W::acc_i128(a.rc.acc[i]) as u64 & mask(2 * W::BITS);
+        if v(64 * 16 + i) != acc && diff.is_none() {
+            diff = Some(format!(
+                "{} acc at the end: Verilog 0x{:x}, Rust 0x{acc:x}",
+                LaneNames::Grid.name(i),
+                v(64 * 16 + i)
+            ));
+        }
+    }
+    for addr in 0..512 {
+        for i in 0..64 {
+            let got = word(a.rc.ram.read(i, addr));
+            let k = 64 * 17 + addr * 64 + i;
+            if v(k) != got && diff.is_none() {
+                diff = Some(format!(
+                    "{} RAM word {addr} at the end: Verilog 0x{:x}, Rust 0x{got:x}",
+                    LaneNames::Grid.name(i),
+                    v(k)
+                ));
+            }
+        }
+    }
+    report.values += (64 * 17 + 512 * 64) as u64;
+    report.mismatch = diff;
+    from.finish()?;
+    report.seconds = t0.elapsed().as_secs_f64();
+    Ok(report)
+}
+
+/// A context word in disassembly, or what is wrong with it.
+fn describe(w: u32, wide: bool) -> String {
+    match Context::decode_for(w, wide) {
+        Ok(c) => format!("`{c}`"),
+        Err(e) => format!("0x{w:08x} ({e})"),
+    }
+}
+
+/// The speed of the Verilated array and of the Rust array on the same
+/// stream, in array cycles per second.
+#[derive(Clone, Copy, Debug)]
+pub struct Speeds {
+    pub cycles: u64,
+    pub verilator: f64,
+    pub rust: f64,
+}
+
+/// Run `steps` `repeat` times through the Verilated array (`program`, its
+/// `--bench` mode: the stream in memory, nothing compared) and through the
+/// Rust array of width `dp`, each timed alone on one thread.
+pub fn bench_array(
+    dp: Datapath,
+    program: &Path,
+    steps: &[ArrayStep],
+    repeat: u32,
+) -> anyhow::Result<Speeds> {
+    let mut child = Command::new(program)
+        .arg("--bench")
+        .arg(repeat.to_string())
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .with_context(|| format!("cannot run {}", program.display()))?;
+    child
+        .stdin
+        .take()
+        .expect("piped")
+        .write_all(&array_input(steps))
+        .context("writing the stream to the Verilog harness")?;
+    let out = child.wait_with_output()?;
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut it = text.split_whitespace();
+    let (Some(n), Some(secs)) = (
+        it.next().and_then(|x| x.parse::<u64>().ok()),
+        it.next().and_then(|x| x.parse::<f64>().ok()),
+    ) else {
+        bail!("the Verilog harness's bench printed `{}`", text.trim());
+    };
+    let rust = match dp {
+        Datapath::W16 => time_rust::<i16>(steps, repeat)?,
+        Datapath::W32 => time_rust::<i32>(steps, repeat)?,
+    };
+    Ok(Speeds {
+        cycles: n,
+        verilator: n as f64 / secs,
+        rust: n as f64 / rust,
+    })
+}
+
+fn time_rust<W: Word>(steps: &[ArrayStep], repeat: u32) -> anyhow::Result<f64> {
+    let decoded = steps
+        .iter()
+        .map(|s| decode_step(s, W::BITS == 32))
+        .collect::<anyhow::Result<Vec<_>>>()?;
+    let mut a: Array<W> = Array::new();
+    let t = Instant::now();
+    for _ in 0..repeat {
+        for (s, c) in steps.iter().zip(&decoded) {
+            array_cycle(&mut a, s, c)?;
+        }
+    }
+    let secs = t.elapsed().as_secs_f64();
+    std::hint::black_box(&a.rc.out);
+    Ok(secs)
 }
 
 fn mask(bits: u32) -> u64 {
@@ -465,6 +865,10 @@ fn mask(bits: u32) -> u64 {
         (1u64 << bits) - 1
     }
 }
+
+/// `tb cosim --bench`: cycles of the stream, and how often it runs.
+const BENCH_CYCLES: usize = 100_000;
+const BENCH_REPEAT: u32 = 3;
 
 /// The default seed of the random streams ("RCVERILG").
 pub const SEED: u64 = 0x5243_5645_5249_4C47;
@@ -481,6 +885,15 @@ pub struct CosimArgs {
     /// Seed of the random stream.
     #[arg(long, value_name = "SEED", default_value_t = SEED, value_parser = parse_seed)]
     pub seed: u64,
+    /// Random cycles of the 8x8 array (the Verilog array with its
+    /// interconnect against the Rust array, all three broadcast modes),
+    /// per width; 0 leaves the array out.
+    #[arg(long, value_name = "N", default_value_t = 100_000)]
+    pub array: usize,
+    /// Also measure the Verilated array's speed against the Rust array's
+    /// on the same stream (array cycles per second, one thread each).
+    #[arg(long)]
+    pub bench: bool,
     /// Where Verilator builds the harnesses.
     #[arg(long, value_name = "DIR", default_value = "target/verilator")]
     pub build_dir: PathBuf,
@@ -516,7 +929,7 @@ pub fn command(a: CosimArgs) -> anyhow::Result<()> {
             "building the {dp} Verilog RC with Verilator in {}",
             a.build_dir.display()
         );
-        let program = build(dp, &verilog_dir(), &a.build_dir)?;
+        let program = build(Top::Rc, dp, &verilog_dir(), &a.build_dir)?;
         crate::note!("  built in {:.1} s", t.elapsed().as_secs_f64());
         for (name, steps) in [
             ("the RC testbench's stream", testbench_stream()),
@@ -541,6 +954,40 @@ pub fn command(a: CosimArgs) -> anyhow::Result<()> {
                 eprintln!("  {m}");
                 failed.push(format!("{dp} RC, {name}"));
             }
+        }
+        if a.array == 0 && !a.bench {
+            continue;
+        }
+        let t = Instant::now();
+        crate::note!("building the {dp} Verilog array with Verilator");
+        let program = build(Top::Array, dp, &verilog_dir(), &a.build_dir)?;
+        crate::note!("  built in {:.1} s", t.elapsed().as_secs_f64());
+        let steps = array_stream(dp, a.array.max(1), a.seed, false);
+        if a.array > 0 {
+            let r = run_array(dp, &program, &steps)?;
+            println!(
+                "{dp} array, random contexts in three modes: {} cycles ({} RC executions), {} values compared in {:.1} s: {}",
+                thousands(r.cycles),
+                thousands(r.executed),
+                thousands(r.values),
+                r.seconds,
+                if r.mismatch.is_some() { "DIFFERENT" } else { "identical" }
+            );
+            if let Some(m) = r.mismatch {
+                eprintln!("  {m}");
+                failed.push(format!("{dp} array"));
+            }
+        }
+        if a.bench {
+            let steps = array_stream(dp, BENCH_CYCLES, a.seed, true);
+            let sp = bench_array(dp, &program, &steps, BENCH_REPEAT)?;
+            println!(
+                "{dp} array speed, {} SIMD cycles of one stream, one thread each: Verilator {:.1} k cycles/s, this model's array {:.2} M cycles/s ({:.0}x)",
+                thousands(sp.cycles),
+                sp.verilator / 1e3,
+                sp.rust / 1e6,
+                sp.rust / sp.verilator
+            );
         }
     }
     if !failed.is_empty() {
