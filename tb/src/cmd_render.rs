@@ -257,9 +257,12 @@ pub(crate) fn render_and_measure(
         "reference_rays": refimg.stats,
         "active_rc_fraction": chip.stats.active_rc_fraction(),
         "dma_stall_cycles": chip.stats.dma_stall_cycles,
+        "dma_stall_share": chip.dma_stall_share(),
         "array_idle_on_control": idle_on_control,
         "objects_tested_per_ray": chip.objects_tested_per_ray(),
         "ray_tests_per_ray": chip.tests_per_ray(),
+        "simd_efficiency": chip.simd_efficiency(),
+        "object_tests_offered": chip.stats.watched_offered,
         "rays_traced": chip.stats.watched_rcs[1],
         "ray_object_tests": chip.stats.watched_rcs[0],
         "host_seconds": host,
@@ -677,7 +680,11 @@ pub fn command(a: RenderArgs) -> Result<()> {
         "active RC fraction       {:.3}",
         j["active_rc_fraction"].as_f64().unwrap_or(0.0)
     );
-    crate::report!("dma stall cycles         {}", j["dma_stall_cycles"]);
+    crate::report!(
+        "dma stall cycles         {} ({:.1}% of the cycles)",
+        j["dma_stall_cycles"],
+        100.0 * j["dma_stall_share"].as_f64().unwrap_or(0.0)
+    );
     crate::report!(
         "array idle on control    {:.1}% of the cycles",
         100.0 * j["array_idle_on_control"].as_f64().unwrap_or(0.0)
@@ -693,6 +700,10 @@ pub fn command(a: RenderArgs) -> Result<()> {
         "objects tested per ray   {:.2} broadcast per packet pass, {:.2} tested per ray traced",
         j["objects_tested_per_ray"].as_f64().unwrap_or(0.0),
         j["ray_tests_per_ray"].as_f64().unwrap_or(0.0)
+    );
+    crate::report!(
+        "simd efficiency          {:.1}% of the object tests broadcast to a pass's rays were ones the ray needed",
+        100.0 * j["simd_efficiency"].as_f64().unwrap_or(0.0)
     );
     crate::report!(
         "host seconds             {:.2}",

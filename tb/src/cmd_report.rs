@@ -193,8 +193,10 @@ pub fn sections() -> Vec<Section> {
             title: "The SPD scenes at their default size",
             about: "Each SPD generator at the size it makes without `-s` (thousands of \
                     objects, but jacks' single jack), 256x256, depth 2, the packet traversal, `--datapath auto`. \
-                    `active RCs` is the share of RC-cycles that executed a context, `DMA stall` \
-                    and `idle` as above.",
+                    `SIMD efficiency` is the share of the object tests the array ran lanes for \
+                    (each test broadcast times the rays of its pass) whose ray needed them \
+                    (`simd_efficiency`); `active RCs` the share of RC-cycles that executed a \
+                    context, `DMA stall` and `idle` as above.",
             checked: false,
             write: spd,
         },

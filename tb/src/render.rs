@@ -142,6 +142,28 @@ impl ChipRender {
     /// Ray-object tests the RCs executed per ray traced: the awake RCs at
     /// the start of every object test over the rays that started a pass
     /// (counted by the simulator, [`rtl::chip::Watch`]).
+    /// The share of the object tests the array ran lanes for whose ray
+    /// needed them: the RCs that executed an object test (their ray
+    /// reaches the object's cell) over each test broadcast times the rays
+    /// of its pass.
+    pub fn simd_efficiency(&self) -> f64 {
+        let offered = self.stats.watched_offered;
+        if offered == 0 {
+            0.0
+        } else {
+            self.stats.watched_rcs[0] as f64 / offered as f64
+        }
+    }
+
+    /// The share of the frame's cycles TinyRISC waits for the DMA channel.
+    pub fn dma_stall_share(&self) -> f64 {
+        if self.stats.cycles == 0 {
+            0.0
+        } else {
+            self.stats.dma_stall_cycles as f64 / self.stats.cycles as f64
+        }
+    }
+
     pub fn tests_per_ray(&self) -> f64 {
         let rays = self.stats.watched_rcs[1];
         if rays == 0 {
@@ -170,6 +192,7 @@ fn add_stats(a: &mut Stats, b: &Stats) {
     a.dma_busy_cycles += b.dma_busy_cycles;
     a.dma_words += b.dma_words;
     a.dma_transfers += b.dma_transfers;
+    a.watched_offered += b.watched_offered;
     for c in 0..2 {
         a.watched_runs[c] += b.watched_runs[c];
         a.watched_rcs[c] += b.watched_rcs[c];
@@ -191,6 +214,7 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     a.dma_busy_cycles -= b.dma_busy_cycles.min(a.dma_busy_cycles);
     a.dma_words -= b.dma_words.min(a.dma_words);
     a.dma_transfers -= b.dma_transfers.min(a.dma_transfers);
+    a.watched_offered -= b.watched_offered.min(a.watched_offered);
     for c in 0..2 {
         a.watched_runs[c] -= b.watched_runs[c].min(a.watched_runs[c]);
         a.watched_rcs[c] -= b.watched_rcs[c].min(a.watched_rcs[c]);

@@ -834,3 +834,70 @@ fn render_plain_equals_the_fast_paths() {
         );
     }
 }
+
+/// `simd_efficiency`: with one object every ray of every pass reaches its
+/// cell, so every test the array spends a lane on is needed (1 exactly,
+/// with partial tiles at the frame's edges, both traversals); on rings-1
+/// (61 objects) most are not, and the JSON's counts agree.
+#[test]
+fn simd_efficiency_is_one_with_one_object() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("one.nff"),
+        "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 45\nhither 0.1\nresolution 32 32\n\
+         b 0.1 0.1 0.1\nl 2 2 4\nf 0.8 0.4 0.2 0.7 0.3 10 0 1\n\
+         p 4\n-10 -10 0\n10 -10 0\n10 10 0\n-10 10 0\n",
+    )
+    .unwrap();
+    for traversal in ["packet", "paper"] {
+        let (ok, _, err) = morphosys(
+            dir.path(),
+            &[
+                "render",
+                "one.nff",
+                "--size",
+                "28x20",
+                "--traversal",
+                traversal,
+                "--json",
+                "j.json",
+            ],
+        );
+        assert!(ok, "{err}");
+        let j: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(dir.path().join("j.json")).unwrap())
+                .unwrap();
+        assert_eq!(j["simd_efficiency"], 1.0, "{traversal}");
+        assert!(j["ray_object_tests"].as_u64().unwrap() > 0);
+    }
+    let rings = scene_path("rings-1.nff");
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &[
+            "render",
+            rings.to_str().unwrap(),
+            "--size",
+            "32x32",
+            "--json",
+            "r.json",
+        ],
+    );
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    let (tests, offered) = (
+        j["ray_object_tests"].as_u64().unwrap(),
+        j["object_tests_offered"].as_u64().unwrap(),
+    );
+    let e = j["simd_efficiency"].as_f64().unwrap();
+    assert!(
+        tests < offered && e > 0.0 && e < 1.0,
+        "{tests} {offered} {e}"
+    );
+    assert_eq!(e, tests as f64 / offered as f64);
+    let share = j["dma_stall_share"].as_f64().unwrap();
+    assert_eq!(
+        share,
+        j["dma_stall_cycles"].as_f64().unwrap() / j["cycles"].as_f64().unwrap()
+    );
+}

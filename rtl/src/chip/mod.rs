@@ -84,6 +84,10 @@ pub struct Stats {
     /// `watched_rcs` split by the [`Watch`] tag in effect when the run
     /// started.
     pub watched_rcs_by_tag: [[u64; WATCH_TAGS]; 2],
+    /// For each class-0 run, the RCs of the latest class-1 run, summed
+    /// (the ray tracer: every object test broadcast times the rays of its
+    /// pass, the tests the array spent its lanes on).
+    pub watched_offered: u64,
 }
 
 /// Tags a [`Watch`] can split its counts by.
@@ -104,6 +108,10 @@ pub struct Watch {
     runs: [u64; 2],
     rcs: [u64; 2],
     rcs_by_tag: [[u64; WATCH_TAGS]; 2],
+    /// The RCs of the latest class-1 run, and `offered` its sum over the
+    /// class-0 runs since.
+    last1: u64,
+    offered: u64,
 }
 
 #[derive(Clone, Copy, Debug, Default)]
@@ -139,6 +147,11 @@ impl Watch {
                 self.runs[c] += 1;
                 self.rcs[c] += n;
                 self.rcs_by_tag[c][self.tag] += n;
+                if c == 1 {
+                    self.last1 = n;
+                } else {
+                    self.offered += self.last1;
+                }
             }
         }
     }
@@ -361,6 +374,7 @@ impl<W: Word> Chip<W> {
             watched_runs: self.watch.runs,
             watched_rcs: self.watch.rcs,
             watched_rcs_by_tag: self.watch.rcs_by_tag,
+            watched_offered: self.watch.offered,
         }
     }
 

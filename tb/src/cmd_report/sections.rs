@@ -308,6 +308,7 @@ pub(super) fn spd(r: &mut Runner) -> Result<String> {
                 f(&j, "objects_tested_per_ray"),
                 f(&j, "ray_tests_per_ray")
             ),
+            pct(f(&j, "simd_efficiency")),
             pct(f(&j, "active_rc_fraction")),
             pct(u(&j, "dma_stall_cycles") as f64 / cycles),
             pct(f(&j, "array_idle_on_control")),
@@ -332,6 +333,7 @@ pub(super) fn spd(r: &mut Runner) -> Result<String> {
             "PSNR (dB)",
             "hits",
             "broadcast / tests per ray",
+            "SIMD efficiency",
             "active RCs",
             "DMA stall",
             "idle",
