@@ -448,6 +448,11 @@ struct Row {
     /// cycles the array waited for TinyRISC.
     ray_tests_per_ray: f64,
     array_idle_on_control: f64,
+    /// The object tests whose ray needed them over every test broadcast
+    /// times the rays of its pass, and the share of cycles TinyRISC waits
+    /// for the DMA.
+    simd_efficiency: f64,
+    dma_stall_share: f64,
     /// The BSP traversal (paper or packet) and the tree built (the split
     /// rule and depth limit it chose).
     traversal: String,
@@ -646,6 +651,8 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
         objects_tested_per_ray: f("objects_tested_per_ray"),
         ray_tests_per_ray: f("ray_tests_per_ray"),
         array_idle_on_control: f("array_idle_on_control"),
+        simd_efficiency: f("simd_efficiency"),
+        dma_stall_share: f("dma_stall_share"),
         traversal: opt.traversal.name().into(),
         bsp_split: s("bsp_split"),
         bsp_depth_limit: j["bsp_depth_limit"].as_u64().unwrap_or(0) as u32,
