@@ -84,9 +84,12 @@ const FLOW: &str = "synth -flatten; dfflegalize -cell $_DFF_P_ x; abc -g AND,NAN
 
 impl Synthesis {
     /// The committed results.
-    pub fn committed() -> Synthesis {
-        serde_json::from_str(COMMITTED)
-            .expect("rtl/verilog/synth/cost.json parses (checked by a test)")
+    pub fn committed() -> &'static Synthesis {
+        static PARSED: std::sync::OnceLock<Synthesis> = std::sync::OnceLock::new();
+        PARSED.get_or_init(|| {
+            serde_json::from_str(COMMITTED)
+                .expect("rtl/verilog/synth/cost.json parses (checked by a test)")
+        })
     }
 
     pub fn unit(&self, name: &str, dp: Datapath) -> Option<&Unit> {
@@ -329,7 +332,8 @@ pub fn to_json(s: &Synthesis) -> serde_json::Value {
 
 /// `morphosys cost`.
 pub fn command(a: CostArgs) -> anyhow::Result<()> {
-    let s = if a.synthesize {
+    let fresh;
+    let s: &Synthesis = if a.synthesize {
         let dir = crate::testbench::cosim::verilog_dir();
         crate::note!(
             "synthesizing the RC's units at 16 and 32 bits with Yosys ({})",
@@ -344,15 +348,16 @@ pub fn command(a: CostArgs) -> anyhow::Result<()> {
             path.display(),
             t.elapsed().as_secs_f64()
         );
-        s
+        fresh = s;
+        &fresh
     } else {
         Synthesis::committed()
     };
-    print!("{}", table(&s));
+    print!("{}", table(s));
     if let Some(j) = &a.json {
         crate::output::write(
             j,
-            (serde_json::to_string_pretty(&to_json(&s))? + "\n").as_bytes(),
+            (serde_json::to_string_pretty(&to_json(s))? + "\n").as_bytes(),
         )?;
     }
     Ok(())

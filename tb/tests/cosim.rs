@@ -69,10 +69,7 @@ fn the_verilog_array_is_the_rust_array_cycle_for_cycle() {
 fn a_difference_names_the_cycle_the_context_and_both_states() {
     let src = cosim::verilog_dir();
     let tmp = tempfile::tempdir().unwrap();
-    for f in cosim::RC_FILES
-        .iter()
-        .chain(&["rc_isa.vh", "cosim/rc_cosim.cpp", "cosim/bits.h"])
-    {
+    for f in Top::Rc.files().iter().chain(&["rc_isa.vh", "cosim/bits.h"]) {
         let to = tmp.path().join(f);
         std::fs::create_dir_all(to.parent().unwrap()).unwrap();
         std::fs::copy(src.join(f), to).unwrap();

@@ -344,10 +344,12 @@ impl State {
         }
     }
 
-    /// The fields that differ, named.
-    fn diff(&self, o: &State) -> Vec<String> {
+    /// The fields that differ, named, and how many fields were compared.
+    fn diff(&self, o: &State) -> (Vec<String>, u64) {
         let mut d = Vec::new();
+        let mut n = 0;
         let mut cmp = |name: &str, a: u64, b: u64| {
+            n += 1;
             if a != b {
                 d.push(format!("{name}: Verilog 0x{a:x}, Rust 0x{b:x}"));
             }
@@ -367,7 +369,7 @@ impl State {
         cmp("ram_we", self.ram_we as u64, o.ram_we as u64);
         cmp("ram_addr", self.ram_addr, o.ram_addr);
         cmp("ram_wdata", self.ram_wdata, o.ram_wdata);
-        d
+        (d, n)
     }
 
     fn show(&self) -> String {
@@ -499,12 +501,12 @@ fn run_w<W: Word>(program: &Path, steps: &[Step]) -> anyhow::Result<Report> {
             .with_context(|| format!("the Verilog harness stopped before cycle {i}"))?;
         let v = State::parse(&rec);
         report.cycles += 1;
-        report.values += 27;
         report.executed += rust.en as u64;
         report.illegal += rust.illegal as u64;
         report.faults += rust.fault as u64;
         report.ram_writes += rust.ram_we as u64;
-        let d = v.diff(&rust);
+        let (d, compared) = v.diff(&rust);
+        report.values += compared;
         if !d.is_empty() {
             report.mismatch = Some(format!(
                 "first difference at cycle {i}: {ctx_text}, ext {}, lane enable {}\n  differs: {}\n  Verilog: {}\n  Rust:    {}",
