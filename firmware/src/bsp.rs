@@ -17,6 +17,12 @@
 //! - [`SplitRule::Sah`]: the surface area heuristic (pbrt's kd-tree costs:
 //!   traversal 1, intersection 80, empty bonus 0.5) over 32 candidate planes
 //!   per axis; a node also becomes a leaf when no split is cheaper.
+//! - [`SplitRule::Chip`]: the surface area heuristic with the chip's own
+//!   costs ([`ChipCosts`]: the array cycles of a node visit, of a leaf's
+//!   overhead and of each object's test and record move), over the
+//!   objects' own bounds as candidate planes (up to [`CHIP_CANDIDATES`]
+//!   per axis), with no empty bonus; a leaf also must fit the FB bank its
+//!   block is moved into ([`ChipCosts::leaf_words`]).
 //!
 //! Nodes are numbered in depth-first pre-order, root 0, so the leaves are
 //! in left-to-right order and the objects under any node are those of a
@@ -30,11 +36,13 @@ use crate::scene::Aabb;
 pub enum SplitRule {
     /// Spatial median, axes cycling with depth (the paper's).
     Median,
-    /// Surface area heuristic.
+    /// Surface area heuristic (pbrt's costs).
     Sah,
+    /// Surface area heuristic with the chip's costs ([`ChipCosts`]).
+    Chip,
     /// Chosen by the user of the tree (the ray tracer: the paper's median
-    /// for the paper's traversal; for the packet traversal the cheaper of
-    /// median and SAH trees by its cost model). Built as `Median`.
+    /// for the paper's traversal; for the packet traversal the fastest of
+    /// its candidate trees on a probe of the frame). Built as `Median`.
     Auto,
 }
 
@@ -63,6 +71,46 @@ impl Default for BspParams {
         }
     }
 }
+
+/// The costs [`SplitRule::Chip`] weighs, in array cycles of a packet (the
+/// ray tracer measures them on its own kernels and TinyRISC loops:
+/// `tracer::chip_costs`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ChipCosts {
+    /// An inner node's visit: its kernel and TinyRISC's decision.
+    pub node: f64,
+    /// A leaf's visit besides its objects: TinyRISC's leaf loop and the
+    /// DMA's set-up.
+    pub leaf: f64,
+    /// Per object: its test (kernels and TinyRISC's loop around them) and
+    /// moving its record into the FB.
+    pub object: Vec<f64>,
+    /// Per object: FB words of its record.
+    pub words: Vec<usize>,
+    /// The most record words a leaf may hold (its block fills at most one
+    /// FB bank; 0: no limit). A node over it is split even where the cost
+    /// says otherwise, down to `max_depth`.
+    pub leaf_words: usize,
+}
+
+impl ChipCosts {
+    /// Costs for `objects` objects alike: pbrt's proportions (a node 1, an
+    /// object 80), no leaf overhead, no size limit.
+    pub fn uniform(objects: usize) -> ChipCosts {
+        ChipCosts {
+            node: 1.0,
+            leaf: 0.0,
+            object: vec![80.0; objects],
+            words: vec![1; objects],
+            leaf_words: 0,
+        }
+    }
+}
+
+/// Candidate planes per axis of [`SplitRule::Chip`] at a node: every
+/// object's bounds where the node holds few enough, else this many spread
+/// evenly over them.
+pub const CHIP_CANDIDATES: usize = 256;
 
 /// One node.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,15 +167,36 @@ impl Bsp {
         params: BspParams,
         meets: &(dyn Fn(u32, &Aabb) -> bool + Sync),
     ) -> Bsp {
+        Bsp::build_costed(object_bounds, bounds, params, meets, None)
+    }
+
+    /// [`Bsp::build_with`], with the costs [`SplitRule::Chip`] weighs
+    /// (`None`: [`ChipCosts::uniform`]; other rules ignore them).
+    pub fn build_costed(
+        object_bounds: &[Aabb],
+        bounds: Aabb,
+        params: BspParams,
+        meets: &(dyn Fn(u32, &Aabb) -> bool + Sync),
+        costs: Option<&ChipCosts>,
+    ) -> Bsp {
         let all: Vec<u32> = (0..object_bounds.len() as u32).collect();
         let mut params = params;
         if params.max_depth == 0 {
             params.max_depth = 15;
         }
+        let uniform;
+        let costs = match costs {
+            Some(c) => c,
+            None => {
+                uniform = ChipCosts::uniform(object_bounds.len());
+                &uniform
+            }
+        };
         let ctx = Ctx {
             ob: object_bounds,
             p: &params,
             meets,
+            costs,
         };
         let nodes = build(&ctx, bounds, all, 0, 0);
         Bsp { nodes, params }
@@ -187,6 +256,7 @@ struct Ctx<'a> {
     ob: &'a [Aabb],
     p: &'a BspParams,
     meets: &'a (dyn Fn(u32, &Aabb) -> bool + Sync),
+    costs: &'a ChipCosts,
 }
 
 /// Nodes of at least this many objects sort them into their children on
@@ -222,6 +292,7 @@ fn build(cx: &Ctx, bounds: Aabb, objects: Vec<u32>, depth: u32, futile: u32) -> 
             Some((axis, bounds.center().axis(axis)))
         }
         SplitRule::Sah => sah_split(ob, &objects, bounds),
+        SplitRule::Chip => chip_split(ob, &objects, bounds, cx.costs),
     };
     let Some((axis, mut pos)) = choice else {
         return leaf(objects);
@@ -347,6 +418,92 @@ fn sah_split(ob: &[Aabb], objects: &[u32], bounds: Aabb) -> Option<(usize, f64)>
     }
 }
 
+/// The cheapest plane by the chip's costs ([`SplitRule::Chip`]), or None
+/// when a leaf is cheaper (and fits the bank). A packet reaching the node
+/// pays `node`, then each child's leaf cost (`leaf` and its objects') with
+/// the probability that a ray through the node's cell meets the child's
+/// cell, their surface areas' ratio. The candidates are the objects'
+/// bounds clipped to the cell (where an object's extent starts or ends:
+/// the only places the counts change), at most [`CHIP_CANDIDATES`] per
+/// axis.
+fn chip_split(ob: &[Aabb], objects: &[u32], bounds: Aabb, c: &ChipCosts) -> Option<(usize, f64)> {
+    let area = bounds.surface_area();
+    if area <= 0.0 {
+        return None;
+    }
+    let cost_of = |i: u32| c.object[i as usize];
+    let all: f64 = objects.iter().map(|&i| cost_of(i)).sum();
+    let words: usize = objects.iter().map(|&i| c.words[i as usize]).sum();
+    let must_split = c.leaf_words > 0 && words > c.leaf_words;
+    let leaf_cost = c.leaf + all;
+    let mut best: Option<(f64, usize, f64)> = None;
+    for axis in 0..3 {
+        let (lo, hi) = (bounds.min.axis(axis), bounds.max.axis(axis));
+        if hi <= lo {
+            continue;
+        }
+        // (position, cost) of the objects' starts and ends in the cell,
+        // sorted; prefix sums of their costs.
+        let sorted = |end: bool| -> (Vec<f64>, Vec<f64>) {
+            let mut v: Vec<(f64, f64)> = objects
+                .iter()
+                .map(|&i| {
+                    let b = &ob[i as usize];
+                    let x = if end {
+                        b.max.axis(axis)
+                    } else {
+                        b.min.axis(axis)
+                    };
+                    (x.clamp(lo, hi), cost_of(i))
+                })
+                .collect();
+            v.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let mut sum = 0.0;
+            let mut prefix = Vec::with_capacity(v.len() + 1);
+            prefix.push(0.0);
+            for &(_, w) in &v {
+                sum += w;
+                prefix.push(sum);
+            }
+            (v.into_iter().map(|(x, _)| x).collect(), prefix)
+        };
+        let (mins, min_sum) = sorted(false);
+        let (maxs, max_sum) = sorted(true);
+        let mut cands: Vec<f64> = mins
+            .iter()
+            .chain(maxs.iter())
+            .copied()
+            .filter(|&x| x > lo && x < hi)
+            .collect();
+        cands.sort_by(f64::total_cmp);
+        cands.dedup();
+        if cands.len() > CHIP_CANDIDATES {
+            let n = cands.len();
+            cands = (0..CHIP_CANDIDATES)
+                .map(|k| cands[(2 * k + 1) * n / (2 * CHIP_CANDIDATES)])
+                .collect();
+        }
+        for pos in cands {
+            // Below: the objects starting at or before the plane; above:
+            // those ending at or after it.
+            let below = min_sum[mins.partition_point(|&m| m <= pos)];
+            let above = all - max_sum[maxs.partition_point(|&m| m < pos)];
+            let (a_below, a_above) = (
+                child_box(bounds, axis, pos, false).surface_area(),
+                child_box(bounds, axis, pos, true).surface_area(),
+            );
+            let cost = c.node + (a_below * (c.leaf + below) + a_above * (c.leaf + above)) / area;
+            if best.is_none_or(|(b, _, _)| cost < b) {
+                best = Some((cost, axis, pos));
+            }
+        }
+    }
+    match best {
+        Some((cost, axis, pos)) if cost < leaf_cost || must_split => Some((axis, pos)),
+        _ => None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -357,6 +514,17 @@ mod tests {
         Aabb {
             min: c - Vec3::ONE * r,
             max: c + Vec3::ONE * r,
+        }
+    }
+
+    /// A uniform random number in [0, 1) per call, from `seed` (an LCG).
+    fn uniform(seed: u64) -> impl FnMut() -> f64 {
+        let mut x = seed;
+        move || {
+            x = x
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (x >> 11) as f64 / (1u64 << 53) as f64
         }
     }
 
@@ -429,18 +597,13 @@ mod tests {
     /// root in the leaves its box meets.
     #[test]
     fn the_same_tree_on_any_number_of_threads() {
-        let mut x = 7u64;
-        let mut next = || {
-            x = x
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (x >> 11) as f64 / (1u64 << 53) as f64 * 18.0 - 9.0
-        };
+        let mut u = uniform(7);
+        let mut next = || u() * 18.0 - 9.0;
         let ob: Vec<Aabb> = (0..700)
             .map(|_| cube([next(), next(), next()], 0.05 + next().abs() / 40.0))
             .collect();
         let world = cube([0.0, 0.0, 0.0], 10.0);
-        for rule in [SplitRule::Median, SplitRule::Sah] {
+        for rule in [SplitRule::Median, SplitRule::Sah, SplitRule::Chip] {
             let params = BspParams {
                 rule,
                 max_depth: 20,
@@ -499,5 +662,113 @@ mod tests {
         let s = t.nodes[0].split.unwrap();
         assert_eq!(s.axis, 0);
         assert!(s.position > 5.0, "{}", s.position);
+    }
+
+    /// The chip rule's plane is the cheapest by its cost, computed here
+    /// object by object at every candidate (an O(n^2) count, not the
+    /// builder's sorted prefix sums), on random boxes of random costs.
+    #[test]
+    fn chip_split_is_the_cheapest_plane() {
+        let mut next = uniform(11);
+        for _ in 0..40 {
+            let n = 2 + (next() * 60.0) as usize;
+            let ob: Vec<Aabb> = (0..n)
+                .map(|_| {
+                    let c = [
+                        next() * 16.0 - 8.0,
+                        next() * 16.0 - 8.0,
+                        next() * 16.0 - 8.0,
+                    ];
+                    cube(c, 0.05 + next() * 2.0)
+                })
+                .collect();
+            let costs = ChipCosts {
+                node: 10.0 + next() * 100.0,
+                leaf: next() * 50.0,
+                object: (0..n).map(|_| 20.0 + next() * 200.0).collect(),
+                words: vec![1; n],
+                leaf_words: 0,
+            };
+            let bounds = cube([0.0, 0.0, 0.0], 8.0);
+            let objects: Vec<u32> = (0..n as u32).collect();
+            let area = bounds.surface_area();
+            let cost_at = |axis: usize, pos: f64| {
+                let (mut below, mut above) = (costs.leaf, costs.leaf);
+                for (i, b) in ob.iter().enumerate() {
+                    if b.min.axis(axis).max(-8.0) <= pos {
+                        below += costs.object[i];
+                    }
+                    if b.max.axis(axis).min(8.0) >= pos {
+                        above += costs.object[i];
+                    }
+                }
+                costs.node
+                    + (child_box(bounds, axis, pos, false).surface_area() * below
+                        + child_box(bounds, axis, pos, true).surface_area() * above)
+                        / area
+            };
+            let mut best = f64::INFINITY;
+            for axis in 0..3 {
+                for b in &ob {
+                    for pos in [b.min.axis(axis), b.max.axis(axis)] {
+                        if pos > -8.0 && pos < 8.0 {
+                            best = best.min(cost_at(axis, pos));
+                        }
+                    }
+                }
+            }
+            let leaf = costs.leaf + costs.object.iter().sum::<f64>();
+            match chip_split(&ob, &objects, bounds, &costs) {
+                Some((axis, pos)) => {
+                    let got = cost_at(axis, pos);
+                    assert!((got - best).abs() <= 1e-9 * best, "{got} against {best}");
+                    assert!(got < leaf, "split at {got}, the leaf costs {leaf}");
+                }
+                None => assert!(best >= leaf, "a leaf, but a plane costs {best} < {leaf}"),
+            }
+        }
+    }
+
+    /// Objects the cost would keep in one leaf (the node costs more than
+    /// any split saves) are split until each leaf's records fit the bank.
+    #[test]
+    fn chip_leaves_fit_the_bank() {
+        let ob: Vec<Aabb> = (0..64)
+            .map(|i| {
+                cube(
+                    [
+                        (i % 4) as f64 * 4.0 - 6.0,
+                        (i / 4 % 4) as f64 * 4.0 - 6.0,
+                        (i / 16) as f64 * 4.0 - 6.0,
+                    ],
+                    0.5,
+                )
+            })
+            .collect();
+        let world = cube([0.0, 0.0, 0.0], 8.0);
+        let costs = |leaf_words| ChipCosts {
+            node: 1e9,
+            leaf: 0.0,
+            object: vec![1.0; 64],
+            words: vec![10; 64],
+            leaf_words,
+        };
+        let params = BspParams {
+            rule: SplitRule::Chip,
+            max_leaf: 1,
+            max_depth: 20,
+            snap: 0.0,
+        };
+        let one = Bsp::build_costed(&ob, world, params, &|_, _| true, Some(&costs(0)));
+        assert_eq!(one.nodes.len(), 1, "the node's cost keeps one leaf");
+        let fit = Bsp::build_costed(&ob, world, params, &|_, _| true, Some(&costs(100)));
+        for n in fit.nodes.iter().filter(|n| n.split.is_none()) {
+            assert!(
+                n.objects.len() * 10 <= 100,
+                "a leaf of {} objects",
+                n.objects.len()
+            );
+        }
+        assert!(fit.stats().leaves >= 7);
     }
 }

@@ -56,10 +56,11 @@ pub struct RenderArgs {
     #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::parse_count::<usize>)]
     pub max_leaf: usize,
     /// BSP split rule: median (the paper's spatial median, axes in turn),
-    /// sah (surface area heuristic) or auto (median for the paper's
-    /// traversal; for the packet traversal the cheaper of the two trees
-    /// by its cost model).
-    #[arg(long, value_name = "auto|median|sah", default_value = "auto", value_parser = ["auto", "median", "sah"])]
+    /// sah (surface area heuristic, pbrt's costs), chip (surface area
+    /// heuristic with the chip's measured cycle costs, leaves that fit an
+    /// FB bank) or auto (median for the paper's traversal; for the packet
+    /// traversal the fastest of the three trees on a probe of the frame).
+    #[arg(long, value_name = "auto|median|sah|chip", default_value = "auto", value_parser = ["auto", "median", "sah", "chip"])]
     pub split: String,
     /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
     /// or compact (index lists); the same image either way.
@@ -140,7 +141,16 @@ pub struct RenderArgs {
     pub argv: Vec<String>,
 }
 
-fn profile_json(p: &crate::profile::Profile) -> serde_json::Value {
+/// The profile's cycles by cause for this render's statistics.
+fn causes(p: &crate::profile::Profile, chip: &crate::render::ChipRender) -> crate::profile::Causes {
+    let tests: Vec<String> = firmware::tracer::primitives::all_test_kernels()
+        .into_iter()
+        .map(String::from)
+        .collect();
+    p.causes(&tests, chip.simd_efficiency(), chip.stats.dma_stall_cycles)
+}
+
+fn profile_json(p: &crate::profile::Profile, causes: &crate::profile::Causes) -> serde_json::Value {
     let rows = |v: &[(String, u64)]| {
         v.iter()
             .map(|(n, c)| json!({"name": n, "cycles": c}))
@@ -150,10 +160,11 @@ fn profile_json(p: &crate::profile::Profile) -> serde_json::Value {
         "cycles": p.cycles,
         "kernels": rows(&p.kernels),
         "control": rows(&p.control),
+        "causes": causes,
     })
 }
 
-fn print_profile(p: &crate::profile::Profile) {
+fn print_profile(p: &crate::profile::Profile, causes: &crate::profile::Causes) {
     let pct = |c: u64| 100.0 * c as f64 / p.cycles.max(1) as f64;
     let busy: u64 = p.kernels.iter().map(|x| x.1).sum();
     println!(
@@ -162,6 +173,16 @@ fn print_profile(p: &crate::profile::Profile) {
         pct(busy),
         pct(p.cycles - busy)
     );
+    println!("  cycles by cause               cycles      share");
+    for (n, c) in [
+        ("object tests needed", causes.tests_needed),
+        ("divergence waste", causes.divergence_waste),
+        ("traversal, shading", causes.traversal_and_shading),
+        ("DMA wait", causes.dma_wait),
+        ("control idle", causes.control_idle),
+    ] {
+        println!("  {n:<24} {c:>12} {:>9.1}%", pct(c));
+    }
     println!("  array busy in kernel          cycles      share");
     for (n, c) in p.kernels.iter().take(14) {
         println!("  {n:<24} {c:>12} {:>9.1}%", pct(*c));
@@ -469,6 +490,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             max_leaf: a.max_leaf,
             rule: match a.split.as_str() {
                 "sah" => firmware::bsp::SplitRule::Sah,
+                "chip" => firmware::bsp::SplitRule::Chip,
                 "median" => firmware::bsp::SplitRule::Median,
                 _ => firmware::bsp::SplitRule::Auto,
             },
@@ -572,7 +594,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         None => "generated".into(),
     };
     if let Some(p) = &chip.profile {
-        rep.json["profile"] = profile_json(p);
+        rep.json["profile"] = profile_json(p, &causes(p, &chip));
     }
     if let Some(why) = chip.firmware_count_disagrees() {
         let w = firmware::scene::Warning {
@@ -714,7 +736,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         j["array_cycles_per_host_second"].as_f64().unwrap_or(0.0)
     );
     if let Some(p) = &chip.profile {
-        print_profile(p);
+        print_profile(p, &causes(p, &chip));
     }
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(j)?;

@@ -336,6 +336,20 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
         },
         nm,
     });
+    // The packet traversal's trees, each forced (its default probes all
+    // three and keeps the fastest).
+    for rule in [SplitRule::Median, SplitRule::Sah, SplitRule::Chip] {
+        let packet = packet_config(width, height);
+        v.push(Knob {
+            knob: "packet_split",
+            value: format!("{rule:?}").to_lowercase(),
+            opt: Options {
+                bsp: BspParams { rule, ..packet.bsp },
+                ..packet
+            },
+            nm,
+        });
+    }
     for datapath in [Datapath::W16, Datapath::W32] {
         v.push(Knob {
             knob: "datapath",

@@ -37,6 +37,52 @@ impl Profile {
     }
 }
 
+/// The frame's cycles by cause ([`Profile::causes`]), in print order.
+#[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
+pub struct Causes {
+    /// Object-test kernels, times the SIMD efficiency: the lanes whose
+    /// ray needed the test.
+    pub tests_needed: u64,
+    /// Object-test kernels, times one minus the SIMD efficiency: the
+    /// lanes whose ray does not reach the object's cell (divergence).
+    pub divergence_waste: u64,
+    /// Every other kernel: traversal (nodes, pushes, pops) and shading.
+    pub traversal_and_shading: u64,
+    /// The array idle while TinyRISC waits for the DMA channel.
+    pub dma_wait: u64,
+    /// The array idle while TinyRISC decides (nodes, leaves, mailboxes).
+    pub control_idle: u64,
+}
+
+impl Profile {
+    /// The cycles split by cause: busy cycles in the object tests' kernels
+    /// (`tests`, the kernels of every primitive's test) are divided by
+    /// `simd_efficiency` (the share of the broadcast tests' lanes whose ray
+    /// needed them: one figure for every test, so each kernel's cycles are
+    /// divided in the same proportion), the other busy cycles are
+    /// traversal and shading; idle cycles are DMA waits (`dma_stall`, the
+    /// chip's count, at most the idle cycles) or control.
+    pub fn causes(&self, tests: &[String], simd_efficiency: f64, dma_stall: u64) -> Causes {
+        let busy: u64 = self.kernels.iter().map(|x| x.1).sum();
+        let test: u64 = self
+            .kernels
+            .iter()
+            .filter(|(n, _)| tests.contains(n))
+            .map(|x| x.1)
+            .sum();
+        let needed = (test as f64 * simd_efficiency.clamp(0.0, 1.0)).round() as u64;
+        let idle = self.cycles.saturating_sub(busy);
+        let dma = dma_stall.min(idle);
+        Causes {
+            tests_needed: needed,
+            divergence_waste: test - needed,
+            traversal_and_shading: busy - test,
+            dma_wait: dma,
+            control_idle: idle - dma,
+        }
+    }
+}
+
 fn sorted<K: ToString>(m: BTreeMap<K, u64>) -> Vec<(String, u64)> {
     let mut v: Vec<(String, u64)> = m.into_iter().map(|(n, x)| (n.to_string(), x)).collect();
     v.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));

@@ -841,6 +841,32 @@ fn render_plain_equals_the_fast_paths() {
 /// (61 objects) most are not, and the JSON's counts agree.
 #[test]
 fn simd_efficiency_is_one_with_one_object() {
+    /// The cycles of the profile's kernels whose names `pick` takes.
+    fn kernel_cycles(j: &serde_json::Value, pick: &dyn Fn(&str) -> bool) -> u64 {
+        j["profile"]["kernels"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .filter(|k| pick(k["name"].as_str().unwrap()))
+            .map(|k| k["cycles"].as_u64().unwrap())
+            .sum()
+    }
+    /// The causes add up to the profile's cycles, the busy ones to its
+    /// kernels', the DMA wait is the chip's stall count.
+    fn assert_causes_sum(j: &serde_json::Value) {
+        let c = &j["profile"]["causes"];
+        let f = |k: &str| c[k].as_u64().unwrap();
+        let busy = kernel_cycles(j, &|_| true);
+        assert_eq!(
+            f("tests_needed") + f("divergence_waste") + f("traversal_and_shading"),
+            busy
+        );
+        assert_eq!(
+            busy + f("dma_wait") + f("control_idle"),
+            j["profile"]["cycles"].as_u64().unwrap()
+        );
+        assert_eq!(f("dma_wait"), j["dma_stall_cycles"].as_u64().unwrap());
+    }
     let dir = tempfile::tempdir().unwrap();
     std::fs::write(
         dir.path().join("one.nff"),
@@ -859,6 +885,7 @@ fn simd_efficiency_is_one_with_one_object() {
                 "28x20",
                 "--traversal",
                 traversal,
+                "--profile",
                 "--json",
                 "j.json",
             ],
@@ -869,6 +896,16 @@ fn simd_efficiency_is_one_with_one_object() {
                 .unwrap();
         assert_eq!(j["simd_efficiency"], 1.0, "{traversal}");
         assert!(j["ray_object_tests"].as_u64().unwrap() > 0);
+        // The profile's causes: no divergence, and the tests' cycles are
+        // the rectangle kernel's (the square is one for the chip).
+        let c = &j["profile"]["causes"];
+        assert_eq!(c["divergence_waste"], 0, "{traversal}");
+        assert_eq!(
+            c["tests_needed"].as_u64().unwrap(),
+            kernel_cycles(&j, &|n| n == "k_rectangle"),
+            "{traversal}"
+        );
+        assert_causes_sum(&j);
     }
     let rings = scene_path("rings-1.nff");
     let (ok, _, err) = morphosys(
@@ -878,6 +915,7 @@ fn simd_efficiency_is_one_with_one_object() {
             rings.to_str().unwrap(),
             "--size",
             "32x32",
+            "--profile",
             "--json",
             "r.json",
         ],
@@ -885,6 +923,20 @@ fn simd_efficiency_is_one_with_one_object() {
     assert!(ok, "{err}");
     let j: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.path().join("r.json")).unwrap()).unwrap();
+    // Spheres, cylinders (their caps too) and the rectangle are the
+    // tests; split by the efficiency.
+    let c = &j["profile"]["causes"];
+    let tests = kernel_cycles(&j, &|n| {
+        ["k_sphere", "k_cylinder", "k_disc", "k_rectangle"].contains(&n)
+    });
+    let (needed, waste) = (
+        c["tests_needed"].as_u64().unwrap(),
+        c["divergence_waste"].as_u64().unwrap(),
+    );
+    assert_eq!(needed + waste, tests);
+    let eff = j["simd_efficiency"].as_f64().unwrap();
+    assert!((needed as f64 - eff * tests as f64).abs() <= 1.0);
+    assert_causes_sum(&j);
     let (tests, offered) = (
         j["ray_object_tests"].as_u64().unwrap(),
         j["object_tests_offered"].as_u64().unwrap(),

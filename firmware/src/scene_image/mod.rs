@@ -91,9 +91,12 @@ pub enum NodeFormat {
 }
 
 /// Compiler options.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Debug)]
 pub struct CompileOptions {
     pub bsp: BspParams,
+    /// The costs an [`crate::bsp::SplitRule::Chip`] tree weighs (`None`:
+    /// [`crate::bsp::ChipCosts::uniform`]).
+    pub chip_costs: Option<std::sync::Arc<crate::bsp::ChipCosts>>,
     /// None: the smaller of the two.
     pub layout: Option<NodeFormat>,
     /// Bits of headroom above the largest coordinate.
@@ -111,6 +114,7 @@ impl Default for CompileOptions {
     fn default() -> Self {
         CompileOptions {
             bsp: BspParams::default(),
+            chip_costs: None,
             layout: None,
             guard_bits: 1,
             min_feature_lsb: 2.0,
@@ -362,7 +366,7 @@ fn build_bsp(scene: &Scene, opt: &CompileOptions, q: QFormat) -> Result<Bsp, Sce
             max: b.max + m,
         })
     };
-    let bsp = Bsp::build_with(
+    let bsp = Bsp::build_costed(
         &bounds,
         snap_out(world),
         BspParams {
@@ -370,6 +374,7 @@ fn build_bsp(scene: &Scene, opt: &CompileOptions, q: QFormat) -> Result<Bsp, Sce
             ..opt.bsp
         },
         &meets,
+        opt.chip_costs.as_deref(),
     );
     if bsp.nodes.len() > NO_CHILD as usize {
         return Err(error(

@@ -84,6 +84,7 @@ impl Report {
             match self.bsp_params.rule {
                 crate::bsp::SplitRule::Median => "median",
                 crate::bsp::SplitRule::Sah => "SAH",
+                crate::bsp::SplitRule::Chip => "chip-cost SAH",
                 crate::bsp::SplitRule::Auto => "auto",
             },
             self.bsp_params.max_depth,

@@ -416,7 +416,7 @@ pub fn build_streamed_with(
 pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
     let b = opt.bsp;
     let depth = |rule: SplitRule| match (b.max_depth, rule) {
-        (0, SplitRule::Sah) => crate::bsp::auto_depth(objects),
+        (0, SplitRule::Sah | SplitRule::Chip) => crate::bsp::auto_depth(objects),
         (0, _) => 15,
         (d, _) => d,
     };
@@ -427,9 +427,11 @@ pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
     };
     match (opt.traversal, b.rule) {
         (Traversal::Paper, SplitRule::Auto) => vec![with(SplitRule::Median)],
-        (Traversal::Packet, SplitRule::Auto) => {
-            vec![with(SplitRule::Median), with(SplitRule::Sah)]
-        }
+        (Traversal::Packet, SplitRule::Auto) => vec![
+            with(SplitRule::Median),
+            with(SplitRule::Sah),
+            with(SplitRule::Chip),
+        ],
         (_, rule) => vec![with(rule)],
     }
 }
@@ -546,8 +548,20 @@ fn build_one(
             opt.depth
         ));
     }
+    let chip_costs = (opt.bsp.rule == SplitRule::Chip).then(|| {
+        let frac = crate::scene_image::fitted_frac(scene, nm.guard_bits).unwrap_or(9)
+            + opt.datapath.bits()
+            - 16;
+        std::sync::Arc::new(layout::packet_nodes::chip_costs(
+            scene,
+            opt.datapath,
+            nm.normals.fine_on(opt.datapath),
+            frac,
+        ))
+    });
     let copt = CompileOptions {
         bsp: opt.bsp,
+        chip_costs,
         layout: Some(crate::scene_image::NodeFormat::BitVectors),
         guard_bits: nm.guard_bits,
         target_extra_frac: opt.datapath.bits() - 16,

@@ -98,6 +98,7 @@ pub(super) fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> V
     let split = match o.bsp.rule {
         SplitRule::Median => "median",
         SplitRule::Sah => "sah",
+        SplitRule::Chip => "chip",
         SplitRule::Auto => "auto",
     };
     let mut v: Vec<String> = vec!["render".into(), scene.display().to_string()];

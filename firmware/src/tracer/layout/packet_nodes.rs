@@ -68,6 +68,56 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
         .collect()
 }
 
+/// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
+/// leaf loop (the block's check, its DMA's issue, the list's scan) and the
+/// DMA's set-up, for [`crate::bsp::SplitRule::Chip`].
+const PK_LEAF_COST: f64 = 40.0;
+
+/// The costs a [`crate::bsp::SplitRule::Chip`] tree of `scene` weighs
+/// (the packet traversal's, as [`object_costs`] and [`PK_NODE_COST`]),
+/// before the scene's format is fitted: per object its test and its
+/// record's move by DMA (words times the FB word's bytes over the DMA's
+/// bytes per cycle), a leaf's block within FB bank 1.
+pub fn chip_costs(
+    scene: &Scene,
+    datapath: rtl::rc::Datapath,
+    fine_normals: bool,
+    frac: u32,
+) -> crate::bsp::ChipCosts {
+    use super::super::primitives::ChipType;
+    let fit = Fit {
+        fine_normals,
+        ..Fit::default()
+    };
+    let s = (frac as f64).exp2();
+    let dma = rtl::dma::DmaTiming::default();
+    let word_cycles = (datapath.bits() / 8) as f64 / dma.bytes_per_cycle.max(1) as f64;
+    let tests = object_costs(scene, s, &fit);
+    let words: Vec<usize> = scene
+        .objects
+        .iter()
+        .map(|o| {
+            let fan = match &o.shape {
+                Shape::Polygon { v, .. } => polygon::edges(v, s).1.len(),
+                _ => 0,
+            };
+            let transmits = scene.materials[o.material].t > 0.0;
+            ChipType::of_object(&o.shape, transmits).record_words(&fit, fan)
+        })
+        .collect();
+    crate::bsp::ChipCosts {
+        node: PK_NODE_COST,
+        leaf: PK_LEAF_COST + dma.setup_cycles as f64,
+        object: tests
+            .iter()
+            .zip(&words)
+            .map(|(t, &w)| t + w as f64 * word_cycles)
+            .collect(),
+        words,
+        leaf_words: super::FB_LIMIT - STREAM_BANK - super::BLOCK_HEAD,
+    }
+}
+
 /// Words of a packet-traversal inner node: axis, parent's slot, split,
 /// own slot, left, right (FB addresses, or byte addresses when streamed).
 pub const PK_INNER: usize = 6;

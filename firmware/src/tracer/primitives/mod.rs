@@ -291,6 +291,26 @@ pub const TEST_KERNELS: [&str; 16] = [
     "k_glass_smooth_triangle",
 ];
 
+/// Every kernel of every primitive's test (the first ones are
+/// [`TEST_KERNELS`]; caps, polygon edges and tails, the glass bodies'
+/// second sides besides), for `render --profile`'s causes.
+pub fn all_test_kernels() -> Vec<&'static str> {
+    let g = Gen {
+        datapath: Datapath::W16,
+        approx: crate::tracer::math::Approx::default(),
+        fine_normals: true,
+    };
+    let mut v: Vec<&'static str> = Vec::new();
+    for t in ChipType::ALL {
+        for (name, _) in t.kernels(&g, &Fit::default()) {
+            if !v.contains(&name) {
+                v.push(name);
+            }
+        }
+    }
+    v
+}
+
 /// Which faces a kernel accepts.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Sides {
