@@ -49,7 +49,7 @@ pub struct RenderArgs {
     pub emit_asm: Option<PathBuf>,
     /// Maximum BSP depth: a number (1..=32) or auto (the paper's 15 for
     /// the paper's traversal; for the packet traversal 15 for a median
-    /// tree and 8 + 1.3 log2(objects) for an SAH tree).
+    /// tree and 8 + 1.3 log2(objects) for the SAH trees).
     #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_depth)]
     pub max_depth: u32,
     /// Maximum objects per BSP leaf.

@@ -935,7 +935,7 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
 
 /// The firmware for `opt`. Where the options leave the BSP to the tracer
 /// and it has more than one candidate ([`tracer::resolve_bsp`]: the packet
-/// traversal's median and SAH trees), each is run on the probe (every
+/// traversal's median, SAH and chip-cost SAH trees), each is run on the probe (every
 /// fourth row and column of tiles, at the frame's size, so each packet is
 /// as coherent as in the frame) and compared with the f64 reference on the
 /// same pixels: the tree with the fewest cycles is kept among those whose

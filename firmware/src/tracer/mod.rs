@@ -53,9 +53,10 @@ pub struct Options {
     pub depth: u32,
     /// The BSP. `max_depth` 0 and `SplitRule::Auto` (the default) are
     /// resolved per traversal ([`resolve_bsp`]): the paper's median split
-    /// to depth 15 for the paper's traversal; for the packet traversal the
-    /// cheaper (by its cost model) of that tree and an SAH tree to
-    /// [`crate::bsp::auto_depth`].
+    /// to depth 15 for the paper's traversal; for the packet traversal that
+    /// tree, a pbrt SAH tree and a chip-cost SAH tree (both to
+    /// [`crate::bsp::auto_depth`]): `render` keeps the fastest on a probe
+    /// of the frame, [`build`] the cheapest by the traversal's cost model.
     pub bsp: BspParams,
     /// How a resident scene's BSP nodes name their objects (the paper's
     /// Fig. 5 bit vectors by default).
@@ -410,9 +411,10 @@ pub fn build_streamed_with(
 }
 
 /// The BSP trees to try for `opt` (automatic choices resolved): one, or
-/// for the packet traversal with `SplitRule::Auto` the paper's median tree
-/// and an SAH tree, of which the build keeps the cheaper by the packet
-/// traversal's cost model.
+/// for the packet traversal with `SplitRule::Auto` the paper's median tree,
+/// a pbrt SAH tree and a chip-cost SAH tree, of which the build keeps the
+/// cheapest by the packet traversal's cost model (`render` probes them
+/// instead).
 pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
     let b = opt.bsp;
     let depth = |rule: SplitRule| match (b.max_depth, rule) {
