@@ -73,8 +73,8 @@ impl Default for BspParams {
 }
 
 /// The costs [`SplitRule::Chip`] weighs, in array cycles of a packet (the
-/// ray tracer measures them on its own kernels and TinyRISC loops:
-/// `tracer::chip_costs`).
+/// ray tracer derives them from its kernels' lengths and its TinyRISC
+/// loops' cycle constants: `tracer::layout::packet_nodes::chip_costs`).
 #[derive(Clone, Debug, PartialEq)]
 pub struct ChipCosts {
     /// An inner node's visit: its kernel and TinyRISC's decision.

@@ -57,7 +57,7 @@ pub struct RenderArgs {
     pub max_leaf: usize,
     /// BSP split rule: median (the paper's spatial median, axes in turn),
     /// sah (surface area heuristic, pbrt's costs), chip (surface area
-    /// heuristic with the chip's measured cycle costs, leaves that fit an
+    /// heuristic with the chip's cycle costs, from its kernels, leaves that fit an
     /// FB bank) or auto (median for the paper's traversal; for the packet
     /// traversal the fastest of the three trees on a probe of the frame).
     #[arg(long, value_name = "auto|median|sah|chip", default_value = "auto", value_parser = ["auto", "median", "sah", "chip"])]
