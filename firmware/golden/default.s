@@ -292,7 +292,6 @@ NSTACK:         .space 256              ; the node stack
 NK:             .word 0, 0, 0           ; per axis: the node kernel of the pass's child order
 NF:             .word 0, 0, 0           ; per axis: the first child's field in a node
 NS:             .word 0, 0, 0           ; per axis: the second child's field
-CUR_BLK:        .word 0                 ; the leaf block in SBANK
         .text
 
 ; _start: the FB image and the contexts in by DMA, every RC's RAM tables and lane words,

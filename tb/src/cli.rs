@@ -201,6 +201,10 @@ pub(crate) fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, Stri
     s.parse()
 }
 
+pub(crate) fn parse_leaf_pieces(s: &str) -> Result<firmware::tracer::LeafPieces, String> {
+    s.parse()
+}
+
 pub(crate) fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
     s.parse()
 }

@@ -118,6 +118,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             datapath: Default::default(),
             traversal: firmware::tracer::Traversal::Paper,
             collapse: Default::default(),
+            pieces: Default::default(),
         },
         firmware::tracer::Traversal::Packet => Options {
             width,

@@ -77,6 +77,13 @@ pub struct RenderArgs {
     /// with at most N objects; 0: none).
     #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_collapse)]
     pub collapse: firmware::tracer::Collapse,
+    /// Streamed packet traversal: the words of the pieces a leaf's records
+    /// are moved in by DMA, FIRST,REST: the first piece of at most FIRST
+    /// words (the wait at every leaf), each further one of at most REST
+    /// (it moves while the piece before it is tested); each 1..=16384,
+    /// FIRST <= REST, a piece holds at least one record.
+    #[arg(long, value_name = "FIRST,REST", default_value = "64,256", value_parser = crate::cli::parse_leaf_pieces)]
+    pub leaf_pieces: firmware::tracer::LeafPieces,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
     /// variant the paper announces; every format gets 16 more fraction
     /// bits), or auto: 16 unless the 16-bit chip cannot hold the scene or
@@ -312,6 +319,7 @@ pub(crate) fn render_and_measure(
         "node_layout": if opt.traversal == firmware::tracer::Traversal::Packet { "packet" } else { opt.layout.name() },
         "traversal": opt.traversal.name(),
         "collapse": opt.collapse.to_string(),
+        "leaf_pieces": opt.pieces.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
@@ -500,6 +508,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         datapath: rtl::rc::Datapath::W16,
         traversal: a.traversal,
         collapse: a.collapse,
+        pieces: a.leaf_pieces,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);

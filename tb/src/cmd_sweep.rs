@@ -350,6 +350,26 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
+    // A streamed scene's leaf pieces (resident scenes have none): whole
+    // leaves (one piece unless a leaf exceeds the bank) and smaller pieces.
+    for pieces in [
+        firmware::tracer::LeafPieces {
+            first: firmware::tracer::LeafPieces::MAX,
+            rest: firmware::tracer::LeafPieces::MAX,
+        },
+        firmware::tracer::LeafPieces {
+            first: 32,
+            rest: 128,
+        },
+    ] {
+        let packet = packet_config(width, height);
+        v.push(Knob {
+            knob: "leaf_pieces",
+            value: pieces.to_string(),
+            opt: Options { pieces, ..packet },
+            nm,
+        });
+    }
     for datapath in [Datapath::W16, Datapath::W32] {
         v.push(Knob {
             knob: "datapath",
@@ -487,7 +507,7 @@ struct Row {
 
 fn key(o: &Options, n: &Numerics) -> String {
     format!(
-        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {} {} {}",
+        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {} {} {} {}",
         o.width,
         o.height,
         o.ways,
@@ -499,7 +519,8 @@ fn key(o: &Options, n: &Numerics) -> String {
         o.layout,
         o.datapath,
         o.traversal,
-        o.collapse
+        o.collapse,
+        o.pieces
     )
 }
 

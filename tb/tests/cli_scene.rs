@@ -290,6 +290,14 @@ fn usage_errors_name_the_argument_and_exit_2() {
             "'--max-leaf <N>': expected a whole number of at least 1",
         ),
         (
+            &["render", "--leaf-pieces", "300,100"][..],
+            "'--leaf-pieces <FIRST,REST>': leaf pieces '300,100': expected FIRST,REST",
+        ),
+        (
+            &["render", "--leaf-pieces", "0,64"][..],
+            "two word counts 1..=16384 with FIRST <= REST",
+        ),
+        (
             &["compile", "--max-leaf", "0"][..],
             "'--max-leaf <N>': expected a whole number of at least 1",
         ),

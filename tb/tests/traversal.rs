@@ -294,3 +294,49 @@ fn a_leaf_larger_than_the_bank_is_streamed_in_pieces() {
         Err(e) => assert!(e.contains("FB bank 1 holds"), "{e}"),
     }
 }
+
+/// The streamed packet traversal moves a leaf's records in pieces that
+/// alternate between FB bank 1 and the top of bank 0, each piece moving
+/// while the one before it is tested: the same objects are tested in the
+/// same order whatever the pieces, so the image is identical to whole
+/// leaves', and the array waits less for the DMA.
+#[test]
+fn leaf_pieces_move_while_the_tests_run() {
+    use firmware::tracer::LeafPieces;
+    let scene = load("rings-1.nff");
+    let render = |pieces: LeafPieces| {
+        let o = Options {
+            pieces,
+            ..opts(32, 32, Traversal::Packet)
+        };
+        let settings = RenderSettings {
+            streamed: true,
+            ..Default::default()
+        };
+        tb::render::render_chip(&scene, &o, &settings).unwrap()
+    };
+    let whole = render(LeafPieces {
+        first: LeafPieces::MAX,
+        rest: LeafPieces::MAX,
+    });
+    for pieces in [LeafPieces::default(), LeafPieces { first: 8, rest: 64 }] {
+        let cut = render(pieces);
+        let st = cut.firmware.layout.stream.as_ref().expect("streamed");
+        eprintln!(
+            "rings-1 32x32 streamed, pieces {pieces}: {} extra pieces, DMA stall {} cycles (whole leaves: {} extra, {})",
+            st.extra_pieces,
+            cut.stats.dma_stall_cycles,
+            whole.firmware.layout.stream.as_ref().unwrap().extra_pieces,
+            whole.stats.dma_stall_cycles
+        );
+        assert!(st.extra_pieces > 50, "{} extra pieces", st.extra_pieces);
+        assert!(cut.rgb8 == whole.rgb8, "pieces {pieces}: the image changed");
+        assert!(cut.hits == whole.hits, "pieces {pieces}: the hits changed");
+        assert!(
+            cut.stats.dma_stall_cycles * 10 < whole.stats.dma_stall_cycles * 8,
+            "pieces {pieces}: DMA stall {} cycles against {} with whole leaves",
+            cut.stats.dma_stall_cycles,
+            whole.stats.dma_stall_cycles
+        );
+    }
+}

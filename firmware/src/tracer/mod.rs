@@ -70,6 +70,9 @@ pub struct Options {
     /// Packet traversal: which BSP subtrees are walked as one leaf of all
     /// the objects under them.
     pub collapse: Collapse,
+    /// Streamed packet traversal: the sizes of the pieces a leaf's records
+    /// are moved in.
+    pub pieces: LeafPieces,
 }
 
 impl Default for Options {
@@ -88,6 +91,7 @@ impl Default for Options {
             datapath: Datapath::W16,
             traversal: Traversal::default(),
             collapse: Collapse::Auto,
+            pieces: LeafPieces::default(),
         }
     }
 }
@@ -124,6 +128,62 @@ impl std::str::FromStr for Collapse {
         s.parse::<usize>()
             .map(Collapse::Objects)
             .map_err(|_| format!("collapse '{s}': expected auto or a number of objects (0: never)"))
+    }
+}
+
+/// The streamed packet traversal moves a leaf's records into the FB in
+/// pieces (`docs/tracer.md`, "Streamed leaves"): the first of at most
+/// `first` words, the others of at most `rest` (a piece holds at least one
+/// record). The pieces of a leaf alternate between FB bank 1 and the top of
+/// bank 0, and each piece after the first moves while the tests of the
+/// piece before it run: a small first piece is a short wait at every leaf,
+/// larger further pieces fewer turns of the loop.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct LeafPieces {
+    pub first: usize,
+    pub rest: usize,
+}
+
+impl Default for LeafPieces {
+    fn default() -> Self {
+        LeafPieces {
+            first: 64,
+            rest: 256,
+        }
+    }
+}
+
+impl LeafPieces {
+    /// The most words either limit may name (an FB bank).
+    pub const MAX: usize = layout::STREAM_BANK;
+}
+
+impl std::fmt::Display for LeafPieces {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{},{}", self.first, self.rest)
+    }
+}
+
+impl std::str::FromStr for LeafPieces {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || {
+            format!(
+                "leaf pieces '{s}': expected FIRST,REST, two word counts 1..={} with FIRST <= REST (e.g. 64,256)",
+                LeafPieces::MAX
+            )
+        };
+        let (a, b) = s.split_once(',').ok_or_else(bad)?;
+        let n = |x: &str| {
+            x.trim()
+                .parse::<usize>()
+                .ok()
+                .filter(|n| (1..=LeafPieces::MAX).contains(n))
+        };
+        match (n(a), n(b)) {
+            (Some(first), Some(rest)) if first <= rest => Ok(LeafPieces { first, rest }),
+            _ => Err(bad()),
+        }
     }
 }
 

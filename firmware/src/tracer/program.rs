@@ -550,7 +550,6 @@ fn data(lay: &FbImage) -> String {
             ".word 0, 0, 0",
             "per axis: the second child's field",
         );
-        d(&mut t, "CUR_BLK", ".word 0", "the leaf block in SBANK");
     } else if lay.stream.is_some() {
         d(
             &mut t,

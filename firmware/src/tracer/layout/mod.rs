@@ -138,8 +138,8 @@ pub struct Stream {
     pub split_slot: usize,
     pub nodes: usize,
     pub largest_block: usize,
-    /// Packet traversal: leaf blocks beyond one per leaf (a leaf whose
-    /// records exceed FB bank 1 is moved in pieces).
+    /// Packet traversal: leaf pieces beyond one per leaf (a leaf's records
+    /// are moved in pieces, [`super::LeafPieces`]).
     pub extra_pieces: usize,
 }
 
@@ -474,6 +474,7 @@ fn build_as(
         traversal: opt.traversal,
         root_box,
         collapse: opt.collapse,
+        pieces: opt.pieces,
         cost: if packet {
             packet_nodes::object_costs(scene, s, &fit)
         } else {
@@ -637,6 +638,7 @@ pub(super) struct Finish {
     traversal: Traversal,
     root_box: usize,
     collapse: super::Collapse,
+    pieces: super::LeafPieces,
     /// Per scene object, the array cycles of its test (kernel contexts and
     /// the TinyRISC loop around them).
     cost: Vec<f64>,

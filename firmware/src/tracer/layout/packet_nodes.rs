@@ -346,17 +346,21 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
     (w.fb, root)
 }
 
-/// Leaf pieces: a leaf's records (grouped by type) cut where a block would
-/// exceed FB bank 1; each piece is a node record of its own, chained from
-/// the leaf (`PS_NEXT`). Per piece its (type index, slot) pairs, and per
-/// node the index of its first piece (`usize::MAX`: none).
+/// Leaf pieces: a leaf's records (grouped by type) cut where a piece
+/// would exceed `first` words (the leaf's first piece) or `rest` (the
+/// others), a piece holding at least one record; each piece is a node
+/// record of its own, chained from the leaf (`PS_NEXT`). Per piece its
+/// (type index, slot) pairs and its place in its leaf (0 for the first),
+/// and per node the index of its first piece (`usize::MAX`: none).
 #[allow(clippy::type_complexity)]
 fn pieces(
     tree: &Tree,
-    err: &dyn Fn(usize, String) -> String,
-) -> Result<(Vec<Vec<(usize, usize)>>, Vec<usize>), String> {
+    first: usize,
+    rest: usize,
+) -> (Vec<Vec<(usize, usize)>>, Vec<usize>, Vec<usize>) {
     let types = tree.types;
     let mut pieces: Vec<Vec<(usize, usize)>> = Vec::new();
+    let mut in_leaf = Vec::new();
     let mut first_piece = vec![usize::MAX; tree.nodes.len()];
     for (k, n) in tree.nodes.iter().enumerate() {
         if n.split.is_some() || n.objects.is_empty() {
@@ -365,20 +369,15 @@ fn pieces(
         first_piece[k] = pieces.len();
         let mut cur: Vec<(usize, usize)> = Vec::new();
         let mut words = 0usize;
+        let mut place = 0;
         for (j, qs) in tree.per_type(n).into_iter().enumerate() {
             for q in qs {
                 let sz = types[j].size;
-                if sz > STREAM_BANK {
-                    return Err(err(
-                        0,
-                        format!(
-                            "a {} record of {sz} words exceeds FB bank 1",
-                            types[j].ty.name()
-                        ),
-                    ));
-                }
-                if words + sz > STREAM_BANK {
+                let limit = if place == 0 { first } else { rest };
+                if words + sz > limit && !cur.is_empty() {
                     pieces.push(std::mem::take(&mut cur));
+                    in_leaf.push(place);
+                    place += 1;
                     words = 0;
                 }
                 cur.push((j, q));
@@ -386,8 +385,9 @@ fn pieces(
             }
         }
         pieces.push(cur);
+        in_leaf.push(place);
     }
-    Ok((pieces, first_piece))
+    (pieces, first_piece, in_leaf)
 }
 
 /// Write a node record (16 words) into the streamed image.
@@ -425,7 +425,23 @@ fn streamed_image(
         ));
     }
     let base = mem::STREAM as usize;
-    let (pieces, first_piece) = pieces(tree, err)?;
+    // A leaf's pieces alternate between FB bank 1 and the top of bank 0,
+    // above the resident words.
+    let largest_record = types.iter().map(|t| t.size).max().unwrap_or(0);
+    let room = STREAM_BANK - w.fb.len();
+    if largest_record > room {
+        return Err(err(
+            0,
+            format!(
+                "a {}-word record does not fit the {room} words bank 0 has above the streamed layout's resident part",
+                largest_record
+            ),
+        ));
+    }
+    let rest = fin.pieces.rest.max(largest_record).min(room);
+    let first = fin.pieces.first.min(rest);
+    let bank0_buf = STREAM_BANK - rest;
+    let (pieces, first_piece, in_leaf) = pieces(tree, first, rest);
     let nn = nodes.len();
     let lists_at = NODE_BYTES * (nn + pieces.len());
     let list_bytes: usize = pieces.iter().map(|p| 4 * p.len()).sum();
@@ -452,6 +468,11 @@ fn streamed_image(
         for &(j, q) in pc {
             lists.push(types[j].objects[q] as u32);
         }
+        f[word(PS_FB)] = if in_leaf[p] % 2 == 0 {
+            STREAM_BANK
+        } else {
+            bank0_buf
+        } as i32;
         f[word(PS_BLOCK)] = (base + blocks_at + blocks.len()) as i32;
         f[word(PS_BLOCK_WORDS)] = words.len() as i32;
         f[PS_COUNTS as usize / 4..][..7].copy_from_slice(&counts);
@@ -502,6 +523,7 @@ fn streamed_image(
                     // block, next piece, counts).
                     let p = piece_rec[first_piece[k]];
                     f[word(PS_LIST)] = p[word(PS_LIST)];
+                    f[word(PS_FB)] = p[word(PS_FB)];
                     f[word(PS_BLOCK)..].copy_from_slice(&p[word(PS_BLOCK)..]);
                 }
             }
@@ -605,6 +627,11 @@ pub mod fields {
         8,
         "  leaf: per object its mailbox's address (0: none)",
     );
+    pub const PS_FB: Name = Name::new(
+        "PS_FB",
+        12,
+        "  leaf: the FB address its block is moved to (bank 1, or the top of bank 0)",
+    );
     pub const PS_BLOCK: Name = Name::new("PS_BLOCK", 16, "  leaf: its block of records");
     pub const PS_BLOCK_WORDS: Name = Name::new("PS_BLOCK_WORDS", 20, "  leaf: the block's words");
     pub const PS_NEXT: Name = Name::new("PS_NEXT", 24, "  leaf: its next piece (0: none)");
@@ -647,6 +674,7 @@ pub fn header(streamed: bool, types: &[&str]) -> Vec<String> {
                 PS_LEFT,
                 PS_RIGHT,
                 PS_LIST,
+                PS_FB,
                 PS_BLOCK,
                 PS_BLOCK_WORDS,
                 PS_NEXT,

@@ -48,8 +48,10 @@
 //! PL_OBJECTS, PL_SHARED`, then per type present a count and per object
 //! its record's FB address and its mailbox index (-1: in one leaf only, no
 //! mailbox). Streamed (main memory, `NODE_BYTES`): the same with byte
-//! addresses (`PS_*`); a leaf's records are a block (in pieces where they
-//! exceed FB bank 1, chained by `PS_NEXT`) moved into `SBANK` by DMA.
+//! addresses (`PS_*`); a leaf's records are moved by DMA in pieces
+//! (chained by `PS_NEXT`, [`super::super::LeafPieces`]) that alternate
+//! between FB bank 1 and the top of bank 0 (`PS_FB`), each piece after the
+//! first moving while the piece before it is tested.
 //! Mailboxes (main memory, `MB_BYTES` each): the pass that last tested
 //! the object and which rays did (`MB_PASS`, `MB_RAYS`).
 //!
@@ -372,7 +374,11 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
             .or(R1, R4, R10)
             .beqz(R1, "trace_done")
             .lw(R11, at("PASS", R0))
-            .j("leaf_objects");
+            .j(if f.streamed {
+                "leaf_first"
+            } else {
+                "leaf_objects"
+            });
     }
     child_order(t, &f);
     t.li(R14, "NSTACK").li(R5, "ROOT");
@@ -510,6 +516,19 @@ fn mailbox_check(t: &mut Code, n: &str) {
     t.m("MAILBOX_CHECK", n);
 }
 
+/// Streamed leaf: once the array is done with the other bank (the tests
+/// of the piece before the current one), the DMA of the next piece (r1)
+/// into it.
+fn next_piece_dma(t: &mut Code, why: &str) {
+    t.rcany(R2)
+        .c("the array done with the other bank")
+        .lw(R2, at("PS_BLOCK", R1))
+        .lw(R3, at("PS_BLOCK_WORDS", R1))
+        .lw(R8, at("PS_FB", R1))
+        .ldfb(R2, R8, R3)
+        .c(why);
+}
+
 /// The leaf (r5): every object not yet tested by every awake ray in this
 /// pass, by type.
 fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
@@ -526,11 +545,16 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .lw(R11, at("PASS", R0));
     };
     if f.streamed {
-        // The block's DMA starts at once: the array reads bank 1 only in a
-        // leaf's object tests, and a pop or a node decision (which waits
-        // for the array) lies between two leaves; the mailbox scan runs
-        // while it moves, and `dwait` only comes before the first object.
-        // A leaf's further pieces wait for the array to finish the last.
+        // A leaf's block comes in pieces, alternately into FB bank 1 and
+        // the top of bank 0 (`PS_FB`). The first piece's DMA starts at
+        // once: the array is idle (a node decision or a pop came before)
+        // and the mailbox scan runs while it moves. Each further piece's
+        // DMA starts before the tests of the piece before it are issued,
+        // once the array is done with the other bank (the tests of the
+        // piece before that), so that it moves while those tests run. A
+        // piece is waited for (`dwait`) before its tests, and before the
+        // leaf is left, so no DMA is under way when a node kernel reads
+        // bank 0 again.
         t.label("leaf")
             .lw(R1, at("PS_OBJECTS", R5))
             .beqz(R1, "leaf_done")
@@ -538,24 +562,20 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .lw(R1, at("PS_SHARED", R5))
             .lw(R2, at("PS_NEXT", R5))
             .or(R1, R1, R2)
-            .beqz(R1, "leaf_piece")
+            .beqz(R1, "leaf_first")
             .c("no mailbox to check");
         awake(t);
-        t.label("leaf_objects");
-        t.label("leaf_piece")
+        t.label("leaf_first")
             .lw(R1, at("PS_BLOCK", R5))
             .lw(R3, at("PS_BLOCK_WORDS", R5))
-            .lw(R2, at("CUR_BLK", R0))
-            .beq(R1, R2, "leaf_scan_start")
-            .c("the block is in SBANK already")
-            .li(R2, "SBANK")
+            .lw(R2, at("PS_FB", R5))
             .ldfb(R1, R2, R3)
-            .c("its DMA starts")
-            .sw(R1, at("CUR_BLK", R0));
-        t.label("leaf_scan_start")
+            .c("the first piece's DMA starts");
+        t.label("leaf_piece")
             .lw(R6, at("PS_LIST", R5))
+            .c("r5: a piece whose DMA has started")
             .lw(R9, at("PS_OBJECTS", R5));
-        t.comment("while the block moves: is there an object some awake ray has not tested?");
+        t.comment("while the piece moves: is there an object some awake ray has not tested?");
         t.label("leaf_scan")
             .lw(R8, deref(R6))
             .addi(R6, R6, 4)
@@ -572,12 +592,25 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .and(R3, R3, R10)
             .bnez(R3, "leaf_load")
             .addi(R9, R9, -1)
-            .bnez(R9, "leaf_scan")
-            .j("leaf_next_piece")
-            .c("every object tested by every awake ray");
+            .bnez(R9, "leaf_scan");
+        t.comment("every object of the piece tested by every awake ray");
+        t.label("leaf_skip")
+            .lw(R1, at("PS_NEXT", R5))
+            .bnez(R1, "leaf_skip_next")
+            .dwait()
+            .c("the last piece in before the leaf is left")
+            .j("leaf_done");
+        t.label("leaf_skip_next");
+        next_piece_dma(t, "the next piece's DMA starts");
+        t.j("leaf_next_piece");
         t.label("leaf_load")
             .dwait()
-            .li(R7, "SBANK")
+            .c("the piece is in the FB")
+            .lw(R1, at("PS_NEXT", R5))
+            .beqz(R1, "leaf_tests");
+        next_piece_dma(t, "the next piece moves while this one's tests run");
+        t.label("leaf_tests")
+            .lw(R7, at("PS_FB", R5))
             .c("r7: the first record")
             .lw(R6, at("PS_LIST", R5));
         for ti in &lay.types {
@@ -601,8 +634,6 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         t.label("leaf_next_piece")
             .lw(R5, at("PS_NEXT", R5))
             .beqz(R5, "leaf_done")
-            .rcany(R2)
-            .c("the array done with the bank")
             .j("leaf_piece");
     } else {
         t.label("leaf")
