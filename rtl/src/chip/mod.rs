@@ -168,9 +168,6 @@ impl Stats {
     }
 }
 
-/// The chip, generic over its datapath word: `Chip` (= `Chip<i16>`) is the
-/// paper's 16-bit chip, `Chip<i32>` the 32-bit variant ([`Chip::new_wide`]);
-
 /// Every file a waveform of the chip at `wave` may come with (save file,
 /// the units' translate filters, the firmware's label filters and Surfer
 /// decoders), for checking outputs before a run.
@@ -186,6 +183,8 @@ pub fn waveform_side_files(wave: &std::path::Path) -> Vec<(std::path::PathBuf, S
     )
 }
 
+/// The chip, generic over its datapath word: `Chip` (= `Chip<i16>`) is the
+/// paper's 16-bit chip, `Chip<i32>` the 32-bit variant ([`Chip::new_wide`]);
 /// see `docs/isa.md`, "The 32-bit datapath".
 pub struct Chip<W: Word = i16> {
     pub risc: TinyRisc,
