@@ -324,6 +324,13 @@ pub(crate) fn render_and_measure(
         "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
         "stream_bytes": chip.firmware.layout.stream.as_ref().map_or(0, |s| s.image.len()),
+        "leaf_fetches": chip.leaf_cache.map(|c| json!({
+            "slots": chip.firmware.layout.stream.as_ref().map_or(0, |s| s.cache_slots),
+            "slot_words": chip.firmware.layout.stream.as_ref().map_or(0, |s| s.slot_words),
+            "hits": c.hits,
+            "misses": c.misses,
+            "stalls": chip.stats.dma_waits_watched,
+        })),
     });
     let rep = RenderReport {
         json,
@@ -722,9 +729,23 @@ pub fn command(a: RenderArgs) -> Result<()> {
     );
     if let Some(st) = &chip.firmware.layout.stream {
         crate::report!(
-            "scene streamed           {} KiB in main memory ({} BSP nodes), leaf blocks by DMA into FB bank 1",
+            "scene streamed           {} KiB in main memory ({} BSP nodes), {}",
             st.image.len().div_ceil(1024),
-            st.nodes
+            st.nodes,
+            if chip.leaf_cache.is_some() {
+                "leaves moved by DMA in pieces into FB banks 1 and 0"
+            } else {
+                "leaf blocks by DMA into FB bank 1"
+            }
+        );
+    }
+    if let Some(c) = chip.leaf_cache {
+        crate::report!(
+            "leaf fetches             {} of {} leaves reached had their first piece in the leaf cache ({:.1}%); {} pieces waited for their DMA",
+            c.hits,
+            c.hits + c.misses,
+            100.0 * c.hits as f64 / (c.hits + c.misses).max(1) as f64,
+            chip.stats.dma_waits_watched
         );
     }
     crate::report!(

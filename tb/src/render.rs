@@ -43,6 +43,10 @@ pub struct ChipRender {
     pub stats: Stats,
     pub object_tests: u64,
     pub passes: u64,
+    /// The streamed packet traversal's leaf cache (`None` for other
+    /// layouts): leaves whose first piece was in its slot, and those whose
+    /// first piece was moved (the firmware's counts).
+    pub leaf_cache: Option<LeafCache>,
     pub tiles: usize,
     pub firmware: Firmware,
     /// With [`RenderSettings::profile`]: where the tile loop's cycles went.
@@ -65,6 +69,17 @@ pub struct ChipRender {
     /// the assembled image (the firmware's generation and any probe
     /// before it aside); the instances and its serial part.
     pub render_seconds: f64,
+}
+
+/// The streamed packet traversal's leaf cache over a frame
+/// (`docs/tracer.md`, "Leaves and pieces").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LeafCache {
+    /// Leaves reached whose first piece was in its slot, moved there
+    /// earlier in the tile.
+    pub hits: u64,
+    /// Leaves reached whose first piece was moved by DMA.
+    pub misses: u64,
 }
 
 /// Everything a render takes besides the scene and the tracer's options:
@@ -192,6 +207,7 @@ fn add_stats(a: &mut Stats, b: &Stats) {
     a.dma_busy_cycles += b.dma_busy_cycles;
     a.dma_words += b.dma_words;
     a.dma_transfers += b.dma_transfers;
+    a.dma_waits_watched += b.dma_waits_watched;
     a.watched_offered += b.watched_offered;
     for c in 0..2 {
         a.watched_runs[c] += b.watched_runs[c];
@@ -214,6 +230,7 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     a.dma_busy_cycles -= b.dma_busy_cycles.min(a.dma_busy_cycles);
     a.dma_words -= b.dma_words.min(a.dma_words);
     a.dma_transfers -= b.dma_transfers.min(a.dma_transfers);
+    a.dma_waits_watched -= b.dma_waits_watched.min(a.dma_waits_watched);
     a.watched_offered -= b.watched_offered.min(a.watched_offered);
     for c in 0..2 {
         a.watched_runs[c] -= b.watched_runs[c].min(a.watched_runs[c]);
@@ -294,6 +311,8 @@ struct Group {
     /// The firmware's object tests and passes over the same span.
     tests: u64,
     passes: u64,
+    /// The leaf cache's hits and misses over the same span.
+    leaf: [u64; 2],
     /// The chip halted within the item's span (always for the frame's
     /// last item; for another, the program ended the frame early).
     halted: bool,
@@ -476,6 +495,12 @@ fn run_item<W: Word>(
     let mut chip = Chip::<W>::build(*timing, mem_bytes);
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
     chip.watch = watch(img, fw);
+    // The leaf pieces' waits for their DMA (the streamed packet traversal).
+    chip.risc.dma_wait_watch = img
+        .symbol("leaf_load")
+        .map(|a| a as u32)
+        .into_iter()
+        .collect();
     let fb = fw.fb_bytes();
     chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
     if let Some(st) = &fw.layout.stream {
@@ -521,6 +546,16 @@ fn run_item<W: Word>(
     let (mut tests, mut passes, mut t_end_tail) = (0, 0, 0);
     let mut t_end_raw = None;
     let (mut tests0, mut passes0) = (0, 0);
+    // The leaf cache's counters, where the firmware has them.
+    let leaf_syms = img.symbol("LEAF_HITS").zip(img.symbol("LEAF_MISSES"));
+    let leaf_now = |sim: &Sim<Chip<W>>| -> [u64; 2] {
+        leaf_syms.map_or([0, 0], |(h, m)| {
+            [h, m].map(|a| sim.top.mem.read(a as u32, 4) as u64)
+        })
+    };
+    let (mut leaf0, mut leaf) = ([0u64; 2], [0u64; 2]);
+    let leaf_since =
+        |now: [u64; 2], then: [u64; 2]| [0, 1].map(|i| now[i].wrapping_sub(then[i]) & 0xffff_ffff);
     // Each own tile's passes (the firmware's count).
     let (mut tile_passes, mut last_passes) = (Vec::with_capacity(own.len()), 0);
     let mut tile_seconds = Vec::with_capacity(own.len());
@@ -563,6 +598,7 @@ fn run_item<W: Word>(
         if k == warm as usize {
             from = sim.top.stats();
             (tests0, passes0) = (m(&sim, "TESTS")?, m(&sim, "PASSES")?);
+            leaf0 = leaf_now(&sim);
             last_passes = passes0;
         }
         if counting {
@@ -589,6 +625,7 @@ fn run_item<W: Word>(
         to = Some(sim.top.stats());
         tests = m(&sim, "TESTS")?.wrapping_sub(tests0) & 0xffff_ffff;
         passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
+        leaf = leaf_since(leaf_now(&sim), leaf0);
         if !halted {
             // On to `halt`: counted for the frame's last item (one chip
             // ends there too), not for the others (one chip goes on to
@@ -606,6 +643,7 @@ fn run_item<W: Word>(
                         to = Some(sim.top.stats());
                         tests = m(&sim, "TESTS")?.wrapping_sub(tests0) & 0xffff_ffff;
                         passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
+                        leaf = leaf_since(leaf_now(&sim), leaf0);
                         halted = true;
                     }
                 }
@@ -665,6 +703,7 @@ fn run_item<W: Word>(
         counted,
         tests,
         passes,
+        leaf,
         halted,
         t_end_tail,
         t_end_raw,
@@ -1170,6 +1209,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     let mut hits = vec![NO_HIT; (w * h) as usize];
     let mut stats = Stats::default();
     let (mut fw_cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
+    let mut leaf = [0u64; 2];
     let mut chip_seconds = 0.0;
     let mut item_seconds_all = Vec::with_capacity(items.len());
     let mut tile_seconds = Vec::with_capacity(tiles.len());
@@ -1205,6 +1245,8 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             }
             tests += g.tests;
             passes += g.passes;
+            leaf[0] += g.leaf[0];
+            leaf[1] += g.leaf[1];
             add_stats(&mut stats, &g.counted);
         }
         for (k, out) in g.out.iter().enumerate() {
@@ -1238,6 +1280,10 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         stats,
         object_tests: tests,
         passes,
+        leaf_cache: (img.symbol("LEAF_HITS").is_some()).then(|| LeafCache {
+            hits: leaf[0],
+            misses: leaf[1],
+        }),
         tiles: tiles.len(),
         firmware: fw,
         profile,

@@ -156,7 +156,7 @@ fn image_and_cycles_do_not_depend_on_host_threads() {
 #[test]
 fn a_frame_cut_at_every_tile_is_one_chips_frame() {
     use firmware::tracer::{Datapath, Traversal};
-    let cases: [(&str, Traversal, Datapath, bool); 8] = [
+    let cases: [(&str, Traversal, Datapath, bool); 9] = [
         ("default.toml", Traversal::Packet, Datapath::W16, false),
         ("default.toml", Traversal::Paper, Datapath::W16, false),
         ("default.toml", Traversal::Packet, Datapath::W32, false),
@@ -164,6 +164,7 @@ fn a_frame_cut_at_every_tile_is_one_chips_frame() {
         ("mount-1.nff", Traversal::Paper, Datapath::W16, false),
         ("gears-1.nff", Traversal::Packet, Datapath::W16, false),
         ("tetra-1.nff", Traversal::Packet, Datapath::W16, true),
+        ("rings-1.nff", Traversal::Packet, Datapath::W32, true),
         ("jacks-1.nff", Traversal::Paper, Datapath::W16, true),
     ];
     for (name, traversal, datapath, streamed) in cases {
@@ -193,6 +194,7 @@ fn a_frame_cut_at_every_tile_is_one_chips_frame() {
             (cut.object_tests, cut.passes),
             "{what}"
         );
+        assert_eq!(one.leaf_cache, cut.leaf_cache, "{what}");
     }
 }
 

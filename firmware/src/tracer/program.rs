@@ -550,6 +550,32 @@ fn data(lay: &FbImage) -> String {
             ".word 0, 0, 0",
             "per axis: the second child's field",
         );
+        if lay.stream.is_some() {
+            d(
+                &mut t,
+                "TILE_GEN",
+                ".word 0",
+                "the tile's number for the leaf cache: its corner, y << 12 | x",
+            );
+            d(
+                &mut t,
+                "LEAF_HITS",
+                ".word 0",
+                "leaves whose first piece was in its slot",
+            );
+            d(
+                &mut t,
+                "LEAF_MISSES",
+                ".word 0",
+                "leaves whose first piece was moved",
+            );
+            d(
+                &mut t,
+                "LEAF_TAGS",
+                ".space 0x8000",
+                "leaf cache tags, at LEAF_TAGS + 2 (a - SBANK) for the slot at FB address a: its block and tile",
+            );
+        }
     } else if lay.stream.is_some() {
         d(
             &mut t,

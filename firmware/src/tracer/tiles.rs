@@ -173,8 +173,14 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32) {
         .lw(R3, at("TILE_PX", R1))
         .lw(R4, at("TILE_PY", R1))
         .lw(R5, at("TILE_OUT", R1))
-        .sw(R5, at("CUR_OUT", R0))
-        .li(R6, "FB_EYE")
+        .sw(R5, at("CUR_OUT", R0));
+    if lay.traversal == super::Traversal::Packet && lay.stream.is_some() {
+        t.slli(R6, R4, 12)
+            .or(R6, R6, R3)
+            .sw(R6, at("TILE_GEN", R0))
+            .c("the leaf cache holds this tile's leaves only");
+    }
+    t.li(R6, "FB_EYE")
         .sfb(R3, at("EYE_PX", R6))
         .sfb(R4, at("EYE_PY", R6))
         .c("the tile's corner into the eye stream");

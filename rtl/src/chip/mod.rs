@@ -77,6 +77,10 @@ pub struct Stats {
     pub dma_busy_cycles: u64,
     pub dma_words: u64,
     pub dma_transfers: u64,
+    /// Waits for the DMA that started at the instructions TinyRISC
+    /// watches (`TinyRisc::dma_wait_watch`; the ray tracer: a leaf piece's
+    /// `dwait` before its tests).
+    pub dma_waits_watched: u64,
     /// Per class of [`Watch`], runs started at a watched address and the
     /// RCs that executed their first context.
     pub watched_runs: [u64; 2],
@@ -366,6 +370,7 @@ impl<W: Word> Chip<W> {
             risc_busy_cycles: self.risc.busy_cycles,
             array_stall_cycles: self.risc.stall_array,
             dma_stall_cycles: self.risc.stall_dma,
+            dma_waits_watched: self.risc.dma_waits_watched,
             array_idle_control_cycles: self.idle_control,
             dma_busy_cycles: self.dma.busy_cycles,
             dma_words: self.dma.words_moved,

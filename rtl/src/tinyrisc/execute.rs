@@ -131,6 +131,13 @@ impl TinyRisc {
                 Wait::None
             };
             if wait != Wait::None {
+                if wait == Wait::Dma
+                    && self.wait != Wait::Dma
+                    && !self.dma_wait_watch.is_empty()
+                    && self.dma_wait_watch.contains(&self.pc)
+                {
+                    self.dma_waits_watched += 1;
+                }
                 self.wait = wait;
                 self.state = if wait == Wait::Dma {
                     State::StallDma

@@ -173,6 +173,12 @@ pub struct TinyRisc {
     pub stall_array: u64,
     pub stall_dma: u64,
     pub busy_cycles: u64,
+    /// A simulator statistic, not a part of the chip: instruction
+    /// addresses whose waits for the DMA are counted
+    /// (`dma_waits_watched`: each time an instruction there starts to
+    /// wait, however long it waits).
+    pub dma_wait_watch: Vec<u32>,
+    pub dma_waits_watched: u64,
 }
 
 impl TinyRisc {

@@ -141,6 +141,14 @@ pub struct Stream {
     /// Packet traversal: leaf pieces beyond one per leaf (a leaf's records
     /// are moved in pieces, [`super::LeafPieces`]).
     pub extra_pieces: usize,
+    /// Packet traversal: the leaf cache, slots of FB bank 1 that keep
+    /// leaves' first pieces for the rest of the tile (`docs/tracer.md`,
+    /// "Leaves and pieces"): their number (1 with no room beside the
+    /// further pieces' buffer, then the slot is that buffer), words each
+    /// and the FB address of the first.
+    pub cache_slots: usize,
+    pub slot_words: usize,
+    pub slots_at: usize,
 }
 
 /// The FB image as it is written: words (16-bit values, or 32-bit on the

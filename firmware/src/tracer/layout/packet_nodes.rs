@@ -441,6 +441,17 @@ fn streamed_image(
     let rest = fin.pieces.rest.max(largest_record).min(room);
     let first = fin.pieces.first.min(rest);
     let bank0_buf = STREAM_BANK - rest;
+    // Bank 1: the further pieces' buffer (even places), then the cache's
+    // slots for first pieces (one per leaf, direct-mapped by the leaf's
+    // order, neighbouring leaves in different slots); with no room for a
+    // slot beside the buffer, one slot that is the buffer.
+    let slot_words = first.max(largest_record).next_multiple_of(4);
+    let buffer = rest.next_multiple_of(4);
+    let (cache_slots, slots_at) = if buffer + slot_words <= STREAM_BANK {
+        ((STREAM_BANK - buffer) / slot_words, STREAM_BANK + buffer)
+    } else {
+        (1, STREAM_BANK)
+    };
     let (pieces, first_piece, in_leaf) = pieces(tree, first, rest);
     let nn = nodes.len();
     let lists_at = NODE_BYTES * (nn + pieces.len());
@@ -452,6 +463,7 @@ fn streamed_image(
     let mut largest = 0usize;
     // Piece records: block address and words, next piece, per-type counts.
     let mut piece_rec = vec![[0i32; 16]; pieces.len()];
+    let mut leaves = 0usize;
     for (p, pc) in pieces.iter().enumerate() {
         let mut words: Vec<i32> = Vec::new();
         let mut counts = [0i32; 7];
@@ -468,11 +480,14 @@ fn streamed_image(
         for &(j, q) in pc {
             lists.push(types[j].objects[q] as u32);
         }
-        f[word(PS_FB)] = if in_leaf[p] % 2 == 0 {
+        f[word(PS_FB)] = if in_leaf[p] == 0 {
+            slots_at + (leaves % cache_slots) * slot_words
+        } else if in_leaf[p] % 2 == 0 {
             STREAM_BANK
         } else {
             bank0_buf
         } as i32;
+        leaves += (in_leaf[p] == 0) as usize;
         f[word(PS_BLOCK)] = (base + blocks_at + blocks.len()) as i32;
         f[word(PS_BLOCK_WORDS)] = words.len() as i32;
         f[PS_COUNTS as usize / 4..][..7].copy_from_slice(&counts);
@@ -554,6 +569,9 @@ fn streamed_image(
         nodes: nn,
         largest_block: largest,
         extra_pieces: pieces.len() - first_piece.iter().filter(|&&p| p != usize::MAX).count(),
+        cache_slots,
+        slot_words,
+        slots_at,
     };
     Ok((w.fb, st))
 }

@@ -519,7 +519,12 @@ fn mailbox_check(t: &mut Code, n: &str) {
 /// Streamed leaf: once the array is done with the other bank (the tests
 /// of the piece before the current one), the DMA of the next piece (r1)
 /// into it.
-fn next_piece_dma(t: &mut Code, why: &str) {
+fn next_piece_dma(t: &mut Code, one_slot: bool, why: &str) {
+    if one_slot {
+        // The cache's one slot is the further pieces' buffer.
+        t.sw(R0, at("LEAF_TAGS", R0))
+            .c("the cache's slot overwritten");
+    }
     t.rcany(R2)
         .c("the array done with the other bank")
         .lw(R2, at("PS_BLOCK", R1))
@@ -555,6 +560,10 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         // piece is waited for (`dwait`) before its tests, and before the
         // leaf is left, so no DMA is under way when a node kernel reads
         // bank 0 again.
+        let one_slot = lay
+            .stream
+            .as_ref()
+            .is_some_and(|st| st.slots_at == super::super::layout::STREAM_BANK);
         t.label("leaf")
             .lw(R1, at("PS_OBJECTS", R5))
             .beqz(R1, "leaf_done")
@@ -565,12 +574,33 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .beqz(R1, "leaf_first")
             .c("no mailbox to check");
         awake(t);
+        t.comment("the first piece: in its slot of the leaf cache since this tile moved it there,")
+            .comment("or its DMA starts");
         t.label("leaf_first")
             .lw(R1, at("PS_BLOCK", R5))
-            .lw(R3, at("PS_BLOCK_WORDS", R5))
             .lw(R2, at("PS_FB", R5))
+            .add(R6, R2, R2)
+            .lw(R3, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .lw(R7, at("TILE_GEN", R0))
+            .bne(R3, R7, "leaf_miss")
+            .c("moved in another tile (checked first: a tag from an earlier tile never costs more)")
+            .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
+            .bne(R1, R3, "leaf_miss")
+            .c("the slot holds another block")
+            .lw(R3, at("LEAF_HITS", R0))
+            .addi(R3, R3, 1)
+            .sw(R3, at("LEAF_HITS", R0))
+            .j("leaf_piece");
+        t.label("leaf_miss")
+            .lw(R3, at("PS_BLOCK_WORDS", R5))
             .ldfb(R1, R2, R3)
-            .c("the first piece's DMA starts");
+            .c("the first piece's DMA starts")
+            .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
+            .lw(R7, at("TILE_GEN", R0))
+            .sw(R7, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .lw(R3, at("LEAF_MISSES", R0))
+            .addi(R3, R3, 1)
+            .sw(R3, at("LEAF_MISSES", R0));
         t.label("leaf_piece")
             .lw(R6, at("PS_LIST", R5))
             .c("r5: a piece whose DMA has started")
@@ -601,14 +631,18 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .c("the last piece in before the leaf is left")
             .j("leaf_done");
         t.label("leaf_skip_next");
-        next_piece_dma(t, "the next piece's DMA starts");
+        next_piece_dma(t, one_slot, "the next piece's DMA starts");
         t.j("leaf_next_piece");
         t.label("leaf_load")
             .dwait()
             .c("the piece is in the FB")
             .lw(R1, at("PS_NEXT", R5))
             .beqz(R1, "leaf_tests");
-        next_piece_dma(t, "the next piece moves while this one's tests run");
+        next_piece_dma(
+            t,
+            one_slot,
+            "the next piece moves while this one's tests run",
+        );
         t.label("leaf_tests")
             .lw(R7, at("PS_FB", R5))
             .c("r7: the first record")
