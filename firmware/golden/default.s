@@ -156,8 +156,12 @@ P_ALIVE = 400           ; 1 while the ray takes part in the pass
 P_Z = 403               ; per axis: shift z - 1 of 1/d
 P_R = 406               ; per axis: signed mantissa of 1/d
 P_DT = 409              ; per axis: a plane's widening in t
+LANE_ID = 412           ; the RC's number, row * 8 + column
+SHADOW_LOADED = 413     ; 1 if the RC holds a ray of the merged shadow packet
+SHADOW_ORIG = 414       ; the RC's own ORIG_OBJ while merged packets load others'
 P_SLOT = 416            ; per BSP depth: the pushed child's interval (tmax, tmin)
 ORIG_STACK = 480        ; per recursion level: the object its refracted ray leaves
+SHADOW_SLOTS = 488      ; merged shadows: per light, N.L and R.V of the hit
 STACK_FRAME = 4         ; words of a STACK frame
 REFR_FRAME = 7          ; words of a REFR frame
 STACK_L0 = STACK + 0*STACK_FRAME ; the frame of recursion level 0, 1, ...
@@ -340,7 +344,11 @@ tile:
         BCAST_FB k_eye, FB_EYE          ; eye rays
         SHADE_LEVEL k_post_eye          ; level 0: trace, shade, every light
         BCAST k_reflect0                ; level 0's reflected rays
+        rcany r1
+        beqz r1, no_reflection1         ; none in the tile
         SHADE_LEVEL k_post              ; level 1: trace, shade, every light
+no_reflection1:
+        BCAST k_wake_tile
         BCAST k_reflected0              ; their colour added
         ; the pixels: R, G, B, object id per RC into an output bank, then DMA out
         lw r5, TL_BANK(r0)

@@ -205,6 +205,10 @@ pub(crate) fn parse_leaf_pieces(s: &str) -> Result<firmware::tracer::LeafPieces,
     s.parse()
 }
 
+pub(crate) fn parse_shadow_packets(s: &str) -> Result<firmware::tracer::ShadowPackets, String> {
+    s.parse()
+}
+
 pub(crate) fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
     s.parse()
 }

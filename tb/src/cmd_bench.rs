@@ -119,6 +119,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             traversal: firmware::tracer::Traversal::Paper,
             collapse: Default::default(),
             pieces: Default::default(),
+            shadows: Default::default(),
         },
         firmware::tracer::Traversal::Packet => Options {
             width,

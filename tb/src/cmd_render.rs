@@ -84,6 +84,14 @@ pub struct RenderArgs {
     /// FIRST <= REST, a piece holds at least one record.
     #[arg(long, value_name = "FIRST,REST", default_value = "64,256", value_parser = crate::cli::parse_leaf_pieces)]
     pub leaf_pieces: firmware::tracer::LeafPieces,
+    /// Packet traversal: the shadow rays of the reflection levels (depth 2
+    /// and more): light (a packet per light, the rays in the RCs that
+    /// spawned them), merged (the rays of every light moved into as few
+    /// packets as hold them, the answers moved back; scenes of 2 to 12
+    /// lights) or auto (both run on a probe of the frame, the faster
+    /// kept). The eye rays' level keeps a packet per light.
+    #[arg(long, value_name = "auto|light|merged", default_value = "auto", value_parser = crate::cli::parse_shadow_packets)]
+    pub shadow_packets: firmware::tracer::ShadowPackets,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
     /// variant the paper announces; every format gets 16 more fraction
     /// bits), or auto: 16 unless the 16-bit chip cannot hold the scene or
@@ -320,6 +328,7 @@ pub(crate) fn render_and_measure(
         "traversal": opt.traversal.name(),
         "collapse": opt.collapse.to_string(),
         "leaf_pieces": opt.pieces.to_string(),
+        "shadow_packets": chip.firmware.shadows.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
@@ -516,6 +525,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         traversal: a.traversal,
         collapse: a.collapse,
         pieces: a.leaf_pieces,
+        shadows: a.shadow_packets,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
@@ -676,6 +686,21 @@ pub fn command(a: RenderArgs) -> Result<()> {
         j["bsp_nodes"],
         j["bsp_max_depth"]
     );
+    if firmware::tracer::shadows::applies(&opt, &chip.firmware.layout) {
+        crate::report!(
+            "shadow packets           {} (the reflection levels' shadow rays: {}{})",
+            chip.firmware.shadows,
+            match chip.firmware.shadows {
+                firmware::tracer::ShadowPackets::Merged => "every light's in as few packets as hold them",
+                _ => "a packet per light",
+            },
+            if opt.shadows == firmware::tracer::ShadowPackets::Auto {
+                "; auto: the faster on the probe"
+            } else {
+                ""
+            }
+        );
+    }
     crate::report!("cycles                   {}", j["cycles"]);
     crate::report!(
         "fps at 300 MHz           {:.2}",

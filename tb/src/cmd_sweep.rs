@@ -370,6 +370,20 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
+    // The reflection levels' shadow rays, each packing forced (the
+    // default probes both and keeps the faster).
+    for shadows in [
+        firmware::tracer::ShadowPackets::PerLight,
+        firmware::tracer::ShadowPackets::Merged,
+    ] {
+        let packet = packet_config(width, height);
+        v.push(Knob {
+            knob: "shadow_packets",
+            value: shadows.to_string(),
+            opt: Options { shadows, ..packet },
+            nm,
+        });
+    }
     for datapath in [Datapath::W16, Datapath::W32] {
         v.push(Knob {
             knob: "datapath",
@@ -507,7 +521,7 @@ struct Row {
 
 fn key(o: &Options, n: &Numerics) -> String {
     format!(
-        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {} {} {} {}",
+        "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {} {} {} {} {}",
         o.width,
         o.height,
         o.ways,
@@ -520,7 +534,8 @@ fn key(o: &Options, n: &Numerics) -> String {
         o.datapath,
         o.traversal,
         o.collapse,
-        o.pieces
+        o.pieces,
+        o.shadows
     )
 }
 

@@ -7,6 +7,7 @@ pub mod cli;
 pub mod cmd_asm;
 pub mod cmd_bench;
 pub mod cmd_fuzz;
+pub mod cmd_regroup;
 pub mod cmd_render;
 pub mod cmd_report;
 pub mod cmd_run;

@@ -85,6 +85,11 @@ enum Command {
     /// Compare two images: PSNR over 8-bit RGB, share of pixels off by more
     /// than a threshold, and (with --hits) per-pixel hit agreement.
     Compare(tb::cmd_scene::CompareArgs),
+    /// Estimate what regrouping rays into other packets would buy: the
+    /// object tests of the chip's packets (a tile, a light) against rays
+    /// split into quadrants or regrouped over tiles and sorted, from the
+    /// f64 reference's rays on a SAH tree (docs/tracer.md, "Regrouping").
+    Regroup(tb::cmd_regroup::RegroupArgs),
     /// Generate one of Eric Haines' Standard Procedural Databases in NFF
     /// (balls, gears, jacks, lattice, mount, rings, shells, tetra, tree).
     Spd(tb::cmd_spd::SpdArgs),
@@ -135,6 +140,7 @@ fn run(cli: Cli) -> anyhow::Result<()> {
         }),
         Command::Compare(a) => tb::cmd_scene::compare_cmd(a),
         Command::Spd(a) => tb::cmd_spd::run(a),
+        Command::Regroup(a) => tb::cmd_regroup::command(a),
     }
 }
 

@@ -981,7 +981,10 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
 /// probe is within [`TREE_PSNR_SLACK`] dB of the best one's (a faster tree
 /// must not cost image quality: the trees find the same hits up to ties,
 /// but a tie between surfaces of different colours is visible); ties go
-/// to the first. Deterministic.
+/// to the first. With `ShadowPackets::Auto` where merging applies
+/// ([`tracer::shadows::applies`]), the chosen tree is probed again with
+/// merged shadow packets and the fewer cycles kept (the images are the
+/// same). Deterministic.
 pub fn choose_firmware(
     scene: &Scene,
     opt: &Options,
@@ -996,6 +999,42 @@ pub(crate) const TREE_PSNR_SLACK: f64 = 0.25;
 
 /// [`choose_firmware`], with the chosen firmware's probe when one ran.
 pub(crate) fn choose_firmware_probed(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    timing: &Timing,
+) -> Result<(Firmware, Option<ProbeRender>)> {
+    let (fw, p) = choose_tree(scene, opt, nm, timing)?;
+    if opt.shadows != tracer::ShadowPackets::Auto
+        || !tracer::shadows::applies(opt, &fw.layout)
+    {
+        return Ok((fw, p));
+    }
+    // `--shadow-packets auto`: the tree chosen, merged shadow packets
+    // against a packet per light on the probe (the same images: the same
+    // rays, traced in other packets), the fewer cycles kept.
+    let merged = Options {
+        bsp: fw.bsp,
+        shadows: tracer::ShadowPackets::Merged,
+        ..*opt
+    };
+    let mfw = tracer::build_with(scene, &merged, nm).map_err(|e| anyhow!("{e}"))?;
+    let (p, mp) = rayon::join(
+        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
+        || probe(&mfw, opt, timing),
+    );
+    let (p, mut mp) = (p?, mp?);
+    if mp.cycles < p.cycles {
+        mp.reference = p.reference;
+        Ok((mfw, Some(mp)))
+    } else {
+        Ok((fw, Some(p)))
+    }
+}
+
+/// [`choose_firmware_probed`]'s choice of the BSP tree (shadow packets
+/// `Auto` built as `PerLight`).
+fn choose_tree(
     scene: &Scene,
     opt: &Options,
     nm: &Numerics,

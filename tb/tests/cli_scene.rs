@@ -298,6 +298,14 @@ fn usage_errors_name_the_argument_and_exit_2() {
             "two word counts 1..=16384 with FIRST <= REST",
         ),
         (
+            &["render", "--shadow-packets", "some"][..],
+            "'--shadow-packets <auto|light|merged>': shadow packets 'some': expected auto, light or merged",
+        ),
+        (
+            &["regroup", "--size", "12"][..],
+            "'--size <N>': '12': expected a multiple of 8, 8..=1024",
+        ),
+        (
             &["compile", "--max-leaf", "0"][..],
             "'--max-leaf <N>': expected a whole number of at least 1",
         ),

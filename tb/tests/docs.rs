@@ -49,6 +49,14 @@ enum Special {
 /// (document, command as written, what to do).
 const SPECIAL: &[(&str, &str, Special)] = &[
     (
+        "docs/tracer.md",
+        "morphosys regroup rings.nff",
+        Special::RunAs(
+            "morphosys regroup rings.nff --size 32",
+            "the same estimate on a smaller frame (seconds, not a minute, in a debug build)",
+        ),
+    ),
+    (
         "README.md",
         "morphosys tb cosim",
         Special::CoveredBy("cosim.rs", "the_verilog_rc_is_the_rust_rc_cycle_for_cycle"),

@@ -1,6 +1,7 @@
 //! Golden firmware: the programs the generator emits for the default scene
-//! and two SPD scenes (256x256, the default options: the packet traversal,
-//! and the paper's traversal on tetra-1), checked in under
+//! and three SPD scenes (256x256, the default options: the packet
+//! traversal, the paper's traversal on tetra-1, and merged shadow packets
+//! on rings-1), checked in under
 //! `firmware/golden/`. A change to the generator shows up here as a diff
 //! of the firmware itself; when it is intended, regenerate them with
 //! `UPDATE_GOLDEN=1 cargo test -p morphosys-tb --test golden` and commit
@@ -9,20 +10,38 @@
 use std::path::PathBuf;
 
 use firmware::scene::Scene;
-use firmware::tracer::{Numerics, Options, Traversal};
+use firmware::tracer::{Numerics, Options, ShadowPackets, Traversal};
 
 fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// (golden file, scene path from the repository root, traversal)
-const GOLDEN: [(&str, &str, Traversal); 3] = [
-    ("default.s", "scenes/default.toml", Traversal::Packet),
-    ("jacks-1.s", "scenes/spd/jacks-1.nff", Traversal::Packet),
+/// (golden file, scene path from the repository root, traversal, shadow
+/// packets)
+const GOLDEN: [(&str, &str, Traversal, ShadowPackets); 4] = [
+    (
+        "default.s",
+        "scenes/default.toml",
+        Traversal::Packet,
+        ShadowPackets::Auto,
+    ),
+    (
+        "jacks-1.s",
+        "scenes/spd/jacks-1.nff",
+        Traversal::Packet,
+        ShadowPackets::Auto,
+    ),
     (
         "tetra-1-paper.s",
         "scenes/spd/tetra-1.nff",
         Traversal::Paper,
+        ShadowPackets::Auto,
+    ),
+    (
+        "rings-1-merged.s",
+        "scenes/spd/rings-1.nff",
+        Traversal::Packet,
+        ShadowPackets::Merged,
     ),
 ];
 
@@ -30,12 +49,13 @@ const GOLDEN: [(&str, &str, Traversal); 3] = [
 fn the_generated_firmware_is_the_golden_one() {
     let update = std::env::var_os("UPDATE_GOLDEN").is_some();
     let mut failures = Vec::new();
-    for (file, scene_path, traversal) in GOLDEN {
+    for (file, scene_path, traversal, shadows) in GOLDEN {
         let mut scene = Scene::load(&root().join(scene_path)).unwrap();
         // As `morphosys render` names it when run from the repository root.
         scene.source = scene_path.to_string();
         let opt = Options {
             traversal,
+            shadows,
             ..Options::default()
         };
         let fw = tb::render::choose_firmware(
@@ -98,7 +118,7 @@ fn the_golden_firmware_names_its_numbers() {
             .next()
             .is_some_and(|c| c.is_ascii_alphabetic() || c == '_')
     };
-    for (file, _, _) in GOLDEN {
+    for (file, _, _, _) in GOLDEN {
         let path = root().join("firmware/golden").join(file);
         let text = std::fs::read_to_string(&path).unwrap();
         let mut problems = Vec::new();

@@ -202,9 +202,10 @@ fn a_frame_cut_at_every_tile_is_one_chips_frame() {
 /// 216x216: 11,664 tiles of 2x2 pixels) runs as one item with its list fed
 /// in chunks, and is the frame cut into items of 1,000 tiles; under the
 /// paper's traversal its 93,312 passes wrap the 16-bit pass numbers twice
-/// (the mailboxes cleared where one chip's count says), and the items in
-/// which they wrap run again from one chip's pass number: the same either
-/// way.
+/// (the packet traversal's, which skip the reflection level of the tiles
+/// with no mirror ray, once), the mailboxes cleared where one chip's count
+/// says, and the items in which they wrap run again from one chip's pass
+/// number: the same either way.
 #[test]
 fn long_tile_lists_and_wrapping_pass_numbers_keep_the_frame() {
     use firmware::tracer::Traversal;
@@ -229,7 +230,10 @@ fn long_tile_lists_and_wrapping_pass_numbers_keep_the_frame() {
         assert_eq!(one.stats, cut.stats, "{traversal:?}");
         assert_eq!(one.firmware_cycles, cut.firmware_cycles, "{traversal:?}");
         assert_eq!(cut.item_seconds.len(), 12, "{traversal:?}");
-        assert_eq!(one.passes, 93_312, "{traversal:?}");
+        match traversal {
+            Traversal::Paper => assert_eq!(one.passes, 93_312),
+            _ => assert!(one.passes > 65_536, "{} passes", one.passes),
+        }
     }
 }
 

@@ -24,6 +24,21 @@ pub const POST: &str = "k_post";
 pub const SHADOW: &str = "k_shadow_rays";
 pub const PHONG: &str = "k_phong";
 
+/// Merged shadow packets ([`super::shadows`]): the RC's number; a lit
+/// RC's N.L and R.V kept per light; a shadow ray's words out; a packet's
+/// loads, its RCs with no ray asleep, its answers; a light's answers back.
+pub const LANE_ID: &str = "k_lane_id";
+pub const SHADOW_KEEP: &str = "k_shadow_keep";
+pub fn ray_word(i: u32) -> String {
+    format!("k_ray_word{i}")
+}
+pub const SHADOW_SAVE: &str = "k_shadow_save";
+pub const SHADOW_CLEAR: &str = "k_shadow_clear";
+pub const SHADOW_LOAD: &str = "k_shadow_load";
+pub const SHADOW_GO: &str = "k_shadow_go";
+pub const SHADOW_SEEN: &str = "k_shadow_seen";
+pub const SHADOW_LIT: &str = "k_shadow_lit";
+
 /// The pixel's output words: red, green, blue, the eye ray's object.
 pub fn out(i: u32) -> &'static str {
     ["k_out_red", "k_out_green", "k_out_blue", "k_out_object"][i as usize]

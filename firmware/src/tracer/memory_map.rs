@@ -131,6 +131,20 @@ pub mod ram {
     pub const P_Z: Name = Name::new("P_Z", 403, "per axis: shift z - 1 of 1/d");
     pub const P_R: Name = Name::new("P_R", 406, "per axis: signed mantissa of 1/d");
     pub const P_DT: Name = Name::new("P_DT", 409, "per axis: a plane's widening in t");
+    /// Merged shadow packets ([`crate::tracer::shadows`]): the RC's
+    /// number, whether it holds a ray of the packet, its own `ORIG_OBJ`
+    /// meanwhile, and per light (up to 12) the N.L and R.V of its hit.
+    pub const LANE_ID: Name = Name::new("LANE_ID", 412, "the RC's number, row * 8 + column");
+    pub const SHADOW_LOADED: Name = Name::new(
+        "SHADOW_LOADED",
+        413,
+        "1 if the RC holds a ray of the merged shadow packet",
+    );
+    pub const SHADOW_ORIG: Name = Name::new(
+        "SHADOW_ORIG",
+        414,
+        "the RC's own ORIG_OBJ while merged packets load others'",
+    );
     /// The interval stack: one slot per BSP depth (the far child of the
     /// node at depth d is pushed into slot d), words `tmax, tmin`.
     pub const P_SLOT: Name = Name::new(
@@ -148,6 +162,11 @@ pub mod ram {
         "ORIG_STACK",
         480,
         "per recursion level: the object its refracted ray leaves",
+    );
+    pub const SHADOW_SLOTS: Name = Name::new(
+        "SHADOW_SLOTS",
+        488,
+        "merged shadows: per light, N.L and R.V of the hit",
     );
 
     /// Every name of the map, in address order (fields of frames after).
@@ -195,8 +214,12 @@ pub mod ram {
         P_Z,
         P_R,
         P_DT,
+        LANE_ID,
+        SHADOW_LOADED,
+        SHADOW_ORIG,
         P_SLOT,
         ORIG_STACK,
+        SHADOW_SLOTS,
     ];
     /// Fields of the frames and slots above.
     pub const FIELDS: &[Name] = &[FR_COL, FR_KS, RF_O, RF_D, RF_T, SLOT_TMAX, SLOT_TMIN];

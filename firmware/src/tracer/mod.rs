@@ -33,6 +33,7 @@ pub mod memory_map;
 pub mod primitives;
 pub mod program;
 pub mod shading;
+pub mod shadows;
 pub mod tiles;
 pub mod traversal;
 
@@ -40,6 +41,7 @@ use crate::bsp::{BspParams, SplitRule};
 use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
 pub use rtl::rc::Datapath;
+pub use shadows::ShadowPackets;
 
 /// Generator options.
 #[derive(Clone, Copy, Debug)]
@@ -73,6 +75,9 @@ pub struct Options {
     /// Streamed packet traversal: the sizes of the pieces a leaf's records
     /// are moved in.
     pub pieces: LeafPieces,
+    /// Packet traversal: the shadow rays of the reflection levels traced
+    /// a packet per light, or merged into full packets.
+    pub shadows: ShadowPackets,
 }
 
 impl Default for Options {
@@ -92,6 +97,7 @@ impl Default for Options {
             traversal: Traversal::default(),
             collapse: Collapse::Auto,
             pieces: LeafPieces::default(),
+            shadows: ShadowPackets::default(),
         }
     }
 }
@@ -415,6 +421,9 @@ pub struct Firmware {
     pub layout: layout::FbImage,
     /// The BSP built (the options' automatic choices resolved).
     pub bsp: BspParams,
+    /// How the reflection levels' shadow rays are packed: `PerLight` or
+    /// `Merged` (never `Auto`).
+    pub shadows: ShadowPackets,
 }
 
 impl Firmware {
@@ -692,6 +701,11 @@ fn build_one(
         opt.datapath.bits() - 16,
     ));
     let prog = program::program(scene, &lay, opt, nm, tw, th)?;
+    let shadows = if shadows::merged(opt, &lay) {
+        ShadowPackets::Merged
+    } else {
+        ShadowPackets::PerLight
+    };
     Ok(Firmware {
         source: prog.source,
         fb: lay.fb.clone(),
@@ -704,6 +718,7 @@ fn build_one(
         kernels: prog.kernels,
         layout: lay,
         bsp: opt.bsp,
+        shadows,
     })
 }
 

@@ -9,7 +9,10 @@
 //!           eye rays; shade(level 0)
 //!             shade(l): trace (closest hit); post;
 //!                       per light: shadow rays, trace (any hit), Phong
+//!                         (packet traversal, l > 0: every light's shadow
+//!                         rays in merged packets, `shadows`, where chosen)
 //!                       if l + 1 < depth: reflected rays, shade(l + 1), pop
+//!                         (packet traversal: where some ray reflects)
 //!                         (and the refracted rays' subtree, where any)
 //!           pixels into an output bank of FB set 1, DMA to main memory
 //!           (the other bank drains while the next tile is traced)
@@ -124,8 +127,9 @@ pub fn macros(lay: &FbImage) -> Code {
     t
 }
 
-/// The main program: `_start`, the tile loop, `finish`.
-pub fn main(t: &mut Code, lay: &FbImage, depth: u32) {
+/// The main program: `_start`, the tile loop, `finish`; `merged`: the
+/// reflection levels' shadow rays go through [`super::shadows`].
+pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
     t.doc(
         "_start: the FB image and the contexts in by DMA, every RC's RAM tables and lane words,\n\
          then the tile loop; T_START, T_END: the cycle counter around it.",
@@ -153,6 +157,9 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32) {
         .c("column j: r8 = j");
     cb(t, names::STORE_COL);
     cb(t, names::LANES).c("the RCs outside the tile sleep");
+    if merged {
+        cb(t, names::LANE_ID).c("every RC's number, for merged shadow packets");
+    }
     t.rcany(R1)
         .c("the array done")
         .rdcyc(R1)
@@ -186,7 +193,7 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32) {
         .c("the tile's corner into the eye stream");
     sb(t, names::EYE, "FB_EYE").c("eye rays");
     let mut skips = 0;
-    tree(t, lay, 0, depth.max(1), &mut skips);
+    tree(t, lay, 0, depth.max(1), merged, &mut skips);
     output(t);
     t.label("finish")
         .dwait()
@@ -195,8 +202,18 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32) {
         .halt();
 }
 
-/// One level's shading ([`macros`]' `SHADE_LEVEL`).
-fn shade_level(t: &mut Code, level: u32) {
+/// One level's shading ([`macros`]' `SHADE_LEVEL`); `merged`: a
+/// reflection level's shadow rays in merged packets (`jal shadows`).
+fn shade_level(t: &mut Code, level: u32, merged: bool) {
+    if merged && level > 0 {
+        t.sw(R0, at("MODE", R0))
+            .c(format!("level {level}: trace (closest hit)"))
+            .jal("trace");
+        cb(t, names::WAKE);
+        sb(t, names::POST, "FB_POST");
+        t.jal("shadows").c("every light's shadow rays, merged");
+        return;
+    }
     t.m(
         "SHADE_LEVEL",
         if level == 0 {
@@ -209,10 +226,11 @@ fn shade_level(t: &mut Code, level: u32) {
 }
 
 /// The ray tree, depth first: a level's shading, then its reflected ray's
-/// subtree and, where the scene refracts, its refracted ray's (skipped
-/// when no ray of the tile refracts there).
-fn tree(t: &mut Code, lay: &FbImage, level: u32, levels: u32, skips: &mut u32) {
-    shade_level(t, level);
+/// subtree and, where the scene refracts, its refracted ray's (each
+/// skipped when no ray of the tile reflects or refracts there; with the
+/// paper's traversal the reflected rays' subtree is always traced).
+fn tree(t: &mut Code, lay: &FbImage, level: u32, levels: u32, merged: bool, skips: &mut u32) {
+    shade_level(t, level, merged);
     if level + 1 >= levels {
         return;
     }
@@ -221,14 +239,25 @@ fn tree(t: &mut Code, lay: &FbImage, level: u32, levels: u32, skips: &mut u32) {
             .c(format!("level {level}'s refracted rays, for later"));
     }
     cb(t, &names::reflect(level)).c(format!("level {level}'s reflected rays"));
-    tree(t, lay, level + 1, levels, skips);
+    if lay.traversal == super::Traversal::Packet {
+        // (The paper's traversal keeps its published cycles: it traces
+        // the level whether or not a ray reflects.)
+        *skips += 1;
+        let skip = format!("no_reflection{}", *skips);
+        t.rcany(R1).beqz(R1, &skip).c("none in the tile");
+        tree(t, lay, level + 1, levels, merged, skips);
+        t.label(&skip);
+        cb(t, names::WAKE);
+    } else {
+        tree(t, lay, level + 1, levels, merged, skips);
+    }
     cb(t, &names::reflected(level)).c("their colour added");
     if lay.refract {
         *skips += 1;
         let skip = format!("no_refraction{}", *skips);
         cb(t, &names::refract(level)).c(format!("level {level}'s refracted rays"));
         t.rcany(R1).beqz(R1, &skip).c("none in the tile");
-        tree(t, lay, level + 1, levels, skips);
+        tree(t, lay, level + 1, levels, merged, skips);
         t.label(&skip);
         cb(t, names::WAKE);
         cb(t, &names::refracted(level)).c("their colour added");

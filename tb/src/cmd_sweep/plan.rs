@@ -115,6 +115,7 @@ pub(super) fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> V
     arg("--max-leaf", o.bsp.max_leaf.to_string());
     arg("--collapse", o.collapse.to_string());
     arg("--leaf-pieces", o.pieces.to_string());
+    arg("--shadow-packets", o.shadows.to_string());
     arg("--layout", o.layout.name().into());
     arg("--datapath", o.datapath.bits().to_string());
     arg("--newton-steps", n.newton_steps.to_string());

@@ -1,0 +1,233 @@
+//! `morphosys regroup`: what regrouping rays into other packets could buy,
+//! estimated on the host before any firmware is written.
+//!
+//! The f64 reference traces a SIZE x SIZE frame (default 128) to depth 2:
+//! eye rays, their shadow rays, the mirror rays and their shadow rays. A
+//! packet's cost is estimated as the packet traversal's object tests: the
+//! objects of every leaf of a pbrt SAH tree that some ray of the packet
+//! reaches before its hit (shadow rays: before their first occluder), each
+//! broadcast once to the packet. Per kind of ray it prints that cost with
+//! the chip's packets (an 8x8 tile, one packet per light), relative to it
+//! with those packets split into their four 4x4 quadrants traced in turn,
+//! and with the rays regrouped: every light's rays of a tile together, of
+//! 4 tiles, of the frame, sorted by origin (Morton order in the scene's
+//! box) or by origin then direction, in packets of 64.
+use crate::reference::{eye_ray, shapes::Ray, Tracer};
+use anyhow::{anyhow, Result};
+use firmware::bsp::{auto_depth, Bsp, BspParams, SplitRule};
+use firmware::scene::Vec3;
+use std::collections::{BTreeMap, HashSet};
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct RegroupArgs {
+    /// Scene file (.nff or .toml); default scenes/default.toml
+    pub scene: Option<PathBuf>,
+    /// Image side in pixels: a multiple of 8, 8..=1024 (square)
+    #[arg(long, value_name = "N", default_value = "128", value_parser = parse_side)]
+    pub size: u32,
+}
+
+fn parse_side(s: &str) -> std::result::Result<u32, String> {
+    s.parse::<u32>()
+        .ok()
+        .filter(|n| (8..=1024).contains(n) && n % 8 == 0)
+        .ok_or_else(|| format!("'{s}': expected a multiple of 8, 8..=1024"))
+}
+
+/// A ray of the frame: its pixel, which of the pixel's rays of its kind it
+/// is (the light, for shadow rays), and the segment it traces.
+struct Seg {
+    pixel: (u32, u32),
+    light: usize,
+    o: Vec3,
+    d: Vec3,
+    tmax: f64,
+}
+
+/// The leaves a segment reaches, front to back.
+fn leaves(bsp: &Bsp, s: &Seg, out: &mut Vec<u32>) {
+    let b = bsp.nodes[0].bounds;
+    let o = [s.o.x, s.o.y, s.o.z];
+    let d = [s.d.x, s.d.y, s.d.z];
+    let (lo, hi) = ([b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z]);
+    let (mut t0, mut t1) = (0.0f64, s.tmax);
+    for a in 0..3 {
+        let (n, f) = ((lo[a] - o[a]) / d[a], (hi[a] - o[a]) / d[a]);
+        t0 = t0.max(n.min(f));
+        t1 = t1.min(n.max(f));
+    }
+    if t0 > t1 {
+        return;
+    }
+    let mut stack = vec![(0u32, t0, t1)];
+    while let Some((i, t0, t1)) = stack.pop() {
+        let Some(sp) = bsp.nodes[i as usize].split else {
+            out.push(i);
+            continue;
+        };
+        let a = sp.axis as usize;
+        let t = (sp.position - o[a]) / d[a];
+        let below = o[a] < sp.position || (o[a] == sp.position && d[a] <= 0.0);
+        let (near, far) = if below {
+            (sp.children[0], sp.children[1])
+        } else {
+            (sp.children[1], sp.children[0])
+        };
+        if t > t1 || t <= 0.0 {
+            stack.push((near, t0, t1));
+        } else if t < t0 {
+            stack.push((far, t0, t1));
+        } else {
+            stack.push((far, t, t1));
+            stack.push((near, t0, t));
+        }
+    }
+}
+
+fn morton(x: u32, y: u32, z: u32, bits: u32) -> u64 {
+    (0..bits).rev().fold(0u64, |m, b| {
+        m << 3 | ((x >> b & 1) as u64) << 2 | ((y >> b & 1) as u64) << 1 | (z >> b & 1) as u64
+    })
+}
+
+/// `morphosys regroup`.
+pub fn command(a: RegroupArgs) -> Result<()> {
+    let scene = crate::cmd_scene::load_scene(a.scene.as_deref())?;
+    let size = a.size;
+    let path = scene.source.clone();
+    let tracer = Tracer::new(&scene);
+    let bounds: Vec<_> = scene.objects.iter().map(|o| o.shape.bounds()).collect();
+    let sb = scene.bounds();
+    if sb.is_empty() || scene.objects.is_empty() {
+        return Err(anyhow!("{path}: nothing to trace"));
+    }
+    let params = BspParams {
+        max_depth: auto_depth(bounds.len()),
+        max_leaf: 5,
+        rule: SplitRule::Sah,
+        snap: 0.0,
+    };
+    let bsp = Bsp::build(&bounds, sb, params);
+    let eps = 1e-6 * sb.min.max_abs().max(sb.max.max_abs());
+    // The segment to the first occluder, or to the light.
+    let shadow = |pixel, p: Vec3, n: Vec3, out: &mut Vec<Seg>| {
+        for (light, l) in scene.lights.iter().enumerate() {
+            let to = l.position - p;
+            let (dist, d) = (to.length(), to.normalized());
+            if n.dot(d) > 0.0 {
+                let o = p + n * eps;
+                let tmax = tracer.closest(&Ray { o, d }).map_or(dist, |h| h.1.t.min(dist));
+                out.push(Seg { pixel, light, o, d, tmax });
+            }
+        }
+    };
+    let names = ["eye", "shadow (eye hits)", "mirror", "shadow (mirror hits)"];
+    let mut kinds: [Vec<Seg>; 4] = Default::default();
+    for py in 0..size {
+        for px in 0..size {
+            let pixel = (px, py);
+            let r = eye_ray(&scene, size, size, px, py);
+            let hit = tracer.closest(&r);
+            let tmax = hit.map_or(f64::INFINITY, |h| h.1.t);
+            kinds[0].push(Seg { pixel, light: 0, o: r.o, d: r.d, tmax });
+            let Some((id, h)) = hit else { continue };
+            let p = r.at(h.t);
+            let n = if h.front { h.ns } else { -h.ns };
+            shadow(pixel, p, n, &mut kinds[1]);
+            if scene.materials[scene.objects[id].material].ks > 0.0 {
+                let d = (r.d - n * (2.0 * r.d.dot(n))).normalized();
+                let m = Ray { o: p + n * eps, d };
+                let hit = tracer.closest(&m);
+                let tmax = hit.map_or(f64::INFINITY, |h| h.1.t);
+                kinds[2].push(Seg { pixel, light: 0, o: m.o, d, tmax });
+                if let Some((_, h)) = hit {
+                    let n = if h.front { h.ns } else { -h.ns };
+                    shadow(pixel, m.at(h.t), n, &mut kinds[3]);
+                }
+            }
+        }
+    }
+    let cell = |v: f64, lo: f64, hi: f64| (((v - lo) / (hi - lo).max(1e-300)).clamp(0.0, 0.9999) * 1024.0) as u32;
+    let dir = |v: f64| ((v * 0.5 + 0.5).clamp(0.0, 0.9999) * 32.0) as u32;
+    println!(
+        "{path} at {size}x{size}, depth 2; pbrt SAH tree of {} nodes; object tests broadcast (fewer is better)",
+        bsp.nodes.len()
+    );
+    println!(
+        "{:<22} {:>7} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
+        "rays", "count", "8x8 tiles", "quadrants", "tile merged", "4 tiles", "frame", "frame o+d"
+    );
+    for (name, segs) in names.iter().zip(&kinds) {
+        let reach: Vec<Vec<u32>> = segs
+            .iter()
+            .map(|s| {
+                let mut l = Vec::new();
+                leaves(&bsp, s, &mut l);
+                l
+            })
+            .collect();
+        let cost = |packets: &[Vec<usize>]| -> usize {
+            packets
+                .iter()
+                .map(|p| {
+                    let u: HashSet<u32> = p.iter().flat_map(|&k| reach[k].iter().copied()).collect();
+                    u.iter().map(|&i| bsp.nodes[i as usize].objects.len()).sum::<usize>()
+                })
+                .sum()
+        };
+        let tile = |s: &Seg| (s.pixel.1 / 8) * (size / 8) + s.pixel.0 / 8;
+        let mut chip: BTreeMap<(u32, usize), Vec<usize>> = BTreeMap::new();
+        for (k, s) in segs.iter().enumerate() {
+            chip.entry((tile(s), s.light)).or_default().push(k);
+        }
+        let chip: Vec<Vec<usize>> = chip.into_values().collect();
+        // Each of those packets split into its 4x4 quadrants, traced one
+        // after another.
+        let mut quads: BTreeMap<(u32, usize, u32), Vec<usize>> = BTreeMap::new();
+        for (k, s) in segs.iter().enumerate() {
+            let q = (s.pixel.1 % 8 / 4) * 2 + s.pixel.0 % 8 / 4;
+            quads.entry((tile(s), s.light, q)).or_default().push(k);
+        }
+        let quads: Vec<Vec<usize>> = quads.into_values().collect();
+        let regroup = |group: u32, with_dir: bool| -> Vec<Vec<usize>> {
+            // Ties (eye rays share their origin) keep the tiles' order.
+            let mut groups: BTreeMap<u32, Vec<(u64, u32, usize)>> = BTreeMap::new();
+            for (k, s) in segs.iter().enumerate() {
+                let (x, y, z) = (cell(s.o.x, sb.min.x, sb.max.x), cell(s.o.y, sb.min.y, sb.max.y), cell(s.o.z, sb.min.z, sb.max.z));
+                let key = if with_dir {
+                    morton(x >> 5, y >> 5, z >> 5, 5) << 15 | morton(dir(s.d.x), dir(s.d.y), dir(s.d.z), 5)
+                } else {
+                    morton(x, y, z, 10)
+                };
+                groups.entry(tile(s) / group).or_default().push((key, tile(s), k));
+            }
+            let mut packets = Vec::new();
+            for (_, mut g) in groups {
+                g.sort_unstable();
+                packets.extend(g.chunks(64).map(|c| c.iter().map(|x| x.2).collect()));
+            }
+            packets
+        };
+        let all = u32::MAX;
+        let base = cost(&chip);
+        let cols = [
+            cost(&quads),
+            cost(&regroup(1, false)),
+            cost(&regroup(4, false)),
+            cost(&regroup(all, false)),
+            cost(&regroup(all, true)),
+        ];
+        let ratio = |c: usize| if base == 0 { String::from("-") } else { format!("{:.2}x", c as f64 / base as f64) };
+        println!(
+            "{name:<22} {:>7} {base:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
+            segs.len(),
+            ratio(cols[0]),
+            ratio(cols[1]),
+            ratio(cols[2]),
+            ratio(cols[3]),
+            ratio(cols[4])
+        );
+    }
+    Ok(())
+}
