@@ -217,15 +217,18 @@ SLOT_TMIN = 1           ; slot: near end
 
 ; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
 ; (kernel `post`: k_post_eye for the eye rays, k_post after), then every light's
-; shadow pass (3 lights).
+; shadow pass (3 lights), where some ray of the level hit (post leaves F = a hit).
 .macro SHADE_LEVEL post
         sw r0, MODE(r0)                 ; closest hit
         jal trace
         BCAST k_wake_tile
         BCAST_FB \post, FB_POST
+        rcany r1
+        beqz r1, no_hit\@               ; no ray hit: no shadow pass
         SHADOW_PASS FB_LIGHT0, FB_SHADE0
         SHADOW_PASS FB_LIGHT1, FB_SHADE1
         SHADOW_PASS FB_LIGHT2, FB_SHADE2
+no_hit\@:
 .endm
 
 ; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,
@@ -1187,6 +1190,8 @@ k_post_eye:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
+        ld r8, [r0 + #ACT]
+        cmp.ne r8, #0                   ; F: a hit (for rcany)
 k_post_eye_end:
 
 ; k_post: after a closest-hit pass: the hit's shading state (stream: background.rgb,
@@ -1231,6 +1236,8 @@ k_post:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
+        ld r8, [r0 + #ACT]
+        cmp.ne r8, #0                   ; F: a hit (for rcany)
 k_post_end:
 
 ; k_shadow_rays: the shadow rays towards one light (stream: the light's position).

@@ -223,15 +223,18 @@ SLOT_TMIN = 1           ; slot: near end
 
 ; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
 ; (kernel `post`: k_post_eye for the eye rays, k_post after), then every light's
-; shadow pass (3 lights).
+; shadow pass (3 lights), where some ray of the level hit (post leaves F = a hit).
 .macro SHADE_LEVEL post
         sw r0, MODE(r0)                 ; closest hit
         jal trace
         BCAST k_wake_tile
         BCAST_FB \post, FB_POST
+        rcany r1
+        beqz r1, no_hit\@               ; no ray hit: no shadow pass
         SHADOW_PASS FB_LIGHT0, FB_SHADE0
         SHADOW_PASS FB_LIGHT1, FB_SHADE1
         SHADOW_PASS FB_LIGHT2, FB_SHADE2
+no_hit\@:
 .endm
 
 ; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,
@@ -369,7 +372,10 @@ tile:
         jal trace
         BCAST k_wake_tile
         BCAST_FB k_post, FB_POST
+        rcany r1
+        beqz r1, no_hit2                ; no ray hit: no shadow pass
         jal shadows                     ; every light's shadow rays, merged
+no_hit2:
 no_reflection1:
         BCAST k_wake_tile
         BCAST k_reflected0              ; their colour added
@@ -1443,6 +1449,8 @@ k_post_eye:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
+        ld r8, [r0 + #ACT]
+        cmp.ne r8, #0                   ; F: a hit (for rcany)
 k_post_eye_end:
 
 ; k_post: after a closest-hit pass: the hit's shading state (stream: background.rgb,
@@ -1487,6 +1495,8 @@ k_post:
         (f) cmp.eq fb0, r13
         (f) st fb0, [#SH_KS]
         .endr
+        ld r8, [r0 + #ACT]
+        cmp.ne r8, #0                   ; F: a hit (for rcany)
 k_post_end:
 
 ; k_shadow_rays: the shadow rays towards one light (stream: the light's position).

@@ -113,14 +113,13 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
         )
     });
     v.push((names::EYE.into(), shading::eye(nm.approx(), lay.refract)));
-    v.push((
-        names::POST_EYE.into(),
-        shading::post(true, lay.materials, smooth, lay.refract),
-    ));
-    v.push((
-        names::POST.into(),
-        shading::post(false, lay.materials, smooth, lay.refract),
-    ));
+    for (name, level0) in [(names::POST_EYE, true), (names::POST, false)] {
+        let mut post = shading::post(level0, lay.materials, smooth, lay.refract);
+        if packet {
+            shading::flag_hit(&mut post);
+        }
+        v.push((name.into(), post));
+    }
     v.push((
         names::SHADOW.into(),
         shading::light_setup(nm.approx(), lay.light_shifted),

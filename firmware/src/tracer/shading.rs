@@ -260,6 +260,15 @@ pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool) -> K {
     k
 }
 
+/// Appended to [`post`] for the packet traversal: F = the RC's ray hit,
+/// so that TinyRISC's `rcany` skips the level's shadow passes where no ray
+/// did.
+pub fn flag_hit(k: &mut K) {
+    k.c(format!("ld r8, [r0 + #{}]", ram::ACT))
+        .c("cmp.ne r8, #0")
+        .note("F: a hit (for rcany)");
+}
+
 /// Shadow ray towards a light (stream: the light's position): from the
 /// offset hit point, unit direction, `tbest` = distance - 2 LSB; RCs with
 /// no hit or with the light behind the surface (N.L <= 0, the SPD rule)

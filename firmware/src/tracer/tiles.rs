@@ -103,15 +103,21 @@ pub fn macros(lay: &FbImage) -> Code {
                 .m("BCAST_FB", format!("{}, \\shade", names::PHONG));
         }),
     );
+    let packet = lay.traversal == super::Traversal::Packet;
     t.define_macro(
         "SHADE_LEVEL",
         "post",
         &format!(
             "SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state\n\
              (kernel `post`: k_post_eye for the eye rays, k_post after), then every light's\n\
-             shadow pass ({} light{}).",
+             shadow pass ({} light{}){}.",
             lay.lights.len(),
-            if lay.lights.len() == 1 { "" } else { "s" }
+            if lay.lights.len() == 1 { "" } else { "s" },
+            if packet {
+                ", where some ray of the level hit (post leaves F = a hit)"
+            } else {
+                ""
+            }
         ),
         body(&|b| {
             b.sw(R0, at("MODE", R0))
@@ -119,8 +125,15 @@ pub fn macros(lay: &FbImage) -> Code {
                 .jal("trace")
                 .m("BCAST", names::WAKE)
                 .m("BCAST_FB", "\\post, FB_POST");
+            if packet {
+                // (The paper's traversal keeps its published cycles.)
+                b.rcany(R1).beqz(R1, "no_hit\\@").c("no ray hit: no shadow pass");
+            }
             for i in 0..lay.lights.len() {
                 b.m("SHADOW_PASS", format!("FB_LIGHT{i}, FB_SHADE{i}"));
+            }
+            if packet {
+                b.label("no_hit\\@");
             }
         }),
     );
@@ -204,14 +217,18 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
 
 /// One level's shading ([`macros`]' `SHADE_LEVEL`); `merged`: a
 /// reflection level's shadow rays in merged packets (`jal shadows`).
-fn shade_level(t: &mut Code, level: u32, merged: bool) {
+fn shade_level(t: &mut Code, level: u32, merged: bool, skips: &mut u32) {
     if merged && level > 0 {
         t.sw(R0, at("MODE", R0))
             .c(format!("level {level}: trace (closest hit)"))
             .jal("trace");
         cb(t, names::WAKE);
         sb(t, names::POST, "FB_POST");
+        *skips += 1;
+        let skip = format!("no_hit{}", *skips);
+        t.rcany(R1).beqz(R1, &skip).c("no ray hit: no shadow pass");
         t.jal("shadows").c("every light's shadow rays, merged");
+        t.label(&skip);
         return;
     }
     t.m(
@@ -230,7 +247,7 @@ fn shade_level(t: &mut Code, level: u32, merged: bool) {
 /// skipped when no ray of the tile reflects or refracts there; with the
 /// paper's traversal the reflected rays' subtree is always traced).
 fn tree(t: &mut Code, lay: &FbImage, level: u32, levels: u32, merged: bool, skips: &mut u32) {
-    shade_level(t, level, merged);
+    shade_level(t, level, merged, skips);
     if level + 1 >= levels {
         return;
     }
