@@ -117,8 +117,16 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             let (dist, d) = (to.length(), to.normalized());
             if n.dot(d) > 0.0 {
                 let o = p + n * eps;
-                let tmax = tracer.closest(&Ray { o, d }).map_or(dist, |h| h.1.t.min(dist));
-                out.push(Seg { pixel, light, o, d, tmax });
+                let tmax = tracer
+                    .closest(&Ray { o, d })
+                    .map_or(dist, |h| h.1.t.min(dist));
+                out.push(Seg {
+                    pixel,
+                    light,
+                    o,
+                    d,
+                    tmax,
+                });
             }
         }
     };
@@ -130,7 +138,13 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             let r = eye_ray(&scene, size, size, px, py);
             let hit = tracer.closest(&r);
             let tmax = hit.map_or(f64::INFINITY, |h| h.1.t);
-            kinds[0].push(Seg { pixel, light: 0, o: r.o, d: r.d, tmax });
+            kinds[0].push(Seg {
+                pixel,
+                light: 0,
+                o: r.o,
+                d: r.d,
+                tmax,
+            });
             let Some((id, h)) = hit else { continue };
             let p = r.at(h.t);
             let n = if h.front { h.ns } else { -h.ns };
@@ -140,7 +154,13 @@ pub fn command(a: RegroupArgs) -> Result<()> {
                 let m = Ray { o: p + n * eps, d };
                 let hit = tracer.closest(&m);
                 let tmax = hit.map_or(f64::INFINITY, |h| h.1.t);
-                kinds[2].push(Seg { pixel, light: 0, o: m.o, d, tmax });
+                kinds[2].push(Seg {
+                    pixel,
+                    light: 0,
+                    o: m.o,
+                    d,
+                    tmax,
+                });
                 if let Some((_, h)) = hit {
                     let n = if h.front { h.ns } else { -h.ns };
                     shadow(pixel, m.at(h.t), n, &mut kinds[3]);
@@ -148,7 +168,9 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             }
         }
     }
-    let cell = |v: f64, lo: f64, hi: f64| (((v - lo) / (hi - lo).max(1e-300)).clamp(0.0, 0.9999) * 1024.0) as u32;
+    let cell = |v: f64, lo: f64, hi: f64| {
+        (((v - lo) / (hi - lo).max(1e-300)).clamp(0.0, 0.9999) * 1024.0) as u32
+    };
     let dir = |v: f64| ((v * 0.5 + 0.5).clamp(0.0, 0.9999) * 32.0) as u32;
     println!(
         "{path} at {size}x{size}, depth 2; pbrt SAH tree of {} nodes; object tests broadcast (fewer is better)",
@@ -171,8 +193,11 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             packets
                 .iter()
                 .map(|p| {
-                    let u: HashSet<u32> = p.iter().flat_map(|&k| reach[k].iter().copied()).collect();
-                    u.iter().map(|&i| bsp.nodes[i as usize].objects.len()).sum::<usize>()
+                    let u: HashSet<u32> =
+                        p.iter().flat_map(|&k| reach[k].iter().copied()).collect();
+                    u.iter()
+                        .map(|&i| bsp.nodes[i as usize].objects.len())
+                        .sum::<usize>()
                 })
                 .sum()
         };
@@ -194,13 +219,21 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             // Ties (eye rays share their origin) keep the tiles' order.
             let mut groups: BTreeMap<u32, Vec<(u64, u32, usize)>> = BTreeMap::new();
             for (k, s) in segs.iter().enumerate() {
-                let (x, y, z) = (cell(s.o.x, sb.min.x, sb.max.x), cell(s.o.y, sb.min.y, sb.max.y), cell(s.o.z, sb.min.z, sb.max.z));
+                let (x, y, z) = (
+                    cell(s.o.x, sb.min.x, sb.max.x),
+                    cell(s.o.y, sb.min.y, sb.max.y),
+                    cell(s.o.z, sb.min.z, sb.max.z),
+                );
                 let key = if with_dir {
-                    morton(x >> 5, y >> 5, z >> 5, 5) << 15 | morton(dir(s.d.x), dir(s.d.y), dir(s.d.z), 5)
+                    morton(x >> 5, y >> 5, z >> 5, 5) << 15
+                        | morton(dir(s.d.x), dir(s.d.y), dir(s.d.z), 5)
                 } else {
                     morton(x, y, z, 10)
                 };
-                groups.entry(tile(s) / group).or_default().push((key, tile(s), k));
+                groups
+                    .entry(tile(s) / group)
+                    .or_default()
+                    .push((key, tile(s), k));
             }
             let mut packets = Vec::new();
             for (_, mut g) in groups {
@@ -218,7 +251,13 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             cost(&regroup(all, false)),
             cost(&regroup(all, true)),
         ];
-        let ratio = |c: usize| if base == 0 { String::from("-") } else { format!("{:.2}x", c as f64 / base as f64) };
+        let ratio = |c: usize| {
+            if base == 0 {
+                String::from("-")
+            } else {
+                format!("{:.2}x", c as f64 / base as f64)
+            }
+        };
         println!(
             "{name:<22} {:>7} {base:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
             segs.len(),

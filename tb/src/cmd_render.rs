@@ -691,7 +691,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
             "shadow packets           {} (the reflection levels' shadow rays: {}{})",
             chip.firmware.shadows,
             match chip.firmware.shadows {
-                firmware::tracer::ShadowPackets::Merged => "every light's in as few packets as hold them",
+                firmware::tracer::ShadowPackets::Merged =>
+                    "every light's in as few packets as hold them",
                 _ => "a packet per light",
             },
             if opt.shadows == firmware::tracer::ShadowPackets::Auto {

@@ -1005,9 +1005,7 @@ pub(crate) fn choose_firmware_probed(
     timing: &Timing,
 ) -> Result<(Firmware, Option<ProbeRender>)> {
     let (fw, p) = choose_tree(scene, opt, nm, timing)?;
-    if opt.shadows != tracer::ShadowPackets::Auto
-        || !tracer::shadows::applies(opt, &fw.layout)
-    {
+    if opt.shadows != tracer::ShadowPackets::Auto || !tracer::shadows::applies(opt, &fw.layout) {
         return Ok((fw, p));
     }
     // `--shadow-packets auto`: the tree chosen, merged shadow packets

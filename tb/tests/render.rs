@@ -230,7 +230,11 @@ fn long_tile_lists_and_wrapping_pass_numbers_keep_the_frame() {
         assert_eq!(one.hits, cut.hits, "{traversal:?}");
         assert_eq!(one.stats, cut.stats, "{traversal:?}");
         assert_eq!(one.firmware_cycles, cut.firmware_cycles, "{traversal:?}");
-        assert_eq!(cut.item_seconds.len(), tiles.div_ceil(1000), "{traversal:?}");
+        assert_eq!(
+            cut.item_seconds.len(),
+            tiles.div_ceil(1000),
+            "{traversal:?}"
+        );
         match traversal {
             Traversal::Paper => assert_eq!(one.passes, 93_312),
             _ => assert!(one.passes > 65_536, "{} passes", one.passes),

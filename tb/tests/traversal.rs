@@ -397,7 +397,11 @@ fn merged_shadow_packets_trace_the_same_rays() {
         assert!(merged.rgb8 == light.rgb8, "{what}: the image changed");
         assert!(merged.hits == light.hits, "{what}: the hits changed");
         assert_eq!(merged.ray_census(), light.ray_census(), "{what}");
-        assert!(light.ray_census()[1] > 1000, "{what}: {:?}", light.ray_census());
+        assert!(
+            light.ray_census()[1] > 1000,
+            "{what}: {:?}",
+            light.ray_census()
+        );
         assert!(
             merged.passes < light.passes,
             "{what}: {} passes merged, {} with a packet per light",

@@ -143,7 +143,10 @@ fn an_emitted_firmware_renders_the_same_and_an_edited_one_differs() {
         .and_then(|r| r.split_whitespace().next())
         .and_then(|a| a.parse().ok())
         .unwrap_or_else(|| panic!("no RAM address named: {err}"));
-    assert!((600..728).contains(&addr) && err.contains("outside 0..=511"), "{err}");
+    assert!(
+        (600..728).contains(&addr) && err.contains("outside 0..=511"),
+        "{err}"
+    );
     assert!(!d.join("f.png").exists());
 }
 

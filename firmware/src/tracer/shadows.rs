@@ -69,7 +69,9 @@ impl std::str::FromStr for ShadowPackets {
             "auto" => Ok(ShadowPackets::Auto),
             "light" => Ok(ShadowPackets::PerLight),
             "merged" => Ok(ShadowPackets::Merged),
-            _ => Err(format!("shadow packets '{s}': expected auto, light or merged")),
+            _ => Err(format!(
+                "shadow packets '{s}': expected auto, light or merged"
+            )),
         }
     }
 }
@@ -125,7 +127,11 @@ pub fn header(lay: &FbImage) -> Vec<String> {
             SC_PACK,
             "the packet stream: per ray its RC, then its words",
         ),
-        define("SC_REC", ray_words(lay) + 1, "words of a ray in the packet stream:"),
+        define(
+            "SC_REC",
+            ray_words(lay) + 1,
+            "words of a ray in the packet stream:",
+        ),
         define("SC_RAY_RC", 0, "  the RC it goes to"),
         define("SC_RAY_W", 1, "  its words, r1..r7[, ORIG_OBJ]"),
         define(
@@ -151,7 +157,12 @@ pub fn data(t: &mut Code, lay: &FbImage, lanes: &[u32]) {
         });
     };
     d(t, "SC_RET", ".word 0".into(), "shadows' return address");
-    d(t, "SC_FB", ".word 0".into(), "the tile's output bank (FB address)");
+    d(
+        t,
+        "SC_FB",
+        ".word 0".into(),
+        "the tile's output bank (FB address)",
+    );
     d(t, "SC_L", ".word 0".into(), "the light being packed");
     d(
         t,
@@ -252,7 +263,16 @@ fn keep() -> K {
 /// `ORIG_OBJ`.
 fn ray_word(i: u32) -> K {
     let mut k = K::new();
-    let what = ["origin x", "origin y", "origin z", "direction x", "direction y", "direction z", "tbest", "the object it leaves"];
+    let what = [
+        "origin x",
+        "origin y",
+        "origin z",
+        "direction x",
+        "direction y",
+        "direction z",
+        "tbest",
+        "the object it leaves",
+    ];
     k.doc(&format!(
         "{}: the shadow ray's {} into the output register (for wfb).",
         names::ray_word(i),
@@ -393,7 +413,9 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         cb(t, names::SHADOW_SAVE);
     }
     for l in 0..nl {
-        t.comment(format!("light {l}: its rays, the lit RCs, the rays' words into the stage"));
+        t.comment(format!(
+            "light {l}: its rays, the lit RCs, the rays' words into the stage"
+        ));
         t.li(R3, format!("SHADOW_SLOTS + {}", 2 * l))
             .sfb(R3, at(format!("SC_PARAM + {}", 5 * l), R4));
         t.m("BCAST_FB", format!("{}, FB_LIGHT{l}", names::SHADOW));
@@ -498,10 +520,7 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .addi(R10, R10, -1)
         .bnez(R10, "sc_load");
     cb(t, names::SHADOW_GO);
-    t.li(R1, 1)
-        .sw(R1, at("MODE", R0))
-        .c("any hit")
-        .jal("trace");
+    t.li(R1, 1).sw(R1, at("MODE", R0)).c("any hit").jal("trace");
     cb(t, names::WAKE);
     cb(t, names::SHADOW_SEEN);
     t.rcfl(R8)
@@ -515,9 +534,7 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .beqz(R5, "sc_result_high")
         .srl(R5, R8, R4)
         .j("sc_result_bit");
-    t.label("sc_result_high")
-        .addi(R5, R4, -32)
-        .srl(R5, R9, R5);
+    t.label("sc_result_high").addi(R5, R4, -32).srl(R5, R9, R5);
     t.label("sc_result_bit")
         .andi(R5, R5, 1)
         .beqz(R5, "sc_result_next")
@@ -553,6 +570,5 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         t.m("BCAST_AT", format!("{}, r3", names::SHADOW_LIT));
         t.m("BCAST_FB", format!("{}, FB_SHADE{l}", names::PHONG));
     }
-    t.lw(super::emit::R15, at("SC_RET", R0))
-        .line("jr r15");
+    t.lw(super::emit::R15, at("SC_RET", R0)).line("jr r15");
 }

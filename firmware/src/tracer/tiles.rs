@@ -127,7 +127,9 @@ pub fn macros(lay: &FbImage) -> Code {
                 .m("BCAST_FB", "\\post, FB_POST");
             if packet {
                 // (The paper's traversal keeps its published cycles.)
-                b.rcany(R1).beqz(R1, "no_hit\\@").c("no ray hit: no shadow pass");
+                b.rcany(R1)
+                    .beqz(R1, "no_hit\\@")
+                    .c("no ray hit: no shadow pass");
             }
             for i in 0..lay.lights.len() {
                 b.m("SHADOW_PASS", format!("FB_LIGHT{i}, FB_SHADE{i}"));
