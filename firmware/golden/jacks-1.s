@@ -192,6 +192,23 @@ SLOT_TMIN = 1           ; slot: near end
         sbcb r1, r2, (\k\()_end - \k) / 4
 .endm
 
+; BCAST_UPTO k, cut, ra, field: broadcast kernel k's contexts up to its cut `cut`,
+; with the FB words from `field` of the record at ra as their stream. Clobbers r1, r2.
+.macro BCAST_UPTO k, cut, ra, field
+        li r1, (\k - CTXBASE) / 4
+        addi r2, \ra, \field
+        sbcb r1, r2, (\cut - \k) / 4
+.endm
+
+; BCAST_FROM cut, end, ra, field: broadcast a kernel's contexts from its cut `cut` up
+; to label `end`, the stream going on from `field` of the record at ra past the
+; words read before the cut (`cut_fb`). Clobbers r1, r2.
+.macro BCAST_FROM cut, end, ra, field
+        li r1, (\cut - CTXBASE) / 4
+        addi r2, \ra, \field + \cut\()_fb
+        sbcb r1, r2, (\end - \cut) / 4
+.endm
+
 ; SHADOW_PASS light, shade: shadow rays from the hits towards the light of stream
 ; `light`, traced (any hit), then its Phong terms (stream `shade`) where it is visible.
 .macro SHADOW_PASS light, shade
@@ -535,7 +552,31 @@ lo_sphere_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere
-        BCAST_AT k_sphere, r7
+lo_sphere_test:
+        BCAST_UPTO k_sphere, k_sphere_cut_line, r7, 0 ; up to F: the ray's line meets the sphere
+        mv r15, r7                      ; r15: the object under test
+        ; while its first part runs: the next object to test (r9 = 0: none)
+        addi r9, r9, -1
+        beqz r9, lo_sphere_parts
+lo_sphere_ahead_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_sphere_ahead_go  ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        MAILBOX_CHECK lo_sphere_ahead
+lo_sphere_parts:
+        rcany r3
+        beqz r3, lo_sphere_done         ; no awake ray can hit it
+        BCAST_FROM k_sphere_cut_line, k_sphere_end, r15, 0
+lo_sphere_done:
+        bnez r9, lo_sphere_test
+        j lo_sphere_end
+lo_sphere_ahead_next:
+        addi r9, r9, -1
+        bnez r9, lo_sphere_ahead_obj
+        j lo_sphere_parts
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -551,12 +592,34 @@ lo_cylinder_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
-        BCAST_REC k_cylinder, r7, CYL_BODY ; the body
-        lfb r3, CYL_CAPS(r7)
-        beqz r3, lo_cylinder_nocap
-        BCAST_REC k_disc, r7, CYL_CAP0
-        BCAST_REC k_disc, r7, CYL_CAP1  ; the caps
-lo_cylinder_nocap:
+lo_cylinder_test:
+        BCAST_UPTO k_cylinder, k_cylinder_cut_line, r7, CYL_BODY ; up to F: the ray's line meets the cylinder
+        mv r15, r7                      ; r15: the object under test
+        ; while its first part runs: the next object to test (r9 = 0: none)
+        addi r9, r9, -1
+        beqz r9, lo_cylinder_parts
+lo_cylinder_ahead_obj:
+        lfb r7, LE_RECORD(r6)
+        lfb r8, LE_MAILBOX(r6)
+        addi r6, r6, LE_WORDS
+        blt r8, r0, lo_cylinder_ahead_go ; no mailbox
+        slli r8, r8, MB_SHIFT
+        add r8, r8, r12                 ; r8: its mailbox
+        MAILBOX_CHECK lo_cylinder_ahead
+lo_cylinder_parts:
+        rcany r3
+        beqz r3, lo_cylinder_done       ; no awake ray can hit it
+        BCAST_FROM k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY ; up to F: the root ahead, before tbest
+        rcany r3
+        beqz r3, lo_cylinder_done       ; no awake ray can hit it
+        BCAST_FROM k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY
+lo_cylinder_done:
+        bnez r9, lo_cylinder_test
+        j lo_cylinder_end
+lo_cylinder_ahead_next:
+        addi r9, r9, -1
+        bnez r9, lo_cylinder_ahead_obj
+        j lo_cylinder_parts
 lo_cylinder_next:
         addi r9, r9, -1
         bnez r9, lo_cylinder_obj
@@ -1447,6 +1510,7 @@ k_sphere:
         msu out, r9, r9
         msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
         cmp.gt r15, #0                  ; F: the line meets the sphere
+k_sphere_cut_line:
         ; sqrt
         ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
@@ -1498,6 +1562,7 @@ k_sphere:
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
 k_sphere_end:
+k_sphere_cut_line_fb = 5                ; FB words of the stream read before the cut
 
 ; k_cylinder: the open cylinder test of one body record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
@@ -1602,6 +1667,7 @@ k_cylinder:
         msu r15, r12, r12, >>Q14        ; s = 1 - |p2/r|^2
         cmp.gt r15, #0
         (f) cmp.gt r10, #0
+k_cylinder_cut_line:
         ; sqrt
         ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
@@ -1638,6 +1704,7 @@ k_cylinder:
         msu out, r7, r10
         acch r11
         (f) cmp.lt r11, #0              ; F: tau < tbest |d2|
+k_cylinder_cut_ahead:
         ; divide
         clz r8, r10
         sub r8, r8, #1
@@ -1704,6 +1771,8 @@ k_cylinder:
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
 k_cylinder_end:
+k_cylinder_cut_line_fb = 18             ; FB words of the stream read before the cut
+k_cylinder_cut_ahead_fb = 20            ; FB words of the stream read before the cut
 
 ; k_disc: the disc test of one record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.

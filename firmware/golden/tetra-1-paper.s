@@ -1039,6 +1039,7 @@ k_triangle:
         msu out, r7, r11
         acch r8
         (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
+k_triangle_cut_plane:
         ; divide
         clz r8, r11
         sub r8, r8, #1
@@ -1092,4 +1093,5 @@ k_triangle:
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
 k_triangle_end:
+k_triangle_cut_plane_fb = 6             ; FB words of the stream read before the cut
 ctx_end:

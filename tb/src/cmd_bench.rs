@@ -120,6 +120,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             collapse: Default::default(),
             pieces: Default::default(),
             shadows: Default::default(),
+            test_cuts: Default::default(),
         },
         firmware::tracer::Traversal::Packet => Options {
             width,

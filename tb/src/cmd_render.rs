@@ -92,6 +92,11 @@ pub struct RenderArgs {
     /// kept). The eye rays' level keeps a packet per light.
     #[arg(long, value_name = "auto|light|merged", default_value = "auto", value_parser = crate::cli::parse_shadow_packets)]
     pub shadow_packets: firmware::tracer::ShadowPackets,
+    /// Packet traversal: run each object test in parts, at the cuts of its
+    /// kernels, the rest skipped where no awake ray can still hit the
+    /// object (on), or whole (off). The same image either way.
+    #[arg(long, value_name = "on|off", default_value = "on", value_parser = crate::cli::parse_test_cuts)]
+    pub test_cuts: firmware::tracer::TestCuts,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
     /// variant the paper announces; every format gets 16 more fraction
     /// bits), or auto: 16 unless the 16-bit chip cannot hold the scene or
@@ -329,6 +334,7 @@ pub(crate) fn render_and_measure(
         "collapse": opt.collapse.to_string(),
         "leaf_pieces": opt.pieces.to_string(),
         "shadow_packets": chip.firmware.shadows.to_string(),
+        "test_cuts": opt.test_cuts.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
@@ -526,6 +532,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         collapse: a.collapse,
         pieces: a.leaf_pieces,
         shadows: a.shadow_packets,
+        test_cuts: a.test_cuts,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
@@ -699,6 +706,16 @@ pub fn command(a: RenderArgs) -> Result<()> {
                 "; auto: the faster on the probe"
             } else {
                 ""
+            }
+        );
+    }
+    if opt.traversal == firmware::tracer::Traversal::Packet {
+        crate::report!(
+            "object tests             {}",
+            if chip.firmware.layout.test_cuts {
+                "in parts (each part after a cut where some awake ray can still hit the object)"
+            } else {
+                "whole (--test-cuts off)"
             }
         );
     }

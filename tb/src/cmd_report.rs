@@ -216,7 +216,8 @@ pub fn sections() -> Vec<Section> {
             about: "One sweep over the paper's configuration on three scenes, one knob at a \
                     time (ways, recursion depth, BSP depth, leaf size, split rule, Newton-Raphson \
                     steps, table entries, guard bits, ray offset, node layout, normals, \
-                    datapath, traversal, issue model), with each scene's Pareto front, and the \
+                    datapath, traversal, issue model; on the packet traversal its split rule, \
+                    leaf pieces, shadow packets and test cuts), with each scene's Pareto front, and the \
                     SPD families at growing sizes under both traversals. The whole table is \
                     `results/results.csv`.",
             checked: false,

@@ -99,14 +99,20 @@ pub struct Names {
 impl Names {
     pub fn new(img: &Image, ctx_base: u32) -> Names {
         // TinyRISC's code labels (the macros' included), and the kernels:
-        // the context labels `k_NAME` (not their `k_NAME_end`).
+        // the context labels `k_NAME` (not their `k_NAME_end`, nor the
+        // cuts `k_NAME_cut_C` inside them: their cycles are the kernel's).
         let labels = img
             .labels_in(Section::Text)
             .map(|l| (l.addr, l.name.clone()))
             .collect();
         let kernels = img
             .labels_in(Section::Ctx)
-            .filter(|l| l.name.starts_with("k_") && !l.name.ends_with("_end") && l.addr >= ctx_base)
+            .filter(|l| {
+                l.name.starts_with("k_")
+                    && !l.name.ends_with("_end")
+                    && !l.name.contains("_cut_")
+                    && l.addr >= ctx_base
+            })
             .map(|l| ((l.addr - ctx_base) / 4, l.name.clone()))
             .collect();
         Names { kernels, labels }

@@ -302,6 +302,10 @@ fn usage_errors_name_the_argument_and_exit_2() {
             "'--shadow-packets <auto|light|merged>': shadow packets 'some': expected auto, light or merged",
         ),
         (
+            &["render", "--test-cuts", "maybe"][..],
+            "'--test-cuts <on|off>': test cuts 'maybe': expected on or off",
+        ),
+        (
             &["regroup", "--size", "12"][..],
             "'--size <N>': '12': expected a multiple of 8, 8..=1024",
         ),

@@ -410,3 +410,91 @@ fn merged_shadow_packets_trace_the_same_rays() {
         );
     }
 }
+
+/// Object tests in parts (`--test-cuts on`, the default): a test's kernel
+/// runs up to a cut, and the rest only where some awake ray can still hit
+/// the object. The rest can only narrow F and writes nothing else where F
+/// is clear, so the frame is the one of whole tests, bit for bit, in fewer
+/// cycles: every type with a cut (spheres, cylinders and cones with and
+/// without caps, rectangles, triangles, smooth triangles, polygons opaque
+/// and glass), resident and streamed, on both chips.
+#[test]
+fn object_tests_in_parts_trace_the_same_rays() {
+    use firmware::tracer::TestCuts;
+    let parts = firmware::scene::native::parse(
+        "[camera]\nfrom = [4.0, -6.0, 3.0]\nat = [0.0, 0.0, 0.5]\nup = [0.0, 0.0, 1.0]\n\
+         angle = 45.0\nresolution = [32, 32]\n\
+         [[light]]\nposition = [5.0, -3.0, 8.0]\n[[light]]\nposition = [-4.0, -5.0, 6.0]\n\
+         [material.m]\ncolor = [0.8, 0.5, 0.3]\nkd = 0.6\nks = 0.4\nshine = 20\n\
+         [[object]]\ntype = \"cone\"\nmaterial = \"m\"\nbase = [-1.5, 0.0, 0.0]\n\
+         base_radius = 0.6\napex = [-1.5, 0.3, 1.8]\napex_radius = 0.2\ncaps = true\n\
+         [[object]]\ntype = \"cone\"\nmaterial = \"m\"\nbase = [1.5, 1.0, 0.0]\n\
+         base_radius = 0.5\napex = [1.2, 1.0, 1.5]\napex_radius = 0.1\n\
+         [[object]]\ntype = \"cylinder\"\nmaterial = \"m\"\nbase = [0.0, 1.5, 0.0]\n\
+         apex = [0.5, 1.5, 1.2]\nradius = 0.3\n\
+         [[object]]\ntype = \"polygon\"\nmaterial = \"m\"\n\
+         vertices = [[-3.0, -3.0, -0.2], [3.0, -3.0, -0.2], [3.0, 3.0, -0.2], [0.0, 1.0, -0.2], [-3.0, 3.0, -0.2]]\n\
+         [[object]]\ntype = \"sphere\"\nmaterial = \"m\"\ncenter = [0.5, -0.5, 0.6]\nradius = 0.6\n",
+        "parts.toml",
+    )
+    .unwrap();
+    let glass = firmware::scene::nff::parse(
+        "v\nfrom 0 0 8\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 32 32\n\
+         b 0.1 0.2 0.3\nl 4 5 9\nl -5 3 6\n\
+         f 1 1 1 0.1 0.1 30 0.9 1.5\np 5\n-2 -2 1\n2 -2 1\n2 1 1\n0 2 1\n-2 1 1\n\
+         f 0.8 0.4 0.2 0.6 0.4 10 0 0\ns 0 0 -1 1\ns 1 -1 -0.5 0.4\n\
+         f 0.3 0.8 0.3 0.7 0.3 20 0 0\np 4\n-4 -3 -3\n4 -3 -3\n4 3 -3\n-4 3 -3\n",
+        "glass.nff",
+    )
+    .unwrap();
+    let (default, rings, torus) = (
+        load("default.toml"),
+        load("rings-1.nff"),
+        load("torus-pp.nff"),
+    );
+    let w16 = rtl::rc::Datapath::W16;
+    let cases = [
+        ("default", &default, false, w16),
+        ("default", &default, true, rtl::rc::Datapath::W32),
+        ("cones, caps, polygon", &parts, false, w16),
+        ("cones, caps, polygon", &parts, true, w16),
+        ("glass polygon", &glass, false, w16),
+        ("rings-1", &rings, true, w16),
+        ("torus-pp", &torus, false, w16),
+    ];
+    for (name, scene, streamed, datapath) in cases {
+        let render = |test_cuts| {
+            let mut o = Options {
+                datapath,
+                depth: 3,
+                test_cuts,
+                ..opts(32, 32, Traversal::Packet)
+            };
+            o.bsp.rule = firmware::bsp::SplitRule::Sah;
+            let s = RenderSettings {
+                streamed,
+                ..Default::default()
+            };
+            render_chip(scene, &o, &s).unwrap()
+        };
+        let (on, off) = (render(TestCuts::On), render(TestCuts::Off));
+        let what = format!(
+            "{name}, {}, {datapath}",
+            if streamed { "streamed" } else { "resident" }
+        );
+        assert!(on.firmware.layout.test_cuts && !off.firmware.layout.test_cuts);
+        eprintln!(
+            "{what}: {} cycles in parts, {} whole",
+            on.cycles, off.cycles
+        );
+        assert!(on.rgb8 == off.rgb8, "{what}: the image changed");
+        assert!(on.hits == off.hits, "{what}: the hits changed");
+        assert_eq!(on.ray_census(), off.ray_census(), "{what}");
+        assert!(
+            on.cycles < off.cycles,
+            "{what}: {} in parts, {} whole",
+            on.cycles,
+            off.cycles
+        );
+    }
+}

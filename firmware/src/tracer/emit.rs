@@ -124,6 +124,16 @@ pub struct K {
     /// Contexts (lines that are not comments).
     len: usize,
     doc: Vec<String>,
+    /// The kernel's cuts ([`K::cut`]): name and the FB words read before it.
+    cuts: Vec<(String, usize)>,
+}
+
+/// The marker line of a cut, replaced by its label in [`K::text`].
+const CUT_MARK: &str = "\u{0}cut ";
+
+/// The label of cut `name` of kernel `label` ([`K::cut`]).
+pub fn cut_label(label: &str, name: &str) -> String {
+    format!("{label}_cut_{name}")
 }
 
 impl K {
@@ -169,6 +179,22 @@ impl K {
         self.len += n as usize * inner.len;
         self
     }
+    /// A cut: where TinyRISC may end the kernel's run early, ask the
+    /// array (`rcany`) whether any awake RC still has F, and run the rest
+    /// only if one does. The contexts after a cut may only narrow F (every
+    /// compare predicated on it) and write nothing but temporaries where F
+    /// is clear, so that stopping there leaves the same state where it
+    /// matters. [`K::text`] labels it `{label}_cut_{name}` and defines
+    /// `{label}_cut_{name}_fb`, the FB words of the stream read before it.
+    pub fn cut(&mut self, name: &str) -> &mut Self {
+        self.lines.push(format!("{CUT_MARK}{name}"));
+        self.cuts.push((name.to_string(), self.fb_reads));
+        self
+    }
+    /// The names of the kernel's cuts, in order.
+    pub fn cuts(&self) -> impl Iterator<Item = &str> {
+        self.cuts.iter().map(|c| c.0.as_str())
+    }
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
@@ -178,6 +204,9 @@ impl K {
     }
     /// Append another kernel's contexts.
     pub fn extend(&mut self, other: K) -> &mut Self {
+        let at = self.fb_reads;
+        self.cuts
+            .extend(other.cuts.into_iter().map(|(n, f)| (n, at + f)));
         self.fb_reads += other.fb_reads;
         self.len += other.len;
         self.lines.extend(other.lines);
@@ -196,9 +225,27 @@ impl K {
         }
         let _ = writeln!(s, "{label}:");
         for l in &self.lines {
-            let _ = writeln!(s, "{l}");
+            match l.strip_prefix(CUT_MARK) {
+                Some(name) => {
+                    let _ = writeln!(s, "{}:", cut_label(label, name));
+                }
+                None => {
+                    let _ = writeln!(s, "{l}");
+                }
+            }
         }
         let _ = writeln!(s, "{label}_end:");
+        for (name, fb) in &self.cuts {
+            let c = cut_label(label, name);
+            let _ = writeln!(
+                s,
+                "{}",
+                with_note(
+                    format!("{c}_fb = {fb}"),
+                    "FB words of the stream read before the cut"
+                )
+            );
+        }
         s
     }
 }

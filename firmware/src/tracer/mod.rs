@@ -78,6 +78,9 @@ pub struct Options {
     /// Packet traversal: the shadow rays of the reflection levels traced
     /// a packet per light, or merged into full packets.
     pub shadows: ShadowPackets,
+    /// Packet traversal: object tests run in parts, the rest skipped
+    /// where no awake ray can still hit the object, or whole.
+    pub test_cuts: TestCuts,
 }
 
 impl Default for Options {
@@ -98,6 +101,38 @@ impl Default for Options {
             collapse: Collapse::Auto,
             pieces: LeafPieces::default(),
             shadows: ShadowPackets::default(),
+            test_cuts: TestCuts::default(),
+        }
+    }
+}
+
+/// Packet traversal: whether an object test runs in parts at its kernels'
+/// cuts ([`primitives::CutTest`]), the rest skipped where no awake ray can
+/// still hit the object (`on`, the default), or whole (`off`). The same
+/// image either way.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum TestCuts {
+    #[default]
+    On,
+    Off,
+}
+
+impl std::fmt::Display for TestCuts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            TestCuts::On => "on",
+            TestCuts::Off => "off",
+        })
+    }
+}
+
+impl std::str::FromStr for TestCuts {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "on" => Ok(TestCuts::On),
+            "off" => Ok(TestCuts::Off),
+            _ => Err(format!("test cuts '{s}': expected on or off")),
         }
     }
 }

@@ -216,12 +216,17 @@ fn header(
         opt.bsp.max_leaf,
         if opt.traversal == Traversal::Packet {
             format!(
-                ", collapse {}{}",
+                ", collapse {}{}{}",
                 opt.collapse,
                 if merged {
                     ", merged shadow packets"
                 } else {
                     ""
+                },
+                if lay.test_cuts {
+                    ""
+                } else {
+                    ", whole object tests"
                 }
             )
         } else {

@@ -88,6 +88,31 @@ pub fn macros(lay: &FbImage) -> Code {
                 .sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
         }),
     );
+    if lay.traversal == super::Traversal::Packet {
+        t.define_macro(
+            "BCAST_UPTO",
+            "k, cut, ra, field",
+            "BCAST_UPTO k, cut, ra, field: broadcast kernel k's contexts up to its cut `cut`,\n\
+             with the FB words from `field` of the record at ra as their stream. Clobbers r1, r2.",
+            body(&|b| {
+                b.li(R1, "(\\k - CTXBASE) / 4")
+                    .line("addi r2, \\ra, \\field")
+                    .sbcb(R1, R2, "(\\cut - \\k) / 4");
+            }),
+        );
+        t.define_macro(
+            "BCAST_FROM",
+            "cut, end, ra, field",
+            "BCAST_FROM cut, end, ra, field: broadcast a kernel's contexts from its cut `cut` up\n\
+             to label `end`, the stream going on from `field` of the record at ra past the\n\
+             words read before the cut (`cut_fb`). Clobbers r1, r2.",
+            body(&|b| {
+                b.li(R1, "(\\cut - CTXBASE) / 4")
+                    .line("addi r2, \\ra, \\field + \\cut\\()_fb")
+                    .sbcb(R1, R2, "(\\end - \\cut) / 4");
+            }),
+        );
+    }
     t.define_macro(
         "SHADOW_PASS",
         "light, shade",

@@ -52,6 +52,8 @@ pub struct TypeInfo {
     /// Polygons: edges per record (the largest polygon's non-horizontal
     /// edges in its projection).
     pub fan: usize,
+    /// Cylinders and cones: some object of the type has caps.
+    pub caps: bool,
 }
 
 /// The laid-out image and everything the generator needs to know of it.
@@ -82,6 +84,9 @@ pub struct FbImage {
     pub node_layout: NodeLayout,
     /// The traversal the nodes are laid out for.
     pub traversal: Traversal,
+    /// Packet traversal: object tests run in parts at their kernels' cuts
+    /// ([`super::TestCuts`]).
+    pub test_cuts: bool,
     /// Packet traversal: FB address of the root cell widened by
     /// [`super::traversal::packet::P_TOL`] (6 words: per axis min, max).
     pub root_box: usize,
@@ -480,6 +485,7 @@ fn build_as(
         light_shifted,
         node_layout: opt.layout,
         traversal: opt.traversal,
+        test_cuts: opt.traversal == Traversal::Packet && opt.test_cuts == super::TestCuts::On,
         root_box,
         collapse: opt.collapse,
         pieces: opt.pieces,
@@ -644,6 +650,7 @@ pub(super) struct Finish {
     light_shifted: bool,
     node_layout: NodeLayout,
     traversal: Traversal,
+    test_cuts: bool,
     root_box: usize,
     collapse: super::Collapse,
     pieces: super::LeafPieces,
@@ -680,6 +687,7 @@ impl Finish {
             node_words,
             node_layout: self.node_layout,
             traversal: self.traversal,
+            test_cuts: self.test_cuts,
             root_box: self.root_box,
             root_leaf: false,
             expected_cost: 0.0,
@@ -904,6 +912,9 @@ fn records(
             bv_words,
             mailbox: mailbox_slots,
             fan,
+            caps: objs
+                .iter()
+                .any(|&i| matches!(scene.objects[i].shape, Shape::Cone { caps: true, .. })),
         });
         bv_offset += bv_words;
         mailbox_slots += objs.len();

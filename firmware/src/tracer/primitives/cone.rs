@@ -43,7 +43,7 @@
 //! one, a nearly cylindrical one seen from inside): `t` within 3 LSB, the
 //! normal within 0.03.
 
-use super::super::emit::{at, define, Code, K, R3, R7};
+use super::super::emit::{define, Code, Reg, K, R7};
 use super::super::math::{divide_q13, normalize, sqrt_q14, Approx};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
@@ -289,15 +289,32 @@ pub fn kernel(g: &Gen, body: Body) -> K {
             ", HIT_BACK_OBJ"
         },
     ));
+    let opaque = body == Body::Opaque;
     bounding_sphere(&mut k);
+    if opaque {
+        k.cut(CUTS[0].0);
+    }
     frame(&mut k);
-    quadratic(&mut k, nr);
+    quadratic(&mut k, nr, opaque.then_some(CUTS[1].0));
     root(&mut k, g, body);
+    if opaque {
+        k.cut(CUTS[2].0);
+    }
     height(&mut k);
     normal(&mut k, nr);
     commit_obj_mat(&mut k, body);
     k
 }
+
+/// The opaque body kernel's cuts ([`K::cut`]) and what F holds at each.
+pub const CUTS: [(&str, &str); 3] = [
+    ("sphere", "the ray's line meets the bounding sphere"),
+    ("real", "and the cone's quadratic has real roots"),
+    (
+        "ahead",
+        "the root ahead, before tbest, within the bounding sphere",
+    ),
+];
 
 /// Broadcast a cone's test (record at r7): the body (both runs for a glass
 /// cone), then the caps where its flag is set. Labels begin with `lbl`.
@@ -320,12 +337,21 @@ pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides) {
             ["GCONE_CAP0", "GCONE_CAP1"]
         }
     };
-    t.lfb(R3, at("CONE_CAPS", R7)).beqz(R3, &nocap);
-    for c in caps {
-        t.m("BCAST_REC", format!("{cap}, r7, {c}"));
-    }
-    t.c("the caps");
-    t.label(nocap);
+    super::caps(t, &nocap, R7, "CONE_CAPS", cap, caps);
+}
+
+/// An opaque cone's caps (record at `rec`), where its flag is set (after
+/// its body's run in parts, [`super::run_with_cuts`]).
+pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
+    let cap = planar::kernel_name(Inside::Disc, Sides::Front);
+    super::caps(
+        t,
+        &format!("{lbl}_nocap"),
+        rec,
+        "CONE_CAPS",
+        cap,
+        ["CONE_CAP0", "CONE_CAP1"],
+    );
 }
 
 /// The bounding sphere: `b = (M - o).d` into `TMP0`, `w = ((M - o) - b d) / S`
@@ -413,8 +439,9 @@ fn frame(k: &mut K) {
 }
 
 /// The quadratic `A tau^2 + 2 B tau + C` (zoomed), times `sg`, its discriminant and
-/// `sqrt(4D)` (r8).
-fn quadratic(k: &mut K, nr: Approx) {
+/// `sqrt(4D)` (r8); with `cut`, the kernel's cut of that name before the
+/// square root.
+fn quadratic(k: &mut K, nr: Approx, cut: Option<&str>) {
     k.comment("A, -2B, 4C (zoomed: 2^e B, 2^2e C), times sg; 4D = 4B^2 - 4A C");
     k.c("mul out, r8, r8")
         .c("mac out, r9, r9")
@@ -438,6 +465,9 @@ fn quadratic(k: &mut K, nr: Approx) {
         .note("D")
         .c("(f) cmp.ge r14, #0")
         .c(format!("st r15, [#{}]", ram::TMP3));
+    if let Some(c) = cut {
+        k.cut(c);
+    }
     sqrt_q14(k, 14, 8, [9, 10, 13, 15], nr);
 }
 

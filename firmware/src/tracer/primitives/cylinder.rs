@@ -38,7 +38,7 @@
 //! 3 LSB, the normal within 0.03; fine normals beat coarse ones on a thin
 //! cylinder.
 
-use super::super::emit::{at, define, Code, K, R3, R7};
+use super::super::emit::{define, Code, Reg, K, R7};
 use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
@@ -324,6 +324,9 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .note("s = 1 - |p2/r|^2")
         .c("cmp.gt r15, #0")
         .c("(f) cmp.gt r10, #0");
+    if body == Body::Opaque {
+        k.cut(CUTS[0].0);
+    }
     sqrt_q14(&mut k, 15, 8, [9, 11, 12, 14], nr);
     k.c(format!("st r8, [#{}]", ram::TMP4));
     let er = if fine { "+EP_CYL" } else { "" };
@@ -340,6 +343,9 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("acch r11")
         .c("(f) cmp.lt r11, #0")
         .note("F: tau < tbest |d2|");
+    if body == Body::Opaque {
+        k.cut(CUTS[1].0);
+    }
     divide(&mut k, 9, 10, 9, [8, 11, 12, 13, 14], nr);
     if body != Body::Opaque {
         self_margin(&mut k, 8, g.datapath);
@@ -349,6 +355,14 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     commit_obj_mat(&mut k, body);
     k
 }
+
+/// The opaque body kernel's cuts ([`K::cut`]) and what F holds at each:
+/// some ray's line meets the infinite cylinder (`s > 0`); its root lies
+/// ahead of the ray and before `tbest`.
+pub const CUTS: [(&str, &str); 2] = [
+    ("line", "the ray's line meets the cylinder"),
+    ("ahead", "the root ahead, before tbest"),
+];
 
 /// Broadcast a cylinder's test (record at r7): the body (both runs for a
 /// glass cylinder), then the caps where its flag is set. Labels begin
@@ -371,12 +385,21 @@ pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides) {
             ["GCYL_CAP0", "GCYL_CAP1"]
         }
     };
-    t.lfb(R3, at("CYL_CAPS", R7)).beqz(R3, &nocap);
-    for c in caps {
-        t.m("BCAST_REC", format!("{cap}, r7, {c}"));
-    }
-    t.c("the caps");
-    t.label(nocap);
+    super::caps(t, &nocap, R7, "CYL_CAPS", cap, caps);
+}
+
+/// An opaque cylinder's caps (record at `rec`), where its flag is set
+/// (after its body's run in parts, [`super::run_with_cuts`]).
+pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
+    let cap = planar::kernel_name(Inside::Disc, Sides::Front);
+    super::caps(
+        t,
+        &format!("{lbl}_nocap"),
+        rec,
+        "CYL_CAPS",
+        cap,
+        ["CYL_CAP0", "CYL_CAP1"],
+    );
 }
 
 /// After the division (`t` in r9, F the hit so far): the hit's axial

@@ -32,7 +32,7 @@ pub mod sphere;
 
 use rtl::rc::Datapath;
 
-use super::emit::{define, Code, K};
+use super::emit::{define, Code, Reg, K, R3};
 use super::math::Approx;
 use super::memory_map::ram;
 use crate::scene::{PrimType, Shape};
@@ -268,6 +268,160 @@ impl ChipType {
             ChipType::Polygon | ChipType::GlassPolygon => polygon::broadcast(t, at, s),
         }
     }
+}
+
+/// A test whose first kernel has cuts ([`super::emit::K::cut`]): the
+/// packet traversal runs it in parts ([`run_with_cuts`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CutTest {
+    /// The kernel.
+    pub kernel: &'static str,
+    /// The record field its stream starts at.
+    pub field: &'static str,
+    /// Its cuts, in order: name, and what F holds there.
+    pub cuts: &'static [(&'static str, &'static str)],
+    /// What F holds at its end, where the test goes on with further
+    /// kernels that run only if some awake RC has F then (a polygon's
+    /// edges and tail).
+    pub then: Option<&'static str>,
+}
+
+impl ChipType {
+    /// The test that runs in parts, for the types that have one (opaque
+    /// spheres and cylinders: most of their tests miss, and the miss is
+    /// known early in the kernel).
+    pub fn cut_test(self) -> Option<CutTest> {
+        match self {
+            ChipType::Sphere => Some(CutTest {
+                kernel: sphere::kernel_name(Sides::Front),
+                field: "0",
+                cuts: &sphere::CUTS,
+                then: None,
+            }),
+            ChipType::Cylinder => Some(CutTest {
+                kernel: "k_cylinder",
+                field: "CYL_BODY",
+                cuts: &cylinder::CUTS,
+                then: None,
+            }),
+            ChipType::Cone => Some(CutTest {
+                kernel: "k_cone",
+                field: "CONE_BODY",
+                cuts: &cone::CUTS,
+                then: None,
+            }),
+            ChipType::Rectangle | ChipType::Triangle => Some(CutTest {
+                kernel: planar::kernel_name(planar_inside(self), Sides::Front),
+                field: "0",
+                cuts: &planar::CUTS,
+                then: None,
+            }),
+            ChipType::SmoothTriangle => Some(CutTest {
+                kernel: smooth_triangle::kernel_name(Sides::Front),
+                field: "0",
+                cuts: &planar::CUTS,
+                then: None,
+            }),
+            ChipType::Polygon | ChipType::GlassPolygon => Some(CutTest {
+                kernel: polygon::head_name(self.sides()),
+                field: "POLY_HEAD",
+                cuts: &[],
+                then: Some("the plane hit before tbest"),
+            }),
+            _ => None,
+        }
+    }
+
+    /// What a cut test's object runs after its first kernel, its record
+    /// at `rec`, labels beginning with `at`: where some awake RC has F
+    /// ([`CutTest::then`]), a polygon's edges and tail.
+    fn broadcast_then(self, t: &mut Code, at: &str, rec: Reg) {
+        if matches!(self, ChipType::Polygon | ChipType::GlassPolygon) {
+            polygon::broadcast_edges(t, at, self.sides(), rec);
+        }
+    }
+
+    /// What a cut test's object runs after its first kernel whatever F (a
+    /// cylinder's or cone's caps, where the scene has some: `caps`), its
+    /// record at `rec`; labels begin with `at`.
+    pub fn broadcast_after_cut_test(self, t: &mut Code, at: &str, rec: Reg, caps: bool) {
+        if !caps {
+            return;
+        }
+        match self {
+            ChipType::Cylinder => cylinder::broadcast_caps(t, at, rec),
+            ChipType::Cone => cone::broadcast_caps(t, at, rec),
+            _ => {}
+        }
+    }
+}
+
+/// A cylinder's or cone's caps, two disc records from `caps` of the
+/// record at `rec`, where its flag (`flag`) is set.
+fn caps(t: &mut Code, nocap: &str, rec: Reg, flag: &str, cap: &str, caps: [&str; 2]) {
+    t.lfb(R3, super::emit::at(flag, rec)).beqz(R3, nocap);
+    for c in caps {
+        t.m("BCAST_REC", format!("{cap}, {rec}, {c}"));
+    }
+    t.c("the caps");
+    t.label(nocap);
+}
+
+fn planar_inside(t: ChipType) -> planar::Inside {
+    if matches!(t, ChipType::Triangle | ChipType::GlassTriangle) {
+        planar::Inside::Triangle
+    } else {
+        planar::Inside::Rectangle
+    }
+}
+
+/// Broadcast the test of type `ty` (its [`CutTest`] `c`) on a record in
+/// parts, at its kernel's cuts: after each part, where no awake RC has F
+/// (`rcany`), on to `done`, the rest not run (`then`: the further kernels
+/// likewise). `between` is TinyRISC's work after the first part is
+/// issued, done while it runs. The record's address is in `first` for the
+/// first part and in `rec` after `between`. Labels begin with `at`.
+/// Clobbers r1..r3.
+pub fn run_with_cuts(
+    t: &mut Code,
+    ty: ChipType,
+    c: &CutTest,
+    [first, rec]: [Reg; 2],
+    at: &str,
+    done: &str,
+    between: impl FnOnce(&mut Code),
+) {
+    let (k, field) = (c.kernel, c.field);
+    let mut between = Some(between);
+    let mut from = k.to_string();
+    let mut check = |t: &mut Code| {
+        if let Some(b) = between.take() {
+            b(t);
+        }
+        t.rcany(R3).beqz(R3, done).c("no awake ray can hit it");
+    };
+    for (name, holds) in c.cuts {
+        let cut = super::emit::cut_label(k, name);
+        if from == k {
+            t.m("BCAST_UPTO", format!("{k}, {cut}, {first}, {field}"));
+        } else {
+            t.m("BCAST_FROM", format!("{from}, {cut}, {rec}, {field}"));
+        }
+        t.c(format!("up to F: {holds}"));
+        check(t);
+        from = cut;
+    }
+    if from == k {
+        t.m("BCAST_REC", format!("{k}, {first}, {field}"));
+    } else {
+        t.m("BCAST_FROM", format!("{from}, {k}_end, {rec}, {field}"));
+    }
+    if let Some(holds) = c.then {
+        t.c(format!("F: {holds}"));
+        check(t);
+        ty.broadcast_then(t, at, rec);
+    }
+    t.label(done);
 }
 
 /// The kernels whose runs start an object test (their RCs at the first

@@ -174,12 +174,17 @@ pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize)
     w.raw(mat as i64);
 }
 
+/// The cut of the opaque triangle and rectangle kernels ([`K::cut`]) and
+/// what F holds there.
+pub const CUTS: [(&str, &str); 1] = [("plane", "the plane hit in front, before tbest")];
+
 /// The ray-plane part shared by the planar, polygon and smooth triangle
 /// kernels: reads the plane normal and a vertex from the stream, and
 /// leaves `t = num / den` in r9 with F set where the plane is hit in
 /// front (two-sided: on either side, `TMP3` = 1 on the back), closer than
-/// `tbest`.
-pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides) {
+/// `tbest`. With `cut`, the kernel has a cut ([`K::cut`]) of that name
+/// once F is known, before the division.
+pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
     k.comment("den = -n.d, num = -n.(v0 - o)");
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
@@ -209,6 +214,9 @@ pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides) {
         .c("acch r8")
         .c("(f) cmp.lt r8, #0")
         .note("F: num 2^14 < tbest den, t fits");
+    if let Some(c) = cut {
+        k.cut(c);
+    }
     divide(k, 15, 11, 9, [8, 10, 12, 13, 14], g.approx);
 }
 
@@ -283,7 +291,8 @@ pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
             ""
         },
     ));
-    plane_hit(&mut k, g, sides);
+    let cut = (sides == Sides::Front && inside != Inside::Disc).then_some(CUTS[0].0);
+    plane_hit(&mut k, g, sides, cut);
     inside_test(&mut k, inside);
     match sides {
         Sides::Front => commit_streamed_normal(&mut k, 9),

@@ -37,7 +37,7 @@
 //! **Error** against the f64 polygon (`tb/tests/kernels.rs`, a convex, a
 //! concave and a gear-like polygon): `t` within 3 LSB, no crack.
 
-use super::super::emit::{define, Code, K, R1, R2, R3, R7};
+use super::super::emit::{define, Code, Reg, K, R1, R2, R3, R7};
 use super::super::memory_map::ram;
 use super::planar::plane_hit;
 use super::{commit_streamed_normal, commit_streamed_normal_two, kaddr, klen, Gen, Sides};
@@ -68,7 +68,7 @@ pub fn header() -> Vec<String> {
     ]
 }
 
-fn head_name(s: Sides) -> &'static str {
+pub fn head_name(s: Sides) -> &'static str {
     match s {
         Sides::Front => "k_polygon_head",
         Sides::Both => "k_glass_polygon_head",
@@ -175,7 +175,7 @@ fn head(g: &Gen, sides: Sides) -> K {
             ""
         }
     ));
-    plane_hit(&mut k, g, sides);
+    plane_hit(&mut k, g, sides, None);
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
         k.c(format!("ldacc r{o}, <<Q14"))
@@ -254,12 +254,16 @@ fn tail(sides: Sides) -> K {
 /// Broadcast a polygon's test (record at r7): the head, one edge run per
 /// edge, the tail. Labels begin with `at`.
 pub fn broadcast(t: &mut Code, at: &str, sides: Sides) {
-    let (head, tail) = (head_name(sides), tail_name(sides));
-    t.m("BCAST_REC", format!("{head}, r7, POLY_HEAD"))
-        .c("the plane")
-        .lfb(R3, super::super::emit::at("POLY_EDGES", R7))
+    t.m("BCAST_REC", format!("{}, r7, POLY_HEAD", head_name(sides)))
+        .c("the plane");
+    broadcast_edges(t, at, sides, R7);
+}
+
+/// After the head (record at `rec`): one edge run per edge, the tail.
+pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
+    t.lfb(R3, super::super::emit::at("POLY_EDGES", rec))
         .c("edges")
-        .addi(R2, R7, "POLY_FAN")
+        .addi(R2, rec, "POLY_FAN")
         .li(R1, kaddr(EDGE));
     t.label(format!("{at}_fan"))
         .beqz(R3, format!("{at}_tail"))
@@ -269,6 +273,6 @@ pub fn broadcast(t: &mut Code, at: &str, sides: Sides) {
         .addi(R3, R3, -1)
         .j(format!("{at}_fan"));
     t.label(format!("{at}_tail"))
-        .m("BCAST_AT", format!("{tail}, r2"))
+        .m("BCAST_AT", format!("{}, r2", tail_name(sides)))
         .c("commit where the parity is odd");
 }

@@ -60,6 +60,9 @@ pub fn words(fit: &Fit) -> usize {
     }
 }
 
+/// The opaque kernel's cut ([`K::cut`]) and what F holds there.
+pub const CUTS: [(&str, &str); 1] = [("line", "the ray's line meets the sphere")];
+
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
         Sides::Front => "k_sphere",
@@ -177,6 +180,9 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         .note("s = 1 - |p/r|^2")
         .c("cmp.gt r15, #0")
         .note("F: the line meets the sphere");
+    if !two {
+        k.cut(CUTS[0].0);
+    }
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
     if two {
         k.c(format!("mul r9, r12, r8, >>Q14{er}"))

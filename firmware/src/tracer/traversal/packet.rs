@@ -61,10 +61,10 @@
 use super::super::emit::{
     at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
-use super::super::layout::FbImage;
+use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
-use super::super::primitives::{kaddr, klen};
+use super::super::primitives::{kaddr, klen, run_with_cuts};
 use crate::tracer::kernel_names as names;
 
 /// Widening of every split plane and of the root box in the packet
@@ -652,18 +652,16 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             let up = ti.ty.name().to_uppercase();
             t.lw(R9, at(format!("PS_COUNT_{up}"), R5))
                 .beqz(R9, format!("{n}_end"));
-            t.label(format!("{n}_obj"))
-                .lw(R8, deref(R6))
-                .addi(R6, R6, 4)
-                .beqz(R8, format!("{n}_go"))
-                .c("no mailbox");
-            mailbox_check(t, &n);
-            ti.ty.broadcast(t, &n, &lay.fit);
-            t.label(format!("{n}_next"))
-                .addi(R7, R7, format!("{up}_WORDS"))
-                .addi(R9, R9, -1)
-                .bnez(R9, format!("{n}_obj"));
-            t.label(format!("{n}_end"));
+            let fetch = |t: &mut Code, p: &str| {
+                t.lw(R8, deref(R6))
+                    .addi(R6, R6, 4)
+                    .beqz(R8, format!("{p}_go"))
+                    .c("no mailbox");
+            };
+            let advance = |t: &mut Code| {
+                t.addi(R7, R7, format!("{up}_WORDS"));
+            };
+            type_loop(t, lay, ti, &n, &fetch, &advance);
         }
         t.label("leaf_next_piece")
             .lw(R5, at("PS_NEXT", R5))
@@ -687,23 +685,76 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
                 .addi(R6, R6, 1)
                 .beqz(R9, format!("{n}_end"))
                 .c(format!("{} in the leaf", ti.ty.plural()));
-            t.label(format!("{n}_obj"))
-                .lfb(R7, at("LE_RECORD", R6))
-                .lfb(R8, at("LE_MAILBOX", R6))
-                .addi(R6, R6, "LE_WORDS")
-                .blt(R8, R0, format!("{n}_go"))
-                .c("no mailbox")
-                .slli(R8, R8, "MB_SHIFT")
-                .add(R8, R8, R12)
-                .c("r8: its mailbox");
-            mailbox_check(t, &n);
-            ti.ty.broadcast(t, &n, &lay.fit);
-            t.label(format!("{n}_next"))
-                .addi(R9, R9, -1)
-                .bnez(R9, format!("{n}_obj"));
-            t.label(format!("{n}_end"));
+            let fetch = |t: &mut Code, p: &str| {
+                t.lfb(R7, at("LE_RECORD", R6))
+                    .lfb(R8, at("LE_MAILBOX", R6))
+                    .addi(R6, R6, "LE_WORDS")
+                    .blt(R8, R0, format!("{p}_go"))
+                    .c("no mailbox")
+                    .slli(R8, R8, "MB_SHIFT")
+                    .add(R8, R8, R12)
+                    .c("r8: its mailbox");
+            };
+            type_loop(t, lay, ti, &n, &fetch, &|_| {});
         }
     }
+}
+
+/// The tests of one type's objects in a leaf (or piece): r9 objects, the
+/// list at r6. `fetch` takes the next object (its record in r7, its
+/// mailbox in r8, on to `{p}_go` when it has none); `advance` moves r7
+/// past an object, tested or not. Each object not yet tested by every
+/// awake ray is broadcast. A test that runs in parts
+/// ([`ChipType::cut_test`]) is held in r15 while its first part runs, and
+/// TinyRISC finds the next object to test meanwhile, so that a test
+/// stopped at a cut costs the array only the `rcany` and the next issue.
+fn type_loop(
+    t: &mut Code,
+    lay: &FbImage,
+    ti: &TypeInfo,
+    n: &str,
+    fetch: &dyn Fn(&mut Code, &str),
+    advance: &dyn Fn(&mut Code),
+) {
+    let (ty, caps) = (ti.ty, ti.caps);
+    let Some(cut) = ty.cut_test().filter(|_| lay.test_cuts) else {
+        t.label(format!("{n}_obj"));
+        fetch(t, n);
+        mailbox_check(t, n);
+        ty.broadcast(t, n, &lay.fit);
+        t.label(format!("{n}_next"));
+        advance(t);
+        t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
+        t.label(format!("{n}_end"));
+        return;
+    };
+    let ahead = format!("{n}_ahead");
+    t.label(format!("{n}_obj"));
+    fetch(t, n);
+    mailbox_check(t, n);
+    t.label(format!("{n}_test"));
+    run_with_cuts(t, ty, &cut, [R7, R15], n, &format!("{n}_done"), |t| {
+        t.mv(R15, R7)
+            .c("r15: the object under test")
+            .comment("while its first part runs: the next object to test (r9 = 0: none)");
+        advance(t);
+        t.addi(R9, R9, -1).beqz(R9, format!("{n}_parts"));
+        t.label(format!("{ahead}_obj"));
+        fetch(t, &ahead);
+        mailbox_check(t, &ahead);
+        t.label(format!("{n}_parts"));
+    });
+    ty.broadcast_after_cut_test(t, n, R15, caps);
+    t.bnez(R9, format!("{n}_test")).j(format!("{n}_end"));
+    t.label(format!("{ahead}_next"));
+    advance(t);
+    t.addi(R9, R9, -1)
+        .bnez(R9, format!("{ahead}_obj"))
+        .j(format!("{n}_parts"));
+    t.label(format!("{n}_next"));
+    advance(t);
+    t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
+    t.label(format!("{n}_end"));
 }
 
 /// `majority`: r8 = 1 when more awake rays have F (a negative direction
