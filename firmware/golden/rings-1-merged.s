@@ -149,6 +149,8 @@ TMP4 = 290
 CONE_TMP = 291          ; the cone kernel's temporaries, 8 words
 TMP5 = 291              ; the cylinder kernel's (CONE_TMP's words)
 TMP6 = 292
+TMP7 = 293
+TMP8 = 294
 ORIG_OBJ = 299          ; the object the rays leave (-1: none): not hit again
 STACK = 300             ; per recursion level: colour so far and reflection weight
 UNORD = 340             ; unordered subtrees entered against the ray's direction
@@ -898,7 +900,7 @@ lo_cylinder_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
 lo_cylinder_test:
-        BCAST_UPTO k_cylinder, k_cylinder_cut_line, r7, CYL_BODY ; up to F: the ray's line meets the cylinder
+        BCAST_UPTO k_cylinder, k_cylinder_cut_near, r7, CYL_BODY ; up to F: the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1)
         mv r15, r7                      ; r15: the object under test
         ; while its first part runs: the next object to test (r9 = 0: none)
         addi r9, r9, -1
@@ -912,6 +914,9 @@ lo_cylinder_ahead_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder_ahead
 lo_cylinder_parts:
+        rcany r3
+        beqz r3, lo_cylinder_done       ; no awake ray can hit it
+        BCAST_FROM k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY ; up to F: the ray's line meets the cylinder
         rcany r3
         beqz r3, lo_cylinder_done       ; no awake ray can hit it
         BCAST_FROM k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY ; up to F: the root ahead, before tbest
@@ -2232,6 +2237,21 @@ k_cylinder:
         mul out, fb0, r4
         mac out, fb0, r5
         mac r9, fb0, r6, >>Q14          ; d2 = (d.e1, d.e2)
+        ; bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1
+        mov r13, fb0
+        st r13, [#TMP7]                 ; invr
+        mov r14, fb0
+        st r14, [#TMP8]                 ; r
+        mul out, r11, r9
+        msu r10, r12, r8, >>Q14         ; oc2 x d2
+        abs r10, r10
+        abs r13, r8
+        abs r15, r9
+        add r13, r13, r15               ; |d2|_1
+        mul r13, r14, r13, >>Q14+EP_CYL
+        add r13, r13, #8
+        cmp.le r10, r13                 ; F: the line may meet it
+k_cylinder_cut_near:
         movb r10, #0
         ; normalize
         sra r8, r8, #1
@@ -2291,7 +2311,7 @@ k_cylinder:
         msu r11, r14, r8, >>Q14
         ldacc r12, <<Q14
         msu r12, r14, r9, >>Q14
-        mov r14, fb0                    ; invr
+        ld r14, [r0 + #TMP7]            ; invr
         mul r11, r11, r14, >>KS_CYL+EP_CYL
         mul r12, r12, r14, >>KS_CYL+EP_CYL
         st r11, [#TMP0]
@@ -2329,7 +2349,7 @@ k_cylinder_cut_line:
         sra r9, r9, #1
         sra r8, r8, r9
         st r8, [#TMP4]
-        mov r9, fb0
+        ld r9, [r0 + #TMP8]
         mul r9, r9, r8, >>Q14+EP_CYL    ; h = r sqrt(s)
         mov r11, fb0
         mul r9, r9, r11, >>Q14
@@ -2406,7 +2426,8 @@ k_cylinder_cut_ahead:
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
 k_cylinder_end:
-k_cylinder_cut_line_fb = 18             ; FB words of the stream read before the cut
+k_cylinder_cut_near_fb = 19             ; FB words of the stream read before the cut
+k_cylinder_cut_line_fb = 19             ; FB words of the stream read before the cut
 k_cylinder_cut_ahead_fb = 20            ; FB words of the stream read before the cut
 
 ; k_disc: the disc test of one record (the stream).

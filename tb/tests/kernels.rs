@@ -76,6 +76,42 @@ fn with_driver(fw: &Firmware, body: impl FnOnce(&mut Code)) -> asm::Image {
 /// object's material transmits (two-sided kernels). Returns per lane (t in
 /// scene LSBs or None, normal), and the LSB.
 fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(f64, Vec3)>>, f64) {
+    let (sim, fw) = run_with::<W>(shape, rays, transmit, |t, ty, fit| {
+        ty.broadcast(t, "test", fit)
+    });
+    let ty = fw.layout.types[0].ty;
+    let lsb = (-(fw.frac as f64)).exp2();
+    let max = ((W::BITS - 1) as f64).exp2() - 1.0;
+    let one = ((W::BITS - 2) as f64).exp2();
+    let rc = &sim.top.array.rc;
+    // A smooth triangle's shading normal (the face normal is in HIT_N).
+    let at = if matches!(ty, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) {
+        ram::HIT_NS.at()
+    } else {
+        ram::HIT_N.at()
+    };
+    let out = (0..64)
+        .map(|i| {
+            let t = rc.regs.read(7)[i].to_i64() as f64;
+            (t < max).then(|| {
+                let n = |k: usize| rc.ram.read(i, at + k).to_i64() as f64 / one;
+                (t, Vec3::new(n(0), n(1), n(2)))
+            })
+        })
+        .collect();
+    (out, lsb)
+}
+
+/// The chip of datapath `W` after `broadcast` (TinyRISC code, with r7 the
+/// object's record) ran on 64 rays, in a one-object scene: the generated
+/// firmware's own kernels. `transmit`: the object's material transmits
+/// (two-sided kernels).
+fn run_with<W: Word>(
+    shape: Shape,
+    rays: &[Ray; 64],
+    transmit: bool,
+    broadcast: impl FnOnce(&mut Code, ChipType, &firmware::tracer::primitives::Fit),
+) -> (Sim<Chip<W>>, Firmware) {
     let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
     if transmit {
         scene.materials[0].t = 0.8;
@@ -103,7 +139,7 @@ fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(
     let ty = lay.types[0].ty;
     let img = with_driver(&fw, |t| {
         t.li(R7, format!("FB_{}", ty.name().to_uppercase()));
-        ty.broadcast(t, "test", &lay.fit);
+        broadcast(t, ty, &lay.fit);
     });
     let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
     img.load(&mut chip).unwrap();
@@ -144,23 +180,7 @@ fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(
     let go = img.symbol("GO").unwrap() as u32;
     sim.top.mem.write(go, 4, 1);
     rtl::chip::run_to_halt(&mut sim, 10_000_000).unwrap();
-    let rc = &sim.top.array.rc;
-    // A smooth triangle's shading normal (the face normal is in HIT_N).
-    let at = if matches!(ty, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) {
-        ram::HIT_NS.at()
-    } else {
-        ram::HIT_N.at()
-    };
-    let out = (0..64)
-        .map(|i| {
-            let t = rc.regs.read(7)[i].to_i64() as f64;
-            (t < max).then(|| {
-                let n = |k: usize| rc.ram.read(i, at + k).to_i64() as f64 / one;
-                (t, Vec3::new(n(0), n(1), n(2)))
-            })
-        })
-        .collect();
-    (out, lsb)
+    (sim, fw)
 }
 
 struct PathBufExt;
@@ -422,6 +442,115 @@ fn thin_cylinder_fine_normals_beat_coarse_ones() {
         fine.mean_n < 6e-3,
         "fine mean normal error {:.2e}",
         fine.mean_n
+    );
+}
+
+/// The cylinder kernel's bound (with tests in parts, its first cut,
+/// `near`: `|oc2 x d2| <= r |d2|_1` plus a margin) keeps every ray that
+/// its exact line test (the cut `line`: `s > 0`) keeps, so stopping at the
+/// bound never drops a hit: rays whose lines pass the axis within 8% of
+/// the radius (and rays 1.5 to 3 radii away, which it should stop), a
+/// thick and a thin cylinder, fine and coarse normals, both chips.
+#[test]
+fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
+    let thin = Shape::Cone {
+        base: Vec3::new(-0.3013, 0.2071, -0.1187),
+        base_radius: 0.0371,
+        apex: Vec3::new(0.4029, 0.5237, 0.6101),
+        apex_radius: 0.0371,
+        inside: false,
+        caps: false,
+    };
+    let grazing = |shape: &Shape, seed: u64| -> [Ray; 64] {
+        let Shape::Cone {
+            base,
+            apex,
+            base_radius: r,
+            ..
+        } = *shape
+        else {
+            unreachable!()
+        };
+        let a = (apex - base).normalized();
+        let e1 = if a.x.abs() < 0.9 {
+            a.cross(Vec3::new(1.0, 0.0, 0.0))
+        } else {
+            a.cross(Vec3::new(0.0, 1.0, 0.0))
+        }
+        .normalized();
+        let e2 = a.cross(e1);
+        let size = (apex - base).length() + 2.0 * r;
+        let mut g = Lcg(seed);
+        std::array::from_fn(|i| {
+            let on_axis = base + (apex - base) * g.range(0.1, 0.9);
+            let th = g.range(0.0, std::f64::consts::TAU);
+            let e = e1 * th.cos() + e2 * th.sin();
+            // Half the lanes graze the surface, half pass well away.
+            let rho = if i % 2 == 0 {
+                g.range(0.92, 1.08)
+            } else {
+                g.range(1.5, 3.0)
+            };
+            let q = on_axis + e * (r * rho);
+            let phi = g.range(0.2, std::f64::consts::PI - 0.2);
+            let d = (a * phi.cos() + a.cross(e) * phi.sin()).normalized();
+            Ray {
+                o: q - d * (2.0 * size),
+                d,
+            }
+        })
+    };
+    let flags = |shape: &Shape, rays: &[Ray; 64], cut: &str, wide: bool| -> u64 {
+        let part = |t: &mut Code, _: ChipType, _: &firmware::tracer::primitives::Fit| {
+            t.li(R1, kaddr("k_cylinder")).addi(R2, R7, "CYL_BODY").sbcb(
+                R1,
+                R2,
+                format!("(k_cylinder_cut_{cut} - k_cylinder) / 4"),
+            );
+        };
+        if wide {
+            run_with::<i32>(shape.clone(), rays, false, part)
+                .0
+                .top
+                .array
+                .rc
+                .flags
+                .f
+        } else {
+            run_with::<i16>(shape.clone(), rays, false, part)
+                .0
+                .top
+                .array
+                .rc
+                .flags
+                .f
+        }
+    };
+    let (mut kept, mut bounded_out) = (0u32, 0u32);
+    for (fine, wide) in [(true, false), (false, false), (true, true)] {
+        FINE_NORMALS.with(|f| f.set(fine));
+        for shape in [shape_cylinder(), thin.clone()] {
+            for seed in 1..=4u64 {
+                let rays = grazing(&shape, seed);
+                let near = flags(&shape, &rays, "near", wide);
+                let line = flags(&shape, &rays, "line", wide);
+                assert_eq!(
+                    line & !near,
+                    0,
+                    "fine normals {fine}, 32-bit {wide}, seed {seed}: lanes {:#018x} meet the \
+                     cylinder but fail the bound",
+                    line & !near
+                );
+                kept += line.count_ones();
+                bounded_out += (!near).count_ones();
+            }
+        }
+    }
+    FINE_NORMALS.with(|f| f.set(true));
+    eprintln!("{kept} rays meet the cylinders' lines; the bound stops {bounded_out} rays");
+    assert!(
+        kept > 300 && bounded_out > 300,
+        "{kept} kept, {bounded_out} stopped"
     );
 }
 

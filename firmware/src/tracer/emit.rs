@@ -181,10 +181,11 @@ impl K {
     }
     /// A cut: where TinyRISC may end the kernel's run early, ask the
     /// array (`rcany`) whether any awake RC still has F, and run the rest
-    /// only if one does. The contexts after a cut may only narrow F (every
-    /// compare predicated on it) and write nothing but temporaries where F
-    /// is clear, so that stopping there leaves the same state where it
-    /// matters. [`K::text`] labels it `{label}_cut_{name}` and defines
+    /// only if one does. F at a cut must hold wherever the whole kernel's F
+    /// would at its end (the compares after it predicated on F, or an exact
+    /// test that F contains), and the contexts after it write nothing but
+    /// temporaries where F is clear, so that stopping there leaves the same
+    /// state where it matters. [`K::text`] labels it `{label}_cut_{name}` and defines
     /// `{label}_cut_{name}_fb`, the FB words of the stream read before it.
     pub fn cut(&mut self, name: &str) -> &mut Self {
         self.lines.push(format!("{CUT_MARK}{name}"));

@@ -56,10 +56,13 @@ pub mod ram {
     /// The cone kernel's frame values and zoom (8 words, temporaries of
     /// that kernel).
     pub const CONE_TMP: Name = Name::new("CONE_TMP", 291, "the cone kernel's temporaries, 8 words");
-    /// Two more temporaries of one kernel (the cylinder's), sharing the
-    /// cone kernel's words.
+    /// Four more temporaries of one kernel (the cylinder's: `TMP7`, `TMP8`
+    /// keep its `1/r` and `r` from its bound on), sharing the cone
+    /// kernel's words.
     pub const TMP5: Name = Name::new("TMP5", 291, "the cylinder kernel's (CONE_TMP's words)");
     pub const TMP6: Name = Name::new("TMP6", 292, "");
+    pub const TMP7: Name = Name::new("TMP7", 293, "");
+    pub const TMP8: Name = Name::new("TMP8", 294, "");
     /// Two-sided planar objects: the object the current rays leave (-1:
     /// none, eye rays), which they do not hit again.
     pub const ORIG_OBJ: Name = Name::new(
@@ -201,6 +204,8 @@ pub mod ram {
         CONE_TMP,
         TMP5,
         TMP6,
+        TMP7,
+        TMP8,
         ORIG_OBJ,
         STACK,
         UNORD,

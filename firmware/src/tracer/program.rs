@@ -36,6 +36,7 @@ pub fn program(
         datapath: opt.datapath,
         approx: nm.approx(),
         fine_normals: lay.fine_normals,
+        test_cuts: lay.test_cuts,
     };
     let merged = shadows::merged(opt, lay);
     let kernels = kernels(lay, opt, nm, &g, merged);

@@ -33,6 +33,8 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
         datapath: rtl::rc::Datapath::W16,
         approx: super::super::math::Approx::default(),
         fine_normals: fit.fine_normals,
+        // Whole kernels: the tree is the same with tests in parts or not.
+        test_cuts: false,
     };
     let sphere = sphere::kernel(&g, fit, Sides::Front).len();
     let disc = planar::kernel(&g, planar::Inside::Disc, Sides::Front).len();

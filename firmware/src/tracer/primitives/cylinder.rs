@@ -46,6 +46,11 @@ use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
 use crate::scene::Vec3;
 use crate::tracer::layout::{Fitter, W};
 
+/// The margin of the bound before the first cut, in LSB: the bound's
+/// rounding (under 2 LSB: `oc2` rounded, the products) and the exact
+/// test's (about 1 LSB in `p2`), with room to spare.
+const BOUND_MARGIN_LSB: i32 = 8;
+
 /// Words of the body, fine and coarse normals.
 pub const BODY_WORDS: usize = 36;
 pub const BODY_WORDS_COARSE: usize = 34;
@@ -282,6 +287,33 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("mac out, fb0, r5")
         .c("mac r9, fb0, r6, >>Q14")
         .note("d2 = (d.e1, d.e2)");
+    let bound = body == Body::Opaque && g.test_cuts;
+    let er = if fine { "+EP_CYL" } else { "" };
+    if bound {
+        // |oc2 x d2| = |p2| |d2| <= r |d2| <= r |d2|_1 where the line
+        // meets the cylinder: a cheap bound before the normalisation, with
+        // a margin for its rounding and the exact test's (a few LSB each).
+        k.comment("bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1")
+            .c("mov r13, fb0")
+            .c(format!("st r13, [#{}]", ram::TMP7))
+            .note("invr")
+            .c("mov r14, fb0")
+            .c(format!("st r14, [#{}]", ram::TMP8))
+            .note("r")
+            .c("mul out, r11, r9")
+            .c("msu r10, r12, r8, >>Q14")
+            .note("oc2 x d2")
+            .c("abs r10, r10")
+            .c("abs r13, r8")
+            .c("abs r15, r9")
+            .c("add r13, r13, r15")
+            .note("|d2|_1")
+            .c(format!("mul r13, r14, r13, >>Q14{er}"))
+            .c(format!("add r13, r13, #{BOUND_MARGIN_LSB}"))
+            .c("cmp.le r10, r13")
+            .note("F: the line may meet it");
+        k.cut(CUTS[0].0);
+    }
     k.c("movb r10, #0");
     normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
     k.c("mov r10, r11")
@@ -310,8 +342,12 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         // p2 perpendicular to the 2D direction d2n
         perpendicular_to(&mut k, &[11, 12], &[8, 9], 14);
     }
-    k.c("mov r14, fb0")
-        .note("invr")
+    if bound {
+        k.c(format!("ld r14, [r0 + #{}]", ram::TMP7));
+    } else {
+        k.c("mov r14, fb0");
+    }
+    k.note("invr")
         .c("mul r11, r11, r14, >>KS_CYL+EP_CYL")
         .c("mul r12, r12, r14, >>KS_CYL+EP_CYL")
         .c(format!("st r11, [#{}]", ram::TMP0))
@@ -325,13 +361,16 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("cmp.gt r15, #0")
         .c("(f) cmp.gt r10, #0");
     if body == Body::Opaque {
-        k.cut(CUTS[0].0);
+        k.cut(CUTS[1].0);
     }
     sqrt_q14(&mut k, 15, 8, [9, 11, 12, 14], nr);
     k.c(format!("st r8, [#{}]", ram::TMP4));
-    let er = if fine { "+EP_CYL" } else { "" };
-    k.c("mov r9, fb0")
-        .c(format!("mul r9, r9, r8, >>Q14{er}"))
+    if bound {
+        k.c(format!("ld r9, [r0 + #{}]", ram::TMP8));
+    } else {
+        k.c("mov r9, fb0");
+    }
+    k.c(format!("mul r9, r9, r8, >>Q14{er}"))
         .note("h = r sqrt(s)")
         .c("mov r11, fb0")
         .c("mul r9, r9, r11, >>Q14")
@@ -344,7 +383,7 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("(f) cmp.lt r11, #0")
         .note("F: tau < tbest |d2|");
     if body == Body::Opaque {
-        k.cut(CUTS[1].0);
+        k.cut(CUTS[2].0);
     }
     divide(&mut k, 9, 10, 9, [8, 11, 12, 13, 14], nr);
     if body != Body::Opaque {
@@ -356,10 +395,15 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     k
 }
 
-/// The opaque body kernel's cuts ([`K::cut`]) and what F holds at each:
-/// some ray's line meets the infinite cylinder (`s > 0`); its root lies
-/// ahead of the ray and before `tbest`.
-pub const CUTS: [(&str, &str); 2] = [
+/// The opaque body kernel's cuts ([`K::cut`], with [`Gen::test_cuts`])
+/// and what F holds at each: a bound says the ray's line may meet the
+/// infinite cylinder; it does (`s > 0`); its root lies ahead of the ray and
+/// before `tbest`.
+pub const CUTS: [(&str, &str); 3] = [
+    (
+        "near",
+        "the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1)",
+    ),
     ("line", "the ray's line meets the cylinder"),
     ("ahead", "the root ahead, before tbest"),
 ];

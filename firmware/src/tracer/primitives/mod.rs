@@ -453,6 +453,7 @@ pub fn all_test_kernels() -> Vec<&'static str> {
         datapath: Datapath::W16,
         approx: crate::tracer::math::Approx::default(),
         fine_normals: true,
+        test_cuts: true,
     };
     let mut v: Vec<&'static str> = Vec::new();
     for t in ChipType::ALL {
@@ -497,6 +498,9 @@ pub struct Gen {
     pub approx: Approx,
     /// Fine normals ([`super::Normals`], resolved for the datapath).
     pub fine_normals: bool,
+    /// The kernels run in parts ([`super::TestCuts`]): the cylinder's
+    /// starts with a cheap bound and a cut after it.
+    pub test_cuts: bool,
 }
 
 /// The scale shifts and record variants fitted to the scene (the layout
@@ -760,6 +764,7 @@ mod tests {
                         datapath: dp,
                         approx: Approx::default(),
                         fine_normals,
+                        test_cuts: fine_normals,
                     };
                     let fit = Fit {
                         sphere_fine,
