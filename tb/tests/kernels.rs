@@ -406,6 +406,19 @@ fn cylinder_kernel_vs_float_cone() {
     measure("cylinder", shape_cylinder(), 18.0, 0.025);
 }
 
+/// A thin cylinder, 38 LSB in radius in the test scene's format (like SPD
+/// jacks').
+fn shape_thin_cylinder() -> Shape {
+    Shape::Cone {
+        base: Vec3::new(-0.3013, 0.2071, -0.1187),
+        base_radius: 0.0371,
+        apex: Vec3::new(0.4029, 0.5237, 0.6101),
+        apex_radius: 0.0371,
+        inside: false,
+        caps: false,
+    }
+}
+
 /// A thin cylinder (38 LSB in radius, like SPD jacks') seen from 2,000 to
 /// 4,000 LSB away: the fine kernel's normals (the perpendicular vector
 /// from the unrounded axis and projections, perpendicular to the ray)
@@ -415,14 +428,7 @@ fn cylinder_kernel_vs_float_cone() {
 /// radian).
 #[test]
 fn thin_cylinder_fine_normals_beat_coarse_ones() {
-    let thin = Shape::Cone {
-        base: Vec3::new(-0.3013, 0.2071, -0.1187),
-        base_radius: 0.0371,
-        apex: Vec3::new(0.4029, 0.5237, 0.6101),
-        apex_radius: 0.0371,
-        inside: false,
-        caps: false,
-    };
+    let thin = shape_thin_cylinder();
     let fine = errors::<i16>("thin cylinder, fine", thin.clone(), false);
     FINE_NORMALS.with(|f| f.set(false));
     let coarse = errors::<i16>("thin cylinder, coarse", thin, false);
@@ -453,14 +459,7 @@ fn thin_cylinder_fine_normals_beat_coarse_ones() {
 /// thick and a thin cylinder, fine and coarse normals, both chips.
 #[test]
 fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
-    let thin = Shape::Cone {
-        base: Vec3::new(-0.3013, 0.2071, -0.1187),
-        base_radius: 0.0371,
-        apex: Vec3::new(0.4029, 0.5237, 0.6101),
-        apex_radius: 0.0371,
-        inside: false,
-        caps: false,
-    };
+    let thin = shape_thin_cylinder();
     let grazing = |shape: &Shape, seed: u64| -> [Ray; 64] {
         let Shape::Cone {
             base,
