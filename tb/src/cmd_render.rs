@@ -170,6 +170,66 @@ fn causes(p: &crate::profile::Profile, chip: &crate::render::ChipRender) -> crat
     p.causes(&tests, chip.simd_efficiency(), chip.stats.dma_stall_cycles)
 }
 
+/// The packet traversal's cost model ([`firmware::tracer::layout::packet_nodes`]:
+/// a node visit, a leaf's loop, TinyRISC's share of an object test)
+/// against this frame's profile; `None` where the frame does not show it
+/// (a leaf's loop: resident scenes do not count their leaves).
+#[derive(Clone, Copy, Debug)]
+struct CostCheck {
+    node_visit: Option<f64>,
+    leaf_loop: Option<f64>,
+    object_risc: Option<f64>,
+}
+
+impl CostCheck {
+    fn of(
+        p: &crate::profile::Profile,
+        causes: &crate::profile::Causes,
+        chip: &crate::render::ChipRender,
+    ) -> Option<CostCheck> {
+        use firmware::tracer::traversal::packet::cost_items as ci;
+        if chip.firmware.layout.traversal != firmware::tracer::Traversal::Packet {
+            return None;
+        }
+        let per = |c: u64, n: f64| (n > 0.0).then(|| c as f64 / n);
+        let node_len = chip
+            .firmware
+            .kernels
+            .iter()
+            .find(|(n, _)| n.starts_with(ci::NODE_KERNEL_PREFIX))
+            .map_or(0, |k| k.1);
+        let node_runs: u64 = p
+            .kernels
+            .iter()
+            .filter(|(n, _)| n.starts_with(ci::NODE_KERNEL_PREFIX))
+            .map(|x| x.1)
+            .sum();
+        let node_other: u64 = p
+            .kernels
+            .iter()
+            .filter(|(n, _)| ci::NODE_KERNELS.contains(&n.as_str()))
+            .map(|x| x.1)
+            .sum();
+        let control = |f: &dyn Fn(&str) -> bool| -> u64 {
+            p.control.iter().filter(|(n, _)| f(n)).map(|x| x.1).sum()
+        };
+        let node_control = control(&|n| ci::NODE_LABELS.contains(&n));
+        let leaf_control = control(&|n| ci::is_leaf_label(n)).saturating_sub(causes.dma_wait);
+        let leaves = chip.leaf_cache.map_or(0, |c| c.hits + c.misses);
+        Some(CostCheck {
+            node_visit: per(
+                node_runs + node_other + node_control,
+                node_runs as f64 / node_len.max(1) as f64,
+            ),
+            leaf_loop: per(leaf_control, leaves as f64),
+            object_risc: per(
+                control(&|n| ci::is_object_label(n)),
+                chip.object_tests as f64,
+            ),
+        })
+    }
+}
+
 fn profile_json(p: &crate::profile::Profile, causes: &crate::profile::Causes) -> serde_json::Value {
     let rows = |v: &[(String, u64)]| {
         v.iter()
@@ -184,7 +244,11 @@ fn profile_json(p: &crate::profile::Profile, causes: &crate::profile::Causes) ->
     })
 }
 
-fn print_profile(p: &crate::profile::Profile, causes: &crate::profile::Causes) {
+fn print_profile(
+    p: &crate::profile::Profile,
+    causes: &crate::profile::Causes,
+    check: Option<CostCheck>,
+) {
     let pct = |c: u64| 100.0 * c as f64 / p.cycles.max(1) as f64;
     let busy: u64 = p.kernels.iter().map(|x| x.1).sum();
     println!(
@@ -202,6 +266,18 @@ fn print_profile(p: &crate::profile::Profile, causes: &crate::profile::Causes) {
         ("control idle", causes.control_idle),
     ] {
         println!("  {n:<24} {c:>12} {:>9.1}%", pct(c));
+    }
+    if let Some(c) = check {
+        use firmware::tracer::layout::packet_nodes as pn;
+        println!("  cost model (chip split)     measured      model");
+        let show = |x: Option<f64>| x.map_or("-".to_string(), |x| format!("{x:.1}"));
+        for (n, m, model) in [
+            ("node visit", c.node_visit, pn::PK_NODE_COST),
+            ("leaf loop", c.leaf_loop, pn::PK_LEAF_COST),
+            ("TinyRISC per test", c.object_risc, pn::PK_OBJECT_RISC),
+        ] {
+            println!("  {n:<24} {:>12} {model:>10.1}", show(m));
+        }
     }
     println!("  array busy in kernel          cycles      share");
     for (n, c) in p.kernels.iter().take(14) {
@@ -627,7 +703,20 @@ pub fn command(a: RenderArgs) -> Result<()> {
         None => "generated".into(),
     };
     if let Some(p) = &chip.profile {
-        rep.json["profile"] = profile_json(p, &causes(p, &chip));
+        let c = causes(p, &chip);
+        rep.json["profile"] = profile_json(p, &c);
+        if let Some(check) = CostCheck::of(p, &c, &chip) {
+            rep.json["profile"]["cost_model"] = json!({
+                "node_visit": check.node_visit,
+                "leaf_loop": check.leaf_loop,
+                "object_risc": check.object_risc,
+                "model": {
+                    "node_visit": firmware::tracer::layout::packet_nodes::PK_NODE_COST,
+                    "leaf_loop": firmware::tracer::layout::packet_nodes::PK_LEAF_COST,
+                    "object_risc": firmware::tracer::layout::packet_nodes::PK_OBJECT_RISC,
+                },
+            });
+        }
     }
     if let Some(why) = chip.firmware_count_disagrees() {
         let w = firmware::scene::Warning {
@@ -809,7 +898,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
         j["array_cycles_per_host_second"].as_f64().unwrap_or(0.0)
     );
     if let Some(p) = &chip.profile {
-        print_profile(p, &causes(p, &chip));
+        let c = causes(p, &chip);
+        print_profile(p, &c, CostCheck::of(p, &c, &chip));
     }
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(j)?;

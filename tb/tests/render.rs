@@ -964,3 +964,46 @@ fn simd_efficiency_is_one_with_one_object() {
         j["dma_stall_cycles"].as_f64().unwrap() / j["cycles"].as_f64().unwrap()
     );
 }
+
+/// `render --profile` checks the packet traversal's cost model against the
+/// frame: a node visit, a leaf's loop and TinyRISC's share of an object
+/// test, measured from the chip's cycles, each within a factor of two of
+/// the constants the chip split and the collapse weigh (a firmware change
+/// that leaves the model stale fails here). A resident scene counts no
+/// leaves; the paper's traversal has no such model.
+#[test]
+fn the_profile_checks_the_cost_model_against_the_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let balls = scene_path("balls-4.nff");
+    let rings = scene_path("rings-1.nff");
+    let json = |args: &[&str]| -> serde_json::Value {
+        let mut a = vec!["render", "--size", "32x32", "--profile", "--json", "j.json"];
+        a.extend_from_slice(args);
+        let (ok, out, err) = morphosys(dir.path(), &a);
+        assert!(ok, "{err}");
+        assert!(
+            out.contains("cost model (chip split)") == (args.len() == 1),
+            "{out}"
+        );
+        serde_json::from_str(&std::fs::read_to_string(dir.path().join("j.json")).unwrap()).unwrap()
+    };
+    let j = json(&[balls.to_str().unwrap()]);
+    assert_eq!(j["fb_layout"], "streamed");
+    let c = &j["profile"]["cost_model"];
+    for item in ["node_visit", "leaf_loop", "object_risc"] {
+        let (measured, model) = (
+            c[item].as_f64().unwrap(),
+            c["model"][item].as_f64().unwrap(),
+        );
+        assert!(
+            measured > model / 2.0 && measured < model * 2.0,
+            "{item}: measured {measured}, model {model}"
+        );
+    }
+    let j = json(&[rings.to_str().unwrap()]);
+    assert_eq!(j["fb_layout"], "resident");
+    assert!(j["profile"]["cost_model"]["leaf_loop"].is_null());
+    assert!(j["profile"]["cost_model"]["node_visit"].as_f64().unwrap() > 0.0);
+    let j = json(&[rings.to_str().unwrap(), "--traversal", "paper"]);
+    assert!(j["profile"].get("cost_model").is_none());
+}

@@ -124,8 +124,9 @@ pub struct K {
     /// Contexts (lines that are not comments).
     len: usize,
     doc: Vec<String>,
-    /// The kernel's cuts ([`K::cut`]): name and the FB words read before it.
-    cuts: Vec<(String, usize)>,
+    /// The kernel's cuts ([`K::cut`]): name, the FB words read before it
+    /// and the contexts before it.
+    cuts: Vec<(String, usize, usize)>,
 }
 
 /// The marker line of a cut, replaced by its label in [`K::text`].
@@ -189,12 +190,16 @@ impl K {
     /// `{label}_cut_{name}_fb`, the FB words of the stream read before it.
     pub fn cut(&mut self, name: &str) -> &mut Self {
         self.lines.push(format!("{CUT_MARK}{name}"));
-        self.cuts.push((name.to_string(), self.fb_reads));
+        self.cuts.push((name.to_string(), self.fb_reads, self.len));
         self
     }
     /// The names of the kernel's cuts, in order.
     pub fn cuts(&self) -> impl Iterator<Item = &str> {
         self.cuts.iter().map(|c| c.0.as_str())
+    }
+    /// Contexts before the first cut (all of them without a cut).
+    pub fn first_part(&self) -> usize {
+        self.cuts.first().map_or(self.len, |c| c.2)
     }
     pub fn is_empty(&self) -> bool {
         self.len == 0
@@ -205,9 +210,9 @@ impl K {
     }
     /// Append another kernel's contexts.
     pub fn extend(&mut self, other: K) -> &mut Self {
-        let at = self.fb_reads;
+        let (at, len) = (self.fb_reads, self.len);
         self.cuts
-            .extend(other.cuts.into_iter().map(|(n, f)| (n, at + f)));
+            .extend(other.cuts.into_iter().map(|(n, f, c)| (n, at + f, len + c)));
         self.fb_reads += other.fb_reads;
         self.len += other.len;
         self.lines.extend(other.lines);
@@ -236,7 +241,7 @@ impl K {
             }
         }
         let _ = writeln!(s, "{label}_end:");
-        for (name, fb) in &self.cuts {
+        for (name, fb, _) in &self.cuts {
             let c = cut_label(label, name);
             let _ = writeln!(
                 s,

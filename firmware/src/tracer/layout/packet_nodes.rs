@@ -21,59 +21,79 @@ use crate::scene::{PrimType, Scene, Shape};
 
 /// Array cycles a packet spends on an inner node (its kernel and
 /// TinyRISC's decision), for [`super::super::Collapse::Auto`].
-const PK_NODE_COST: f64 = 60.0;
+pub const PK_NODE_COST: f64 = 60.0;
 
-/// Per scene object, the array cycles of one test: its kernels' contexts
-/// (caps and polygon edges included) and about 12 cycles of TinyRISC's
-/// loop (mailbox and issue) that the array does not always hide. The
-/// kernels as with the default numerics (the lengths the cost model was
-/// fitted with).
+/// Per scene object, the array cycles a packet's test of it costs: the
+/// contexts of its kernel up to the first cut, [`PART_ON`] of the rest
+/// (caps and polygon edges included: they run only where the plane or the
+/// line is met), and [`PK_OBJECT_RISC`] cycles of TinyRISC's loop that the
+/// array does not hide. Priced as tests in parts whether or not they run
+/// so (`--test-cuts`), so the tree is the same either way; the kernels as
+/// with the default numerics.
 pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
     let g = Gen {
         datapath: rtl::rc::Datapath::W16,
         approx: super::super::math::Approx::default(),
         fine_normals: fit.fine_normals,
-        // Whole kernels: the tree is the same with tests in parts or not.
-        test_cuts: false,
+        test_cuts: true,
     };
-    let sphere = sphere::kernel(&g, fit, Sides::Front).len();
+    // (contexts up to the first cut, contexts after it)
+    let parts = |k: &super::super::emit::K| (k.first_part(), k.len() - k.first_part());
+    let sphere = parts(&sphere::kernel(&g, fit, Sides::Front));
     let disc = planar::kernel(&g, planar::Inside::Disc, Sides::Front).len();
-    let cyl = cylinder::kernel(&g, Body::Opaque).len();
-    let cone = cone::kernel(&g, Body::Opaque).len();
-    let boxk = aabox::kernel(&g, Sides::Front).len();
-    let planar = planar::kernel(&g, planar::Inside::Triangle, Sides::Front).len();
+    let cyl = parts(&cylinder::kernel(&g, Body::Opaque));
+    let cone = parts(&cone::kernel(&g, Body::Opaque));
+    let boxk = parts(&aabox::kernel(&g, Sides::Front));
+    let planar = parts(&planar::kernel(&g, planar::Inside::Triangle, Sides::Front));
     let poly: Vec<usize> = polygon::kernels(&g, Sides::Front)
         .iter()
         .map(|(_, k)| k.len())
         .collect();
     let (ph, pe, pt) = (poly[0], poly[1], poly[2]);
+    let cost = |(first, rest): (usize, usize), more: usize| {
+        first as f64 + PART_ON * (rest + more) as f64 + PK_OBJECT_RISC
+    };
     scene
         .objects
         .iter()
-        .map(|o| {
-            let c = match &o.shape {
-                Shape::Sphere { .. } => sphere,
-                Shape::Cone { caps, .. } => {
-                    let body = if o.shape.prim_type() == PrimType::Cone {
-                        cone
-                    } else {
-                        cyl
-                    };
-                    body + if *caps { 2 * disc } else { 0 }
-                }
-                Shape::Box { .. } => boxk,
-                Shape::Rectangle { .. } | Shape::Triangle { .. } => planar,
-                Shape::Polygon { v, .. } => ph + pt + pe * polygon::edges(v, s).1.len(),
-            };
-            c as f64 + 12.0
+        .map(|o| match &o.shape {
+            Shape::Sphere { .. } => cost(sphere, 0),
+            Shape::Cone { caps, .. } => {
+                let body = if o.shape.prim_type() == PrimType::Cone {
+                    cone
+                } else {
+                    cyl
+                };
+                cost(body, if *caps { 2 * disc } else { 0 })
+            }
+            Shape::Box { .. } => cost(boxk, 0),
+            Shape::Rectangle { .. } | Shape::Triangle { .. } => cost(planar, 0),
+            Shape::Polygon { v, .. } => cost((ph, 0), pt + pe * polygon::edges(v, s).1.len()),
         })
         .collect()
 }
 
+/// The share of an object test's contexts after its first cut that a
+/// packet runs, for the cost model: `render --test-cuts on` against `off`
+/// with `--profile` on the SPD scenes at their default sizes, 128x128,
+/// runs 0.22 (cones, tree) to 0.71 (rectangles, rings) of the kernels'
+/// contexts, which is 0 to 0.46 of the contexts after the first cut
+/// (`docs/tracer.md`, "The tree it walks").
+const PART_ON: f64 = 0.3;
+
+/// TinyRISC cycles per object test that the array waits for (the mailbox
+/// check, the issues and the `rcany` of each part): 9 to 21 on the SPD
+/// scenes at 128x128 (`render --profile`, the `lo_*` rows over the
+/// object tests).
+pub const PK_OBJECT_RISC: f64 = 16.0;
+
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
-/// leaf loop (the block's check, its DMA's issue, the list's scan) and the
-/// DMA's set-up, for [`crate::bsp::SplitRule::Chip`].
-const PK_LEAF_COST: f64 = 40.0;
+/// leaf loop (the block's check, its DMA's issue, the list's scan, the
+/// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
+/// is added. 99 to 178 on the SPD scenes at 128x128 but for shells' few
+/// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
+/// less the DMA wait, over the leaves reached).
+pub const PK_LEAF_COST: f64 = 130.0;
 
 /// The costs a [`crate::bsp::SplitRule::Chip`] tree of `scene` weighs
 /// (the packet traversal's, as [`object_costs`] and [`PK_NODE_COST`]),
@@ -189,7 +209,14 @@ fn collapsed(nodes: &[Node], fin: &Finish) -> (Vec<Node>, f64) {
     // walking (a node visit, then each child with the probability that a
     // ray through the cell meets the child's, its surface area over the
     // cell's) or testing everything under it.
-    let test_all = |n: &Node| -> f64 { n.objects.iter().map(|&o| fin.cost[o as usize]).sum() };
+    let test_all = |n: &Node| -> f64 {
+        let leaf = if n.objects.is_empty() {
+            0.0
+        } else {
+            PK_LEAF_COST
+        };
+        leaf + n.objects.iter().map(|&o| fin.cost[o as usize]).sum::<f64>()
+    };
     fn expect(nodes: &[Node], k: usize, test_all: &dyn Fn(&Node) -> f64, keep: &mut [bool]) -> f64 {
         let n = &nodes[k];
         let all = test_all(n);

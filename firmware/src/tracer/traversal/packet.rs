@@ -75,6 +75,41 @@ pub const P_TOL: i32 = 4;
 /// intervals' widening assumes a relative error under 2^-14, which one
 /// step reaches from the 128-entry table (0.4% before the step, 1.5e-5
 /// after) and two from any smaller one.
+/// The packet traversal's code by the items of its cost model
+/// ([`crate::tracer::layout::packet_nodes::chip_costs`]), for `render
+/// --profile`'s check of the model against a frame: a node visit (the
+/// TinyRISC labels and kernels of a decision, a push and a pop), a leaf's
+/// loop (the labels of the leaf loop, streamed) and TinyRISC's share of
+/// an object test (the labels of the per-type loops).
+pub mod cost_items {
+    /// TinyRISC labels of a node visit.
+    pub const NODE_LABELS: &[&str] = &[
+        "inner_node",
+        "all_first",
+        "visit_first",
+        "some_first",
+        "pop_node",
+    ];
+    /// Kernels of a node visit besides the node kernels (`k_node_*`).
+    pub const NODE_KERNELS: &[&str] = &[
+        "k_pop_node",
+        "k_push_second",
+        "k_take_second",
+        "k_second_too",
+        "k_first_or_sleep",
+    ];
+    /// The prefix of the node kernels, one run per node visit.
+    pub const NODE_KERNEL_PREFIX: &str = "k_node_";
+    /// A TinyRISC label of the leaf loop (the DMA waits in it aside).
+    pub fn is_leaf_label(l: &str) -> bool {
+        l.starts_with("leaf") || (l.starts_with("lo_") && l.ends_with("_end"))
+    }
+    /// A TinyRISC label of an object test (its type's loop).
+    pub fn is_object_label(l: &str) -> bool {
+        l.starts_with("lo_") && !l.ends_with("_end")
+    }
+}
+
 fn p_newton(nr: Approx) -> u32 {
     if nr.table_entries >= 128 {
         1
