@@ -588,7 +588,8 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         // A leaf's block comes in pieces, alternately into FB bank 1 and
         // the top of bank 0 (`PS_FB`). The first piece's DMA starts at
         // once: the array is idle (a node decision or a pop came before)
-        // and the mailbox scan runs while it moves. Each further piece's
+        // and the awake rays' read, the mailbox scan and the loads the
+        // tests start from run while it moves. Each further piece's
         // DMA starts before the tests of the piece before it are issued,
         // once the array is done with the other bank (the tests of the
         // piece before that), so that it moves while those tests run. A
@@ -605,10 +606,8 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .c("an empty leaf")
             .lw(R1, at("PS_SHARED", R5))
             .lw(R2, at("PS_NEXT", R5))
-            .or(R1, R1, R2)
-            .beqz(R1, "leaf_first")
-            .c("no mailbox to check");
-        awake(t);
+            .or(R12, R1, R2)
+            .c("r12 = 0: no mailbox to check");
         t.comment("the first piece: in its slot of the leaf cache since this tile moved it there,")
             .comment("or its DMA starts");
         t.label("leaf_first")
@@ -625,7 +624,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .lw(R3, at("LEAF_HITS", R0))
             .addi(R3, R3, 1)
             .sw(R3, at("LEAF_HITS", R0))
-            .j("leaf_piece");
+            .j("leaf_awake");
         t.label("leaf_miss")
             .lw(R3, at("PS_BLOCK_WORDS", R5))
             .ldfb(R1, R2, R3)
@@ -636,6 +635,11 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .lw(R3, at("LEAF_MISSES", R0))
             .addi(R3, R3, 1)
             .sw(R3, at("LEAF_MISSES", R0));
+        t.comment("while the first piece moves: the awake rays, for the mailboxes");
+        t.label("leaf_awake")
+            .beqz(R12, "leaf_piece")
+            .c("no mailbox to check");
+        awake(t);
         t.label("leaf_piece")
             .lw(R6, at("PS_LIST", R5))
             .c("r5: a piece whose DMA has started")
@@ -644,18 +648,18 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         t.label("leaf_scan")
             .lw(R8, deref(R6))
             .addi(R6, R6, 4)
-            .beqz(R8, "leaf_load")
+            .beqz(R8, "leaf_go")
             .c("no mailbox: to be tested")
             .lw(R1, at("MB_PASS", R8))
-            .bne(R1, R11, "leaf_load")
+            .bne(R1, R11, "leaf_go")
             .lw(R2, at("MB_RAYS", R8))
             .nor(R2, R2, R0)
             .and(R2, R2, R4)
-            .bnez(R2, "leaf_load")
+            .bnez(R2, "leaf_go")
             .lw(R3, at("MB_RAYS+MASK_HI", R8))
             .nor(R3, R3, R0)
             .and(R3, R3, R10)
-            .bnez(R3, "leaf_load")
+            .bnez(R3, "leaf_go")
             .addi(R9, R9, -1)
             .bnez(R9, "leaf_scan");
         t.comment("every object of the piece tested by every awake ray");
@@ -668,25 +672,33 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         t.label("leaf_skip_next");
         next_piece_dma(t, one_slot, "the next piece's DMA starts");
         t.j("leaf_next_piece");
+        t.comment("while the piece still moves: what its tests start from");
+        let count_field = |ti: &TypeInfo| format!("PS_COUNT_{}", ti.ty.name().to_uppercase());
+        t.label("leaf_go")
+            .lw(R1, at("PS_NEXT", R5))
+            .lw(R7, at("PS_FB", R5))
+            .c("r7: the first record")
+            .lw(R6, at("PS_LIST", R5));
+        if let Some(ti) = lay.types.first() {
+            t.lw(R9, at(count_field(ti), R5));
+        }
         t.label("leaf_load")
             .dwait()
             .c("the piece is in the FB")
-            .lw(R1, at("PS_NEXT", R5))
             .beqz(R1, "leaf_tests");
         next_piece_dma(
             t,
             one_slot,
             "the next piece moves while this one's tests run",
         );
-        t.label("leaf_tests")
-            .lw(R7, at("PS_FB", R5))
-            .c("r7: the first record")
-            .lw(R6, at("PS_LIST", R5));
-        for ti in &lay.types {
+        t.label("leaf_tests");
+        for (i, ti) in lay.types.iter().enumerate() {
             let n = format!("lo_{}", ti.ty.name());
             let up = ti.ty.name().to_uppercase();
-            t.lw(R9, at(format!("PS_COUNT_{up}"), R5))
-                .beqz(R9, format!("{n}_end"));
+            if i > 0 {
+                t.lw(R9, at(count_field(ti), R5));
+            }
+            t.beqz(R9, format!("{n}_end"));
             let fetch = |t: &mut Code, p: &str| {
                 t.lw(R8, deref(R6))
                     .addi(R6, R6, 4)
