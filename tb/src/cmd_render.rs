@@ -198,7 +198,7 @@ impl CostCheck {
             .iter()
             .find(|(n, _)| n.starts_with(ci::NODE_KERNEL_PREFIX))
             .map_or(0, |k| k.1);
-        let node_runs: u64 = p
+        let node_cycles: u64 = p
             .kernels
             .iter()
             .filter(|(n, _)| n.starts_with(ci::NODE_KERNEL_PREFIX))
@@ -218,8 +218,8 @@ impl CostCheck {
         let leaves = chip.leaf_cache.map_or(0, |c| c.hits + c.misses);
         Some(CostCheck {
             node_visit: per(
-                node_runs + node_other + node_control,
-                node_runs as f64 / node_len.max(1) as f64,
+                node_cycles + node_other + node_control,
+                node_cycles as f64 / node_len.max(1) as f64,
             ),
             leaf_loop: per(leaf_control, leaves as f64),
             object_risc: per(

@@ -71,10 +71,6 @@ use crate::tracer::kernel_names as names;
 /// traversal, in LSB of the scene format.
 pub const P_TOL: i32 = 4;
 
-/// Newton-Raphson steps of the traversal's direction reciprocals: the
-/// intervals' widening assumes a relative error under 2^-14, which one
-/// step reaches from the 128-entry table (0.4% before the step, 1.5e-5
-/// after) and two from any smaller one.
 /// The packet traversal's code by the items of its cost model
 /// ([`crate::tracer::layout::packet_nodes::chip_costs`]), for `render
 /// --profile`'s check of the model against a frame: a node visit (the
@@ -110,6 +106,10 @@ pub mod cost_items {
     }
 }
 
+/// Newton-Raphson steps of the traversal's direction reciprocals: the
+/// intervals' widening assumes a relative error under 2^-14, which one
+/// step reaches from the 128-entry table (0.4% before the step, 1.5e-5
+/// after) and two from any smaller one.
 fn p_newton(nr: Approx) -> u32 {
     if nr.table_entries >= 128 {
         1
