@@ -39,7 +39,7 @@ INSIDE_TOL = 2          ; tolerance of the planar inside tests, Q.14
 ; ---- main memory (byte addresses) ----
 CTXBASE = 0x20000       ; the kernels (loaded into context memory)
 FBIMG = 0x40000         ; the FB image, loaded by the host
-FBWORDS = 612           ; its words
+FBWORDS = 489           ; its words
 TILELIST = 0x60000      ; the tile list, written by the host:
 TL_COUNT = 0            ;   the number of tiles
 TL_FIRST = 4            ;   the first tile's entry:
@@ -63,16 +63,13 @@ ROOTBOX = 289           ; the root cell widened by P_TOL: per axis min, max
 FB_SPHERE = 295         ; the sphere records
 SPHERE_WORDS = 8        ;   words of one
 FB_CYLINDER = 343       ; the cylinder records
-CYLINDER_WORDS = 77     ;   words of one
-ROOT = 574              ; the BSP root node
+CYLINDER_WORDS = 36     ;   words of one
+ROOT = 451              ; the BSP root node
 MAILBOX = 1048576       ; the mailboxes (main memory)
 NOBJ = 9                ; objects in the scene
 
 ; ---- record fields (FB words from a record's start) ----
-CYL_CAPS = 0            ; cylinder record: caps flag
-CYL_BODY = 1            ; cylinder record: the body's stream
-CYL_CAP0 = 37           ; cylinder record: base cap (a disc)
-CYL_CAP1 = 57           ; cylinder record: apex cap
+CYL_BODY = 0            ; cylinder record: the body's stream
 
 ; ---- BSP nodes ----
 PN_FLAGS = 0            ; packet node: the split axis, or bit 15 a leaf

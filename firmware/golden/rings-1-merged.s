@@ -40,7 +40,7 @@ INSIDE_TOL = 2          ; tolerance of the planar inside tests, Q.14
 ; ---- main memory (byte addresses) ----
 CTXBASE = 0x20000       ; the kernels (loaded into context memory)
 FBIMG = 0x40000         ; the FB image, loaded by the host
-FBWORDS = 3801          ; its words
+FBWORDS = 2539          ; its words
 TILELIST = 0x60000      ; the tile list, written by the host:
 TL_COUNT = 0            ;   the number of tiles
 TL_FIRST = 4            ;   the first tile's entry:
@@ -68,18 +68,15 @@ ROOTBOX = 481           ; the root cell widened by P_TOL: per axis min, max
 FB_SPHERE = 487         ; the sphere records
 SPHERE_WORDS = 8        ;   words of one
 FB_CYLINDER = 727       ; the cylinder records
-CYLINDER_WORDS = 77     ;   words of one
-FB_RECTANGLE = 3037     ; the rectangle records
+CYLINDER_WORDS = 36     ;   words of one
+FB_RECTANGLE = 1807     ; the rectangle records
 RECTANGLE_WORDS = 20    ;   words of one
-ROOT = 3057             ; the BSP root node
+ROOT = 1827             ; the BSP root node
 MAILBOX = 1048576       ; the mailboxes (main memory)
 NOBJ = 61               ; objects in the scene
 
 ; ---- record fields (FB words from a record's start) ----
-CYL_CAPS = 0            ; cylinder record: caps flag
-CYL_BODY = 1            ; cylinder record: the body's stream
-CYL_CAP0 = 37           ; cylinder record: base cap (a disc)
-CYL_CAP1 = 57           ; cylinder record: apex cap
+CYL_BODY = 0            ; cylinder record: the body's stream
 
 ; ---- BSP nodes ----
 PN_FLAGS = 0            ; packet node: the split axis, or bit 15 a leaf

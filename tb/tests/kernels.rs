@@ -14,7 +14,7 @@
 use firmware::asm;
 use firmware::scene::{Object, Scene, Shape, Vec3};
 use firmware::tracer::emit::{Code, R1, R2, R7};
-use firmware::tracer::layout::ChipType;
+use firmware::tracer::layout::{ChipType, TypeInfo};
 use firmware::tracer::memory_map::ram;
 use firmware::tracer::primitives::{kaddr, klen};
 use firmware::tracer::{self, Firmware, Options};
@@ -76,8 +76,8 @@ fn with_driver(fw: &Firmware, body: impl FnOnce(&mut Code)) -> asm::Image {
 /// object's material transmits (two-sided kernels). Returns per lane (t in
 /// scene LSBs or None, normal), and the LSB.
 fn run<W: Word>(shape: Shape, rays: &[Ray; 64], transmit: bool) -> (Vec<Option<(f64, Vec3)>>, f64) {
-    let (sim, fw) = run_with::<W>(shape, rays, transmit, |t, ty, fit| {
-        ty.broadcast(t, "test", fit)
+    let (sim, fw) = run_with::<W>(shape, rays, transmit, |t, ti, fit| {
+        ti.ty.broadcast(t, "test", fit, ti.caps)
     });
     let ty = fw.layout.types[0].ty;
     let lsb = (-(fw.frac as f64)).exp2();
@@ -110,7 +110,7 @@ fn run_with<W: Word>(
     shape: Shape,
     rays: &[Ray; 64],
     transmit: bool,
-    broadcast: impl FnOnce(&mut Code, ChipType, &firmware::tracer::primitives::Fit),
+    broadcast: impl FnOnce(&mut Code, &TypeInfo, &firmware::tracer::primitives::Fit),
 ) -> (Sim<Chip<W>>, Firmware) {
     let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
     if transmit {
@@ -139,7 +139,7 @@ fn run_with<W: Word>(
     let ty = lay.types[0].ty;
     let img = with_driver(&fw, |t| {
         t.li(R7, format!("FB_{}", ty.name().to_uppercase()));
-        broadcast(t, ty, &lay.fit);
+        broadcast(t, &lay.types[0], &lay.fit);
     });
     let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
     img.load(&mut chip).unwrap();
@@ -500,7 +500,7 @@ fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
         })
     };
     let flags = |shape: &Shape, rays: &[Ray; 64], cut: &str, wide: bool| -> u64 {
-        let part = |t: &mut Code, _: ChipType, _: &firmware::tracer::primitives::Fit| {
+        let part = |t: &mut Code, _: &TypeInfo, _: &firmware::tracer::primitives::Fit| {
             t.li(R1, kaddr("k_cylinder")).addi(R2, R7, "CYL_BODY").sbcb(
                 R1,
                 R2,

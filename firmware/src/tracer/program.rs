@@ -281,13 +281,22 @@ fn header(
             .map(|t| t.sides())
             .collect()
     };
+    // Whether a family's records carry caps (the same for its opaque and
+    // glass type).
+    let caps = |a: ChipType, b: ChipType| {
+        lay.types
+            .iter()
+            .any(|ti| (ti.ty == a || ti.ty == b) && ti.caps)
+    };
     let cyl = sides(ChipType::Cylinder, ChipType::GlassCylinder);
     if !cyl.is_empty() {
-        rec.extend(primitives::cylinder::header(&lay.fit, &cyl));
+        let c = caps(ChipType::Cylinder, ChipType::GlassCylinder);
+        rec.extend(primitives::cylinder::header(&lay.fit, &cyl, c));
     }
     let cone = sides(ChipType::Cone, ChipType::GlassCone);
     if !cone.is_empty() {
-        rec.extend(primitives::cone::header(&cone));
+        let c = caps(ChipType::Cone, ChipType::GlassCone);
+        rec.extend(primitives::cone::header(&cone, c));
     }
     if types
         .iter()

@@ -52,7 +52,8 @@ pub struct TypeInfo {
     /// Polygons: edges per record (the largest polygon's non-horizontal
     /// edges in its projection).
     pub fan: usize,
-    /// Cylinders and cones: some object of the type has caps.
+    /// Cylinders and cones: the records carry caps (a flag and two discs,
+    /// [`records_carry_caps`]).
     pub caps: bool,
 }
 
@@ -465,8 +466,18 @@ fn build_as(
     };
 
     let records_start = w.fb.len();
-    let (types, bv_offset, mailbox_slots) =
-        records(&mut w, scene, &by, &geo, &fit, fan, &mat_of, fine, &err)?;
+    let (types, bv_offset, mailbox_slots) = records(
+        &mut w,
+        scene,
+        &by,
+        &geo,
+        &fit,
+        fan,
+        &mat_of,
+        fine,
+        opt.traversal,
+        &err,
+    )?;
     let nodes = &image.bsp.nodes;
     let fin = Finish {
         frac,
@@ -821,6 +832,7 @@ fn records(
     fan: usize,
     mat_of: &[usize],
     unrounded: bool,
+    traversal: Traversal,
     err: &dyn Fn(usize, String) -> String,
 ) -> Result<(Vec<TypeInfo>, usize, usize), String> {
     let mut types = Vec::new();
@@ -831,7 +843,8 @@ fn records(
         if objs.is_empty() {
             continue;
         }
-        let size = t.record_words(fit, fan);
+        let caps = records_carry_caps(scene, t, traversal);
+        let size = t.record_words(fit, fan, caps);
         let first = w.fb.len();
         for &i in objs {
             let o = &scene.objects[i];
@@ -843,8 +856,17 @@ fn records(
                         inside, caps: on, ..
                     },
                     Geometry::Cone(fc),
-                ) => cone::write(w, fit, t.sides(), &fc.0, *inside, *on, &fc.1, i, mat)
-                    .map_err(|m| err(o.line, m))?,
+                ) => cone::write(
+                    w,
+                    fit,
+                    t.sides(),
+                    &fc.0,
+                    *inside,
+                    caps.then_some((*on, &fc.1)),
+                    i,
+                    mat,
+                )
+                .map_err(|m| err(o.line, m))?,
                 (
                     Shape::Sphere {
                         center,
@@ -862,7 +884,7 @@ fn records(
                         caps: on,
                         ..
                     },
-                    Geometry::Planars(caps),
+                    Geometry::Planars(discs),
                 ) => cylinder::write(
                     w,
                     fit,
@@ -871,8 +893,7 @@ fn records(
                     *apex,
                     *base_radius,
                     *inside,
-                    *on,
-                    &[caps[0], caps[1]],
+                    caps.then_some((*on, &[discs[0], discs[1]])),
                     i,
                     mat,
                 ),
@@ -912,15 +933,29 @@ fn records(
             bv_words,
             mailbox: mailbox_slots,
             fan,
-            caps: objs
-                .iter()
-                .any(|&i| matches!(scene.objects[i].shape, Shape::Cone { caps: true, .. })),
+            caps,
         });
         bv_offset += bv_words;
         mailbox_slots += objs.len();
     }
 
     Ok((types, bv_offset, mailbox_slots))
+}
+
+/// Whether the records of type `t` carry caps (a flag and two discs):
+/// a cylinder's or cone's under the paper's traversal always (its records
+/// as published), under the packet traversal where some cylinder (cone)
+/// of the scene, opaque or glass, has caps; other types never.
+pub(crate) fn records_carry_caps(scene: &Scene, t: ChipType, traversal: Traversal) -> bool {
+    let family = match t {
+        ChipType::Cylinder | ChipType::GlassCylinder => PrimType::Cylinder,
+        ChipType::Cone | ChipType::GlassCone => PrimType::Cone,
+        _ => return false,
+    };
+    traversal == Traversal::Paper
+        || scene.objects.iter().any(|o| {
+            matches!(o.shape, Shape::Cone { caps: true, .. }) && o.shape.prim_type() == family
+        })
 }
 
 /// The scene's objects by chip type (indexed by `ChipType as usize`, in

@@ -124,7 +124,9 @@ pub fn chip_costs(
                 _ => 0,
             };
             let transmits = scene.materials[o.material].t > 0.0;
-            ChipType::of_object(&o.shape, transmits).record_words(&fit, fan)
+            let t = ChipType::of_object(&o.shape, transmits);
+            let caps = super::records_carry_caps(scene, t, crate::tracer::Traversal::Packet);
+            t.record_words(&fit, fan, caps)
         })
         .collect();
     crate::bsp::ChipCosts {

@@ -4,7 +4,9 @@
 //! **Record**: a caps flag (`CONE_CAPS`), the body (`CONE_BODY`, 40
 //! words), the two caps as disc records (`CONE_CAP0`, `CONE_CAP1`; a cap
 //! of a pointed end never hits). A glass cone's record holds the body
-//! twice (`sg`, then `-sg`: `GCONE_INNER`) before its caps. The body:
+//! twice (`sg`, then `-sg`: `GCONE_INNER`) before its caps. Under the
+//! packet traversal, where no cone of the scene has caps, the record is
+//! the body (or bodies) alone: no flag, no discs. The body:
 //! `M.xyz, invS, ce1.xyz, ce2.xyz, a.xyz, ce1.xyz, ce2.xyz, a.xyz, s, g,
 //! sg, R, hh, -sg c, -sg s, (e1, e2, a) x, (e1, e2, a) y, (e1, e2, a) z,
 //! obj, mat`: M the middle of the axis, R (scene LSBs) at least the radius
@@ -54,14 +56,31 @@ use crate::tracer::layout::{Fitter, W};
 /// Words of the body.
 pub const BODY_WORDS: usize = 40;
 
-/// Words of a record: caps flag, body (twice for a glass cone), caps.
-pub fn words(s: Sides) -> usize {
+/// Words of a record: caps flag, body (twice for a glass cone), caps;
+/// without `caps` (records that carry none) the body alone.
+pub fn words(s: Sides, caps: bool) -> usize {
     let bodies = if s == Sides::Both { 2 } else { 1 };
-    1 + bodies * BODY_WORDS + 2 * planar::WORDS
+    if caps {
+        1 + bodies * BODY_WORDS + 2 * planar::WORDS
+    } else {
+        bodies * BODY_WORDS
+    }
 }
 
-/// The record's fields the broadcast addresses (header lines).
-pub fn header(types_sides: &[Sides]) -> Vec<String> {
+/// The record's fields the broadcast addresses (header lines); `caps`:
+/// the records carry caps.
+pub fn header(types_sides: &[Sides], caps: bool) -> Vec<String> {
+    if !caps {
+        let mut v = vec![define("CONE_BODY", 0, "cone record: the body's stream")];
+        if types_sides.contains(&Sides::Both) {
+            v.push(define(
+                "GCONE_INNER",
+                BODY_WORDS,
+                "glass cone record: the inner body",
+            ));
+        }
+        return v;
+    }
     let mut v = vec![
         define("CONE_CAPS", 0, "cone record: caps flag"),
         define("CONE_BODY", 1, "cone record: the body's stream"),
@@ -203,7 +222,8 @@ pub(crate) fn fit(fits: impl Iterator<Item = ConeFit> + Clone, f: &Fitter) -> (u
     (f.ks(s_min), f.shift(2.0 * r_max, 4))
 }
 
-/// Write the record of a cone of fit `cf` and caps `caps`; an error where
+/// Write the record of a cone of fit `cf` and caps `caps` (whether they
+/// are on, the discs; `None`: the record carries no caps); an error where
 /// the cone is too large for the kernel beside the scene's smallest cone.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn write(
@@ -212,8 +232,7 @@ pub(crate) fn write(
     sides: Sides,
     cf: &ConeFit,
     inside: bool,
-    caps_on: bool,
-    caps: &[Planar; 2],
+    caps: Option<(bool, &[Planar; 2])>,
     id: usize,
     mat: usize,
 ) -> Result<(), String> {
@@ -226,7 +245,9 @@ pub(crate) fn write(
     }
     let sg = if inside { -1.0 } else { 1.0 };
     let one = w.one();
-    w.raw(caps_on as i64);
+    if let Some((on, _)) = caps {
+        w.raw(on as i64);
+    }
     // A transmitting cone: the body twice, the second seen from the other
     // side.
     let copies: &[f64] = if sides == Sides::Both {
@@ -260,7 +281,7 @@ pub(crate) fn write(
         w.raw(id as i64);
         w.raw(mat as i64);
     }
-    for p in caps {
+    for p in caps.into_iter().flat_map(|(_, c)| c) {
         let mut p = *p;
         p.n = p.n * sg;
         planar::write(w, &fit.kt, &p, id, mat);
@@ -317,8 +338,9 @@ pub const CUTS: [(&str, &str); 3] = [
 ];
 
 /// Broadcast a cone's test (record at r7): the body (both runs for a glass
-/// cone), then the caps where its flag is set. Labels begin with `lbl`.
-pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides) {
+/// cone), then, where the records carry caps (`caps_on`), the caps where
+/// its flag is set. Labels begin with `lbl`.
+pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides, caps_on: bool) {
     let cap = planar::kernel_name(Inside::Disc, sides);
     let nocap = format!("{lbl}_nocap");
     let caps: [&str; 2] = match sides {
@@ -337,7 +359,9 @@ pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides) {
             ["GCONE_CAP0", "GCONE_CAP1"]
         }
     };
-    super::caps(t, &nocap, R7, "CONE_CAPS", cap, caps);
+    if caps_on {
+        super::caps(t, &nocap, R7, "CONE_CAPS", cap, caps);
+    }
 }
 
 /// An opaque cone's caps (record at `rec`), where its flag is set (after

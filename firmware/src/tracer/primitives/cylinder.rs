@@ -12,7 +12,9 @@
 //! 2^(14+KS_CYL) / r` of the unrounded radius). With coarse normals the
 //! body has no `b1`, `b2` (34 words), `r` is rounded to the LSB and `invr`
 //! is of that. A glass cylinder's record holds the body twice (`sg`, then
-//! `-sg`: `GCYL_INNER`) before its caps (`GCYL_CAP0`, `GCYL_CAP1`).
+//! `-sg`: `GCYL_INNER`) before its caps (`GCYL_CAP0`, `GCYL_CAP1`). Under
+//! the packet traversal, where no cylinder of the scene has caps, the
+//! record is the body (or bodies) alone: no flag, no discs.
 //!
 //! **Method**: in the plane across the axis the ray is a 2D ray: its
 //! direction `d2 = (d.e1, d.e2)` is normalised (`|d2|` kept), the 2D
@@ -64,15 +66,33 @@ pub const fn body_words(fine_normals: bool) -> usize {
     }
 }
 
-/// Words of a record: caps flag, body (twice for a glass cylinder), caps.
-pub fn words(fit: &Fit, s: Sides) -> usize {
+/// Words of a record: caps flag, body (twice for a glass cylinder), caps;
+/// without `caps` (records that carry none) the body alone.
+pub fn words(fit: &Fit, s: Sides, caps: bool) -> usize {
     let bodies = if s == Sides::Both { 2 } else { 1 };
-    1 + bodies * body_words(fit.fine_normals) + 2 * planar::WORDS
+    let b = bodies * body_words(fit.fine_normals);
+    if caps {
+        1 + b + 2 * planar::WORDS
+    } else {
+        b
+    }
 }
 
-/// The record's fields the broadcast addresses (header lines).
-pub fn header(fit: &Fit, types_sides: &[Sides]) -> Vec<String> {
+/// The record's fields the broadcast addresses (header lines); `caps`:
+/// the records carry caps.
+pub fn header(fit: &Fit, types_sides: &[Sides], caps: bool) -> Vec<String> {
     let body = body_words(fit.fine_normals);
+    if !caps {
+        let mut v = vec![define("CYL_BODY", 0, "cylinder record: the body's stream")];
+        if types_sides.contains(&Sides::Both) {
+            v.push(define(
+                "GCYL_INNER",
+                body,
+                "glass cylinder record: the inner body",
+            ));
+        }
+        return v;
+    }
     let mut v = vec![
         define("CYL_CAPS", 0, "cylinder record: caps flag"),
         define("CYL_BODY", 1, "cylinder record: the body's stream"),
@@ -158,7 +178,8 @@ pub fn caps(base: Vec3, apex: Vec3, r: f64) -> [Planar; 2] {
     ]
 }
 
-/// Write the record of a cylinder (its caps from [`caps`]).
+/// Write the record of a cylinder; `caps`: whether its caps are on and
+/// the discs (from [`caps`]), `None` where the record carries no caps.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn write(
     w: &mut W,
@@ -168,8 +189,7 @@ pub(crate) fn write(
     apex: Vec3,
     radius: f64,
     inside: bool,
-    caps_on: bool,
-    caps: &[Planar; 2],
+    caps: Option<(bool, &[Planar; 2])>,
     id: usize,
     mat: usize,
 ) {
@@ -188,7 +208,9 @@ pub(crate) fn write(
     let bq = Vec3::from(base.to_array().map(|x| w.sat(x * s) as f64));
     let brem = base * s - bq;
     let sg = if inside { -1.0 } else { 1.0 };
-    w.raw(caps_on as i64);
+    if let Some((on, _)) = caps {
+        w.raw(on as i64);
+    }
     // A transmitting cylinder: the body twice, the second seen from the
     // other side.
     let copies: &[f64] = if sides == Sides::Both {
@@ -227,7 +249,7 @@ pub(crate) fn write(
         w.raw(id as i64);
         w.raw(mat as i64);
     }
-    for p in caps {
+    for p in caps.into_iter().flat_map(|(_, c)| c) {
         let mut p = *p;
         p.n = p.n * sg;
         planar::write(w, &fit.kt, &p, id, mat);
@@ -409,9 +431,9 @@ pub const CUTS: [(&str, &str); 3] = [
 ];
 
 /// Broadcast a cylinder's test (record at r7): the body (both runs for a
-/// glass cylinder), then the caps where its flag is set. Labels begin
-/// with `lbl`.
-pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides) {
+/// glass cylinder), then, where the records carry caps (`caps_on`), the caps
+/// where its flag is set. Labels begin with `lbl`.
+pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides, caps_on: bool) {
     let cap = planar::kernel_name(Inside::Disc, sides);
     let nocap = format!("{lbl}_nocap");
     let caps: [&str; 2] = match sides {
@@ -429,7 +451,9 @@ pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides) {
             ["GCYL_CAP0", "GCYL_CAP1"]
         }
     };
-    super::caps(t, &nocap, R7, "CYL_CAPS", cap, caps);
+    if caps_on {
+        super::caps(t, &nocap, R7, "CYL_CAPS", cap, caps);
+    }
 }
 
 /// An opaque cylinder's caps (record at `rec`), where its flag is set

@@ -199,12 +199,15 @@ impl ChipType {
         }
     }
 
-    /// Words of one object's record (`fan`: the polygons' edges per record).
-    pub fn record_words(self, fit: &Fit, fan: usize) -> usize {
+    /// Words of one object's record (`fan`: the polygons' edges per record;
+    /// `caps`: a cylinder's or cone's record carries caps).
+    pub fn record_words(self, fit: &Fit, fan: usize, caps: bool) -> usize {
         match self {
             ChipType::Sphere | ChipType::GlassSphere => sphere::words(fit),
-            ChipType::Cylinder | ChipType::GlassCylinder => cylinder::words(fit, self.sides()),
-            ChipType::Cone | ChipType::GlassCone => cone::words(self.sides()),
+            ChipType::Cylinder | ChipType::GlassCylinder => {
+                cylinder::words(fit, self.sides(), caps)
+            }
+            ChipType::Cone | ChipType::GlassCone => cone::words(self.sides(), caps),
             ChipType::Box | ChipType::GlassBox => aabox::words(self.sides()),
             ChipType::Rectangle
             | ChipType::Triangle
@@ -248,8 +251,9 @@ impl ChipType {
 
     /// TinyRISC code broadcasting the test of one object of this type,
     /// whose FB record starts at the address in r7 (labels begin with
-    /// `at`; clobbers r1..r3).
-    pub fn broadcast(self, t: &mut Code, at: &str, fit: &Fit) {
+    /// `at`; clobbers r1..r3; `caps`: a cylinder's or cone's record
+    /// carries caps, whose flag is checked).
+    pub fn broadcast(self, t: &mut Code, at: &str, fit: &Fit, caps: bool) {
         let s = self.sides();
         match self {
             ChipType::Sphere | ChipType::GlassSphere => one(t, sphere::kernel_name(s)),
@@ -263,8 +267,10 @@ impl ChipType {
             ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => {
                 one(t, smooth_triangle::kernel_name(s))
             }
-            ChipType::Cylinder | ChipType::GlassCylinder => cylinder::broadcast(t, at, fit, s),
-            ChipType::Cone | ChipType::GlassCone => cone::broadcast(t, at, s),
+            ChipType::Cylinder | ChipType::GlassCylinder => {
+                cylinder::broadcast(t, at, fit, s, caps)
+            }
+            ChipType::Cone | ChipType::GlassCone => cone::broadcast(t, at, s, caps),
             ChipType::Polygon | ChipType::GlassPolygon => polygon::broadcast(t, at, s),
         }
     }
@@ -721,33 +727,6 @@ pub fn perpendicular(a: crate::scene::Vec3) -> crate::scene::Vec3 {
     a.cross(t).normalized()
 }
 
-/// The header lines of every record field the types present name.
-pub fn header(types: &[ChipType], fit: &Fit) -> Vec<String> {
-    let mut v = fit.header(types);
-    let sides = |a: ChipType, b: ChipType| -> Vec<Sides> {
-        [a, b]
-            .into_iter()
-            .filter(|t| types.contains(t))
-            .map(|t| t.sides())
-            .collect()
-    };
-    let cyl = sides(ChipType::Cylinder, ChipType::GlassCylinder);
-    if !cyl.is_empty() {
-        v.extend(cylinder::header(fit, &cyl));
-    }
-    let cone = sides(ChipType::Cone, ChipType::GlassCone);
-    if !cone.is_empty() {
-        v.extend(cone::header(&cone));
-    }
-    if types
-        .iter()
-        .any(|t| matches!(t, ChipType::Polygon | ChipType::GlassPolygon))
-    {
-        v.extend(polygon::header());
-    }
-    v
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -797,15 +776,18 @@ mod tests {
                                 polygon::TAIL_WORDS
                             ]
                         );
-                        // Caps flag (read by TinyRISC), the body runs, two caps.
+                        // Caps flag (read by TinyRISC), the body runs, two
+                        // caps; without caps, the body runs alone.
                         let cyl: usize = cylinder::kernels(&g, s)
                             .iter()
                             .map(|(_, k)| k.fb_reads)
                             .sum();
-                        assert_eq!(1 + cyl + planar::WORDS, cylinder::words(&fit, s));
+                        assert_eq!(1 + cyl + planar::WORDS, cylinder::words(&fit, s, true));
+                        assert_eq!(cyl - planar::WORDS, cylinder::words(&fit, s, false));
                         let cone: usize =
                             cone::kernels(&g, s).iter().map(|(_, k)| k.fb_reads).sum();
-                        assert_eq!(1 + cone + planar::WORDS, cone::words(s));
+                        assert_eq!(1 + cone + planar::WORDS, cone::words(s, true));
+                        assert_eq!(cone - planar::WORDS, cone::words(s, false));
                     }
                 }
             }

@@ -768,7 +768,7 @@ fn type_loop(
         t.label(format!("{n}_obj"));
         fetch(t, n);
         mailbox_check(t, n);
-        ty.broadcast(t, n, &lay.fit);
+        ty.broadcast(t, n, &lay.fit, caps);
         t.label(format!("{n}_next"));
         advance(t);
         t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));

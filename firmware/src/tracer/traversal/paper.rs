@@ -372,7 +372,7 @@ fn test_objects(t: &mut Code, lay: &FbImage, compact: bool) {
         t.lw(R1, at("TESTS", R0))
             .addi(R1, R1, 1)
             .sw(R1, at("TESTS", R0));
-        ti.ty.broadcast(t, &n, &lay.fit);
+        ti.ty.broadcast(t, &n, &lay.fit, ti.caps);
         if compact {
             t.label(format!("{n}_next"))
                 .addi(R9, R9, -1)

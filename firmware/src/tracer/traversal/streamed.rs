@@ -292,7 +292,7 @@ fn test_objects(t: &mut Code, lay: &FbImage) {
             .lw(R1, at("TESTS", R0))
             .addi(R1, R1, 1)
             .sw(R1, at("TESTS", R0));
-        ti.ty.broadcast(t, &n, &lay.fit);
+        ti.ty.broadcast(t, &n, &lay.fit, ti.caps);
         t.label(format!("{n}_next"))
             .addi(R7, R7, format!("{up}_WORDS"))
             .addi(R9, R9, -1)
