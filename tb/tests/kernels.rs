@@ -254,6 +254,18 @@ fn measure_sides<W: Word>(
     assert!(e.worst_n <= max_n, "{name}: normal error {:.5}", e.worst_n);
 }
 
+/// The ray the chip traces for `r`: its origin rounded to the LSB.
+fn traced(r: &Ray, lsb: f64) -> Ray {
+    Ray {
+        o: Vec3::new(
+            (r.o.x / lsb).round() * lsb,
+            (r.o.y / lsb).round() * lsb,
+            (r.o.z / lsb).round() * lsb,
+        ),
+        d: r.d,
+    }
+}
+
 /// A kernel's errors against the float reference over 256 rays.
 struct Errors {
     hits: usize,
@@ -298,15 +310,7 @@ fn errors<W: Word>(name: &str, shape: Shape, two_sided: bool) -> Errors {
         let (chip, lsb) = run::<W>(shape.clone(), &rs, two_sided);
         for (r, c) in rs.iter().zip(&chip) {
             // The float reference on the ray the chip actually traced.
-            let ro = Ray {
-                o: Vec3::new(
-                    (r.o.x / lsb).round() * lsb,
-                    (r.o.y / lsb).round() * lsb,
-                    (r.o.z / lsb).round() * lsb,
-                ),
-                d: r.d,
-            };
-            let f = intersect(&shape, &ro, 0.0, f64::INFINITY, two_sided);
+            let f = intersect(&shape, &traced(r, lsb), 0.0, f64::INFINITY, two_sided);
             match (f, c) {
                 (Some(f), Some((t, n))) => {
                     let e = (f.t / lsb - t).abs();
@@ -839,6 +843,70 @@ fn gear_like_concave_polygon_kernel_vs_float_polygon() {
         12.0,
         1e-3,
     );
+}
+
+/// The gear face is a banded record under the packet traversal (160
+/// edges: `polygon::BANDED_FROM`): TinyRISC runs only the sub-edges of
+/// the bands between the lowest and the highest row of a valid plane hit.
+/// Rays aimed at narrow strips of rows (inside a band, across band
+/// bounds) and at the whole face hit and miss as the f64 polygon does,
+/// and a strip's test takes fewer cycles than the whole face's: a band
+/// search that ended one band short would leave the strip's rays in that
+/// band with the wrong parity.
+#[test]
+fn banded_polygon_runs_the_bands_of_its_points() {
+    fn strip_test<W: Word>(y0: f64, y1: f64, seed: u64) -> (usize, usize, u64) {
+        let shape = shape_gear_like_concave_polygon();
+        let mut g = Lcg(seed);
+        let rays: [Ray; 64] = std::array::from_fn(|_| {
+            let target = Vec3::new(g.range(-1.05, 1.05), g.range(y0, y1), 0.0);
+            let o = target + Vec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), 2.0);
+            Ray {
+                o,
+                d: (target - o).normalized(),
+            }
+        });
+        let (sim, fw) = run_with::<W>(shape.clone(), &rays, false, |t, ti, fit| {
+            assert!(fit.polygon_bands, "the gear face is banded");
+            ti.ty.broadcast(t, "test", fit, ti.caps)
+        });
+        let lsb = (-(fw.frac as f64)).exp2();
+        let max = ((W::BITS - 1) as f64).exp2() - 1.0;
+        let (mut hits, mut disagree) = (0, 0);
+        for (i, r) in rays.iter().enumerate() {
+            let chip = (sim.top.array.rc.regs.read(7)[i].to_i64() as f64) < max;
+            let f = intersect(&shape, &traced(r, lsb), 0.0, f64::INFINITY, false).is_some();
+            hits += f as usize;
+            disagree += (f != chip) as usize;
+        }
+        (hits, disagree, sim.cycle())
+    }
+    fn on<W: Word>() {
+        let (_, _, whole) = strip_test::<W>(-1.0, 1.0, 1);
+        for (seed, (y0, y1)) in [(0.30, 0.32), (-0.13, -0.09), (0.05, 0.2), (-1.0, 1.0)]
+            .into_iter()
+            .enumerate()
+        {
+            let (hits, disagree, cycles) = strip_test::<W>(y0, y1, seed as u64 + 2);
+            eprintln!(
+                "{} gear face, rows {y0}..{y1}: {hits} hits of 64, {disagree} disagreements, {cycles} cycles (whole face {whole})",
+                W::DATAPATH
+            );
+            assert!(hits >= 16, "rows {y0}..{y1}: {hits} hits");
+            assert!(
+                disagree <= 1,
+                "rows {y0}..{y1}: {disagree} hit/miss disagreements"
+            );
+            if y1 - y0 < 0.5 {
+                assert!(
+                    cycles * 3 < whole * 2,
+                    "rows {y0}..{y1}: {cycles} cycles against the whole face's {whole}"
+                );
+            }
+        }
+    }
+    on::<i16>();
+    on::<i32>();
 }
 
 /// Every kernel on the 32-bit chip (formats with 16 more fraction bits),

@@ -302,7 +302,7 @@ fn header(
         .iter()
         .any(|t| matches!(t, ChipType::Polygon | ChipType::GlassPolygon))
     {
-        rec.extend(primitives::polygon::header());
+        rec.extend(primitives::polygon::header(lay.fit.polygon_bands));
     }
     if !rec.is_empty() {
         block(
@@ -535,6 +535,14 @@ fn data(lay: &FbImage, merged_lanes: Option<&[u32]>) -> String {
         "0: closest hit, 1: any hit (shadow rays)",
     );
     d(&mut t, "SAVE_LR", ".word 0", "trace's return address");
+    if lay.fit.polygon_bands {
+        d(
+            &mut t,
+            "BAND_SAVE",
+            ".word 0, 0, 0",
+            "r8, r12, r13 while a banded polygon's bands are found",
+        );
+    }
     d(
         &mut t,
         "AWAKE",

@@ -428,7 +428,8 @@ fn build_as(
         ));
     }
 
-    let (geo, fan, fit) = fit_scene(scene, s, frac, xb, fine_normals);
+    let packet = opt.traversal == Traversal::Packet;
+    let (geo, fan, fit) = fit_scene(scene, s, frac, xb, fine_normals, packet);
     let mut w = W {
         fb: Vec::new(),
         s,
@@ -451,7 +452,6 @@ fn build_as(
 
     // Packet traversal: the root cell widened by the traversal's tolerance
     // (the stream of its pass-start kernel), resident in either layout.
-    let packet = opt.traversal == Traversal::Packet;
     let root_box = if packet {
         let at = w.fb.len();
         let b = image.bsp.nodes[0].bounds;
@@ -719,17 +719,19 @@ impl Finish {
 
 /// The geometry every record is written from, and the kernels' scale
 /// shifts fitted to it (`xb`: the datapath's extra bits; `s`: LSBs per
-/// unit of the scene format `frac`). Also the polygons' largest fan.
+/// unit of the scene format `frac`). Also the polygons' largest fan
+/// ([`polygon_fan`]; `packet`: the packet traversal's records).
 fn fit_scene(
     scene: &Scene,
     s: f64,
     frac: u32,
     xb: u32,
     fine_normals: bool,
+    packet: bool,
 ) -> (Vec<Geometry>, usize, Fit) {
     let fitter = Fitter { x: xb };
     let mut geo: Vec<Geometry> = Vec::with_capacity(scene.objects.len());
-    let mut fan = 0usize;
+    let (fan, polygon_bands) = polygon_fan(scene, s, packet);
     for o in &scene.objects {
         geo.push(match &o.shape {
             Shape::Cone {
@@ -763,11 +765,7 @@ fn fit_scene(
                 let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
                 Geometry::Planars(vec![planar::Planar::triangle(v[0], v[1], v[2], n)])
             }
-            Shape::Polygon { v, .. } => {
-                fan = fan.max(polygon::edges(v, s).1.len());
-                Geometry::None
-            }
-            Shape::Sphere { .. } | Shape::Box { .. } => Geometry::None,
+            Shape::Polygon { .. } | Shape::Sphere { .. } | Shape::Box { .. } => Geometry::None,
         });
     }
     let mut m = [0.0f64; 3];
@@ -814,9 +812,38 @@ fn fit_scene(
         ep_cone,
         kt,
         fine_normals,
+        polygon_bands,
     };
 
     (geo, fan, fit)
+}
+
+/// The polygon records' room: the most edges of a polygon of the scene
+/// (at `s` LSB per unit), or where the records are banded (the packet
+/// traversal's, a polygon of [`polygon::BANDED_FROM`] edges or more) the
+/// most sub-edges; and whether they are banded.
+pub(crate) fn polygon_fan(scene: &Scene, s: f64, packet: bool) -> (usize, bool) {
+    let edges: Vec<Vec<[i64; 5]>> = scene
+        .objects
+        .iter()
+        .filter_map(|o| match &o.shape {
+            Shape::Polygon { v, .. } => Some(polygon::edges(v, s).1),
+            _ => None,
+        })
+        .collect();
+    let banded = packet && edges.iter().any(|e| e.len() >= polygon::BANDED_FROM);
+    let fan = edges
+        .iter()
+        .map(|e| {
+            if banded {
+                polygon::band_edges(e)
+            } else {
+                e.len()
+            }
+        })
+        .max()
+        .unwrap_or(0);
+    (fan, banded)
 }
 
 /// The object records, grouped by type in test order, with what the
@@ -898,7 +925,9 @@ fn records(
                     mat,
                 ),
                 (Shape::Box { min, max }, _) => aabox::write(w, t.sides(), *min, *max, i, mat),
-                (Shape::Polygon { v, .. }, _) => polygon::write(w, v, size, i, mat),
+                (Shape::Polygon { v, .. }, _) => {
+                    polygon::write(w, v, size, fit.polygon_bands, i, mat)
+                }
                 (
                     Shape::Triangle {
                         normals: Some(ns), ..

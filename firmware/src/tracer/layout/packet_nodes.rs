@@ -45,7 +45,7 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
     let cone = parts(&cone::kernel(&g, Body::Opaque));
     let boxk = parts(&aabox::kernel(&g, Sides::Front));
     let planar = parts(&planar::kernel(&g, planar::Inside::Triangle, Sides::Front));
-    let poly: Vec<usize> = polygon::kernels(&g, Sides::Front)
+    let poly: Vec<usize> = polygon::kernels(&g, Sides::Front, false)
         .iter()
         .map(|(_, k)| k.len())
         .collect();
@@ -107,11 +107,12 @@ pub fn chip_costs(
     frac: u32,
 ) -> crate::bsp::ChipCosts {
     use super::super::primitives::ChipType;
+    let s = (frac as f64).exp2();
     let fit = Fit {
         fine_normals,
+        polygon_bands: super::polygon_fan(scene, s, true).1,
         ..Fit::default()
     };
-    let s = (frac as f64).exp2();
     let dma = rtl::dma::DmaTiming::default();
     let word_cycles = (datapath.bits() / 8) as f64 / dma.bytes_per_cycle.max(1) as f64;
     let tests = object_costs(scene, s, &fit);
@@ -120,6 +121,9 @@ pub fn chip_costs(
         .iter()
         .map(|o| {
             let fan = match &o.shape {
+                Shape::Polygon { v, .. } if fit.polygon_bands => {
+                    polygon::band_edges(&polygon::edges(v, s).1)
+                }
                 Shape::Polygon { v, .. } => polygon::edges(v, s).1.len(),
                 _ => 0,
             };

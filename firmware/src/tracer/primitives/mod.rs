@@ -214,7 +214,7 @@ impl ChipType {
             | ChipType::GlassRectangle
             | ChipType::GlassTriangle => planar::WORDS,
             ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => smooth_triangle::WORDS,
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::words(fan),
+            ChipType::Polygon | ChipType::GlassPolygon => polygon::words(fan, fit.polygon_bands),
         }
     }
 
@@ -245,7 +245,7 @@ impl ChipType {
                     smooth_triangle::kernel(g, s),
                 )]
             }
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::kernels(g, s),
+            ChipType::Polygon | ChipType::GlassPolygon => polygon::kernels(g, s, fit.polygon_bands),
         }
     }
 
@@ -271,7 +271,9 @@ impl ChipType {
                 cylinder::broadcast(t, at, fit, s, caps)
             }
             ChipType::Cone | ChipType::GlassCone => cone::broadcast(t, at, s, caps),
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::broadcast(t, at, s),
+            ChipType::Polygon | ChipType::GlassPolygon => {
+                polygon::broadcast(t, at, s, fit.polygon_bands)
+            }
         }
     }
 }
@@ -341,9 +343,9 @@ impl ChipType {
     /// What a cut test's object runs after its first kernel, its record
     /// at `rec`, labels beginning with `at`: where some awake RC has F
     /// ([`CutTest::then`]), a polygon's edges and tail.
-    fn broadcast_then(self, t: &mut Code, at: &str, rec: Reg) {
+    fn broadcast_then(self, t: &mut Code, at: &str, rec: Reg, fit: &Fit) {
         if matches!(self, ChipType::Polygon | ChipType::GlassPolygon) {
-            polygon::broadcast_edges(t, at, self.sides(), rec);
+            polygon::broadcast_edges(t, at, self.sides(), rec, fit.polygon_bands);
         }
     }
 
@@ -386,12 +388,14 @@ fn planar_inside(t: ChipType) -> planar::Inside {
 /// (`rcany`), on to `done`, the rest not run (`then`: the further kernels
 /// likewise). `between` is TinyRISC's work after the first part is
 /// issued, done while it runs. The record's address is in `first` for the
-/// first part and in `rec` after `between`. Labels begin with `at`.
-/// Clobbers r1..r3.
+/// first part and in `rec` after `between`. Labels begin with `at`;
+/// `fit`: the records' variants. Clobbers r1..r3.
+#[allow(clippy::too_many_arguments)]
 pub fn run_with_cuts(
     t: &mut Code,
     ty: ChipType,
     c: &CutTest,
+    fit: &Fit,
     [first, rec]: [Reg; 2],
     at: &str,
     done: &str,
@@ -425,7 +429,7 @@ pub fn run_with_cuts(
     if let Some(holds) = c.then {
         t.c(format!("F: {holds}"));
         check(t);
-        ty.broadcast_then(t, at, rec);
+        ty.broadcast_then(t, at, rec, fit);
     }
     t.label(done);
 }
@@ -462,10 +466,16 @@ pub fn all_test_kernels() -> Vec<&'static str> {
         test_cuts: true,
     };
     let mut v: Vec<&'static str> = Vec::new();
-    for t in ChipType::ALL {
-        for (name, _) in t.kernels(&g, &Fit::default()) {
-            if !v.contains(&name) {
-                v.push(name);
+    for polygon_bands in [false, true] {
+        let fit = Fit {
+            polygon_bands,
+            ..Fit::default()
+        };
+        for t in ChipType::ALL {
+            for (name, _) in t.kernels(&g, &fit) {
+                if !v.contains(&name) {
+                    v.push(name);
+                }
             }
         }
     }
@@ -529,6 +539,8 @@ pub struct Fit {
     pub kt: [u32; 3],
     /// Fine normals (the cylinder record's remainders).
     pub fine_normals: bool,
+    /// Polygon records in bands ([`polygon::BANDED_FROM`]).
+    pub polygon_bands: bool,
 }
 
 impl Fit {
@@ -764,7 +776,7 @@ mod tests {
                             smooth_triangle::kernel(&g, s).fb_reads,
                             smooth_triangle::WORDS
                         );
-                        let p: Vec<usize> = polygon::kernels(&g, s)
+                        let p: Vec<usize> = polygon::kernels(&g, s, false)
                             .iter()
                             .map(|(_, k)| k.fb_reads)
                             .collect();
@@ -773,6 +785,21 @@ mod tests {
                             [
                                 polygon::HEAD_WORDS,
                                 polygon::EDGE_WORDS,
+                                polygon::TAIL_WORDS
+                            ]
+                        );
+                        // Banded: the head, a sub-edge, the probes' bound.
+                        let p: Vec<usize> = polygon::kernels(&g, s, true)
+                            .iter()
+                            .map(|(_, k)| k.fb_reads)
+                            .collect();
+                        assert_eq!(
+                            p,
+                            [
+                                polygon::HEAD_WORDS,
+                                polygon::BAND_EDGE_WORDS,
+                                1,
+                                1,
                                 polygon::TAIL_WORDS
                             ]
                         );

@@ -26,6 +26,27 @@
 //! - tail (5 words: `n.xyz, obj, mat`): commit where valid and the parity
 //!   is odd; then zeros up to the record's size.
 //!
+//! **Banded record** (the packet traversal, where the scene has a polygon
+//! of [`BANDED_FROM`] edges or more): the polygon's projected rows are cut
+//! into up to [`BANDS`] bands `[Y_b, Y_b+1)` (integer LSB, about
+//! [`EDGES_PER_BAND`] edges each), and each edge into one **sub-edge** per
+//! band its rows meet: the rows it straddles clipped to the band (`ya`,
+//! `yb`), with the edge's own line for the crossing (`xi, yi, s ey, s ex`).
+//! A point's row lies in one band, where its sub-edges straddle it exactly
+//! where the edge does, so the parity over the sub-edges of the bands that
+//! hold the packet's points is the parity over every edge: the same bit
+//! for bit. Record (`1 + 15 + 2 (BANDS + 1) + 1 + 6 fan + 5` words, `fan`
+//! the scene's most sub-edges): the band count (`POLY_NB`), the head, the
+//! band bounds `Y_0..Y_nb` (`POLY_BOUNDS`), per band the word offset of
+//! its first sub-edge from `POLY_FAN` and the end's (`POLY_STARTS`), the
+//! tail's offset in the record (`POLY_TAIL`), the sub-edges by band
+//! (`POLY_FAN`, 6 words each: `xi, ya, yb, yi, s ey, s ex`), the tail.
+//! TinyRISC finds the lowest and the highest band holding a point of an
+//! awake ray whose plane hit is valid, by bisection over the bands (a
+//! 4-context probe and an `rcany` each, `k_polygon_below` /
+//! `k_polygon_above`), and runs only the sub-edges from the one to the
+//! other (`k_polygon_band_edge`, 15 contexts).
+//!
 //! **Two-sided** (a transmitting polygon): the head's plane test on both
 //! sides and the planar kernels' two-sided commit in the tail.
 //!
@@ -37,7 +58,7 @@
 //! **Error** against the f64 polygon (`tb/tests/kernels.rs`, a convex, a
 //! concave and a gear-like polygon): `t` within 3 LSB, no crack.
 
-use super::super::emit::{define, Code, Reg, K, R1, R2, R3, R7};
+use super::super::emit::{define, Code, Reg, K, R0, R1, R2, R3, R7};
 use super::super::memory_map::ram;
 use super::planar::plane_hit;
 use super::{commit_streamed_normal, commit_streamed_normal_two, kaddr, klen, Gen, Sides};
@@ -49,13 +70,60 @@ pub const HEAD_WORDS: usize = 15;
 pub const EDGE_WORDS: usize = 5;
 pub const TAIL_WORDS: usize = 5;
 
-/// Words of a record with room for `fan` edges.
-pub fn words(fan: usize) -> usize {
-    1 + HEAD_WORDS + fan * EDGE_WORDS + TAIL_WORDS
+/// Words of a sub-edge of a banded record.
+pub const BAND_EDGE_WORDS: usize = 6;
+
+/// The most bands of a banded record.
+pub const BANDS: usize = 16;
+
+/// Records are banded (the packet traversal) where the scene has a
+/// polygon of this many edges or more.
+pub const BANDED_FROM: usize = 16;
+
+/// Edges per band aimed at.
+pub const EDGES_PER_BAND: usize = 16;
+
+/// Words of the banded record's table: the bounds, the starts, the tail's
+/// offset.
+const TABLE_WORDS: usize = 2 * (BANDS + 1) + 1;
+
+/// Words of a record with room for `fan` edges (sub-edges where
+/// `banded`).
+pub fn words(fan: usize, banded: bool) -> usize {
+    if banded {
+        1 + HEAD_WORDS + TABLE_WORDS + fan * BAND_EDGE_WORDS + TAIL_WORDS
+    } else {
+        1 + HEAD_WORDS + fan * EDGE_WORDS + TAIL_WORDS
+    }
 }
 
 /// The record's fields the broadcast addresses (header lines).
-pub fn header() -> Vec<String> {
+pub fn header(banded: bool) -> Vec<String> {
+    if banded {
+        let bounds = 1 + HEAD_WORDS;
+        let starts = bounds + BANDS + 1;
+        return vec![
+            define("POLY_NB", 0, "banded polygon record: number of bands"),
+            define("POLY_HEAD", 1, "polygon record: the head kernel's stream"),
+            define("POLY_BOUNDS", bounds, "  the bands' bounds Y_0..Y_nb"),
+            define(
+                "POLY_STARTS",
+                starts,
+                "  per band its first sub-edge (words from POLY_FAN), and the end",
+            ),
+            define("POLY_TAIL", starts + BANDS + 1, "  the tail's offset"),
+            define(
+                "POLY_FAN",
+                1 + HEAD_WORDS + TABLE_WORDS,
+                "  the first sub-edge's stream",
+            ),
+            define(
+                "POLY_BAND_EDGE_WORDS",
+                BAND_EDGE_WORDS,
+                "words of a sub-edge's stream",
+            ),
+        ];
+    }
     vec![
         define("POLY_EDGES", 0, "polygon record: number of edges (words)"),
         define("POLY_HEAD", 1, "polygon record: the head kernel's stream"),
@@ -83,14 +151,23 @@ fn tail_name(s: Sides) -> &'static str {
 }
 
 const EDGE: &str = "k_polygon_edge";
+const BAND_EDGE: &str = "k_polygon_band_edge";
+const BELOW: &str = "k_polygon_below";
+const ABOVE: &str = "k_polygon_above";
 
-/// The kernels of a polygon's test, in load order.
-pub fn kernels(g: &Gen, s: Sides) -> Vec<(&'static str, K)> {
-    vec![
-        (head_name(s), head(g, s)),
-        (EDGE, edge()),
-        (tail_name(s), tail(s)),
-    ]
+/// The kernels of a polygon's test, in load order: the head, the edge
+/// (banded records: the sub-edge and the two probes), the tail.
+pub fn kernels(g: &Gen, s: Sides, banded: bool) -> Vec<(&'static str, K)> {
+    let mut v = vec![(head_name(s), head(g, s))];
+    if banded {
+        v.push((BAND_EDGE, band_edge()));
+        v.push((BELOW, probe(false)));
+        v.push((ABOVE, probe(true)));
+    } else {
+        v.push((EDGE, edge()));
+    }
+    v.push((tail_name(s), tail(s)));
+    v
 }
 
 /// A polygon's normal, as NFF and the reference take it: from its first
@@ -134,12 +211,52 @@ pub fn edges(v: &[Vec3], s: f64) -> ((usize, usize), Vec<[i64; 5]>) {
     ((ua, va), edges)
 }
 
-/// Write the record of polygon `v` into a record of `size` words.
-pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, id: usize, mat: usize) {
+/// A polygon's bands (from its [`edges`]): the bounds `Y_0 < .. < Y_nb`
+/// of its rows (integer LSB relative to `v0`) and per band its
+/// sub-edges, `[xi, ya, yb, yi, s ey, s ex]`: the rows `[ya, yb)` the edge
+/// straddles within the band, the edge's line. Each band about
+/// [`EDGES_PER_BAND`] edges tall, at most [`BANDS`].
+pub fn bands(edges: &[[i64; 5]]) -> (Vec<i64>, Vec<Vec<[i64; 6]>>) {
+    // An edge straddles the rows [min(yi, yj), max(yi, yj)).
+    let rows = |e: &[i64; 5]| (e[1].min(e[2]), e[1].max(e[2]));
+    let lo = edges.iter().map(|e| rows(e).0).min().unwrap_or(0);
+    let hi = edges.iter().map(|e| rows(e).1).max().unwrap_or(1);
+    let nb = (edges.len() / EDGES_PER_BAND)
+        .clamp(1, BANDS)
+        .min((hi - lo).max(1) as usize) as i64;
+    let bounds: Vec<i64> = (0..=nb).map(|b| lo + (hi - lo) * b / nb).collect();
+    let sub = bounds
+        .windows(2)
+        .map(|y| {
+            edges
+                .iter()
+                .filter_map(|e| {
+                    let (a, b) = rows(e);
+                    let (ya, yb) = (a.max(y[0]), b.min(y[1]));
+                    (ya < yb).then_some([e[0], ya, yb, e[1], e[3], e[4]])
+                })
+                .collect()
+        })
+        .collect();
+    (bounds, sub)
+}
+
+/// Sub-edges of a polygon's banded record.
+pub fn band_edges(edges: &[[i64; 5]]) -> usize {
+    bands(edges).1.iter().map(Vec::len).sum()
+}
+
+/// Write the record of polygon `v` into a record of `size` words (banded
+/// where `banded`).
+pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, banded: bool, id: usize, mat: usize) {
     let start = w.fb.len();
     let n = normal(v);
     let ((ua, va), edges) = edges(v, w.s);
-    w.raw(edges.len() as i64);
+    w.raw(if banded {
+        bands(&edges).0.len() as i64 - 1
+    } else {
+        edges.len() as i64
+    });
     w.unit(n);
     w.point(v[0]);
     w.point(v[0]);
@@ -152,9 +269,29 @@ pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, id: usize, mat: usize) {
     };
     w.unit(axis(ua));
     w.unit(axis(va));
-    for e in &edges {
-        for x in e {
+    if banded {
+        let (bounds, sub) = bands(&edges);
+        let row = |w: &mut W, xs: &[i64], n: usize| {
+            for k in 0..n {
+                w.raw(*xs.get(k).unwrap_or(&0));
+            }
+        };
+        row(w, &bounds, BANDS + 1);
+        let mut at = vec![0i64];
+        for b in &sub {
+            at.push(at.last().unwrap() + (b.len() * BAND_EDGE_WORDS) as i64);
+        }
+        row(w, &at, BANDS + 1);
+        let fan = 1 + HEAD_WORDS + TABLE_WORDS;
+        w.raw(fan as i64 + at.last().unwrap());
+        for x in sub.iter().flatten().flatten() {
             w.raw(*x);
+        }
+    } else {
+        for e in &edges {
+            for x in e {
+                w.raw(*x);
+            }
         }
     }
     w.unit(n);
@@ -229,6 +366,62 @@ fn edge() -> K {
     k
 }
 
+fn band_edge() -> K {
+    let mut k = K::new();
+    k.doc(
+        "k_polygon_band_edge: one sub-edge of a banded record's crossing test (stream: xi, ya, yb,\n\
+         yi, s ey, s ex). In: r10, r11 = -px, -py, r8 parity. Out: r8 flipped where the point's\n\
+         row lies in [ya, yb) and the edge's line crosses it to the right: s ((xi - px) ey - ex (yi - py)) > 0.",
+    );
+    k.c("adds r12, fb0, r10")
+        .note("xi - px")
+        .c("adds r13, fb0, r11")
+        .note("ya - py")
+        .c("adds r14, fb0, r11")
+        .note("yb - py")
+        .c("movb r15, #0")
+        .c("cmp.gt r13, #0")
+        .c("(f) movb r15, #1")
+        .c("cmp.gt r14, #0")
+        .c("(f) xor r15, r15, #1")
+        .note("straddles the row within the band")
+        .c("adds r13, fb0, r11")
+        .note("yi - py")
+        .c("mov r14, fb0")
+        .c("mul out, r12, r14")
+        .c("msu r13, fb0, r13")
+        .c("cmp.ne r15, #0")
+        .c("(f) cmp.gt r13, #0")
+        .c("(f) xor r8, r8, #1")
+        .note("crosses to the right: flip");
+    k
+}
+
+/// A band probe (stream: a band bound Y): F where the plane hit is valid
+/// and the point's row is below Y (`above`: at or above it).
+fn probe(above: bool) -> K {
+    let mut k = K::new();
+    let (name, what) = if above {
+        (ABOVE, "py >= Y")
+    } else {
+        (BELOW, "py < Y")
+    };
+    k.doc(&format!(
+        "{name}: a band probe (stream: a band bound Y). In: TMP0 = valid, r11 = -py.\n\
+         Out: F where valid and {what} (F is free between the head and the tail)."
+    ));
+    k.c(format!("ld r12, [r0 + #{}]", ram::TMP0))
+        .c("cmp.ne r12, #0")
+        .c("adds r13, fb0, r11")
+        .note("Y - py")
+        .c(if above {
+            "(f) cmp.le r13, #0"
+        } else {
+            "(f) cmp.gt r13, #0"
+        });
+    k
+}
+
 fn tail(sides: Sides) -> K {
     let mut k = K::new();
     k.doc(&format!(
@@ -253,14 +446,20 @@ fn tail(sides: Sides) -> K {
 
 /// Broadcast a polygon's test (record at r7): the head, one edge run per
 /// edge, the tail. Labels begin with `at`.
-pub fn broadcast(t: &mut Code, at: &str, sides: Sides) {
+pub fn broadcast(t: &mut Code, at: &str, sides: Sides, banded: bool) {
     t.m("BCAST_REC", format!("{}, r7, POLY_HEAD", head_name(sides)))
         .c("the plane");
-    broadcast_edges(t, at, sides, R7);
+    broadcast_edges(t, at, sides, R7, banded);
 }
 
-/// After the head (record at `rec`): one edge run per edge, the tail.
-pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
+/// After the head (record at `rec`): one edge run per edge, the tail;
+/// a banded record's sub-edges of the bands that hold a point (clobbers
+/// r1..r3; r8, r12, r13 kept in `BAND_SAVE`).
+pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg, banded: bool) {
+    if banded {
+        broadcast_bands(t, at, sides, rec);
+        return;
+    }
     t.lfb(R3, super::super::emit::at("POLY_EDGES", rec))
         .c("edges")
         .addi(R2, rec, "POLY_FAN")
@@ -275,4 +474,86 @@ pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
     t.label(format!("{at}_tail"))
         .m("BCAST_AT", format!("{}, r2", tail_name(sides)))
         .c("commit where the parity is odd");
+}
+
+/// A banded record's sub-edges (record at `rec`): the lowest band that
+/// holds a point of an awake ray with a valid plane hit (r1), by
+/// bisection on "some such point lies below `Y_b+1`", the highest (r1
+/// again) on "some lies at or above `Y_b`", then the sub-edges between
+/// them and the tail. A point outside every band straddles no sub-edge,
+/// so whichever bands its search ends at, its parity is even there.
+fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
+    use super::super::emit::{at as field, R12, R13, R8};
+    let save = |k: usize| format!("BAND_SAVE+{}", 4 * k);
+    t.sw(R8, field(save(0), R0))
+        .sw(R12, field(save(1), R0))
+        .sw(R13, field(save(2), R0))
+        .c("r8, r12, r13 kept")
+        .lfb(R3, field("POLY_NB", rec))
+        .addi(R3, R3, -1)
+        .li(R1, 0)
+        .c("r1, r3: the bands the lowest can be");
+    t.label(format!("{at}_blo"))
+        .bge(R1, R3, format!("{at}_blo_end"))
+        .add(R8, R1, R3)
+        .srli(R8, R8, 1)
+        .add(R12, rec, R8)
+        .addi(R12, R12, "POLY_BOUNDS+1")
+        .li(R2, kaddr(BELOW))
+        .sbcb(R2, R12, klen(BELOW))
+        .c("some point below Y_mid+1?")
+        .rcany(R2)
+        .beqz(R2, format!("{at}_blo_up"))
+        .mv(R3, R8)
+        .j(format!("{at}_blo"));
+    t.label(format!("{at}_blo_up"))
+        .addi(R1, R8, 1)
+        .j(format!("{at}_blo"));
+    t.label(format!("{at}_blo_end"))
+        .add(R12, rec, R1)
+        .lfb(R13, field("POLY_STARTS", R12))
+        .c("r13: the lowest band's first sub-edge")
+        .lfb(R3, field("POLY_NB", rec))
+        .addi(R3, R3, -1)
+        .c("r1, r3: the bands the highest can be");
+    t.label(format!("{at}_bhi"))
+        .bge(R1, R3, format!("{at}_bhi_end"))
+        .add(R8, R1, R3)
+        .addi(R8, R8, 1)
+        .srli(R8, R8, 1)
+        .add(R12, rec, R8)
+        .addi(R12, R12, "POLY_BOUNDS")
+        .li(R2, kaddr(ABOVE))
+        .sbcb(R2, R12, klen(ABOVE))
+        .c("some point at or above Y_mid?")
+        .rcany(R2)
+        .beqz(R2, format!("{at}_bhi_down"))
+        .mv(R1, R8)
+        .j(format!("{at}_bhi"));
+    t.label(format!("{at}_bhi_down"))
+        .addi(R3, R8, -1)
+        .j(format!("{at}_bhi"));
+    t.label(format!("{at}_bhi_end"))
+        .add(R12, rec, R1)
+        .lfb(R3, field("POLY_STARTS+1", R12))
+        .sub(R3, R3, R13)
+        .c("r3: words of the sub-edges to run")
+        .add(R2, rec, R13)
+        .addi(R2, R2, "POLY_FAN")
+        .li(R1, kaddr(BAND_EDGE));
+    t.label(format!("{at}_fan"))
+        .beqz(R3, format!("{at}_tail"))
+        .sbcb(R1, R2, klen(BAND_EDGE))
+        .c("one sub-edge of the crossing test")
+        .addi(R2, R2, "POLY_BAND_EDGE_WORDS")
+        .addi(R3, R3, -(BAND_EDGE_WORDS as i64))
+        .j(format!("{at}_fan"));
+    t.label(format!("{at}_tail"))
+        .lfb(R2, field("POLY_TAIL", rec))
+        .add(R2, R2, rec)
+        .m("BCAST_AT", format!("{}, r2", tail_name(sides)))
+        .c("commit where the parity is odd")
+        .lw(R8, field(save(0), R0))
+        .lw(R12, field(save(1), R0))
+        .lw(R13, field(save(2), R0));
 }

@@ -780,17 +780,26 @@ fn type_loop(
     fetch(t, n);
     mailbox_check(t, n);
     t.label(format!("{n}_test"));
-    run_with_cuts(t, ty, &cut, [R7, R15], n, &format!("{n}_done"), |t| {
-        t.mv(R15, R7)
-            .c("r15: the object under test")
-            .comment("while its first part runs: the next object to test (r9 = 0: none)");
-        advance(t);
-        t.addi(R9, R9, -1).beqz(R9, format!("{n}_parts"));
-        t.label(format!("{ahead}_obj"));
-        fetch(t, &ahead);
-        mailbox_check(t, &ahead);
-        t.label(format!("{n}_parts"));
-    });
+    run_with_cuts(
+        t,
+        ty,
+        &cut,
+        &lay.fit,
+        [R7, R15],
+        n,
+        &format!("{n}_done"),
+        |t| {
+            t.mv(R15, R7)
+                .c("r15: the object under test")
+                .comment("while its first part runs: the next object to test (r9 = 0: none)");
+            advance(t);
+            t.addi(R9, R9, -1).beqz(R9, format!("{n}_parts"));
+            t.label(format!("{ahead}_obj"));
+            fetch(t, &ahead);
+            mailbox_check(t, &ahead);
+            t.label(format!("{n}_parts"));
+        },
+    );
     ty.broadcast_after_cut_test(t, n, R15, caps);
     t.bnez(R9, format!("{n}_test")).j(format!("{n}_end"));
     t.label(format!("{ahead}_next"));
