@@ -77,12 +77,12 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 /// packet runs, for the cost model: `render --test-cuts on` against `off`
 /// with `--profile` on the SPD scenes at their default sizes, 128x128,
 /// runs 0.22 (cones, tree) to 0.71 (rectangles, rings) of the kernels'
-/// contexts, which is 0 to 0.46 of the contexts after the first cut
-/// (`docs/tracer.md`, "The tree it walks").
+/// contexts, first parts included (`docs/tracer.md`, "The tree it
+/// walks").
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check, the issues and the `rcany` of each part): 9 to 21 on the SPD
+/// check, the issues and the `rcany` of each part): 9 to 22 on the SPD
 /// scenes at 128x128 (`render --profile`, the `lo_*` rows over the
 /// object tests).
 pub const PK_OBJECT_RISC: f64 = 16.0;
@@ -90,7 +90,7 @@ pub const PK_OBJECT_RISC: f64 = 16.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 99 to 176 on the SPD scenes at 128x128 but for shells' few
+/// is added. 95 to 180 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
 pub const PK_LEAF_COST: f64 = 130.0;
