@@ -849,24 +849,28 @@ fn gear_like_concave_polygon_kernel_vs_float_polygon() {
 /// edges: `polygon::BANDED_FROM`): TinyRISC runs only the sub-edges of
 /// the bands between the lowest and the highest row of a valid plane hit.
 /// Rays aimed at narrow strips of rows (inside a band, across band
-/// bounds) and at the whole face hit and miss as the f64 polygon does,
+/// bounds) and at the whole face, from one side and (a glass face) from
+/// both, hit and miss as the f64 polygon does,
 /// and a strip's test takes fewer cycles than the whole face's: a band
 /// search that ended one band short would leave the strip's rays in that
 /// band with the wrong parity.
 #[test]
 fn banded_polygon_runs_the_bands_of_its_points() {
-    fn strip_test<W: Word>(y0: f64, y1: f64, seed: u64) -> (usize, usize, u64) {
+    // `glass`: a transmitting face (two-sided kernels), half the rays from
+    // below.
+    fn strip_test<W: Word>(y0: f64, y1: f64, seed: u64, glass: bool) -> (usize, usize, u64) {
         let shape = shape_gear_like_concave_polygon();
         let mut g = Lcg(seed);
-        let rays: [Ray; 64] = std::array::from_fn(|_| {
+        let rays: [Ray; 64] = std::array::from_fn(|i| {
             let target = Vec3::new(g.range(-1.05, 1.05), g.range(y0, y1), 0.0);
-            let o = target + Vec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), 2.0);
+            let side = if glass && i % 2 == 1 { -2.0 } else { 2.0 };
+            let o = target + Vec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), side);
             Ray {
                 o,
                 d: (target - o).normalized(),
             }
         });
-        let (sim, fw) = run_with::<W>(shape.clone(), &rays, false, |t, ti, fit| {
+        let (sim, fw) = run_with::<W>(shape.clone(), &rays, glass, |t, ti, fit| {
             assert!(fit.polygon_bands, "the gear face is banded");
             ti.ty.broadcast(t, "test", fit, ti.caps)
         });
@@ -875,22 +879,23 @@ fn banded_polygon_runs_the_bands_of_its_points() {
         let (mut hits, mut disagree) = (0, 0);
         for (i, r) in rays.iter().enumerate() {
             let chip = (sim.top.array.rc.regs.read(7)[i].to_i64() as f64) < max;
-            let f = intersect(&shape, &traced(r, lsb), 0.0, f64::INFINITY, false).is_some();
+            let f = intersect(&shape, &traced(r, lsb), 0.0, f64::INFINITY, glass).is_some();
             hits += f as usize;
             disagree += (f != chip) as usize;
         }
         (hits, disagree, sim.cycle())
     }
-    fn on<W: Word>() {
-        let (_, _, whole) = strip_test::<W>(-1.0, 1.0, 1);
+    fn on<W: Word>(glass: bool) {
+        let (_, _, whole) = strip_test::<W>(-1.0, 1.0, 1, glass);
         for (seed, (y0, y1)) in [(0.30, 0.32), (-0.13, -0.09), (0.05, 0.2), (-1.0, 1.0)]
             .into_iter()
             .enumerate()
         {
-            let (hits, disagree, cycles) = strip_test::<W>(y0, y1, seed as u64 + 2);
+            let (hits, disagree, cycles) = strip_test::<W>(y0, y1, seed as u64 + 2, glass);
             eprintln!(
-                "{} gear face, rows {y0}..{y1}: {hits} hits of 64, {disagree} disagreements, {cycles} cycles (whole face {whole})",
-                W::DATAPATH
+                "{} {}gear face, rows {y0}..{y1}: {hits} hits of 64, {disagree} disagreements, {cycles} cycles (whole face {whole})",
+                W::DATAPATH,
+                if glass { "glass " } else { "" }
             );
             assert!(hits >= 16, "rows {y0}..{y1}: {hits} hits");
             assert!(
@@ -905,8 +910,10 @@ fn banded_polygon_runs_the_bands_of_its_points() {
             }
         }
     }
-    on::<i16>();
-    on::<i32>();
+    for glass in [false, true] {
+        on::<i16>(glass);
+        on::<i32>(glass);
+    }
 }
 
 /// Every kernel on the 32-bit chip (formats with 16 more fraction bits),
