@@ -676,7 +676,7 @@ lo_rectangle_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_rectangle
 lo_rectangle_test:
-        BCAST_UPTO k_rectangle, k_rectangle_cut_plane, r7, 0 ; up to F: the plane hit in front, before tbest
+        BCAST_UPTO k_rectangle, k_rectangle_cut_plane, r7, 0 ; up to F: the plane hit in front (two-sided: on either side), before tbest
         mv r15, r7                      ; r15: the object under test
         ; while its first part runs: the next object to test (r9 = 0: none)
         addi r9, r9, -1
@@ -716,7 +716,7 @@ lo_triangle_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_triangle
 lo_triangle_test:
-        BCAST_UPTO k_triangle, k_triangle_cut_plane, r7, 0 ; up to F: the plane hit in front, before tbest
+        BCAST_UPTO k_triangle, k_triangle_cut_plane, r7, 0 ; up to F: the plane hit in front (two-sided: on either side), before tbest
         mv r15, r7                      ; r15: the object under test
         ; while its first part runs: the next object to test (r9 = 0: none)
         addi r9, r9, -1

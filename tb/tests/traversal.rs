@@ -417,7 +417,8 @@ fn merged_shadow_packets_trace_the_same_rays() {
 /// is clear, so the frame is the one of whole tests, bit for bit, in fewer
 /// cycles: every type with a cut (spheres, cylinders and cones with and
 /// without caps, rectangles, triangles, smooth triangles, polygons opaque
-/// and glass), resident and streamed, on both chips.
+/// and glass, glass rectangles and triangles), resident and streamed, on
+/// both chips.
 #[test]
 fn object_tests_in_parts_trace_the_same_rays() {
     use firmware::tracer::TestCuts;
@@ -442,6 +443,7 @@ fn object_tests_in_parts_trace_the_same_rays() {
         "v\nfrom 0 0 8\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 32 32\n\
          b 0.1 0.2 0.3\nl 4 5 9\nl -5 3 6\n\
          f 1 1 1 0.1 0.1 30 0.9 1.5\np 5\n-2 -2 1\n2 -2 1\n2 1 1\n0 2 1\n-2 1 1\n\
+         p 4\n-3 -1 2\n-1 -1 2\n-1 1 2.5\n-3 1 2.5\np 3\n1 -1 2\n3 -1 2\n2 1 2.5\n\
          f 0.8 0.4 0.2 0.6 0.4 10 0 0\ns 0 0 -1 1\ns 1 -1 -0.5 0.4\n\
          f 0.3 0.8 0.3 0.7 0.3 20 0 0\np 4\n-4 -3 -3\n4 -3 -3\n4 3 -3\n-4 3 -3\n",
         "glass.nff",
@@ -458,7 +460,7 @@ fn object_tests_in_parts_trace_the_same_rays() {
         ("default", &default, true, rtl::rc::Datapath::W32),
         ("cones, caps, polygon", &parts, false, w16),
         ("cones, caps, polygon", &parts, true, w16),
-        ("glass polygon", &glass, false, w16),
+        ("glass polygon, rectangle, triangle", &glass, false, w16),
         ("rings-1", &rings, true, w16),
         ("torus-pp", &torus, false, w16),
     ];

@@ -296,8 +296,9 @@ pub struct CutTest {
 
 impl ChipType {
     /// The test that runs in parts, for the types that have one (opaque
-    /// spheres and cylinders: most of their tests miss, and the miss is
-    /// known early in the kernel).
+    /// spheres, cylinders and cones, and the planar types opaque or glass:
+    /// most of their tests miss, and the miss is known early in the
+    /// kernel; a glass polygon's head decides its edges).
     pub fn cut_test(self) -> Option<CutTest> {
         match self {
             ChipType::Sphere => Some(CutTest {
@@ -318,14 +319,17 @@ impl ChipType {
                 cuts: &cone::CUTS,
                 then: None,
             }),
-            ChipType::Rectangle | ChipType::Triangle => Some(CutTest {
-                kernel: planar::kernel_name(planar_inside(self), Sides::Front),
+            ChipType::Rectangle
+            | ChipType::Triangle
+            | ChipType::GlassRectangle
+            | ChipType::GlassTriangle => Some(CutTest {
+                kernel: planar::kernel_name(planar_inside(self), self.sides()),
                 field: "0",
                 cuts: &planar::CUTS,
                 then: None,
             }),
-            ChipType::SmoothTriangle => Some(CutTest {
-                kernel: smooth_triangle::kernel_name(Sides::Front),
+            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => Some(CutTest {
+                kernel: smooth_triangle::kernel_name(self.sides()),
                 field: "0",
                 cuts: &planar::CUTS,
                 then: None,

@@ -176,7 +176,10 @@ pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize)
 
 /// The cut of the opaque triangle and rectangle kernels ([`K::cut`]) and
 /// what F holds there.
-pub const CUTS: [(&str, &str); 1] = [("plane", "the plane hit in front, before tbest")];
+pub const CUTS: [(&str, &str); 1] = [(
+    "plane",
+    "the plane hit in front (two-sided: on either side), before tbest",
+)];
 
 /// The ray-plane part shared by the planar, polygon and smooth triangle
 /// kernels: reads the plane normal and a vertex from the stream, and
@@ -291,7 +294,7 @@ pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
             ""
         },
     ));
-    let cut = (sides == Sides::Front && inside != Inside::Disc).then_some(CUTS[0].0);
+    let cut = (inside != Inside::Disc).then_some(CUTS[0].0);
     plane_hit(&mut k, g, sides, cut);
     inside_test(&mut k, inside);
     match sides {

@@ -97,7 +97,7 @@ pub fn kernel(g: &Gen, sides: Sides) -> K {
             ""
         },
     ));
-    let cut = (sides == Sides::Front).then_some(planar::CUTS[0].0);
+    let cut = Some(planar::CUTS[0].0);
     planar::plane_hit(&mut k, g, sides, cut);
     planar::inside_test(&mut k, Inside::Triangle);
     k.comment("Ns = (1 - u - w) n0 + u n1 + w n2, normalised");
