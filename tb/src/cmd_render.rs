@@ -991,9 +991,14 @@ fn choose_datapath(
             ),
             Some(fw32),
         )),
-        _ => Ok((
+        Ok(_) => Ok((
             Datapath::W16,
             format!("auto: {m16}, {bar}, and the 32-bit chip does no better"),
+            Some(fw16),
+        )),
+        Err(e) => Ok((
+            Datapath::W16,
+            format!("auto: {m16}, {bar}, and the 32-bit chip cannot render it ({e:#})"),
             Some(fw16),
         )),
     }

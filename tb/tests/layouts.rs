@@ -317,3 +317,33 @@ fn the_fitted_slope_is_the_power_law_exponent() {
     assert!((k - 0.75).abs() < 1e-9, "{k}");
     assert_eq!(tb::cmd_sweep::loglog_slope(&pts[..1]), None);
 }
+
+/// Banded polygon records (`primitives::polygon`) are longer than plain
+/// ones and copied into every leaf a polygon crosses: SPD gears at its
+/// default size is banded on the 16-bit chip, but on the 32-bit chip its
+/// banded streamed image is over the main memory reserved for it, and the
+/// packet traversal lays it out with plain records instead of refusing
+/// it (the auto datapath then still has the 32-bit chip to choose).
+#[test]
+fn gears_banded_where_the_image_fits_plain_where_not() {
+    let text = firmware::scene::spd::generate("gears", 4).unwrap();
+    let scene = firmware::scene::nff::parse(&text, "gears.nff").unwrap();
+    for (datapath, banded) in [
+        (rtl::rc::Datapath::W16, true),
+        (rtl::rc::Datapath::W32, false),
+    ] {
+        let o = Options {
+            datapath,
+            traversal: firmware::tracer::Traversal::Packet,
+            bsp: firmware::bsp::BspParams {
+                rule: firmware::bsp::SplitRule::Median,
+                ..Options::default().bsp
+            },
+            ..opts(16, 16, NodeLayout::Fig5)
+        };
+        let fw = firmware::tracer::build(&scene, &o)
+            .unwrap_or_else(|e| panic!("gears, {datapath}: {e}"));
+        assert!(fw.layout.stream.is_some(), "gears, {datapath}: streamed");
+        assert_eq!(fw.layout.fit.polygon_bands, banded, "gears, {datapath}");
+    }
+}

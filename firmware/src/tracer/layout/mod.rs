@@ -344,7 +344,16 @@ pub fn build(
     force_stream: bool,
 ) -> Result<FbImage, String> {
     if !force_stream {
-        let lay = build_as(scene, image, opt, guard_bits, fine_normals, false, false)?;
+        let lay = build_as(
+            scene,
+            image,
+            opt,
+            guard_bits,
+            fine_normals,
+            false,
+            false,
+            false,
+        )?;
         if lay.stream.is_none() {
             return Ok(lay);
         }
@@ -361,6 +370,7 @@ pub fn build(
         fine_normals,
         true,
         true,
+        false,
     )
 }
 
@@ -381,7 +391,23 @@ pub fn build_packet(
     fine: bool,
 ) -> Result<FbImage, String> {
     let g = if fine { guard_bits.min(1) } else { guard_bits };
-    build_as(scene, image, opt, g, fine_normals, fine, force_stream)
+    // Banded polygon records are longer than plain ones (6-word
+    // sub-edges, copied into every leaf the polygon crosses): where the
+    // banded layout cannot be built (SPD gears on the 32-bit chip: its
+    // streamed image over the main memory reserved for it), the plain one
+    // is, whose error stands if it fails too.
+    build_as(scene, image, opt, g, fine_normals, fine, force_stream, true).or_else(|_| {
+        build_as(
+            scene,
+            image,
+            opt,
+            g,
+            fine_normals,
+            fine,
+            force_stream,
+            false,
+        )
+    })
 }
 
 /// The geometry a primitive's record is written from, computed once for
@@ -395,6 +421,7 @@ enum Geometry {
     Cone(Box<(cone::ConeFit, [planar::Planar; 2])>),
 }
 
+#[allow(clippy::too_many_arguments)]
 fn build_as(
     scene: &Scene,
     image: &SceneImage,
@@ -403,6 +430,7 @@ fn build_as(
     fine_normals: bool,
     fine: bool,
     streamed: bool,
+    bands: bool,
 ) -> Result<FbImage, String> {
     // The 32-bit chip: every format gets `xb` more fraction bits.
     let xb = opt.datapath.bits() - 16;
@@ -429,7 +457,7 @@ fn build_as(
     }
 
     let packet = opt.traversal == Traversal::Packet;
-    let (geo, fan, fit) = fit_scene(scene, s, frac, xb, fine_normals, packet);
+    let (geo, fan, fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
     let mut w = W {
         fb: Vec::new(),
         s,
@@ -720,18 +748,18 @@ impl Finish {
 /// The geometry every record is written from, and the kernels' scale
 /// shifts fitted to it (`xb`: the datapath's extra bits; `s`: LSBs per
 /// unit of the scene format `frac`). Also the polygons' largest fan
-/// ([`polygon_fan`]; `packet`: the packet traversal's records).
+/// ([`polygon_fan`]; `bands`: banded records where they pay).
 fn fit_scene(
     scene: &Scene,
     s: f64,
     frac: u32,
     xb: u32,
     fine_normals: bool,
-    packet: bool,
+    bands: bool,
 ) -> (Vec<Geometry>, usize, Fit) {
     let fitter = Fitter { x: xb };
     let mut geo: Vec<Geometry> = Vec::with_capacity(scene.objects.len());
-    let (fan, polygon_bands) = polygon_fan(scene, s, packet);
+    let (fan, polygon_bands) = polygon_fan(scene, s, bands);
     for o in &scene.objects {
         geo.push(match &o.shape {
             Shape::Cone {
@@ -819,10 +847,10 @@ fn fit_scene(
 }
 
 /// The polygon records' room: the most edges of a polygon of the scene
-/// (at `s` LSB per unit), or where the records are banded (the packet
-/// traversal's, a polygon of [`polygon::BANDED_FROM`] edges or more) the
-/// most sub-edges; and whether they are banded.
-pub(crate) fn polygon_fan(scene: &Scene, s: f64, packet: bool) -> (usize, bool) {
+/// (at `s` LSB per unit), or where the records are banded (`bands`: the
+/// packet traversal's, a polygon of [`polygon::BANDED_FROM`] edges or
+/// more) the most sub-edges; and whether they are banded.
+pub(crate) fn polygon_fan(scene: &Scene, s: f64, bands: bool) -> (usize, bool) {
     let edges: Vec<Vec<[i64; 5]>> = scene
         .objects
         .iter()
@@ -831,7 +859,7 @@ pub(crate) fn polygon_fan(scene: &Scene, s: f64, packet: bool) -> (usize, bool) 
             _ => None,
         })
         .collect();
-    let banded = packet && edges.iter().any(|e| e.len() >= polygon::BANDED_FROM);
+    let banded = bands && edges.iter().any(|e| e.len() >= polygon::BANDED_FROM);
     let fan = edges
         .iter()
         .map(|e| {
