@@ -395,9 +395,14 @@ pub fn build_packet(
     // sub-edges, copied into every leaf the polygon crosses): where the
     // banded layout cannot be built (SPD gears on the 32-bit chip: its
     // streamed image over the main memory reserved for it), the plain one
-    // is, whose error stands if it fails too.
-    build_as(scene, image, opt, g, fine_normals, fine, force_stream, true).or_else(|_| {
-        build_as(
+    // is, whose error stands if it fails too. (Only a scene with a
+    // polygon of that many vertices can have banded records.)
+    let may_band = scene
+        .objects
+        .iter()
+        .any(|o| matches!(&o.shape, Shape::Polygon { v, .. } if v.len() >= polygon::BANDED_FROM));
+    match build_as(scene, image, opt, g, fine_normals, fine, force_stream, true) {
+        Err(_) if may_band => build_as(
             scene,
             image,
             opt,
@@ -406,8 +411,9 @@ pub fn build_packet(
             fine,
             force_stream,
             false,
-        )
-    })
+        ),
+        r => r,
+    }
 }
 
 /// The geometry a primitive's record is written from, computed once for

@@ -116,6 +116,12 @@ pub fn chip_costs(
     let dma = rtl::dma::DmaTiming::default();
     let word_cycles = (datapath.bits() / 8) as f64 / dma.bytes_per_cycle.max(1) as f64;
     let tests = object_costs(scene, s, &fit);
+    // Whether each chip type's records carry caps, decided once per type
+    // (indexed by `ChipType as usize`).
+    let mut caps = [false; ChipType::ALL.len()];
+    for t in ChipType::ALL {
+        caps[t as usize] = super::records_carry_caps(scene, t, crate::tracer::Traversal::Packet);
+    }
     let words: Vec<usize> = scene
         .objects
         .iter()
@@ -129,8 +135,7 @@ pub fn chip_costs(
             };
             let transmits = scene.materials[o.material].t > 0.0;
             let t = ChipType::of_object(&o.shape, transmits);
-            let caps = super::records_carry_caps(scene, t, crate::tracer::Traversal::Packet);
-            t.record_words(&fit, fan, caps)
+            t.record_words(&fit, fan, caps[t as usize])
         })
         .collect();
     crate::bsp::ChipCosts {

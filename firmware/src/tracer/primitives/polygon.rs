@@ -252,10 +252,10 @@ pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, banded: bool, id: usize,
     let start = w.fb.len();
     let n = normal(v);
     let ((ua, va), edges) = edges(v, w.s);
-    w.raw(if banded {
-        bands(&edges).0.len() as i64 - 1
-    } else {
-        edges.len() as i64
+    let banded = banded.then(|| bands(&edges));
+    w.raw(match &banded {
+        Some((bounds, _)) => bounds.len() as i64 - 1,
+        None => edges.len() as i64,
     });
     w.unit(n);
     w.point(v[0]);
@@ -269,16 +269,15 @@ pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, banded: bool, id: usize,
     };
     w.unit(axis(ua));
     w.unit(axis(va));
-    if banded {
-        let (bounds, sub) = bands(&edges);
+    if let Some((bounds, sub)) = &banded {
         let row = |w: &mut W, xs: &[i64], n: usize| {
             for k in 0..n {
                 w.raw(*xs.get(k).unwrap_or(&0));
             }
         };
-        row(w, &bounds, BANDS + 1);
+        row(w, bounds, BANDS + 1);
         let mut at = vec![0i64];
-        for b in &sub {
+        for b in sub {
             at.push(at.last().unwrap() + (b.len() * BAND_EDGE_WORDS) as i64);
         }
         row(w, &at, BANDS + 1);
