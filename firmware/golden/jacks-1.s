@@ -72,7 +72,7 @@ NOBJ = 9                ; objects in the scene
 CYL_BODY = 0            ; cylinder record: the body's stream
 
 ; ---- BSP nodes ----
-PN_FLAGS = 0            ; packet node: the split axis, or bit 15 a leaf
+PN_FLAGS = 0            ; packet node: the split axis times 4, or bit 15 a leaf
 PN_PARENT_SLOT = 1      ;   the RAM slot its parent pushed it with
 PN_SPLIT = 2            ;   inner: the split's position
 PN_SLOT = 3             ;   inner: the RAM slot of its depth
@@ -467,24 +467,34 @@ order_z_set:
         li r5, ROOT
         lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
-        slli r7, r6, 2
-        lw r1, NK(r7)
+        lw r1, NK(r6)
         addi r2, r5, PN_SPLIT
         sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
+all_first:
+        BCAST k_second_too
+        rcany r4
+        beqz r4, visit_first            ; no ray reaches the second
+        addi r12, r5, PN_SLOT           ; r12 = the second child's slot
+        BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
+        sw r10, (r14)
+        addi r14, r14, 4                ; push it
+visit_first:
+        mv r5, r9
+        blt r6, r0, leaf
+        addi r2, r5, PN_SPLIT
+        sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
         ; r5 = a node whose kernel runs: read its children, issue the first's kernel
 inner_node:
-        lw r8, NF(r7)
+        lw r8, NF(r6)
         add r8, r8, r5
         lfb r9, (r8)                    ; r9 = the first child
-        lw r10, NS(r7)
+        lw r10, NS(r6)
         add r10, r10, r5
         lfb r10, (r10)                  ; r10 = the second child
         lfb r6, PN_FLAGS(r9)
-        andi r3, r6, 3
-        slli r3, r3, 2
+        andi r3, r6, 12
         lw r11, NK(r3)                  ; r11 = its kernel, if inner
-        addi r12, r5, PN_SLOT           ; r12 = the second child's slot (stream)
         rcst r4                         ; the awake rays reaching the first child: none, some, all
         addi r1, r4, -3
         beqz r1, all_first
@@ -495,33 +505,18 @@ inner_node:
         mv r5, r10
         lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
-        slli r7, r6, 2
-        lw r1, NK(r7)
+        lw r1, NK(r6)
         addi r2, r5, PN_SPLIT
         sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
 some_first:
+        addi r12, r5, PN_SLOT           ; r12 = the second child's slot
         BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
         BCAST k_first_or_sleep          ; the rays not reaching the first sleep
         mv r5, r9
         blt r6, r0, leaf
-        mv r7, r3
-        addi r2, r5, PN_SPLIT
-        sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
-        j inner_node
-all_first:
-        BCAST k_second_too
-        rcany r4
-        beqz r4, visit_first            ; no ray reaches the second
-        BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
-        sw r10, (r14)
-        addi r14, r14, 4                ; push it
-visit_first:
-        mv r5, r9
-        blt r6, r0, leaf
-        mv r7, r3
         addi r2, r5, PN_SPLIT
         sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
         j inner_node
@@ -638,14 +633,15 @@ pop_node:
         li r1, (k_pop_node - CTXBASE) / 4
         addi r2, r5, PN_PARENT_SLOT
         sbcb r1, r2, (k_pop_node_end - k_pop_node) / 4 ; the rays take their intervals for it
+        ; while they do: its kernel and split, if inner
         lfb r6, PN_FLAGS(r5)
+        andi r3, r6, 12
+        lw r11, NK(r3)
+        addi r2, r5, PN_SPLIT
         rcany r4
         beqz r4, pop_node               ; no ray needs it
         blt r6, r0, leaf
-        slli r7, r6, 2
-        lw r1, NK(r7)
-        addi r2, r5, PN_SPLIT
-        sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
+        sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
 trace_done:
         lw r1, TESTS(r0)

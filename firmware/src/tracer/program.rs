@@ -477,11 +477,10 @@ fn fb(lay: &FbImage) -> Vec<String> {
             "the split of the node being classified",
         ));
         if lay.traversal == Traversal::Packet {
-            v.push(define("SPLIT_SLOT", "SPLIT + 1", "its slot's RAM address"));
             v.push(define(
-                "POP_SLOT",
-                "SPLIT + 2",
-                "a popped node's parent slot",
+                "SLOTS",
+                "SPLIT + 1",
+                "per node stack entry (every 4th word) its RAM slot",
             ));
         }
         v.push(define(

@@ -360,7 +360,7 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
     for n in &tree.nodes {
         match n.split {
             Some(sp) => {
-                w.raw(sp.axis as i64);
+                w.raw(4 * sp.axis as i64);
                 w.raw(Tree::parent_slot(n));
                 w.coord(sp.position);
                 w.raw(pk_slot(n.depth));
@@ -453,8 +453,18 @@ fn streamed_image(
     let records = w.fb.split_off(records_start);
     let split_slot = w.fb.len();
     w.raw(0); // split
-    w.raw(0); // its slot
-    w.raw(0); // a popped node's parent slot
+              // `SLOTS`: a pushed node's RAM slot by its place on the node stack,
+              // every 4th word (the stack's entries are 4 bytes apart, so TinyRISC
+              // finds the slot of the top at a constant offset from its stack
+              // pointer).
+    for d in 0..super::super::memory_map::ram::P_SLOTS {
+        w.raw(pk_slot(d));
+        if d + 1 < super::super::memory_map::ram::P_SLOTS {
+            for _ in 0..3 {
+                w.raw(0);
+            }
+        }
+    }
     if w.fb.len() > STREAM_BANK {
         return Err(err(
             0,
@@ -562,12 +572,10 @@ fn streamed_image(
     }
     for (k, n) in nodes.iter().enumerate() {
         let mut f = [0i32; 16];
-        f[word(PS_PARENT_SLOT)] = Tree::parent_slot(n) as i32;
         match n.split {
             Some(sp) => {
-                f[word(PS_FLAGS)] = sp.axis as i32;
+                f[word(PS_FLAGS)] = 4 * sp.axis as i32;
                 f[word(PS_SPLIT)] = w.sat(sp.position * w.s);
-                f[word(PS_SLOT)] = pk_slot(n.depth) as i32;
                 f[word(PS_LEFT)] = (base + NODE_BYTES * sp.children[0] as usize) as i32;
                 f[word(PS_RIGHT)] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
             }
@@ -625,7 +633,7 @@ pub mod fields {
     pub const PN_FLAGS: Name = Name::new(
         "PN_FLAGS",
         0,
-        "packet node: the split axis, or bit 15 a leaf",
+        "packet node: the split axis times 4, or bit 15 a leaf",
     );
     pub const PN_PARENT_SLOT: Name = Name::new(
         "PN_PARENT_SLOT",
@@ -669,15 +677,9 @@ pub mod fields {
     pub const PS_FLAGS: Name = Name::new(
         "PS_FLAGS",
         0,
-        "  -32768 a leaf or a piece, else the split axis",
-    );
-    pub const PS_PARENT_SLOT: Name = Name::new(
-        "PS_PARENT_SLOT",
-        4,
-        "  the RAM slot its parent pushed it with",
+        "  -32768 a leaf or a piece, else the split axis times 4",
     );
     pub const PS_SPLIT: Name = Name::new("PS_SPLIT", 8, "  inner: the split's position");
-    pub const PS_SLOT: Name = Name::new("PS_SLOT", 12, "  inner: the RAM slot of its depth");
     pub const PS_LEFT: Name = Name::new("PS_LEFT", 16, "  inner: the children (byte addresses)");
     pub const PS_RIGHT: Name = Name::new("PS_RIGHT", 20, "");
     pub const PS_LIST: Name = Name::new(
@@ -726,9 +728,7 @@ pub fn header(streamed: bool, types: &[&str]) -> Vec<String> {
         v.extend(
             [
                 PS_FLAGS,
-                PS_PARENT_SLOT,
                 PS_SPLIT,
-                PS_SLOT,
                 PS_LEFT,
                 PS_RIGHT,
                 PS_LIST,

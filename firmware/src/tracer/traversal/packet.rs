@@ -55,8 +55,10 @@
 //! Mailboxes (main memory, `MB_BYTES` each): the pass that last tested
 //! the object and which rays did (`MB_PASS`, `MB_RAYS`).
 //!
-//! TinyRISC registers: r5 the node, r6 its flags, r7 its axis times 4,
-//! r13 the pass's object tests, r14 the node stack pointer (`NSTACK`).
+//! TinyRISC registers: r5 the node, r6 its flags (the split axis times 4,
+//! negative for a leaf), r7 `SPLIT` (streamed: the FB word a node
+//! kernel's split is written to), r13 the pass's object tests, r14 the
+//! node stack pointer (`NSTACK`).
 
 use super::super::emit::{
     at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
@@ -417,27 +419,36 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     }
     child_order(t, &f);
     t.li(R14, "NSTACK").li(R5, "ROOT");
+    if streamed {
+        t.li(R7, "SPLIT").c("r7 = SPLIT throughout the walk");
+    }
     f.load(t, R6, at(flags, R5));
     dispatch_full(t, &f);
+    // Placed before `inner_node`, which the first child's dispatch falls
+    // into: the commonest way from one node visit to the next takes no
+    // jump.
+    t.label("all_first")
+        .m("BCAST", names::SECOND_TOO)
+        .rcany(R4)
+        .beqz(R4, "visit_first")
+        .c("no ray reaches the second");
+    push_second(t, &f);
+    t.label("visit_first");
+    dispatch_first(t, &f, false);
     t.comment("r5 = a node whose kernel runs: read its children, issue the first's kernel");
-    t.label("inner_node").lw(R8, at("NF", R7)).add(R8, R8, R5);
+    t.label("inner_node").lw(R8, at("NF", R6)).add(R8, R8, R5);
     f.load(t, R9, deref(R8));
     t.c("r9 = the first child");
-    t.lw(R10, at("NS", R7)).add(R10, R10, R5);
+    t.lw(R10, at("NS", R6)).add(R10, R10, R5);
     f.load(t, R10, deref(R10));
     t.c("r10 = the second child");
     f.load(t, R6, at(flags, R9));
-    t.andi(R3, R6, 3)
-        .slli(R3, R3, 2)
+    t.andi(R3, R6, 12)
         .lw(R11, at("NK", R3))
         .c("r11 = its kernel, if inner");
     if streamed {
         t.lw(R15, at("PS_SPLIT", R9)).c("r15 = its split");
-        t.lw(R12, at("PS_SLOT", R5));
-    } else {
-        t.addi(R12, R5, "PN_SLOT");
     }
-    t.c("r12 = the second child's slot (stream)");
     t.rcst(R4)
         .c("the awake rays reaching the first child: none, some, all")
         .addi(R1, R4, -3)
@@ -455,15 +466,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     push_second(t, &f);
     t.m("BCAST", names::FIRST_OR_SLEEP)
         .c("the rays not reaching the first sleep");
-    dispatch_first(t, &f);
-    t.label("all_first")
-        .m("BCAST", names::SECOND_TOO)
-        .rcany(R4)
-        .beqz(R4, "visit_first")
-        .c("no ray reaches the second");
-    push_second(t, &f);
-    t.label("visit_first");
-    dispatch_first(t, &f);
+    dispatch_first(t, &f, true);
     leaf(t, lay, &f);
     t.label("leaf_done")
         .lw(R1, at("MODE", R0))
@@ -477,17 +480,27 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .lw(R5, deref(R14))
         .li(R1, kaddr(names::POP_NODE));
     if streamed {
-        t.lw(R2, at("PS_PARENT_SLOT", R5))
-            .sfb(R2, at("POP_SLOT", R0))
-            .li(R2, "POP_SLOT");
+        t.addi(R2, R14, "SLOTS-NSTACK")
+            .c("its slot: the stack entry's");
     } else {
         t.addi(R2, R5, "PN_PARENT_SLOT");
     }
     t.sbcb(R1, R2, klen(names::POP_NODE))
         .c("the rays take their intervals for it");
+    t.comment("while they do: its kernel and split, if inner");
     f.load(t, R6, at(flags, R5));
-    t.rcany(R4).beqz(R4, "pop_node").c("no ray needs it");
-    dispatch_full(t, &f);
+    t.andi(R3, R6, 12).lw(R11, at("NK", R3));
+    if streamed {
+        t.li(R7, "SPLIT").c("the leaf's code may have used r7");
+    }
+    let split = split_word(t, &f, R2);
+    t.rcany(R4)
+        .beqz(R4, "pop_node")
+        .c("no ray needs it")
+        .blt(R6, R0, "leaf")
+        .sbcb(R11, split, klen(&names::node(0, false)))
+        .c("its node kernel")
+        .j("inner_node");
     t.label("trace_done")
         .lw(R1, at("TESTS", R0))
         .add(R1, R1, R13)
@@ -500,43 +513,54 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
 /// r5 = a node, r6 = its flags: a leaf, or its kernel issued (the split
 /// streamed), then `inner_node`.
 fn dispatch_full(t: &mut Code, f: &Fields) {
-    t.blt(R6, R0, "leaf").slli(R7, R6, 2).lw(R1, at("NK", R7));
-    if f.streamed {
-        t.lw(R2, at("PS_SPLIT", R5))
-            .sfb(R2, at("SPLIT", R0))
-            .li(R2, "SPLIT");
-    } else {
-        t.addi(R2, R5, "PN_SPLIT");
-    }
-    t.sbcb(R1, R2, klen(&names::node(0, false)))
+    t.blt(R6, R0, "leaf").lw(R1, at("NK", R6));
+    let split = split_word(t, f, R2);
+    t.sbcb(R1, split, klen(&names::node(0, false)))
         .c("its node kernel")
         .j("inner_node");
 }
 
-/// Visit the first child (r9, flags r6, kernel r11, axis r3 read by
-/// `inner_node`): a leaf, or its kernel issued at once.
-fn dispatch_first(t: &mut Code, f: &Fields) {
-    t.mv(R5, R9).blt(R6, R0, "leaf").mv(R7, R3);
+/// The FB address of the split of the node r5 for its kernel: streamed,
+/// `SPLIT` (in r7 throughout the walk), where the split (in `from`, else
+/// loaded) is written; resident, the node's own word (into r2).
+fn split_word(t: &mut Code, f: &Fields, from: Reg) -> Reg {
     if f.streamed {
-        t.sfb(R15, at("SPLIT", R0)).li(R2, "SPLIT");
+        if from == R2 {
+            t.lw(R2, at("PS_SPLIT", R5));
+        }
+        t.sfb(from, at("SPLIT", R0));
+        R7
     } else {
         t.addi(R2, R5, "PN_SPLIT");
+        R2
     }
-    t.sbcb(R11, R2, klen(&names::node(0, false)))
-        .c("the first child's node kernel")
-        .j("inner_node");
 }
 
-/// Push the second child (r10) with every awake ray's interval for it
-/// (the push kernel streams the node's slot address, r12).
+/// Visit the first child (r9, flags r6, kernel r11, axis r3 read by
+/// `inner_node`): a leaf, or its kernel issued at once; then `inner_node`
+/// (a jump unless it follows).
+fn dispatch_first(t: &mut Code, f: &Fields, jump: bool) {
+    t.mv(R5, R9).blt(R6, R0, "leaf");
+    let split = split_word(t, f, R15);
+    t.sbcb(R11, split, klen(&names::node(0, false)))
+        .c("the first child's node kernel");
+    if jump {
+        t.j("inner_node");
+    }
+}
+
+/// Push the second child (r10) of the node r5 with every awake ray's
+/// interval for it (the push kernel streams the node's slot address, r12).
 fn push_second(t: &mut Code, f: &Fields) {
     if f.streamed {
-        t.sfb(R12, at("SPLIT_SLOT", R0))
-            .li(R2, "SPLIT_SLOT")
+        t.addi(R2, R14, "SLOTS-NSTACK")
+            .c("its slot: the stack entry's")
             .li(R1, kaddr(names::PUSH_SECOND))
             .sbcb(R1, R2, klen(names::PUSH_SECOND));
     } else {
-        t.m("BCAST_AT", format!("{}, r12", names::PUSH_SECOND));
+        t.addi(R12, R5, "PN_SLOT")
+            .c("r12 = the second child's slot")
+            .m("BCAST_AT", format!("{}, r12", names::PUSH_SECOND));
     }
     t.c("the rays' intervals for the second child")
         .sw(R10, deref(R14))
