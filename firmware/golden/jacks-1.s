@@ -199,12 +199,16 @@ SLOT_TMIN = 1           ; slot: near end
         sbcb r1, r2, (\cut - \k) / 4
 .endm
 
-; BCAST_FROM cut, end, ra, field: broadcast a kernel's contexts from its cut `cut` up
-; to label `end`, the stream going on from `field` of the record at ra past the
-; words read before the cut (`cut_fb`). Clobbers r1, r2.
-.macro BCAST_FROM cut, end, ra, field
+; BCAST_FROM_ANY cut, end, ra, field, none: once the array is done, if some awake RC
+; has F, broadcast a kernel's contexts from its cut `cut` up to label `end`, the
+; stream going on from `field` of the record at ra past the words read before the
+; cut (`cut_fb`); else on to `none`. The run's operands are set before the status
+; read, while the array may still be busy. Clobbers r1, r2, r3.
+.macro BCAST_FROM_ANY cut, end, ra, field, none
         li r1, (\cut - CTXBASE) / 4
         addi r2, \ra, \field + \cut\()_fb
+        rcany r3
+        beqz r3, \none
         sbcb r1, r2, (\end - \cut) / 4
 .endm
 
@@ -561,9 +565,7 @@ lo_sphere_ahead_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere_ahead
 lo_sphere_parts:
-        rcany r3
-        beqz r3, lo_sphere_done         ; no awake ray can hit it
-        BCAST_FROM k_sphere_cut_line, k_sphere_end, r15, 0
+        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_done ; the rest, if some awake ray can still hit it
 lo_sphere_done:
         bnez r9, lo_sphere_test
         j lo_sphere_end
@@ -601,15 +603,9 @@ lo_cylinder_ahead_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder_ahead
 lo_cylinder_parts:
-        rcany r3
-        beqz r3, lo_cylinder_done       ; no awake ray can hit it
-        BCAST_FROM k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY ; up to F: the ray's line meets the cylinder
-        rcany r3
-        beqz r3, lo_cylinder_done       ; no awake ray can hit it
-        BCAST_FROM k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY ; up to F: the root ahead, before tbest
-        rcany r3
-        beqz r3, lo_cylinder_done       ; no awake ray can hit it
-        BCAST_FROM k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY
+        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_done ; up to F: the ray's line meets the cylinder
+        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_done ; up to F: the root ahead, before tbest
+        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_done ; the rest, if some awake ray can still hit it
 lo_cylinder_done:
         bnez r9, lo_cylinder_test
         j lo_cylinder_end

@@ -101,14 +101,18 @@ pub fn macros(lay: &FbImage) -> Code {
             }),
         );
         t.define_macro(
-            "BCAST_FROM",
-            "cut, end, ra, field",
-            "BCAST_FROM cut, end, ra, field: broadcast a kernel's contexts from its cut `cut` up\n\
-             to label `end`, the stream going on from `field` of the record at ra past the\n\
-             words read before the cut (`cut_fb`). Clobbers r1, r2.",
+            "BCAST_FROM_ANY",
+            "cut, end, ra, field, none",
+            "BCAST_FROM_ANY cut, end, ra, field, none: once the array is done, if some awake RC\n\
+             has F, broadcast a kernel's contexts from its cut `cut` up to label `end`, the\n\
+             stream going on from `field` of the record at ra past the words read before the\n\
+             cut (`cut_fb`); else on to `none`. The run's operands are set before the status\n\
+             read, while the array may still be busy. Clobbers r1, r2, r3.",
             body(&|b| {
                 b.li(R1, "(\\cut - CTXBASE) / 4")
                     .line("addi r2, \\ra, \\field + \\cut\\()_fb")
+                    .rcany(R3)
+                    .line("beqz r3, \\none")
                     .sbcb(R1, R2, "(\\end - \\cut) / 4");
             }),
         );

@@ -407,32 +407,41 @@ pub fn run_with_cuts(
 ) {
     let (k, field) = (c.kernel, c.field);
     let mut between = Some(between);
-    let mut from = k.to_string();
-    let mut check = |t: &mut Code| {
+    // A part after a cut runs only if some awake ray can still hit the
+    // object (`BCAST_FROM_ANY`); `between` runs before the first such
+    // check, while the first part does.
+    let mut run_from = |t: &mut Code, from: &str, to: &str| {
         if let Some(b) = between.take() {
             b(t);
         }
-        t.rcany(R3).beqz(R3, done).c("no awake ray can hit it");
+        t.m(
+            "BCAST_FROM_ANY",
+            format!("{from}, {to}, {rec}, {field}, {done}"),
+        );
     };
+    let mut from = k.to_string();
     for (name, holds) in c.cuts {
         let cut = super::emit::cut_label(k, name);
         if from == k {
             t.m("BCAST_UPTO", format!("{k}, {cut}, {first}, {field}"));
         } else {
-            t.m("BCAST_FROM", format!("{from}, {cut}, {rec}, {field}"));
+            run_from(t, &from, &cut);
         }
         t.c(format!("up to F: {holds}"));
-        check(t);
         from = cut;
     }
     if from == k {
         t.m("BCAST_REC", format!("{k}, {first}, {field}"));
     } else {
-        t.m("BCAST_FROM", format!("{from}, {k}_end, {rec}, {field}"));
+        run_from(t, &from, &format!("{k}_end"));
+        t.c("the rest, if some awake ray can still hit it");
     }
     if let Some(holds) = c.then {
         t.c(format!("F: {holds}"));
-        check(t);
+        if let Some(b) = between.take() {
+            b(t);
+        }
+        t.rcany(R3).beqz(R3, done).c("no awake ray can hit it");
         ty.broadcast_then(t, at, rec, fit);
     }
     t.label(done);

@@ -636,11 +636,12 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .comment("or its DMA starts");
         t.label("leaf_first")
             .lw(R1, at("PS_BLOCK", R5))
-            .lw(R2, at("PS_FB", R5))
-            .add(R6, R2, R2)
+            .lw(R7, at("PS_FB", R5))
+            .c("r7: the piece's first record, through the scan")
+            .add(R6, R7, R7)
             .lw(R3, at("LEAF_TAGS - 2*SBANK + 4", R6))
-            .lw(R7, at("TILE_GEN", R0))
-            .bne(R3, R7, "leaf_miss")
+            .lw(R2, at("TILE_GEN", R0))
+            .bne(R3, R2, "leaf_miss")
             .c("moved in another tile (checked first: a tag from an earlier tile never costs more)")
             .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
             .bne(R1, R3, "leaf_miss")
@@ -651,11 +652,11 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .j("leaf_awake");
         t.label("leaf_miss")
             .lw(R3, at("PS_BLOCK_WORDS", R5))
-            .ldfb(R1, R2, R3)
+            .ldfb(R1, R7, R3)
             .c("the first piece's DMA starts")
             .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
-            .lw(R7, at("TILE_GEN", R0))
-            .sw(R7, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .c("r2 = TILE_GEN")
             .lw(R3, at("LEAF_MISSES", R0))
             .addi(R3, R3, 1)
             .sw(R3, at("LEAF_MISSES", R0));
@@ -700,8 +701,6 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         let count_field = |ti: &TypeInfo| format!("PS_COUNT_{}", ti.ty.name().to_uppercase());
         t.label("leaf_go")
             .lw(R1, at("PS_NEXT", R5))
-            .lw(R7, at("PS_FB", R5))
-            .c("r7: the first record")
             .lw(R6, at("PS_LIST", R5));
         if let Some(ti) = lay.types.first() {
             t.lw(R9, at(count_field(ti), R5));
@@ -737,6 +736,8 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         t.label("leaf_next_piece")
             .lw(R5, at("PS_NEXT", R5))
             .beqz(R5, "leaf_done")
+            .lw(R7, at("PS_FB", R5))
+            .c("r7: the piece's first record")
             .j("leaf_piece");
     } else {
         t.label("leaf")
