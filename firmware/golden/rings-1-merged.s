@@ -79,7 +79,7 @@ NOBJ = 61               ; objects in the scene
 CYL_BODY = 0            ; cylinder record: the body's stream
 
 ; ---- BSP nodes ----
-PN_FLAGS = 0            ; packet node: the split axis times 4, or bit 15 a leaf
+PN_FLAGS = 0            ; packet node: the split axis times 4, or bit 15 a leaf (+1: some object with a mailbox, +2: empty)
 PN_PARENT_SLOT = 1      ;   the RAM slot its parent pushed it with
 PN_SPLIT = 2            ;   inner: the split's position
 PN_SLOT = 3             ;   inner: the RAM slot of its depth
@@ -832,9 +832,9 @@ some_first:
         ; the leaf r5: an object in more than one leaf has a mailbox (the pass that last
         ; tested it and which rays did); it is broadcast unless every awake ray has tested it
 leaf:
-        lfb r1, PL_OBJECTS(r5)
-        beqz r1, leaf_done              ; an empty leaf
-        lfb r1, PL_SHARED(r5)
+        andi r1, r6, 2
+        bnez r1, leaf_done              ; an empty leaf
+        andi r1, r6, 1
         beqz r1, leaf_objects           ; no mailbox to check
         rcsl r4
         rcsh r10

@@ -93,7 +93,7 @@ pub const PK_OBJECT_RISC: f64 = 16.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 92 to 186 on the SPD scenes at 128x128 but for shells' few
+/// is added. 87 to 180 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
 pub const PK_LEAF_COST: f64 = 130.0;
@@ -153,6 +153,13 @@ pub fn chip_costs(
         leaf_words: super::FB_LIMIT - STREAM_BANK - super::BLOCK_HEAD,
     }
 }
+
+/// A leaf's flags (bit 15 set): TinyRISC reads the awake rays for the
+/// mailbox checks (some object of the leaf has a mailbox, or, streamed,
+/// the leaf has more pieces).
+pub const LEAF_AWAKE: i32 = 1;
+/// A leaf's flags: it has no object.
+pub const LEAF_EMPTY: i32 = 2;
 
 /// Words of a packet-traversal inner node: axis, parent's slot, split,
 /// own slot, left, right (FB addresses, or byte addresses when streamed).
@@ -371,7 +378,14 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
                 w.raw((root + node_at[sp.children[1] as usize]) as i64);
             }
             None => {
-                w.word16(0x8000);
+                let flags = if n.objects.is_empty() {
+                    LEAF_EMPTY
+                } else if tree.shared(n.objects.iter().map(|&o| o as usize)) > 0 {
+                    LEAF_AWAKE
+                } else {
+                    0
+                };
+                w.word16(0x8000 | flags as u16);
                 w.raw(Tree::parent_slot(n));
                 w.raw(n.objects.len() as i64);
                 w.raw(tree.shared(n.objects.iter().map(|&o| o as usize)) as i64);
@@ -583,7 +597,7 @@ fn streamed_image(
                 f[word(PS_RIGHT)] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
             }
             None => {
-                f[word(PS_FLAGS)] = -32768;
+                f[word(PS_FLAGS)] = -32768 | LEAF_EMPTY;
                 if first_piece[k] != usize::MAX {
                     // The leaf's record is its first piece's (its list,
                     // block, next piece, counts).
@@ -591,6 +605,8 @@ fn streamed_image(
                     f[word(PS_LIST)] = p[word(PS_LIST)];
                     f[word(PS_FB)] = p[word(PS_FB)];
                     f[word(PS_BLOCK)..].copy_from_slice(&p[word(PS_BLOCK)..]);
+                    let awake = p[word(PS_SHARED)] != 0 || p[word(PS_NEXT)] != 0;
+                    f[word(PS_FLAGS)] = -32768 | if awake { LEAF_AWAKE } else { 0 };
                 }
             }
         }
@@ -636,7 +652,7 @@ pub mod fields {
     pub const PN_FLAGS: Name = Name::new(
         "PN_FLAGS",
         0,
-        "packet node: the split axis times 4, or bit 15 a leaf",
+        "packet node: the split axis times 4, or bit 15 a leaf (+1: some object with a mailbox, +2: empty)",
     );
     pub const PN_PARENT_SLOT: Name = Name::new(
         "PN_PARENT_SLOT",
@@ -680,7 +696,7 @@ pub mod fields {
     pub const PS_FLAGS: Name = Name::new(
         "PS_FLAGS",
         0,
-        "  -32768 a leaf or a piece, else the split axis times 4",
+        "  the split axis times 4; -32768 a piece or a leaf (+1: the awake rays read, +2: empty)",
     );
     pub const PS_SPLIT: Name = Name::new("PS_SPLIT", 8, "  inner: the split's position");
     pub const PS_LEFT: Name = Name::new("PS_LEFT", 16, "  inner: the children (byte addresses)");

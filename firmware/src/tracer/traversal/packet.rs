@@ -63,6 +63,7 @@
 use super::super::emit::{
     at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
+use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY};
 use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
@@ -625,12 +626,10 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .as_ref()
             .is_some_and(|st| st.slots_at == super::super::layout::STREAM_BANK);
         t.label("leaf")
-            .lw(R1, at("PS_OBJECTS", R5))
-            .beqz(R1, "leaf_done")
+            .andi(R1, R6, LEAF_EMPTY)
+            .bnez(R1, "leaf_done")
             .c("an empty leaf")
-            .lw(R1, at("PS_SHARED", R5))
-            .lw(R2, at("PS_NEXT", R5))
-            .or(R12, R1, R2)
+            .andi(R12, R6, LEAF_AWAKE)
             .c("r12 = 0: no mailbox to check");
         t.comment("the first piece: in its slot of the leaf cache since this tile moved it there,")
             .comment("or its DMA starts");
@@ -741,10 +740,10 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .j("leaf_piece");
     } else {
         t.label("leaf")
-            .lfb(R1, at("PL_OBJECTS", R5))
-            .beqz(R1, "leaf_done")
+            .andi(R1, R6, LEAF_EMPTY)
+            .bnez(R1, "leaf_done")
             .c("an empty leaf")
-            .lfb(R1, at("PL_SHARED", R5))
+            .andi(R1, R6, LEAF_AWAKE)
             .beqz(R1, "leaf_objects")
             .c("no mailbox to check");
         awake(t);
