@@ -469,11 +469,11 @@ fn streamed_image(
     let nodes = &tree.nodes;
     let records = w.fb.split_off(records_start);
     let split_slot = w.fb.len();
-    w.raw(0); // split
-              // `SLOTS`: a pushed node's RAM slot by its place on the node stack,
-              // every 4th word (the stack's entries are 4 bytes apart, so TinyRISC
-              // finds the slot of the top at a constant offset from its stack
-              // pointer).
+    // `SPLIT`, then `SLOTS`: a pushed node's RAM slot by its place on the
+    // node stack, every 4th word (the stack's entries are 4 bytes apart,
+    // so TinyRISC finds the slot of the top at a constant offset from its
+    // stack pointer).
+    w.raw(0);
     for d in 0..super::super::memory_map::ram::P_SLOTS {
         w.raw(pk_slot(d));
         if d + 1 < super::super::memory_map::ram::P_SLOTS {
