@@ -784,8 +784,8 @@ all_first:
         BCAST k_second_too
         rcany r4
         beqz r4, visit_first            ; no ray reaches the second
-        addi r12, r5, PN_SLOT           ; r12 = the second child's slot
-        BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
+        addi r2, r5, PN_SLOT            ; its slot: the node's
+        BCAST_AT k_push_second, r2      ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
 visit_first:
@@ -819,8 +819,8 @@ inner_node:
         sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
 some_first:
-        addi r12, r5, PN_SLOT           ; r12 = the second child's slot
-        BCAST_AT k_push_second, r12     ; the rays' intervals for the second child
+        addi r2, r5, PN_SLOT            ; its slot: the node's
+        BCAST_AT k_push_second, r2      ; the rays' intervals for the second child
         sw r10, (r14)
         addi r14, r14, 4                ; push it
         BCAST k_first_or_sleep          ; the rays not reaching the first sleep

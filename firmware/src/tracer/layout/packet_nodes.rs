@@ -378,9 +378,10 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
                 w.raw((root + node_at[sp.children[1] as usize]) as i64);
             }
             None => {
+                let shared = tree.shared(n.objects.iter().map(|&o| o as usize));
                 let flags = if n.objects.is_empty() {
                     LEAF_EMPTY
-                } else if tree.shared(n.objects.iter().map(|&o| o as usize)) > 0 {
+                } else if shared > 0 {
                     LEAF_AWAKE
                 } else {
                     0
@@ -388,7 +389,7 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
                 w.word16(0x8000 | flags as u16);
                 w.raw(Tree::parent_slot(n));
                 w.raw(n.objects.len() as i64);
-                w.raw(tree.shared(n.objects.iter().map(|&o| o as usize)) as i64);
+                w.raw(shared as i64);
                 for (ti, qs) in tree.types.iter().zip(tree.per_type(n)) {
                     w.raw(qs.len() as i64);
                     for q in qs {

@@ -494,7 +494,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     if streamed {
         t.li(R7, "SPLIT").c("the leaf's code may have used r7");
     }
-    let split = split_word(t, &f, R2);
+    let split = split_word(t, &f, None);
     t.rcany(R4)
         .beqz(R4, "pop_node")
         .c("no ray needs it")
@@ -515,21 +515,23 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
 /// streamed), then `inner_node`.
 fn dispatch_full(t: &mut Code, f: &Fields) {
     t.blt(R6, R0, "leaf").lw(R1, at("NK", R6));
-    let split = split_word(t, f, R2);
+    let split = split_word(t, f, None);
     t.sbcb(R1, split, klen(&names::node(0, false)))
         .c("its node kernel")
         .j("inner_node");
 }
 
 /// The FB address of the split of the node r5 for its kernel: streamed,
-/// `SPLIT` (in r7 throughout the walk), where the split (in `from`, else
-/// loaded) is written; resident, the node's own word (into r2).
-fn split_word(t: &mut Code, f: &Fields, from: Reg) -> Reg {
+/// `SPLIT` (in r7 throughout the walk), where the split (`held` in a
+/// register, else loaded into r2) is written; resident, the node's own
+/// word (into r2).
+fn split_word(t: &mut Code, f: &Fields, held: Option<Reg>) -> Reg {
     if f.streamed {
-        if from == R2 {
+        let split = held.unwrap_or_else(|| {
             t.lw(R2, at("PS_SPLIT", R5));
-        }
-        t.sfb(from, at("SPLIT", R0));
+            R2
+        });
+        t.sfb(split, at("SPLIT", R0));
         R7
     } else {
         t.addi(R2, R5, "PN_SPLIT");
@@ -542,7 +544,7 @@ fn split_word(t: &mut Code, f: &Fields, from: Reg) -> Reg {
 /// (a jump unless it follows).
 fn dispatch_first(t: &mut Code, f: &Fields, jump: bool) {
     t.mv(R5, R9).blt(R6, R0, "leaf");
-    let split = split_word(t, f, R15);
+    let split = split_word(t, f, Some(R15));
     t.sbcb(R11, split, klen(&names::node(0, false)))
         .c("the first child's node kernel");
     if jump {
@@ -551,19 +553,18 @@ fn dispatch_first(t: &mut Code, f: &Fields, jump: bool) {
 }
 
 /// Push the second child (r10) of the node r5 with every awake ray's
-/// interval for it (the push kernel streams the node's slot address, r12).
+/// interval for it (the push kernel streams the slot's RAM address: a
+/// streamed node's, its stack entry's in `SLOTS`; a resident node's, its
+/// own word).
 fn push_second(t: &mut Code, f: &Fields) {
     if f.streamed {
         t.addi(R2, R14, "SLOTS-NSTACK")
-            .c("its slot: the stack entry's")
-            .li(R1, kaddr(names::PUSH_SECOND))
-            .sbcb(R1, R2, klen(names::PUSH_SECOND));
+            .c("its slot: the stack entry's");
     } else {
-        t.addi(R12, R5, "PN_SLOT")
-            .c("r12 = the second child's slot")
-            .m("BCAST_AT", format!("{}, r12", names::PUSH_SECOND));
+        t.addi(R2, R5, "PN_SLOT").c("its slot: the node's");
     }
-    t.c("the rays' intervals for the second child")
+    t.m("BCAST_AT", format!("{}, r2", names::PUSH_SECOND))
+        .c("the rays' intervals for the second child")
         .sw(R10, deref(R14))
         .addi(R14, R14, 4)
         .c("push it");
