@@ -239,7 +239,7 @@ no_hit\@:
 
 ; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,
 ; r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the
-; pass and the rays, and on to `p_go` (r13 counts the test). Clobbers r1..r3.
+; pass and the rays, and on to `p_go`. Clobbers r1..r3.
 .macro MAILBOX_CHECK p
         lw r1, MB_PASS(r8)
         bne r1, r11, \p\()_fresh        ; not tested in this pass yet
@@ -260,7 +260,6 @@ no_hit\@:
         sw r4, MB_RAYS(r8)
         sw r10, MB_RAYS+MASK_HI(r8)
 \p\()_go:
-        addi r13, r13, 1                ; one more object test
 .endm
 
 ; POPCOUNT x, t1, t2: x = the number of bits set in x (SWAR). Clobbers t1, t2.
@@ -295,7 +294,6 @@ NEG_Y:          .word 0, 0
 NEG_Z:          .word 0, 0
 T_START:        .word 0                 ; the cycle counter at the tile loop's start
 T_END:          .word 0                 ; ... and at its end
-TESTS:          .word 0                 ; object tests broadcast
 PASSES:         .word 0                 ; ray passes
 TL_PTR:         .word 0                 ; the tile list's current entry
 TL_CNT:         .word 0                 ; tiles left
@@ -403,7 +401,7 @@ trace:
         lw r1, PASS(r0)
         addi r1, r1, 1
         sw r1, PASS(r0)
-        li r13, 0                       ; object tests of the pass
+        lw r13, MODE(r0)                ; r13 = MODE through the walk
         BCAST_FB k_pass_start, ROOTBOX  ; intervals in the root cell, 1/d
         BCAST k_sign_x
         rcst r3                         ; the awake rays going down along x: none, some, all
@@ -467,7 +465,7 @@ order_z_set:
         sw r1, NK+AXIS_Z(r0)
         sw r2, NF+AXIS_Z(r0)
         sw r3, NS+AXIS_Z(r0)            ; node kernel, first and second child
-        li r14, NSTACK
+        li r14, 0                       ; the node stack: empty
         li r5, ROOT
         lfb r6, PN_FLAGS(r5)
         blt r6, r0, leaf
@@ -481,7 +479,7 @@ all_first:
         beqz r4, visit_first            ; no ray reaches the second
         addi r2, r5, PN_SLOT            ; its slot: the node's
         BCAST_AT k_push_second, r2      ; the rays' intervals for the second child
-        sw r10, (r14)
+        sw r10, NSTACK(r14)
         addi r14, r14, 4                ; push it
 visit_first:
         mv r5, r9
@@ -516,7 +514,7 @@ inner_node:
 some_first:
         addi r2, r5, PN_SLOT            ; its slot: the node's
         BCAST_AT k_push_second, r2      ; the rays' intervals for the second child
-        sw r10, (r14)
+        sw r10, NSTACK(r14)
         addi r14, r14, 4                ; push it
         BCAST k_first_or_sleep          ; the rays not reaching the first sleep
         mv r5, r9
@@ -618,14 +616,12 @@ lo_cylinder_next:
         bnez r9, lo_cylinder_obj
 lo_cylinder_end:
 leaf_done:
-        lw r1, MODE(r0)
-        beqz r1, pop_node
+        beqz r13, pop_node              ; closest hit
         BCAST k_done_with_hit           ; any hit: the rays with a hit are done
 pop_node:
-        li r9, NSTACK
-        beq r14, r9, trace_done
+        beqz r14, trace_done            ; the node stack empty
         addi r14, r14, -4
-        lw r5, (r14)
+        lw r5, NSTACK(r14)
         li r1, (k_pop_node - CTXBASE) / 4
         addi r2, r5, PN_PARENT_SLOT
         sbcb r1, r2, (k_pop_node_end - k_pop_node) / 4 ; the rays take their intervals for it
@@ -640,9 +636,6 @@ pop_node:
         sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
 trace_done:
-        lw r1, TESTS(r0)
-        add r1, r1, r13
-        sw r1, TESTS(r0)
         lw r15, SAVE_LR(r0)
         ret
 

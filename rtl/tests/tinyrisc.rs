@@ -324,3 +324,32 @@ fn illegal_and_out_of_range_operands_fault() {
     t.commit();
     assert!(t.eval(&m2).unwrap_err().message.contains("not 8-aligned"));
 }
+
+#[test]
+fn watched_addresses_count_issues_not_stalls() {
+    // r1 = 5; loop: r1 -= 1 (watched) while r1 != 0; r2 = 1; rcany
+    // (watched, stalled three cycles on a busy array first).
+    let mut m = Double::new(&[
+        Instr::new(Addi, 1, 0, 0, 5),  // 0x00
+        Instr::new(Addi, 1, 1, 0, -1), // 0x04, five times
+        Instr::new(Bne, 1, 0, 0, -2),  // 0x08 -> 0x04
+        Instr::new(Addi, 2, 0, 0, 1),  // 0x0c
+        Instr::new(Rcany, 3, 0, 0, 0), // 0x10
+    ]);
+    let mut t = TinyRisc::new(0, RiscTiming::default());
+    t.issue_watch = [Some(0x04), Some(0x10)];
+    run(&mut t, &m, 1 + 2 * 5 + 1);
+    assert_eq!(t.regs.read(1), 0);
+    assert_eq!(t.issues_watched, [5, 0]);
+    m.array_idle = Cell::new(false);
+    for _ in 0..3 {
+        t.eval(&m).unwrap();
+        assert_eq!(t.state, State::StallArray);
+        t.commit();
+    }
+    assert_eq!(t.issues_watched, [5, 0]);
+    m.array_idle = Cell::new(true);
+    run(&mut t, &m, 1);
+    assert_eq!(t.issues_watched, [5, 1]);
+    assert_eq!(t.stall_array, 3);
+}

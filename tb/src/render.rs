@@ -208,6 +208,9 @@ fn add_stats(a: &mut Stats, b: &Stats) {
     a.dma_words += b.dma_words;
     a.dma_transfers += b.dma_transfers;
     a.dma_waits_watched += b.dma_waits_watched;
+    for (a, b) in a.issues_watched.iter_mut().zip(b.issues_watched) {
+        *a += b;
+    }
     a.watched_offered += b.watched_offered;
     for c in 0..2 {
         a.watched_runs[c] += b.watched_runs[c];
@@ -231,6 +234,9 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
     a.dma_words -= b.dma_words.min(a.dma_words);
     a.dma_transfers -= b.dma_transfers.min(a.dma_transfers);
     a.dma_waits_watched -= b.dma_waits_watched.min(a.dma_waits_watched);
+    for (a, b) in a.issues_watched.iter_mut().zip(b.issues_watched) {
+        *a -= b.min(*a);
+    }
     a.watched_offered -= b.watched_offered.min(a.watched_offered);
     for c in 0..2 {
         a.watched_runs[c] -= b.watched_runs[c].min(a.watched_runs[c]);
@@ -240,6 +246,13 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
                 b.watched_rcs_by_tag[c][t].min(a.watched_rcs_by_tag[c][t]);
         }
     }
+}
+
+/// The addresses of the leaf cache's lookup and miss (the streamed packet
+/// traversal's `leaf_first` and `leaf_miss`), whose issues the simulator
+/// counts.
+fn leaf_watch(img: &Image) -> Option<(i64, i64)> {
+    img.symbol("leaf_first").zip(img.symbol("leaf_miss"))
 }
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
@@ -308,11 +321,8 @@ struct Group {
     /// the arrival at the tile after its last, or to `halt` for the frame's
     /// last item.
     counted: Stats,
-    /// The firmware's object tests and passes over the same span.
-    tests: u64,
+    /// The firmware's passes over the same span.
     passes: u64,
-    /// The leaf cache's hits and misses over the same span.
-    leaf: [u64; 2],
     /// The chip halted within the item's span (always for the frame's
     /// last item; for another, the program ended the frame early).
     halted: bool,
@@ -501,6 +511,11 @@ fn run_item<W: Word>(
         .map(|a| a as u32)
         .into_iter()
         .collect();
+    // The leaf cache's lookups and misses (the streamed packet traversal):
+    // counted by the simulator, at no cycle of the program's.
+    if let Some((first, miss)) = leaf_watch(img) {
+        chip.risc.issue_watch = [Some(first as u32), Some(miss as u32)];
+    }
     let fb = fw.fb_bytes();
     chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
     if let Some(st) = &fw.layout.stream {
@@ -543,19 +558,9 @@ fn run_item<W: Word>(
     let mut from = Stats::default();
     let mut to: Option<Stats> = None;
     let mut halted = false;
-    let (mut tests, mut passes, mut t_end_tail) = (0, 0, 0);
+    let (mut passes, mut t_end_tail) = (0, 0);
     let mut t_end_raw = None;
-    let (mut tests0, mut passes0) = (0, 0);
-    // The leaf cache's counters, where the firmware has them.
-    let leaf_syms = img.symbol("LEAF_HITS").zip(img.symbol("LEAF_MISSES"));
-    let leaf_now = |sim: &Sim<Chip<W>>| -> [u64; 2] {
-        leaf_syms.map_or([0, 0], |(h, m)| {
-            [h, m].map(|a| sim.top.mem.read(a as u32, 4) as u64)
-        })
-    };
-    let (mut leaf0, mut leaf) = ([0u64; 2], [0u64; 2]);
-    let leaf_since =
-        |now: [u64; 2], then: [u64; 2]| [0, 1].map(|i| now[i].wrapping_sub(then[i]) & 0xffff_ffff);
+    let mut passes0 = 0;
     // Each own tile's passes (the firmware's count).
     let (mut tile_passes, mut last_passes) = (Vec::with_capacity(own.len()), 0);
     let mut tile_seconds = Vec::with_capacity(own.len());
@@ -597,8 +602,7 @@ fn run_item<W: Word>(
         }
         if k == warm as usize {
             from = sim.top.stats();
-            (tests0, passes0) = (m(&sim, "TESTS")?, m(&sim, "PASSES")?);
-            leaf0 = leaf_now(&sim);
+            passes0 = m(&sim, "PASSES")?;
             last_passes = passes0;
         }
         if counting {
@@ -623,9 +627,7 @@ fn run_item<W: Word>(
     }
     if result.is_ok() {
         to = Some(sim.top.stats());
-        tests = m(&sim, "TESTS")?.wrapping_sub(tests0) & 0xffff_ffff;
         passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
-        leaf = leaf_since(leaf_now(&sim), leaf0);
         if !halted {
             // On to `halt`: counted for the frame's last item (one chip
             // ends there too), not for the others (one chip goes on to
@@ -641,9 +643,7 @@ fn run_item<W: Word>(
                 Ok(_) => {
                     if last {
                         to = Some(sim.top.stats());
-                        tests = m(&sim, "TESTS")?.wrapping_sub(tests0) & 0xffff_ffff;
                         passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
-                        leaf = leaf_since(leaf_now(&sim), leaf0);
                         halted = true;
                     }
                 }
@@ -701,9 +701,7 @@ fn run_item<W: Word>(
     Ok(Group {
         startup,
         counted,
-        tests,
         passes,
-        leaf,
         halted,
         t_end_tail,
         t_end_raw,
@@ -1245,8 +1243,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
     let mut rgb8 = vec![0u8; (w * h * 3) as usize];
     let mut hits = vec![NO_HIT; (w * h) as usize];
     let mut stats = Stats::default();
-    let (mut fw_cycles, mut startup, mut tests, mut passes) = (0u64, 0u64, 0u64, 0u64);
-    let mut leaf = [0u64; 2];
+    let (mut fw_cycles, mut startup, mut passes) = (0u64, 0u64, 0u64);
     let mut chip_seconds = 0.0;
     let mut item_seconds_all = Vec::with_capacity(items.len());
     let mut tile_seconds = Vec::with_capacity(tiles.len());
@@ -1280,10 +1277,7 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
                 fw_cycles = g.t_end_raw.unwrap_or(stats.cycles + g.t_end_tail);
                 ended = true;
             }
-            tests += g.tests;
             passes += g.passes;
-            leaf[0] += g.leaf[0];
-            leaf[1] += g.leaf[1];
             add_stats(&mut stats, &g.counted);
         }
         for (k, out) in g.out.iter().enumerate() {
@@ -1315,11 +1309,18 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         startup_cycles: startup,
         firmware_cycles: fw_cycles,
         stats,
-        object_tests: tests,
+        // The object tests: the runs of the test kernels (counted by the
+        // simulator, [`watch`]).
+        object_tests: stats.watched_runs[0],
         passes,
-        leaf_cache: (img.symbol("LEAF_HITS").is_some()).then(|| LeafCache {
-            hits: leaf[0],
-            misses: leaf[1],
+        // The leaf cache: every issue at `leaf_first` looks a leaf's first
+        // piece up, every one at `leaf_miss` moves it.
+        leaf_cache: leaf_watch(&img).is_some().then(|| {
+            let [looked, misses] = stats.issues_watched;
+            LeafCache {
+                hits: looked - misses.min(looked),
+                misses,
+            }
         }),
         tiles: tiles.len(),
         firmware: fw,

@@ -564,7 +564,10 @@ fn data(lay: &FbImage, merged_lanes: Option<&[u32]>) -> String {
         "the cycle counter at the tile loop's start",
     );
     d(&mut t, "T_END", ".word 0", "... and at its end");
-    d(&mut t, "TESTS", ".word 0", "object tests broadcast");
+    if lay.traversal == Traversal::Paper {
+        // (The packet traversal's tests are counted by the simulator.)
+        d(&mut t, "TESTS", ".word 0", "object tests broadcast");
+    }
     d(&mut t, "PASSES", ".word 0", "ray passes");
     d(&mut t, "TL_PTR", ".word 0", "the tile list's current entry");
     d(&mut t, "TL_CNT", ".word 0", "tiles left");
@@ -606,18 +609,6 @@ fn data(lay: &FbImage, merged_lanes: Option<&[u32]>) -> String {
                 "TILE_GEN",
                 ".word 0",
                 "the tile's number for the leaf cache: its corner, y << 12 | x",
-            );
-            d(
-                &mut t,
-                "LEAF_HITS",
-                ".word 0",
-                "leaves whose first piece was in its slot",
-            );
-            d(
-                &mut t,
-                "LEAF_MISSES",
-                ".word 0",
-                "leaves whose first piece was moved",
             );
             d(
                 &mut t,

@@ -81,6 +81,9 @@ pub struct Stats {
     /// watches (`TinyRisc::dma_wait_watch`; the ray tracer: a leaf piece's
     /// `dwait` before its tests).
     pub dma_waits_watched: u64,
+    /// Issues of the instructions TinyRISC watches
+    /// (`TinyRisc::issue_watch`), per watched address.
+    pub issues_watched: [u64; crate::tinyrisc::ISSUE_WATCH],
     /// Per class of [`Watch`], runs started at a watched address and the
     /// RCs that executed their first context.
     pub watched_runs: [u64; 2],
@@ -371,6 +374,7 @@ impl<W: Word> Chip<W> {
             array_stall_cycles: self.risc.stall_array,
             dma_stall_cycles: self.risc.stall_dma,
             dma_waits_watched: self.risc.dma_waits_watched,
+            issues_watched: self.risc.issues_watched,
             array_idle_control_cycles: self.idle_control,
             dma_busy_cycles: self.dma.busy_cycles,
             dma_words: self.dma.words_moved,

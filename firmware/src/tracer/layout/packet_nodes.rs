@@ -20,7 +20,7 @@ use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};
 
 /// Array cycles a packet spends on an inner node (its kernel and
-/// TinyRISC's decision), for [`super::super::Collapse::Auto`]. 46 to 48
+/// TinyRISC's decision), for [`super::super::Collapse::Auto`]. 45 to 48
 /// on the SPD scenes at 128x128 (`render --profile`); 48 here walks more
 /// nodes and costs balls, rings and tree 0.4-1.1% more cycles
 /// (`docs/tracer.md`, "The tree it walks").
@@ -85,7 +85,7 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check, the issues and the `rcany` of each part): 9 to 21 on the SPD
+/// check, the issues and the `rcany` of each part): 8 to 21 on the SPD
 /// scenes at 128x128 (`render --profile`, the `lo_*` rows over the
 /// object tests).
 pub const PK_OBJECT_RISC: f64 = 16.0;
@@ -93,7 +93,7 @@ pub const PK_OBJECT_RISC: f64 = 16.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 87 to 180 on the SPD scenes at 128x128 but for shells' few
+/// is added. 80 to 173 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
 pub const PK_LEAF_COST: f64 = 130.0;

@@ -57,8 +57,11 @@
 //!
 //! TinyRISC registers: r5 the node, r6 its flags (the split axis times 4,
 //! negative for a leaf), r7 `SPLIT` (streamed: the FB word a node
-//! kernel's split is written to), r13 the pass's object tests, r14 the
-//! node stack pointer (`NSTACK`).
+//! kernel's split is written to), r13 `MODE` (0: closest hit), r14 the
+//! node stack's depth in bytes (0: empty; its entries at `NSTACK`).
+//! The traversal keeps no statistics of its own: the simulator counts the
+//! object tests (the runs of the test kernels) and the leaf cache's hits
+//! and misses (the issues at `leaf_first` and `leaf_miss`).
 
 use super::super::emit::{
     at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
@@ -394,8 +397,8 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .lw(R1, at("PASS", R0))
         .addi(R1, R1, 1)
         .sw(R1, at("PASS", R0))
-        .li(R13, 0)
-        .c("object tests of the pass");
+        .lw(R13, at("MODE", R0))
+        .c("r13 = MODE through the walk");
     if lay.root_leaf {
         // The whole tree is one leaf: its objects are tested by the awake
         // rays, nothing to walk. (`k_sign_x` runs only to mark the pass's
@@ -403,7 +406,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         // the pass's.)
         t.comment("the tree is one leaf: its objects, tested by the awake rays")
             .m("BCAST", names::sign(0))
-            .li(R14, "NSTACK")
+            .li(R14, 0)
             .li(R5, "ROOT")
             .rcsl(R4)
             .rcsh(R10)
@@ -419,7 +422,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
             });
     }
     child_order(t, &f);
-    t.li(R14, "NSTACK").li(R5, "ROOT");
+    t.li(R14, 0).c("the node stack: empty").li(R5, "ROOT");
     if streamed {
         t.li(R7, "SPLIT").c("r7 = SPLIT throughout the walk");
     }
@@ -470,19 +473,18 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     dispatch_first(t, &f, true);
     leaf(t, lay, &f);
     t.label("leaf_done")
-        .lw(R1, at("MODE", R0))
-        .beqz(R1, "pop_node")
+        .beqz(R13, "pop_node")
+        .c("closest hit")
         .m("BCAST", names::DONE_WITH_HIT)
         .c("any hit: the rays with a hit are done");
     t.label("pop_node")
-        .li(R9, "NSTACK")
-        .beq(R14, R9, "trace_done")
+        .beqz(R14, "trace_done")
+        .c("the node stack empty")
         .addi(R14, R14, -4)
-        .lw(R5, deref(R14))
+        .lw(R5, at("NSTACK", R14))
         .li(R1, kaddr(names::POP_NODE));
     if streamed {
-        t.addi(R2, R14, "SLOTS-NSTACK")
-            .c("its slot: the stack entry's");
+        t.addi(R2, R14, "SLOTS").c("its slot: the stack entry's");
     } else {
         t.addi(R2, R5, "PN_PARENT_SLOT");
     }
@@ -502,12 +504,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .sbcb(R11, split, klen(&names::node(0, false)))
         .c("its node kernel")
         .j("inner_node");
-    t.label("trace_done")
-        .lw(R1, at("TESTS", R0))
-        .add(R1, R1, R13)
-        .sw(R1, at("TESTS", R0))
-        .lw(R15, at("SAVE_LR", R0))
-        .ret();
+    t.label("trace_done").lw(R15, at("SAVE_LR", R0)).ret();
     majority(t);
 }
 
@@ -558,14 +555,13 @@ fn dispatch_first(t: &mut Code, f: &Fields, jump: bool) {
 /// own word).
 fn push_second(t: &mut Code, f: &Fields) {
     if f.streamed {
-        t.addi(R2, R14, "SLOTS-NSTACK")
-            .c("its slot: the stack entry's");
+        t.addi(R2, R14, "SLOTS").c("its slot: the stack entry's");
     } else {
         t.addi(R2, R5, "PN_SLOT").c("its slot: the node's");
     }
     t.m("BCAST_AT", format!("{}, r2", names::PUSH_SECOND))
         .c("the rays' intervals for the second child")
-        .sw(R10, deref(R14))
+        .sw(R10, at("NSTACK", R14))
         .addi(R14, R14, 4)
         .c("push it");
 }
@@ -644,22 +640,15 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .bne(R3, R2, "leaf_miss")
             .c("moved in another tile (checked first: a tag from an earlier tile never costs more)")
             .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
-            .bne(R1, R3, "leaf_miss")
-            .c("the slot holds another block")
-            .lw(R3, at("LEAF_HITS", R0))
-            .addi(R3, R3, 1)
-            .sw(R3, at("LEAF_HITS", R0))
-            .j("leaf_awake");
+            .beq(R1, R3, "leaf_awake")
+            .c("the slot holds the block: a hit");
         t.label("leaf_miss")
             .lw(R3, at("PS_BLOCK_WORDS", R5))
             .ldfb(R1, R7, R3)
             .c("the first piece's DMA starts")
             .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
             .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
-            .c("r2 = TILE_GEN")
-            .lw(R3, at("LEAF_MISSES", R0))
-            .addi(R3, R3, 1)
-            .sw(R3, at("LEAF_MISSES", R0));
+            .c("r2 = TILE_GEN");
         t.comment("while the first piece moves: the awake rays, for the mailboxes");
         t.label("leaf_awake")
             .beqz(R12, "leaf_piece")
@@ -893,15 +882,13 @@ pub fn macros() -> Code {
         .sw(R11, at("MB_PASS", R8))
         .sw(R4, at("MB_RAYS", R8))
         .sw(R10, at("MB_RAYS+MASK_HI", R8));
-    b.label("\\p\\()_go")
-        .addi(R13, R13, 1)
-        .c("one more object test");
+    b.label("\\p\\()_go");
     t.define_macro(
         "MAILBOX_CHECK",
         "p",
         "MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,\n\
          r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the\n\
-         pass and the rays, and on to `p_go` (r13 counts the test). Clobbers r1..r3.",
+         pass and the rays, and on to `p_go`. Clobbers r1..r3.",
         b,
     );
     let mut b = Code::new();
