@@ -86,7 +86,7 @@ LE_MAILBOX = 1          ;     its mailbox index (-1: none)
 LE_WORDS = 2
 MB_SHIFT = 4            ; a mailbox (main memory, 16 bytes, MAILBOX + index << MB_SHIFT):
 MB_PASS = 0             ;   the pass that last tested the object
-MB_RAYS = 4             ;   the rays that did (64-bit mask)
+MB_RAYS = 4             ;   the rays that have not in that pass (64-bit mask, 1: asleep at every test)
 
 ; ---- FB set 1: output banks (word addresses) ----
 OUT_BANK0 = 32768       ; the two output banks, alternating by tile
@@ -237,26 +237,27 @@ SLOT_TMIN = 1           ; slot: near end
 no_hit\@:
 .endm
 
-; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,
-; r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the
-; pass and the rays, and on to `p_go`. Clobbers r1..r3.
+; MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (the
+; sleeping ones in r4, r10) has tested it in this pass (r13), on to `p_next`; else
+; the mailbox takes the pass and the rays still to test it, and on to `p_go`.
+; Clobbers r1..r3.
 .macro MAILBOX_CHECK p
         lw r1, MB_PASS(r8)
-        bne r1, r11, \p\()_fresh        ; not tested in this pass yet
+        bne r1, r13, \p\()_fresh        ; not tested in this pass yet
         lw r2, MB_RAYS(r8)
         lw r3, MB_RAYS+MASK_HI(r8)
         or r1, r2, r4
-        bne r1, r2, \p\()_upd
+        bne r1, r4, \p\()_upd           ; an awake ray has not tested it
         or r1, r3, r10
-        beq r1, r3, \p\()_next          ; every awake ray has tested it
+        beq r1, r10, \p\()_next         ; every awake ray has tested it
 \p\()_upd:
-        or r2, r2, r4
-        or r3, r3, r10
+        and r2, r2, r4
+        and r3, r3, r10
         sw r2, MB_RAYS(r8)
         sw r3, MB_RAYS+MASK_HI(r8)
         j \p\()_go
 \p\()_fresh:
-        sw r11, MB_PASS(r8)
+        sw r13, MB_PASS(r8)
         sw r4, MB_RAYS(r8)
         sw r10, MB_RAYS+MASK_HI(r8)
 \p\()_go:
@@ -401,7 +402,9 @@ trace:
         lw r1, PASS(r0)
         addi r1, r1, 1
         sw r1, PASS(r0)
-        lw r13, MODE(r0)                ; r13 = MODE through the walk
+        lw r13, MODE(r0)
+        slli r13, r13, 31
+        or r13, r13, r1                 ; r13: the pass's stamp, PASS | MODE << 31 (negative: any hit)
         BCAST_FB k_pass_start, ROOTBOX  ; intervals in the root cell, 1/d
         BCAST k_sign_x
         rcst r3                         ; the awake rays going down along x: none, some, all
@@ -523,17 +526,14 @@ some_first:
         sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
         j inner_node
         ; the leaf r5: an object in more than one leaf has a mailbox (the pass that last
-        ; tested it and which rays did); it is broadcast unless every awake ray has tested it
+        ; tested it and which rays have not); it is broadcast unless every awake ray has tested it
 leaf:
         andi r1, r6, 2
         bnez r1, leaf_done              ; an empty leaf
         andi r1, r6, 1
         beqz r1, leaf_objects           ; no mailbox to check
         rcsl r4
-        rcsh r10
-        nor r4, r4, r0
-        nor r10, r10, r0                ; r4, r10: the awake rays
-        lw r11, PASS(r0)
+        rcsh r10                        ; r4, r10: the sleeping rays
 leaf_objects:
         li r12, MAILBOX
         addi r6, r5, PL_LISTS
@@ -553,7 +553,7 @@ lo_sphere_test:
         mv r15, r7                      ; r15: the object under test
         ; while its first part runs: the next object to test (r9 = 0: none)
         addi r9, r9, -1
-        beqz r9, lo_sphere_parts
+        beqz r9, lo_sphere_last
 lo_sphere_ahead_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -563,14 +563,15 @@ lo_sphere_ahead_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere_ahead
 lo_sphere_parts:
-        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_done ; the rest, if some awake ray can still hit it
-lo_sphere_done:
-        bnez r9, lo_sphere_test
-        j lo_sphere_end
+        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_test ; the rest, if some awake ray can still hit it
+        j lo_sphere_test
 lo_sphere_ahead_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_ahead_obj
-        j lo_sphere_parts
+        ; the last object's rest
+lo_sphere_last:
+        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_end ; the rest, if some awake ray can still hit it
+        j lo_sphere_end
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -591,7 +592,7 @@ lo_cylinder_test:
         mv r15, r7                      ; r15: the object under test
         ; while its first part runs: the next object to test (r9 = 0: none)
         addi r9, r9, -1
-        beqz r9, lo_cylinder_parts
+        beqz r9, lo_cylinder_last
 lo_cylinder_ahead_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -601,22 +602,25 @@ lo_cylinder_ahead_obj:
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder_ahead
 lo_cylinder_parts:
-        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_done ; up to F: the ray's line meets the cylinder
-        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_done ; up to F: the root ahead, before tbest
-        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_done ; the rest, if some awake ray can still hit it
-lo_cylinder_done:
-        bnez r9, lo_cylinder_test
-        j lo_cylinder_end
+        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_test ; up to F: the ray's line meets the cylinder
+        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_test ; up to F: the root ahead, before tbest
+        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_test ; the rest, if some awake ray can still hit it
+        j lo_cylinder_test
 lo_cylinder_ahead_next:
         addi r9, r9, -1
         bnez r9, lo_cylinder_ahead_obj
-        j lo_cylinder_parts
+        ; the last object's rest
+lo_cylinder_last:
+        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_end ; up to F: the ray's line meets the cylinder
+        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_end ; up to F: the root ahead, before tbest
+        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_end ; the rest, if some awake ray can still hit it
+        j lo_cylinder_end
 lo_cylinder_next:
         addi r9, r9, -1
         bnez r9, lo_cylinder_obj
 lo_cylinder_end:
 leaf_done:
-        beqz r13, pop_node              ; closest hit
+        bge r13, r0, pop_node           ; closest hit
         BCAST k_done_with_hit           ; any hit: the rays with a hit are done
 pop_node:
         beqz r14, trace_done            ; the node stack empty

@@ -406,6 +406,11 @@ impl Code {
         Code::default()
     }
 
+    /// No line yet.
+    pub fn is_empty(&self) -> bool {
+        self.lines.is_empty()
+    }
+
     /// One instruction, as the assembler reads it.
     fn i(&mut self, text: impl Into<String>) -> &mut Self {
         self.lines.push(Line::Instr(text.into(), String::new()));

@@ -85,7 +85,7 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check, the issues and the `rcany` of each part): 8 to 21 on the SPD
+/// check, the issues and the `rcany` of each part): 7 to 18 on the SPD
 /// scenes at 128x128 (`render --profile`, the `lo_*` rows over the
 /// object tests).
 pub const PK_OBJECT_RISC: f64 = 16.0;
@@ -93,7 +93,7 @@ pub const PK_OBJECT_RISC: f64 = 16.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 80 to 173 on the SPD scenes at 128x128 but for shells' few
+/// is added. 75 to 163 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
 pub const PK_LEAF_COST: f64 = 130.0;
@@ -727,7 +727,11 @@ pub mod fields {
         "a mailbox (main memory, 16 bytes, MAILBOX + index << MB_SHIFT):",
     );
     pub const MB_PASS: Name = Name::new("MB_PASS", 0, "  the pass that last tested the object");
-    pub const MB_RAYS: Name = Name::new("MB_RAYS", 4, "  the rays that did (64-bit mask)");
+    pub const MB_RAYS: Name = Name::new(
+        "MB_RAYS",
+        4,
+        "  the rays that have not in that pass (64-bit mask, 1: asleep at every test)",
+    );
 }
 
 /// A streamed node record's word of field `f`.

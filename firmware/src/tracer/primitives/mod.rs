@@ -387,64 +387,68 @@ fn planar_inside(t: ChipType) -> planar::Inside {
     }
 }
 
-/// Broadcast the test of type `ty` (its [`CutTest`] `c`) on a record in
-/// parts, at its kernel's cuts: after each part, where no awake RC has F
-/// (`rcany`), on to `done`, the rest not run (`then`: the further kernels
-/// likewise). `between` is TinyRISC's work after the first part is
-/// issued, done while it runs. The record's address is in `first` for the
-/// first part and in `rec` after `between`. Labels begin with `at`;
-/// `fit`: the records' variants. Clobbers r1..r3.
-#[allow(clippy::too_many_arguments)]
-pub fn run_with_cuts(
+/// Broadcast the first part of a test in parts ([`CutTest`] `c`) on the
+/// record at `first`: its kernel up to the first cut (`BCAST_UPTO`), or the
+/// whole kernel where it has no cut. TinyRISC's work while it runs comes
+/// next, then [`run_rest`].
+pub fn run_first_part(t: &mut Code, c: &CutTest, first: Reg) {
+    let (k, field) = (c.kernel, c.field);
+    match c.cuts.first() {
+        Some((name, holds)) => {
+            let cut = super::emit::cut_label(k, name);
+            t.m("BCAST_UPTO", format!("{k}, {cut}, {first}, {field}"))
+                .c(format!("up to F: {holds}"));
+        }
+        None => {
+            t.m("BCAST_REC", format!("{k}, {first}, {field}"));
+            if let Some(holds) = c.then {
+                t.c(format!("F: {holds}"));
+            }
+        }
+    }
+}
+
+/// The rest of a test of type `ty` in parts ([`CutTest`] `c`) after
+/// [`run_first_part`], on the record at `rec`: each part after a cut, and
+/// then the further kernels (`then`), only where some awake RC has F
+/// (`rcany`), else on to `none`. Labels begin with `at`; `fit`: the
+/// records' variants. Clobbers r1..r3.
+pub fn run_rest(
     t: &mut Code,
     ty: ChipType,
     c: &CutTest,
     fit: &Fit,
-    [first, rec]: [Reg; 2],
+    rec: Reg,
     at: &str,
-    done: &str,
-    between: impl FnOnce(&mut Code),
+    none: &str,
 ) {
     let (k, field) = (c.kernel, c.field);
-    let mut between = Some(between);
-    // A part after a cut runs only if some awake ray can still hit the
-    // object (`BCAST_FROM_ANY`); `between` runs before the first such
-    // check, while the first part does.
-    let mut run_from = |t: &mut Code, from: &str, to: &str| {
-        if let Some(b) = between.take() {
-            b(t);
-        }
+    let run_from = |t: &mut Code, from: &str, to: &str| {
         t.m(
             "BCAST_FROM_ANY",
-            format!("{from}, {to}, {rec}, {field}, {done}"),
+            format!("{from}, {to}, {rec}, {field}, {none}"),
         );
     };
-    let mut from = k.to_string();
-    for (name, holds) in c.cuts {
-        let cut = super::emit::cut_label(k, name);
-        if from == k {
-            t.m("BCAST_UPTO", format!("{k}, {cut}, {first}, {field}"));
-        } else {
-            run_from(t, &from, &cut);
-        }
+    let cuts: Vec<String> = c
+        .cuts
+        .iter()
+        .map(|(name, _)| super::emit::cut_label(k, name))
+        .collect();
+    for (i, (_, holds)) in c.cuts.iter().enumerate().skip(1) {
+        run_from(t, &cuts[i - 1], &cuts[i]);
         t.c(format!("up to F: {holds}"));
-        from = cut;
     }
-    if from == k {
-        t.m("BCAST_REC", format!("{k}, {first}, {field}"));
-    } else {
-        run_from(t, &from, &format!("{k}_end"));
+    if let Some(last) = cuts.last() {
+        run_from(t, last, &format!("{k}_end"));
         t.c("the rest, if some awake ray can still hit it");
-    }
-    if let Some(holds) = c.then {
-        t.c(format!("F: {holds}"));
-        if let Some(b) = between.take() {
-            b(t);
+        if let Some(holds) = c.then {
+            t.c(format!("F: {holds}"));
         }
-        t.rcany(R3).beqz(R3, done).c("no awake ray can hit it");
+    }
+    if c.then.is_some() {
+        t.rcany(R3).beqz(R3, none).c("no awake ray can hit it");
         ty.broadcast_then(t, at, rec, fit);
     }
-    t.label(done);
 }
 
 /// The kernels whose runs start an object test (their RCs at the first

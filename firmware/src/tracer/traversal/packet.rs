@@ -53,11 +53,15 @@
 //! between FB bank 1 and the top of bank 0 (`PS_FB`), each piece after the
 //! first moving while the piece before it is tested.
 //! Mailboxes (main memory, `MB_BYTES` each): the pass that last tested
-//! the object and which rays did (`MB_PASS`, `MB_RAYS`).
+//! the object (`MB_PASS`, the pass's stamp) and the rays that have not
+//! tested it in that pass (`MB_RAYS`: the rays asleep at each of its
+//! tests, a mask in the sense of the sleep mask `rcsl`/`rcsh` reads, so
+//! that no mask is inverted).
 //!
 //! TinyRISC registers: r5 the node, r6 its flags (the split axis times 4,
 //! negative for a leaf), r7 `SPLIT` (streamed: the FB word a node
-//! kernel's split is written to), r13 `MODE` (0: closest hit), r14 the
+//! kernel's split is written to), r13 the pass's stamp
+//! (`PASS | MODE << 31`: negative for any hit), r14 the
 //! node stack's depth in bytes (0: empty; its entries at `NSTACK`).
 //! The traversal keeps no statistics of its own: the simulator counts the
 //! object tests (the runs of the test kernels) and the leaf cache's hits
@@ -70,7 +74,7 @@ use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY};
 use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
-use super::super::primitives::{kaddr, klen, run_with_cuts};
+use super::super::primitives::{kaddr, klen, run_first_part, run_rest};
 use crate::tracer::kernel_names as names;
 
 /// Widening of every split plane and of the root box in the packet
@@ -398,7 +402,9 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .addi(R1, R1, 1)
         .sw(R1, at("PASS", R0))
         .lw(R13, at("MODE", R0))
-        .c("r13 = MODE through the walk");
+        .slli(R13, R13, 31)
+        .or(R13, R13, R1)
+        .c("r13: the pass's stamp, PASS | MODE << 31 (negative: any hit)");
     if lay.root_leaf {
         // The whole tree is one leaf: its objects are tested by the awake
         // rays, nothing to walk. (`k_sign_x` runs only to mark the pass's
@@ -410,11 +416,11 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
             .li(R5, "ROOT")
             .rcsl(R4)
             .rcsh(R10)
-            .nor(R4, R4, R0)
-            .nor(R10, R10, R0)
-            .or(R1, R4, R10)
+            .c("r4, r10: the sleeping rays")
+            .and(R1, R4, R10)
+            .nor(R1, R1, R0)
             .beqz(R1, "trace_done")
-            .lw(R11, at("PASS", R0))
+            .c("every ray asleep")
             .j(if f.streamed {
                 "leaf_first"
             } else {
@@ -473,7 +479,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     dispatch_first(t, &f, true);
     leaf(t, lay, &f);
     t.label("leaf_done")
-        .beqz(R13, "pop_node")
+        .bge(R13, R0, "pop_node")
         .c("closest hit")
         .m("BCAST", names::DONE_WITH_HIT)
         .c("any hit: the rays with a hit are done");
@@ -596,15 +602,10 @@ fn next_piece_dma(t: &mut Code, one_slot: bool, why: &str) {
 fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
     t.comment("the leaf r5: an object in more than one leaf has a mailbox (the pass that last")
         .comment(
-            "tested it and which rays did); it is broadcast unless every awake ray has tested it",
+            "tested it and which rays have not); it is broadcast unless every awake ray has tested it",
         );
     let awake = |t: &mut Code| {
-        t.rcsl(R4)
-            .rcsh(R10)
-            .nor(R4, R4, R0)
-            .nor(R10, R10, R0)
-            .c("r4, r10: the awake rays")
-            .lw(R11, at("PASS", R0));
+        t.rcsl(R4).rcsh(R10).c("r4, r10: the sleeping rays");
     };
     if f.streamed {
         // A leaf's block comes in pieces, alternately into FB bank 1 and
@@ -665,15 +666,14 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .beqz(R8, "leaf_go")
             .c("no mailbox: to be tested")
             .lw(R1, at("MB_PASS", R8))
-            .bne(R1, R11, "leaf_go")
+            .bne(R1, R13, "leaf_go")
             .lw(R2, at("MB_RAYS", R8))
-            .nor(R2, R2, R0)
-            .and(R2, R2, R4)
-            .bnez(R2, "leaf_go")
+            .or(R2, R2, R4)
+            .bne(R2, R4, "leaf_go")
+            .c("an awake ray has not tested it")
             .lw(R3, at("MB_RAYS+MASK_HI", R8))
-            .nor(R3, R3, R0)
-            .and(R3, R3, R10)
-            .bnez(R3, "leaf_go")
+            .or(R3, R3, R10)
+            .bne(R3, R10, "leaf_go")
             .addi(R9, R9, -1)
             .bnez(R9, "leaf_scan");
         t.comment("every object of the piece tested by every awake ray");
@@ -789,42 +789,56 @@ fn type_loop(
         t.label(format!("{n}_end"));
         return;
     };
+    // The test's first part, then the next object to test found while it
+    // runs; the rest of the test (its parts after the cuts, where some
+    // awake ray can still hit it) comes in two copies, one that goes on to
+    // the next object's test and one for the leaf's last object of the
+    // type, so that a part not run jumps straight on.
     let ahead = format!("{n}_ahead");
+    let (test, last, end) = (format!("{n}_test"), format!("{n}_last"), format!("{n}_end"));
+    // What runs after the parts whatever F (a cylinder's or cone's caps).
+    let after = |at: &str| {
+        let mut c = Code::new();
+        ty.broadcast_after_cut_test(&mut c, at, R15, caps);
+        c
+    };
+    // The rest, on to `next` where a part does not run.
+    let rest = |t: &mut Code, at: &str, next: &str| {
+        let after = after(at);
+        let done = format!("{at}_done");
+        let none = if after.is_empty() { next } else { &done };
+        run_rest(t, ty, &cut, &lay.fit, R15, at, none);
+        if !after.is_empty() {
+            t.label(&done).extend(after);
+        }
+    };
     t.label(format!("{n}_obj"));
     fetch(t, n);
     mailbox_check(t, n);
-    t.label(format!("{n}_test"));
-    run_with_cuts(
-        t,
-        ty,
-        &cut,
-        &lay.fit,
-        [R7, R15],
-        n,
-        &format!("{n}_done"),
-        |t| {
-            t.mv(R15, R7)
-                .c("r15: the object under test")
-                .comment("while its first part runs: the next object to test (r9 = 0: none)");
-            advance(t);
-            t.addi(R9, R9, -1).beqz(R9, format!("{n}_parts"));
-            t.label(format!("{ahead}_obj"));
-            fetch(t, &ahead);
-            mailbox_check(t, &ahead);
-            t.label(format!("{n}_parts"));
-        },
-    );
-    ty.broadcast_after_cut_test(t, n, R15, caps);
-    t.bnez(R9, format!("{n}_test")).j(format!("{n}_end"));
+    t.label(&test);
+    run_first_part(t, &cut, R7);
+    t.mv(R15, R7)
+        .c("r15: the object under test")
+        .comment("while its first part runs: the next object to test (r9 = 0: none)");
+    advance(t);
+    t.addi(R9, R9, -1).beqz(R9, &last);
+    t.label(format!("{ahead}_obj"));
+    fetch(t, &ahead);
+    mailbox_check(t, &ahead);
+    t.label(format!("{n}_parts"));
+    rest(t, n, &test);
+    t.j(&test);
     t.label(format!("{ahead}_next"));
     advance(t);
-    t.addi(R9, R9, -1)
-        .bnez(R9, format!("{ahead}_obj"))
-        .j(format!("{n}_parts"));
+    t.addi(R9, R9, -1).bnez(R9, format!("{ahead}_obj"));
+    t.comment("the last object's rest");
+    t.label(&last);
+    rest(t, &last, &end);
+    t.j(&end);
     t.label(format!("{n}_next"));
     advance(t);
     t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
-    t.label(format!("{n}_end"));
+    t.label(&end);
 }
 
 /// `majority`: r8 = 1 when more awake rays have F (a negative direction
@@ -863,32 +877,34 @@ pub fn macros() -> Code {
     let mut t = Code::new();
     let mut b = Code::new();
     b.lw(R1, at("MB_PASS", R8))
-        .line("bne r1, r11, \\p\\()_fresh")
+        .line("bne r1, r13, \\p\\()_fresh")
         .c("not tested in this pass yet")
         .lw(R2, at("MB_RAYS", R8))
         .lw(R3, at("MB_RAYS+MASK_HI", R8))
         .or(R1, R2, R4)
-        .line("bne r1, r2, \\p\\()_upd")
+        .line("bne r1, r4, \\p\\()_upd")
+        .c("an awake ray has not tested it")
         .or(R1, R3, R10)
-        .line("beq r1, r3, \\p\\()_next")
+        .line("beq r1, r10, \\p\\()_next")
         .c("every awake ray has tested it");
     b.label("\\p\\()_upd")
-        .or(R2, R2, R4)
-        .or(R3, R3, R10)
+        .and(R2, R2, R4)
+        .and(R3, R3, R10)
         .sw(R2, at("MB_RAYS", R8))
         .sw(R3, at("MB_RAYS+MASK_HI", R8))
         .line("j \\p\\()_go");
     b.label("\\p\\()_fresh")
-        .sw(R11, at("MB_PASS", R8))
+        .sw(R13, at("MB_PASS", R8))
         .sw(R4, at("MB_RAYS", R8))
         .sw(R10, at("MB_RAYS+MASK_HI", R8));
     b.label("\\p\\()_go");
     t.define_macro(
         "MAILBOX_CHECK",
         "p",
-        "MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (r4,\n\
-         r10) has tested it in this pass (r11), on to `p_next`; else the mailbox takes the\n\
-         pass and the rays, and on to `p_go`. Clobbers r1..r3.",
+        "MAILBOX_CHECK p: the mailbox at r8 of the object at hand. Where every awake ray (the\n\
+         sleeping ones in r4, r10) has tested it in this pass (r13), on to `p_next`; else\n\
+         the mailbox takes the pass and the rays still to test it, and on to `p_go`.\n\
+         Clobbers r1..r3.",
         b,
     );
     let mut b = Code::new();
