@@ -69,17 +69,14 @@ impl<'t> Parser<'t> {
 
     fn binary(&mut self, c: &Ctx, min_prec: u8) -> Result<Value, ExprError> {
         let mut lhs = self.unary(c)?;
-        loop {
-            let (op, prec) = match self.peek() {
-                Some(Tok::P(p)) => match *p {
-                    "|" => ("|", 1),
-                    "^" => ("^", 2),
-                    "&" => ("&", 3),
-                    "<<" | ">>" => (*p, 4),
-                    "+" | "-" => (*p, 5),
-                    "*" | "/" | "%" => (*p, 6),
-                    _ => break,
-                },
+        while let Some(Tok::P(p)) = self.peek() {
+            let (op, prec) = match *p {
+                "|" => ("|", 1),
+                "^" => ("^", 2),
+                "&" => ("&", 3),
+                "<<" | ">>" => (*p, 4),
+                "+" | "-" => (*p, 5),
+                "*" | "/" | "%" => (*p, 6),
                 _ => break,
             };
             if prec < min_prec {

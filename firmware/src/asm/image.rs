@@ -146,7 +146,7 @@ impl Image {
                 .collect(),
             context: self
                 .labels_in(Section::Ctx)
-                .filter(|l| l.addr >= ctx_base && (l.addr - ctx_base) % 4 == 0)
+                .filter(|l| l.addr >= ctx_base && (l.addr - ctx_base).is_multiple_of(4))
                 .map(|l| ((l.addr - ctx_base) / 4, l.name.clone()))
                 .collect(),
         }

@@ -260,7 +260,7 @@ pub fn assemble(src: &str, file: &str) -> Result<Image, AsmErrors> {
         }
     }
     let mut labels = std::mem::take(&mut a.labels);
-    labels.sort_by(|x, y| (x.section as u8, x.addr).cmp(&(y.section as u8, y.addr)));
+    labels.sort_by_key(|l| (l.section as u8, l.addr));
     Ok(Image {
         entry,
         segments: segs,
