@@ -224,7 +224,7 @@ impl CostCheck {
             leaf_loop: per(leaf_control, leaves as f64),
             object_risc: per(
                 control(&|n| ci::is_object_label(n)),
-                chip.object_tests as f64,
+                chip.object_tests() as f64,
             ),
         })
     }
@@ -391,7 +391,7 @@ pub(crate) fn render_and_measure(
         "startup_cycles": chip.startup_cycles,
         "tiles": chip.tiles,
         "passes": chip.passes,
-        "object_tests": chip.object_tests,
+        "object_tests": chip.object_tests(),
         "array_busy_cycles": chip.stats.array_busy_cycles,
         "dma_busy_cycles": chip.stats.dma_busy_cycles,
         "datapath_bits": opt.datapath.bits(),

@@ -41,11 +41,10 @@ pub struct ChipRender {
     /// get wrong: see [`ChipRender::firmware_count_disagrees`].
     pub firmware_cycles: u64,
     pub stats: Stats,
-    pub object_tests: u64,
     pub passes: u64,
     /// The streamed packet traversal's leaf cache (`None` for other
     /// layouts): leaves whose first piece was in its slot, and those whose
-    /// first piece was moved (the firmware's counts).
+    /// first piece was moved (counted by the simulator).
     pub leaf_cache: Option<LeafCache>,
     pub tiles: usize,
     pub firmware: Firmware,
@@ -143,8 +142,14 @@ impl ChipRender {
         if self.passes == 0 {
             0.0
         } else {
-            self.object_tests as f64 / self.passes as f64
+            self.object_tests() as f64 / self.passes as f64
         }
+    }
+
+    /// The object tests broadcast: the runs of the test kernels (counted
+    /// by the simulator, [`watch`]).
+    pub fn object_tests(&self) -> u64 {
+        self.stats.watched_runs[0]
     }
 
     /// The rays the chip traced, by kind: the RCs awake at the start of
@@ -1309,16 +1314,13 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
         startup_cycles: startup,
         firmware_cycles: fw_cycles,
         stats,
-        // The object tests: the runs of the test kernels (counted by the
-        // simulator, [`watch`]).
-        object_tests: stats.watched_runs[0],
         passes,
         // The leaf cache: every issue at `leaf_first` looks a leaf's first
         // piece up, every one at `leaf_miss` moves it.
         leaf_cache: leaf_watch(&img).is_some().then(|| {
             let [looked, misses] = stats.issues_watched;
             LeafCache {
-                hits: looked - misses.min(looked),
+                hits: looked.saturating_sub(misses),
                 misses,
             }
         }),

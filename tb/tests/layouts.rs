@@ -107,7 +107,7 @@ fn same_image(name: &str, scene: &Scene, w: u32, h: u32) {
             "{name} {w}x{h} {l}: {} cycles, {} FB words, {} object tests, {psnr:.2} dB, hits {hits:.4}",
             c.cycles,
             c.firmware.fb.len(),
-            c.object_tests
+            c.object_tests()
         );
         assert!(psnr >= 30.0, "{name} {l}: PSNR {psnr:.2} dB < 30");
         assert!(hits >= 0.98, "{name} {l}: hit agreement {hits:.4} < 0.98");
@@ -122,7 +122,7 @@ fn same_image(name: &str, scene: &Scene, w: u32, h: u32) {
         a.hits == b.hits,
         "{name}: the layouts give different hit maps"
     );
-    assert_eq!(a.object_tests, b.object_tests, "{name}: object tests");
+    assert_eq!(a.object_tests(), b.object_tests(), "{name}: object tests");
     assert_eq!(a.passes, b.passes, "{name}: ray passes");
 }
 

@@ -190,8 +190,8 @@ fn a_frame_cut_at_every_tile_is_one_chips_frame() {
         assert_eq!(one.stats, cut.stats, "{what}");
         assert_eq!(one.firmware_cycles, cut.firmware_cycles, "{what}");
         assert_eq!(
-            (one.object_tests, one.passes),
-            (cut.object_tests, cut.passes),
+            (one.object_tests(), one.passes),
+            (cut.object_tests(), cut.passes),
             "{what}"
         );
         assert_eq!(one.leaf_cache, cut.leaf_cache, "{what}");
