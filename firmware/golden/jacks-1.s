@@ -1490,11 +1490,8 @@ k_sphere:
         mov r12, fb0                    ; r
         mov r13, fb0                    ; invr
         mul r8, r8, r13, >>KS_SPHERE+EP_SPHERE
-        st r8, [#TMP0]
         mul r9, r9, r13, >>KS_SPHERE+EP_SPHERE
-        st r9, [#TMP0+1]
-        mul r10, r10, r13, >>KS_SPHERE+EP_SPHERE
-        st r10, [#TMP0+2]               ; p/r in TMP0..2
+        mul r10, r10, r13, >>KS_SPHERE+EP_SPHERE ; p/r
         ld r14, [r0 + #C_ONE]
         ldacc r14, <<Q14
         msu out, r8, r8
@@ -1502,6 +1499,9 @@ k_sphere:
         msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
         cmp.gt r15, #0                  ; F: the line meets the sphere
 k_sphere_cut_line:
+        st r8, [#TMP0]
+        st r9, [#TMP0+1]
+        st r10, [#TMP0+2]               ; p/r in TMP0..2
         ; sqrt
         ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
@@ -1580,8 +1580,6 @@ k_cylinder:
         sub r15, r15, r13
         add r15, fb0, r15
         st r15, [#TMP6]                 ; the projection's remainder, plus B's
-        st r11, [#TMP0]
-        st r12, [#TMP1]                 ; oc2
         mul out, fb0, r4
         mac out, fb0, r5
         mac r8, fb0, r6, >>Q14
@@ -1589,58 +1587,52 @@ k_cylinder:
         mac out, fb0, r5
         mac r9, fb0, r6, >>Q14          ; d2 = (d.e1, d.e2)
         ; bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1
-        mov r13, fb0
-        st r13, [#TMP7]                 ; invr
-        mov r14, fb0
-        st r14, [#TMP8]                 ; r
+        mov r13, fb0                    ; invr
+        mov r14, fb0                    ; r
+        abs r10, r8
+        abs r15, r9
+        add r15, r10, r15               ; |d2|_1
+        mul r15, r14, r15, >>Q14+EP_CYL
+        add r15, r15, #8
         mul out, r11, r9
         msu r10, r12, r8, >>Q14         ; oc2 x d2
         abs r10, r10
-        abs r13, r8
-        abs r15, r9
-        add r13, r13, r15               ; |d2|_1
-        mul r13, r14, r13, >>Q14+EP_CYL
-        add r13, r13, #8
-        cmp.le r10, r13                 ; F: the line may meet it
+        cmp.le r10, r15                 ; F: the line may meet it
 k_cylinder_cut_near:
-        movb r10, #0
+        st r11, [#TMP0]
+        st r12, [#TMP1]                 ; oc2
+        st r13, [#TMP7]                 ; invr
+        st r14, [#TMP8]                 ; r
         ; normalize
         sra r8, r8, #1
         sra r9, r9, #1
-        sra r10, r10, #1
-        abs r11, r8
-        abs r12, r9
-        max r11, r11, r12
-        abs r12, r10
-        max r11, r11, r12
-        clz r11, r11
-        sub r11, r11, #2                ; shift to the top of the word
-        sll r8, r8, r11
-        sll r9, r9, r11
-        sll r10, r10, r11
+        abs r10, r8
+        abs r11, r9
+        max r10, r10, r11
+        clz r10, r10
+        sub r10, r10, #2                ; shift to the top of the word
+        sll r8, r8, r10
+        sll r9, r9, r10
         mul out, r8, r8
-        mac out, r9, r9
-        mac r12, r10, r10, >>Q15        ; X = |v|^2, Q.11
-        srl r13, r12, #RSQ_SHIFT
-        ld r13, [r13 + #RSQ]            ; y = 1/sqrt(X) from the table
-        ld r15, [r0 + #C_ONE]
-        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
-        mul r14, r14, r12, >>Q11
-        sub r14, r14, r15
-        ldacc r13, <<Q15
-        msu r13, r13, r14, >>Q15
-        mul r14, r13, r13, >>Q14        ; Newton: y += y (1 - X y^2) / 2
-        mul r14, r14, r12, >>Q11
-        sub r14, r14, r15
-        ldacc r13, <<Q15
-        msu r13, r13, r14, >>Q15
-        mul r12, r12, r13, >>Q12        ; |v| = X y, the shifts undone
-        sra r12, r12, r11
-        adds r11, r12, r12
-        mul r8, r8, r13, >>Q13
-        mul r9, r9, r13, >>Q13
-        mul r10, r10, r13, >>Q13
-        mov r10, r11                    ; |d2|, Q.14
+        mac r11, r9, r9, >>Q15          ; X = |v|^2, Q.11
+        srl r12, r11, #RSQ_SHIFT
+        ld r12, [r12 + #RSQ]            ; y = 1/sqrt(X) from the table
+        ld r14, [r0 + #C_ONE]
+        mul r13, r12, r12, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r13, r13, r11, >>Q11
+        sub r13, r13, r14
+        ldacc r12, <<Q15
+        msu r12, r12, r13, >>Q15
+        mul r13, r12, r12, >>Q14        ; Newton: y += y (1 - X y^2) / 2
+        mul r13, r13, r11, >>Q11
+        sub r13, r13, r14
+        ldacc r12, <<Q15
+        msu r12, r12, r13, >>Q15
+        mul r11, r11, r12, >>Q12        ; |v| = X y, the shifts undone
+        sra r11, r11, r10
+        adds r10, r11, r11
+        mul r8, r8, r12, >>Q13
+        mul r9, r9, r12, >>Q13          ; |d2| in r10, Q.14
         st r8, [#TMP2]
         st r9, [#TMP3]                  ; d2n
         ld r11, [r0 + #TMP0]

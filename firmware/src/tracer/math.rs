@@ -99,26 +99,37 @@ fn r(k: u8) -> String {
 /// square root from the RSQ table (index X >> 8) and two Newton-Raphson
 /// steps `y += y (1 - X y^2) / 2`.
 pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: Approx) {
-    let [a, b, c] = v.map(r);
+    normalize_n(k, &v, t, len, nr)
+}
+
+/// [`normalize`] of a vector of 2 or 3 components (`v`): a 2D vector costs
+/// what the 3D one with a zero third component would, less the
+/// instructions on that component, with the same result.
+pub fn normalize_n(k: &mut K, v: &[u8], t: [u8; 5], len: bool, nr: Approx) {
+    assert!(matches!(v.len(), 2 | 3), "normalize: 2 or 3 components");
+    let v: Vec<String> = v.iter().map(|&x| r(x)).collect();
     let [t0, t1, t2, t3, t4] = t.map(r);
     k.comment("normalize");
-    for x in [&a, &b, &c] {
+    for x in &v {
         k.c(format!("sra {x}, {x}, #1"));
     }
-    k.c(format!("abs {t0}, {a}"))
-        .c(format!("abs {t1}, {b}"))
-        .c(format!("max {t0}, {t0}, {t1}"))
-        .c(format!("abs {t1}, {c}"))
-        .c(format!("max {t0}, {t0}, {t1}"))
-        .c(format!("clz {t0}, {t0}"))
+    k.c(format!("abs {t0}, {}", v[0]));
+    for x in &v[1..] {
+        k.c(format!("abs {t1}, {x}"))
+            .c(format!("max {t0}, {t0}, {t1}"));
+    }
+    k.c(format!("clz {t0}, {t0}"))
         .c(format!("sub {t0}, {t0}, #2"))
         .note("shift to the top of the word");
-    for x in [&a, &b, &c] {
+    for x in &v {
         k.c(format!("sll {x}, {x}, {t0}"));
     }
-    k.c(format!("mul out, {a}, {a}"))
-        .c(format!("mac out, {b}, {b}"))
-        .c(format!("mac {t1}, {c}, {c}, >>Q15"))
+    let last = v.len() - 1;
+    k.c(format!("mul out, {}, {}", v[0], v[0]));
+    for x in &v[1..last] {
+        k.c(format!("mac out, {x}, {x}"));
+    }
+    k.c(format!("mac {t1}, {}, {}, >>Q15", v[last], v[last]))
         .note("X = |v|^2, Q.11")
         .c(format!("srl {t2}, {t1}, #RSQ_SHIFT"))
         .c(format!("ld {t2}, [{t2} + #{}]", ram::RSQ))
@@ -139,7 +150,7 @@ pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: Approx) {
             .c(format!("sra {t1}, {t1}, {t0}"))
             .c(format!("adds {t0}, {t1}, {t1}"));
     }
-    for x in [&a, &b, &c] {
+    for x in &v {
         k.c(format!("mul {x}, {x}, {t2}, >>Q13"));
     }
 }

@@ -37,6 +37,7 @@ pub fn program(
         approx: nm.approx(),
         fine_normals: lay.fine_normals,
         test_cuts: lay.test_cuts,
+        published: lay.traversal == Traversal::Paper,
     };
     let merged = shadows::merged(opt, lay);
     let kernels = kernels(lay, opt, nm, &g, merged);

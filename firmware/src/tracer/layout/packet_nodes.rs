@@ -39,6 +39,7 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
         approx: super::super::math::Approx::default(),
         fine_normals: fit.fine_normals,
         test_cuts: true,
+        published: false,
     };
     // (contexts up to the first cut, contexts after it)
     let parts = |k: &super::super::emit::K| (k.first_part(), k.len() - k.first_part());
@@ -79,13 +80,13 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 /// The share of an object test's contexts after its first cut that a
 /// packet runs, for the cost model: `render --test-cuts on` against `off`
 /// with `--profile` on the SPD scenes at their default sizes, 128x128,
-/// runs 0.22 (cones, tree) to 0.71 (rectangles, rings) of the kernels'
+/// runs 0.21 (cones, tree) to 0.71 (rectangles, rings) of the kernels'
 /// contexts, first parts included (`docs/tracer.md`, "The tree it
 /// walks").
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check, the issues and the `rcany` of each part): 7 to 18 on the SPD
+/// check, the issues and the `rcany` of each part): 8 to 18 on the SPD
 /// scenes at 128x128 (`render --profile`, the `lo_*` rows over the
 /// object tests).
 pub const PK_OBJECT_RISC: f64 = 16.0;

@@ -315,6 +315,8 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     if opaque {
         k.cut(CUTS[0].0);
     }
+    // b for the root, stored past the cut (a test cut there spends no store).
+    k.c(format!("st r11, [#{}]", ram::TMP0)).note("b");
     frame(&mut k);
     quadratic(&mut k, nr, opaque.then_some(CUTS[1].0));
     root(&mut k, g, body);
@@ -378,7 +380,7 @@ pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
     );
 }
 
-/// The bounding sphere: `b = (M - o).d` into `TMP0`, `w = ((M - o) - b d) / S`
+/// The bounding sphere: `b = (M - o).d` (r11), `w = ((M - o) - b d) / S`
 /// (r8..r10); F where the line meets the sphere (`|w| <= 1/4`).
 fn bounding_sphere(k: &mut K) {
     k.comment("bounding sphere about M: b = (M - o).d, p = (M - o) - b d");
@@ -405,8 +407,7 @@ fn bounding_sphere(k: &mut K) {
         .c("msu r15, r10, r10, >>Q14")
         .note("1/4 - |w|^2")
         .c("cmp.ge r15, #0")
-        .note("F: the line meets the bounding sphere")
-        .c(format!("st r11, [#{}]", ram::TMP0));
+        .note("F: the line meets the bounding sphere");
 }
 
 /// The cone's frame: `c q_perp`, `G` (zoomed into [1/8, 1/4) by `2^e`) and `c d_perp`,
@@ -487,11 +488,11 @@ fn quadratic(k: &mut K, nr: Approx, cut: Option<&str>) {
         .c("mul out, r11, r11")
         .c("msu r14, r15, r12, >>Q14")
         .note("D")
-        .c("(f) cmp.ge r14, #0")
-        .c(format!("st r15, [#{}]", ram::TMP3));
+        .c("(f) cmp.ge r14, #0");
     if let Some(c) = cut {
         k.cut(c);
     }
+    k.c(format!("st r15, [#{}]", ram::TMP3)).note("A");
     sqrt_q14(k, 14, 8, [9, 10, 13, 15], nr);
 }
 

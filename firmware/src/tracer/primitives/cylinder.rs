@@ -41,7 +41,7 @@
 //! cylinder.
 
 use super::super::emit::{define, Code, Reg, K, R7};
-use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
+use super::super::math::{divide, normalize_n, perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
 use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
@@ -299,9 +299,18 @@ pub fn kernel(g: &Gen, body: Body) -> K {
                 .note("the projection's remainder, plus B's");
         }
     }
-    k.c(format!("st r11, [#{}]", ram::TMP0))
-        .c(format!("st r12, [#{}]", ram::TMP1))
-        .note("oc2");
+    let bound = body == Body::Opaque && g.test_cuts;
+    let er = if fine { "+EP_CYL" } else { "" };
+    // oc2 goes to RAM for after the normalisation; with the bound, only
+    // once the test goes on past it (a test cut there spends no store).
+    let store_oc2 = |k: &mut K| {
+        k.c(format!("st r11, [#{}]", ram::TMP0))
+            .c(format!("st r12, [#{}]", ram::TMP1))
+            .note("oc2");
+    };
+    if !bound {
+        store_oc2(&mut k);
+    }
     k.c("mul out, fb0, r4")
         .c("mac out, fb0, r5")
         .c("mac r8, fb0, r6, >>Q14");
@@ -309,38 +318,44 @@ pub fn kernel(g: &Gen, body: Body) -> K {
         .c("mac out, fb0, r5")
         .c("mac r9, fb0, r6, >>Q14")
         .note("d2 = (d.e1, d.e2)");
-    let bound = body == Body::Opaque && g.test_cuts;
-    let er = if fine { "+EP_CYL" } else { "" };
     if bound {
         // |oc2 x d2| = |p2| |d2| <= r |d2| <= r |d2|_1 where the line
         // meets the cylinder: a cheap bound before the normalisation, with
         // a margin for its rounding and the exact test's (a few LSB each).
+        // invr and r stay in r13, r14 up to the cut.
         k.comment("bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1")
             .c("mov r13, fb0")
-            .c(format!("st r13, [#{}]", ram::TMP7))
             .note("invr")
             .c("mov r14, fb0")
-            .c(format!("st r14, [#{}]", ram::TMP8))
             .note("r")
+            .c("abs r10, r8")
+            .c("abs r15, r9")
+            .c("add r15, r10, r15")
+            .note("|d2|_1")
+            .c(format!("mul r15, r14, r15, >>Q14{er}"))
+            .c(format!("add r15, r15, #{BOUND_MARGIN_LSB}"))
             .c("mul out, r11, r9")
             .c("msu r10, r12, r8, >>Q14")
             .note("oc2 x d2")
             .c("abs r10, r10")
-            .c("abs r13, r8")
-            .c("abs r15, r9")
-            .c("add r13, r13, r15")
-            .note("|d2|_1")
-            .c(format!("mul r13, r14, r13, >>Q14{er}"))
-            .c(format!("add r13, r13, #{BOUND_MARGIN_LSB}"))
-            .c("cmp.le r10, r13")
+            .c("cmp.le r10, r15")
             .note("F: the line may meet it");
         k.cut(CUTS[0].0);
+        store_oc2(&mut k);
+        k.c(format!("st r13, [#{}]", ram::TMP7))
+            .note("invr")
+            .c(format!("st r14, [#{}]", ram::TMP8))
+            .note("r");
     }
-    k.c("movb r10, #0");
-    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
-    k.c("mov r10, r11")
-        .note("|d2|, Q.14")
-        .c(format!("st r8, [#{}]", ram::TMP2))
+    if g.published {
+        k.c("movb r10, #0");
+        normalize_n(&mut k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+        k.c("mov r10, r11").note("|d2|, Q.14");
+    } else {
+        normalize_n(&mut k, &[8, 9], [10, 11, 12, 13, 14], true, nr);
+        k.note("|d2| in r10, Q.14");
+    }
+    k.c(format!("st r8, [#{}]", ram::TMP2))
         .c(format!("st r9, [#{}]", ram::TMP3))
         .note("d2n");
     k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))

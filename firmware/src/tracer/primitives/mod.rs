@@ -481,6 +481,7 @@ pub fn all_test_kernels() -> Vec<&'static str> {
         approx: crate::tracer::math::Approx::default(),
         fine_normals: true,
         test_cuts: true,
+        published: false,
     };
     let mut v: Vec<&'static str> = Vec::new();
     for polygon_bands in [false, true] {
@@ -534,6 +535,10 @@ pub struct Gen {
     /// The kernels run in parts ([`super::TestCuts`]): the cylinder's
     /// starts with a cheap bound and a cut after it.
     pub test_cuts: bool,
+    /// The paper's traversal: the kernels keep the contexts its published
+    /// cycle counts were measured with (the cylinder normalises its 2D
+    /// direction as a 3D vector with a zero third component).
+    pub published: bool,
 }
 
 /// The scale shifts and record variants fitted to the scene (the layout
@@ -773,6 +778,7 @@ mod tests {
                         approx: Approx::default(),
                         fine_normals,
                         test_cuts: fine_normals,
+                        published: !fine_normals,
                     };
                     let fit = Fit {
                         sphere_fine,

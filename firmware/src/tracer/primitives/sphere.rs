@@ -167,11 +167,10 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     }
     let er = if fine { "+EP_SPHERE" } else { "" };
     k.c("mov r12, fb0").note("r").c("mov r13, fb0").note("invr");
-    for (i, x) in [8, 9, 10].into_iter().enumerate() {
-        k.c(format!("mul r{x}, r{x}, r13, >>KS_SPHERE+EP_SPHERE"))
-            .c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
+    for x in [8, 9, 10] {
+        k.c(format!("mul r{x}, r{x}, r13, >>KS_SPHERE+EP_SPHERE"));
     }
-    k.note("p/r in TMP0..2");
+    k.note("p/r");
     k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
         .c("ldacc r14, <<Q14")
         .c("msu out, r8, r8")
@@ -183,6 +182,12 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     if !two {
         k.cut(CUTS[0].0);
     }
+    // p/r to RAM for the normal: past the cut, so that a test cut there
+    // spends no store.
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
+    }
+    k.note("p/r in TMP0..2");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
     if two {
         k.c(format!("mul r9, r12, r8, >>Q14{er}"))
