@@ -280,26 +280,6 @@ no_hit\@:
 \p\()_go:
 .endm
 
-; POPCOUNT x, t1, t2: x = the number of bits set in x (SWAR). Clobbers t1, t2.
-.macro POPCOUNT x, t1, t2
-        srli \t1, \x, 1
-        li \t2, 0x55555555
-        and \t1, \t1, \t2
-        sub \x, \x, \t1                 ; pairs
-        li \t2, 0x33333333
-        and \t1, \x, \t2
-        srli \x, \x, 2
-        and \x, \x, \t2
-        add \x, \x, \t1                 ; nibbles
-        srli \t1, \x, 4
-        add \x, \x, \t1
-        li \t2, 0x0f0f0f0f
-        and \x, \x, \t2                 ; bytes
-        li \t2, 0x01010101
-        mul \x, \x, \t2
-        srli \x, \x, 24                 ; their sum
-.endm
-
 ; ==== TinyRISC data ====
         .data
 PASS:           .word 0                 ; the ray pass's number (mailboxes)
@@ -422,16 +402,40 @@ trace:
         lw r13, MODE(r0)
         slli r13, r13, 31
         or r13, r13, r1                 ; r13: the pass's stamp, PASS | MODE << 31 (negative: any hit)
-        BCAST_FB k_pass_start, ROOTBOX  ; intervals in the root cell, 1/d
         BCAST k_sign_x
-        rcst r3                         ; the awake rays going down along x: none, some, all
-        li r4, 2
-        beq r3, r4, trace_done          ; no ray awake
+        rcfl r3
+        rcfh r4                         ; the rays going down along x
+        BCAST k_sign_y
+        rcfl r5
+        rcfh r6                         ; the rays going down along y
+        BCAST k_sign_z
+        rcfl r8
+        rcfh r9                         ; the rays going down along z
+        rcsl r11
+        rcsh r12                        ; r11, r12: the rays asleep before the pass starts
+        BCAST_FB k_pass_start, ROOTBOX  ; intervals in the root cell, 1/d; while they are computed: the orders
+        sw r3, NEG_X(r0)
+        sw r4, NEG_X+MASK_HI(r0)
+        sw r5, NEG_Y(r0)
+        sw r6, NEG_Y+MASK_HI(r0)
+        sw r8, NEG_Z(r0)
+        sw r9, NEG_Z+MASK_HI(r0)
+order_pass:
+        nor r11, r11, r0
+        nor r12, r12, r0                ; r11, r12: the awake rays
+        or r1, r11, r12
+        beqz r1, trace_done             ; no ray awake
+        lw r1, NEG_X(r0)
+        lw r2, NEG_X+MASK_HI(r0)
+        and r1, r1, r11
+        and r2, r2, r12                 ; r1, r2: the awake rays going down along x
         li r8, 0
-        beqz r3, order_x
+        or r3, r1, r2
+        beqz r3, order_x                ; none
         li r8, 1
-        li r4, 3
-        beq r3, r4, order_x
+        bne r1, r11, order_x_some
+        beq r2, r12, order_x            ; all
+order_x_some:
         jal majority                    ; some: r8 = most go down
 order_x:
         li r1, (k_node_x_below_first - CTXBASE) / 4
@@ -445,13 +449,17 @@ order_x_set:
         sw r1, NK+AXIS_X(r0)
         sw r2, NF+AXIS_X(r0)
         sw r3, NS+AXIS_X(r0)            ; node kernel, first and second child
-        BCAST k_sign_y
-        rcst r3                         ; the awake rays going down along y: none, some, all
+        lw r1, NEG_Y(r0)
+        lw r2, NEG_Y+MASK_HI(r0)
+        and r1, r1, r11
+        and r2, r2, r12                 ; r1, r2: the awake rays going down along y
         li r8, 0
-        beqz r3, order_y
+        or r3, r1, r2
+        beqz r3, order_y                ; none
         li r8, 1
-        li r4, 3
-        beq r3, r4, order_y
+        bne r1, r11, order_y_some
+        beq r2, r12, order_y            ; all
+order_y_some:
         jal majority                    ; some: r8 = most go down
 order_y:
         li r1, (k_node_y_below_first - CTXBASE) / 4
@@ -465,13 +473,17 @@ order_y_set:
         sw r1, NK+AXIS_Y(r0)
         sw r2, NF+AXIS_Y(r0)
         sw r3, NS+AXIS_Y(r0)            ; node kernel, first and second child
-        BCAST k_sign_z
-        rcst r3                         ; the awake rays going down along z: none, some, all
+        lw r1, NEG_Z(r0)
+        lw r2, NEG_Z+MASK_HI(r0)
+        and r1, r1, r11
+        and r2, r2, r12                 ; r1, r2: the awake rays going down along z
         li r8, 0
-        beqz r3, order_z
+        or r3, r1, r2
+        beqz r3, order_z                ; none
         li r8, 1
-        li r4, 3
-        beq r3, r4, order_z
+        bne r1, r11, order_z_some
+        beq r2, r12, order_z            ; all
+order_z_some:
         jal majority                    ; some: r8 = most go down
 order_z:
         li r1, (k_node_z_below_first - CTXBASE) / 4
@@ -485,6 +497,17 @@ order_z_set:
         sw r1, NK+AXIS_Z(r0)
         sw r2, NF+AXIS_Z(r0)
         sw r3, NS+AXIS_Z(r0)            ; node kernel, first and second child
+        rcsl r1
+        rcsh r2                         ; the rays asleep once the pass has started
+        nor r11, r11, r0
+        nor r12, r12, r0
+        bne r1, r11, order_again
+        beq r2, r12, order_done
+order_again:
+        mv r11, r1
+        mv r12, r2
+        j order_pass                    ; some ray missed the root cell: the orders from the awake rays left
+order_done:
         li r14, 0                       ; the node stack: empty
         li r5, ROOT
         lfb r6, PN_FLAGS(r5)
@@ -766,27 +789,57 @@ trace_done:
         lw r15, SAVE_LR(r0)
         ret
 
-; majority: r8 = 1 if more awake RCs have F set than not. Clobbers r1..r6, r9, r10.
+; majority: r8 = 1 if more of the awake RCs (r11, r12) are in r1, r2 than not.
+; Clobbers r1..r6, r9.
 majority:
-        rcfl r1
-        rcfh r2
-        rcsl r3
-        rcsh r4
-        nor r3, r3, r0
-        nor r4, r4, r0
-        and r5, r1, r3
-        and r6, r2, r4                  ; r5, r6: awake with F
-        nor r1, r1, r0
-        nor r2, r2, r0
-        and r1, r1, r3
-        and r2, r2, r4                  ; r1, r2: awake without F
-        POPCOUNT r5, r9, r10
-        POPCOUNT r6, r9, r10
-        POPCOUNT r1, r9, r10
-        POPCOUNT r2, r9, r10
-        add r5, r5, r6
+        li r5, 0x55555555
+        li r6, 0x33333333
+        srli r9, r1, 1
+        and r9, r9, r5
+        sub r1, r1, r9
+        srli r9, r2, 1
+        and r9, r9, r5
+        sub r2, r2, r9
+        srli r9, r11, 1
+        and r9, r9, r5
+        sub r3, r11, r9
+        srli r9, r12, 1
+        and r9, r9, r5
+        sub r4, r12, r9                 ; 2-bit counts
+        and r9, r1, r6
+        srli r1, r1, 2
+        and r1, r1, r6
+        add r1, r1, r9
+        and r9, r2, r6
+        srli r2, r2, 2
+        and r2, r2, r6
+        add r2, r2, r9
+        and r9, r3, r6
+        srli r3, r3, 2
+        and r3, r3, r6
+        add r3, r3, r9
+        and r9, r4, r6
+        srli r4, r4, 2
+        and r4, r4, r6
+        add r4, r4, r9                  ; 4-bit counts
         add r1, r1, r2
-        slt r8, r1, r5
+        add r3, r3, r4                  ; the halves summed: down in r1, awake in r3
+        li r5, 0x0f0f0f0f
+        li r6, 0x01010101
+        srli r9, r1, 4
+        and r9, r9, r5
+        and r1, r1, r5
+        add r1, r1, r9
+        mul r1, r1, r6
+        srli r1, r1, 24
+        srli r9, r3, 4
+        and r9, r9, r5
+        and r3, r3, r5
+        add r3, r3, r9
+        mul r3, r3, r6
+        srli r3, r3, 24                 ; the byte counts summed
+        slli r1, r1, 1
+        slt r8, r3, r1                  ; awake < 2 down: fewer go up than down
         ret
 
 ; ==== RC context kernels (context memory) ====

@@ -500,3 +500,71 @@ fn object_tests_in_parts_trace_the_same_rays() {
         );
     }
 }
+
+/// The packet traversal's `majority` (which child a pass visits first
+/// along each axis: the one most of the awake rays meet first), run on the
+/// model against a plain count: `r8 = 1` exactly when more of the awake
+/// rays (r11, r12) are among those going down (r1, r2) than not. Masks
+/// of every density, ties (32 of 64) and the extremes.
+#[test]
+fn majority_counts_the_rays_going_down() {
+    use firmware::tracer::emit::{Code, R1, R11, R12, R13, R2, R7, R8};
+    let mut s: u64 = 0x9e37_79b9_7f4a_7c15;
+    let mut next = || {
+        s ^= s << 13;
+        s ^= s >> 7;
+        s ^= s << 17;
+        s
+    };
+    let mut cases: Vec<(u64, u64)> = vec![
+        (u64::MAX, u64::MAX),
+        (u64::MAX, 0),
+        (u64::MAX, 0xffff_ffff),
+        (u64::MAX, 0xffff_ffff_0000_0000),
+        (u64::MAX, 0x5555_5555_5555_5555),
+        (1, 1),
+        (1, 0),
+        (0x8000_0000_0000_0000, 0x8000_0000_0000_0000),
+        (0xff00_ff00_ff00_ff00, 0xff00_0000_ff00_0000),
+        (0xff00_ff00_ff00_ff00, 0x0000_ff00_0000_ff00),
+    ];
+    for _ in 0..300 {
+        let awake = match next() % 4 {
+            0 => u64::MAX,
+            1 => next() & next(),
+            _ => next(),
+        };
+        let down = match next() % 3 {
+            0 => next(),
+            1 => next() | next(),
+            _ => next() & next(),
+        } & awake;
+        cases.push((awake, down));
+    }
+    let mut t = Code::new();
+    t.directive(".text").label("_start");
+    for (i, &(awake, down)) in cases.iter().enumerate() {
+        let expect = (awake.count_ones() < 2 * down.count_ones()) as u32;
+        t.li(R13, i)
+            .li(R1, down as u32)
+            .li(R2, (down >> 32) as u32)
+            .li(R11, awake as u32)
+            .li(R12, (awake >> 32) as u32)
+            .jal("majority")
+            .li(R7, expect)
+            .bne(R8, R7, "fail");
+    }
+    t.li(R1, 1).halt();
+    t.label("fail").li(R1, 0xbad).halt();
+    firmware::tracer::traversal::packet::majority(&mut t);
+    let img = firmware::asm::assemble(&t.text(), "majority-test.s").unwrap();
+    let out = tb::cmd_run::run_image(&img, rtl::Timing::default(), 1_000_000, None).unwrap();
+    out.result.as_ref().unwrap();
+    if out.reg(1) != 1 {
+        let (awake, down) = cases[out.reg(13) as usize];
+        panic!(
+            "majority of awake {awake:#018x}, down {down:#018x}: r8 = {}",
+            out.reg(8)
+        );
+    }
+}

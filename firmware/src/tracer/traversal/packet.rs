@@ -7,9 +7,11 @@
 //!
 //! ```text
 //! trace:
-//!   PASS += 1; k_pass_start: every awake ray alive, its interval [0, tbest]
-//!     clipped to the root cell, 1/d per axis
-//!   per axis: the child order the majority of the awake rays meets first
+//!   PASS += 1; per axis k_sign: which rays go down (F masks read)
+//!   k_pass_start: every awake ray alive, its interval [0, tbest]
+//!     clipped to the root cell, 1/d per axis; while it runs, per axis:
+//!     the child order the majority of the awake rays meets first
+//!     (decided again if the start put a ray to sleep)
 //!     (NK: the node kernel, NF/NS: the first and second child's field)
 //!   node = ROOT
 //!   loop:
@@ -841,38 +843,49 @@ fn type_loop(
     t.label(&end);
 }
 
-/// `majority`: r8 = 1 when more awake rays have F (a negative direction
-/// component) than not.
-fn majority(t: &mut Code) {
-    t.doc("majority: r8 = 1 if more awake RCs have F set than not. Clobbers r1..r6, r9, r10.");
+/// `majority`: r8 = 1 when more of the awake rays (r11, r12) go down
+/// (r1, r2: those of them whose direction component is negative) than
+/// not: `awake < 2 down`. Both counts are SWAR population counts of the
+/// 64-bit masks, the halves summed at 4-bit fields (at most 8 each).
+pub fn majority(t: &mut Code) {
+    t.doc(
+        "majority: r8 = 1 if more of the awake RCs (r11, r12) are in r1, r2 than not.\n\
+         Clobbers r1..r6, r9.",
+    );
     t.label("majority")
-        .rcfl(R1)
-        .rcfh(R2)
-        .rcsl(R3)
-        .rcsh(R4)
-        .nor(R3, R3, R0)
-        .nor(R4, R4, R0)
-        .and(R5, R1, R3)
-        .and(R6, R2, R4)
-        .c("r5, r6: awake with F")
-        .nor(R1, R1, R0)
-        .nor(R2, R2, R0)
-        .and(R1, R1, R3)
-        .and(R2, R2, R4)
-        .c("r1, r2: awake without F");
-    for x in [R5, R6, R1, R2] {
-        popcount(t, x, R9, R10);
+        .li(R5, "0x55555555")
+        .li(R6, "0x33333333");
+    // pairs: x - ((x >> 1) & 0x55..)
+    for (x, src) in [(R1, R1), (R2, R2), (R3, R11), (R4, R12)] {
+        t.srli(R9, src, 1).and(R9, R9, R5).sub(x, src, R9);
     }
-    t.add(R5, R5, R6).add(R1, R1, R2).slt(R8, R1, R5).ret();
+    t.c("2-bit counts");
+    for x in [R1, R2, R3, R4] {
+        t.and(R9, x, R6).srli(x, x, 2).and(x, x, R6).add(x, x, R9);
+    }
+    t.c("4-bit counts")
+        .add(R1, R1, R2)
+        .add(R3, R3, R4)
+        .c("the halves summed: down in r1, awake in r3")
+        .li(R5, "0x0f0f0f0f")
+        .li(R6, "0x01010101");
+    // Bytes: both nibbles masked before the sum (up to 16, five bits).
+    for x in [R1, R3] {
+        t.srli(R9, x, 4)
+            .and(R9, R9, R5)
+            .and(x, x, R5)
+            .add(x, x, R9)
+            .mul(x, x, R6)
+            .srli(x, x, 24);
+    }
+    t.c("the byte counts summed")
+        .slli(R1, R1, 1)
+        .slt(R8, R3, R1)
+        .c("awake < 2 down: fewer go up than down")
+        .ret();
 }
 
-/// Popcount of `x` into `x` (SWAR), clobbering `t1`, `t2`.
-fn popcount(t: &mut Code, x: Reg, t1: Reg, t2: Reg) {
-    t.m("POPCOUNT", format!("{x}, {t1}, {t2}"));
-}
-
-/// The packet traversal's macros: the mailbox check of a leaf's object and
-/// a population count.
+/// The packet traversal's macro: the mailbox check of a leaf's object.
 pub fn macros() -> Code {
     let mut t = Code::new();
     let mut b = Code::new();
@@ -907,55 +920,58 @@ pub fn macros() -> Code {
          Clobbers r1..r3.",
         b,
     );
-    let mut b = Code::new();
-    b.line("srli \\t1, \\x, 1")
-        .line("li \\t2, 0x55555555")
-        .line("and \\t1, \\t1, \\t2")
-        .line("sub \\x, \\x, \\t1")
-        .c("pairs")
-        .line("li \\t2, 0x33333333")
-        .line("and \\t1, \\x, \\t2")
-        .line("srli \\x, \\x, 2")
-        .line("and \\x, \\x, \\t2")
-        .line("add \\x, \\x, \\t1")
-        .c("nibbles")
-        .line("srli \\t1, \\x, 4")
-        .line("add \\x, \\x, \\t1")
-        .line("li \\t2, 0x0f0f0f0f")
-        .line("and \\x, \\x, \\t2")
-        .c("bytes")
-        .line("li \\t2, 0x01010101")
-        .line("mul \\x, \\x, \\t2")
-        .line("srli \\x, \\x, 24")
-        .c("their sum");
-    t.define_macro(
-        "POPCOUNT",
-        "x, t1, t2",
-        "POPCOUNT x, t1, t2: x = the number of bits set in x (SWAR). Clobbers t1, t2.",
-        b,
-    );
     t
 }
 
 /// The pass's start: `k_pass_start`, then per axis the order of the children
 /// the majority of the awake rays meets first (`NK`, `NF`, `NS`); no ray
-/// awake: `trace_done`.
+/// awake: `trace_done`. The directions' signs (`k_sign_*`, F = going down)
+/// are read into `NEG_*` before the pass starts, with the awake rays, so
+/// that TinyRISC decides the orders while `k_pass_start` runs; the rays
+/// the pass start puts to sleep (those that miss the root cell) are known
+/// only after it, so the orders are decided again when there were any
+/// (the same orders as from the awake rays after the start).
 fn child_order(t: &mut Code, f: &Fields) {
+    // Each axis's masks stay in registers until the pass start is issued.
+    let masks = [(R3, R4), (R5, R6), (R8, R9)];
+    for (a, &(lo, hi)) in masks.iter().enumerate() {
+        t.m("BCAST", names::sign(a as u8))
+            .rcfl(lo)
+            .rcfh(hi)
+            .c(format!("the rays going down along {}", ["x", "y", "z"][a]));
+    }
+    t.rcsl(R11)
+        .rcsh(R12)
+        .c("r11, r12: the rays asleep before the pass starts");
     t.m("BCAST_FB", format!("{}, ROOTBOX", names::PASS_START))
-        .c("intervals in the root cell, 1/d");
+        .c("intervals in the root cell, 1/d; while they are computed: the orders");
+    for (&(lo, hi), axis) in masks.iter().zip(["X", "Y", "Z"]) {
+        t.sw(lo, at(format!("NEG_{axis}"), R0))
+            .sw(hi, at(format!("NEG_{axis}+MASK_HI"), R0));
+    }
+    t.label("order_pass")
+        .nor(R11, R11, R0)
+        .nor(R12, R12, R0)
+        .c("r11, r12: the awake rays")
+        .or(R1, R11, R12)
+        .beqz(R1, "trace_done")
+        .c("no ray awake");
     for (a, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
         let lo = axis.to_lowercase();
-        t.m("BCAST", names::sign(a as u8)).rcst(R3).c(format!(
-            "the awake rays going down along {lo}: none, some, all"
-        ));
-        if a == 0 {
-            t.li(R4, 2).beq(R3, R4, "trace_done").c("no ray awake");
-        }
-        t.li(R8, 0)
+        t.lw(R1, at(format!("NEG_{axis}"), R0))
+            .lw(R2, at(format!("NEG_{axis}+MASK_HI"), R0))
+            .and(R1, R1, R11)
+            .and(R2, R2, R12)
+            .c(format!("r1, r2: the awake rays going down along {lo}"))
+            .li(R8, 0)
+            .or(R3, R1, R2)
             .beqz(R3, format!("order_{lo}"))
+            .c("none")
             .li(R8, 1)
-            .li(R4, 3)
-            .beq(R3, R4, format!("order_{lo}"))
+            .bne(R1, R11, format!("order_{lo}_some"))
+            .beq(R2, R12, format!("order_{lo}"))
+            .c("all");
+        t.label(format!("order_{lo}_some"))
             .jal("majority")
             .c("some: r8 = most go down");
         t.label(format!("order_{lo}"))
@@ -973,4 +989,17 @@ fn child_order(t: &mut Code, f: &Fields) {
             .sw(R3, at(format!("NS+AXIS_{axis}"), R0))
             .c("node kernel, first and second child");
     }
+    t.rcsl(R1)
+        .rcsh(R2)
+        .c("the rays asleep once the pass has started")
+        .nor(R11, R11, R0)
+        .nor(R12, R12, R0)
+        .bne(R1, R11, "order_again")
+        .beq(R2, R12, "order_done");
+    t.label("order_again")
+        .mv(R11, R1)
+        .mv(R12, R2)
+        .j("order_pass")
+        .c("some ray missed the root cell: the orders from the awake rays left");
+    t.label("order_done");
 }
