@@ -91,21 +91,16 @@ fn r(k: u8) -> String {
     format!("r{k}")
 }
 
-/// Normalise the vector in registers `v` in place to a unit Q1.14 vector;
-/// with `len`, also its length (in the input's units) into `t[0]`.
-/// Temporaries `t` (5 registers). Method: halve (so the largest component
-/// is below 2^14), shift left by `clz(max) - 2` (largest component in
-/// [2^13, 2^14)), `X = |v'|^2 >> 15` in Q.11 (range [1, 12)), reciprocal
-/// square root from the RSQ table (index X >> 8) and two Newton-Raphson
-/// steps `y += y (1 - X y^2) / 2`.
-pub fn normalize(k: &mut K, v: [u8; 3], t: [u8; 5], len: bool, nr: Approx) {
-    normalize_n(k, &v, t, len, nr)
-}
-
-/// [`normalize`] of a vector of 2 or 3 components (`v`): a 2D vector costs
-/// what the 3D one with a zero third component would, less the
-/// instructions on that component, with the same result.
-pub fn normalize_n(k: &mut K, v: &[u8], t: [u8; 5], len: bool, nr: Approx) {
+/// Normalise the vector in registers `v` (2 or 3 components) in place to a
+/// unit Q1.14 vector; with `len`, also its length (in the input's units)
+/// into `t[0]`. Temporaries `t` (5 registers). Method: halve (so the
+/// largest component is below 2^14), shift left by `clz(max) - 2` (largest
+/// component in [2^13, 2^14)), `X = |v'|^2 >> 15` in Q.11 (range [1, 12)),
+/// reciprocal square root from the RSQ table (index X >> 8) and two
+/// Newton-Raphson steps `y += y (1 - X y^2) / 2`. A 2D vector gives what
+/// the 3D one with a zero third component would, without the instructions
+/// on that component.
+pub fn normalize(k: &mut K, v: &[u8], t: [u8; 5], len: bool, nr: Approx) {
     assert!(matches!(v.len(), 2 | 3), "normalize: 2 or 3 components");
     let v: Vec<String> = v.iter().map(|&x| r(x)).collect();
     let [t0, t1, t2, t3, t4] = t.map(r);

@@ -152,7 +152,7 @@ pub fn eye(nr: Approx, refract: bool) -> K {
             .c("mac out, fb0, r8")
             .c(format!("mac r{x}, fb0, r9, >>KD-Q13"));
     }
-    normalize(&mut k, [10, 11, 12], [13, 14, 15, 8, 9], false, nr);
+    normalize(&mut k, &[10, 11, 12], [13, 14, 15, 8, 9], false, nr);
     k.c("mov r4, r10").c("mov r5, r11").c("mov r6, r12");
     new_level_common(&mut k);
     k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::OUT_OBJ));
@@ -303,7 +303,7 @@ pub fn light_setup(nr: Approx, shifted: bool) -> K {
             .c("sub r10, fb0, r3")
             .note("L - P");
     }
-    normalize(&mut k, [8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+    normalize(&mut k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
     k.c("mov r4, r8").c("mov r5, r9").c("mov r6, r10");
     if shifted {
         k.c(format!("ld r15, [r0 + #{}]", ram::TMP0))
@@ -542,7 +542,7 @@ pub fn refract_prepare(level: u32, materials: usize, nr: Approx) -> K {
         k.c(format!("mul out, r13, r{d}"))
             .c(format!("mac r{x}, r10, r{n}, >>Q12"));
     }
-    normalize(&mut k, [8, 9, 14], [1, 2, 3, 4, 5], false, nr);
+    normalize(&mut k, &[8, 9, 14], [1, 2, 3, 4, 5], false, nr);
     for i in 0..3 {
         k.c(format!("ld r1, [r0 + #{}]", ram::SH_P + i))
             .c(format!("st r1, [#{}]", word(&rf, "RF_O", i)));

@@ -585,7 +585,7 @@ fn normal(k: &mut K, nr: Approx) {
         .c("mul r9, r9, r13, >>Q14")
         .c("mul r10, fb0, r11, >>Q14")
         .note("-sg s c rho");
-    normalize(k, [8, 9, 10], [11, 12, 13, 14, 15], false, nr);
+    normalize(k, &[8, 9, 10], [11, 12, 13, 14, 15], false, nr);
     for x in [11, 12, 13] {
         k.c("mul out, fb0, r8")
             .c("mac out, fb0, r9")

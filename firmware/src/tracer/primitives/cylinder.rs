@@ -41,7 +41,7 @@
 //! cylinder.
 
 use super::super::emit::{define, Code, Reg, K, R7};
-use super::super::math::{divide, normalize_n, perpendicular_to, sqrt_q14};
+use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
 use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
@@ -349,10 +349,10 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     }
     if g.published {
         k.c("movb r10, #0");
-        normalize_n(&mut k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+        normalize(&mut k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
         k.c("mov r10, r11").note("|d2|, Q.14");
     } else {
-        normalize_n(&mut k, &[8, 9], [10, 11, 12, 13, 14], true, nr);
+        normalize(&mut k, &[8, 9], [10, 11, 12, 13, 14], true, nr);
         k.note("|d2| in r10, Q.14");
     }
     k.c(format!("st r8, [#{}]", ram::TMP2))

@@ -75,7 +75,7 @@ fn interpolate_normal(k: &mut K, g: &Gen) {
             .c("mac out, fb0, r13")
             .c(format!("mac r{x}, fb0, r14, >>Q14"));
     }
-    normalize(k, [10, 11, 12], [9, 8, 13, 14, 15], false, g.approx);
+    normalize(k, &[10, 11, 12], [9, 8, 13, 14, 15], false, g.approx);
 }
 
 /// The smooth triangle kernel.
