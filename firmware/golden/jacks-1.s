@@ -427,7 +427,7 @@ order_x:
         beqz r8, order_x_set
         li r1, (k_node_x_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
-        li r3, PN_LEFT                  ; most go down: above first
+        li r3, PN_LEFT                  ; r8 = 1: above first
 order_x_set:
         sw r1, NK+AXIS_X(r0)
         sw r2, NF+AXIS_X(r0)
@@ -451,7 +451,7 @@ order_y:
         beqz r8, order_y_set
         li r1, (k_node_y_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
-        li r3, PN_LEFT                  ; most go down: above first
+        li r3, PN_LEFT                  ; r8 = 1: above first
 order_y_set:
         sw r1, NK+AXIS_Y(r0)
         sw r2, NF+AXIS_Y(r0)
@@ -467,7 +467,11 @@ order_y_set:
         bne r1, r11, order_z_some
         beq r2, r12, order_z            ; all
 order_z_some:
-        jal majority                    ; some: r8 = most go down
+        blt r13, r0, order_z_any        ; an any-hit pass
+        li r8, 0                        ; some (closest hit): the rays going up first
+        j order_z
+order_z_any:
+        jal majority                    ; some (any hit): r8 = most go down
 order_z:
         li r1, (k_node_z_below_first - CTXBASE) / 4
         li r2, PN_LEFT
@@ -475,7 +479,7 @@ order_z:
         beqz r8, order_z_set
         li r1, (k_node_z_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
-        li r3, PN_LEFT                  ; most go down: above first
+        li r3, PN_LEFT                  ; r8 = 1: above first
 order_z_set:
         sw r1, NK+AXIS_Z(r0)
         sw r2, NF+AXIS_Z(r0)

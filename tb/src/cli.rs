@@ -213,6 +213,10 @@ pub(crate) fn parse_test_cuts(s: &str) -> Result<firmware::tracer::TestCuts, Str
     s.parse()
 }
 
+pub(crate) fn parse_child_order(s: &str) -> Result<firmware::tracer::ChildOrder, String> {
+    s.parse()
+}
+
 pub(crate) fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
     s.parse()
 }

@@ -121,6 +121,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             pieces: Default::default(),
             shadows: Default::default(),
             test_cuts: Default::default(),
+            child_order: Default::default(),
         },
         firmware::tracer::Traversal::Packet => Options {
             width,

@@ -97,6 +97,17 @@ pub struct RenderArgs {
     /// object (on), or whole (off). The same image either way.
     #[arg(long, value_name = "on|off", default_value = "on", value_parser = crate::cli::parse_test_cuts)]
     pub test_cuts: firmware::tracer::TestCuts,
+    /// Packet traversal: which child of a node a packet visits first where
+    /// its awake rays go both ways along the node's axis: majority (the
+    /// near child of most of them), XYZ[,XYZ] (per axis x, y, z of
+    /// closest-hit passes, then of any-hit passes, majority if omitted:
+    /// m the majority, d the rays going down first, u the rays going up
+    /// first; e.g. uud) or auto (per axis the way most of the view's
+    /// sampled secondary rays that hit, and shadow rays that are blocked,
+    /// go; kept where faster than majority on a probe of the frame). The
+    /// same image either way.
+    #[arg(long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto", value_parser = crate::cli::parse_child_order)]
+    pub child_order: firmware::tracer::ChildOrder,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
     /// variant the paper announces; every format gets 16 more fraction
     /// bits), or auto: 16 unless the 16-bit chip cannot hold the scene or
@@ -410,6 +421,7 @@ pub(crate) fn render_and_measure(
         "collapse": opt.collapse.to_string(),
         "leaf_pieces": opt.pieces.to_string(),
         "shadow_packets": chip.firmware.shadows.to_string(),
+        "child_order": chip.firmware.child_order.to_string(),
         "test_cuts": opt.test_cuts.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
@@ -609,6 +621,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         pieces: a.leaf_pieces,
         shadows: a.shadow_packets,
         test_cuts: a.test_cuts,
+        child_order: a.child_order,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
@@ -799,6 +812,15 @@ pub fn command(a: RenderArgs) -> Result<()> {
         );
     }
     if opt.traversal == firmware::tracer::Traversal::Packet {
+        crate::report!(
+            "child order              {} (where a packet's awake rays go both ways along a node's axis{})",
+            chip.firmware.child_order.describe(),
+            if opt.child_order == firmware::tracer::ChildOrder::Auto {
+                "; auto: per axis the way most of the view's sampled rays that end go, kept where faster than majority on the probe"
+            } else {
+                ""
+            }
+        );
         crate::report!(
             "object tests             {}",
             if chip.firmware.layout.test_cuts {

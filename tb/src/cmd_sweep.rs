@@ -384,6 +384,19 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
+    // The child order of mixed packets by the majority alone (the
+    // default serves the ways the view's rays end, where the probe runs
+    // that faster).
+    let packet = packet_config(width, height);
+    v.push(Knob {
+        knob: "child_order",
+        value: firmware::tracer::ChildOrder::MAJORITY.to_string(),
+        opt: Options {
+            child_order: firmware::tracer::ChildOrder::MAJORITY,
+            ..packet
+        },
+        nm,
+    });
     // Object tests whole (the default runs them in parts at their cuts).
     let packet = packet_config(width, height);
     v.push(Knob {

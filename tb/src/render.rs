@@ -987,7 +987,8 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
 /// to the first. With `ShadowPackets::Auto` where merging applies
 /// ([`tracer::shadows::applies`]), the chosen tree is probed again with
 /// merged shadow packets and the fewer cycles kept (the images are the
-/// same). Deterministic.
+/// same); with `ChildOrder::Auto`, the order the view's rays ask for
+/// likewise ([`choose_child_order`]). Deterministic.
 pub fn choose_firmware(
     scene: &Scene,
     opt: &Options,
@@ -1008,29 +1009,97 @@ pub(crate) fn choose_firmware_probed(
     timing: &Timing,
 ) -> Result<(Firmware, Option<ProbeRender>)> {
     let (fw, p) = choose_tree(scene, opt, nm, timing)?;
+    let (fw, p) = choose_shadows(scene, opt, nm, timing, fw, p)?;
+    choose_child_order(scene, opt, nm, timing, fw, p)
+}
+
+/// The faster of `fw` (its probe `p`, if run) and `other` on the probe
+/// (the same images: the same rays, traced in another order or other
+/// packets); a tie keeps `fw`.
+fn faster_on_probe(
+    opt: &Options,
+    timing: &Timing,
+    (fw, p): (Firmware, Option<ProbeRender>),
+    other: Firmware,
+) -> Result<(Firmware, Option<ProbeRender>)> {
+    let (p, op) = rayon::join(
+        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
+        || probe(&other, opt, timing),
+    );
+    let (p, mut op) = (p?, op?);
+    if op.cycles < p.cycles {
+        op.reference = p.reference;
+        Ok((other, Some(op)))
+    } else {
+        Ok((fw, Some(p)))
+    }
+}
+
+/// `--shadow-packets auto`: the tree chosen, merged shadow packets
+/// against a packet per light on the probe, the fewer cycles kept.
+fn choose_shadows(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    timing: &Timing,
+    fw: Firmware,
+    p: Option<ProbeRender>,
+) -> Result<(Firmware, Option<ProbeRender>)> {
     if opt.shadows != tracer::ShadowPackets::Auto || !tracer::shadows::applies(opt, &fw.layout) {
         return Ok((fw, p));
     }
-    // `--shadow-packets auto`: the tree chosen, merged shadow packets
-    // against a packet per light on the probe (the same images: the same
-    // rays, traced in other packets), the fewer cycles kept.
     let merged = Options {
         bsp: fw.bsp,
         shadows: tracer::ShadowPackets::Merged,
         ..*opt
     };
     let mfw = tracer::build_with(scene, &merged, nm).map_err(|e| anyhow!("{e}"))?;
-    let (p, mp) = rayon::join(
-        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
-        || probe(&mfw, opt, timing),
-    );
-    let (p, mut mp) = (p?, mp?);
-    if mp.cycles < p.cycles {
-        mp.reference = p.reference;
-        Ok((mfw, Some(mp)))
-    } else {
-        Ok((fw, Some(p)))
+    faster_on_probe(opt, timing, (fw, p), mfw)
+}
+
+/// Eye rays the host traces to learn the ways rays end
+/// ([`choose_child_order`]): about this many, every k-th pixel of the
+/// frame in both directions.
+pub(crate) const CHILD_ORDER_SAMPLES: u64 = 16_384;
+
+/// `--child-order auto` (packet traversal): per axis and kind of pass,
+/// the way most of the view's rays that end went
+/// ([`tracer::ChildOrder::from_hits`], from the f64 reference's rays of
+/// every k-th pixel: the secondary rays that hit, the shadow rays that
+/// are blocked), kept where the probe runs it in fewer cycles than the
+/// majority (the same images: the same hits, found in another order).
+fn choose_child_order(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    timing: &Timing,
+    fw: Firmware,
+    p: Option<ProbeRender>,
+) -> Result<(Firmware, Option<ProbeRender>)> {
+    if opt.child_order != tracer::ChildOrder::Auto || opt.traversal != tracer::Traversal::Packet {
+        return Ok((fw, p));
     }
+    let pixels = opt.width as u64 * opt.height as u64;
+    let stride = ((pixels / CHILD_ORDER_SAMPLES) as f64)
+        .sqrt()
+        .floor()
+        .max(1.0) as u32;
+    let w = crate::reference::ray_ways(scene, opt.width, opt.height, opt.depth, stride);
+    let order = tracer::ChildOrder::from_hits(
+        (&w.secondary_hit, &w.secondary),
+        (&w.shadow_blocked, &w.shadow),
+    );
+    if order == tracer::ChildOrder::MAJORITY {
+        return Ok((fw, p));
+    }
+    let o = Options {
+        bsp: fw.bsp,
+        shadows: fw.shadows,
+        child_order: order,
+        ..*opt
+    };
+    let ofw = tracer::build_with(scene, &o, nm).map_err(|e| anyhow!("{e}"))?;
+    faster_on_probe(opt, timing, (fw, p), ofw)
 }
 
 /// [`choose_firmware_probed`]'s choice of the BSP tree (shadow packets

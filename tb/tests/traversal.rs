@@ -347,6 +347,31 @@ fn leaf_pieces_move_while_the_tests_run() {
     }
 }
 
+/// `scene` rendered with `o` on a pbrt SAH tree, resident or streamed.
+fn render_sah(scene: &Scene, mut o: Options, streamed: bool) -> tb::render::ChipRender {
+    o.bsp.rule = firmware::bsp::SplitRule::Sah;
+    let s = RenderSettings {
+        streamed,
+        ..Default::default()
+    };
+    render_chip(scene, &o, &s).unwrap()
+}
+
+/// Glass of every type (a smooth triangle, a sphere, a cylinder) over
+/// opaque spheres and a wall, lit by three lights.
+fn glass_three_lights() -> Scene {
+    firmware::scene::nff::parse(
+        "v\nfrom 0 0 8\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 32 32\n\
+         b 0.1 0.2 0.3\nl 4 5 9\nl -5 3 6\nl 0 -6 7\n\
+         f 1 1 1 0.1 0.1 30 0.9 1.5\npp 3\n-2 -2 1 -0.2 0 1\n2 -2 1 0.2 0 1\n0 2 1 0 0.2 1\n\
+         s 1.5 1 0 0.5\nc\n-1.5 1 0 0.4\n-1.5 2 0 0.2\n\
+         f 0.8 0.4 0.2 0.6 0.4 10 0 0\ns 0 0 -1 1\ns 1 -1 -0.5 0.4\n\
+         f 0.3 0.8 0.3 0.7 0.3 20 0 0\np 4\n-4 -3 -3\n4 -3 -3\n4 3 -3\n-4 3 -3\n",
+        "glass.nff",
+    )
+    .unwrap()
+}
+
 /// Merged shadow packets (`--shadow-packets merged`): the reflection
 /// levels' shadow rays of all the lights move into as few packets as hold
 /// them, and the answers move back to the RCs that spawned the rays. Each
@@ -358,16 +383,7 @@ fn leaf_pieces_move_while_the_tests_run() {
 #[test]
 fn merged_shadow_packets_trace_the_same_rays() {
     use firmware::tracer::ShadowPackets;
-    let glass = firmware::scene::nff::parse(
-        "v\nfrom 0 0 8\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.01\nresolution 32 32\n\
-         b 0.1 0.2 0.3\nl 4 5 9\nl -5 3 6\nl 0 -6 7\n\
-         f 1 1 1 0.1 0.1 30 0.9 1.5\npp 3\n-2 -2 1 -0.2 0 1\n2 -2 1 0.2 0 1\n0 2 1 0 0.2 1\n\
-         s 1.5 1 0 0.5\nc\n-1.5 1 0 0.4\n-1.5 2 0 0.2\n\
-         f 0.8 0.4 0.2 0.6 0.4 10 0 0\ns 0 0 -1 1\ns 1 -1 -0.5 0.4\n\
-         f 0.3 0.8 0.3 0.7 0.3 20 0 0\np 4\n-4 -3 -3\n4 -3 -3\n4 3 -3\n-4 3 -3\n",
-        "glass.nff",
-    )
-    .unwrap();
+    let glass = glass_three_lights();
     let rings = load("rings-1.nff");
     let cases = [
         ("rings-1", &rings, 64, 2, rtl::rc::Datapath::W16),
@@ -466,18 +482,13 @@ fn object_tests_in_parts_trace_the_same_rays() {
     ];
     for (name, scene, streamed, datapath) in cases {
         let render = |test_cuts| {
-            let mut o = Options {
+            let o = Options {
                 datapath,
                 depth: 3,
                 test_cuts,
                 ..opts(32, 32, Traversal::Packet)
             };
-            o.bsp.rule = firmware::bsp::SplitRule::Sah;
-            let s = RenderSettings {
-                streamed,
-                ..Default::default()
-            };
-            render_chip(scene, &o, &s).unwrap()
+            render_sah(scene, o, streamed)
         };
         let (on, off) = (render(TestCuts::On), render(TestCuts::Off));
         let what = format!(
@@ -499,6 +510,102 @@ fn object_tests_in_parts_trace_the_same_rays() {
             off.cycles
         );
     }
+}
+
+/// The child order (`--child-order`): which child of a node a packet
+/// whose awake rays go both ways along its axis visits first decides only
+/// where the rays find their hits, so every fixed order finds the
+/// majority's hits, image and rays bit for bit, in other cycles: rings-1
+/// (mirrors, three lights, merged shadow packets), streamed, and glass of
+/// every type to depth 5 (refracted rays, two-sided objects) on both
+/// chips.
+#[test]
+fn child_orders_find_the_same_hits() {
+    use firmware::tracer::{ChildOrder, ShadowPackets};
+    let glass = glass_three_lights();
+    let rings = load("rings-1.nff");
+    let w16 = rtl::rc::Datapath::W16;
+    let cases = [
+        ("rings-1", &rings, false, 2, w16),
+        ("rings-1", &rings, true, 2, w16),
+        ("glass", &glass, false, 5, w16),
+        ("glass", &glass, false, 5, rtl::rc::Datapath::W32),
+    ];
+    for (name, scene, streamed, depth, datapath) in cases {
+        let render = |child_order| {
+            // A tree walked to its leaves (a scene this small may
+            // otherwise be one leaf, with no order to take).
+            let o = Options {
+                depth,
+                datapath,
+                child_order,
+                shadows: ShadowPackets::Merged,
+                collapse: firmware::tracer::Collapse::Objects(0),
+                ..opts(32, 32, Traversal::Packet)
+            };
+            render_sah(scene, o, streamed)
+        };
+        let what = format!(
+            "{name}, {}, {datapath}",
+            if streamed { "streamed" } else { "resident" }
+        );
+        let majority = render(ChildOrder::MAJORITY);
+        assert_eq!(
+            majority.firmware.child_order,
+            ChildOrder::MAJORITY,
+            "{what}"
+        );
+        let mut cycles = vec![majority.cycles];
+        for spec in ["uuu,uuu", "ddd,ddd", "udm,dum"] {
+            let order: ChildOrder = spec.parse().unwrap();
+            let r = render(order);
+            assert_eq!(r.firmware.child_order, order, "{what}");
+            assert_eq!(r.firmware.child_order.to_string(), spec, "{what}");
+            assert!(r.rgb8 == majority.rgb8, "{what}, {spec}: the image changed");
+            assert!(r.hits == majority.hits, "{what}, {spec}: the hits changed");
+            assert_eq!(r.ray_census(), majority.ray_census(), "{what}, {spec}");
+            cycles.push(r.cycles);
+        }
+        eprintln!("{what}: cycles with majority, uuu,uuu, ddd,ddd, udm,dum: {cycles:?}");
+        assert!(
+            cycles.iter().any(|&c| c != cycles[0]),
+            "{what}: every order took the same cycles ({cycles:?}): the order is not applied"
+        );
+    }
+}
+
+/// What `--child-order auto` serves: a mirror sphere before a wall, seen
+/// from the side opposite the wall. A reflected ray can hit only the wall
+/// (the sphere is convex), so every secondary ray that hits goes towards
+/// it (up along y), while those from the sphere's middle go back towards
+/// the eye (down along y) and miss; the rule serves the ones that hit.
+#[test]
+fn the_rays_that_end_decide_the_child_order() {
+    use firmware::tracer::{AxisOrder, ChildOrder};
+    let scene = firmware::scene::nff::parse(
+        "v\nfrom 0 -6 0\nat 0 0 0\nup 0 0 1\nangle 30\nhither 0.01\nresolution 64 64\n\
+         b 0 0 0\nl 0 -5 5\n\
+         f 0.8 0.8 0.8 0.5 0.5 10 0 0\ns 0 0 0 1\n\
+         f 0.3 0.8 0.3 0.9 0 1 0 0\np 4\n-20 8 -20\n20 8 -20\n20 8 20\n-20 8 20\n",
+        "mirror.nff",
+    )
+    .unwrap();
+    let w = reference::ray_ways(&scene, 64, 64, 2, 1);
+    let [down, up] = w.secondary[1];
+    let [down_hit, up_hit] = w.secondary_hit[1];
+    eprintln!("along y: {down} reflected rays down ({down_hit} hit), {up} up ({up_hit} hit)");
+    assert_eq!(
+        down_hit, 0,
+        "a reflected ray going away from the wall hit something"
+    );
+    assert!(up_hit > 0 && up_hit <= up, "{up_hit} of {up}");
+    assert!(down > 0, "no reflected ray goes back towards the eye");
+    let order = ChildOrder::from_hits(
+        (&w.secondary_hit, &w.secondary),
+        (&w.shadow_blocked, &w.shadow),
+    );
+    let (closest, _) = order.rules();
+    assert_eq!(closest[1], AxisOrder::Up, "{order}");
 }
 
 /// The packet traversal's `majority` (which child a pass visits first
@@ -556,7 +663,7 @@ fn majority_counts_the_rays_going_down() {
     }
     t.li(R1, 1).halt();
     t.label("fail").li(R1, 0xbad).halt();
-    firmware::tracer::traversal::packet::majority(&mut t);
+    firmware::tracer::traversal::child_order::majority(&mut t);
     let img = firmware::asm::assemble(&t.text(), "majority-test.s").unwrap();
     let out = tb::cmd_run::run_image(&img, rtl::Timing::default(), 1_000_000, None).unwrap();
     out.result.as_ref().unwrap();

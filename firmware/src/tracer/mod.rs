@@ -42,6 +42,7 @@ use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
 pub use rtl::rc::Datapath;
 pub use shadows::ShadowPackets;
+pub use traversal::child_order::{AxisOrder, ChildOrder};
 
 /// Generator options.
 #[derive(Clone, Copy, Debug)]
@@ -81,6 +82,9 @@ pub struct Options {
     /// Packet traversal: object tests run in parts, the rest skipped
     /// where no awake ray can still hit the object, or whole.
     pub test_cuts: TestCuts,
+    /// Packet traversal: which child of a node a packet whose rays go
+    /// both ways along its axis visits first.
+    pub child_order: ChildOrder,
 }
 
 impl Default for Options {
@@ -102,6 +106,7 @@ impl Default for Options {
             pieces: LeafPieces::default(),
             shadows: ShadowPackets::default(),
             test_cuts: TestCuts::default(),
+            child_order: ChildOrder::default(),
         }
     }
 }
@@ -459,6 +464,9 @@ pub struct Firmware {
     /// How the reflection levels' shadow rays are packed: `PerLight` or
     /// `Merged` (never `Auto`).
     pub shadows: ShadowPackets,
+    /// The packet traversal's child order of mixed packets (never `Auto`:
+    /// built as the majority; the paper's traversal has none, `MAJORITY`).
+    pub child_order: ChildOrder,
 }
 
 impl Firmware {
@@ -754,6 +762,11 @@ fn build_one(
         layout: lay,
         bsp: opt.bsp,
         shadows,
+        child_order: match opt.child_order {
+            ChildOrder::Auto => ChildOrder::MAJORITY,
+            o if opt.traversal == Traversal::Packet => o,
+            _ => ChildOrder::MAJORITY,
+        },
     })
 }
 

@@ -50,7 +50,7 @@ pub fn program(
         shadows::routine(&mut t, lay);
     }
     match (lay.traversal, lay.stream.is_some()) {
-        (Traversal::Packet, _) => traversal::packet::trace(&mut t, lay),
+        (Traversal::Packet, _) => traversal::packet::trace(&mut t, lay, opt.child_order),
         (Traversal::Paper, false) => traversal::paper::trace(&mut t, lay),
         (Traversal::Paper, true) => traversal::streamed::trace(&mut t, lay),
     }

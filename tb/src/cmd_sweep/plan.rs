@@ -117,6 +117,7 @@ pub(super) fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> V
     arg("--leaf-pieces", o.pieces.to_string());
     arg("--shadow-packets", o.shadows.to_string());
     arg("--test-cuts", o.test_cuts.to_string());
+    arg("--child-order", o.child_order.to_string());
     arg("--layout", o.layout.name().into());
     arg("--datapath", o.datapath.bits().to_string());
     arg("--newton-steps", n.newton_steps.to_string());

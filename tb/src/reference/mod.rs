@@ -58,6 +58,47 @@ pub struct RayStats {
     pub live_reflect_rays: u64,
     pub live_refract_rays: u64,
     pub live_shadow_rays: u64,
+    /// Which way the live secondary and shadow rays went, and those that
+    /// ended (hit, blocked).
+    #[serde(skip)]
+    pub ways: RayWays,
+}
+
+/// Per axis, how many rays went down (`[axis][0]`: a negative direction
+/// component) and up (`[axis][1]`), of the live secondary (reflected and
+/// refracted) rays and of those that hit something, and of the live
+/// shadow rays and of those that were blocked: what the packet
+/// traversal's `--child-order auto` serves ([`ray_ways`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RayWays {
+    pub secondary: [[u64; 2]; 3],
+    pub secondary_hit: [[u64; 2]; 3],
+    pub shadow: [[u64; 2]; 3],
+    pub shadow_blocked: [[u64; 2]; 3],
+}
+
+impl RayWays {
+    /// Count direction `d` in `counts`.
+    fn add(counts: &mut [[u64; 2]; 3], d: Vec3) {
+        for (a, c) in counts.iter_mut().enumerate() {
+            c[(d.axis(a) >= 0.0) as usize] += 1;
+        }
+    }
+}
+
+impl std::ops::AddAssign for RayWays {
+    fn add_assign(&mut self, o: RayWays) {
+        for (m, n) in [
+            (&mut self.secondary, o.secondary),
+            (&mut self.secondary_hit, o.secondary_hit),
+            (&mut self.shadow, o.shadow),
+            (&mut self.shadow_blocked, o.shadow_blocked),
+        ] {
+            for (x, y) in m.iter_mut().flatten().zip(n.iter().flatten()) {
+                *x += y;
+            }
+        }
+    }
 }
 
 impl std::ops::AddAssign for RayStats {
@@ -70,6 +111,7 @@ impl std::ops::AddAssign for RayStats {
         self.live_refract_rays += o.live_refract_rays;
         self.live_shadow_rays += o.live_shadow_rays;
         self.shadow_rays += o.shadow_rays;
+        self.ways += o.ways;
     }
 }
 
@@ -196,7 +238,14 @@ impl<'s> Tracer<'s> {
         live: bool,
         stats: &mut RayStats,
     ) -> (Vec3, Option<usize>) {
-        let Some((id, h)) = self.closest(r) else {
+        let hit = self.closest(r);
+        if depth > 1 && live {
+            RayWays::add(&mut stats.ways.secondary, r.d);
+            if hit.is_some() {
+                RayWays::add(&mut stats.ways.secondary_hit, r.d);
+            }
+        }
+        let Some((id, h)) = hit else {
             return (self.scene.background, None);
         };
         let obj = &self.scene.objects[id];
@@ -218,10 +267,16 @@ impl<'s> Tracer<'s> {
             stats.live_shadow_rays += live as u64;
             let o = self.offset(p, n, l);
             let shadow = Ray { o, d: l };
-            if self
-                .bvh
-                .occluded(self.scene, &shadow, 0.0, (light.position - o).length())
-            {
+            let blocked =
+                self.bvh
+                    .occluded(self.scene, &shadow, 0.0, (light.position - o).length());
+            if live {
+                RayWays::add(&mut stats.ways.shadow, l);
+                if blocked {
+                    RayWays::add(&mut stats.ways.shadow_blocked, l);
+                }
+            }
+            if blocked {
                 continue;
             }
             let mut c = m.color * (m.kd * nl);
@@ -337,6 +392,29 @@ pub(crate) fn render_pixels(
             .collect(),
         px.iter().map(|p| p.1).collect(),
     )
+}
+
+/// [`RayWays`] of the rays of every `stride`-th pixel in both directions
+/// of a `w` x `h` image (from `stride / 2`), traced as [`render`] traces
+/// them to `max_depth`.
+pub fn ray_ways(scene: &Scene, w: u32, h: u32, max_depth: u32, stride: u32) -> RayWays {
+    let tracer = Tracer::new(scene);
+    let view = View::new(scene);
+    let (w, h, k) = (w.max(1), h.max(1), stride.max(1));
+    let rows: Vec<u32> = (k / 2..h).step_by(k as usize).collect();
+    rows.par_iter()
+        .map(|&j| {
+            let mut stats = RayStats::default();
+            for i in (k / 2..w).step_by(k as usize) {
+                let (sx, sy) = screen(w, h, w, h, i, j);
+                tracer.trace(&view.ray(sx, sy), 1, max_depth, &mut stats);
+            }
+            stats.ways
+        })
+        .reduce(RayWays::default, |mut a, b| {
+            a += b;
+            a
+        })
 }
 
 /// Render a scene.

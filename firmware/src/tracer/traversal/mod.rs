@@ -10,12 +10,14 @@
 //!   of records moved into FB bank 1 by DMA; a node where the rays
 //!   disagree is resolved by visiting both children.
 //! - [`packet`]: masked packet traversal with per-ray intervals
-//!   (resident or streamed), the default.
+//!   (resident or streamed), the default; [`child_order`]: which child
+//!   of a node its packets visit first.
 //!
 //! Every traversal's `trace` is called by the tile loop ([`super::tiles`])
 //! with the rays in r1..r7 of every RC and `MODE` 0 (closest hit) or 1
 //! (any hit: shadow rays), and returns when every ray is done.
 
+pub mod child_order;
 pub mod packet;
 pub mod paper;
 pub mod streamed;

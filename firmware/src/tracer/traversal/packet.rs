@@ -10,8 +10,9 @@
 //!   PASS += 1; per axis k_sign: which rays go down (F masks read)
 //!   k_pass_start: every awake ray alive, its interval [0, tbest]
 //!     clipped to the root cell, 1/d per axis; while it runs, per axis:
-//!     the child order the majority of the awake rays meets first
-//!     (decided again if the start put a ray to sleep)
+//!     the child order (the awake rays' near child where they agree; the
+//!     rule of `super::child_order` where they do not), decided again if
+//!     the start put a ray to sleep
 //!     (NK: the node kernel, NF/NS: the first and second child's field)
 //!   node = ROOT
 //!   loop:
@@ -77,6 +78,7 @@ use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
 use super::super::primitives::{kaddr, klen, run_first_part, run_rest};
+use super::child_order::{self, ChildOrder};
 use crate::tracer::kernel_names as names;
 
 /// Widening of every split plane and of the root box in the packet
@@ -383,8 +385,9 @@ impl Fields {
     }
 }
 
-/// The packet `trace`, its leaf loop and `majority`.
-pub fn trace(t: &mut Code, lay: &FbImage) {
+/// The packet `trace`, its leaf loop and `majority`; `order`: the child
+/// order of mixed packets.
+pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
     let streamed = lay.stream.is_some();
     let f = Fields { streamed };
     let flags = f.n("PN_FLAGS", "PS_FLAGS");
@@ -429,7 +432,12 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
                 "leaf_objects"
             });
     }
-    child_order(t, &f);
+    child_order::pass_start(
+        t,
+        order,
+        f.n("PN_LEFT", "PS_LEFT"),
+        f.n("PN_RIGHT", "PS_RIGHT"),
+    );
     t.li(R14, 0).c("the node stack: empty").li(R5, "ROOT");
     if streamed {
         t.li(R7, "SPLIT").c("r7 = SPLIT throughout the walk");
@@ -513,7 +521,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .c("its node kernel")
         .j("inner_node");
     t.label("trace_done").lw(R15, at("SAVE_LR", R0)).ret();
-    majority(t);
+    child_order::majority(t);
 }
 
 /// r5 = a node, r6 = its flags: a leaf, or its kernel issued (the split
@@ -843,48 +851,6 @@ fn type_loop(
     t.label(&end);
 }
 
-/// `majority`: r8 = 1 when more of the awake rays (r11, r12) go down
-/// (r1, r2: those of them whose direction component is negative) than
-/// not: `awake < 2 down`. Both counts are SWAR population counts of the
-/// 64-bit masks, the halves summed at 4-bit fields (at most 8 each).
-pub fn majority(t: &mut Code) {
-    t.doc(
-        "majority: r8 = 1 if more of the awake RCs (r11, r12) are in r1, r2 than not.\n\
-         Clobbers r1..r6, r9.",
-    );
-    t.label("majority")
-        .li(R5, "0x55555555")
-        .li(R6, "0x33333333");
-    // pairs: x - ((x >> 1) & 0x55..)
-    for (x, src) in [(R1, R1), (R2, R2), (R3, R11), (R4, R12)] {
-        t.srli(R9, src, 1).and(R9, R9, R5).sub(x, src, R9);
-    }
-    t.c("2-bit counts");
-    for x in [R1, R2, R3, R4] {
-        t.and(R9, x, R6).srli(x, x, 2).and(x, x, R6).add(x, x, R9);
-    }
-    t.c("4-bit counts")
-        .add(R1, R1, R2)
-        .add(R3, R3, R4)
-        .c("the halves summed: down in r1, awake in r3")
-        .li(R5, "0x0f0f0f0f")
-        .li(R6, "0x01010101");
-    // Bytes: both nibbles masked before the sum (up to 16, five bits).
-    for x in [R1, R3] {
-        t.srli(R9, x, 4)
-            .and(R9, R9, R5)
-            .and(x, x, R5)
-            .add(x, x, R9)
-            .mul(x, x, R6)
-            .srli(x, x, 24);
-    }
-    t.c("the byte counts summed")
-        .slli(R1, R1, 1)
-        .slt(R8, R3, R1)
-        .c("awake < 2 down: fewer go up than down")
-        .ret();
-}
-
 /// The packet traversal's macro: the mailbox check of a leaf's object.
 pub fn macros() -> Code {
     let mut t = Code::new();
@@ -921,85 +887,4 @@ pub fn macros() -> Code {
         b,
     );
     t
-}
-
-/// The pass's start: `k_pass_start`, then per axis the order of the children
-/// the majority of the awake rays meets first (`NK`, `NF`, `NS`); no ray
-/// awake: `trace_done`. The directions' signs (`k_sign_*`, F = going down)
-/// are read into `NEG_*` before the pass starts, with the awake rays, so
-/// that TinyRISC decides the orders while `k_pass_start` runs; the rays
-/// the pass start puts to sleep (those that miss the root cell) are known
-/// only after it, so the orders are decided again when there were any
-/// (the same orders as from the awake rays after the start).
-fn child_order(t: &mut Code, f: &Fields) {
-    // Each axis's masks stay in registers until the pass start is issued.
-    let masks = [(R3, R4), (R5, R6), (R8, R9)];
-    for (a, &(lo, hi)) in masks.iter().enumerate() {
-        t.m("BCAST", names::sign(a as u8))
-            .rcfl(lo)
-            .rcfh(hi)
-            .c(format!("the rays going down along {}", ["x", "y", "z"][a]));
-    }
-    t.rcsl(R11)
-        .rcsh(R12)
-        .c("r11, r12: the rays asleep before the pass starts");
-    t.m("BCAST_FB", format!("{}, ROOTBOX", names::PASS_START))
-        .c("intervals in the root cell, 1/d; while they are computed: the orders");
-    for (&(lo, hi), axis) in masks.iter().zip(["X", "Y", "Z"]) {
-        t.sw(lo, at(format!("NEG_{axis}"), R0))
-            .sw(hi, at(format!("NEG_{axis}+MASK_HI"), R0));
-    }
-    t.label("order_pass")
-        .nor(R11, R11, R0)
-        .nor(R12, R12, R0)
-        .c("r11, r12: the awake rays")
-        .or(R1, R11, R12)
-        .beqz(R1, "trace_done")
-        .c("no ray awake");
-    for (a, axis) in ["X", "Y", "Z"].into_iter().enumerate() {
-        let lo = axis.to_lowercase();
-        t.lw(R1, at(format!("NEG_{axis}"), R0))
-            .lw(R2, at(format!("NEG_{axis}+MASK_HI"), R0))
-            .and(R1, R1, R11)
-            .and(R2, R2, R12)
-            .c(format!("r1, r2: the awake rays going down along {lo}"))
-            .li(R8, 0)
-            .or(R3, R1, R2)
-            .beqz(R3, format!("order_{lo}"))
-            .c("none")
-            .li(R8, 1)
-            .bne(R1, R11, format!("order_{lo}_some"))
-            .beq(R2, R12, format!("order_{lo}"))
-            .c("all");
-        t.label(format!("order_{lo}_some"))
-            .jal("majority")
-            .c("some: r8 = most go down");
-        t.label(format!("order_{lo}"))
-            .li(R1, kaddr(&names::node(a as u8, false)))
-            .li(R2, f.n("PN_LEFT", "PS_LEFT"))
-            .li(R3, f.n("PN_RIGHT", "PS_RIGHT"))
-            .beqz(R8, format!("order_{lo}_set"))
-            .li(R1, kaddr(&names::node(a as u8, true)))
-            .li(R2, f.n("PN_RIGHT", "PS_RIGHT"))
-            .li(R3, f.n("PN_LEFT", "PS_LEFT"))
-            .c("most go down: above first");
-        t.label(format!("order_{lo}_set"))
-            .sw(R1, at(format!("NK+AXIS_{axis}"), R0))
-            .sw(R2, at(format!("NF+AXIS_{axis}"), R0))
-            .sw(R3, at(format!("NS+AXIS_{axis}"), R0))
-            .c("node kernel, first and second child");
-    }
-    t.rcsl(R1)
-        .rcsh(R2)
-        .c("the rays asleep once the pass has started")
-        .nor(R11, R11, R0)
-        .nor(R12, R12, R0)
-        .bne(R1, R11, "order_again")
-        .beq(R2, R12, "order_done");
-    t.label("order_again")
-        .mv(R11, R1)
-        .mv(R12, R2)
-        .j("order_pass")
-        .c("some ray missed the root cell: the orders from the awake rays left");
-    t.label("order_done");
 }
