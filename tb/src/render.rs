@@ -44,7 +44,7 @@ pub struct ChipRender {
     pub passes: u64,
     /// The streamed packet traversal's leaf cache (`None` for other
     /// layouts): leaves whose first piece was in its slot, and those whose
-    /// first piece was moved (counted by the simulator).
+    /// first piece was not (counted by the simulator).
     pub leaf_cache: Option<LeafCache>,
     pub tiles: usize,
     pub firmware: Firmware,
@@ -77,7 +77,9 @@ pub struct LeafCache {
     /// Leaves reached whose first piece was in its slot, moved there
     /// earlier in the tile.
     pub hits: u64,
-    /// Leaves reached whose first piece was moved by DMA.
+    /// Leaves reached whose first piece was not in its slot: moved by
+    /// DMA, or (a large one, `LEAF_LATE`) left unmoved where every awake
+    /// ray had tested its objects.
     pub misses: u64,
 }
 

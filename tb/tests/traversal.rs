@@ -675,3 +675,45 @@ fn majority_counts_the_rays_going_down() {
         );
     }
 }
+
+/// A streamed leaf whose first piece is one large record of an object in
+/// several leaves (SPD gears' faces, banded polygons of 144 vertices:
+/// 1,088 words, over the further pieces' 256) is moved only once the
+/// mailbox scan finds the object untested by some awake ray
+/// (`LEAF_LATE`): the frame is the one of further pieces large enough
+/// for the faces (`--leaf-pieces 64,2048`: no leaf late), pixel for
+/// pixel, on both chips.
+#[test]
+fn large_first_pieces_move_only_when_tested() {
+    use firmware::tracer::{ChildOrder, LeafPieces, ShadowPackets};
+    let scene = load("gears-1.nff");
+    for datapath in [rtl::rc::Datapath::W16, rtl::rc::Datapath::W32] {
+        let render = |rest| {
+            let o = Options {
+                datapath,
+                child_order: ChildOrder::MAJORITY,
+                shadows: ShadowPackets::PerLight,
+                pieces: LeafPieces { first: 64, rest },
+                ..opts(48, 48, Traversal::Packet)
+            };
+            render_sah(&scene, o, true)
+        };
+        let (late, whole) = (render(256), render(2048));
+        let n = |r: &tb::render::ChipRender| r.firmware.layout.stream.as_ref().unwrap().late_leaves;
+        eprintln!(
+            "gears-1, {datapath}: {} late leaves, {} cycles; with 64,2048: {} late, {} cycles",
+            n(&late),
+            late.cycles,
+            n(&whole),
+            whole.cycles
+        );
+        assert!(
+            n(&late) > 0,
+            "{datapath}: no leaf moves its first piece late"
+        );
+        assert_eq!(n(&whole), 0, "{datapath}");
+        assert!(late.rgb8 == whole.rgb8, "{datapath}: the image changed");
+        assert!(late.hits == whole.hits, "{datapath}: the hits changed");
+        assert_eq!(late.ray_census(), whole.ray_census(), "{datapath}");
+    }
+}

@@ -147,6 +147,10 @@ pub struct Stream {
     /// Packet traversal: leaf pieces beyond one per leaf (a leaf's records
     /// are moved in pieces, [`super::LeafPieces`]).
     pub extra_pieces: usize,
+    /// Packet traversal: leaves whose first piece is moved only once an
+    /// object in it is to be tested
+    /// ([`packet_nodes::LEAF_LATE`]).
+    pub late_leaves: usize,
     /// Packet traversal: the leaf cache, slots of FB bank 1 that keep
     /// leaves' first pieces for the rest of the tile (`docs/tracer.md`,
     /// "Leaves and pieces"): their number (1 with no room beside the

@@ -161,6 +161,14 @@ pub fn chip_costs(
 pub const LEAF_AWAKE: i32 = 1;
 /// A leaf's flags: it has no object.
 pub const LEAF_EMPTY: i32 = 2;
+/// A streamed leaf's flags: its first piece is larger than further pieces
+/// may be (`--leaf-pieces`' REST: one large record) and every object in it
+/// has a mailbox, so the piece is moved only once the mailbox scan finds
+/// an object in it some awake ray has not tested (on a miss of the leaf
+/// cache): a large record the packet's rays have all tested in another
+/// leaf is not moved again. The scan costs about ten TinyRISC cycles, the
+/// move at least a cycle per two words.
+pub const LEAF_LATE: i32 = 4;
 
 /// Words of a packet-traversal inner node: axis, parent's slot, split,
 /// own slot, left, right (FB addresses, or byte addresses when streamed).
@@ -589,6 +597,7 @@ fn streamed_image(
         };
         img[lists_at + 4 * i..lists_at + 4 * i + 4].copy_from_slice(&a.to_le_bytes());
     }
+    let mut late_leaves = 0usize;
     for (k, n) in nodes.iter().enumerate() {
         let mut f = [0i32; 16];
         match n.split {
@@ -608,7 +617,12 @@ fn streamed_image(
                     f[word(PS_FB)] = p[word(PS_FB)];
                     f[word(PS_BLOCK)..].copy_from_slice(&p[word(PS_BLOCK)..]);
                     let awake = p[word(PS_SHARED)] != 0 || p[word(PS_NEXT)] != 0;
-                    f[word(PS_FLAGS)] = -32768 | if awake { LEAF_AWAKE } else { 0 };
+                    let late = p[word(PS_BLOCK_WORDS)] as usize > fin.pieces.rest
+                        && p[word(PS_SHARED)] == p[word(PS_OBJECTS)];
+                    late_leaves += late as usize;
+                    f[word(PS_FLAGS)] = -32768
+                        | if awake { LEAF_AWAKE } else { 0 }
+                        | if late { LEAF_LATE } else { 0 };
                 }
             }
         }
@@ -638,6 +652,7 @@ fn streamed_image(
         nodes: nn,
         largest_block: largest,
         extra_pieces: pieces.len() - first_piece.iter().filter(|&&p| p != usize::MAX).count(),
+        late_leaves,
         cache_slots,
         slot_words,
         slots_at,

@@ -234,6 +234,7 @@ fn streamed_image(
         nodes: nn,
         largest_block: largest,
         extra_pieces: 0,
+        late_leaves: 0,
         cache_slots: 0,
         slot_words: 0,
         slots_at: 0,

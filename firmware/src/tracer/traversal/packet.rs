@@ -73,7 +73,7 @@
 use super::super::emit::{
     at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
-use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY};
+use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY, LEAF_LATE};
 use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
@@ -626,19 +626,29 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         // DMA starts before the tests of the piece before it are issued,
         // once the array is done with the other bank (the tests of the
         // piece before that), so that it moves while those tests run. A
-        // piece is waited for (`dwait`) before its tests, and before the
-        // leaf is left, so no DMA is under way when a node kernel reads
-        // bank 0 again.
+        // piece is waited for (`dwait`) before its tests; one whose
+        // objects every awake ray has tested is left as it moves, unless
+        // it goes to bank 0, which the node kernels read (the array reads
+        // bank 1 only in a leaf's tests, after that leaf's `dwait`).
         let one_slot = lay
             .stream
             .as_ref()
             .is_some_and(|st| st.slots_at == super::super::layout::STREAM_BANK);
+        // Leaves whose first piece is one large record of an object in
+        // several leaves (LEAF_LATE) move it only once the mailbox scan
+        // finds it untested by some awake ray: r11 says the move is still
+        // to come.
+        let late = lay.stream.as_ref().is_some_and(|st| st.late_leaves > 0);
         t.label("leaf")
             .andi(R1, R6, LEAF_EMPTY)
             .bnez(R1, "leaf_done")
             .c("an empty leaf")
             .andi(R12, R6, LEAF_AWAKE)
             .c("r12 = 0: no mailbox to check");
+        if late {
+            t.andi(R11, R6, LEAF_LATE)
+                .c("r11: a large first piece, moved only if one of its objects is to be tested");
+        }
         t.comment("the first piece: in its slot of the leaf cache since this tile moved it there,")
             .comment("or its DMA starts");
         t.label("leaf_first")
@@ -651,10 +661,13 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .bne(R3, R2, "leaf_miss")
             .c("moved in another tile (checked first: a tag from an earlier tile never costs more)")
             .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
-            .beq(R1, R3, "leaf_awake")
+            .beq(R1, R3, if late { "leaf_hit" } else { "leaf_awake" })
             .c("the slot holds the block: a hit");
-        t.label("leaf_miss")
-            .lw(R3, at("PS_BLOCK_WORDS", R5))
+        t.label("leaf_miss");
+        if late {
+            t.bnez(R11, "leaf_awake").c("not yet: the scan first");
+        }
+        t.lw(R3, at("PS_BLOCK_WORDS", R5))
             .ldfb(R1, R7, R3)
             .c("the first piece's DMA starts")
             .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
@@ -690,17 +703,27 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         t.label("leaf_skip")
             .lw(R1, at("PS_NEXT", R5))
             .bnez(R1, "leaf_skip_next")
+            .andi(R1, R7, "SBANK")
+            .bnez(R1, "leaf_done")
+            .c("a piece in bank 1 may move on: the array reads it only after a leaf's dwait")
             .dwait()
-            .c("the last piece in before the leaf is left")
+            .c("a piece in bank 0: in before a node kernel reads the bank")
             .j("leaf_done");
         t.label("leaf_skip_next");
+        if late {
+            t.li(R11, 0)
+                .c("a late first piece skipped: the next moves as usual");
+        }
         next_piece_dma(t, one_slot, "the next piece's DMA starts");
         t.j("leaf_next_piece");
         t.comment("while the piece still moves: what its tests start from");
         let count_field = |ti: &TypeInfo| format!("PS_COUNT_{}", ti.ty.name().to_uppercase());
-        t.label("leaf_go")
-            .lw(R1, at("PS_NEXT", R5))
-            .lw(R6, at("PS_LIST", R5));
+        t.label("leaf_go");
+        if late {
+            t.bnez(R11, "leaf_late").c("a large first piece to move");
+            t.label("leaf_go_moving");
+        }
+        t.lw(R1, at("PS_NEXT", R5)).lw(R6, at("PS_LIST", R5));
         if let Some(ti) = lay.types.first() {
             t.lw(R9, at(count_field(ti), R5));
         }
@@ -738,6 +761,23 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .lw(R7, at("PS_FB", R5))
             .c("r7: the piece's first record")
             .j("leaf_piece");
+        if late {
+            t.comment("a large first piece some awake ray has not tested: its DMA starts, the slot takes it");
+            t.label("leaf_late")
+                .li(R11, 0)
+                .lw(R1, at("PS_BLOCK", R5))
+                .lw(R3, at("PS_BLOCK_WORDS", R5))
+                .ldfb(R1, R7, R3)
+                .add(R6, R7, R7)
+                .lw(R2, at("TILE_GEN", R0))
+                .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
+                .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
+                .j("leaf_go_moving");
+            t.label("leaf_hit")
+                .li(R11, 0)
+                .c("in its slot: nothing to move")
+                .j("leaf_awake");
+        }
     } else {
         t.label("leaf")
             .andi(R1, R6, LEAF_EMPTY)
