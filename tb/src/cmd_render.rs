@@ -104,8 +104,9 @@ pub struct RenderArgs {
     /// m the majority, d the rays going down first, u the rays going up
     /// first; e.g. uud) or auto (per axis the way most of the view's
     /// sampled secondary rays that hit, and shadow rays that are blocked,
-    /// go; kept where faster than majority on a probe of the frame). The
-    /// same image either way.
+    /// go, kept where faster than majority on a probe of the frame; then
+    /// each closest-hit axis left to the majority tried with d and u on
+    /// the probe). The same image either way.
     #[arg(long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto", value_parser = crate::cli::parse_child_order)]
     pub child_order: firmware::tracer::ChildOrder,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
@@ -816,7 +817,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             "child order              {} (where a packet's awake rays go both ways along a node's axis{})",
             chip.firmware.child_order.describe(),
             if opt.child_order == firmware::tracer::ChildOrder::Auto {
-                "; auto: per axis the way most of the view's sampled rays that end go, kept where faster than majority on the probe"
+                "; auto: per axis the way most of the view's sampled rays that end go, and the rules the probe runs faster"
             } else {
                 ""
             }

@@ -574,6 +574,46 @@ fn child_orders_find_the_same_hits() {
     }
 }
 
+/// `tracer::with_child_order` (how `--child-order auto` tries orders on
+/// the probe without laying the scene out again) gives the program and
+/// data image a build for that order gives, resident and streamed.
+#[test]
+fn another_child_order_is_the_build_for_it() {
+    use firmware::tracer::{build_streamed_with, build_with, with_child_order, ChildOrder};
+    let nm = Numerics::default();
+    for (name, streamed) in [
+        ("rings-1.nff", false),
+        ("rings-1.nff", true),
+        ("gears-1.nff", true),
+    ] {
+        let scene = load(name);
+        let o = opts(32, 32, Traversal::Packet);
+        let build = |o: &Options| {
+            if streamed {
+                build_streamed_with(&scene, o, &nm)
+            } else {
+                build_with(&scene, o, &nm)
+            }
+            .unwrap()
+        };
+        let base = build(&o);
+        for spec in ["uud,dmu", "majority"] {
+            let order: ChildOrder = spec.parse().unwrap();
+            let other = with_child_order(&scene, &base, &o, &nm, order).unwrap();
+            let built = build(&Options {
+                child_order: order,
+                ..o
+            });
+            assert_eq!(other.child_order, order, "{name}, {spec}");
+            assert!(
+                other.source == built.source,
+                "{name}, {spec}: another program"
+            );
+            assert!(other.fb == built.fb, "{name}, {spec}: another data image");
+        }
+    }
+}
+
 /// What `--child-order auto` serves: a mirror sphere before a wall, seen
 /// from the side opposite the wall. A reflected ray can hit only the wall
 /// (the sphere is convex), so every secondary ray that hits goes towards

@@ -511,6 +511,44 @@ pub fn build_with(scene: &Scene, opt: &Options, nm: &Numerics) -> Result<Firmwar
     build_as(scene, opt, nm, false)
 }
 
+/// `fw`, built by [`build_with`] for `scene` and `opt`, with its program
+/// generated again for the child order `order`
+/// ([`traversal::child_order`]): the same data image, layout and BSP, the
+/// same program but for `trace`'s orders of mixed packets, without
+/// building the scene's layout again.
+pub fn with_child_order(
+    scene: &Scene,
+    fw: &Firmware,
+    opt: &Options,
+    nm: &Numerics,
+    order: ChildOrder,
+) -> Result<Firmware, String> {
+    let o = Options {
+        bsp: fw.bsp,
+        shadows: fw.shadows,
+        child_order: order,
+        ..*opt
+    };
+    let prog = program::program(scene, &fw.layout, &o, nm, fw.tile_w, fw.tile_h)?;
+    Ok(Firmware {
+        source: prog.source,
+        context_words: prog.context_words,
+        kernels: prog.kernels,
+        child_order: resolved_child_order(&o),
+        ..fw.clone()
+    })
+}
+
+/// The child order a build for `opt` takes: `Auto` as the majority, and
+/// none (the majority) for the paper's traversal.
+fn resolved_child_order(opt: &Options) -> ChildOrder {
+    match opt.child_order {
+        ChildOrder::Auto => ChildOrder::MAJORITY,
+        o if opt.traversal == Traversal::Packet => o,
+        _ => ChildOrder::MAJORITY,
+    }
+}
+
 /// Build the firmware with the streamed layout whether or not the scene
 /// fits the FB (for tests and comparisons; [`build_with`] streams only the
 /// scenes that do not fit).
@@ -762,11 +800,7 @@ fn build_one(
         layout: lay,
         bsp: opt.bsp,
         shadows,
-        child_order: match opt.child_order {
-            ChildOrder::Auto => ChildOrder::MAJORITY,
-            o if opt.traversal == Traversal::Packet => o,
-            _ => ChildOrder::MAJORITY,
-        },
+        child_order: resolved_child_order(opt),
     })
 }
 
