@@ -105,8 +105,8 @@ pub struct RenderArgs {
     /// first; e.g. uud) or auto (per axis the way most of the view's
     /// sampled secondary rays that hit, and shadow rays that are blocked,
     /// go, kept where faster than majority on a probe of the frame; then
-    /// each closest-hit axis left to the majority tried with d and u on
-    /// the probe). The same image either way.
+    /// each closest-hit axis left to the majority tried on the probe with
+    /// the way its sampled rays that hit lean). The same image either way.
     #[arg(long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto", value_parser = crate::cli::parse_child_order)]
     pub child_order: firmware::tracer::ChildOrder,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
