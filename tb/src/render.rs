@@ -1015,28 +1015,6 @@ pub(crate) fn choose_firmware_probed(
     choose_child_order(scene, opt, nm, timing, fw, p)
 }
 
-/// The faster of `fw` (its probe `p`, if run) and `other` on the probe
-/// (the same images: the same rays, traced in another order or other
-/// packets); a tie keeps `fw`.
-fn faster_on_probe(
-    opt: &Options,
-    timing: &Timing,
-    (fw, p): (Firmware, Option<ProbeRender>),
-    other: Firmware,
-) -> Result<(Firmware, Option<ProbeRender>)> {
-    let (p, op) = rayon::join(
-        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
-        || probe(&other, opt, timing),
-    );
-    let (p, mut op) = (p?, op?);
-    if op.cycles < p.cycles {
-        op.reference = p.reference;
-        Ok((other, Some(op)))
-    } else {
-        Ok((fw, Some(p)))
-    }
-}
-
 /// `--shadow-packets auto`: the tree chosen, merged shadow packets
 /// against a packet per light on the probe, the fewer cycles kept.
 fn choose_shadows(
@@ -1056,7 +1034,18 @@ fn choose_shadows(
         ..*opt
     };
     let mfw = tracer::build_with(scene, &merged, nm).map_err(|e| anyhow!("{e}"))?;
-    faster_on_probe(opt, timing, (fw, p), mfw)
+    // The same images: the same rays, traced in other packets.
+    let (p, mp) = rayon::join(
+        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
+        || probe(&mfw, opt, timing),
+    );
+    let (p, mut mp) = (p?, mp?);
+    if mp.cycles < p.cycles {
+        mp.reference = p.reference;
+        Ok((mfw, Some(mp)))
+    } else {
+        Ok((fw, Some(p)))
+    }
 }
 
 /// Eye rays the host traces to learn the ways rays end
@@ -1108,9 +1097,10 @@ fn choose_child_order(
     if prior == ChildOrder::MAJORITY && mixed.is_empty() {
         return Ok((fw, p));
     }
-    let base = fw.clone();
-    let build = |order: ChildOrder| {
-        tracer::with_child_order(scene, &base, opt, nm, order).map_err(|e| anyhow!("{e}"))
+    // Every order is generated on the same layout (the kept firmware's:
+    // the orders differ only in their programs).
+    let build = |base: &Firmware, order: ChildOrder| {
+        tracer::with_child_order(scene, base, opt, nm, order).map_err(|e| anyhow!("{e}"))
     };
     let mut best = match p {
         Some(p) => (fw, p),
@@ -1126,7 +1116,7 @@ fn choose_child_order(
         }
     };
     if prior != ChildOrder::MAJORITY {
-        let pfw = build(prior)?;
+        let pfw = build(&best.0, prior)?;
         let pp = probe(&pfw, opt, timing)?;
         keep(&mut best, pfw, pp, 0.0);
     }
@@ -1142,7 +1132,7 @@ fn choose_child_order(
         } else {
             AxisOrder::Up
         };
-        let f = build(ChildOrder::Fixed { closest, any })?;
+        let f = build(&best.0, ChildOrder::Fixed { closest, any })?;
         let p = probe(&f, opt, timing)?;
         keep(&mut best, f, p, CHILD_ORDER_MARGIN);
     }
