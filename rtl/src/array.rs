@@ -124,6 +124,12 @@ impl<W: Word> Array<W> {
         self.active
     }
 
+    /// Does some awake RC have F (what `rcany` reads, and a cut)?
+    #[inline(always)]
+    pub fn any_awake_f(&self) -> bool {
+        self.rc.flags.f & !self.rc.flags.sleep != 0
+    }
+
     pub fn mode(&self) -> Mode {
         self.mode
     }

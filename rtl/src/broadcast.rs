@@ -16,6 +16,14 @@
 //! not read the FB leave it). A context that reads `fbs` in a run that does
 //! not stream set `s`, a stream that runs out of its set, and a read of a
 //! bank the DMA owns are faults.
+//!
+//! **Cuts.** A run ends early after a `cut` context ([`Context::CUT`], a
+//! `nop` to the RCs) where no awake RC has F: the unit reads the 64 flags
+//! as `rcany` does, in the cut's own cycle, and the queued run, if any,
+//! starts in the next. A kernel that knows early that no ray can go on (an
+//! object test whose rays all miss) thus stops without TinyRISC's status
+//! read; a cut where some awake RC has F costs its one cycle. Row and
+//! column runs have no cuts (a `cut` word there is a `nop`).
 
 use crate::array::{Array, Mode};
 use crate::context_memory::{self, ContextMemory};
@@ -87,6 +95,8 @@ pub struct Broadcast {
     queued: Option<Run>,
     // next state of `cur`, computed by eval
     d_ptr: [u16; 2],
+    /// The run ends at this clock edge: a cut with no awake RC's F.
+    d_cut: bool,
     /// Context words driven this cycle (for waveforms).
     pub word: u32,
     /// Contexts (SIMD) or groups executed.
@@ -187,6 +197,7 @@ impl Broadcast {
             let c = get(addr)?;
             self.d_ptr = cur.ptr;
             self.word = cm.word(addr);
+            self.d_cut = self.word == Context::CUT_WORD && !array.any_awake_f();
             // Built whole from the datum (a store into one half of the pair
             // read back at once as the whole pair stalls the forwarding).
             let fbd = if c.asrc == ASrc::Fb {
@@ -213,6 +224,7 @@ impl Broadcast {
         }
         let mut fbd = [W::ZERO; 2];
         self.d_ptr = cur.ptr;
+        self.d_cut = false;
         for (s, d) in fbd.iter_mut().enumerate() {
             if reads >> s & 1 != 0 {
                 *d = self.stream(s, &run, addr, fbm, dma_fb_banks)?;
@@ -283,7 +295,7 @@ impl Broadcast {
             }
             self.steps += 1;
             cur.k += 1;
-            if cur.k == cur.run.count {
+            if cur.k == cur.run.count || word == Context::CUT_WORD && !array.any_awake_f() {
                 self.cur = self.queued.take().map(Self::start);
             }
             n += 1;
@@ -339,14 +351,16 @@ impl Broadcast {
         )
     }
 
-    /// Clock edge: advance the run; start the queued one when it ends.
+    /// Clock edge: advance the run; start the queued one when it ends
+    /// (its last context, or a cut that ends it).
     #[inline]
     pub fn commit(&mut self) {
         if let Some(cur) = &mut self.cur {
             self.steps += 1;
             cur.ptr = self.d_ptr;
             cur.k += 1;
-            if cur.k == cur.run.count {
+            let cut = std::mem::take(&mut self.d_cut);
+            if cur.k == cur.run.count || cut {
                 self.cur = self.queued.take().map(Self::start);
             }
         }

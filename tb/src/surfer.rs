@@ -23,7 +23,7 @@
 
 use std::fmt::Write;
 
-use rtl::rc::context::{Op, ALL_CONDS, ALL_OPS};
+use rtl::rc::context::{Context, Op, ALL_CONDS, ALL_OPS};
 use rtl::tinyrisc::decode::{Format, ALL_OPCODES};
 
 /// One format of a decoder file: its name, type, template and
@@ -459,7 +459,15 @@ pub(crate) fn context_toml() -> String {
             assert_eq!(n, 1, "{op:?} (immediate {imm}) in {n} classes");
         }
     }
-    let names: Vec<String> = classes.iter().map(|c| format!("\"{}\"", c.0)).collect();
+    // `cut`, one word of `nop`'s (docs/isa.md, "Cuts"): a format of its
+    // own, named to come after every `c_` format, so that it wins.
+    const CUT: &str = "cut";
+    let names: Vec<String> = classes
+        .iter()
+        .map(|c| c.0)
+        .chain([CUT])
+        .map(|n| format!("\"{n}\""))
+        .collect();
     let _ = writeln!(s, "\n[formats]\nnames = [{}]", names.join(", "));
     s.push_str(
         "parts = [\n    [\"op\", 6, \"u8\"],\n    [\"guard\", 2, \"Guard\"],\n    [\"d\", 5, \"Dest\"],\n    \
@@ -611,6 +619,12 @@ pub(crate) fn context_toml() -> String {
                 })
                 .collect(),
         })
+        .chain([Fmt {
+            name: CUT.into(),
+            ty: "ri",
+            repr: "$name$".into(),
+            instrs: vec![(CUT.into(), u32::MAX, Context::CUT_WORD, false)],
+        }])
         .collect();
     push_formats(&mut s, &formats);
     s

@@ -52,6 +52,7 @@ conformance! {
     wfb => "wfb.s",
     rcrisc => "rcrisc.s",
     status_rcany_rcall_masks => "status.s",
+    cut_ends_a_run_where_no_awake_rc_has_f => "cut.s",
     lfb_sfb => "lfb_sfb.s",
     guarded_if_then_else => "ifelse.s",
     tinyrisc_scalar => "tinyrisc.s",

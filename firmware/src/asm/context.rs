@@ -72,6 +72,15 @@ pub(crate) fn context(asm: &Asm, lc: &LineCtx, mut i: usize) -> Result<u32, AsmE
     let Some(Tok::Ident(m)) = t.get(head).map(|x| &x.tok) else {
         return Err(lc.err_at(Some(head), "expected a context"));
     };
+    if m == "cut" {
+        if guard != Guard::Always {
+            return Err(lc.err_at(Some(head), "a `cut` takes no guard"));
+        }
+        if t.get(head + 1).is_some() {
+            return Err(lc.err_at(Some(head + 1), "`cut` takes no operands"));
+        }
+        return Ok(Context::CUT_WORD);
+    }
     let mut parts = m.split('.');
     let base = parts.next().unwrap_or("");
     let Some(op) = ALL_OPS.iter().copied().find(|o| o.mnemonic() == base) else {
@@ -285,5 +294,5 @@ pub(crate) fn guard_prefix(t: &[Token], i: usize) -> (Guard, usize) {
 /// An RC operation's name (with or without its suffixes).
 pub(crate) fn is_mnemonic(w: &str) -> bool {
     let base = w.split('.').next().unwrap_or("");
-    ALL_OPS.iter().any(|o| o.mnemonic() == base)
+    w == "cut" || ALL_OPS.iter().any(|o| o.mnemonic() == base)
 }

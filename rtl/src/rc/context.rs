@@ -363,6 +363,24 @@ impl Context {
         trunc: false,
     };
 
+    /// `cut`: a `nop` whose operand B is the immediate 1 and every other
+    /// field 0. The RCs execute it as a `nop`; the broadcast unit ends the
+    /// run after it where no awake RC has F ([`crate::broadcast`]). Only
+    /// this exact word is a cut: any other `nop` is a `nop`.
+    pub const CUT: Context = Context {
+        b: BSrc::Imm(1),
+        ..Context::NOP
+    };
+
+    /// The context word of [`Context::CUT`].
+    pub const CUT_WORD: u32 = 1 << 11 | 1;
+
+    /// Is this context a [`Context::CUT`]?
+    #[inline(always)]
+    pub fn is_cut(&self) -> bool {
+        *self == Context::CUT
+    }
+
     /// A context with operand A from register `ra`, B from register `rb`,
     /// result to `rd`.
     pub fn rrr(op: Op, rd: u8, ra: u8, rb: u8) -> Context {
@@ -469,6 +487,9 @@ impl Context {
 impl fmt::Display for Context {
     /// The disassembly; the assembler of the firmware crate reads it back.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.is_cut() {
+            return write!(f, "cut");
+        }
         match self.guard {
             Guard::Always => {}
             Guard::IfF => write!(f, "(f) ")?,
@@ -524,6 +545,19 @@ impl fmt::Display for Context {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_cut_is_one_nop_word() {
+        assert_eq!(Context::CUT.encode(), Context::CUT_WORD);
+        assert_eq!(Context::decode(Context::CUT_WORD), Ok(Context::CUT));
+        assert_eq!(Context::CUT.to_string(), "cut");
+        // a nop with another immediate, or guarded, is no cut
+        for w in [1 << 11 | 2, 1 << 24 | 1 << 11 | 1, 0] {
+            let c = Context::decode(w).unwrap();
+            assert_eq!(c.op, Op::Nop);
+            assert!(!c.is_cut(), "{w:#x}");
+        }
+    }
 
     #[test]
     fn every_op_round_trips_through_its_encoding() {

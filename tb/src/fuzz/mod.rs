@@ -137,6 +137,7 @@ pub const CONFORMANCE: &[(&str, &str)] = &[
         "cbcr.s",
         include_str!("../../../firmware/conformance/cbcr.s"),
     ),
+    ("cut.s", include_str!("../../../firmware/conformance/cut.s")),
     (
         "dbcb.s",
         include_str!("../../../firmware/conformance/dbcb.s"),
