@@ -596,30 +596,7 @@ lo_sphere_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere
-lo_sphere_test:
-        BCAST_UPTO k_sphere, k_sphere_cut_line, r7, 0 ; up to F: the ray's line meets the sphere
-        mv r15, r7                      ; r15: the object under test
-        ; while its first part runs: the next object to test (r9 = 0: none)
-        addi r9, r9, -1
-        beqz r9, lo_sphere_last
-lo_sphere_ahead_obj:
-        lfb r7, LE_RECORD(r6)
-        lfb r8, LE_MAILBOX(r6)
-        addi r6, r6, LE_WORDS
-        blt r8, r0, lo_sphere_ahead_go  ; no mailbox
-        slli r8, r8, MB_SHIFT
-        add r8, r8, r12                 ; r8: its mailbox
-        MAILBOX_CHECK lo_sphere_ahead
-lo_sphere_parts:
-        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_test ; the rest, if some awake ray can still hit it
-        j lo_sphere_test
-lo_sphere_ahead_next:
-        addi r9, r9, -1
-        bnez r9, lo_sphere_ahead_obj
-        ; the last object's rest
-lo_sphere_last:
-        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_end ; the rest, if some awake ray can still hit it
-        j lo_sphere_end
+        BCAST_REC k_sphere, r7, 0       ; the test; its cuts end the run where no awake ray can still hit it
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -635,46 +612,13 @@ lo_cylinder_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
-lo_cylinder_test:
-        BCAST_UPTO k_cylinder, k_cylinder_cut_near, r7, CYL_BODY ; up to F: the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1)
-        mv r15, r7                      ; r15: the object under test
-        ; while its first part runs: the next object to test (r9 = 0: none)
-        addi r9, r9, -1
-        beqz r9, lo_cylinder_last
-lo_cylinder_ahead_obj:
-        lfb r7, LE_RECORD(r6)
-        lfb r8, LE_MAILBOX(r6)
-        addi r6, r6, LE_WORDS
-        blt r8, r0, lo_cylinder_ahead_go ; no mailbox
-        slli r8, r8, MB_SHIFT
-        add r8, r8, r12                 ; r8: its mailbox
-        MAILBOX_CHECK lo_cylinder_ahead
-lo_cylinder_parts:
-        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_done ; up to F: the ray's line meets the cylinder
-        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_done ; up to F: the root ahead, before tbest
-        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_done ; the rest, if some awake ray can still hit it
+        BCAST_REC k_cylinder, r7, CYL_BODY ; the test; its cuts end the run where no awake ray can still hit it
 lo_cylinder_done:
-        lfb r3, CYL_CAPS(r15)
+        lfb r3, CYL_CAPS(r7)
         beqz r3, lo_cylinder_nocap
-        BCAST_REC k_disc, r15, CYL_CAP0
-        BCAST_REC k_disc, r15, CYL_CAP1 ; the caps
+        BCAST_REC k_disc, r7, CYL_CAP0
+        BCAST_REC k_disc, r7, CYL_CAP1  ; the caps
 lo_cylinder_nocap:
-        j lo_cylinder_test
-lo_cylinder_ahead_next:
-        addi r9, r9, -1
-        bnez r9, lo_cylinder_ahead_obj
-        ; the last object's rest
-lo_cylinder_last:
-        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_last_done ; up to F: the ray's line meets the cylinder
-        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_last_done ; up to F: the root ahead, before tbest
-        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_last_done ; the rest, if some awake ray can still hit it
-lo_cylinder_last_done:
-        lfb r3, CYL_CAPS(r15)
-        beqz r3, lo_cylinder_last_nocap
-        BCAST_REC k_disc, r15, CYL_CAP0
-        BCAST_REC k_disc, r15, CYL_CAP1 ; the caps
-lo_cylinder_last_nocap:
-        j lo_cylinder_end
 lo_cylinder_next:
         addi r9, r9, -1
         bnez r9, lo_cylinder_obj
@@ -706,30 +650,7 @@ lo_rectangle_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_rectangle
-lo_rectangle_test:
-        BCAST_UPTO k_rectangle, k_rectangle_cut_plane, r7, 0 ; up to F: the plane hit in front (two-sided: on either side), before tbest
-        mv r15, r7                      ; r15: the object under test
-        ; while its first part runs: the next object to test (r9 = 0: none)
-        addi r9, r9, -1
-        beqz r9, lo_rectangle_last
-lo_rectangle_ahead_obj:
-        lfb r7, LE_RECORD(r6)
-        lfb r8, LE_MAILBOX(r6)
-        addi r6, r6, LE_WORDS
-        blt r8, r0, lo_rectangle_ahead_go ; no mailbox
-        slli r8, r8, MB_SHIFT
-        add r8, r8, r12                 ; r8: its mailbox
-        MAILBOX_CHECK lo_rectangle_ahead
-lo_rectangle_parts:
-        BCAST_FROM_ANY k_rectangle_cut_plane, k_rectangle_end, r15, 0, lo_rectangle_test ; the rest, if some awake ray can still hit it
-        j lo_rectangle_test
-lo_rectangle_ahead_next:
-        addi r9, r9, -1
-        bnez r9, lo_rectangle_ahead_obj
-        ; the last object's rest
-lo_rectangle_last:
-        BCAST_FROM_ANY k_rectangle_cut_plane, k_rectangle_end, r15, 0, lo_rectangle_end ; the rest, if some awake ray can still hit it
-        j lo_rectangle_end
+        BCAST_REC k_rectangle, r7, 0    ; the test; its cuts end the run where no awake ray can still hit it
 lo_rectangle_next:
         addi r9, r9, -1
         bnez r9, lo_rectangle_obj
@@ -745,30 +666,7 @@ lo_triangle_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_triangle
-lo_triangle_test:
-        BCAST_UPTO k_triangle, k_triangle_cut_plane, r7, 0 ; up to F: the plane hit in front (two-sided: on either side), before tbest
-        mv r15, r7                      ; r15: the object under test
-        ; while its first part runs: the next object to test (r9 = 0: none)
-        addi r9, r9, -1
-        beqz r9, lo_triangle_last
-lo_triangle_ahead_obj:
-        lfb r7, LE_RECORD(r6)
-        lfb r8, LE_MAILBOX(r6)
-        addi r6, r6, LE_WORDS
-        blt r8, r0, lo_triangle_ahead_go ; no mailbox
-        slli r8, r8, MB_SHIFT
-        add r8, r8, r12                 ; r8: its mailbox
-        MAILBOX_CHECK lo_triangle_ahead
-lo_triangle_parts:
-        BCAST_FROM_ANY k_triangle_cut_plane, k_triangle_end, r15, 0, lo_triangle_test ; the rest, if some awake ray can still hit it
-        j lo_triangle_test
-lo_triangle_ahead_next:
-        addi r9, r9, -1
-        bnez r9, lo_triangle_ahead_obj
-        ; the last object's rest
-lo_triangle_last:
-        BCAST_FROM_ANY k_triangle_cut_plane, k_triangle_end, r15, 0, lo_triangle_end ; the rest, if some awake ray can still hit it
-        j lo_triangle_end
+        BCAST_REC k_triangle, r7, 0     ; the test; its cuts end the run where no awake ray can still hit it
 lo_triangle_next:
         addi r9, r9, -1
         bnez r9, lo_triangle_obj
@@ -1825,6 +1723,7 @@ k_sphere:
         msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
         cmp.gt r15, #0                  ; F: the line meets the sphere
 k_sphere_cut_line:
+        cut                             ; the run ends here where no awake RC has F
         st r8, [#TMP0]
         st r9, [#TMP0+1]
         st r10, [#TMP0+2]               ; p/r in TMP0..2
@@ -1925,6 +1824,7 @@ k_cylinder:
         abs r10, r10
         cmp.le r10, r15                 ; F: the line may meet it
 k_cylinder_cut_near:
+        cut                             ; the run ends here where no awake RC has F
         st r11, [#TMP0]
         st r12, [#TMP1]                 ; oc2
         st r13, [#TMP7]                 ; invr
@@ -1992,6 +1892,7 @@ k_cylinder_cut_near:
         cmp.gt r15, #0
         (f) cmp.gt r10, #0
 k_cylinder_cut_line:
+        cut                             ; the run ends here where no awake RC has F
         ; sqrt
         ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
@@ -2029,6 +1930,7 @@ k_cylinder_cut_line:
         acch r11
         (f) cmp.lt r11, #0              ; F: tau < tbest |d2|
 k_cylinder_cut_ahead:
+        cut                             ; the run ends here where no awake RC has F
         ; divide
         clz r8, r10
         sub r8, r8, #1
@@ -2374,6 +2276,7 @@ k_rectangle:
         acch r8
         (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
 k_rectangle_cut_plane:
+        cut                             ; the run ends here where no awake RC has F
         ; divide
         clz r8, r11
         sub r8, r8, #1
@@ -2455,6 +2358,7 @@ k_triangle:
         acch r8
         (f) cmp.lt r8, #0               ; F: num 2^14 < tbest den, t fits
 k_triangle_cut_plane:
+        cut                             ; the run ends here where no awake RC has F
         ; divide
         clz r8, r11
         sub r8, r8, #1

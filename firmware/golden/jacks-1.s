@@ -575,30 +575,7 @@ lo_sphere_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere
-lo_sphere_test:
-        BCAST_UPTO k_sphere, k_sphere_cut_line, r7, 0 ; up to F: the ray's line meets the sphere
-        mv r15, r7                      ; r15: the object under test
-        ; while its first part runs: the next object to test (r9 = 0: none)
-        addi r9, r9, -1
-        beqz r9, lo_sphere_last
-lo_sphere_ahead_obj:
-        lfb r7, LE_RECORD(r6)
-        lfb r8, LE_MAILBOX(r6)
-        addi r6, r6, LE_WORDS
-        blt r8, r0, lo_sphere_ahead_go  ; no mailbox
-        slli r8, r8, MB_SHIFT
-        add r8, r8, r12                 ; r8: its mailbox
-        MAILBOX_CHECK lo_sphere_ahead
-lo_sphere_parts:
-        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_test ; the rest, if some awake ray can still hit it
-        j lo_sphere_test
-lo_sphere_ahead_next:
-        addi r9, r9, -1
-        bnez r9, lo_sphere_ahead_obj
-        ; the last object's rest
-lo_sphere_last:
-        BCAST_FROM_ANY k_sphere_cut_line, k_sphere_end, r15, 0, lo_sphere_end ; the rest, if some awake ray can still hit it
-        j lo_sphere_end
+        BCAST_REC k_sphere, r7, 0       ; the test; its cuts end the run where no awake ray can still hit it
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -614,34 +591,7 @@ lo_cylinder_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
-lo_cylinder_test:
-        BCAST_UPTO k_cylinder, k_cylinder_cut_near, r7, CYL_BODY ; up to F: the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1)
-        mv r15, r7                      ; r15: the object under test
-        ; while its first part runs: the next object to test (r9 = 0: none)
-        addi r9, r9, -1
-        beqz r9, lo_cylinder_last
-lo_cylinder_ahead_obj:
-        lfb r7, LE_RECORD(r6)
-        lfb r8, LE_MAILBOX(r6)
-        addi r6, r6, LE_WORDS
-        blt r8, r0, lo_cylinder_ahead_go ; no mailbox
-        slli r8, r8, MB_SHIFT
-        add r8, r8, r12                 ; r8: its mailbox
-        MAILBOX_CHECK lo_cylinder_ahead
-lo_cylinder_parts:
-        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_test ; up to F: the ray's line meets the cylinder
-        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_test ; up to F: the root ahead, before tbest
-        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_test ; the rest, if some awake ray can still hit it
-        j lo_cylinder_test
-lo_cylinder_ahead_next:
-        addi r9, r9, -1
-        bnez r9, lo_cylinder_ahead_obj
-        ; the last object's rest
-lo_cylinder_last:
-        BCAST_FROM_ANY k_cylinder_cut_near, k_cylinder_cut_line, r15, CYL_BODY, lo_cylinder_end ; up to F: the ray's line meets the cylinder
-        BCAST_FROM_ANY k_cylinder_cut_line, k_cylinder_cut_ahead, r15, CYL_BODY, lo_cylinder_end ; up to F: the root ahead, before tbest
-        BCAST_FROM_ANY k_cylinder_cut_ahead, k_cylinder_end, r15, CYL_BODY, lo_cylinder_end ; the rest, if some awake ray can still hit it
-        j lo_cylinder_end
+        BCAST_REC k_cylinder, r7, CYL_BODY ; the test; its cuts end the run where no awake ray can still hit it
 lo_cylinder_next:
         addi r9, r9, -1
         bnez r9, lo_cylinder_obj
@@ -1556,6 +1506,7 @@ k_sphere:
         msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
         cmp.gt r15, #0                  ; F: the line meets the sphere
 k_sphere_cut_line:
+        cut                             ; the run ends here where no awake RC has F
         st r8, [#TMP0]
         st r9, [#TMP0+1]
         st r10, [#TMP0+2]               ; p/r in TMP0..2
@@ -1656,6 +1607,7 @@ k_cylinder:
         abs r10, r10
         cmp.le r10, r15                 ; F: the line may meet it
 k_cylinder_cut_near:
+        cut                             ; the run ends here where no awake RC has F
         st r11, [#TMP0]
         st r12, [#TMP1]                 ; oc2
         st r13, [#TMP7]                 ; invr
@@ -1723,6 +1675,7 @@ k_cylinder_cut_near:
         cmp.gt r15, #0
         (f) cmp.gt r10, #0
 k_cylinder_cut_line:
+        cut                             ; the run ends here where no awake RC has F
         ; sqrt
         ld r14, [r0 + #C_ONE]
         add r14, r14, #-1
@@ -1760,6 +1713,7 @@ k_cylinder_cut_line:
         acch r11
         (f) cmp.lt r11, #0              ; F: tau < tbest |d2|
 k_cylinder_cut_ahead:
+        cut                             ; the run ends here where no awake RC has F
         ; divide
         clz r8, r10
         sub r8, r8, #1

@@ -94,8 +94,11 @@ pub struct RenderArgs {
     pub shadow_packets: firmware::tracer::ShadowPackets,
     /// Packet traversal: run each object test in parts, at the cuts of its
     /// kernels, the rest skipped where no awake ray can still hit the
-    /// object (on), or whole (off). The same image either way.
-    #[arg(long, value_name = "on|off", default_value = "on", value_parser = crate::cli::parse_test_cuts)]
+    /// object: on (a `cut` context in the kernel's run, where the
+    /// broadcast unit ends the run), tinyrisc (TinyRISC broadcasts each
+    /// part after a status read), or off (whole). The same image every
+    /// way.
+    #[arg(long, value_name = "on|tinyrisc|off", default_value = "on", value_parser = crate::cli::parse_test_cuts)]
     pub test_cuts: firmware::tracer::TestCuts,
     /// Packet traversal: which child of a node a packet visits first where
     /// its awake rays go both ways along the node's axis: majority (the
@@ -824,10 +827,12 @@ pub fn command(a: RenderArgs) -> Result<()> {
         );
         crate::report!(
             "object tests             {}",
-            if chip.firmware.layout.test_cuts {
-                "in parts (each part after a cut where some awake ray can still hit the object)"
-            } else {
-                "whole (--test-cuts off)"
+            match (chip.firmware.layout.test_cuts, chip.firmware.layout.cut_runs) {
+                (true, true) =>
+                    "in parts (the broadcast unit ends a test's run at a cut where no awake ray can still hit the object)",
+                (true, false) =>
+                    "in parts steered by TinyRISC (each part after a cut where some awake ray can still hit the object)",
+                _ => "whole (--test-cuts off)",
             }
         );
     }

@@ -397,17 +397,23 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
         },
         nm,
     });
-    // Object tests whole (the default runs them in parts at their cuts).
+    // Object tests in parts steered by TinyRISC, and whole (the default
+    // runs them in parts, ended by the broadcast unit at their cuts).
     let packet = packet_config(width, height);
-    v.push(Knob {
-        knob: "test_cuts",
-        value: firmware::tracer::TestCuts::Off.to_string(),
-        opt: Options {
-            test_cuts: firmware::tracer::TestCuts::Off,
-            ..packet
-        },
-        nm,
-    });
+    for test_cuts in [
+        firmware::tracer::TestCuts::Tinyrisc,
+        firmware::tracer::TestCuts::Off,
+    ] {
+        v.push(Knob {
+            knob: "test_cuts",
+            value: test_cuts.to_string(),
+            opt: Options {
+                test_cuts,
+                ..packet
+            },
+            nm,
+        });
+    }
     for datapath in [Datapath::W16, Datapath::W32] {
         v.push(Knob {
             knob: "datapath",

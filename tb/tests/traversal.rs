@@ -427,11 +427,14 @@ fn merged_shadow_packets_trace_the_same_rays() {
     }
 }
 
-/// Object tests in parts (`--test-cuts on`, the default): a test's kernel
-/// runs up to a cut, and the rest only where some awake ray can still hit
-/// the object. The rest can only narrow F and writes nothing else where F
-/// is clear, so the frame is the one of whole tests, bit for bit, in fewer
-/// cycles: every type with a cut (spheres, cylinders and cones with and
+/// Object tests in parts: a test's kernel runs up to a cut, and the rest
+/// only where some awake ray can still hit the object, whether the
+/// broadcast unit ends the run at a `cut` context (`--test-cuts on`, the
+/// default) or TinyRISC broadcasts the parts after a status read
+/// (`tinyrisc`). The rest can only narrow F and writes nothing else where
+/// F is clear, so the frame is the one of whole tests, bit for bit, in
+/// fewer cycles, and fewer with the cut contexts than with TinyRISC's
+/// parts: every type with a cut (spheres, cylinders and cones with and
 /// without caps, rectangles, triangles, smooth triangles, polygons opaque
 /// and glass, glass rectangles and triangles), resident and streamed, on
 /// both chips.
@@ -490,23 +493,36 @@ fn object_tests_in_parts_trace_the_same_rays() {
             };
             render_sah(scene, o, streamed)
         };
-        let (on, off) = (render(TestCuts::On), render(TestCuts::Off));
+        let (on, risc, off) = (
+            render(TestCuts::On),
+            render(TestCuts::Tinyrisc),
+            render(TestCuts::Off),
+        );
         let what = format!(
             "{name}, {}, {datapath}",
             if streamed { "streamed" } else { "resident" }
         );
-        assert!(on.firmware.layout.test_cuts && !off.firmware.layout.test_cuts);
-        eprintln!(
-            "{what}: {} cycles in parts, {} whole",
-            on.cycles, off.cycles
+        let lay = |r: &tb::render::ChipRender| {
+            (r.firmware.layout.test_cuts, r.firmware.layout.cut_runs)
+        };
+        assert_eq!(
+            (lay(&on), lay(&risc), lay(&off)),
+            ((true, true), (true, false), (false, false))
         );
-        assert!(on.rgb8 == off.rgb8, "{what}: the image changed");
-        assert!(on.hits == off.hits, "{what}: the hits changed");
-        assert_eq!(on.ray_census(), off.ray_census(), "{what}");
+        eprintln!(
+            "{what}: {} cycles in parts cut by the array, {} steered by TinyRISC, {} whole",
+            on.cycles, risc.cycles, off.cycles
+        );
+        for (how, r) in [("cut contexts", &on), ("TinyRISC's parts", &risc)] {
+            assert!(r.rgb8 == off.rgb8, "{what}, {how}: the image changed");
+            assert!(r.hits == off.hits, "{what}, {how}: the hits changed");
+            assert_eq!(r.ray_census(), off.ray_census(), "{what}, {how}");
+        }
         assert!(
-            on.cycles < off.cycles,
-            "{what}: {} in parts, {} whole",
+            on.cycles < risc.cycles && risc.cycles < off.cycles,
+            "{what}: {} with cut contexts, {} in TinyRISC's parts, {} whole",
             on.cycles,
+            risc.cycles,
             off.cycles
         );
     }

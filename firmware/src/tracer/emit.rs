@@ -180,14 +180,18 @@ impl K {
         self.len += n as usize * inner.len;
         self
     }
-    /// A cut: where TinyRISC may end the kernel's run early, ask the
-    /// array (`rcany`) whether any awake RC still has F, and run the rest
-    /// only if one does. F at a cut must hold wherever the whole kernel's F
-    /// would at its end (the compares after it predicated on F, or an exact
-    /// test that F contains), and the contexts after it write nothing but
-    /// temporaries where F is clear, so that stopping there leaves the same
-    /// state where it matters. [`K::text`] labels it `{label}_cut_{name}` and defines
-    /// `{label}_cut_{name}_fb`, the FB words of the stream read before it.
+    /// A cut: where the kernel's run may end early, where no awake RC
+    /// still has F. Either the kernel holds a `cut` context there, after
+    /// which the broadcast unit ends the run itself ([`K::text_with_cuts`]),
+    /// or TinyRISC broadcasts the kernel in parts, asks the array (`rcany`)
+    /// after each, and runs the rest only if some RC has F ([`K::text`]: no
+    /// context, only the label). F at a cut must hold wherever the whole
+    /// kernel's F would at its end (the compares after it predicated on F,
+    /// or an exact test that F contains), and the contexts after it write
+    /// nothing but temporaries where F is clear, so that stopping there
+    /// leaves the same state where it matters. The text labels it
+    /// `{label}_cut_{name}` and defines `{label}_cut_{name}_fb`, the FB
+    /// words of the stream read before it.
     pub fn cut(&mut self, name: &str) -> &mut Self {
         self.lines.push(format!("{CUT_MARK}{name}"));
         self.cuts.push((name.to_string(), self.fb_reads, self.len));
@@ -204,9 +208,15 @@ impl K {
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }
-    /// Contexts in the kernel.
+    /// Contexts in the kernel, its `cut` contexts not counted (what a
+    /// test costs, whichever way its cuts are run).
     pub fn len(&self) -> usize {
         self.len
+    }
+    /// Context words in the kernel's text: [`K::len`], and with
+    /// `cut_contexts` one per cut.
+    pub fn words(&self, cut_contexts: bool) -> usize {
+        self.len + if cut_contexts { self.cuts.len() } else { 0 }
     }
     /// Append another kernel's contexts.
     pub fn extend(&mut self, other: K) -> &mut Self {
@@ -219,8 +229,13 @@ impl K {
         self
     }
     /// The kernel as assembly: its documentation, `label:`, the contexts,
-    /// `label_end:`.
+    /// `label_end:`; a cut is a label only.
     pub fn text(&self, label: &str) -> String {
+        self.text_with_cuts(label, false)
+    }
+    /// [`K::text`], with `cut_contexts` a `cut` context at each cut (after
+    /// its label).
+    pub fn text_with_cuts(&self, label: &str, cut_contexts: bool) -> String {
         let mut s = String::new();
         for d in &self.doc {
             if d.is_empty() {
@@ -234,6 +249,16 @@ impl K {
             match l.strip_prefix(CUT_MARK) {
                 Some(name) => {
                     let _ = writeln!(s, "{}:", cut_label(label, name));
+                    if cut_contexts {
+                        let _ = writeln!(
+                            s,
+                            "{}",
+                            with_note(
+                                "        cut".into(),
+                                "the run ends here where no awake RC has F"
+                            )
+                        );
+                    }
                 }
                 None => {
                     let _ = writeln!(s, "{l}");

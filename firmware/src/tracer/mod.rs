@@ -113,12 +113,15 @@ impl Default for Options {
 
 /// Packet traversal: whether an object test runs in parts at its kernels'
 /// cuts ([`primitives::CutTest`]), the rest skipped where no awake ray can
-/// still hit the object (`on`, the default), or whole (`off`). The same
-/// image either way.
+/// still hit the object, and who skips it: the broadcast unit, at a `cut`
+/// context in the kernel's run (`on`, the default), or TinyRISC, which
+/// broadcasts each part after a status read (`tinyrisc`); or whole (`off`).
+/// The same image every way.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum TestCuts {
     #[default]
     On,
+    Tinyrisc,
     Off,
 }
 
@@ -126,6 +129,7 @@ impl std::fmt::Display for TestCuts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
             TestCuts::On => "on",
+            TestCuts::Tinyrisc => "tinyrisc",
             TestCuts::Off => "off",
         })
     }
@@ -136,8 +140,9 @@ impl std::str::FromStr for TestCuts {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "on" => Ok(TestCuts::On),
+            "tinyrisc" => Ok(TestCuts::Tinyrisc),
             "off" => Ok(TestCuts::Off),
-            _ => Err(format!("test cuts '{s}': expected on or off")),
+            _ => Err(format!("test cuts '{s}': expected on, tinyrisc or off")),
         }
     }
 }

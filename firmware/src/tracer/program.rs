@@ -61,9 +61,9 @@ pub fn program(
     let mut words = 0usize;
     for (n, k) in &kernels {
         s.push('\n');
-        s.push_str(&k.text(n));
-        names.push((n.clone(), k.len()));
-        words += k.len();
+        s.push_str(&k.text_with_cuts(n, lay.cut_runs));
+        names.push((n.clone(), k.words(lay.cut_runs)));
+        words += k.words(lay.cut_runs);
     }
     s.push_str("ctx_end:\n");
     if words > 8192 {
@@ -225,10 +225,10 @@ fn header(
                 } else {
                     ""
                 },
-                if lay.test_cuts {
-                    ""
-                } else {
-                    ", whole object tests"
+                match (lay.test_cuts, lay.cut_runs) {
+                    (true, true) => "",
+                    (true, false) => ", object tests in parts steered by TinyRISC",
+                    _ => ", whole object tests",
                 }
             )
         } else {

@@ -88,6 +88,9 @@ pub struct FbImage {
     /// Packet traversal: object tests run in parts at their kernels' cuts
     /// ([`super::TestCuts`]).
     pub test_cuts: bool,
+    /// ... and the kernels hold a `cut` context at each, where the
+    /// broadcast unit ends the run (`on`); else TinyRISC runs the parts.
+    pub cut_runs: bool,
     /// Packet traversal: FB address of the root cell widened by
     /// [`super::traversal::packet::P_TOL`] (6 words: per axis min, max).
     pub root_box: usize,
@@ -534,7 +537,8 @@ fn build_as(
         light_shifted,
         node_layout: opt.layout,
         traversal: opt.traversal,
-        test_cuts: opt.traversal == Traversal::Packet && opt.test_cuts == super::TestCuts::On,
+        test_cuts: opt.traversal == Traversal::Packet && opt.test_cuts != super::TestCuts::Off,
+        cut_runs: opt.traversal == Traversal::Packet && opt.test_cuts == super::TestCuts::On,
         root_box,
         collapse: opt.collapse,
         pieces: opt.pieces,
@@ -700,6 +704,7 @@ pub(super) struct Finish {
     node_layout: NodeLayout,
     traversal: Traversal,
     test_cuts: bool,
+    cut_runs: bool,
     root_box: usize,
     collapse: super::Collapse,
     pieces: super::LeafPieces,
@@ -737,6 +742,7 @@ impl Finish {
             node_layout: self.node_layout,
             traversal: self.traversal,
             test_cuts: self.test_cuts,
+            cut_runs: self.cut_runs,
             root_box: self.root_box,
             root_leaf: false,
             expected_cost: 0.0,

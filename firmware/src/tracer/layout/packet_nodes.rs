@@ -86,18 +86,20 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check, the issues and the `rcany` of each part): 8 to 18 on the SPD
-/// scenes at 128x128 (`render --profile`, the `lo_*` rows over the
-/// object tests).
-pub const PK_OBJECT_RISC: f64 = 16.0;
+/// check and the issue; the test's cuts end its run without TinyRISC): 1.4
+/// (shells) to 8.3 (lattice) on the SPD scenes at 128x128 (`render
+/// --profile`, the `lo_*` rows over the object tests). 7 here costs
+/// rings, lattice and tree 0.2-1% more cycles; 12 and 16 agree within
+/// 0.3% (`docs/tracer.md`, "The tree it walks").
+pub const PK_OBJECT_RISC: f64 = 12.0;
 
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 75 to 163 on the SPD scenes at 128x128 but for shells' few
+/// is added. 50 to 130 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
-pub const PK_LEAF_COST: f64 = 130.0;
+pub const PK_LEAF_COST: f64 = 100.0;
 
 /// The costs a [`crate::bsp::SplitRule::Chip`] tree of `scene` weighs
 /// (the packet traversal's, as [`object_costs`] and [`PK_NODE_COST`]),

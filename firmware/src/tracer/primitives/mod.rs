@@ -451,6 +451,35 @@ pub fn run_rest(
     }
 }
 
+/// A test in parts ([`CutTest`] `c`) of type `ty` as one run of its
+/// kernel, whose `cut` contexts end it where no awake RC has F
+/// ([`super::emit::K::text_with_cuts`]), on the record at `rec`; then the
+/// further kernels (`then`) only where some awake RC has F (`rcany`), else
+/// on to `none`. Labels begin with `at`; `fit`: the records' variants.
+/// Clobbers r1..r3.
+pub fn run_with_cut_contexts(
+    t: &mut Code,
+    ty: ChipType,
+    c: &CutTest,
+    fit: &Fit,
+    rec: Reg,
+    at: &str,
+    none: &str,
+) {
+    let (k, field) = (c.kernel, c.field);
+    t.m("BCAST_REC", format!("{k}, {rec}, {field}"));
+    if c.cuts.is_empty() {
+        t.c("the test");
+    } else {
+        t.c("the test; its cuts end the run where no awake ray can still hit it");
+    }
+    if let Some(holds) = c.then {
+        t.rcany(R3).c(format!("F: {holds}"));
+        t.beqz(R3, none).c("no awake ray can hit it");
+        ty.broadcast_then(t, at, rec, fit);
+    }
+}
+
 /// The kernels whose runs start an object test (their RCs at the first
 /// context are the rays tested): the render's count of tests per ray.
 pub const TEST_KERNELS: [&str; 16] = [

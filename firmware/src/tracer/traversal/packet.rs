@@ -77,7 +77,7 @@ use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY, LEAF_LATE};
 use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
-use super::super::primitives::{kaddr, klen, run_first_part, run_rest};
+use super::super::primitives::{kaddr, klen, run_first_part, run_rest, run_with_cut_contexts};
 use super::child_order::{self, ChildOrder};
 use crate::tracer::kernel_names as names;
 
@@ -839,6 +839,30 @@ fn type_loop(
         t.label(format!("{n}_end"));
         return;
     };
+    if lay.cut_runs {
+        // One run per test, ended by the broadcast unit at a cut where no
+        // awake ray can still hit the object: TinyRISC finds the next
+        // object while it runs (the broadcast queue holds its run).
+        let (next, done) = (format!("{n}_next"), format!("{n}_done"));
+        let after = {
+            let mut c = Code::new();
+            ty.broadcast_after_cut_test(&mut c, n, R7, caps);
+            c
+        };
+        t.label(format!("{n}_obj"));
+        fetch(t, n);
+        mailbox_check(t, n);
+        let none = if after.is_empty() { &next } else { &done };
+        run_with_cut_contexts(t, ty, &cut, &lay.fit, R7, n, none);
+        if !after.is_empty() {
+            t.label(&done).extend(after);
+        }
+        t.label(&next);
+        advance(t);
+        t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
+        t.label(format!("{n}_end"));
+        return;
+    }
     // The test's first part, then the next object to test found while it
     // runs; the rest of the test (its parts after the cuts, where some
     // awake ray can still hit it) comes in two copies, one that goes on to
