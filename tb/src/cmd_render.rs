@@ -182,7 +182,7 @@ fn causes(p: &crate::profile::Profile, chip: &crate::render::ChipRender) -> crat
         .into_iter()
         .map(String::from)
         .collect();
-    p.causes(&tests, chip.simd_efficiency(), chip.stats.dma_stall_cycles)
+    p.causes(&tests, chip.simd_efficiency(), chip.array_idle_on_dma())
 }
 
 /// The packet traversal's cost model ([`firmware::tracer::layout::packet_nodes`]:
@@ -391,6 +391,11 @@ pub(crate) fn render_and_measure(
         "dma_stall_cycles": chip.stats.dma_stall_cycles,
         "dma_stall_share": chip.dma_stall_share(),
         "array_idle_on_control": idle_on_control,
+        "array_idle_on_dma": if chip.stats.cycles > 0 {
+            chip.array_idle_on_dma() as f64 / chip.stats.cycles as f64
+        } else {
+            0.0
+        },
         "objects_tested_per_ray": chip.objects_tested_per_ray(),
         "ray_tests_per_ray": chip.tests_per_ray(),
         "simd_efficiency": chip.simd_efficiency(),
@@ -518,6 +523,7 @@ fn impossible_value(j: &serde_json::Value) -> Option<String> {
         "hit_agreement",
         "active_rc_fraction",
         "array_idle_on_control",
+        "array_idle_on_dma",
         "eye_misclassified",
     ] {
         if let Some(v) = j.get(k).filter(|v| !v.is_null()) {
@@ -879,9 +885,10 @@ pub fn command(a: RenderArgs) -> Result<()> {
         j["active_rc_fraction"].as_f64().unwrap_or(0.0)
     );
     crate::report!(
-        "dma stall cycles         {} ({:.1}% of the cycles)",
+        "dma stall cycles         {} ({:.1}% of the cycles; the array idle in {:.1}%)",
         j["dma_stall_cycles"],
-        100.0 * j["dma_stall_share"].as_f64().unwrap_or(0.0)
+        100.0 * j["dma_stall_share"].as_f64().unwrap_or(0.0),
+        100.0 * j["array_idle_on_dma"].as_f64().unwrap_or(0.0)
     );
     crate::report!(
         "array idle on control    {:.1}% of the cycles",

@@ -60,9 +60,10 @@ impl Profile {
     /// `simd_efficiency` (the share of the broadcast tests' lanes whose ray
     /// needed them: one figure for every test, so each kernel's cycles are
     /// divided in the same proportion), the other busy cycles are
-    /// traversal and shading; idle cycles are DMA waits (`dma_stall`, the
-    /// chip's count, at most the idle cycles) or control.
-    pub fn causes(&self, tests: &[String], simd_efficiency: f64, dma_stall: u64) -> Causes {
+    /// traversal and shading; idle cycles are DMA waits (`dma_idle`, the
+    /// cycles the array had no context while TinyRISC waited for the DMA,
+    /// at most the idle cycles) or control.
+    pub fn causes(&self, tests: &[String], simd_efficiency: f64, dma_idle: u64) -> Causes {
         let busy: u64 = self.kernels.iter().map(|x| x.1).sum();
         let test: u64 = self
             .kernels
@@ -72,7 +73,7 @@ impl Profile {
             .sum();
         let needed = (test as f64 * simd_efficiency.clamp(0.0, 1.0)).round() as u64;
         let idle = self.cycles.saturating_sub(busy);
-        let dma = dma_stall.min(idle);
+        let dma = dma_idle.min(idle);
         Causes {
             tests_needed: needed,
             divergence_waste: test - needed,

@@ -178,6 +178,15 @@ impl ChipRender {
     }
 
     /// The share of the frame's cycles TinyRISC waits for the DMA channel.
+    /// Cycles in which the array had no context while TinyRISC waited
+    /// for the DMA (TinyRISC's DMA stall less the cycles in which the
+    /// array still ran the runs queued before the wait).
+    pub fn array_idle_on_dma(&self) -> u64 {
+        let s = &self.stats;
+        s.cycles
+            .saturating_sub(s.array_busy_cycles + s.array_idle_control_cycles)
+    }
+
     pub fn dma_stall_share(&self) -> f64 {
         if self.stats.cycles == 0 {
             0.0

@@ -613,6 +613,12 @@ fn data(lay: &FbImage, merged_lanes: Option<&[u32]>) -> String {
             );
             d(
                 &mut t,
+                "PREV_GEN",
+                ".word 0",
+                "the tile before's number: its leaves in the cache are hits too",
+            );
+            d(
+                &mut t,
                 "LEAF_TAGS",
                 ".space 0x8000",
                 "leaf cache tags, at LEAF_TAGS + 2 (a - SBANK) for the slot at FB address a: its block and tile",

@@ -226,10 +226,12 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
         .lw(R5, at("TILE_OUT", R1))
         .sw(R5, at("CUR_OUT", R0));
     if lay.traversal == super::Traversal::Packet && lay.stream.is_some() {
-        t.slli(R6, R4, 12)
+        t.lw(R2, at("TILE_GEN", R0))
+            .sw(R2, at("PREV_GEN", R0))
+            .slli(R6, R4, 12)
             .or(R6, R6, R3)
             .sw(R6, at("TILE_GEN", R0))
-            .c("the leaf cache holds this tile's leaves only");
+            .c("the leaf cache holds the leaves of this tile and of the one before");
     }
     t.li(R6, "FB_EYE")
         .sfb(R3, at("EYE_PX", R6))

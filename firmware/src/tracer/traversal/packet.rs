@@ -649,8 +649,9 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             t.andi(R11, R6, LEAF_LATE)
                 .c("r11: a large first piece, moved only if one of its objects is to be tested");
         }
-        t.comment("the first piece: in its slot of the leaf cache since this tile moved it there,")
-            .comment("or its DMA starts");
+        let hit = if late { "leaf_hit" } else { "leaf_awake" };
+        t.comment("the first piece: in its slot of the leaf cache since this tile or the one before")
+            .comment("moved or used it there, or its DMA starts");
         t.label("leaf_first")
             .lw(R1, at("PS_BLOCK", R5))
             .lw(R7, at("PS_FB", R5))
@@ -658,10 +659,19 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .add(R6, R7, R7)
             .lw(R3, at("LEAF_TAGS - 2*SBANK + 4", R6))
             .lw(R2, at("TILE_GEN", R0))
-            .bne(R3, R2, "leaf_miss")
-            .c("moved in another tile (checked first: a tag from an earlier tile never costs more)")
+            .beq(R3, R2, "leaf_this_tile")
+            .c("moved or used in this tile")
+            .lw(R8, at("PREV_GEN", R0))
+            .bne(R3, R8, "leaf_miss")
+            .c("in neither this tile nor the one before (checked first: an older tag never costs more)")
             .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
-            .beq(R1, R3, if late { "leaf_hit" } else { "leaf_awake" })
+            .bne(R1, R3, "leaf_miss")
+            .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .c("a hit on the tile before's block: this tile's now")
+            .j(hit);
+        t.label("leaf_this_tile")
+            .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
+            .beq(R1, R3, hit)
             .c("the slot holds the block: a hit");
         t.label("leaf_miss");
         if late {
