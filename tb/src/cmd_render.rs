@@ -96,9 +96,10 @@ pub struct RenderArgs {
     /// kernels, the rest skipped where no awake ray can still hit the
     /// object: on (a `cut` context in the kernel's run, where the
     /// broadcast unit ends the run), tinyrisc (TinyRISC broadcasts each
-    /// part after a status read), or off (whole). The same image every
-    /// way.
-    #[arg(long, value_name = "on|tinyrisc|off", default_value = "on", value_parser = crate::cli::parse_test_cuts)]
+    /// part after a status read), off (whole), or auto (on; tinyrisc
+    /// under the timing's instruction issue model, where TinyRISC issues
+    /// every context itself). The same image every way.
+    #[arg(long, value_name = "auto|on|tinyrisc|off", default_value = "auto", value_parser = crate::cli::parse_test_cuts)]
     pub test_cuts: firmware::tracer::TestCuts,
     /// Packet traversal: which child of a node a packet visits first where
     /// its awake rays go both ways along the node's axis: majority (the
@@ -333,6 +334,10 @@ pub(crate) fn render_and_measure(
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
     let progress = host.progress;
     let nm = host.numerics;
+    let opt = &Options {
+        test_cuts: opt.test_cuts.for_issue(host.timing.risc.issue),
+        ..*opt
+    };
     let t0 = Instant::now();
     let chip = match built {
         Some(fw) => crate::render::render_built(fw, opt, host)?,
@@ -630,7 +635,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         collapse: a.collapse,
         pieces: a.leaf_pieces,
         shadows: a.shadow_packets,
-        test_cuts: a.test_cuts,
+        test_cuts: a.test_cuts.for_issue(timing.risc.issue),
         child_order: a.child_order,
     };
     if a.newton_steps > 3 {

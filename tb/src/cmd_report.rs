@@ -175,7 +175,9 @@ pub fn sections() -> Vec<Section> {
                     instruction streams a run of contexts while TinyRISC goes on, walking the \
                     next node or mailbox. The M1 chip issues each context by an instruction and \
                     the array waits while TinyRISC does anything else (`issue = \"instruction\"` \
-                    in a timing file). Frames/s under each, and the share the M1 issue keeps.",
+                    in a timing file); there the packet traversal's object tests run in parts \
+                    TinyRISC steers (`--test-cuts auto`), since a `cut` would not free it. \
+                    Frames/s under each, and the share the M1 issue keeps.",
             checked: false,
             write: issue,
         },

@@ -303,7 +303,7 @@ fn usage_errors_name_the_argument_and_exit_2() {
         ),
         (
             &["render", "--test-cuts", "maybe"][..],
-            "'--test-cuts <on|tinyrisc|off>': test cuts 'maybe': expected on, tinyrisc or off",
+            "'--test-cuts <auto|on|tinyrisc|off>': test cuts 'maybe': expected auto, on, tinyrisc or off",
         ),
         (
             &["regroup", "--size", "12"][..],

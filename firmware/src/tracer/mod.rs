@@ -114,20 +114,47 @@ impl Default for Options {
 /// Packet traversal: whether an object test runs in parts at its kernels'
 /// cuts ([`primitives::CutTest`]), the rest skipped where no awake ray can
 /// still hit the object, and who skips it: the broadcast unit, at a `cut`
-/// context in the kernel's run (`on`, the default), or TinyRISC, which
-/// broadcasts each part after a status read (`tinyrisc`); or whole (`off`).
-/// The same image every way.
+/// context in the kernel's run (`on`), or TinyRISC, which broadcasts each
+/// part after a status read (`tinyrisc`); or whole (`off`). `auto` (the
+/// default) is `on` under the run issue model and `tinyrisc` under the M1
+/// chip's instruction issue, where TinyRISC issues every context itself
+/// and would be held for the contexts a cut skips
+/// ([`TestCuts::for_issue`]; the firmware built without a timing takes
+/// `on`). The same image every way.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum TestCuts {
     #[default]
+    Auto,
     On,
     Tinyrisc,
     Off,
 }
 
+impl TestCuts {
+    /// `auto` resolved for the chip's issue model; the others as they are.
+    pub fn for_issue(self, issue: rtl::tinyrisc::IssueModel) -> TestCuts {
+        match (self, issue) {
+            (TestCuts::Auto, rtl::tinyrisc::IssueModel::Run) => TestCuts::On,
+            (TestCuts::Auto, rtl::tinyrisc::IssueModel::Instruction) => TestCuts::Tinyrisc,
+            (t, _) => t,
+        }
+    }
+
+    /// Tests run in parts at their cuts.
+    pub fn in_parts(self) -> bool {
+        self != TestCuts::Off
+    }
+
+    /// The kernels hold `cut` contexts (`on`, and `auto` unresolved).
+    pub fn cut_contexts(self) -> bool {
+        matches!(self, TestCuts::On | TestCuts::Auto)
+    }
+}
+
 impl std::fmt::Display for TestCuts {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.write_str(match self {
+            TestCuts::Auto => "auto",
             TestCuts::On => "on",
             TestCuts::Tinyrisc => "tinyrisc",
             TestCuts::Off => "off",
@@ -139,10 +166,11 @@ impl std::str::FromStr for TestCuts {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
+            "auto" => Ok(TestCuts::Auto),
             "on" => Ok(TestCuts::On),
             "tinyrisc" => Ok(TestCuts::Tinyrisc),
             "off" => Ok(TestCuts::Off),
-            _ => Err(format!("test cuts '{s}': expected on, tinyrisc or off")),
+            _ => Err(format!("test cuts '{s}': expected auto, on, tinyrisc or off")),
         }
     }
 }
