@@ -96,7 +96,7 @@ pub const PK_OBJECT_RISC: f64 = 12.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 50 to 130 on the SPD scenes at 128x128 but for shells' few
+/// is added. 57 to 148 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
 pub const PK_LEAF_COST: f64 = 100.0;
