@@ -164,14 +164,14 @@ SLOT_TMIN = 1           ; slot: near end
 ; ---- macros ----
 ; BCAST k: broadcast kernel k to the array (its contexts, no FB stream). Clobbers r1.
 .macro BCAST k
-        li r1, (\k - CTXBASE) / 4
+        addi r1, r0, (\k - CTXBASE) / 4
         cbcast r1, (\k\()_end - \k) / 4
 .endm
 
 ; BCAST_FB k, fb: broadcast kernel k with the FB words from address fb as its stream.
 ; Clobbers r1, r2.
 .macro BCAST_FB k, fb
-        li r1, (\k - CTXBASE) / 4
+        addi r1, r0, (\k - CTXBASE) / 4
         li r2, \fb
         sbcb r1, r2, (\k\()_end - \k) / 4
 .endm
@@ -179,14 +179,14 @@ SLOT_TMIN = 1           ; slot: near end
 ; BCAST_AT k, ra: broadcast kernel k with the FB words from the address in ra as its
 ; stream. Clobbers r1.
 .macro BCAST_AT k, ra
-        li r1, (\k - CTXBASE) / 4
+        addi r1, r0, (\k - CTXBASE) / 4
         sbcb r1, \ra, (\k\()_end - \k) / 4
 .endm
 
 ; BCAST_REC k, ra, field: broadcast kernel k with the FB words from `field` of the
 ; record (or node) at ra as its stream. Clobbers r1, r2.
 .macro BCAST_REC k, ra, field
-        li r1, (\k - CTXBASE) / 4
+        addi r1, r0, (\k - CTXBASE) / 4
         addi r2, \ra, \field
         sbcb r1, r2, (\k\()_end - \k) / 4
 .endm
@@ -194,7 +194,7 @@ SLOT_TMIN = 1           ; slot: near end
 ; BCAST_UPTO k, cut, ra, field: broadcast kernel k's contexts up to its cut `cut`,
 ; with the FB words from `field` of the record at ra as their stream. Clobbers r1, r2.
 .macro BCAST_UPTO k, cut, ra, field
-        li r1, (\k - CTXBASE) / 4
+        addi r1, r0, (\k - CTXBASE) / 4
         addi r2, \ra, \field
         sbcb r1, r2, (\cut - \k) / 4
 .endm
@@ -205,7 +205,7 @@ SLOT_TMIN = 1           ; slot: near end
 ; cut (`cut_fb`); else on to `none`. The run's operands are set before the status
 ; read, while the array may still be busy. Clobbers r1, r2, r3.
 .macro BCAST_FROM_ANY cut, end, ra, field, none
-        li r1, (\cut - CTXBASE) / 4
+        addi r1, r0, (\cut - CTXBASE) / 4
         addi r2, \ra, \field + \cut\()_fb
         rcany r3
         beqz r3, \none
@@ -421,11 +421,11 @@ order_pass:
 order_x_some:
         jal majority                    ; some: r8 = most go down
 order_x:
-        li r1, (k_node_x_below_first - CTXBASE) / 4
+        addi r1, r0, (k_node_x_below_first - CTXBASE) / 4
         li r2, PN_LEFT
         li r3, PN_RIGHT
         beqz r8, order_x_set
-        li r1, (k_node_x_above_first - CTXBASE) / 4
+        addi r1, r0, (k_node_x_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
         li r3, PN_LEFT                  ; r8 = 1: above first
 order_x_set:
@@ -445,11 +445,11 @@ order_x_set:
 order_y_some:
         jal majority                    ; some: r8 = most go down
 order_y:
-        li r1, (k_node_y_below_first - CTXBASE) / 4
+        addi r1, r0, (k_node_y_below_first - CTXBASE) / 4
         li r2, PN_LEFT
         li r3, PN_RIGHT
         beqz r8, order_y_set
-        li r1, (k_node_y_above_first - CTXBASE) / 4
+        addi r1, r0, (k_node_y_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
         li r3, PN_LEFT                  ; r8 = 1: above first
 order_y_set:
@@ -473,11 +473,11 @@ order_z_some:
 order_z_any:
         jal majority                    ; some (any hit): r8 = most go down
 order_z:
-        li r1, (k_node_z_below_first - CTXBASE) / 4
+        addi r1, r0, (k_node_z_below_first - CTXBASE) / 4
         li r2, PN_LEFT
         li r3, PN_RIGHT
         beqz r8, order_z_set
-        li r1, (k_node_z_above_first - CTXBASE) / 4
+        addi r1, r0, (k_node_z_above_first - CTXBASE) / 4
         li r2, PN_RIGHT
         li r3, PN_LEFT                  ; r8 = 1: above first
 order_z_set:
@@ -603,7 +603,7 @@ pop_node:
         beqz r14, trace_done            ; the node stack empty
         addi r14, r14, -4
         lw r5, NSTACK(r14)
-        li r1, (k_pop_node - CTXBASE) / 4
+        addi r1, r0, (k_pop_node - CTXBASE) / 4
         addi r2, r5, PN_PARENT_SLOT
         sbcb r1, r2, (k_pop_node_end - k_pop_node) / 4 ; the rays take their intervals for it
         ; while they do: its kernel and split, if inner

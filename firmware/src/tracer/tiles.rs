@@ -47,13 +47,25 @@ pub fn macros(lay: &FbImage) -> Code {
         f(&mut b);
         b
     };
+    let packet = lay.traversal == super::Traversal::Packet;
+    // A kernel's context address into r1: one `addi` from r0 in the packet
+    // traversal (the address fits its immediate), the paper's `li` (two
+    // instructions for a label defined further on) in the paper's, whose
+    // cycle counts are published.
+    let kernel_address = move |b: &mut Code, k: &str| {
+        if packet {
+            b.addi(R1, R0, format!("({k} - CTXBASE) / 4"));
+        } else {
+            b.li(R1, format!("({k} - CTXBASE) / 4"));
+        }
+    };
     t.define_macro(
         "BCAST",
         "k",
         "BCAST k: broadcast kernel k to the array (its contexts, no FB stream). Clobbers r1.",
         body(&|b| {
-            b.li(R1, "(\\k - CTXBASE) / 4")
-                .cbcast(R1, "(\\k\\()_end - \\k) / 4");
+            kernel_address(b, "\\k");
+            b.cbcast(R1, "(\\k\\()_end - \\k) / 4");
         }),
     );
     t.define_macro(
@@ -62,8 +74,8 @@ pub fn macros(lay: &FbImage) -> Code {
         "BCAST_FB k, fb: broadcast kernel k with the FB words from address fb as its stream.\n\
          Clobbers r1, r2.",
         body(&|b| {
-            b.li(R1, "(\\k - CTXBASE) / 4")
-                .li(R2, "\\fb")
+            kernel_address(b, "\\k");
+            b.li(R2, "\\fb")
                 .sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
         }),
     );
@@ -73,8 +85,8 @@ pub fn macros(lay: &FbImage) -> Code {
         "BCAST_AT k, ra: broadcast kernel k with the FB words from the address in ra as its\n\
          stream. Clobbers r1.",
         body(&|b| {
-            b.li(R1, "(\\k - CTXBASE) / 4")
-                .line("sbcb r1, \\ra, (\\k\\()_end - \\k) / 4");
+            kernel_address(b, "\\k");
+            b.line("sbcb r1, \\ra, (\\k\\()_end - \\k) / 4");
         }),
     );
     t.define_macro(
@@ -83,8 +95,8 @@ pub fn macros(lay: &FbImage) -> Code {
         "BCAST_REC k, ra, field: broadcast kernel k with the FB words from `field` of the\n\
          record (or node) at ra as its stream. Clobbers r1, r2.",
         body(&|b| {
-            b.li(R1, "(\\k - CTXBASE) / 4")
-                .line("addi r2, \\ra, \\field")
+            kernel_address(b, "\\k");
+            b.line("addi r2, \\ra, \\field")
                 .sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
         }),
     );
@@ -95,8 +107,8 @@ pub fn macros(lay: &FbImage) -> Code {
             "BCAST_UPTO k, cut, ra, field: broadcast kernel k's contexts up to its cut `cut`,\n\
              with the FB words from `field` of the record at ra as their stream. Clobbers r1, r2.",
             body(&|b| {
-                b.li(R1, "(\\k - CTXBASE) / 4")
-                    .line("addi r2, \\ra, \\field")
+                kernel_address(b, "\\k");
+                b.line("addi r2, \\ra, \\field")
                     .sbcb(R1, R2, "(\\cut - \\k) / 4");
             }),
         );
@@ -109,8 +121,8 @@ pub fn macros(lay: &FbImage) -> Code {
              cut (`cut_fb`); else on to `none`. The run's operands are set before the status\n\
              read, while the array may still be busy. Clobbers r1, r2, r3.",
             body(&|b| {
-                b.li(R1, "(\\cut - CTXBASE) / 4")
-                    .line("addi r2, \\ra, \\field + \\cut\\()_fb")
+                kernel_address(b, "\\cut");
+                b.line("addi r2, \\ra, \\field + \\cut\\()_fb")
                     .rcany(R3)
                     .line("beqz r3, \\none")
                     .sbcb(R1, R2, "(\\end - \\cut) / 4");

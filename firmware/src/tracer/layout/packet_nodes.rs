@@ -20,7 +20,7 @@ use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};
 
 /// Array cycles a packet spends on an inner node (its kernel and
-/// TinyRISC's decision), for [`super::super::Collapse::Auto`]. 45 to 48
+/// TinyRISC's decision), for [`super::super::Collapse::Auto`]. 43 to 45
 /// on the SPD scenes at 128x128 (`render --profile`); 48 here walks more
 /// nodes and costs balls, rings and tree 0.4-1.1% more cycles
 /// (`docs/tracer.md`, "The tree it walks").
@@ -86,8 +86,8 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check and the issue; the test's cuts end its run without TinyRISC): 1.4
-/// (shells) to 8.3 (lattice) on the SPD scenes at 128x128 (`render
+/// check and the issue; the test's cuts end its run without TinyRISC): 1.2
+/// (shells) to 7.9 (lattice) on the SPD scenes at 128x128 (`render
 /// --profile`, the `lo_*` rows over the object tests). 7 here costs
 /// rings, lattice and tree 0.2-1% more cycles; 12 and 16 agree within
 /// 0.3% (`docs/tracer.md`, "The tree it walks").
@@ -96,7 +96,7 @@ pub const PK_OBJECT_RISC: f64 = 12.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 57 to 148 on the SPD scenes at 128x128 but for shells' few
+/// is added. 64 to 146 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
 /// less the DMA wait, over the leaves reached).
 pub const PK_LEAF_COST: f64 = 100.0;

@@ -498,7 +498,7 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
         .srli(R8, R8, 1)
         .add(R12, rec, R8)
         .addi(R12, R12, "POLY_BOUNDS+1")
-        .li(R2, kaddr(BELOW))
+        .addi(R2, R0, kaddr(BELOW))
         .sbcb(R2, R12, klen(BELOW))
         .c("some point below Y_mid+1?")
         .rcany(R2)
@@ -522,7 +522,7 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
         .srli(R8, R8, 1)
         .add(R12, rec, R8)
         .addi(R12, R12, "POLY_BOUNDS")
-        .li(R2, kaddr(ABOVE))
+        .addi(R2, R0, kaddr(ABOVE))
         .sbcb(R2, R12, klen(ABOVE))
         .c("some point at or above Y_mid?")
         .rcany(R2)
@@ -539,7 +539,7 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
         .c("r3: words of the sub-edges to run")
         .add(R2, rec, R13)
         .addi(R2, R2, "POLY_FAN")
-        .li(R1, kaddr(BAND_EDGE));
+        .addi(R1, R0, kaddr(BAND_EDGE));
     t.label(format!("{at}_fan"))
         .beqz(R3, format!("{at}_tail"))
         .sbcb(R1, R2, klen(BAND_EDGE))

@@ -290,11 +290,11 @@ pub fn pass_start(t: &mut Code, order: ChildOrder, left: &str, right: &str) {
             mixed(t, c, "");
         }
         t.label(&done)
-            .li(R1, kaddr(&names::node(a as u8, false)))
+            .addi(R1, R0, kaddr(&names::node(a as u8, false)))
             .li(R2, left)
             .li(R3, right)
             .beqz(R8, format!("order_{lo}_set"))
-            .li(R1, kaddr(&names::node(a as u8, true)))
+            .addi(R1, R0, kaddr(&names::node(a as u8, true)))
             .li(R2, right)
             .li(R3, left)
             .c("r8 = 1: above first");

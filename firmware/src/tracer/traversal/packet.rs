@@ -498,7 +498,7 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
         .c("the node stack empty")
         .addi(R14, R14, -4)
         .lw(R5, at("NSTACK", R14))
-        .li(R1, kaddr(names::POP_NODE));
+        .addi(R1, R0, kaddr(names::POP_NODE));
     if streamed {
         t.addi(R2, R14, "SLOTS").c("its slot: the stack entry's");
     } else {
