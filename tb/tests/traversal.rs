@@ -502,9 +502,8 @@ fn object_tests_in_parts_trace_the_same_rays() {
             "{name}, {}, {datapath}",
             if streamed { "streamed" } else { "resident" }
         );
-        let lay = |r: &tb::render::ChipRender| {
-            (r.firmware.layout.test_cuts, r.firmware.layout.cut_runs)
-        };
+        let lay =
+            |r: &tb::render::ChipRender| (r.firmware.layout.test_cuts, r.firmware.layout.cut_runs);
         assert_eq!(
             (lay(&on), lay(&risc), lay(&off)),
             ((true, true), (true, false), (false, false))

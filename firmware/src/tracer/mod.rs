@@ -170,7 +170,9 @@ impl std::str::FromStr for TestCuts {
             "on" => Ok(TestCuts::On),
             "tinyrisc" => Ok(TestCuts::Tinyrisc),
             "off" => Ok(TestCuts::Off),
-            _ => Err(format!("test cuts '{s}': expected auto, on, tinyrisc or off")),
+            _ => Err(format!(
+                "test cuts '{s}': expected auto, on, tinyrisc or off"
+            )),
         }
     }
 }

@@ -75,8 +75,7 @@ pub fn macros(lay: &FbImage) -> Code {
          Clobbers r1, r2.",
         body(&|b| {
             kernel_address(b, "\\k");
-            b.li(R2, "\\fb")
-                .sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
+            b.li(R2, "\\fb").sbcb(R1, R2, "(\\k\\()_end - \\k) / 4");
         }),
     );
     t.define_macro(

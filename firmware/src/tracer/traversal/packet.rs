@@ -650,8 +650,10 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
                 .c("r11: a large first piece, moved only if one of its objects is to be tested");
         }
         let hit = if late { "leaf_hit" } else { "leaf_awake" };
-        t.comment("the first piece: in its slot of the leaf cache since this tile or the one before")
-            .comment("moved or used it there, or its DMA starts");
+        t.comment(
+            "the first piece: in its slot of the leaf cache since this tile or the one before",
+        )
+        .comment("moved or used it there, or its DMA starts");
         t.label("leaf_first")
             .lw(R1, at("PS_BLOCK", R5))
             .lw(R7, at("PS_FB", R5))
