@@ -840,39 +840,37 @@ fn type_loop(
     advance: &dyn Fn(&mut Code),
 ) {
     let (ty, caps) = (ti.ty, ti.caps);
-    let Some(cut) = ty.cut_test().filter(|_| lay.test_cuts) else {
+    // Each object's mailbox check, then its test issued as written by
+    // `test` (given the label of the next object's turn), then the next.
+    let one_run_each = |t: &mut Code, test: &dyn Fn(&mut Code, &str)| {
+        let next = format!("{n}_next");
         t.label(format!("{n}_obj"));
         fetch(t, n);
         mailbox_check(t, n);
-        ty.broadcast(t, n, &lay.fit, caps);
-        t.label(format!("{n}_next"));
+        test(t, &next);
+        t.label(&next);
         advance(t);
         t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
         t.label(format!("{n}_end"));
+    };
+    let Some(cut) = ty.cut_test().filter(|_| lay.test_cuts) else {
+        one_run_each(t, &|t, _| ty.broadcast(t, n, &lay.fit, caps));
         return;
     };
     if lay.cut_runs {
         // One run per test, ended by the broadcast unit at a cut where no
         // awake ray can still hit the object: TinyRISC finds the next
         // object while it runs (the broadcast queue holds its run).
-        let (next, done) = (format!("{n}_next"), format!("{n}_done"));
-        let after = {
-            let mut c = Code::new();
-            ty.broadcast_after_cut_test(&mut c, n, R7, caps);
-            c
-        };
-        t.label(format!("{n}_obj"));
-        fetch(t, n);
-        mailbox_check(t, n);
-        let none = if after.is_empty() { &next } else { &done };
-        run_with_cut_contexts(t, ty, &cut, &lay.fit, R7, n, none);
-        if !after.is_empty() {
-            t.label(&done).extend(after);
-        }
-        t.label(&next);
-        advance(t);
-        t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
-        t.label(format!("{n}_end"));
+        one_run_each(t, &|t, next| {
+            let mut after = Code::new();
+            ty.broadcast_after_cut_test(&mut after, n, R7, caps);
+            let done = format!("{n}_done");
+            let none = if after.is_empty() { next } else { &done };
+            run_with_cut_contexts(t, ty, &cut, &lay.fit, R7, n, none);
+            if !after.is_empty() {
+                t.label(&done).extend(after);
+            }
+        });
         return;
     }
     // The test's first part, then the next object to test found while it
