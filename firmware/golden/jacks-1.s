@@ -1505,6 +1505,7 @@ k_sphere:
         msu out, r9, r9
         msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
         cmp.gt r15, #0                  ; F: the line meets the sphere
+        (f) cmp.gt r11, #0              ; and its centre lies ahead
 k_sphere_cut_line:
         cut                             ; the run ends here where no awake RC has F
         st r8, [#TMP0]
@@ -1606,6 +1607,9 @@ k_cylinder:
         msu r10, r12, r8, >>Q14         ; oc2 x d2
         abs r10, r10
         cmp.le r10, r15                 ; F: the line may meet it
+        mul out, r11, r8
+        mac r10, r12, r9, >>Q14
+        (f) cmp.gt r10, #-8             ; and the axis lies ahead across it
 k_cylinder_cut_near:
         cut                             ; the run ends here where no awake RC has F
         st r11, [#TMP0]

@@ -724,11 +724,7 @@ order_pass:
         bne r1, r11, order_x_some
         beq r2, r12, order_x            ; all
 order_x_some:
-        blt r13, r0, order_x_any        ; an any-hit pass
-        jal majority                    ; some (closest hit): r8 = most go down
-        j order_x
-order_x_any:
-        li r8, 0                        ; some (any hit): the rays going up first
+        li r8, 0                        ; some: the rays going up first
 order_x:
         addi r1, r0, (k_node_x_below_first - CTXBASE) / 4
         li r2, PN_LEFT
@@ -2124,6 +2120,7 @@ k_sphere:
         msu out, r9, r9
         msu r15, r10, r10, >>Q14        ; s = 1 - |p/r|^2
         cmp.gt r15, #0                  ; F: the line meets the sphere
+        (f) cmp.gt r11, #0              ; and its centre lies ahead
 k_sphere_cut_line:
         cut                             ; the run ends here where no awake RC has F
         st r8, [#TMP0]
@@ -2225,6 +2222,9 @@ k_cylinder:
         msu r10, r12, r8, >>Q14         ; oc2 x d2
         abs r10, r10
         cmp.le r10, r15                 ; F: the line may meet it
+        mul out, r11, r8
+        mac r10, r12, r9, >>Q14
+        (f) cmp.gt r10, #-8             ; and the axis lies ahead across it
 k_cylinder_cut_near:
         cut                             ; the run ends here where no awake RC has F
         st r11, [#TMP0]

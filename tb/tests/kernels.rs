@@ -455,6 +455,38 @@ fn thin_cylinder_fine_normals_beat_coarse_ones() {
     );
 }
 
+/// F of every lane after the kernel `k` ran on the record (at `rec`) up
+/// to its cut `cut`, on the 16-bit chip or (`wide`) the 32-bit one.
+fn flags_at_cut(
+    shape: &Shape,
+    rays: &[Ray; 64],
+    (k, rec, cut): (&str, &str, &str),
+    wide: bool,
+) -> u64 {
+    let part = |t: &mut Code, _: &TypeInfo, _: &firmware::tracer::primitives::Fit| {
+        t.li(R1, kaddr(k))
+            .addi(R2, R7, rec)
+            .sbcb(R1, R2, format!("({k}_cut_{cut} - {k}) / 4"));
+    };
+    if wide {
+        run_with::<i32>(shape.clone(), rays, false, part)
+            .0
+            .top
+            .array
+            .rc
+            .flags
+            .f
+    } else {
+        run_with::<i16>(shape.clone(), rays, false, part)
+            .0
+            .top
+            .array
+            .rc
+            .flags
+            .f
+    }
+}
+
 /// The cylinder kernel's bound (with tests in parts, its first cut,
 /// `near`: `|oc2 x d2| <= r |d2|_1` plus a margin) keeps every ray that
 /// its exact line test (the cut `line`: `s > 0`) keeps, so stopping at the
@@ -503,31 +535,8 @@ fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
             }
         })
     };
-    let flags = |shape: &Shape, rays: &[Ray; 64], cut: &str, wide: bool| -> u64 {
-        let part = |t: &mut Code, _: &TypeInfo, _: &firmware::tracer::primitives::Fit| {
-            t.li(R1, kaddr("k_cylinder")).addi(R2, R7, "CYL_BODY").sbcb(
-                R1,
-                R2,
-                format!("(k_cylinder_cut_{cut} - k_cylinder) / 4"),
-            );
-        };
-        if wide {
-            run_with::<i32>(shape.clone(), rays, false, part)
-                .0
-                .top
-                .array
-                .rc
-                .flags
-                .f
-        } else {
-            run_with::<i16>(shape.clone(), rays, false, part)
-                .0
-                .top
-                .array
-                .rc
-                .flags
-                .f
-        }
+    let flags = |shape: &Shape, rays: &[Ray; 64], cut: &str, wide: bool| {
+        flags_at_cut(shape, rays, ("k_cylinder", "CYL_BODY", cut), wide)
     };
     let (mut kept, mut bounded_out) = (0u32, 0u32);
     for (fine, wide) in [(true, false), (false, false), (true, true)] {
@@ -555,6 +564,91 @@ fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
         kept > 300 && bounded_out > 300,
         "{kept} kept, {bounded_out} stopped"
     );
+}
+
+/// The sphere's and the cylinder's first parts (with tests in parts)
+/// also stop rays for which the object lies behind: the sphere's centre
+/// (`b = (c - o).d <= 0`), the cylinder's axis across it (`oc2.d2 <= 0`),
+/// where a surface seen from outside has no root ahead. Rays from points
+/// just outside the object in every direction (about half leave it
+/// behind, as reflected and shadow rays leave a surface): every lane the
+/// whole kernel finds a hit for has F at the first cut, and the first cut
+/// stops lanes whose line meets the object behind the ray (counted by the
+/// f64 test), both chips.
+#[test]
+fn first_parts_keep_every_hit_and_stop_objects_behind() {
+    let around = |shape: &Shape, seed: u64| -> [Ray; 64] {
+        let b = shape.bounds();
+        let (c, size) = (b.center(), b.extent().length() / 2.0);
+        let mut g = Lcg(seed);
+        let mut unit = move || {
+            Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized()
+        };
+        std::array::from_fn(|_| Ray {
+            o: c + unit() * (size * 1.05),
+            d: unit(),
+        })
+    };
+    let first_cut = |shape: &Shape, rays: &[Ray; 64], wide: bool| {
+        let at = match shape {
+            Shape::Sphere { .. } => ("k_sphere", "0", "line"),
+            _ => ("k_cylinder", "CYL_BODY", "near"),
+        };
+        flags_at_cut(shape, rays, at, wide)
+    };
+    let hits = |shape: &Shape, rays: &[Ray; 64], wide: bool| -> u64 {
+        let out = if wide {
+            run::<i32>(shape.clone(), rays, false).0
+        } else {
+            run::<i16>(shape.clone(), rays, false).0
+        };
+        out.iter()
+            .enumerate()
+            .filter(|(_, h)| h.is_some())
+            .fold(0, |m, (i, _)| m | 1 << i)
+    };
+    // The f64 line test: the ray's whole line, both ways.
+    let line_meets = |shape: &Shape, r: &Ray| {
+        let back = Ray {
+            o: r.o + r.d * 100.0,
+            d: r.d * -1.0,
+        };
+        let any = |r: &Ray| intersect(shape, r, 0.0, f64::INFINITY, true).is_some();
+        any(r) || any(&back)
+    };
+    // The open cylinder: caps are tests of their own.
+    let mut open = shape_cylinder();
+    if let Shape::Cone { caps, .. } = &mut open {
+        *caps = false;
+    }
+    for shape in [shape_sphere(), open] {
+        let (mut hit, mut stopped_behind) = (0u32, 0u32);
+        for wide in [false, true] {
+            for seed in 1..=6u64 {
+                let rays = around(&shape, seed);
+                let (f, h) = (first_cut(&shape, &rays, wide), hits(&shape, &rays, wide));
+                assert_eq!(
+                    h & !f,
+                    0,
+                    "{shape:?}, 32-bit {wide}, seed {seed}: lanes {:#018x} hit but stop at the first cut",
+                    h & !f
+                );
+                hit += h.count_ones();
+                stopped_behind += (0..64)
+                    .filter(|&i| {
+                        f & 1 << i == 0
+                            && line_meets(&shape, &rays[i])
+                            && intersect(&shape, &rays[i], 0.0, f64::INFINITY, false).is_none()
+                    })
+                    .count() as u32;
+            }
+        }
+        eprintln!("{shape:?}: {hit} hits kept, {stopped_behind} lines meeting it behind stopped");
+        assert!(
+            hit >= 30 && stopped_behind >= 40,
+            "{hit} hits, {stopped_behind} stopped"
+        );
+    }
 }
 
 fn shape_box() -> Shape {

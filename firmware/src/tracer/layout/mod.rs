@@ -830,6 +830,14 @@ fn fit_scene(
         _ => None,
     });
     let (ks_sphere, ep_sphere, sphere_fine) = sphere::fit(radii, &fitter);
+    let sphere_inside = scene
+        .objects
+        .iter()
+        .any(|o| matches!(o.shape, Shape::Sphere { inside: true, .. }));
+    let cyl_inside = scene.objects.iter().any(|o| {
+        matches!(o.shape, Shape::Cone { inside: true, .. })
+            && o.shape.prim_type() == PrimType::Cylinder
+    });
     let cyl_radii = scene.objects.iter().filter_map(|o| match o.shape {
         Shape::Cone { base_radius, .. } if o.shape.prim_type() == PrimType::Cylinder => {
             Some(base_radius.abs() * s)
@@ -850,6 +858,8 @@ fn fit_scene(
         ks_sphere,
         ep_sphere,
         sphere_fine,
+        sphere_inside,
+        cyl_inside,
         ks_cyl,
         ep_cyl,
         ks_cone,

@@ -45,7 +45,7 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
     let parts = |k: &super::super::emit::K| (k.first_part(), k.len() - k.first_part());
     let sphere = parts(&sphere::kernel(&g, fit, Sides::Front));
     let disc = planar::kernel(&g, planar::Inside::Disc, Sides::Front).len();
-    let cyl = parts(&cylinder::kernel(&g, Body::Opaque));
+    let cyl = parts(&cylinder::kernel(&g, fit, Body::Opaque));
     let cone = parts(&cone::kernel(&g, Body::Opaque));
     let boxk = parts(&aabox::kernel(&g, Sides::Front));
     let planar = parts(&planar::kernel(&g, planar::Inside::Triangle, Sides::Front));

@@ -139,16 +139,16 @@ fn body_name(b: Body) -> &'static str {
 
 /// The kernels of a cylinder's test, in load order: the body run(s), the
 /// caps' disc.
-pub fn kernels(g: &Gen, s: Sides) -> Vec<(&'static str, K)> {
+pub fn kernels(g: &Gen, fit: &Fit, s: Sides) -> Vec<(&'static str, K)> {
     let cap = planar::kernel_name(Inside::Disc, s);
     match s {
         Sides::Front => vec![
-            (body_name(Body::Opaque), kernel(g, Body::Opaque)),
+            (body_name(Body::Opaque), kernel(g, fit, Body::Opaque)),
             (cap, planar::kernel(g, Inside::Disc, s)),
         ],
         Sides::Both => vec![
-            (body_name(Body::Outer), kernel(g, Body::Outer)),
-            (body_name(Body::Inner), kernel(g, Body::Inner)),
+            (body_name(Body::Outer), kernel(g, fit, Body::Outer)),
+            (body_name(Body::Inner), kernel(g, fit, Body::Inner)),
             (cap, planar::kernel(g, Inside::Disc, s)),
         ],
     }
@@ -257,7 +257,7 @@ pub(crate) fn write(
 }
 
 /// One run of the cylinder body kernel.
-pub fn kernel(g: &Gen, body: Body) -> K {
+pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
     let fine = g.fine_normals;
     let nr = g.approx;
     let mut k = K::new();
@@ -340,6 +340,15 @@ pub fn kernel(g: &Gen, body: Body) -> K {
             .c("abs r10, r10")
             .c("cmp.le r10, r15")
             .note("F: the line may meet it");
+        if !g.published && !fit.cyl_inside {
+            // Seen from outside (sg = +1), tau = b - h with h >= 0 and
+            // b = oc2.d2 / |d2|: no root ahead where oc2.d2 <= 0. The
+            // margin covers b's rounding after the normalisation.
+            k.c("mul out, r11, r8")
+                .c("mac r10, r12, r9, >>Q14")
+                .c(format!("(f) cmp.gt r10, #-{BOUND_MARGIN_LSB}"))
+                .note("and the axis lies ahead across it");
+        }
         k.cut(CUTS[0].0);
         store_oc2(&mut k);
         k.c(format!("st r13, [#{}]", ram::TMP7))
@@ -439,7 +448,7 @@ pub fn kernel(g: &Gen, body: Body) -> K {
 pub const CUTS: [(&str, &str); 3] = [
     (
         "near",
-        "the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1)",
+        "the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1) and, where none is seen from inside, its axis lies ahead across it",
     ),
     ("line", "the ray's line meets the cylinder"),
     ("ahead", "the root ahead, before tbest"),

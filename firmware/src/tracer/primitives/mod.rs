@@ -226,7 +226,7 @@ impl ChipType {
             ChipType::Sphere | ChipType::GlassSphere => {
                 vec![(sphere::kernel_name(s), sphere::kernel(g, fit, s))]
             }
-            ChipType::Cylinder | ChipType::GlassCylinder => cylinder::kernels(g, s),
+            ChipType::Cylinder | ChipType::GlassCylinder => cylinder::kernels(g, fit, s),
             ChipType::Cone | ChipType::GlassCone => cone::kernels(g, s),
             ChipType::Box | ChipType::GlassBox => {
                 vec![(aabox::kernel_name(s), aabox::kernel(g, s))]
@@ -580,6 +580,13 @@ pub struct Fit {
     pub ks_sphere: u32,
     pub ep_sphere: u32,
     pub sphere_fine: bool,
+    /// Some opaque sphere is seen from inside (NFF's negative radius,
+    /// `sg` = -1): the sphere kernel's first part cannot then reject a
+    /// sphere whose centre is behind the ray.
+    pub sphere_inside: bool,
+    /// Some opaque cylinder is seen from inside: likewise for the
+    /// cylinder's bound.
+    pub cyl_inside: bool,
     /// Cylinders and cones: the same shifts.
     pub ks_cyl: u32,
     pub ep_cyl: u32,
@@ -857,7 +864,7 @@ mod tests {
                         );
                         // Caps flag (read by TinyRISC), the body runs, two
                         // caps; without caps, the body runs alone.
-                        let cyl: usize = cylinder::kernels(&g, s)
+                        let cyl: usize = cylinder::kernels(&g, &fit, s)
                             .iter()
                             .map(|(_, k)| k.fb_reads)
                             .sum();

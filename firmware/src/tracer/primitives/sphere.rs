@@ -61,7 +61,10 @@ pub fn words(fit: &Fit) -> usize {
 }
 
 /// The opaque kernel's cut ([`K::cut`]) and what F holds there.
-pub const CUTS: [(&str, &str); 1] = [("line", "the ray's line meets the sphere")];
+pub const CUTS: [(&str, &str); 1] = [(
+    "line",
+    "the ray's line meets the sphere and, where none is seen from inside, its centre lies ahead",
+)];
 
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
@@ -179,6 +182,11 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         .note("s = 1 - |p/r|^2")
         .c("cmp.gt r15, #0")
         .note("F: the line meets the sphere");
+    if !two && !g.published && !fit.sphere_inside {
+        // Seen from outside (sg = +1), t = b - h with h >= 0: a sphere
+        // whose centre is not ahead has no root ahead, exactly.
+        k.c("(f) cmp.gt r11, #0").note("and its centre lies ahead");
+    }
     if !two {
         k.cut(CUTS[0].0);
     }
