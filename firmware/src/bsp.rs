@@ -137,7 +137,17 @@ pub struct Split {
 pub struct Bsp {
     pub nodes: Vec<Node>,
     pub params: BspParams,
+    /// The tree would have more than [`NODE_BUDGET`] nodes: its building
+    /// stopped there (every node after the budget a leaf), so `nodes` is
+    /// not the tree `params` asked for, only enough to say it is too large.
+    pub over_budget: bool,
 }
+
+/// The most nodes a tree is built to (node indices are 16-bit in the
+/// scene image): beyond it, a deep median tree of overlapping objects
+/// (SPD shells at `--max-depth 30`) would take more host memory than
+/// there is before the image could refuse it.
+pub const NODE_BUDGET: usize = 1 << 16;
 
 /// Summary figures of a tree.
 #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize)]
@@ -197,9 +207,18 @@ impl Bsp {
             p: &params,
             meets,
             costs,
+            made: std::sync::atomic::AtomicUsize::new(0),
         };
         let nodes = build(&ctx, bounds, all, 0, 0);
-        Bsp { nodes, params }
+        // Deterministic on any number of threads: the tree is built as
+        // asked until the budget is reached, which it is exactly when the
+        // whole tree has more nodes.
+        let over_budget = ctx.made.into_inner() > NODE_BUDGET;
+        Bsp {
+            nodes,
+            params,
+            over_budget,
+        }
     }
 
     pub fn stats(&self) -> BspStats {
@@ -257,6 +276,8 @@ struct Ctx<'a> {
     p: &'a BspParams,
     meets: &'a (dyn Fn(u32, &Aabb) -> bool + Sync),
     costs: &'a ChipCosts,
+    /// Nodes made so far, against [`NODE_BUDGET`].
+    made: std::sync::atomic::AtomicUsize,
 }
 
 /// Nodes of at least this many objects sort them into their children on
@@ -283,7 +304,12 @@ fn build(cx: &Ctx, bounds: Aabb, objects: Vec<u32>, depth: u32, futile: u32) -> 
             split: None,
         }]
     };
-    if objects.len() <= p.max_leaf || depth >= p.max_depth || futile >= FUTILE_SPLITS {
+    let made = cx.made.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    if objects.len() <= p.max_leaf
+        || depth >= p.max_depth
+        || futile >= FUTILE_SPLITS
+        || made >= NODE_BUDGET
+    {
         return leaf(objects);
     }
     let choice = match p.rule {

@@ -999,8 +999,12 @@ fn choose_datapath(
         Err(e16) => {
             // A scene the 16-bit format cannot hold may still fit the
             // 32-bit chip's (16 more fraction bits).
-            let Ok((fw32, ..)) = measured(Datapath::W32) else {
-                anyhow::bail!("{e16:#}");
+            let (fw32, ..) = match measured(Datapath::W32) {
+                Ok(m) => m,
+                Err(e32) => anyhow::bail!(
+                    "neither chip can render the scene (--datapath auto): the 16-bit chip: \
+                     {e16:#}; the 32-bit chip: {e32:#}"
+                ),
             };
             return Ok((
                 Datapath::W32,

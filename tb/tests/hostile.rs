@@ -405,3 +405,37 @@ fn a_polygon_of_many_short_edges_is_not_degenerate() {
         "{err}"
     );
 }
+
+/// A deep median tree over objects that overlap by the hundred (SPD shells
+/// at `--max-depth 30` took the host's memory until the kernel killed it):
+/// the build stops at the node budget and the render says why, naming the
+/// options, without writing the image.
+#[test]
+fn a_tree_too_large_for_node_indices_is_refused_before_memory_runs_out() {
+    let d = tempfile::tempdir().unwrap();
+    let mut nff = NFF_HEAD.to_string();
+    for i in 0..1500 {
+        let x = -0.75 + i as f64 * 0.001;
+        nff += &format!("s {x} {x} {x} 0.05\n");
+    }
+    std::fs::write(d.path().join("overlap.nff"), nff).unwrap();
+    fails_with(
+        d.path(),
+        &[
+            "render",
+            "overlap.nff",
+            "--split",
+            "median",
+            "--max-depth",
+            "32",
+            "--datapath",
+            "32",
+            "--size",
+            "8x8",
+            "--out",
+            "x.png",
+        ],
+        &["overlap.nff", "grows past 65536 nodes", "--max-depth"],
+    );
+    assert!(!d.path().join("x.png").exists());
+}

@@ -376,6 +376,19 @@ fn build_bsp(scene: &Scene, opt: &CompileOptions, q: QFormat) -> Result<Bsp, Sce
         &meets,
         opt.chip_costs.as_deref(),
     );
+    if bsp.over_budget {
+        return Err(error(
+            scene,
+            0,
+            format!(
+                "the BSP ({:?} split, depth limit {}) grows past {} nodes; node indices are \
+                 16-bit (at most 65535): lower --max-depth or raise --max-leaf",
+                bsp.params.rule,
+                bsp.params.max_depth,
+                crate::bsp::NODE_BUDGET
+            ),
+        ));
+    }
     if bsp.nodes.len() > NO_CHILD as usize {
         return Err(error(
             scene,
