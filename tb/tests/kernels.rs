@@ -12,7 +12,7 @@
 //! the 32-bit chip run there against the same shapes.
 
 use firmware::asm;
-use firmware::scene::{Object, Scene, Shape, Vec3};
+use firmware::scene::{Object, PrimType, Scene, Shape, Vec3};
 use firmware::tracer::emit::{Code, R1, R2, R7};
 use firmware::tracer::layout::{ChipType, TypeInfo};
 use firmware::tracer::memory_map::ram;
@@ -592,7 +592,8 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
     let first_cut = |shape: &Shape, rays: &[Ray; 64], wide: bool| {
         let at = match shape {
             Shape::Sphere { .. } => ("k_sphere", "0", "line"),
-            _ => ("k_cylinder", "CYL_BODY", "near"),
+            s if s.prim_type() == PrimType::Cylinder => ("k_cylinder", "CYL_BODY", "near"),
+            _ => ("k_cone", "CONE_BODY", "sphere"),
         };
         flags_at_cut(shape, rays, at, wide)
     };
@@ -617,11 +618,13 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
         any(r) || any(&back)
     };
     // The open cylinder: caps are tests of their own.
-    let mut open = shape_cylinder();
-    if let Shape::Cone { caps, .. } = &mut open {
-        *caps = false;
-    }
-    for shape in [shape_sphere(), open] {
+    let open = |mut s: Shape| {
+        if let Shape::Cone { caps, .. } = &mut s {
+            *caps = false;
+        }
+        s
+    };
+    for shape in [shape_sphere(), open(shape_cylinder()), open(shape_cone())] {
         let (mut hit, mut stopped_behind) = (0u32, 0u32);
         for wide in [false, true] {
             for seed in 1..=6u64 {
