@@ -1660,25 +1660,11 @@ k_phong:
         ld r11, [r0 + #SH_NL]
         ld r12, [r0 + #SH_RV]
         ld r13, [r0 + #SH_MAT]
-        ; material 0: exponent 4096
+        ; material 0: exponent 0
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
-        ; pow ^4096
+        ; pow ^0
         ld r14, [r0 + #C_ONE]
-        mov r15, r12
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r15, r15, r15, >>Q14
-        mul r14, r14, r15, >>Q14
         mul out, fb0, r11
         mac r15, fb0, r14, >>Q14
         ld r9, [r0 + #COL]

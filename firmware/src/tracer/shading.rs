@@ -45,6 +45,20 @@ pub fn split_shine(shine: f64) -> (u32, f64) {
     }
 }
 
+/// The exponent `k_phong` raises `R.V` to for material `m`
+/// ([`split_shine`]); none (`x^0`, no fraction) where the material has no
+/// specular term and `skip_dull` (the packet traversal's firmware): its
+/// `ks lc` words are 0, so the power would be multiplied by 0 and the
+/// colour is the same bit for bit. The paper's traversal keeps the power
+/// its published cycles were counted with.
+pub fn phong_exponent(m: &crate::scene::Material, skip_dull: bool) -> (u32, f64) {
+    if skip_dull && m.ks == 0.0 {
+        (0, 0.0)
+    } else {
+        split_shine(m.shine)
+    }
+}
+
 /// `frame+field+i`, a word of a stack frame.
 fn word(frame: &str, field: &str, i: u32) -> String {
     match i {

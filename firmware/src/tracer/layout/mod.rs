@@ -29,7 +29,7 @@ use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
 use super::math::{table_slots_for, word_max};
 pub use super::primitives::ChipType;
 use super::primitives::{aabox, cone, cylinder, planar, polygon, smooth_triangle, sphere, Fit};
-use super::shading::split_shine;
+use super::shading::phong_exponent;
 use super::{NodeLayout, Options, Traversal};
 pub use packet_nodes::{PK_INNER, PK_LEAF_HEAD, PK_MAILBOX_BYTES};
 pub use paper_nodes::{compact_head, COMPACT_INNER_HEAD, COMPACT_LEAF_HEAD, NODE_HEAD};
@@ -108,7 +108,7 @@ pub struct FbImage {
     pub mailbox: usize,
     pub objects: usize,
     pub materials: usize,
-    /// Phong exponents: integer part and fraction (see [`split_shine`]).
+    /// Phong exponents: integer part and fraction (see [`phong_exponent`]).
     pub shines: Vec<(u32, f64)>,
     /// Scale shift of the eye rays' pixel steps.
     pub kd: u32,
@@ -488,8 +488,8 @@ fn build_as(
         .any(|c| c.refracts() && !by[*c as usize].is_empty());
     let (post, transmit, transmit_materials) = post_streams(&mut w, scene, &mats, refract);
     let (lights, shades, light_shifted) =
-        lights(&mut w, scene, &mats, frac, xb).map_err(|m| err(0, m))?;
-    let shines: Vec<(u32, f64)> = mats.iter().map(|m| split_shine(m.shine)).collect();
+        lights(&mut w, scene, &mats, frac, xb, packet).map_err(|m| err(0, m))?;
+    let shines: Vec<(u32, f64)> = mats.iter().map(|m| phong_exponent(m, packet)).collect();
 
     // Packet traversal: the root cell widened by the traversal's tolerance
     // (the stream of its pass-start kernel), resident in either layout.
@@ -640,6 +640,7 @@ fn lights(
     mats: &[crate::scene::Material],
     frac: u32,
     xb: u32,
+    skip_dull: bool,
 ) -> Result<(Vec<usize>, Vec<usize>, bool), String> {
     let nl = scene.lights.len().max(1) as f64;
     let m = extent(scene);
@@ -667,7 +668,7 @@ fn lights(
         let lc = l.color.unwrap_or(Vec3::ONE * (1.0 / nl.sqrt()));
         for (i, mt) in mats.iter().enumerate() {
             w.raw(i as i64);
-            let (_, f) = split_shine(mt.shine);
+            let (_, f) = phong_exponent(mt, skip_dull);
             if f > 0.0 {
                 w.push(f * w.one());
                 w.push((1.0 - f) * w.one());
