@@ -96,10 +96,13 @@ pub const PK_OBJECT_RISC: f64 = 12.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 64 to 146 on the SPD scenes at 128x128 but for shells' few
+/// is added. 48 to 131 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
-/// less the DMA wait, over the leaves reached).
-pub const PK_LEAF_COST: f64 = 100.0;
+/// less the DMA wait, over the leaves reached). Larger values measure a
+/// little faster (a leaf also costs its decision and its pieces' waits,
+/// which the model prices per object), so the model takes the largest
+/// within a factor of two of the cheapest loop measured (balls-4, 41).
+pub const PK_LEAF_COST: f64 = 80.0;
 
 /// The costs a [`crate::bsp::SplitRule::Chip`] tree of `scene` weighs
 /// (the packet traversal's, as [`object_costs`] and [`PK_NODE_COST`]),

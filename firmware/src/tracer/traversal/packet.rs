@@ -649,7 +649,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             t.andi(R11, R6, LEAF_LATE)
                 .c("r11: a large first piece, moved only if one of its objects is to be tested");
         }
-        let hit = if late { "leaf_hit" } else { "leaf_awake" };
+        let hit = if late { "leaf_hit" } else { "leaf_cached" };
         t.comment(
             "the first piece: in its slot of the leaf cache since this tile or the one before",
         )
@@ -685,6 +685,14 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
             .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
             .c("r2 = TILE_GEN");
+        // A first piece in the cache has no move to hide: its tests start
+        // at once, each object's mailbox checked in the type loop (the
+        // scan would check the same ones first).
+        t.label("leaf_cached")
+            .beqz(R12, "leaf_go")
+            .c("in its slot: the tests start, no mailbox to check");
+        awake(t);
+        t.j("leaf_go");
         t.comment("while the first piece moves: the awake rays, for the mailboxes");
         t.label("leaf_awake")
             .beqz(R12, "leaf_piece")
@@ -788,7 +796,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             t.label("leaf_hit")
                 .li(R11, 0)
                 .c("in its slot: nothing to move")
-                .j("leaf_awake");
+                .j("leaf_cached");
         }
     } else {
         t.label("leaf")
