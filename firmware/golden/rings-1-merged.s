@@ -40,7 +40,7 @@ INSIDE_TOL = 2          ; tolerance of the planar inside tests, Q.14
 ; ---- main memory (byte addresses) ----
 CTXBASE = 0x20000       ; the kernels (loaded into context memory)
 FBIMG = 0x40000         ; the FB image, loaded by the host
-FBWORDS = 2539          ; its words
+FBWORDS = 2594          ; its words
 TILELIST = 0x60000      ; the tile list, written by the host:
 TL_COUNT = 0            ;   the number of tiles
 TL_FIRST = 4            ;   the first tile's entry:
