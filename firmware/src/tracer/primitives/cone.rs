@@ -312,14 +312,6 @@ pub fn kernel(g: &Gen, body: Body) -> K {
     ));
     let opaque = body == Body::Opaque;
     bounding_sphere(&mut k);
-    if opaque && !g.published {
-        // The bounding sphere (radius S / 2) wholly behind the ray: no root
-        // ahead, whichever side is seen. b / S in Q.10 against -1/2, with
-        // 8 units (S / 128) for its rounding.
-        k.c("mul r13, r11, r12, >>KS_CONE+Q14-Q10")
-            .c("(f) cmp.gt r13, #-520")
-            .note("and the bounding sphere is not wholly behind");
-    }
     if opaque {
         k.cut(CUTS[0].0);
     }
@@ -339,10 +331,7 @@ pub fn kernel(g: &Gen, body: Body) -> K {
 
 /// The opaque body kernel's cuts ([`K::cut`]) and what F holds at each.
 pub const CUTS: [(&str, &str); 3] = [
-    (
-        "sphere",
-        "the ray's line meets the bounding sphere, not wholly behind the ray",
-    ),
+    ("sphere", "the ray's line meets the bounding sphere"),
     ("real", "and the cone's quadratic has real roots"),
     (
         "ahead",

@@ -182,7 +182,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         .note("s = 1 - |p/r|^2")
         .c("cmp.gt r15, #0")
         .note("F: the line meets the sphere");
-    if !two && !g.published && !fit.sphere_inside {
+    if !two && g.test_cuts && !g.published && !fit.sphere_inside {
         // Seen from outside (sg = +1), t = b - h with h >= 0: a sphere
         // whose centre is not ahead has no root ahead, exactly.
         k.c("(f) cmp.gt r11, #0").note("and its centre lies ahead");
