@@ -487,6 +487,20 @@ fn flags_at_cut(
     }
 }
 
+/// The lanes whose ray the whole test of `shape` finds a hit for, on the
+/// 16-bit chip or (`wide`) the 32-bit one.
+fn hit_lanes(shape: &Shape, rays: &[Ray; 64], wide: bool) -> u64 {
+    let out = if wide {
+        run::<i32>(shape.clone(), rays, false).0
+    } else {
+        run::<i16>(shape.clone(), rays, false).0
+    };
+    out.iter()
+        .enumerate()
+        .filter(|(_, h)| h.is_some())
+        .fold(0, |m, (i, _)| m | 1 << i)
+}
+
 /// The cylinder kernel's bound (with tests in parts, its first cut,
 /// `near`: `|oc2 x d2| <= r |d2|_1` plus a margin) keeps every ray that
 /// its exact line test (the cut `line`: `s > 0`) keeps, so stopping at the
@@ -570,8 +584,8 @@ fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
 /// also stop rays for which the object lies behind: the sphere's centre
 /// (`b = (c - o).d <= 0`), the cylinder's axis across it (`oc2.d2 <= 0`),
 /// where a surface seen from outside has no root ahead. Rays from points
-/// just outside the object in every direction (about half leave it
-/// behind, as reflected and shadow rays leave a surface): every lane the
+/// just outside the object and inside it, in every direction (about half
+/// leave it behind, as reflected and shadow rays leave a surface): every lane the
 /// whole kernel finds a hit for has F at the first cut, and the first cut
 /// stops lanes whose line meets the object behind the ray (counted by the
 /// f64 test), both chips.
@@ -599,17 +613,6 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
         };
         flags_at_cut(shape, rays, at, wide)
     };
-    let hits = |shape: &Shape, rays: &[Ray; 64], wide: bool| -> u64 {
-        let out = if wide {
-            run::<i32>(shape.clone(), rays, false).0
-        } else {
-            run::<i16>(shape.clone(), rays, false).0
-        };
-        out.iter()
-            .enumerate()
-            .filter(|(_, h)| h.is_some())
-            .fold(0, |m, (i, _)| m | 1 << i)
-    };
     // The f64 line test: the ray's whole line, both ways.
     let line_meets = |shape: &Shape, r: &Ray| {
         let back = Ray {
@@ -631,7 +634,10 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
         for wide in [false, true] {
             for seed in 1..=24u64 {
                 let rays = around(&shape, seed);
-                let (f, h) = (first_cut(&shape, &rays, wide), hits(&shape, &rays, wide));
+                let (f, h) = (
+                    first_cut(&shape, &rays, wide),
+                    hit_lanes(&shape, &rays, wide),
+                );
                 assert_eq!(
                     h & !f,
                     0,
@@ -697,16 +703,7 @@ fn a_cone_hit_ahead_of_a_centre_behind_is_kept() {
     });
     for wide in [false, true] {
         let f = flags_at_cut(&shape, &rays, ("k_cone", "CONE_BODY", "sphere"), wide);
-        let out = if wide {
-            run::<i32>(shape.clone(), &rays, false).0
-        } else {
-            run::<i16>(shape.clone(), &rays, false).0
-        };
-        let h = out
-            .iter()
-            .enumerate()
-            .filter(|(_, h)| h.is_some())
-            .fold(0u64, |m, (i, _)| m | 1 << i);
+        let h = hit_lanes(&shape, &rays, wide);
         assert!(
             h.count_ones() >= 32,
             "32-bit {wide}: only {} hits",

@@ -54,9 +54,9 @@ pub fn macros(lay: &FbImage) -> Code {
     // cycle counts are published.
     let kernel_address = move |b: &mut Code, k: &str| {
         if packet {
-            b.addi(R1, R0, format!("({k} - CTXBASE) / 4"));
+            b.addi(R1, R0, kaddr(k));
         } else {
-            b.li(R1, format!("({k} - CTXBASE) / 4"));
+            b.li(R1, kaddr(k));
         }
     };
     t.define_macro(
