@@ -209,6 +209,10 @@ pub(crate) fn parse_shadow_packets(s: &str) -> Result<firmware::tracer::ShadowPa
     s.parse()
 }
 
+pub(crate) fn parse_sub_edges(s: &str) -> Result<firmware::tracer::SubEdges, String> {
+    s.parse()
+}
+
 pub(crate) fn parse_test_cuts(s: &str) -> Result<firmware::tracer::TestCuts, String> {
     s.parse()
 }

@@ -122,6 +122,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
             shadows: Default::default(),
             test_cuts: Default::default(),
             child_order: Default::default(),
+            sub_edges: Default::default(),
         },
         firmware::tracer::Traversal::Packet => Options {
             width,

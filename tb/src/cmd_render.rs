@@ -92,6 +92,14 @@ pub struct RenderArgs {
     /// kept). The eye rays' level keeps a packet per light.
     #[arg(long, value_name = "auto|light|merged", default_value = "auto", value_parser = crate::cli::parse_shadow_packets)]
     pub shadow_packets: firmware::tracer::ShadowPackets,
+    /// Streamed packet traversal: where a banded polygon's sub-edges are
+    /// (polygons of 16 edges or more): apart (where a record would be
+    /// over 256 words: in main memory, once per polygon, only the bands a
+    /// packet's points lie in moved by DMA once they are known) or records
+    /// (in the record, moved with every leaf piece that holds it, as the
+    /// resident layout keeps them). The same image.
+    #[arg(long, value_name = "apart|records", default_value = "apart", value_parser = crate::cli::parse_sub_edges)]
+    pub sub_edges: firmware::tracer::SubEdges,
     /// Packet traversal: run each object test in parts, at the cuts of its
     /// kernels, the rest skipped where no awake ray can still hit the
     /// object: on (a `cut` context in the kernel's run, where the
@@ -435,6 +443,7 @@ pub(crate) fn render_and_measure(
         "collapse": opt.collapse.to_string(),
         "leaf_pieces": opt.pieces.to_string(),
         "shadow_packets": chip.firmware.shadows.to_string(),
+        "sub_edges": opt.sub_edges.to_string(),
         "child_order": chip.firmware.child_order.to_string(),
         "test_cuts": opt.test_cuts.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
@@ -637,6 +646,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
         shadows: a.shadow_packets,
         test_cuts: a.test_cuts.for_issue(timing.risc.issue),
         child_order: a.child_order,
+        sub_edges: a.sub_edges,
     };
     if a.newton_steps > 3 {
         anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);

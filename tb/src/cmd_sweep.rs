@@ -384,6 +384,18 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
+    // Banded polygons' sub-edges in the records a leaf's pieces move
+    // (the default keeps them apart and moves a packet's bands).
+    let packet = packet_config(width, height);
+    v.push(Knob {
+        knob: "sub_edges",
+        value: firmware::tracer::SubEdges::InRecords.to_string(),
+        opt: Options {
+            sub_edges: firmware::tracer::SubEdges::InRecords,
+            ..packet
+        },
+        nm,
+    });
     // The child order of mixed packets by the majority alone (the
     // default serves the ways the view's rays end, where the probe runs
     // that faster).

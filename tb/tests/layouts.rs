@@ -318,20 +318,19 @@ fn the_fitted_slope_is_the_power_law_exponent() {
     assert_eq!(tb::cmd_sweep::loglog_slope(&pts[..1]), None);
 }
 
-/// Banded polygon records (`primitives::polygon`) are longer than plain
-/// ones and copied into every leaf a polygon crosses: SPD gears at its
-/// default size is banded on the 16-bit chip, but on the 32-bit chip its
-/// banded streamed image is over the main memory reserved for it, and the
-/// packet traversal lays it out with plain records instead of refusing
-/// it (the auto datapath then still has the 32-bit chip to choose).
+/// Banded polygon records (`primitives::polygon`): a streamed layout keeps
+/// the sub-edges apart from the record (`Form::Apart`), once per polygon
+/// in main memory, so SPD gears at its default size is banded on both
+/// chips (with the sub-edges in the records, copied into every leaf a
+/// face crosses, its 32-bit image was over the main memory reserved for
+/// it and it fell back to plain records), its faces' records 57 words,
+/// the sub-edges' FB buffer one face's 172 sub-edges.
 #[test]
-fn gears_banded_where_the_image_fits_plain_where_not() {
+fn gears_streamed_keeps_the_sub_edges_apart() {
+    use firmware::tracer::primitives::{polygon, ChipType};
     let text = firmware::scene::spd::generate("gears", 4).unwrap();
     let scene = firmware::scene::nff::parse(&text, "gears.nff").unwrap();
-    for (datapath, banded) in [
-        (rtl::rc::Datapath::W16, true),
-        (rtl::rc::Datapath::W32, false),
-    ] {
+    for datapath in [rtl::rc::Datapath::W16, rtl::rc::Datapath::W32] {
         let o = Options {
             datapath,
             traversal: firmware::tracer::Traversal::Packet,
@@ -343,7 +342,19 @@ fn gears_banded_where_the_image_fits_plain_where_not() {
         };
         let fw = firmware::tracer::build(&scene, &o)
             .unwrap_or_else(|e| panic!("gears, {datapath}: {e}"));
-        assert!(fw.layout.stream.is_some(), "gears, {datapath}: streamed");
-        assert_eq!(fw.layout.fit.polygon_bands, banded, "gears, {datapath}");
+        let lay = &fw.layout;
+        let st = lay.stream.as_ref().expect("streamed");
+        assert!(lay.fit.polygon_bands, "gears, {datapath}: banded");
+        assert!(lay.fit.polygon_fans_apart, "gears, {datapath}: apart");
+        let face = lay
+            .types
+            .iter()
+            .find(|t| t.ty == ChipType::Polygon)
+            .expect("gears has polygons");
+        assert_eq!(face.size, polygon::words(0, polygon::Form::Apart));
+        assert_eq!(face.size, 57, "gears, {datapath}");
+        // 144 edges, 172 sub-edges of 6 words in 16 bands.
+        let fans = st.fans.expect("the sub-edges' place");
+        assert_eq!(fans.words, 6 * 172, "gears, {datapath}");
     }
 }

@@ -732,12 +732,12 @@ fn majority_counts_the_rays_going_down() {
 }
 
 /// A streamed leaf whose first piece is one large record of an object in
-/// several leaves (SPD gears' faces, banded polygons of 144 vertices:
-/// 1,088 words, over the further pieces' 256) is moved only once the
-/// mailbox scan finds the object untested by some awake ray
-/// (`LEAF_LATE`): the frame is the one of further pieces large enough
-/// for the faces (`--leaf-pieces 64,2048`: no leaf late), pixel for
-/// pixel, on both chips.
+/// several leaves (over the further pieces' size: with `--leaf-pieces
+/// 8,16`, SPD gears' rectangles of 20 words and faces of 57) is moved
+/// only once the mailbox scan finds the object untested by some awake
+/// ray (`LEAF_LATE`): the frame is the one of further pieces large
+/// enough for every record (`--leaf-pieces 8,2048`: no leaf late), pixel
+/// for pixel, on both chips.
 #[test]
 fn large_first_pieces_move_only_when_tested() {
     use firmware::tracer::{ChildOrder, LeafPieces, ShadowPackets};
@@ -748,15 +748,15 @@ fn large_first_pieces_move_only_when_tested() {
                 datapath,
                 child_order: ChildOrder::MAJORITY,
                 shadows: ShadowPackets::PerLight,
-                pieces: LeafPieces { first: 64, rest },
+                pieces: LeafPieces { first: 8, rest },
                 ..opts(48, 48, Traversal::Packet)
             };
             render_sah(&scene, o, true)
         };
-        let (late, whole) = (render(256), render(2048));
+        let (late, whole) = (render(16), render(2048));
         let n = |r: &tb::render::ChipRender| r.firmware.layout.stream.as_ref().unwrap().late_leaves;
         eprintln!(
-            "gears-1, {datapath}: {} late leaves, {} cycles; with 64,2048: {} late, {} cycles",
+            "gears-1, {datapath}: {} late leaves, {} cycles; with 8,2048: {} late, {} cycles",
             n(&late),
             late.cycles,
             n(&whole),
@@ -770,5 +770,78 @@ fn large_first_pieces_move_only_when_tested() {
         assert!(late.rgb8 == whole.rgb8, "{datapath}: the image changed");
         assert!(late.hits == whole.hits, "{datapath}: the hits changed");
         assert_eq!(late.ray_census(), whole.ray_census(), "{datapath}");
+    }
+}
+
+/// A streamed layout keeps banded polygons' sub-edges apart from their
+/// records, in main memory, and moves a packet's bands of them by DMA
+/// once the bisection has found them (`polygon::Form::Apart`), instead of
+/// moving them in the record with every leaf piece that holds it
+/// (`SubEdges::InRecords`, the resident layout's form). The same frame
+/// either way, pixel for pixel: SPD gears-1's faces (144 vertices, 16
+/// bands; in fewer cycles) on both chips, and a 20-pointed star (one
+/// band: no probe runs before the sub-edges' DMA, which must wait for the
+/// array) over a 64-gon floor (which makes the records large enough to
+/// keep the sub-edges apart) with object tests whole, in TinyRISC's parts
+/// and cut by the array.
+#[test]
+fn sub_edges_apart_trace_the_same_rays() {
+    use firmware::tracer::{SubEdges, TestCuts};
+    let mut star = String::from(
+        "v\nfrom 0 -6 4\nat 0 0 0\nup 0 0 1\nangle 40\nhither 0.01\nresolution 32 32\n\
+         b 0.1 0.2 0.3\nl 4 -5 9\nl -5 -3 6\nf 0.8 0.5 0.3 0.6 0.4 20 0 0\np 20\n",
+    );
+    for k in 0..20 {
+        let a = std::f64::consts::PI * k as f64 / 10.0;
+        let r = if k % 2 == 0 { 2.0 } else { 1.0 };
+        star.push_str(&format!("{} {} 0\n", r * a.cos(), r * a.sin()));
+    }
+    // A 64-gon floor under it: records over `polygon::APART_FROM` words.
+    star.push_str("f 0.3 0.8 0.3 0.7 0.3 20 0 0\ns 0.5 0.5 0.6 0.5\ns -0.8 0.2 0.4 0.3\np 64\n");
+    for k in 0..64 {
+        let a = std::f64::consts::PI * k as f64 / 32.0;
+        star.push_str(&format!("{} {} -0.5\n", 3.0 * a.cos(), 3.0 * a.sin()));
+    }
+    let star = firmware::scene::nff::parse(&star, "star.nff").unwrap();
+    let gears = load("gears-1.nff");
+    let w16 = rtl::rc::Datapath::W16;
+    let cases = [
+        ("gears-1", &gears, w16, TestCuts::On),
+        ("gears-1", &gears, rtl::rc::Datapath::W32, TestCuts::On),
+        ("star", &star, w16, TestCuts::Off),
+        ("star", &star, w16, TestCuts::Tinyrisc),
+        ("star", &star, w16, TestCuts::On),
+    ];
+    for (name, scene, datapath, test_cuts) in cases {
+        let render = |sub_edges| {
+            let o = Options {
+                datapath,
+                sub_edges,
+                test_cuts,
+                ..opts(48, 48, Traversal::Packet)
+            };
+            render_sah(scene, o, true)
+        };
+        let what = format!("{name}, {datapath}, tests {test_cuts}");
+        let (apart, inside) = (render(SubEdges::Apart), render(SubEdges::InRecords));
+        let (al, il) = (&apart.firmware.layout, &inside.firmware.layout);
+        assert!(al.fit.polygon_bands && al.fit.polygon_fans_apart, "{what}");
+        assert!(il.fit.polygon_bands && !il.fit.polygon_fans_apart, "{what}");
+        let fans = al
+            .stream
+            .as_ref()
+            .and_then(|st| st.fans)
+            .expect("the sub-edges' place");
+        eprintln!(
+            "{what}, 48x48 streamed: sub-edges apart {} cycles (a {}-word buffer), in the records {}",
+            apart.cycles, fans.words, inside.cycles
+        );
+        assert!(apart.rgb8 == inside.rgb8, "{what}: the image changed");
+        assert!(apart.hits == inside.hits, "{what}: the hits changed");
+        assert_eq!(apart.ray_census(), inside.ray_census(), "{what}");
+        if name == "gears-1" {
+            // What the form is for: faces of 172 sub-edges in many leaves.
+            assert!(apart.cycles < inside.cycles, "{what}");
+        }
     }
 }

@@ -42,6 +42,7 @@ use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
 pub use rtl::rc::Datapath;
 pub use shadows::ShadowPackets;
+
 pub use traversal::child_order::{AxisOrder, ChildOrder};
 
 /// Generator options.
@@ -85,6 +86,42 @@ pub struct Options {
     /// Packet traversal: which child of a node a packet whose rays go
     /// both ways along its axis visits first.
     pub child_order: ChildOrder,
+    /// Streamed packet traversal: where banded polygons' sub-edges are.
+    pub sub_edges: SubEdges,
+}
+
+/// Streamed packet traversal: where a banded polygon's sub-edges are
+/// (`primitives::polygon::Form`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum SubEdges {
+    /// In main memory apart from the record where a record would be
+    /// over [`primitives::polygon::APART_FROM`] words, a packet's bands
+    /// of them moved by DMA once its points are known.
+    #[default]
+    Apart,
+    /// In the record, moved with every leaf piece that holds it (the
+    /// resident layout's form).
+    InRecords,
+}
+
+impl std::fmt::Display for SubEdges {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            SubEdges::Apart => "apart",
+            SubEdges::InRecords => "records",
+        })
+    }
+}
+
+impl std::str::FromStr for SubEdges {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "apart" => Ok(SubEdges::Apart),
+            "records" => Ok(SubEdges::InRecords),
+            _ => Err(format!("sub-edges '{s}': expected apart or records")),
+        }
+    }
 }
 
 impl Default for Options {
@@ -107,6 +144,7 @@ impl Default for Options {
             shadows: ShadowPackets::default(),
             test_cuts: TestCuts::default(),
             child_order: ChildOrder::default(),
+            sub_edges: SubEdges::default(),
         }
     }
 }

@@ -303,7 +303,9 @@ fn header(
         .iter()
         .any(|t| matches!(t, ChipType::Polygon | ChipType::GlassPolygon))
     {
-        rec.extend(primitives::polygon::header(lay.fit.polygon_bands));
+        rec.extend(primitives::polygon::header(primitives::polygon::Form::of(
+            &lay.fit,
+        )));
     }
     if !rec.is_empty() {
         block(
@@ -489,6 +491,28 @@ fn fb(lay: &FbImage) -> Vec<String> {
             format!("0x{STREAM_BANK:x}"),
             "FB bank 1: the leaf blocks, by DMA",
         ));
+        if let Some(f) = &st.fans {
+            v.push(define(
+                "FANS",
+                format!("0x{:x}", f.at),
+                "the banded polygons' sub-edges (main memory)",
+            ));
+            v.push(define(
+                "FAN_UNIT_SHIFT",
+                primitives::polygon::FAN_UNIT.trailing_zeros(),
+                "  POLY_FANS_AT counts units of this many bytes (log2)",
+            ));
+            v.push(define(
+                "FB_WORD_SHIFT",
+                f.word_shift,
+                "  an FB word's bytes in main memory (log2)",
+            ));
+            v.push(define(
+                "FAN_BUF",
+                format!("0x{:x}", f.buf),
+                "FB: a polygon's bands of sub-edges, by DMA (the top of bank 1)",
+            ));
+        }
         if lay.traversal == Traversal::Paper {
             v.push(define(
                 "BLOCK_HEAD",

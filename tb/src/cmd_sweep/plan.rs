@@ -116,6 +116,7 @@ pub(super) fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> V
     arg("--collapse", o.collapse.to_string());
     arg("--leaf-pieces", o.pieces.to_string());
     arg("--shadow-packets", o.shadows.to_string());
+    arg("--sub-edges", o.sub_edges.to_string());
     arg("--test-cuts", o.test_cuts.to_string());
     arg("--child-order", o.child_order.to_string());
     arg("--layout", o.layout.name().into());

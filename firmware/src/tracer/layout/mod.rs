@@ -162,6 +162,23 @@ pub struct Stream {
     pub cache_slots: usize,
     pub slot_words: usize,
     pub slots_at: usize,
+    /// Packet traversal: where the banded polygons' sub-edges are
+    /// ([`super::primitives::polygon::Form::Apart`]), if the scene has any.
+    pub fans: Option<FansApart>,
+}
+
+/// The banded polygons' sub-edges in main memory and the FB buffer a
+/// packet's bands of them are moved into.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FansApart {
+    /// Main-memory byte address of the first (`FANS`).
+    pub at: u32,
+    /// FB address of the buffer (`FAN_BUF`, the top of bank 1).
+    pub buf: usize,
+    /// Words of the buffer: the most sub-edge words of a polygon.
+    pub words: usize,
+    /// log2 of an FB word's bytes (`FB_WORD_SHIFT`).
+    pub word_shift: u32,
 }
 
 /// The FB image as it is written: words (16-bit values, or 32-bit on the
@@ -174,9 +191,22 @@ pub(crate) struct W {
     pub(crate) frac: u32,
     /// Extra bits of the datapath (0 or 16).
     pub(crate) x: u32,
+    /// Words that live in main memory only (streamed layouts): the banded
+    /// polygons' sub-edges ([`polygon::Form::Apart`]).
+    pub(crate) fans: Vec<i32>,
+    /// The most words of one polygon's sub-edges in `fans`.
+    pub(crate) fan_most: usize,
 }
 
 impl W {
+    /// Bytes of an FB word: 2 (16-bit chip) or 4.
+    pub(crate) fn word_bytes(&self) -> usize {
+        if self.x == 0 {
+            2
+        } else {
+            4
+        }
+    }
     pub(crate) fn max(&self) -> f64 {
         word_max(self.x)
     }
@@ -359,7 +389,7 @@ pub fn build(
             fine_normals,
             false,
             false,
-            false,
+            polygon::Form::Plain,
         )?;
         if lay.stream.is_none() {
             return Ok(lay);
@@ -377,7 +407,7 @@ pub fn build(
         fine_normals,
         true,
         true,
-        false,
+        polygon::Form::Plain,
     )
 }
 
@@ -398,27 +428,37 @@ pub fn build_packet(
     fine: bool,
 ) -> Result<FbImage, String> {
     let g = if fine { guard_bits.min(1) } else { guard_bits };
-    // Banded polygon records are longer than plain ones (6-word
-    // sub-edges, copied into every leaf the polygon crosses): where the
-    // banded layout cannot be built (SPD gears on the 32-bit chip: its
-    // streamed image over the main memory reserved for it), the plain one
-    // is, whose error stands if it fails too. (Only a scene with a
-    // polygon of that many vertices can have banded records.)
+    // Polygons of many edges get banded records (`polygon::Form`): in the
+    // record where the scene is resident, apart from it in main memory
+    // where it is streamed and a record would be over
+    // `polygon::APART_FROM` words (so that a leaf's piece moves the record
+    // without its sub-edges). Where no banded layout can be built, the
+    // plain one is, whose error stands if it fails too. (Only a scene
+    // with a polygon of that many vertices can have banded records.)
     let may_band = scene
         .objects
         .iter()
         .any(|o| matches!(&o.shape, Shape::Polygon { v, .. } if v.len() >= polygon::BANDED_FROM));
-    match build_as(scene, image, opt, g, fine_normals, fine, force_stream, true) {
-        Err(_) if may_band => build_as(
-            scene,
-            image,
-            opt,
-            g,
-            fine_normals,
-            fine,
-            force_stream,
-            false,
-        ),
+    let build = |form| build_as(scene, image, opt, g, fine_normals, fine, force_stream, form);
+    let large = |lay: &FbImage| {
+        lay.types.iter().any(|t| {
+            matches!(t.ty, ChipType::Polygon | ChipType::GlassPolygon)
+                && t.size > polygon::APART_FROM
+        })
+    };
+    match build(polygon::Form::Banded) {
+        Ok(lay)
+            if lay.stream.is_some()
+                && lay.fit.polygon_bands
+                && large(&lay)
+                && opt.sub_edges == super::SubEdges::Apart =>
+        {
+            Ok(build(polygon::Form::Apart).unwrap_or(lay))
+        }
+        Err(_) if may_band && opt.sub_edges == super::SubEdges::Apart => {
+            build(polygon::Form::Apart).or_else(|_| build(polygon::Form::Plain))
+        }
+        Err(_) if may_band => build(polygon::Form::Plain),
         r => r,
     }
 }
@@ -443,8 +483,11 @@ fn build_as(
     fine_normals: bool,
     fine: bool,
     streamed: bool,
-    bands: bool,
+    form: polygon::Form,
 ) -> Result<FbImage, String> {
+    // `Form::Apart` streams the scene; `Form::Plain`: no banded records.
+    let bands = form != polygon::Form::Plain;
+    let streamed = streamed || form == polygon::Form::Apart;
     // The 32-bit chip: every format gets `xb` more fraction bits.
     let xb = opt.datapath.bits() - 16;
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
@@ -470,12 +513,17 @@ fn build_as(
     }
 
     let packet = opt.traversal == Traversal::Packet;
-    let (geo, fan, fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
+    let (geo, fan, mut fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
+    // A streamed layout keeps the banded polygons' sub-edges in main
+    // memory, once each, and moves a packet's bands of them.
+    fit.polygon_fans_apart = fit.polygon_bands && form == polygon::Form::Apart;
     let mut w = W {
         fb: Vec::new(),
         s,
         frac,
         x: xb,
+        fans: Vec::new(),
+        fan_most: 0,
     };
     // Init stream.
     w.fb.extend(table_slots_for(128, xb));
@@ -868,6 +916,7 @@ fn fit_scene(
         kt,
         fine_normals,
         polygon_bands,
+        polygon_fans_apart: false,
     };
 
     (geo, fan, fit)
@@ -981,7 +1030,8 @@ fn records(
                 ),
                 (Shape::Box { min, max }, _) => aabox::write(w, t.sides(), *min, *max, i, mat),
                 (Shape::Polygon { v, .. }, _) => {
-                    polygon::write(w, v, size, fit.polygon_bands, i, mat)
+                    polygon::write(w, v, size, polygon::Form::of(fit), i, mat)
+                        .map_err(|m| err(0, m))?
                 }
                 (
                     Shape::Triangle {

@@ -14,7 +14,8 @@ use super::super::primitives::{
 };
 use super::super::{mem, Collapse};
 use super::{
-    fb_word_bytes, FbImage, Finish, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK, W,
+    fb_word_bytes, FansApart, FbImage, Finish, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK,
+    W,
 };
 use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};
@@ -49,7 +50,7 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
     let cone = parts(&cone::kernel(&g, Body::Opaque));
     let boxk = parts(&aabox::kernel(&g, Sides::Front));
     let planar = parts(&planar::kernel(&g, planar::Inside::Triangle, Sides::Front));
-    let poly: Vec<usize> = polygon::kernels(&g, Sides::Front, false)
+    let poly: Vec<usize> = polygon::kernels(&g, Sides::Front, polygon::Form::Plain)
         .iter()
         .map(|(_, k)| k.len())
         .collect();
@@ -96,8 +97,8 @@ pub const PK_OBJECT_RISC: f64 = 12.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 48 to 131 on the SPD scenes at 128x128 but for shells' few
-/// large leaves (`render --profile`: the `leaf*` rows and `lo_*_end`,
+/// is added. 48 to 85 on the SPD scenes at 128x128 but for shells' few
+/// large leaves (`render --profile`: the `leaf*`, `lo_*_end` and `lo_*_fan_wait` rows,
 /// less the DMA wait, over the leaves reached). Larger values measure a
 /// little faster (a leaf also costs its decision and its pieces' waits,
 /// which the model prices per object), so the model takes the largest
@@ -117,9 +118,13 @@ pub fn chip_costs(
 ) -> crate::bsp::ChipCosts {
     use super::super::primitives::ChipType;
     let s = (frac as f64).exp2();
+    // (Scenes a chip-cost tree serves are mostly streamed: a banded
+    // polygon's record moves without its sub-edges.)
+    let polygon_bands = super::polygon_fan(scene, s, true).1;
     let fit = Fit {
         fine_normals,
-        polygon_bands: super::polygon_fan(scene, s, true).1,
+        polygon_bands,
+        polygon_fans_apart: polygon_bands,
         ..Fit::default()
     };
     let dma = rtl::dma::DmaTiming::default();
@@ -529,8 +534,21 @@ fn streamed_image(
     // slot beside the buffer, one slot that is the buffer.
     let slot_words = first.max(largest_record).next_multiple_of(4);
     let buffer = rest.next_multiple_of(4);
-    let (cache_slots, slots_at) = if buffer + slot_words <= STREAM_BANK {
-        ((STREAM_BANK - buffer) / slot_words, STREAM_BANK + buffer)
+    // The top of bank 1: the buffer a packet's bands of a polygon's
+    // sub-edges are moved into (sub-edges apart).
+    let fan_buf = w.fan_most.next_multiple_of(4);
+    if buffer + fan_buf > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "a banded polygon's {} words of sub-edges and the leaf pieces' {buffer}-word buffer do not fit FB bank 1 ({STREAM_BANK} words)",
+                w.fan_most
+            ),
+        ));
+    }
+    let bank1 = STREAM_BANK - fan_buf;
+    let (cache_slots, slots_at) = if buffer + slot_words <= bank1 {
+        ((bank1 - buffer) / slot_words, STREAM_BANK + buffer)
     } else {
         (1, STREAM_BANK)
     };
@@ -592,6 +610,20 @@ fn streamed_image(
             rec[word(PS_NEXT)] = (base + NODE_BYTES * (nn + p + 1)) as i32;
         }
     }
+    // The banded polygons' sub-edges (apart) follow the blocks, each
+    // polygon's on a unit of its own.
+    let fans = (!w.fans.is_empty()).then(|| {
+        let unit = super::super::primitives::polygon::FAN_UNIT;
+        let at = (base + blocks_at + blocks.len()).next_multiple_of(unit);
+        blocks.resize(at - base - blocks_at, 0);
+        blocks.extend(fb_word_bytes(&w.fans, w.x));
+        FansApart {
+            at: at as u32,
+            buf: 2 * STREAM_BANK - fan_buf,
+            words: w.fan_most,
+            word_shift: w.word_bytes().trailing_zeros(),
+        }
+    });
     // The mailboxes follow the image; the lists hold their addresses.
     let mailbox = (base + blocks_at + blocks.len()).next_multiple_of(PK_MAILBOX_BYTES);
     for (i, o) in lists.iter().enumerate() {
@@ -661,6 +693,7 @@ fn streamed_image(
         cache_slots,
         slot_words,
         slots_at,
+        fans,
     };
     Ok((w.fb, st))
 }

@@ -238,6 +238,7 @@ fn streamed_image(
         cache_slots: 0,
         slot_words: 0,
         slots_at: 0,
+        fans: None,
     })
 }
 

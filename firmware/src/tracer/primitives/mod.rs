@@ -214,7 +214,9 @@ impl ChipType {
             | ChipType::GlassRectangle
             | ChipType::GlassTriangle => planar::WORDS,
             ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => smooth_triangle::WORDS,
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::words(fan, fit.polygon_bands),
+            ChipType::Polygon | ChipType::GlassPolygon => {
+                polygon::words(fan, polygon::Form::of(fit))
+            }
         }
     }
 
@@ -245,7 +247,9 @@ impl ChipType {
                     smooth_triangle::kernel(g, s),
                 )]
             }
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::kernels(g, s, fit.polygon_bands),
+            ChipType::Polygon | ChipType::GlassPolygon => {
+                polygon::kernels(g, s, polygon::Form::of(fit))
+            }
         }
     }
 
@@ -272,7 +276,7 @@ impl ChipType {
             }
             ChipType::Cone | ChipType::GlassCone => cone::broadcast(t, at, s, caps),
             ChipType::Polygon | ChipType::GlassPolygon => {
-                polygon::broadcast(t, at, s, fit.polygon_bands)
+                polygon::broadcast(t, at, s, polygon::Form::of(fit))
             }
         }
     }
@@ -349,7 +353,7 @@ impl ChipType {
     /// ([`CutTest::then`]), a polygon's edges and tail.
     fn broadcast_then(self, t: &mut Code, at: &str, rec: Reg, fit: &Fit) {
         if matches!(self, ChipType::Polygon | ChipType::GlassPolygon) {
-            polygon::broadcast_edges(t, at, self.sides(), rec, fit.polygon_bands);
+            polygon::broadcast_edges(t, at, self.sides(), rec, polygon::Form::of(fit));
         }
     }
 
@@ -599,6 +603,9 @@ pub struct Fit {
     pub fine_normals: bool,
     /// Polygon records in bands ([`polygon::BANDED_FROM`]).
     pub polygon_bands: bool,
+    /// Banded records' sub-edges apart from the record, in main memory
+    /// (the streamed layout): [`polygon::Form::Apart`].
+    pub polygon_fans_apart: bool,
 }
 
 impl Fit {
@@ -835,7 +842,7 @@ mod tests {
                             smooth_triangle::kernel(&g, s).fb_reads,
                             smooth_triangle::WORDS
                         );
-                        let p: Vec<usize> = polygon::kernels(&g, s, false)
+                        let p: Vec<usize> = polygon::kernels(&g, s, polygon::Form::Plain)
                             .iter()
                             .map(|(_, k)| k.fb_reads)
                             .collect();
@@ -847,21 +854,24 @@ mod tests {
                                 polygon::TAIL_WORDS
                             ]
                         );
-                        // Banded: the head, a sub-edge, the probes' bound.
-                        let p: Vec<usize> = polygon::kernels(&g, s, true)
-                            .iter()
-                            .map(|(_, k)| k.fb_reads)
-                            .collect();
-                        assert_eq!(
-                            p,
-                            [
-                                polygon::HEAD_WORDS,
-                                polygon::BAND_EDGE_WORDS,
-                                1,
-                                1,
-                                polygon::TAIL_WORDS
-                            ]
-                        );
+                        // Banded (sub-edges in the record or apart): the
+                        // head, a sub-edge, the probes' bound.
+                        for form in [polygon::Form::Banded, polygon::Form::Apart] {
+                            let p: Vec<usize> = polygon::kernels(&g, s, form)
+                                .iter()
+                                .map(|(_, k)| k.fb_reads)
+                                .collect();
+                            assert_eq!(
+                                p,
+                                [
+                                    polygon::HEAD_WORDS,
+                                    polygon::BAND_EDGE_WORDS,
+                                    1,
+                                    1,
+                                    polygon::TAIL_WORDS
+                                ]
+                            );
+                        }
                         // Caps flag (read by TinyRISC), the body runs, two
                         // caps; without caps, the body runs alone.
                         let cyl: usize = cylinder::kernels(&g, &fit, s)

@@ -47,6 +47,19 @@
 //! `k_polygon_above`), and runs only the sub-edges from the one to the
 //! other (`k_polygon_band_edge`, 15 contexts).
 //!
+//! **Sub-edges apart** (a streamed layout's banded records over
+//! [`APART_FROM`] words, [`super::Fit::polygon_fans_apart`]): the record that moves with a
+//! leaf's piece stops after the table: in place of the sub-edges, the
+//! main-memory place of the polygon's sub-edges (`POLY_FANS_AT`, in
+//! [`FAN_UNIT`]-byte units from `FANS`, once per polygon however many
+//! leaves it is in), then the tail (`1 + 15 + 2 (BANDS + 1) + 1 + 1 + 5`
+//! words, 57 for SPD gears' faces against 1,088). Once the bisection has
+//! found the bands and the array is done, TinyRISC moves only their
+//! sub-edges by DMA into `FAN_BUF` (the top of FB bank 1) and runs them
+//! from there: a packet
+//! whose points lie in two of a face's 16 bands moves an eighth of its
+//! sub-edges, and a face no awake ray's plane hit reaches moves none.
+//!
 //! **Two-sided** (a transmitting polygon): the head's plane test on both
 //! sides and the planar kernels' two-sided commit in the tail.
 //!
@@ -87,21 +100,59 @@ pub const EDGES_PER_BAND: usize = 16;
 /// offset.
 const TABLE_WORDS: usize = 2 * (BANDS + 1) + 1;
 
-/// Words of a record with room for `fan` edges (sub-edges where
-/// `banded`).
-pub fn words(fan: usize, banded: bool) -> usize {
-    if banded {
-        1 + HEAD_WORDS + TABLE_WORDS + fan * BAND_EDGE_WORDS + TAIL_WORDS
-    } else {
-        1 + HEAD_WORDS + fan * EDGE_WORDS + TAIL_WORDS
+/// A streamed layout keeps banded records' sub-edges apart where the
+/// records would be over this many words (the further leaf pieces'
+/// default size): such a record moves alone, and a packet runs a few of
+/// its bands. Smaller ones move with their pieces, overlapped with the
+/// tests, for less than the sub-edges' own DMA would cost.
+pub const APART_FROM: usize = 256;
+
+/// Bytes of the unit `POLY_FANS_AT` counts in (sub-edges apart): each
+/// polygon's sub-edges start on a multiple of it in main memory, so a
+/// 16-bit word reaches 2 MiB of them.
+pub const FAN_UNIT: usize = 64;
+
+/// The record forms of a polygon.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Form {
+    /// Every edge in the record.
+    Plain,
+    /// Sub-edges by band, in the record.
+    Banded,
+    /// Sub-edges by band in main memory, moved by DMA for the bands a
+    /// packet's points lie in (streamed layouts).
+    Apart,
+}
+
+impl Form {
+    pub fn of(fit: &super::Fit) -> Form {
+        match (fit.polygon_bands, fit.polygon_fans_apart) {
+            (false, _) => Form::Plain,
+            (true, false) => Form::Banded,
+            (true, true) => Form::Apart,
+        }
+    }
+    fn banded(self) -> bool {
+        self != Form::Plain
+    }
+}
+
+/// Words of a record with room for `fan` edges (sub-edges where banded;
+/// none where they are apart).
+pub fn words(fan: usize, form: Form) -> usize {
+    match form {
+        Form::Plain => 1 + HEAD_WORDS + fan * EDGE_WORDS + TAIL_WORDS,
+        Form::Banded => 1 + HEAD_WORDS + TABLE_WORDS + fan * BAND_EDGE_WORDS + TAIL_WORDS,
+        Form::Apart => 1 + HEAD_WORDS + TABLE_WORDS + 1 + TAIL_WORDS,
     }
 }
 
 /// The record's fields the broadcast addresses (header lines).
-pub fn header(banded: bool) -> Vec<String> {
-    if banded {
+pub fn header(form: Form) -> Vec<String> {
+    if form.banded() {
         let bounds = 1 + HEAD_WORDS;
         let starts = bounds + BANDS + 1;
+        let apart = form == Form::Apart;
         return vec![
             define("POLY_NB", 0, "banded polygon record: number of bands"),
             define("POLY_HEAD", 1, "polygon record: the head kernel's stream"),
@@ -109,14 +160,26 @@ pub fn header(banded: bool) -> Vec<String> {
             define(
                 "POLY_STARTS",
                 starts,
-                "  per band its first sub-edge (words from POLY_FAN), and the end",
+                if apart {
+                    "  per band its first sub-edge (words from the first), and the end"
+                } else {
+                    "  per band its first sub-edge (words from POLY_FAN), and the end"
+                },
             ),
             define("POLY_TAIL", starts + BANDS + 1, "  the tail's offset"),
-            define(
-                "POLY_FAN",
-                1 + HEAD_WORDS + TABLE_WORDS,
-                "  the first sub-edge's stream",
-            ),
+            if apart {
+                define(
+                    "POLY_FANS_AT",
+                    starts + BANDS + 2,
+                    "  its sub-edges in main memory: FAN_UNIT-byte units from FANS",
+                )
+            } else {
+                define(
+                    "POLY_FAN",
+                    1 + HEAD_WORDS + TABLE_WORDS,
+                    "  the first sub-edge's stream",
+                )
+            },
             define(
                 "POLY_BAND_EDGE_WORDS",
                 BAND_EDGE_WORDS,
@@ -157,9 +220,9 @@ const ABOVE: &str = "k_polygon_above";
 
 /// The kernels of a polygon's test, in load order: the head, the edge
 /// (banded records: the sub-edge and the two probes), the tail.
-pub fn kernels(g: &Gen, s: Sides, banded: bool) -> Vec<(&'static str, K)> {
+pub fn kernels(g: &Gen, s: Sides, form: Form) -> Vec<(&'static str, K)> {
     let mut v = vec![(head_name(s), head(g, s))];
-    if banded {
+    if form.banded() {
         v.push((BAND_EDGE, band_edge()));
         v.push((BELOW, probe(false)));
         v.push((ABOVE, probe(true)));
@@ -246,13 +309,21 @@ pub fn band_edges(edges: &[[i64; 5]]) -> usize {
     bands(edges).1.iter().map(Vec::len).sum()
 }
 
-/// Write the record of polygon `v` into a record of `size` words (banded
-/// where `banded`).
-pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, banded: bool, id: usize, mat: usize) {
+/// Write the record of polygon `v` into a record of `size` words (in
+/// `form`; the sub-edges of `Form::Apart` into `w.fans`). Err: the
+/// sub-edges apart are past what `POLY_FANS_AT` reaches.
+pub(crate) fn write(
+    w: &mut W,
+    v: &[Vec3],
+    size: usize,
+    form: Form,
+    id: usize,
+    mat: usize,
+) -> Result<(), String> {
     let start = w.fb.len();
     let n = normal(v);
     let ((ua, va), edges) = edges(v, w.s);
-    let banded = banded.then(|| bands(&edges));
+    let banded = form.banded().then(|| bands(&edges));
     w.raw(match &banded {
         Some((bounds, _)) => bounds.len() as i64 - 1,
         None => edges.len() as i64,
@@ -282,9 +353,30 @@ pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, banded: bool, id: usize,
         }
         row(w, &at, BANDS + 1);
         let fan = 1 + HEAD_WORDS + TABLE_WORDS;
-        w.raw(fan as i64 + at.last().unwrap());
-        for x in sub.iter().flatten().flatten() {
-            w.raw(*x);
+        if form == Form::Apart {
+            // The tail after the sub-edges' place; the sub-edges on a
+            // unit of their own in main memory.
+            w.raw(fan as i64 + 1);
+            let unit = FAN_UNIT / w.word_bytes();
+            let units = w.fans.len() / unit;
+            if units > i16::MAX as usize {
+                return Err(format!(
+                    "the banded polygons' sub-edges take over {} KiB of main memory, more than POLY_FANS_AT reaches",
+                    units * FAN_UNIT / 1024
+                ));
+            }
+            w.raw(units as i64);
+            w.fan_most = w.fan_most.max(at[at.len() - 1] as usize);
+            for x in sub.iter().flatten().flatten() {
+                let v = w.sat(*x as f64);
+                w.fans.push(v);
+            }
+            w.fans.resize(w.fans.len().next_multiple_of(unit), 0);
+        } else {
+            w.raw(fan as i64 + at.last().unwrap());
+            for x in sub.iter().flatten().flatten() {
+                w.raw(*x);
+            }
         }
     } else {
         for e in &edges {
@@ -297,6 +389,7 @@ pub(crate) fn write(w: &mut W, v: &[Vec3], size: usize, banded: bool, id: usize,
     w.raw(id as i64);
     w.raw(mat as i64);
     w.fb.resize(start + size, 0);
+    Ok(())
 }
 
 fn head(g: &Gen, sides: Sides) -> K {
@@ -445,18 +538,18 @@ fn tail(sides: Sides) -> K {
 
 /// Broadcast a polygon's test (record at r7): the head, one edge run per
 /// edge, the tail. Labels begin with `at`.
-pub fn broadcast(t: &mut Code, at: &str, sides: Sides, banded: bool) {
+pub fn broadcast(t: &mut Code, at: &str, sides: Sides, form: Form) {
     t.m("BCAST_REC", format!("{}, r7, POLY_HEAD", head_name(sides)))
         .c("the plane");
-    broadcast_edges(t, at, sides, R7, banded);
+    broadcast_edges(t, at, sides, R7, form);
 }
 
 /// After the head (record at `rec`): one edge run per edge, the tail;
 /// a banded record's sub-edges of the bands that hold a point (clobbers
 /// r1..r3; r8, r12, r13 kept in `BAND_SAVE`).
-pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg, banded: bool) {
-    if banded {
-        broadcast_bands(t, at, sides, rec);
+pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg, form: Form) {
+    if form.banded() {
+        broadcast_bands(t, at, sides, rec, form == Form::Apart);
         return;
     }
     t.lfb(R3, super::super::emit::at("POLY_EDGES", rec))
@@ -481,7 +574,9 @@ pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg, banded: b
 /// again) on "some lies at or above `Y_b`", then the sub-edges between
 /// them and the tail. A point outside every band straddles no sub-edge,
 /// so whichever bands its search ends at, its parity is even there.
-fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
+/// `apart`: the sub-edges are moved by DMA from main memory into
+/// `FAN_BUF` first.
+fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) {
     use super::super::emit::{at as field, R12, R13, R8};
     let save = |k: usize| format!("BAND_SAVE+{}", 4 * k);
     t.sw(R8, field(save(0), R0))
@@ -536,10 +631,30 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg) {
         .add(R12, rec, R1)
         .lfb(R3, field("POLY_STARTS+1", R12))
         .sub(R3, R3, R13)
-        .c("r3: words of the sub-edges to run")
-        .add(R2, rec, R13)
-        .addi(R2, R2, "POLY_FAN")
-        .addi(R1, R0, kaddr(BAND_EDGE));
+        .c("r3: words of the sub-edges to run");
+    if apart {
+        t.beqz(R3, format!("{at}_tail"))
+            .rcany(R2)
+            .c("the array done with the bank (no probe runs before a record of one band)")
+            .lfb(R2, field("POLY_FANS_AT", rec))
+            .slli(R2, R2, "FAN_UNIT_SHIFT")
+            .slli(R13, R13, "FB_WORD_SHIFT")
+            .add(R2, R2, R13)
+            .li(R1, "FANS")
+            .add(R2, R2, R1)
+            .c("r2: the lowest band's first sub-edge in main memory")
+            .li(R1, "FAN_BUF")
+            .ldfb(R2, R1, R3)
+            .c("the bands' sub-edges into FAN_BUF");
+        t.label(format!("{at}_fan_wait"))
+            .dwait()
+            .mv(R2, R1)
+            .addi(R1, R0, kaddr(BAND_EDGE));
+    } else {
+        t.add(R2, rec, R13)
+            .addi(R2, R2, "POLY_FAN")
+            .addi(R1, R0, kaddr(BAND_EDGE));
+    }
     t.label(format!("{at}_fan"))
         .beqz(R3, format!("{at}_tail"))
         .sbcb(R1, R2, klen(BAND_EDGE))

@@ -110,13 +110,16 @@ pub mod cost_items {
     ];
     /// The prefix of the node kernels, one run per node visit.
     pub const NODE_KERNEL_PREFIX: &str = "k_node_";
-    /// A TinyRISC label of the leaf loop (the DMA waits in it aside).
+    /// A TinyRISC label of the leaf loop (the DMA waits in it aside),
+    /// with the waits for a polygon's sub-edges (`lo_*_fan_wait`, DMA
+    /// waits the profile's DMA cause counts, set aside with the others).
     pub fn is_leaf_label(l: &str) -> bool {
-        l.starts_with("leaf") || (l.starts_with("lo_") && l.ends_with("_end"))
+        l.starts_with("leaf")
+            || (l.starts_with("lo_") && (l.ends_with("_end") || l.ends_with("_fan_wait")))
     }
     /// A TinyRISC label of an object test (its type's loop).
     pub fn is_object_label(l: &str) -> bool {
-        l.starts_with("lo_") && !l.ends_with("_end")
+        l.starts_with("lo_") && !is_leaf_label(l)
     }
 }
 
