@@ -235,7 +235,8 @@ SLOT_TMIN = 1           ; slot: near end
         sw r1, MODE(r0)                 ; any hit
         jal trace
         BCAST k_wake_tile
-        BCAST_FB k_phong, \shade
+        li r3, \shade
+        jal phong                       ; its Phong terms, a material at a time
 .endm
 
 ; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
@@ -387,6 +388,28 @@ finish:
         rdcyc r1
         sw r1, T_END(r0)
         halt
+
+; phong: the light's Phong terms (stream at r3) a material at a time: a block whose
+; material no lit RC has ends at its cut. Clobbers r1, r2.
+phong:
+        addi r1, r0, (k_phong - CTXBASE) / 4
+        sbcb r1, r3, (k_phong_from_m1 - k_phong) / 4 ; the terms' set-up and material 0
+        addi r1, r0, (k_phong_from_m1 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m1_fb
+        sbcb r1, r2, (k_phong_from_m2 - k_phong_from_m1) / 4 ; material 1
+        addi r1, r0, (k_phong_from_m2 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m2_fb
+        sbcb r1, r2, (k_phong_from_m3 - k_phong_from_m2) / 4 ; material 2
+        addi r1, r0, (k_phong_from_m3 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m3_fb
+        sbcb r1, r2, (k_phong_from_m4 - k_phong_from_m3) / 4 ; material 3
+        addi r1, r0, (k_phong_from_m4 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m4_fb
+        sbcb r1, r2, (k_phong_from_m5 - k_phong_from_m4) / 4 ; material 4
+        addi r1, r0, (k_phong_from_m5 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m5_fb
+        sbcb r1, r2, (k_phong_end - k_phong_from_m5) / 4 ; material 5
+        jr r15
 
 ; trace: one ray pass, the packet traversal of a resident scene. In: the rays in r1..r7 of
 ; every RC, MODE (0: closest hit, 1: any hit). Out: the hits in HIT_*, r7.
@@ -1413,6 +1436,8 @@ k_phong:
         ; material 0: exponent 60
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m0:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^60
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1440,9 +1465,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m1:
         ; material 1: exponent 10
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m1:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^10
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1466,9 +1494,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m2:
         ; material 2: exponent 80
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m2:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^80
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1495,9 +1526,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m3:
         ; material 3: exponent 30
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m3:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^30
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1524,9 +1558,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m4:
         ; material 4: exponent 200
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m4:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^200
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1555,9 +1592,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m5:
         ; material 5: exponent 40
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m5:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^40
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1584,6 +1624,17 @@ k_phong:
         adds r9, r9, r15
         (f) st r9, [#COL+2]
 k_phong_end:
+k_phong_from_m1_fb = 7                  ; FB words of the stream read before the entry
+k_phong_from_m2_fb = 14                 ; FB words of the stream read before the entry
+k_phong_from_m3_fb = 21                 ; FB words of the stream read before the entry
+k_phong_from_m4_fb = 28                 ; FB words of the stream read before the entry
+k_phong_from_m5_fb = 35                 ; FB words of the stream read before the entry
+k_phong_cut_m0_fb = 1                   ; FB words of the stream read before the cut
+k_phong_cut_m1_fb = 8                   ; FB words of the stream read before the cut
+k_phong_cut_m2_fb = 15                  ; FB words of the stream read before the cut
+k_phong_cut_m3_fb = 22                  ; FB words of the stream read before the cut
+k_phong_cut_m4_fb = 29                  ; FB words of the stream read before the cut
+k_phong_cut_m5_fb = 36                  ; FB words of the stream read before the cut
 
 ; k_out_red: the pixel's red into the output register (for wfb).
 k_out_red:

@@ -238,7 +238,8 @@ SLOT_TMIN = 1           ; slot: near end
         sw r1, MODE(r0)                 ; any hit
         jal trace
         BCAST k_wake_tile
-        BCAST_FB k_phong, \shade
+        li r3, \shade
+        jal phong                       ; its Phong terms, a material at a time
 .endm
 
 ; SHADE_LEVEL post: the rays of a level traced (closest hit), the hits' shading state
@@ -646,7 +647,8 @@ sc_shade:
         sfb r3, SC_PARAM + 4(r4)
         addi r3, r4, SC_PARAM + 0
         BCAST_AT k_shadow_lit, r3
-        BCAST_FB k_phong, FB_SHADE0
+        li r3, FB_SHADE0
+        jal phong                       ; its Phong terms, a material at a time
         lw r1, SC_VIS + 8(r0)
         lw r2, SC_VIS + 12(r0)
         andi r3, r1, 0xffff
@@ -659,7 +661,8 @@ sc_shade:
         sfb r3, SC_PARAM + 9(r4)
         addi r3, r4, SC_PARAM + 5
         BCAST_AT k_shadow_lit, r3
-        BCAST_FB k_phong, FB_SHADE1
+        li r3, FB_SHADE1
+        jal phong                       ; its Phong terms, a material at a time
         lw r1, SC_VIS + 16(r0)
         lw r2, SC_VIS + 20(r0)
         andi r3, r1, 0xffff
@@ -672,8 +675,34 @@ sc_shade:
         sfb r3, SC_PARAM + 14(r4)
         addi r3, r4, SC_PARAM + 10
         BCAST_AT k_shadow_lit, r3
-        BCAST_FB k_phong, FB_SHADE2
+        li r3, FB_SHADE2
+        jal phong                       ; its Phong terms, a material at a time
         lw r15, SC_RET(r0)
+        jr r15
+
+; phong: the light's Phong terms (stream at r3) a material at a time: a block whose
+; material no lit RC has ends at its cut. Clobbers r1, r2.
+phong:
+        addi r1, r0, (k_phong - CTXBASE) / 4
+        sbcb r1, r3, (k_phong_from_m1 - k_phong) / 4 ; the terms' set-up and material 0
+        addi r1, r0, (k_phong_from_m1 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m1_fb
+        sbcb r1, r2, (k_phong_from_m2 - k_phong_from_m1) / 4 ; material 1
+        addi r1, r0, (k_phong_from_m2 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m2_fb
+        sbcb r1, r2, (k_phong_from_m3 - k_phong_from_m2) / 4 ; material 2
+        addi r1, r0, (k_phong_from_m3 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m3_fb
+        sbcb r1, r2, (k_phong_from_m4 - k_phong_from_m3) / 4 ; material 3
+        addi r1, r0, (k_phong_from_m4 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m4_fb
+        sbcb r1, r2, (k_phong_from_m5 - k_phong_from_m4) / 4 ; material 4
+        addi r1, r0, (k_phong_from_m5 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m5_fb
+        sbcb r1, r2, (k_phong_from_m6 - k_phong_from_m5) / 4 ; material 5
+        addi r1, r0, (k_phong_from_m6 - CTXBASE) / 4
+        addi r2, r3, k_phong_from_m6_fb
+        sbcb r1, r2, (k_phong_end - k_phong_from_m6) / 4 ; material 6
         jr r15
 
 ; trace: one ray pass, the packet traversal of a resident scene. In: the rays in r1..r7 of
@@ -1663,6 +1692,8 @@ k_phong:
         ; material 0: exponent 0
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m0:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^0
         ld r14, [r0 + #C_ONE]
         mul out, fb0, r11
@@ -1680,9 +1711,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m1:
         ; material 1: exponent 3.0827
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m1:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^3
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1708,9 +1742,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m2:
         ; material 2: exponent 3.0827
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m2:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^3
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1736,9 +1773,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m3:
         ; material 3: exponent 3.0827
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m3:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^3
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1764,9 +1804,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m4:
         ; material 4: exponent 3.0827
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m4:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^3
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1792,9 +1835,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m5:
         ; material 5: exponent 3.0827
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m5:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^3
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1820,9 +1866,12 @@ k_phong:
         ld r9, [r0 + #COL+2]
         adds r9, r9, r15
         (f) st r9, [#COL+2]
+k_phong_from_m6:
         ; material 6: exponent 3.0827
         cmp.ne r10, #0
         (f) cmp.eq fb0, r13
+k_phong_cut_m6:
+        cut                             ; the run ends here where no awake RC has F
         ; pow ^3
         ld r14, [r0 + #C_ONE]
         mov r15, r12
@@ -1849,6 +1898,19 @@ k_phong:
         adds r9, r9, r15
         (f) st r9, [#COL+2]
 k_phong_end:
+k_phong_from_m1_fb = 7                  ; FB words of the stream read before the entry
+k_phong_from_m2_fb = 16                 ; FB words of the stream read before the entry
+k_phong_from_m3_fb = 25                 ; FB words of the stream read before the entry
+k_phong_from_m4_fb = 34                 ; FB words of the stream read before the entry
+k_phong_from_m5_fb = 43                 ; FB words of the stream read before the entry
+k_phong_from_m6_fb = 52                 ; FB words of the stream read before the entry
+k_phong_cut_m0_fb = 1                   ; FB words of the stream read before the cut
+k_phong_cut_m1_fb = 8                   ; FB words of the stream read before the cut
+k_phong_cut_m2_fb = 17                  ; FB words of the stream read before the cut
+k_phong_cut_m3_fb = 26                  ; FB words of the stream read before the cut
+k_phong_cut_m4_fb = 35                  ; FB words of the stream read before the cut
+k_phong_cut_m5_fb = 44                  ; FB words of the stream read before the cut
+k_phong_cut_m6_fb = 53                  ; FB words of the stream read before the cut
 
 ; k_out_red: the pixel's red into the output register (for wfb).
 k_out_red:

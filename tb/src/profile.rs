@@ -101,7 +101,8 @@ impl Names {
     pub fn new(img: &Image, ctx_base: u32) -> Names {
         // TinyRISC's code labels (the macros' included), and the kernels:
         // the context labels `k_NAME` (not their `k_NAME_end`, nor the
-        // cuts `k_NAME_cut_C` inside them: their cycles are the kernel's).
+        // cuts `k_NAME_cut_C` and entries `k_NAME_from_E` inside them:
+        // their cycles are the kernel's).
         let labels = img
             .labels_in(Section::Text)
             .map(|l| (l.addr, l.name.clone()))
@@ -112,6 +113,7 @@ impl Names {
                 l.name.starts_with("k_")
                     && !l.name.ends_with("_end")
                     && !l.name.contains("_cut_")
+                    && !l.name.contains("_from_")
                     && l.addr >= ctx_base
             })
             .map(|l| ((l.addr - ctx_base) / 4, l.name.clone()))

@@ -437,7 +437,10 @@ fn merged_shadow_packets_trace_the_same_rays() {
 /// parts: every type with a cut (spheres, cylinders and cones with and
 /// without caps, rectangles, triangles, smooth triangles, polygons opaque
 /// and glass, glass rectangles and triangles), resident and streamed, on
-/// both chips.
+/// both chips. With the cut contexts `k_phong` also runs a material at a
+/// time, each block ending at its cut where no lit RC has its material
+/// (the default scene's and the glass scene's several materials): the
+/// same frame.
 #[test]
 fn object_tests_in_parts_trace_the_same_rays() {
     use firmware::tracer::TestCuts;

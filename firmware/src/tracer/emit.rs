@@ -127,14 +127,23 @@ pub struct K {
     /// The kernel's cuts ([`K::cut`]): name, the FB words read before it
     /// and the contexts before it.
     cuts: Vec<(String, usize, usize)>,
+    /// The kernel's entries ([`K::entry`]): name, the FB words read
+    /// before it.
+    entries: Vec<(String, usize)>,
 }
 
 /// The marker line of a cut, replaced by its label in [`K::text`].
 const CUT_MARK: &str = "\u{0}cut ";
+const ENTRY_MARK: &str = "\u{0}entry ";
 
 /// The label of cut `name` of kernel `label` ([`K::cut`]).
 pub fn cut_label(label: &str, name: &str) -> String {
     format!("{label}_cut_{name}")
+}
+
+/// The label of entry `name` of kernel `label` ([`K::entry`]).
+pub fn entry_label(label: &str, name: &str) -> String {
+    format!("{label}_from_{name}")
 }
 
 impl K {
@@ -197,6 +206,16 @@ impl K {
         self.cuts.push((name.to_string(), self.fb_reads, self.len));
         self
     }
+    /// An entry: where a run of the kernel may start, TinyRISC giving it
+    /// the stream from there. The text labels it `{label}_from_{name}`
+    /// and defines `{label}_from_{name}_fb`, the FB words of the stream
+    /// read before it (a run that starts there streams from the kernel's
+    /// stream plus that many words).
+    pub fn entry(&mut self, name: &str) -> &mut Self {
+        self.lines.push(format!("{ENTRY_MARK}{name}"));
+        self.entries.push((name.to_string(), self.fb_reads));
+        self
+    }
     /// The names of the kernel's cuts, in order.
     pub fn cuts(&self) -> impl Iterator<Item = &str> {
         self.cuts.iter().map(|c| c.0.as_str())
@@ -223,6 +242,8 @@ impl K {
         let (at, len) = (self.fb_reads, self.len);
         self.cuts
             .extend(other.cuts.into_iter().map(|(n, f, c)| (n, at + f, len + c)));
+        self.entries
+            .extend(other.entries.into_iter().map(|(n, f)| (n, at + f)));
         self.fb_reads += other.fb_reads;
         self.len += other.len;
         self.lines.extend(other.lines);
@@ -246,6 +267,10 @@ impl K {
         }
         let _ = writeln!(s, "{label}:");
         for l in &self.lines {
+            if let Some(name) = l.strip_prefix(ENTRY_MARK) {
+                let _ = writeln!(s, "{}:", entry_label(label, name));
+                continue;
+            }
             match l.strip_prefix(CUT_MARK) {
                 Some(name) => {
                     let _ = writeln!(s, "{}:", cut_label(label, name));
@@ -266,6 +291,16 @@ impl K {
             }
         }
         let _ = writeln!(s, "{label}_end:");
+        for (name, fb) in &self.entries {
+            let _ = writeln!(
+                s,
+                "{}",
+                with_note(
+                    format!("{}_fb = {fb}", entry_label(label, name)),
+                    "FB words of the stream read before the entry"
+                )
+            );
+        }
         for (name, fb, _) in &self.cuts {
             let c = cut_label(label, name);
             let _ = writeln!(

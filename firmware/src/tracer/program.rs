@@ -49,6 +49,9 @@ pub fn program(
     if merged {
         shadows::routine(&mut t, lay);
     }
+    if shading::phong_in_runs(lay) {
+        shading::phong_runs(&mut t, lay.shines.len());
+    }
     match (lay.traversal, lay.stream.is_some()) {
         (Traversal::Packet, _) => traversal::packet::trace(&mut t, lay, opt.child_order),
         (Traversal::Paper, false) => traversal::paper::trace(&mut t, lay),
@@ -126,7 +129,10 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
         names::SHADOW.into(),
         shading::light_setup(nm.approx(), lay.light_shifted),
     ));
-    v.push((names::PHONG.into(), shading::shade(&lay.shines)));
+    v.push((
+        names::PHONG.into(),
+        shading::shade(&lay.shines, shading::phong_in_runs(lay)),
+    ));
     for i in 0..4 {
         v.push((names::out(i).into(), shading::out_word(i)));
     }

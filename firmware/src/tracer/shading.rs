@@ -10,7 +10,7 @@
 //! (`SH_*`, `ACT`, `COL`), a stack frame per recursion level (`STACK_Ln`)
 //! and per refracting level (`REFR_Ln`).
 
-use super::emit::K;
+use super::emit::{Code, K, R0, R1, R2, R3};
 use super::kernel_names as names;
 use super::math::{normalize, pow_q14, sqrt_q14, Approx};
 use super::memory_map::ram;
@@ -369,7 +369,11 @@ pub fn light_setup(nr: Approx, shifted: bool) -> K {
 /// exponent `f` and `1 - f` (Q.14), then per channel `kd c lc, ks lc`
 /// (Q3.12); `shines[m]` the Phong exponent of material m as integer part
 /// and fraction: `x^(n+f)` is computed as `x^n (1 - f + f x)`.
-pub fn shade(shines: &[(u32, f64)]) -> K {
+/// `runs` (the broadcast unit's `cut` contexts): each material's block
+/// from material 1 on is an entry (`k_phong_from_mM`) and has a cut after
+/// its material test, so that TinyRISC runs the kernel a material at a
+/// time ([`phong_runs`]) and a material no lit RC has costs its test.
+pub fn shade(shines: &[(u32, f64)], runs: bool) -> K {
     let mut k = K::new();
     k.doc(
         "k_phong: after a shadow pass, the light's Phong terms where it is visible\n\
@@ -387,8 +391,14 @@ pub fn shade(shines: &[(u32, f64)]) -> K {
         .c(format!("ld r12, [r0 + #{}]", ram::SH_RV))
         .c(format!("ld r13, [r0 + #{}]", ram::SH_MAT));
     for (m, &(n, f)) in shines.iter().enumerate() {
+        if runs && m > 0 {
+            k.entry(&format!("m{m}"));
+        }
         k.comment(&format!("material {m}: exponent {}", n as f64 + f));
         k.c("cmp.ne r10, #0").c("(f) cmp.eq fb0, r13");
+        if runs {
+            k.cut(&format!("m{m}"));
+        }
         pow_q14(&mut k, 12, 14, 15, n);
         if f > 0.0 {
             k.c("mov r15, fb0")
@@ -666,6 +676,58 @@ pub fn out_word(i: u32) -> K {
     k
 }
 
+/// Whether `k_phong` runs a material at a time ([`shade`]'s `runs`): the
+/// broadcast unit's `cut` contexts, and more than one material.
+pub fn phong_in_runs(lay: &super::layout::FbImage) -> bool {
+    lay.cut_runs && lay.shines.len() > 1
+}
+
+/// TinyRISC code shading the light of Phong stream `stream` (an FB
+/// address): `k_phong` broadcast whole, or a call of the `phong` routine
+/// ([`phong_in_runs`]: clobbers r1..r3 and r15).
+pub fn broadcast_phong(t: &mut Code, lay: &super::layout::FbImage, stream: &str) {
+    if phong_in_runs(lay) {
+        t.li(R3, stream)
+            .jal("phong")
+            .c("its Phong terms, a material at a time");
+    } else {
+        t.m("BCAST_FB", format!("{}, {stream}", names::PHONG));
+    }
+}
+
+/// TinyRISC's `phong` routine (with [`shade`]'s `runs`): the light's Phong
+/// terms a material at a time, the stream of the light at r3: the
+/// kernel's start and material 0's block, then each further material's
+/// block from its entry, the stream from its words. A block whose
+/// material no lit RC has ends at its cut. Clobbers r1, r2; returns by
+/// r15.
+pub fn phong_runs(t: &mut Code, materials: usize) {
+    let k = names::PHONG;
+    let from = |m: usize| crate::tracer::emit::entry_label(k, &format!("m{m}"));
+    let end = |m: usize| {
+        if m + 1 < materials {
+            from(m + 1)
+        } else {
+            format!("{k}_end")
+        }
+    };
+    t.doc(
+        "phong: the light's Phong terms (stream at r3) a material at a time: a block whose\n\
+         material no lit RC has ends at its cut. Clobbers r1, r2.",
+    );
+    t.label("phong")
+        .addi(R1, R0, format!("({k} - CTXBASE) / 4"))
+        .sbcb(R1, R3, format!("({} - {k}) / 4", end(0)))
+        .c("the terms' set-up and material 0");
+    for m in 1..materials {
+        t.addi(R1, R0, format!("({} - CTXBASE) / 4", from(m)))
+            .addi(R2, R3, format!("{}_fb", from(m)))
+            .sbcb(R1, R2, format!("({} - {}) / 4", end(m), from(m)))
+            .c(format!("material {m}"));
+    }
+    t.line("jr r15");
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -683,10 +745,12 @@ mod tests {
         assert_eq!(post(false, 5, true, true).fb_reads, 3 + 2 * 5);
         // Per material: the id, then per channel two words; a fractional
         // exponent two more.
-        assert_eq!(
-            shade(&[(1, 0.0), (10, 0.5), (200, 0.0)]).fb_reads,
-            7 * 3 + 2
-        );
+        for runs in [false, true] {
+            assert_eq!(
+                shade(&[(1, 0.0), (10, 0.5), (200, 0.0)], runs).fb_reads,
+                7 * 3 + 2
+            );
+        }
         assert_eq!(refract_prepare(0, 3, nr).fb_reads, 4 * 3);
     }
 }

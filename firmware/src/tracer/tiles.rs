@@ -139,8 +139,8 @@ pub fn macros(lay: &FbImage) -> Code {
                 .sw(R1, at("MODE", R0))
                 .c("any hit")
                 .jal("trace")
-                .m("BCAST", names::WAKE)
-                .m("BCAST_FB", format!("{}, \\shade", names::PHONG));
+                .m("BCAST", names::WAKE);
+            super::shading::broadcast_phong(b, lay, "\\shade");
         }),
     );
     let packet = lay.traversal == super::Traversal::Packet;
