@@ -97,7 +97,7 @@ pub const PK_OBJECT_RISC: f64 = 12.0;
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
 /// leaf loop (the block's check, its DMA's issue, the list's scan, the
 /// pieces' turns), for [`crate::bsp::SplitRule::Chip`]; the DMA's set-up
-/// is added. 48 to 85 on the SPD scenes at 128x128 but for shells' few
+/// is added. 48 to 86 on the SPD scenes at 128x128 but for shells' few
 /// large leaves (`render --profile`: the `leaf*`, `lo_*_end` and `lo_*_fan_wait` rows,
 /// less the DMA wait, over the leaves reached). Larger values measure a
 /// little faster (a leaf also costs its decision and its pieces' waits,
