@@ -118,13 +118,15 @@ pub fn chip_costs(
 ) -> crate::bsp::ChipCosts {
     use super::super::primitives::ChipType;
     let s = (frac as f64).exp2();
-    // (Scenes a chip-cost tree serves are mostly streamed: a banded
-    // polygon's record moves without its sub-edges.)
-    let polygon_bands = super::polygon_fan(scene, s, true).1;
+    // (Scenes a chip-cost tree serves are mostly streamed: where banded
+    // records would be over `polygon::APART_FROM` words, a record moves
+    // without its sub-edges, as `build_packet` lays them out.)
+    let (fan, polygon_bands) = super::polygon_fan(scene, s, true);
     let fit = Fit {
         fine_normals,
         polygon_bands,
-        polygon_fans_apart: polygon_bands,
+        polygon_fans_apart: polygon_bands
+            && polygon::words(fan, polygon::Form::Banded) > polygon::APART_FROM,
         ..Fit::default()
     };
     let dma = rtl::dma::DmaTiming::default();
