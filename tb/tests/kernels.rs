@@ -1032,7 +1032,7 @@ fn banded_polygon_runs_the_bands_of_its_points() {
             }
         });
         let (sim, fw) = run_with::<W>(shape.clone(), &rays, glass, |t, ti, fit| {
-            assert!(fit.polygon_bands, "the gear face is banded");
+            assert!(fit.polygon_form.banded(), "the gear face is banded");
             ti.ty.broadcast(t, "test", fit, ti.caps)
         });
         let lsb = (-(fw.frac as f64)).exp2();

@@ -344,8 +344,12 @@ fn gears_streamed_keeps_the_sub_edges_apart() {
             .unwrap_or_else(|e| panic!("gears, {datapath}: {e}"));
         let lay = &fw.layout;
         let st = lay.stream.as_ref().expect("streamed");
-        assert!(lay.fit.polygon_bands, "gears, {datapath}: banded");
-        assert!(lay.fit.polygon_fans_apart, "gears, {datapath}: apart");
+        assert!(lay.fit.polygon_form.banded(), "gears, {datapath}: banded");
+        assert_eq!(
+            lay.fit.polygon_form,
+            polygon::Form::Apart,
+            "gears, {datapath}: apart"
+        );
         let face = lay
             .types
             .iter()

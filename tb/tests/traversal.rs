@@ -828,8 +828,9 @@ fn sub_edges_apart_trace_the_same_rays() {
         let what = format!("{name}, {datapath}, tests {test_cuts}");
         let (apart, inside) = (render(SubEdges::Apart), render(SubEdges::InRecords));
         let (al, il) = (&apart.firmware.layout, &inside.firmware.layout);
-        assert!(al.fit.polygon_bands && al.fit.polygon_fans_apart, "{what}");
-        assert!(il.fit.polygon_bands && !il.fit.polygon_fans_apart, "{what}");
+        use firmware::tracer::primitives::polygon::Form;
+        assert_eq!(al.fit.polygon_form, Form::Apart, "{what}");
+        assert_eq!(il.fit.polygon_form, Form::Banded, "{what}");
         let fans = al
             .stream
             .as_ref()

@@ -42,7 +42,6 @@ use crate::scene::Scene;
 use crate::scene_image::{compile, CompileOptions, Report};
 pub use rtl::rc::Datapath;
 pub use shadows::ShadowPackets;
-
 pub use traversal::child_order::{AxisOrder, ChildOrder};
 
 /// Generator options.

@@ -309,9 +309,7 @@ fn header(
         .iter()
         .any(|t| matches!(t, ChipType::Polygon | ChipType::GlassPolygon))
     {
-        rec.extend(primitives::polygon::header(primitives::polygon::Form::of(
-            &lay.fit,
-        )));
+        rec.extend(primitives::polygon::header(lay.fit.polygon_form));
     }
     if !rec.is_empty() {
         block(
@@ -565,7 +563,7 @@ fn data(lay: &FbImage, merged_lanes: Option<&[u32]>) -> String {
         "0: closest hit, 1: any hit (shadow rays)",
     );
     d(&mut t, "SAVE_LR", ".word 0", "trace's return address");
-    if lay.fit.polygon_bands {
+    if lay.fit.polygon_form.banded() {
         d(
             &mut t,
             "BAND_SAVE",

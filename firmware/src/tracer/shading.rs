@@ -14,7 +14,7 @@ use super::emit::{Code, K, R0, R1, R2, R3};
 use super::kernel_names as names;
 use super::math::{normalize, pow_q14, sqrt_q14, Approx};
 use super::memory_map::ram;
-use super::primitives::smooth_triangle;
+use super::primitives::{kaddr, smooth_triangle};
 
 /// Offset of a spawned ray's origin along the normal, in LSBs. Default 0:
 /// every kernel is one-sided and its primitive convex (or planar), so a ray
@@ -716,11 +716,11 @@ pub fn phong_runs(t: &mut Code, materials: usize) {
          material no lit RC has ends at its cut. Clobbers r1, r2.",
     );
     t.label("phong")
-        .addi(R1, R0, format!("({k} - CTXBASE) / 4"))
+        .addi(R1, R0, kaddr(k))
         .sbcb(R1, R3, format!("({} - {k}) / 4", end(0)))
         .c("the terms' set-up and material 0");
     for m in 1..materials {
-        t.addi(R1, R0, format!("({} - CTXBASE) / 4", from(m)))
+        t.addi(R1, R0, kaddr(&from(m)))
             .addi(R2, R3, format!("{}_fb", from(m)))
             .sbcb(R1, R2, format!("({} - {}) / 4", end(m), from(m)))
             .c(format!("material {m}"));

@@ -443,13 +443,13 @@ pub fn build_packet(
     let large = |lay: &FbImage| {
         lay.types.iter().any(|t| {
             matches!(t.ty, ChipType::Polygon | ChipType::GlassPolygon)
-                && t.size > polygon::APART_FROM
+                && polygon::keeps_apart(t.size)
         })
     };
     match build(polygon::Form::Banded) {
         Ok(lay)
             if lay.stream.is_some()
-                && lay.fit.polygon_bands
+                && lay.fit.polygon_form.banded()
                 && large(&lay)
                 && opt.sub_edges == super::SubEdges::Apart =>
         {
@@ -516,7 +516,9 @@ fn build_as(
     let (geo, fan, mut fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
     // A streamed layout keeps the banded polygons' sub-edges in main
     // memory, once each, and moves a packet's bands of them.
-    fit.polygon_fans_apart = fit.polygon_bands && form == polygon::Form::Apart;
+    if fit.polygon_form.banded() {
+        fit.polygon_form = form;
+    }
     let mut w = W {
         fb: Vec::new(),
         s,
@@ -915,8 +917,11 @@ fn fit_scene(
         ep_cone,
         kt,
         fine_normals,
-        polygon_bands,
-        polygon_fans_apart: false,
+        polygon_form: if polygon_bands {
+            polygon::Form::Banded
+        } else {
+            polygon::Form::Plain
+        },
     };
 
     (geo, fan, fit)
@@ -1030,8 +1035,7 @@ fn records(
                 ),
                 (Shape::Box { min, max }, _) => aabox::write(w, t.sides(), *min, *max, i, mat),
                 (Shape::Polygon { v, .. }, _) => {
-                    polygon::write(w, v, size, polygon::Form::of(fit), i, mat)
-                        .map_err(|m| err(0, m))?
+                    polygon::write(w, v, size, fit.polygon_form, i, mat).map_err(|m| err(0, m))?
                 }
                 (
                     Shape::Triangle {

@@ -122,11 +122,16 @@ pub fn chip_costs(
     // records would be over `polygon::APART_FROM` words, a record moves
     // without its sub-edges, as `build_packet` lays them out.)
     let (fan, polygon_bands) = super::polygon_fan(scene, s, true);
+    let polygon_form = match polygon_bands {
+        false => polygon::Form::Plain,
+        true if polygon::keeps_apart(polygon::words(fan, polygon::Form::Banded)) => {
+            polygon::Form::Apart
+        }
+        true => polygon::Form::Banded,
+    };
     let fit = Fit {
         fine_normals,
-        polygon_bands,
-        polygon_fans_apart: polygon_bands
-            && polygon::words(fan, polygon::Form::Banded) > polygon::APART_FROM,
+        polygon_form,
         ..Fit::default()
     };
     let dma = rtl::dma::DmaTiming::default();
@@ -143,7 +148,7 @@ pub fn chip_costs(
         .iter()
         .map(|o| {
             let fan = match &o.shape {
-                Shape::Polygon { v, .. } if fit.polygon_bands => {
+                Shape::Polygon { v, .. } if fit.polygon_form.banded() => {
                     polygon::band_edges(&polygon::edges(v, s).1)
                 }
                 Shape::Polygon { v, .. } => polygon::edges(v, s).1.len(),

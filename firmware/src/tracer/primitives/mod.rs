@@ -214,9 +214,7 @@ impl ChipType {
             | ChipType::GlassRectangle
             | ChipType::GlassTriangle => planar::WORDS,
             ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => smooth_triangle::WORDS,
-            ChipType::Polygon | ChipType::GlassPolygon => {
-                polygon::words(fan, polygon::Form::of(fit))
-            }
+            ChipType::Polygon | ChipType::GlassPolygon => polygon::words(fan, fit.polygon_form),
         }
     }
 
@@ -247,9 +245,7 @@ impl ChipType {
                     smooth_triangle::kernel(g, s),
                 )]
             }
-            ChipType::Polygon | ChipType::GlassPolygon => {
-                polygon::kernels(g, s, polygon::Form::of(fit))
-            }
+            ChipType::Polygon | ChipType::GlassPolygon => polygon::kernels(g, s, fit.polygon_form),
         }
     }
 
@@ -276,7 +272,7 @@ impl ChipType {
             }
             ChipType::Cone | ChipType::GlassCone => cone::broadcast(t, at, s, caps),
             ChipType::Polygon | ChipType::GlassPolygon => {
-                polygon::broadcast(t, at, s, polygon::Form::of(fit))
+                polygon::broadcast(t, at, s, fit.polygon_form)
             }
         }
     }
@@ -353,7 +349,7 @@ impl ChipType {
     /// ([`CutTest::then`]), a polygon's edges and tail.
     fn broadcast_then(self, t: &mut Code, at: &str, rec: Reg, fit: &Fit) {
         if matches!(self, ChipType::Polygon | ChipType::GlassPolygon) {
-            polygon::broadcast_edges(t, at, self.sides(), rec, polygon::Form::of(fit));
+            polygon::broadcast_edges(t, at, self.sides(), rec, fit.polygon_form);
         }
     }
 
@@ -517,9 +513,9 @@ pub fn all_test_kernels() -> Vec<&'static str> {
         published: false,
     };
     let mut v: Vec<&'static str> = Vec::new();
-    for polygon_bands in [false, true] {
+    for polygon_form in [polygon::Form::Plain, polygon::Form::Banded] {
         let fit = Fit {
-            polygon_bands,
+            polygon_form,
             ..Fit::default()
         };
         for t in ChipType::ALL {
@@ -601,11 +597,10 @@ pub struct Fit {
     pub kt: [u32; 3],
     /// Fine normals (the cylinder record's remainders).
     pub fine_normals: bool,
-    /// Polygon records in bands ([`polygon::BANDED_FROM`]).
-    pub polygon_bands: bool,
-    /// Banded records' sub-edges apart from the record, in main memory
-    /// (the streamed layout): [`polygon::Form::Apart`].
-    pub polygon_fans_apart: bool,
+    /// The polygons' record form: plain, in bands
+    /// ([`polygon::BANDED_FROM`]), or in bands with the sub-edges apart
+    /// in main memory (streamed layouts).
+    pub polygon_form: polygon::Form,
 }
 
 impl Fit {

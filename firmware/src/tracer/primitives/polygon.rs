@@ -48,7 +48,7 @@
 //! other (`k_polygon_band_edge`, 15 contexts).
 //!
 //! **Sub-edges apart** (a streamed layout's banded records over
-//! [`APART_FROM`] words, [`super::Fit::polygon_fans_apart`]): the record that moves with a
+//! [`APART_FROM`] words, [`Form::Apart`]): the record that moves with a
 //! leaf's piece stops after the table: in place of the sub-edges, the
 //! main-memory place of the polygon's sub-edges (`POLY_FANS_AT`, in
 //! [`FAN_UNIT`]-byte units from `FANS`, once per polygon however many
@@ -56,9 +56,9 @@
 //! words, 57 for SPD gears' faces against 1,088). Once the bisection has
 //! found the bands and the array is done, TinyRISC moves only their
 //! sub-edges by DMA into `FAN_BUF` (the top of FB bank 1) and runs them
-//! from there: a packet
-//! whose points lie in two of a face's 16 bands moves an eighth of its
-//! sub-edges, and a face no awake ray's plane hit reaches moves none.
+//! from there: a packet whose points lie in two of a face's 16 bands
+//! moves an eighth of its sub-edges, and a face no awake ray's plane hit
+//! reaches moves none.
 //!
 //! **Two-sided** (a transmitting polygon): the head's plane test on both
 //! sides and the planar kernels' two-sided commit in the tail.
@@ -113,9 +113,10 @@ pub const APART_FROM: usize = 256;
 pub const FAN_UNIT: usize = 64;
 
 /// The record forms of a polygon.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum Form {
     /// Every edge in the record.
+    #[default]
     Plain,
     /// Sub-edges by band, in the record.
     Banded,
@@ -125,16 +126,16 @@ pub enum Form {
 }
 
 impl Form {
-    pub fn of(fit: &super::Fit) -> Form {
-        match (fit.polygon_bands, fit.polygon_fans_apart) {
-            (false, _) => Form::Plain,
-            (true, false) => Form::Banded,
-            (true, true) => Form::Apart,
-        }
-    }
-    fn banded(self) -> bool {
+    /// Sub-edges by band (in the record or apart).
+    pub fn banded(self) -> bool {
         self != Form::Plain
     }
+}
+
+/// Whether a streamed layout keeps the sub-edges of banded records of
+/// `banded_words` words apart ([`APART_FROM`]).
+pub fn keeps_apart(banded_words: usize) -> bool {
+    banded_words > APART_FROM
 }
 
 /// Words of a record with room for `fan` edges (sub-edges where banded;
@@ -366,7 +367,7 @@ pub(crate) fn write(
                 ));
             }
             w.raw(units as i64);
-            w.fan_most = w.fan_most.max(at[at.len() - 1] as usize);
+            w.fan_most = w.fan_most.max(*at.last().unwrap() as usize);
             for x in sub.iter().flatten().flatten() {
                 let v = w.sat(*x as f64);
                 w.fans.push(v);
