@@ -2421,6 +2421,8 @@ k_cylinder_cut_ahead:
         (f) cmp.ge r14, #-2
         mov r15, fb0
         (f) cmp.le r14, r15             ; F: within the height
+k_cylinder_cut_height:
+        cut                             ; the run ends here where no awake RC has F
         ; normal: n2 = -(sg p2 / r + sqrt(s) d2n) across the axis, n = n2.x e1 + n2.y e2
         (f) mov r7, r9
         mov r15, fb0
@@ -2450,6 +2452,7 @@ k_cylinder_end:
 k_cylinder_cut_near_fb = 19             ; FB words of the stream read before the cut
 k_cylinder_cut_line_fb = 19             ; FB words of the stream read before the cut
 k_cylinder_cut_ahead_fb = 20            ; FB words of the stream read before the cut
+k_cylinder_cut_height_fb = 27           ; FB words of the stream read before the cut
 
 ; k_disc: the disc test of one record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.

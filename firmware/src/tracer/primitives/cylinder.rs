@@ -436,7 +436,7 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
         self_margin(&mut k, 8, g.datapath);
         k.c("(f) cmp.gt r9, r8");
     }
-    axial_and_normal(&mut k);
+    axial_and_normal(&mut k, (body == Body::Opaque).then_some(CUTS[3].0));
     commit_obj_mat(&mut k, body);
     k
 }
@@ -444,14 +444,16 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
 /// The opaque body kernel's cuts ([`K::cut`], with [`Gen::test_cuts`])
 /// and what F holds at each: a bound says the ray's line may meet the
 /// infinite cylinder; it does (`s > 0`); its root lies ahead of the ray and
-/// before `tbest`.
-pub const CUTS: [(&str, &str); 3] = [
+/// before `tbest`; the hit lies within the height (the normal and the
+/// commit are left where no awake ray hits the segment itself).
+pub const CUTS: [(&str, &str); 4] = [
     (
         "near",
         "the ray's line may meet the cylinder (|oc2 x d2| <= r |d2|_1) and, where none is seen from inside, its axis lies ahead across it",
     ),
     ("line", "the ray's line meets the cylinder"),
     ("ahead", "the root ahead, before tbest"),
+    ("height", "the hit within the height"),
 ];
 
 /// Broadcast a cylinder's test (record at r7): the body (both runs for a
@@ -497,8 +499,9 @@ pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
 /// After the division (`t` in r9, F the hit so far): the hit's axial
 /// coordinate within `[-2, H + 2]`, then the normal `n2 = -(sg p2 / r +
 /// sqrt(s) d2n)` across the axis, `n = n2.x e1 + n2.y e2` (from `TMP0..TMP4`)
-/// into `HIT_N` and `t` into `tbest` where F.
-fn axial_and_normal(k: &mut K) {
+/// into `HIT_N` and `t` into `tbest` where F; `cut`: the cut after the
+/// height test (the opaque body's).
+fn axial_and_normal(k: &mut K, cut: Option<&str>) {
     k.comment("axial coordinate of the hit");
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 11 + i;
@@ -514,6 +517,9 @@ fn axial_and_normal(k: &mut K) {
         .c("mov r15, fb0")
         .c("(f) cmp.le r14, r15")
         .note("F: within the height");
+    if let Some(c) = cut {
+        k.cut(c);
+    }
     k.comment("normal: n2 = -(sg p2 / r + sqrt(s) d2n) across the axis, n = n2.x e1 + n2.y e2");
     k.c("(f) mov r7, r9")
         .c("mov r15, fb0")
