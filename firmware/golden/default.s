@@ -2381,6 +2381,8 @@ k_rectangle_cut_plane:
         (f) cmp.ge r14, #-INSIDE_TOL
         (f) cmp.le r13, r8
         (f) cmp.le r14, r8              ; F: inside the rectangle
+k_rectangle_cut_inside:
+        cut                             ; the run ends here where no awake RC has F
         (f) mov r7, r9
         (f) st fb0, [#HIT_N]
         (f) st fb0, [#HIT_N+1]
@@ -2389,6 +2391,7 @@ k_rectangle_cut_plane:
         (f) st fb0, [#HIT_MAT]
 k_rectangle_end:
 k_rectangle_cut_plane_fb = 6            ; FB words of the stream read before the cut
+k_rectangle_cut_inside_fb = 15          ; FB words of the stream read before the cut
 
 ; k_triangle: the triangle test of one record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.
@@ -2463,6 +2466,8 @@ k_triangle_cut_plane:
         (f) cmp.ge r14, #-INSIDE_TOL
         adds r15, r13, r14
         (f) cmp.le r15, r8              ; F: inside the triangle
+k_triangle_cut_inside:
+        cut                             ; the run ends here where no awake RC has F
         (f) mov r7, r9
         (f) st fb0, [#HIT_N]
         (f) st fb0, [#HIT_N+1]
@@ -2471,4 +2476,5 @@ k_triangle_cut_plane:
         (f) st fb0, [#HIT_MAT]
 k_triangle_end:
 k_triangle_cut_plane_fb = 6             ; FB words of the stream read before the cut
+k_triangle_cut_inside_fb = 15           ; FB words of the stream read before the cut
 ctx_end:

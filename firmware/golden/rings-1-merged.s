@@ -2605,6 +2605,8 @@ k_rectangle_cut_plane:
         (f) cmp.ge r14, #-INSIDE_TOL
         (f) cmp.le r13, r8
         (f) cmp.le r14, r8              ; F: inside the rectangle
+k_rectangle_cut_inside:
+        cut                             ; the run ends here where no awake RC has F
         (f) mov r7, r9
         (f) st fb0, [#HIT_N]
         (f) st fb0, [#HIT_N+1]
@@ -2613,4 +2615,5 @@ k_rectangle_cut_plane:
         (f) st fb0, [#HIT_MAT]
 k_rectangle_end:
 k_rectangle_cut_plane_fb = 6            ; FB words of the stream read before the cut
+k_rectangle_cut_inside_fb = 15          ; FB words of the stream read before the cut
 ctx_end:

@@ -1088,6 +1088,7 @@ k_triangle_cut_plane:
         (f) cmp.ge r14, #-INSIDE_TOL
         adds r15, r13, r14
         (f) cmp.le r15, r8              ; F: inside the triangle
+k_triangle_cut_inside:
         (f) mov r7, r9
         (f) st fb0, [#HIT_N]
         (f) st fb0, [#HIT_N+1]
@@ -1096,4 +1097,5 @@ k_triangle_cut_plane:
         (f) st fb0, [#HIT_MAT]
 k_triangle_end:
 k_triangle_cut_plane_fb = 6             ; FB words of the stream read before the cut
+k_triangle_cut_inside_fb = 15           ; FB words of the stream read before the cut
 ctx_end:

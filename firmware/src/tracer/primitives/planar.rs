@@ -174,12 +174,17 @@ pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize)
     w.raw(mat as i64);
 }
 
-/// The cut of the opaque triangle and rectangle kernels ([`K::cut`]) and
-/// what F holds there.
-pub const CUTS: [(&str, &str); 1] = [(
-    "plane",
-    "the plane hit in front (two-sided: on either side), before tbest",
-)];
+/// The cuts of the triangle and rectangle kernels, opaque or glass, and of
+/// the smooth triangle's ([`K::cut`]), and what F holds at each: the
+/// plane is hit before `tbest`; the hit lies inside (the normal and the
+/// commit are left where no awake ray hits the primitive itself).
+pub const CUTS: [(&str, &str); 2] = [
+    (
+        "plane",
+        "the plane hit in front (two-sided: on either side), before tbest",
+    ),
+    ("inside", "and the hit inside"),
+];
 
 /// The ray-plane part shared by the planar, polygon and smooth triangle
 /// kernels: reads the plane normal and a vertex from the stream, and
@@ -297,6 +302,9 @@ pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
     let cut = (inside != Inside::Disc).then_some(CUTS[0].0);
     plane_hit(&mut k, g, sides, cut);
     inside_test(&mut k, inside);
+    if cut.is_some() {
+        k.cut(CUTS[1].0);
+    }
     match sides {
         Sides::Front => commit_streamed_normal(&mut k, 9),
         Sides::Both => commit_streamed_normal_two(&mut k, 9),

@@ -100,6 +100,7 @@ pub fn kernel(g: &Gen, sides: Sides) -> K {
     let cut = Some(planar::CUTS[0].0);
     planar::plane_hit(&mut k, g, sides, cut);
     planar::inside_test(&mut k, Inside::Triangle);
+    k.cut(planar::CUTS[1].0);
     k.comment("Ns = (1 - u - w) n0 + u n1 + w n2, normalised");
     if sides == Sides::Front {
         k.c("(f) mov r7, r9");
