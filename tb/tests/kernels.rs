@@ -16,7 +16,7 @@ use firmware::scene::{Object, Scene, Shape, Vec3};
 use firmware::tracer::emit::{Code, R1, R2, R7};
 use firmware::tracer::layout::{ChipType, TypeInfo};
 use firmware::tracer::memory_map::ram;
-use firmware::tracer::primitives::{kaddr, klen};
+use firmware::tracer::primitives::{kaddr, klen, polygon};
 use firmware::tracer::{self, Firmware, Options};
 use rtl::rc::Word;
 use rtl::{Chip, Sim, Timing};
@@ -124,6 +124,7 @@ fn run_with<W: Word>(
     }];
     let opt = Options {
         datapath: W::DATAPATH,
+        traversal: TRAVERSAL.with(|t| t.get()),
         ..Options::default()
     };
     let nm = tracer::Numerics {
@@ -280,6 +281,10 @@ thread_local! {
     /// Fine (else coarse) [`tracer::Normals`] of the firmware [`run_in`] builds
     /// (each test runs on a thread of its own).
     static FINE_NORMALS: std::cell::Cell<bool> = const { std::cell::Cell::new(true) };
+    /// The traversal of the firmware [`run_with`] builds (the paper's keeps
+    /// polygons' plain records).
+    static TRAVERSAL: std::cell::Cell<tracer::Traversal> =
+        const { std::cell::Cell::new(tracer::Traversal::Packet) };
 }
 
 fn errors<W: Word>(name: &str, shape: Shape, two_sided: bool) -> Errors {
@@ -1070,6 +1075,92 @@ fn banded_polygon_runs_the_bands_of_its_points() {
                 );
             }
         }
+    }
+    for glass in [false, true] {
+        on::<i16>(glass);
+        on::<i32>(glass);
+    }
+}
+
+/// A banded record's parity is the plain record's bit for bit. A packet
+/// whose points all lie on one row runs that row's band alone; on a band's
+/// lowest row every sub-edge crossing the bound starts (`ya`), and the
+/// half-open straddle (`ya - py > 0`, the sign of `(ya - 1) - py`) decides
+/// whether it counts. Packets of rays parallel to the rows, one packet on
+/// each band bound and the rows beside it, hit and miss at the same `t` as
+/// the paper traversal's plain record (every edge, `k_polygon_edge`), on
+/// both chips, opaque and glass.
+#[test]
+fn banded_polygon_is_the_plain_polygon_bit_for_bit() {
+    fn run<W: Word>(rays: &[Ray; 64], glass: bool, paper: bool) -> (Vec<i64>, u32) {
+        TRAVERSAL.with(|t| {
+            t.set(if paper {
+                tracer::Traversal::Paper
+            } else {
+                tracer::Traversal::Packet
+            })
+        });
+        let (sim, fw) = run_with::<W>(
+            shape_gear_like_concave_polygon(),
+            rays,
+            glass,
+            |t, ti, fit| {
+                assert_eq!(fit.polygon_form.banded(), !paper);
+                ti.ty.broadcast(t, "test", fit, ti.caps)
+            },
+        );
+        TRAVERSAL.with(|t| t.set(tracer::Traversal::Packet));
+        let t = (0..64)
+            .map(|i| sim.top.array.rc.regs.read(7)[i].to_i64())
+            .collect();
+        (t, fw.frac)
+    }
+    fn on<W: Word>(glass: bool) {
+        let Shape::Polygon { v, .. } = shape_gear_like_concave_polygon() else {
+            unreachable!()
+        };
+        // The format's scale, from a first run.
+        let probe: [Ray; 64] = std::array::from_fn(|_| Ray {
+            o: Vec3::new(0.0, 0.0, 2.0),
+            d: Vec3::new(0.0, 0.0, -1.0),
+        });
+        let s = (run::<W>(&probe, glass, false).1 as f64).exp2();
+        let (bounds, _) = polygon::bands(&polygon::edges(&v, s).1);
+        assert!(bounds.len() > 4, "{} bands", bounds.len() - 1);
+        let v0 = (v[0].y * s).round();
+        let max = ((W::BITS - 1) as f64).exp2() - 1.0;
+        let mut g = Lcg(7);
+        let mut crossings = 0;
+        for &yb in &bounds[1..bounds.len() - 1] {
+            for row in [yb - 1, yb, yb + 1] {
+                let y = (v0 + row as f64) / s;
+                let rays: [Ray; 64] = std::array::from_fn(|i| {
+                    let target =
+                        Vec3::new(-1.05 + 2.1 * (i as f64 + g.range(0.0, 1.0)) / 64.0, y, 0.0);
+                    let side = if glass && i % 2 == 1 { -2.0 } else { 2.0 };
+                    let o = Vec3::new(target.x + g.range(-0.3, 0.3), y, side);
+                    Ray {
+                        o,
+                        d: (target - o).normalized(),
+                    }
+                });
+                let (banded, _) = run::<W>(&rays, glass, false);
+                let (plain, _) = run::<W>(&rays, glass, true);
+                assert_eq!(
+                    banded,
+                    plain,
+                    "{}, glass {glass}, row {row} (band bound {yb}): banded against plain",
+                    W::DATAPATH
+                );
+                let hits: Vec<bool> = banded.iter().map(|&t| (t as f64) < max).collect();
+                crossings += hits.windows(2).filter(|w| w[0] != w[1]).count();
+            }
+        }
+        // The rows cross teeth: hits and misses alternate along them.
+        assert!(
+            crossings > 50,
+            "{crossings} hit/miss changes along the rows"
+        );
     }
     for glass in [false, true] {
         on::<i16>(glass);

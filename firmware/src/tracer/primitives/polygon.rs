@@ -40,12 +40,12 @@
 //! band bounds `Y_0..Y_nb` (`POLY_BOUNDS`), per band the word offset of
 //! its first sub-edge from `POLY_FAN` and the end's (`POLY_STARTS`), the
 //! tail's offset in the record (`POLY_TAIL`), the sub-edges by band
-//! (`POLY_FAN`, 6 words each: `xi, ya, yb, yi, s ey, s ex`), the tail.
+//! (`POLY_FAN`, 6 words each: `xi, ya - 1, yb - 1, yi, s ey, s ex`), the tail.
 //! TinyRISC finds the lowest and the highest band holding a point of an
 //! awake ray whose plane hit is valid, by bisection over the bands (a
 //! 4-context probe and an `rcany` each, `k_polygon_below` /
 //! `k_polygon_above`), and runs only the sub-edges from the one to the
-//! other (`k_polygon_band_edge`, 15 contexts).
+//! other (`k_polygon_band_edge`, 11 contexts).
 //!
 //! **Sub-edges apart** (a streamed layout's banded records over
 //! [`APART_FROM`] words, [`Form::Apart`]): the record that moves with a
@@ -368,15 +368,15 @@ pub(crate) fn write(
             }
             w.raw(units as i64);
             w.fan_most = w.fan_most.max(*at.last().unwrap() as usize);
-            for x in sub.iter().flatten().flatten() {
-                let v = w.sat(*x as f64);
+            for x in sub.iter().flatten().flat_map(sub_edge_words) {
+                let v = w.sat(x as f64);
                 w.fans.push(v);
             }
             w.fans.resize(w.fans.len().next_multiple_of(unit), 0);
         } else {
             w.raw(fan as i64 + at.last().unwrap());
-            for x in sub.iter().flatten().flatten() {
-                w.raw(*x);
+            for x in sub.iter().flatten().flat_map(sub_edge_words) {
+                w.raw(x);
             }
         }
     } else {
@@ -459,31 +459,36 @@ fn edge() -> K {
     k
 }
 
+/// A sub-edge's record words: `ya`, `yb` one LSB lower, so that `ya - py
+/// > 0` is the sign bit of `(ya - 1) - py` clear, and the straddle test
+/// one `xor` of two sign bits ([`band_edge`]).
+fn sub_edge_words(e: &[i64; 6]) -> [i64; 6] {
+    [e[0], e[1] - 1, e[2] - 1, e[3], e[4], e[5]]
+}
+
 fn band_edge() -> K {
     let mut k = K::new();
     k.doc(
-        "k_polygon_band_edge: one sub-edge of a banded record's crossing test (stream: xi, ya, yb,\n\
-         yi, s ey, s ex). In: r10, r11 = -px, -py, r8 parity. Out: r8 flipped where the point's\n\
-         row lies in [ya, yb) and the edge's line crosses it to the right: s ((xi - px) ey - ex (yi - py)) > 0.",
+        "k_polygon_band_edge: one sub-edge of a banded record's crossing test (stream: xi, ya - 1,\n\
+         yb - 1, yi, s ey, s ex). In: r10, r11 = -px, -py, r8 parity. Out: r8 flipped where the\n\
+         point's row lies in [ya, yb) and the edge's line crosses it to the right: s ((xi - px) ey -\n\
+         ex (yi - py)) > 0. (ya - 1) - py >= 0 where ya - py > 0 (saturating adds keep the sign), so\n\
+         the row is straddled where the sign bits of (ya - 1) - py and (yb - 1) - py differ.",
     );
     k.c("adds r12, fb0, r10")
         .note("xi - px")
         .c("adds r13, fb0, r11")
-        .note("ya - py")
+        .note("ya - 1 - py")
         .c("adds r14, fb0, r11")
-        .note("yb - py")
-        .c("movb r15, #0")
-        .c("cmp.gt r13, #0")
-        .c("(f) movb r15, #1")
-        .c("cmp.gt r14, #0")
-        .c("(f) xor r15, r15, #1")
-        .note("straddles the row within the band")
+        .note("yb - 1 - py")
+        .c("xor r15, r13, r14")
+        .note("negative: straddles the row within the band")
         .c("adds r13, fb0, r11")
         .note("yi - py")
         .c("mov r14, fb0")
         .c("mul out, r12, r14")
         .c("msu r13, fb0, r13")
-        .c("cmp.ne r15, #0")
+        .c("cmp.lt r15, #0")
         .c("(f) cmp.gt r13, #0")
         .c("(f) xor r8, r8, #1")
         .note("crosses to the right: flip");
