@@ -1494,7 +1494,6 @@ k_sphere:
         msu r9, r12, r5, >>Q14
         ldacc r10, <<Q14
         msu r10, r12, r6, >>Q14
-        mov r12, fb0                    ; r
         mov r13, fb0                    ; invr
         mul r8, r8, r13, >>KS_SPHERE+EP_SPHERE
         mul r9, r9, r13, >>KS_SPHERE+EP_SPHERE
@@ -1536,7 +1535,7 @@ k_sphere_cut_line:
         sub r9, r9, #1
         sra r9, r9, #1
         sra r8, r8, r9
-        mul r9, r12, r8, >>Q14          ; h = r sqrt(s)
+        mul r9, fb0, r8, >>Q14          ; h = r sqrt(s)
         mov r10, fb0                    ; sg
         mul r9, r9, r10, >>Q14
         sub r9, r11, r9                 ; t = b - sg h
@@ -1562,7 +1561,7 @@ k_sphere_cut_line:
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
 k_sphere_end:
-k_sphere_cut_line_fb = 5                ; FB words of the stream read before the cut
+k_sphere_cut_line_fb = 4                ; FB words of the stream read before the cut
 
 ; k_cylinder: the open cylinder test of one body record (the stream).
 ; In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT.

@@ -1,10 +1,10 @@
 //! Sphere (`tb/src/reference/shapes.rs`: `sphere`).
 //!
-//! **Record** (8 words): `c.xyz, r, invr, sg, obj, mat`, with `invr =
+//! **Record** (8 words): `c.xyz, invr, r, sg, obj, mat`, with `invr =
 //! 2^(14+KS_SPHERE) / r` (scene LSBs) and `sg` = +1 (Q1.14) for a sphere
 //! seen from outside, -1 for NFF's inside-visible sphere. Fine records
 //! (11 words, where the smallest sphere is under [`FINE_BELOW_LSB`] LSB in
-//! radius): `c.xyz, cl.xyz, r, invr, sg, obj, mat`, with the centre's
+//! radius): `c.xyz, cl.xyz, invr, r, sg, obj, mat`, with the centre's
 //! rounding remainder `cl` in units of 2^-14 LSB and `r` with `EP_SPHERE`
 //! extra fraction bits: spheres a few LSB across, whose rounded centre
 //! and radius would move their silhouettes and shadows by a sizeable part
@@ -112,11 +112,15 @@ pub(crate) fn write(
             let hi = w.sat(x * s) as f64;
             w.push((x * s - hi) * w.one());
         }
+    }
+    // invr before r: the packet traversal's kernel needs only invr before
+    // its cut, and reads r straight from the stream after it.
+    w.push(invr);
+    if fit.sphere_fine {
         w.push(radius.abs() * s * (fit.ep_sphere as f64).exp2());
     } else {
         w.push(rq);
     }
-    w.push(invr);
     w.push(sg * w.one());
     w.raw(id as i64);
     w.raw(mat as i64);
@@ -169,7 +173,14 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
     }
     let er = if fine { "+EP_SPHERE" } else { "" };
-    k.c("mov r12, fb0").note("r").c("mov r13, fb0").note("invr");
+    // The paper's traversal keeps r in a register (its published
+    // contexts); the packet traversal's multiplies by r from the stream
+    // after the cut.
+    k.c("mov r13, fb0").note("invr");
+    if g.published {
+        k.c("mov r12, fb0").note("r");
+    }
+    let r = if g.published { "r12" } else { "fb0" };
     for x in [8, 9, 10] {
         k.c(format!("mul r{x}, r{x}, r13, >>KS_SPHERE+EP_SPHERE"));
     }
@@ -198,7 +209,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     k.note("p/r in TMP0..2");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
     if two {
-        k.c(format!("mul r9, r12, r8, >>Q14{er}"))
+        k.c(format!("mul r9, {r}, r8, >>Q14{er}"))
             .note("h = r sqrt(s)")
             .c("mov r10, fb0")
             .note("sg")
@@ -220,7 +231,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
             .c("(f) cmp.lt r9, r7")
             .note("F: a hit ahead, nearer than tbest");
     } else {
-        k.c(format!("mul r9, r12, r8, >>Q14{er}"))
+        k.c(format!("mul r9, {r}, r8, >>Q14{er}"))
             .note("h = r sqrt(s)")
             .c("mov r10, fb0")
             .note("sg")
