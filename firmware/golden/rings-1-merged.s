@@ -2258,7 +2258,6 @@ k_cylinder:
         mac out, fb0, r5
         mac r9, fb0, r6, >>Q14          ; d2 = (d.e1, d.e2)
         ; bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1
-        mov r13, fb0                    ; invr
         mov r14, fb0                    ; r
         abs r10, r8
         abs r15, r9
@@ -2276,7 +2275,6 @@ k_cylinder_cut_near:
         cut                             ; the run ends here where no awake RC has F
         st r11, [#TMP0]
         st r12, [#TMP1]                 ; oc2
-        st r13, [#TMP7]                 ; invr
         st r14, [#TMP8]                 ; r
         ; normalize
         sra r8, r8, #1
@@ -2329,7 +2327,7 @@ k_cylinder_cut_near:
         msu r11, r14, r8, >>Q14
         ldacc r12, <<Q14
         msu r12, r14, r9, >>Q14
-        ld r14, [r0 + #TMP7]            ; invr
+        mov r14, fb0                    ; invr
         mul r11, r11, r14, >>KS_CYL+EP_CYL
         mul r12, r12, r14, >>KS_CYL+EP_CYL
         st r11, [#TMP0]
@@ -2448,7 +2446,7 @@ k_cylinder_cut_height:
         (f) st fb0, [#HIT_OBJ]
         (f) st fb0, [#HIT_MAT]
 k_cylinder_end:
-k_cylinder_cut_near_fb = 19             ; FB words of the stream read before the cut
+k_cylinder_cut_near_fb = 18             ; FB words of the stream read before the cut
 k_cylinder_cut_line_fb = 19             ; FB words of the stream read before the cut
 k_cylinder_cut_ahead_fb = 20            ; FB words of the stream read before the cut
 k_cylinder_cut_height_fb = 27           ; FB words of the stream read before the cut

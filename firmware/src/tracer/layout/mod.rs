@@ -514,6 +514,7 @@ fn build_as(
 
     let packet = opt.traversal == Traversal::Packet;
     let (geo, fan, mut fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
+    fit.cyl_bound = packet && opt.test_cuts.in_parts();
     // A streamed layout keeps the banded polygons' sub-edges in main
     // memory, once each, and moves a packet's bands of them.
     if fit.polygon_form.banded() {
@@ -911,6 +912,7 @@ fn fit_scene(
         sphere_fine,
         sphere_inside,
         cyl_inside,
+        cyl_bound: false,
         ks_cyl,
         ep_cyl,
         ks_cone,

@@ -9,9 +9,10 @@
 //! frame, a along the axis, B the base centre rounded to the LSB and `b1`,
 //! `b2` what the rounding left of it along e1 and e2 in 2^-14 LSB, H the
 //! height, scene units; `r` with `EP_CYL` extra fraction bits, `invr =
-//! 2^(14+KS_CYL) / r` of the unrounded radius). With coarse normals the
-//! body has no `b1`, `b2` (34 words), `r` is rounded to the LSB and `invr`
-//! is of that. A glass cylinder's record holds the body twice (`sg`, then
+//! 2^(14+KS_CYL) / r` of the unrounded radius; `r` before `invr` where
+//! the opaque kernel starts with its bound, [`Fit::cyl_bound`]). With
+//! coarse normals the body has no `b1`, `b2` (34 words), `r` is rounded to
+//! the LSB and `invr` is of that. A glass cylinder's record holds the body twice (`sg`, then
 //! `-sg`: `GCYL_INNER`) before its caps (`GCYL_CAP0`, `GCYL_CAP1`). Under
 //! the packet traversal, where no cylinder of the scene has caps, the
 //! record is the body (or bodies) alone: no flag, no discs.
@@ -231,11 +232,18 @@ pub(crate) fn write(
         }
         w.unit(e1);
         w.unit(e2);
-        w.push(invr);
-        if fit.fine_normals {
-            w.push(rs * (fit.ep_cyl as f64).exp2());
+        let r = if fit.fine_normals {
+            rs * (fit.ep_cyl as f64).exp2()
         } else {
-            w.push(rq);
+            rq
+        };
+        // The bound needs r before its cut, the rest invr after it.
+        if fit.cyl_bound && sides == Sides::Front {
+            w.push(r);
+            w.push(invr);
+        } else {
+            w.push(invr);
+            w.push(r);
         }
         w.push(sg * w.one());
         w.point(base);
@@ -322,10 +330,8 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
         // |oc2 x d2| = |p2| |d2| <= r |d2| <= r |d2|_1 where the line
         // meets the cylinder: a cheap bound before the normalisation, with
         // a margin for its rounding and the exact test's (a few LSB each).
-        // invr and r stay in r13, r14 up to the cut.
+        // r stays in r14 up to the cut; invr comes from the stream after it.
         k.comment("bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1")
-            .c("mov r13, fb0")
-            .note("invr")
             .c("mov r14, fb0")
             .note("r")
             .c("abs r10, r8")
@@ -351,10 +357,7 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
         }
         k.cut(CUTS[0].0);
         store_oc2(&mut k);
-        k.c(format!("st r13, [#{}]", ram::TMP7))
-            .note("invr")
-            .c(format!("st r14, [#{}]", ram::TMP8))
-            .note("r");
+        k.c(format!("st r14, [#{}]", ram::TMP8)).note("r");
     }
     if g.published {
         k.c("movb r10, #0");
@@ -388,12 +391,8 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
         // p2 perpendicular to the 2D direction d2n
         perpendicular_to(&mut k, &[11, 12], &[8, 9], 14);
     }
-    if bound {
-        k.c(format!("ld r14, [r0 + #{}]", ram::TMP7));
-    } else {
-        k.c("mov r14, fb0");
-    }
-    k.note("invr")
+    k.c("mov r14, fb0")
+        .note("invr")
         .c("mul r11, r11, r14, >>KS_CYL+EP_CYL")
         .c("mul r12, r12, r14, >>KS_CYL+EP_CYL")
         .c(format!("st r11, [#{}]", ram::TMP0))

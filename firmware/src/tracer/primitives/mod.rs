@@ -587,6 +587,10 @@ pub struct Fit {
     /// Some opaque cylinder is seen from inside: likewise for the
     /// cylinder's bound.
     pub cyl_inside: bool,
+    /// The opaque cylinder kernel starts with its bound (tests in parts,
+    /// [`Gen::test_cuts`]): its records hold `r` before `invr`, which the
+    /// kernel reads only after the bound's cut.
+    pub cyl_bound: bool,
     /// Cylinders and cones: the same shifts.
     pub ks_cyl: u32,
     pub ep_cyl: u32,
