@@ -611,6 +611,7 @@ leaf_objects:
         lfb r9, (r6)
         addi r6, r6, 1
         beqz r9, lo_sphere_end          ; spheres in the leaf
+        addi r15, r0, (k_sphere - CTXBASE) / 4 ; r15: the test's kernel, for every object of the type
 lo_sphere_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -619,7 +620,7 @@ lo_sphere_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere
-        BCAST_REC k_sphere, r7, 0       ; the test; its cuts end the run where no awake ray can still hit it
+        sbcb r15, r7, (k_sphere_end - k_sphere) / 4 ; the test; its cuts end the run where no awake ray can still hit it
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -627,6 +628,7 @@ lo_sphere_end:
         lfb r9, (r6)
         addi r6, r6, 1
         beqz r9, lo_cylinder_end        ; cylinders in the leaf
+        addi r15, r0, (k_cylinder - CTXBASE) / 4 ; r15: the test's kernel, for every object of the type
 lo_cylinder_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -635,7 +637,8 @@ lo_cylinder_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
-        BCAST_REC k_cylinder, r7, CYL_BODY ; the test; its cuts end the run where no awake ray can still hit it
+        addi r2, r7, CYL_BODY
+        sbcb r15, r2, (k_cylinder_end - k_cylinder) / 4 ; the test; its cuts end the run where no awake ray can still hit it
 lo_cylinder_done:
         lfb r3, CYL_CAPS(r7)
         beqz r3, lo_cylinder_nocap
@@ -665,6 +668,7 @@ lo_box_end:
         lfb r9, (r6)
         addi r6, r6, 1
         beqz r9, lo_rectangle_end       ; rectangles in the leaf
+        addi r15, r0, (k_rectangle - CTXBASE) / 4 ; r15: the test's kernel, for every object of the type
 lo_rectangle_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -673,7 +677,7 @@ lo_rectangle_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_rectangle
-        BCAST_REC k_rectangle, r7, 0    ; the test; its cuts end the run where no awake ray can still hit it
+        sbcb r15, r7, (k_rectangle_end - k_rectangle) / 4 ; the test; its cuts end the run where no awake ray can still hit it
 lo_rectangle_next:
         addi r9, r9, -1
         bnez r9, lo_rectangle_obj
@@ -681,6 +685,7 @@ lo_rectangle_end:
         lfb r9, (r6)
         addi r6, r6, 1
         beqz r9, lo_triangle_end        ; triangles in the leaf
+        addi r15, r0, (k_triangle - CTXBASE) / 4 ; r15: the test's kernel, for every object of the type
 lo_triangle_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -689,7 +694,7 @@ lo_triangle_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_triangle
-        BCAST_REC k_triangle, r7, 0     ; the test; its cuts end the run where no awake ray can still hit it
+        sbcb r15, r7, (k_triangle_end - k_triangle) / 4 ; the test; its cuts end the run where no awake ray can still hit it
 lo_triangle_next:
         addi r9, r9, -1
         bnez r9, lo_triangle_obj

@@ -567,6 +567,7 @@ leaf_objects:
         lfb r9, (r6)
         addi r6, r6, 1
         beqz r9, lo_sphere_end          ; spheres in the leaf
+        addi r15, r0, (k_sphere - CTXBASE) / 4 ; r15: the test's kernel, for every object of the type
 lo_sphere_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -575,7 +576,7 @@ lo_sphere_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_sphere
-        BCAST_REC k_sphere, r7, 0       ; the test; its cuts end the run where no awake ray can still hit it
+        sbcb r15, r7, (k_sphere_end - k_sphere) / 4 ; the test; its cuts end the run where no awake ray can still hit it
 lo_sphere_next:
         addi r9, r9, -1
         bnez r9, lo_sphere_obj
@@ -583,6 +584,7 @@ lo_sphere_end:
         lfb r9, (r6)
         addi r6, r6, 1
         beqz r9, lo_cylinder_end        ; cylinders in the leaf
+        addi r15, r0, (k_cylinder - CTXBASE) / 4 ; r15: the test's kernel, for every object of the type
 lo_cylinder_obj:
         lfb r7, LE_RECORD(r6)
         lfb r8, LE_MAILBOX(r6)
@@ -591,7 +593,7 @@ lo_cylinder_obj:
         slli r8, r8, MB_SHIFT
         add r8, r8, r12                 ; r8: its mailbox
         MAILBOX_CHECK lo_cylinder
-        BCAST_REC k_cylinder, r7, CYL_BODY ; the test; its cuts end the run where no awake ray can still hit it
+        sbcb r15, r7, (k_cylinder_end - k_cylinder) / 4 ; the test; its cuts end the run where no awake ray can still hit it
 lo_cylinder_next:
         addi r9, r9, -1
         bnez r9, lo_cylinder_obj

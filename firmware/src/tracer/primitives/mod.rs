@@ -451,23 +451,52 @@ pub fn run_rest(
     }
 }
 
+/// The record field a cut test's stream starts at ([`CutTest::field`]),
+/// `"0"` where that is the record itself: a cylinder's or cone's record
+/// without caps (`caps` false) is its body.
+pub fn stream_field(ty: ChipType, c: &CutTest, caps: bool) -> &'static str {
+    match ty {
+        ChipType::Cylinder | ChipType::Cone if !caps => "0",
+        _ => c.field,
+    }
+}
+
 /// A test in parts ([`CutTest`] `c`) of type `ty` as one run of its
 /// kernel, whose `cut` contexts end it where no awake RC has F
-/// ([`super::emit::K::text_with_cuts`]), on the record at `rec`; then the
-/// further kernels (`then`) only where some awake RC has F (`rcany`), else
-/// on to `none`. Labels begin with `at`; `fit`: the records' variants.
-/// Clobbers r1..r3.
+/// ([`super::emit::K::text_with_cuts`]), on the record at `rec`, its
+/// stream from `field` ([`stream_field`]); then the further kernels
+/// (`then`) only where some awake RC has F (`rcany`), else on to `none`.
+/// `kernel`: a register that holds the kernel's address (a type loop
+/// sets it once), else the address is set here. Labels begin with `at`;
+/// `fit`: the records' variants. Clobbers r1..r3.
+#[allow(clippy::too_many_arguments)]
 pub fn run_with_cut_contexts(
     t: &mut Code,
     ty: ChipType,
     c: &CutTest,
+    field: &str,
+    kernel: Option<Reg>,
     fit: &Fit,
     rec: Reg,
     at: &str,
     none: &str,
 ) {
-    let (k, field) = (c.kernel, c.field);
-    t.m("BCAST_REC", format!("{k}, {rec}, {field}"));
+    let k = c.kernel;
+    match (kernel, field) {
+        (None, "0") => {
+            t.m("BCAST_AT", format!("{k}, {rec}"));
+        }
+        (None, _) => {
+            t.m("BCAST_REC", format!("{k}, {rec}, {field}"));
+        }
+        (Some(kr), "0") => {
+            t.sbcb(kr, rec, klen(k));
+        }
+        (Some(kr), _) => {
+            t.addi(super::emit::R2, rec, field)
+                .sbcb(kr, super::emit::R2, klen(k));
+        }
+    }
     if c.cuts.is_empty() {
         t.c("the test");
     } else {

@@ -77,7 +77,9 @@ use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY, LEAF_LATE};
 use super::super::layout::{FbImage, TypeInfo};
 use super::super::math::Approx;
 use super::super::memory_map::ram;
-use super::super::primitives::{kaddr, klen, run_first_part, run_rest, run_with_cut_contexts};
+use super::super::primitives::{
+    kaddr, klen, run_first_part, run_rest, run_with_cut_contexts, stream_field,
+};
 use super::child_order::{self, ChildOrder};
 use crate::tracer::kernel_names as names;
 
@@ -871,13 +873,21 @@ fn type_loop(
     if lay.cut_runs {
         // One run per test, ended by the broadcast unit at a cut where no
         // awake ray can still hit the object: TinyRISC finds the next
-        // object while it runs (the broadcast queue holds its run).
+        // object while it runs (the broadcast queue holds its run). Where
+        // the test is one run (no further kernels), the kernel's address
+        // is set once for the type's objects (r15).
+        let field = stream_field(ty, &cut, caps);
+        let kernel = cut.then.is_none().then_some(R15);
+        if kernel.is_some() {
+            t.addi(R15, R0, kaddr(cut.kernel))
+                .c("r15: the test's kernel, for every object of the type");
+        }
         one_run_each(t, &|t, next| {
             let mut after = Code::new();
             ty.broadcast_after_cut_test(&mut after, n, R7, caps);
             let done = format!("{n}_done");
             let none = if after.is_empty() { next } else { &done };
-            run_with_cut_contexts(t, ty, &cut, &lay.fit, R7, n, none);
+            run_with_cut_contexts(t, ty, &cut, field, kernel, &lay.fit, R7, n, none);
             if !after.is_empty() {
                 t.label(&done).extend(after);
             }
