@@ -697,18 +697,16 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .beqz(R12, "leaf_go")
             .c("in its slot: the tests start, no mailbox to check");
         awake(t);
-        t.j("leaf_go");
-        t.comment("while the first piece moves: the awake rays, for the mailboxes");
-        t.label("leaf_awake")
-            .beqz(R12, "leaf_piece")
-            .c("no mailbox to check");
-        awake(t);
-        t.label("leaf_piece")
+        // The further pieces' scan, placed after the type loops: a first
+        // piece's way falls into `leaf_go`, a further piece's from
+        // `leaf_next_piece` into `leaf_piece`.
+        let mut scan = Code::new();
+        scan.label("leaf_piece")
             .lw(R6, at("PS_LIST", R5))
             .c("r5: a piece whose DMA has started")
             .lw(R9, at("PS_OBJECTS", R5));
-        t.comment("while the piece moves: is there an object some awake ray has not tested?");
-        t.label("leaf_scan")
+        scan.comment("while the piece moves: is there an object some awake ray has not tested?");
+        scan.label("leaf_scan")
             .lw(R8, deref(R6))
             .addi(R6, R6, 4)
             .beqz(R8, "leaf_go")
@@ -724,8 +722,8 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .bne(R3, R10, "leaf_go")
             .addi(R9, R9, -1)
             .bnez(R9, "leaf_scan");
-        t.comment("every object of the piece tested by every awake ray");
-        t.label("leaf_skip")
+        scan.comment("every object of the piece tested by every awake ray");
+        scan.label("leaf_skip")
             .lw(R1, at("PS_NEXT", R5))
             .bnez(R1, "leaf_skip_next")
             .andi(R1, R7, "SBANK")
@@ -734,13 +732,23 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .dwait()
             .c("a piece in bank 0: in before a node kernel reads the bank")
             .j("leaf_done");
-        t.label("leaf_skip_next");
+        scan.label("leaf_skip_next");
         if late {
-            t.li(R11, 0)
+            scan.li(R11, 0)
                 .c("a late first piece skipped: the next moves as usual");
         }
-        next_piece_dma(t, one_slot, "the next piece's DMA starts");
-        t.j("leaf_next_piece");
+        next_piece_dma(&mut scan, one_slot, "the next piece's DMA starts");
+        scan.j("leaf_next_piece");
+        if late {
+            scan.comment(
+                "while a late first piece waits for the scan: the awake rays, for the mailboxes",
+            );
+            scan.label("leaf_awake")
+                .beqz(R12, "leaf_piece")
+                .c("no mailbox to check");
+            awake(&mut scan);
+            scan.j("leaf_piece");
+        }
         t.comment("while the piece still moves: what its tests start from");
         let count_field = |ti: &TypeInfo| format!("PS_COUNT_{}", ti.ty.name().to_uppercase());
         t.label("leaf_go");
@@ -784,8 +792,8 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .lw(R5, at("PS_NEXT", R5))
             .beqz(R5, "leaf_done")
             .lw(R7, at("PS_FB", R5))
-            .c("r7: the piece's first record")
-            .j("leaf_piece");
+            .c("r7: the piece's first record");
+        t.extend(scan);
         if late {
             t.comment("a large first piece some awake ray has not tested: its DMA starts, the slot takes it");
             t.label("leaf_late")
