@@ -572,19 +572,11 @@ inner_node:
         andi r3, r6, 12
         lw r11, NK(r3)                  ; r11 = its kernel, if inner
         rcst r4                         ; the awake rays reaching the first child: none, some, all
+        beqz r4, none_first
         addi r1, r4, -3
         beqz r1, all_first
         addi r1, r4, -1
-        beqz r1, some_first
-        bnez r4, pop_node               ; no ray awake
-        BCAST k_take_second             ; none: the second child only
-        mv r5, r10
-        lfb r6, PN_FLAGS(r5)
-        blt r6, r0, leaf
-        lw r1, NK(r6)
-        addi r2, r5, PN_SPLIT
-        sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
-        j inner_node
+        bnez r1, pop_node               ; no ray awake (rcall without rcany)
 some_first:
         addi r2, r5, PN_SLOT            ; its slot: the node's
         BCAST_AT k_push_second, r2      ; the rays' intervals for the second child
@@ -595,6 +587,15 @@ some_first:
         blt r6, r0, leaf
         addi r2, r5, PN_SPLIT
         sbcb r11, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; the first child's node kernel
+        j inner_node
+none_first:
+        BCAST k_take_second             ; none: the second child only
+        mv r5, r10
+        lfb r6, PN_FLAGS(r5)
+        blt r6, r0, leaf
+        lw r1, NK(r6)
+        addi r2, r5, PN_SPLIT
+        sbcb r1, r2, (k_node_x_below_first_end - k_node_x_below_first) / 4 ; its node kernel
         j inner_node
         ; the leaf r5: an object in more than one leaf has a mailbox (the pass that last
         ; tested it and which rays have not); it is broadcast unless every awake ray has tested it

@@ -474,24 +474,27 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
     if streamed {
         t.lw(R15, at("PS_SPLIT", R9)).c("r15 = its split");
     }
+    // The cases by how often they come (SPD scenes: all about 45%, none
+    // 30%, some 25%), the commonest ways the shortest.
     t.rcst(R4)
         .c("the awake rays reaching the first child: none, some, all")
+        .beqz(R4, "none_first")
         .addi(R1, R4, -3)
         .beqz(R1, "all_first")
         .addi(R1, R4, -1)
-        .beqz(R1, "some_first")
-        .bnez(R4, "pop_node")
-        .c("no ray awake")
-        .m("BCAST", names::TAKE_SECOND)
-        .c("none: the second child only")
-        .mv(R5, R10);
-    f.load(t, R6, at(flags, R5));
-    dispatch_full(t, &f);
+        .bnez(R1, "pop_node")
+        .c("no ray awake (rcall without rcany)");
     t.label("some_first");
     push_second(t, &f);
     t.m("BCAST", names::FIRST_OR_SLEEP)
         .c("the rays not reaching the first sleep");
     dispatch_first(t, &f, true);
+    t.label("none_first")
+        .m("BCAST", names::TAKE_SECOND)
+        .c("none: the second child only")
+        .mv(R5, R10);
+    f.load(t, R6, at(flags, R5));
+    dispatch_full(t, &f);
     leaf(t, lay, &f);
     t.label("leaf_done")
         .bge(R13, R0, "pop_node")
