@@ -32,7 +32,7 @@ pub mod sphere;
 
 use rtl::rc::Datapath;
 
-use super::emit::{define, Code, Reg, K, R3};
+use super::emit::{define, Code, Reg, K, R2, R3};
 use super::math::Approx;
 use super::memory_map::ram;
 use crate::scene::{PrimType, Shape};
@@ -414,7 +414,7 @@ pub fn run_first_part(t: &mut Code, c: &CutTest, first: Reg) {
 /// the status read and second issue of a part cost TinyRISC there: only
 /// the broadcast unit's `cut` contexts end a run at them.
 pub fn tinyrisc_part(name: &str) -> bool {
-    !matches!(name, "height" | "inside")
+    name != cylinder::CUTS[3].0 && name != planar::CUTS[1].0
 }
 
 /// The rest of a test of type `ty` in parts ([`CutTest`] `c`) after
@@ -502,8 +502,7 @@ pub fn run_with_cut_contexts(
             t.sbcb(kr, rec, klen(k));
         }
         (Some(kr), _) => {
-            t.addi(super::emit::R2, rec, field)
-                .sbcb(kr, super::emit::R2, klen(k));
+            t.addi(R2, rec, field).sbcb(kr, R2, klen(k));
         }
     }
     if c.cuts.is_empty() {
