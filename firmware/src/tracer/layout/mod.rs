@@ -514,7 +514,8 @@ fn build_as(
 
     let packet = opt.traversal == Traversal::Packet;
     let (geo, fan, mut fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
-    fit.cyl_bound = packet && opt.test_cuts.in_parts();
+    let test_cuts = packet && opt.test_cuts.in_parts();
+    fit.cyl_bound = test_cuts;
     // A streamed layout keeps the banded polygons' sub-edges in main
     // memory, once each, and moves a packet's bands of them.
     if fit.polygon_form.banded() {
@@ -588,7 +589,7 @@ fn build_as(
         light_shifted,
         node_layout: opt.layout,
         traversal: opt.traversal,
-        test_cuts: opt.traversal == Traversal::Packet && opt.test_cuts.in_parts(),
+        test_cuts,
         cut_runs: opt.traversal == Traversal::Packet && opt.test_cuts.cut_contexts(),
         root_box,
         collapse: opt.collapse,

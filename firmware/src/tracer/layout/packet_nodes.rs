@@ -35,6 +35,11 @@ pub const PK_NODE_COST: f64 = 60.0;
 /// so (`--test-cuts`), so the tree is the same either way; the kernels as
 /// with the default numerics.
 pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
+    // The kernels of tests in parts, whatever the render's `--test-cuts`.
+    let fit = &Fit {
+        cyl_bound: true,
+        ..*fit
+    };
     let g = Gen {
         datapath: rtl::rc::Datapath::W16,
         approx: super::super::math::Approx::default(),

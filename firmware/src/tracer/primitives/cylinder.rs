@@ -307,7 +307,8 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
                 .note("the projection's remainder, plus B's");
         }
     }
-    let bound = body == Body::Opaque && g.test_cuts;
+    // The record's order says whether the opaque kernel has the bound.
+    let bound = body == Body::Opaque && fit.cyl_bound;
     let er = if fine { "+EP_CYL" } else { "" };
     // oc2 goes to RAM for after the normalisation; with the bound, only
     // once the test goes on past it (a test cut there spends no store).
@@ -440,7 +441,7 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
     k
 }
 
-/// The opaque body kernel's cuts ([`K::cut`], with [`Gen::test_cuts`])
+/// The opaque body kernel's cuts ([`K::cut`]; the first with [`Fit::cyl_bound`])
 /// and what F holds at each: a bound says the ray's line may meet the
 /// infinite cylinder; it does (`s > 0`); its root lies ahead of the ray and
 /// before `tbest`; the hit lies within the height (the normal and the

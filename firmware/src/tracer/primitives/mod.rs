@@ -862,6 +862,7 @@ mod tests {
                     let fit = Fit {
                         sphere_fine,
                         fine_normals,
+                        cyl_bound: fine_normals,
                         ..Fit::default()
                     };
                     for s in [Sides::Front, Sides::Both] {
