@@ -11,7 +11,11 @@
 //! with those packets split into their four 4x4 quadrants traced in turn,
 //! and with the rays regrouped: every light's rays of a tile together, of
 //! 4 tiles, of the frame, sorted by origin (Morton order in the scene's
-//! box) or by origin then direction, in packets of 64.
+//! box) or by origin then direction, in packets of 64, and, as a bound no
+//! firmware reaches, the frame's rays sorted by the leaves they reach.
+//! Under each grouping it prints the simd efficiency the chip would count:
+//! the tests the rays need over the tests broadcast times their packet's
+//! rays.
 use crate::reference::{eye_ray, shapes::Ray, Tracer};
 use anyhow::{anyhow, Result};
 use firmware::bsp::{auto_depth, Bsp, BspParams, SplitRule};
@@ -83,6 +87,28 @@ fn leaves(bsp: &Bsp, s: &Seg, out: &mut Vec<u32>) {
             stack.push((near, t0, t));
         }
     }
+}
+
+/// The ray-object tests the rays need: the objects of every leaf each
+/// ray reaches (`reach[ray]`), summed over the rays.
+fn needed_tests(reach: &[Vec<u32>], objects: impl Fn(u32) -> usize) -> usize {
+    reach.iter().flatten().map(|&l| objects(l)).sum()
+}
+
+/// What a grouping of the rays into packets (`packets[p]`: indices into
+/// `reach`) broadcasts: the object tests (each packet's union of leaves'
+/// objects, once per packet) and those times the rays of their packet,
+/// the lanes offered as `simd_efficiency` counts them on the chip.
+fn broadcast(
+    packets: &[Vec<usize>],
+    reach: &[Vec<u32>],
+    objects: impl Fn(u32) -> usize,
+) -> (usize, usize) {
+    packets.iter().fold((0, 0), |(tests, lanes), p| {
+        let u: HashSet<u32> = p.iter().flat_map(|&k| reach[k].iter().copied()).collect();
+        let n: usize = u.into_iter().map(&objects).sum();
+        (tests + n, lanes + n * p.len())
+    })
 }
 
 fn morton(x: u32, y: u32, z: u32, bits: u32) -> u64 {
@@ -177,9 +203,19 @@ pub fn command(a: RegroupArgs) -> Result<()> {
         bsp.nodes.len()
     );
     println!(
-        "{:<22} {:>7} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
-        "rays", "count", "8x8 tiles", "quadrants", "tile merged", "4 tiles", "frame", "frame o+d"
+        "{:<22} {:>7} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
+        "rays",
+        "count",
+        "8x8 tiles",
+        "quadrants",
+        "tile merged",
+        "4 tiles",
+        "frame",
+        "frame o+d",
+        "by leaves"
     );
+    let mut total = [(0usize, 0usize); 7];
+    let mut total_needed = 0usize;
     for (name, segs) in names.iter().zip(&kinds) {
         let reach: Vec<Vec<u32>> = segs
             .iter()
@@ -189,18 +225,9 @@ pub fn command(a: RegroupArgs) -> Result<()> {
                 l
             })
             .collect();
-        let cost = |packets: &[Vec<usize>]| -> usize {
-            packets
-                .iter()
-                .map(|p| {
-                    let u: HashSet<u32> =
-                        p.iter().flat_map(|&k| reach[k].iter().copied()).collect();
-                    u.iter()
-                        .map(|&i| bsp.nodes[i as usize].objects.len())
-                        .sum::<usize>()
-                })
-                .sum()
-        };
+        let objects = |l: u32| bsp.nodes[l as usize].objects.len();
+        let needed = needed_tests(&reach, objects);
+        let cost = |packets: &[Vec<usize>]| broadcast(packets, &reach, objects);
         let tile = |s: &Seg| (s.pixel.1 / 8) * (size / 8) + s.pixel.0 / 8;
         let mut chip: BTreeMap<(u32, usize), Vec<usize>> = BTreeMap::new();
         for (k, s) in segs.iter().enumerate() {
@@ -242,15 +269,25 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             }
             packets
         };
+        // An oracle no firmware has: the frame's rays sorted by the
+        // leaves they reach (front to back, leaves numbered in tree
+        // order), which only tracing them tells.
+        let oracle = {
+            let mut order: Vec<usize> = (0..segs.len()).collect();
+            order.sort_by(|&a, &b| reach[a].cmp(&reach[b]).then(a.cmp(&b)));
+            order.chunks(64).map(|c| c.to_vec()).collect::<Vec<_>>()
+        };
         let all = u32::MAX;
-        let base = cost(&chip);
-        let cols = [
+        let groupings = [
+            cost(&chip),
             cost(&quads),
             cost(&regroup(1, false)),
             cost(&regroup(4, false)),
             cost(&regroup(all, false)),
             cost(&regroup(all, true)),
+            cost(&oracle),
         ];
+        let base = groupings[0].0;
         let ratio = |c: usize| {
             if base == 0 {
                 String::from("-")
@@ -258,15 +295,66 @@ pub fn command(a: RegroupArgs) -> Result<()> {
                 format!("{:.2}x", c as f64 / base as f64)
             }
         };
-        println!(
-            "{name:<22} {:>7} {base:>11} {:>11} {:>11} {:>11} {:>11} {:>11}",
-            segs.len(),
-            ratio(cols[0]),
-            ratio(cols[1]),
-            ratio(cols[2]),
-            ratio(cols[3]),
-            ratio(cols[4])
+        let eff = |(_, offered): (usize, usize)| {
+            if offered == 0 {
+                String::from("-")
+            } else {
+                format!("{:.1}%", 100.0 * needed as f64 / offered as f64)
+            }
+        };
+        let mut line = format!("{name:<22} {:>7} {base:>11}", segs.len());
+        for &g in &groupings[1..] {
+            line += &format!(" {:>11}", ratio(g.0));
+        }
+        println!("{line}");
+        let mut line = format!("{:<22} {:>7}", "  simd efficiency", "");
+        for &g in &groupings {
+            line += &format!(" {:>11}", eff(g));
+        }
+        println!("{line}");
+        for (t, g) in total.iter_mut().zip(groupings) {
+            t.0 += g.0;
+            t.1 += g.1;
+        }
+        total_needed += needed;
+    }
+    let mut line = format!("{:<22} {:>7} {:>11}", "all rays", "", total[0].0);
+    for g in &total[1..] {
+        line += &format!(
+            " {:>11}",
+            format!("{:.2}x", g.0 as f64 / total[0].0.max(1) as f64)
         );
     }
+    println!("{line}");
+    let mut line = format!("{:<22} {:>7}", "  simd efficiency", "");
+    for g in &total {
+        line += &format!(
+            " {:>11}",
+            format!("{:.1}%", 100.0 * total_needed as f64 / g.1.max(1) as f64)
+        );
+    }
+    println!("{line}");
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Leaves of 3, 5 and 7 objects; rays reaching [0], [0, 1], [2] and
+    /// [1, 2]: counted by hand.
+    #[test]
+    fn tests_and_lanes_are_counted_per_packet() {
+        let objects = |l: u32| [3, 5, 7][l as usize];
+        let reach = vec![vec![0], vec![0, 1], vec![2], vec![1, 2]];
+        assert_eq!(needed_tests(&reach, objects), 3 + 8 + 7 + 12);
+        // One packet: leaves 0, 1, 2 once each (15 tests) to 4 rays.
+        assert_eq!(broadcast(&[vec![0, 1, 2, 3]], &reach, objects), (15, 60));
+        // Two packets: {0, 1} reach leaves 0, 1 (8 tests, 2 rays), {2, 3}
+        // leaves 1, 2 (12 tests, 2 rays).
+        assert_eq!(
+            broadcast(&[vec![0, 1], vec![2, 3]], &reach, objects),
+            (20, 40)
+        );
+    }
 }

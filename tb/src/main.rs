@@ -87,8 +87,9 @@ enum Command {
     Compare(tb::cmd_scene::CompareArgs),
     /// Estimate what regrouping rays into other packets would buy: the
     /// object tests of the chip's packets (a tile, a light) against rays
-    /// split into quadrants or regrouped over tiles and sorted, from the
-    /// f64 reference's rays on a SAH tree (docs/tracer.md, "Regrouping").
+    /// split into quadrants or regrouped over tiles and sorted, and the
+    /// simd efficiency of each grouping, from the f64 reference's rays on
+    /// a SAH tree (docs/tracer.md, "Regrouping").
     Regroup(tb::cmd_regroup::RegroupArgs),
     /// Generate one of Eric Haines' Standard Procedural Databases in NFF
     /// (balls, gears, jacks, lattice, mount, rings, shells, tetra, tree).
