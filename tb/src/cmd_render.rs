@@ -78,11 +78,15 @@ pub struct RenderArgs {
     #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_collapse)]
     pub collapse: firmware::tracer::Collapse,
     /// Streamed packet traversal: the words of the pieces a leaf's records
-    /// are moved in by DMA, FIRST,REST: the first piece of at most FIRST
-    /// words (the wait at every leaf), each further one of at most REST
-    /// (it moves while the piece before it is tested); each 1..=16384,
-    /// FIRST <= REST, a piece holds at least one record.
-    #[arg(long, value_name = "FIRST,REST", default_value = "64,256", value_parser = crate::cli::parse_leaf_pieces)]
+    /// are moved in by DMA, FIRST,SECOND,REST (or FIRST,REST: the second
+    /// as the rest): the first piece of at most FIRST words (the wait at
+    /// every leaf), the second of at most SECOND, and what remains in as
+    /// few pieces of at most REST as hold it, of about equal words (each
+    /// moves while the piece before it is tested); each 1..=16384, FIRST
+    /// <= SECOND <= REST, a piece holds at least one record. SECOND auto
+    /// (`auto` = 64,auto,256): 2 x FIRST or REST, whichever runs the probe
+    /// faster.
+    #[arg(long, value_name = "auto|FIRST,[SECOND,]REST", default_value = "auto", value_parser = crate::cli::parse_leaf_pieces)]
     pub leaf_pieces: firmware::tracer::LeafPieces,
     /// Packet traversal: the shadow rays of the reflection levels (depth 2
     /// and more): light (a packet per light, the rays in the RCs that
@@ -441,7 +445,7 @@ pub(crate) fn render_and_measure(
         "node_layout": if opt.traversal == firmware::tracer::Traversal::Packet { "packet" } else { opt.layout.name() },
         "traversal": opt.traversal.name(),
         "collapse": opt.collapse.to_string(),
-        "leaf_pieces": opt.pieces.to_string(),
+        "leaf_pieces": chip.firmware.pieces.to_string(),
         "shadow_packets": chip.firmware.shadows.to_string(),
         "sub_edges": opt.sub_edges.to_string(),
         "child_order": chip.firmware.child_order.to_string(),
@@ -915,9 +919,27 @@ pub fn command(a: RenderArgs) -> Result<()> {
             st.image.len().div_ceil(1024),
             st.nodes,
             if chip.leaf_cache.is_some() {
-                "leaves moved by DMA in pieces into FB banks 1 and 0"
+                let p = chip.firmware.pieces;
+                format!(
+                    "leaves moved by DMA in pieces into FB banks 1 and 0: {}{}",
+                    match p.second_or_rest() {
+                        s if s < p.rest => format!(
+                            "the first of up to {} words, the second {}, the others {}",
+                            p.first, s, p.rest
+                        ),
+                        _ => format!(
+                            "the first of up to {} words, the others {}",
+                            p.first, p.rest
+                        ),
+                    },
+                    if opt.pieces.second.is_none() {
+                        " (auto: the second piece the faster on the probe)"
+                    } else {
+                        ""
+                    }
+                )
             } else {
-                "leaf blocks by DMA into FB bank 1"
+                "leaf blocks by DMA into FB bank 1".to_string()
             }
         );
     }

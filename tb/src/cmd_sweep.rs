@@ -351,15 +351,19 @@ fn knobs(width: u32, height: u32) -> Vec<Knob> {
         });
     }
     // A streamed scene's leaf pieces (resident scenes have none): whole
-    // leaves (one piece unless a leaf exceeds the bank) and smaller pieces.
+    // leaves (one piece unless a leaf exceeds the bank), smaller pieces,
+    // and each of `auto`'s two second pieces forced.
     for pieces in [
+        firmware::tracer::LeafPieces::two(
+            firmware::tracer::LeafPieces::MAX,
+            firmware::tracer::LeafPieces::MAX,
+        ),
+        firmware::tracer::LeafPieces::two(32, 128),
+        firmware::tracer::LeafPieces::two(64, 256),
         firmware::tracer::LeafPieces {
-            first: firmware::tracer::LeafPieces::MAX,
-            rest: firmware::tracer::LeafPieces::MAX,
-        },
-        firmware::tracer::LeafPieces {
-            first: 32,
-            rest: 128,
+            first: 64,
+            second: Some(128),
+            rest: 256,
         },
     ] {
         let packet = packet_config(width, height);

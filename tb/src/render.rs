@@ -998,8 +998,10 @@ pub fn probe(fw: &Firmware, opt: &Options, timing: &Timing) -> Result<ProbeRende
 /// to the first. With `ShadowPackets::Auto` where merging applies
 /// ([`tracer::shadows::applies`]), the chosen tree is probed again with
 /// merged shadow packets and the fewer cycles kept (the images are the
-/// same); with `ChildOrder::Auto`, the order the view's rays ask for
-/// likewise ([`choose_child_order`]). Deterministic.
+/// same); with the second leaf piece `auto` on a streamed scene, the
+/// second piece's size likewise ([`choose_pieces`]); with
+/// `ChildOrder::Auto`, the order the view's rays ask for likewise
+/// ([`choose_child_order`]). Deterministic.
 pub fn choose_firmware(
     scene: &Scene,
     opt: &Options,
@@ -1021,7 +1023,70 @@ pub(crate) fn choose_firmware_probed(
 ) -> Result<(Firmware, Option<ProbeRender>)> {
     let (fw, p) = choose_tree(scene, opt, nm, timing)?;
     let (fw, p) = choose_shadows(scene, opt, nm, timing, fw, p)?;
+    let (fw, p) = choose_pieces(scene, opt, nm, timing, fw, p)?;
     choose_child_order(scene, opt, nm, timing, fw, p)
+}
+
+/// The share of the probe's cycles a second leaf piece of `2 * FIRST`
+/// words must save to replace one of REST's ([`choose_pieces`]).
+pub(crate) const PIECES_MARGIN: f64 = 0.003;
+
+/// `--leaf-pieces` with the second piece `auto` (the default; streamed
+/// scenes): the tree and shadow packets chosen, a second piece of at most
+/// `2 * FIRST` words against one of REST's on the probe. The small second
+/// piece is a shorter wait after the first piece's tests but one more
+/// turn of the leaf's loop, which pays where the array waits for further
+/// pieces (SPD rings, mount) and costs where the tests hide the DMA (SPD
+/// gears); the same objects are tested in the same order, so the images
+/// are the same.
+fn choose_pieces(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    timing: &Timing,
+    fw: Firmware,
+    p: Option<ProbeRender>,
+) -> Result<(Firmware, Option<ProbeRender>)> {
+    let Some(second) = opt.pieces.auto_second() else {
+        return Ok((fw, p));
+    };
+    if fw.layout.stream.is_none() {
+        return Ok((fw, p));
+    }
+    let small = Options {
+        bsp: fw.bsp,
+        shadows: fw.shadows,
+        pieces: tracer::LeafPieces {
+            second: Some(second),
+            ..opt.pieces
+        },
+        ..*opt
+    };
+    let sfw = tracer::build_with(scene, &small, nm).map_err(|e| anyhow!("{e}"))?;
+    keep_faster((fw, p), sfw, opt, timing, PIECES_MARGIN)
+}
+
+/// `fw` (with its probe, if one ran) or `alt`, which renders the same
+/// image, whichever runs the probe in fewer cycles: `alt` where it saves
+/// more than `margin` of `fw`'s.
+fn keep_faster(
+    (fw, p): (Firmware, Option<ProbeRender>),
+    alt: Firmware,
+    opt: &Options,
+    timing: &Timing,
+    margin: f64,
+) -> Result<(Firmware, Option<ProbeRender>)> {
+    let (p, ap) = rayon::join(
+        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
+        || probe(&alt, opt, timing),
+    );
+    let (p, mut ap) = (p?, ap?);
+    if (ap.cycles as f64) < p.cycles as f64 * (1.0 - margin) {
+        ap.reference = p.reference;
+        Ok((alt, Some(ap)))
+    } else {
+        Ok((fw, Some(p)))
+    }
 }
 
 /// `--shadow-packets auto`: the tree chosen, merged shadow packets
@@ -1044,17 +1109,7 @@ fn choose_shadows(
     };
     let mfw = tracer::build_with(scene, &merged, nm).map_err(|e| anyhow!("{e}"))?;
     // The same images: the same rays, traced in other packets.
-    let (p, mp) = rayon::join(
-        || p.map_or_else(|| probe(&fw, opt, timing), Ok),
-        || probe(&mfw, opt, timing),
-    );
-    let (p, mut mp) = (p?, mp?);
-    if mp.cycles < p.cycles {
-        mp.reference = p.reference;
-        Ok((mfw, Some(mp)))
-    } else {
-        Ok((fw, Some(p)))
-    }
+    keep_faster((fw, p), mfw, opt, timing, 0.0)
 }
 
 /// Eye rays the host traces to learn the ways rays end

@@ -291,11 +291,23 @@ fn usage_errors_name_the_argument_and_exit_2() {
         ),
         (
             &["render", "--leaf-pieces", "300,100"][..],
-            "'--leaf-pieces <FIRST,REST>': leaf pieces '300,100': expected FIRST,REST",
+            "'--leaf-pieces <auto|FIRST,[SECOND,]REST>': leaf pieces '300,100': expected auto, FIRST,REST or FIRST,SECOND,REST",
         ),
         (
             &["render", "--leaf-pieces", "0,64"][..],
-            "two word counts 1..=16384 with FIRST <= REST",
+            "word counts 1..=16384 with FIRST <= SECOND <= REST",
+        ),
+        (
+            &["render", "--leaf-pieces", "64,256,128"][..],
+            "leaf pieces '64,256,128': expected auto, FIRST,REST or FIRST,SECOND,REST",
+        ),
+        (
+            &["render", "--leaf-pieces", "64,128,256,512"][..],
+            "leaf pieces '64,128,256,512': expected",
+        ),
+        (
+            &["render", "--leaf-pieces", "64,auto"][..],
+            "leaf pieces '64,auto': expected",
         ),
         (
             &["render", "--shadow-packets", "some"][..],

@@ -321,11 +321,16 @@ fn leaf_pieces_move_while_the_tests_run() {
         };
         tb::render::render_chip(&scene, &o, &settings).unwrap()
     };
-    let whole = render(LeafPieces {
-        first: LeafPieces::MAX,
-        rest: LeafPieces::MAX,
-    });
-    for pieces in [LeafPieces::default(), LeafPieces { first: 8, rest: 64 }] {
+    let whole = render(LeafPieces::two(LeafPieces::MAX, LeafPieces::MAX));
+    for pieces in [
+        LeafPieces::default(),
+        LeafPieces::two(8, 64),
+        LeafPieces {
+            first: 8,
+            second: Some(16),
+            rest: 64,
+        },
+    ] {
         let cut = render(pieces);
         let st = cut.firmware.layout.stream.as_ref().expect("streamed");
         eprintln!(
@@ -751,7 +756,7 @@ fn large_first_pieces_move_only_when_tested() {
                 datapath,
                 child_order: ChildOrder::MAJORITY,
                 shadows: ShadowPackets::PerLight,
-                pieces: LeafPieces { first: 8, rest },
+                pieces: LeafPieces::two(8, rest),
                 ..opts(48, 48, Traversal::Packet)
             };
             render_sah(&scene, o, true)

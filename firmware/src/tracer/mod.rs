@@ -250,15 +250,21 @@ impl std::str::FromStr for Collapse {
 }
 
 /// The streamed packet traversal moves a leaf's records into the FB in
-/// pieces (`docs/tracer.md`, "Streamed leaves"): the first of at most
-/// `first` words, the others of at most `rest` (a piece holds at least one
-/// record). The pieces of a leaf alternate between FB bank 1 and the top of
-/// bank 0, and each piece after the first moves while the tests of the
-/// piece before it run: a small first piece is a short wait at every leaf,
-/// larger further pieces fewer turns of the loop.
+/// pieces (`docs/tracer.md`, "Leaves and pieces"): the first of at most
+/// `first` words, the second of at most `second`, and what remains in as
+/// few pieces of at most `rest` words as hold it, of about equal words (a
+/// piece holds at least one record). The pieces of a leaf alternate
+/// between FB bank 1 and the top of bank 0, and each piece after the first
+/// moves while the tests of the piece before it run: a small first piece
+/// is a short wait at every leaf, a small second piece a short wait after
+/// the first piece's tests but one more turn of the loop, larger further
+/// pieces fewer turns. `second` `None` is `auto`: `tb::render` keeps
+/// `2 * first` or `rest`, whichever runs its probe faster; a build without
+/// a probe takes `rest`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct LeafPieces {
     pub first: usize,
+    pub second: Option<usize>,
     pub rest: usize,
 }
 
@@ -266,42 +272,134 @@ impl Default for LeafPieces {
     fn default() -> Self {
         LeafPieces {
             first: 64,
+            second: None,
             rest: 256,
         }
     }
 }
 
 impl LeafPieces {
-    /// The most words either limit may name (an FB bank).
+    /// The most words any limit may name (an FB bank).
     pub const MAX: usize = layout::STREAM_BANK;
+
+    /// Pieces of `first` words, then of `rest` (the second as the rest).
+    pub fn two(first: usize, rest: usize) -> LeafPieces {
+        LeafPieces {
+            first,
+            second: Some(rest),
+            rest,
+        }
+    }
+
+    /// The second piece's limit a build without a probe takes.
+    pub fn second_or_rest(&self) -> usize {
+        self.second.unwrap_or(self.rest)
+    }
+
+    /// `auto`'s other choice for the second piece (`None` where it would
+    /// be the rest's).
+    pub fn auto_second(&self) -> Option<usize> {
+        (self.second.is_none() && 2 * self.first < self.rest).then_some(2 * self.first)
+    }
 }
 
 impl std::fmt::Display for LeafPieces {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{},{}", self.first, self.rest)
+        match self.second {
+            None if *self == LeafPieces::default() => f.write_str("auto"),
+            None => write!(f, "{},auto,{}", self.first, self.rest),
+            Some(s) if s >= self.rest => write!(f, "{},{}", self.first, self.rest),
+            Some(s) => write!(f, "{},{},{}", self.first, s, self.rest),
+        }
     }
 }
 
 impl std::str::FromStr for LeafPieces {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
+        if s == "auto" {
+            return Ok(LeafPieces::default());
+        }
         let bad = || {
             format!(
-                "leaf pieces '{s}': expected FIRST,REST, two word counts 1..={} with FIRST <= REST (e.g. 64,256)",
+                "leaf pieces '{s}': expected auto, FIRST,REST or FIRST,SECOND,REST (SECOND a count or auto), word counts 1..={} with FIRST <= SECOND <= REST (e.g. 64,128,256)",
                 LeafPieces::MAX
             )
         };
-        let (a, b) = s.split_once(',').ok_or_else(bad)?;
         let n = |x: &str| {
             x.trim()
                 .parse::<usize>()
                 .ok()
                 .filter(|n| (1..=LeafPieces::MAX).contains(n))
         };
-        match (n(a), n(b)) {
-            (Some(first), Some(rest)) if first <= rest => Ok(LeafPieces { first, rest }),
+        let parts: Vec<&str> = s.split(',').collect();
+        match parts[..] {
+            [a, b] => match (n(a), n(b)) {
+                (Some(first), Some(rest)) if first <= rest => Ok(LeafPieces::two(first, rest)),
+                _ => Err(bad()),
+            },
+            [a, b, c] => {
+                let second = if b.trim() == "auto" {
+                    None
+                } else {
+                    Some(n(b).ok_or_else(bad)?)
+                };
+                match (n(a), n(c)) {
+                    (Some(first), Some(rest))
+                        if first <= rest
+                            && second.is_none_or(|sec| first <= sec && sec <= rest) =>
+                    {
+                        Ok(LeafPieces {
+                            first,
+                            second,
+                            rest,
+                        })
+                    }
+                    _ => Err(bad()),
+                }
+            }
             _ => Err(bad()),
         }
+    }
+}
+
+#[cfg(test)]
+mod leaf_pieces_tests {
+    use super::LeafPieces;
+
+    #[test]
+    fn leaf_pieces_read_and_print_as_written() {
+        let p = |s: &str| s.parse::<LeafPieces>();
+        let pc = |first, second, rest| LeafPieces {
+            first,
+            second,
+            rest,
+        };
+        assert_eq!(p("auto"), Ok(pc(64, None, 256)));
+        assert_eq!(p("64,256"), Ok(pc(64, Some(256), 256)));
+        assert_eq!(p("64,128,256"), Ok(pc(64, Some(128), 256)));
+        assert_eq!(p("32,auto,512"), Ok(pc(32, None, 512)));
+        for s in ["auto", "64,256", "64,128,256", "32,auto,512"] {
+            assert_eq!(p(s).unwrap().to_string(), s);
+        }
+        // A second piece as large as the rest is no second piece.
+        assert_eq!(p("64,256,256").unwrap().to_string(), "64,256");
+        for bad in [
+            "",
+            "64",
+            "0,64",
+            "64,32",
+            "64,300,256",
+            "64,32,256",
+            "64,auto",
+            "1,2,3,4",
+            "64,x,256",
+        ] {
+            assert!(p(bad).is_err(), "{bad}");
+        }
+        assert_eq!(pc(64, None, 256).auto_second(), Some(128));
+        assert_eq!(pc(64, None, 128).auto_second(), None);
+        assert_eq!(pc(64, Some(128), 256).auto_second(), None);
     }
 }
 
@@ -539,6 +637,9 @@ pub struct Firmware {
     /// The packet traversal's child order of mixed packets (never `Auto`:
     /// built as the majority; the paper's traversal has none, `MAJORITY`).
     pub child_order: ChildOrder,
+    /// A streamed leaf's pieces (the second's `auto` resolved: built as
+    /// the rest's).
+    pub pieces: LeafPieces,
 }
 
 impl Firmware {
@@ -598,6 +699,7 @@ pub fn with_child_order(
     let o = Options {
         bsp: fw.bsp,
         shadows: fw.shadows,
+        pieces: fw.pieces,
         child_order: order,
         ..*opt
     };
@@ -873,6 +975,10 @@ fn build_one(
         bsp: opt.bsp,
         shadows,
         child_order: resolved_child_order(opt),
+        pieces: LeafPieces {
+            second: Some(opt.pieces.second_or_rest()),
+            ..opt.pieces
+        },
     })
 }
 

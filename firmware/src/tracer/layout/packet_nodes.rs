@@ -435,16 +435,20 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
     (w.fb, root)
 }
 
-/// Leaf pieces: a leaf's records (grouped by type) cut where a piece
-/// would exceed `first` words (the leaf's first piece) or `rest` (the
-/// others), a piece holding at least one record; each piece is a node
-/// record of its own, chained from the leaf (`PS_NEXT`). Per piece its
-/// (type index, slot) pairs and its place in its leaf (0 for the first),
-/// and per node the index of its first piece (`usize::MAX`: none).
+/// Leaf pieces: a leaf's records (grouped by type) cut into a first piece
+/// of at most `first` words, a second of at most `second` (where `second`
+/// is under `rest`), and what remains in as few pieces of at most `rest`
+/// words as hold it, of about equal words (the last no smaller than the
+/// others need be: a small piece moves fast, but the piece after it then
+/// waits for its DMA); a piece holds at least one record. Each piece is a
+/// node record of its own, chained from the leaf (`PS_NEXT`). Per piece
+/// its (type index, slot) pairs and its place in its leaf (0 for the
+/// first), and per node the index of its first piece (`usize::MAX`: none).
 #[allow(clippy::type_complexity)]
 fn pieces(
     tree: &Tree,
     first: usize,
+    second: usize,
     rest: usize,
 ) -> (Vec<Vec<(usize, usize)>>, Vec<usize>, Vec<usize>) {
     let types = tree.types;
@@ -456,25 +460,48 @@ fn pieces(
             continue;
         }
         first_piece[k] = pieces.len();
-        let mut cur: Vec<(usize, usize)> = Vec::new();
-        let mut words = 0usize;
-        let mut place = 0;
-        for (j, qs) in tree.per_type(n).into_iter().enumerate() {
-            for q in qs {
-                let sz = types[j].size;
-                let limit = if place == 0 { first } else { rest };
-                if words + sz > limit && !cur.is_empty() {
-                    pieces.push(std::mem::take(&mut cur));
-                    in_leaf.push(place);
-                    place += 1;
-                    words = 0;
+        let recs: Vec<(usize, usize)> = tree
+            .per_type(n)
+            .into_iter()
+            .enumerate()
+            .flat_map(|(j, qs)| qs.into_iter().map(move |q| (j, q)))
+            .collect();
+        let words = |r: &[(usize, usize)]| -> usize { r.iter().map(|&(j, _)| types[j].size).sum() };
+        // Up to `limit` words from `recs[*i..]`; the piece closes at the
+        // first record that reaches `enough` words.
+        let take = |i: &mut usize, limit: usize, enough: usize| {
+            let (mut piece, mut w) = (Vec::new(), 0);
+            while let Some(&r) = recs.get(*i) {
+                let sz = types[r.0].size;
+                if w + sz > limit && !piece.is_empty() {
+                    break;
                 }
-                cur.push((j, q));
-                words += sz;
+                piece.push(r);
+                w += sz;
+                *i += 1;
+                if w >= enough {
+                    break;
+                }
+            }
+            piece
+        };
+        let mut i = 0;
+        let mut leaf = vec![take(&mut i, first, usize::MAX)];
+        if second < rest && i < recs.len() {
+            leaf.push(take(&mut i, second, usize::MAX));
+        }
+        let left = words(&recs[i..]);
+        if left > 0 {
+            let n = left.div_ceil(rest);
+            let even = left.div_ceil(n);
+            while i < recs.len() {
+                leaf.push(take(&mut i, rest, even));
             }
         }
-        pieces.push(cur);
-        in_leaf.push(place);
+        for (place, piece) in leaf.into_iter().enumerate() {
+            pieces.push(piece);
+            in_leaf.push(place);
+        }
     }
     (pieces, first_piece, in_leaf)
 }
@@ -539,6 +566,7 @@ fn streamed_image(
     }
     let rest = fin.pieces.rest.max(largest_record).min(room);
     let first = fin.pieces.first.min(rest);
+    let second = fin.pieces.second_or_rest().clamp(first, rest);
     let bank0_buf = STREAM_BANK - rest;
     // Bank 1: the further pieces' buffer (even places), then the cache's
     // slots for first pieces (one per leaf, direct-mapped by the leaf's
@@ -564,7 +592,7 @@ fn streamed_image(
     } else {
         (1, STREAM_BANK)
     };
-    let (pieces, first_piece, in_leaf) = pieces(tree, first, rest);
+    let (pieces, first_piece, in_leaf) = pieces(tree, first, second, rest);
     let nn = nodes.len();
     let lists_at = NODE_BYTES * (nn + pieces.len());
     let list_bytes: usize = pieces.iter().map(|p| 4 * p.len()).sum();
