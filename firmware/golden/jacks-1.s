@@ -419,7 +419,11 @@ order_pass:
         bne r1, r11, order_x_some
         beq r2, r12, order_x            ; all
 order_x_some:
-        jal majority                    ; some: r8 = most go down
+        blt r13, r0, order_x_any        ; an any-hit pass
+        ; some (closest hit): the rays going down first (r8 = 1)
+        j order_x
+order_x_any:
+        jal majority                    ; some (any hit): r8 = most go down
 order_x:
         addi r1, r0, (k_node_x_below_first - CTXBASE) / 4
         li r2, PN_LEFT
