@@ -111,6 +111,35 @@ fn broadcast(
     })
 }
 
+/// The groupings `regroup` prices: the chip's tiles, their quadrants, a
+/// tile merged, 4 tiles, the frame, the frame by origin and direction, the
+/// frame by leaves.
+const GROUPINGS: usize = 7;
+
+/// A kind of rays' two rows: the rays, the chip's packets' tests and the
+/// other groupings' relative to them; then each grouping's simd
+/// efficiency (`groupings[g]`: tests broadcast, lanes offered).
+fn print_rows(name: &str, count: &str, groupings: &[(usize, usize)], needed: usize) {
+    let share = |num: f64, den: usize, unit: &str, digits: usize| {
+        if den == 0 {
+            String::from("-")
+        } else {
+            format!("{:.*}{unit}", digits, num / den as f64)
+        }
+    };
+    let base = groupings[0].0;
+    let mut line = format!("{name:<22} {count:>7} {base:>11}");
+    for &(tests, _) in &groupings[1..] {
+        line += &format!(" {:>11}", share(tests as f64, base, "x", 2));
+    }
+    println!("{line}");
+    let mut line = format!("{:<22} {:>7}", "  simd efficiency", "");
+    for &(_, lanes) in groupings {
+        line += &format!(" {:>11}", share(100.0 * needed as f64, lanes, "%", 1));
+    }
+    println!("{line}");
+}
+
 fn morton(x: u32, y: u32, z: u32, bits: u32) -> u64 {
     (0..bits).rev().fold(0u64, |m, b| {
         m << 3 | ((x >> b & 1) as u64) << 2 | ((y >> b & 1) as u64) << 1 | (z >> b & 1) as u64
@@ -214,7 +243,7 @@ pub fn command(a: RegroupArgs) -> Result<()> {
         "frame o+d",
         "by leaves"
     );
-    let mut total = [(0usize, 0usize); 7];
+    let mut total = [(0usize, 0usize); GROUPINGS];
     let mut total_needed = 0usize;
     for (name, segs) in names.iter().zip(&kinds) {
         let reach: Vec<Vec<u32>> = segs
@@ -278,7 +307,7 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             order.chunks(64).map(|c| c.to_vec()).collect::<Vec<_>>()
         };
         let all = u32::MAX;
-        let groupings = [
+        let groupings: [(usize, usize); GROUPINGS] = [
             cost(&chip),
             cost(&quads),
             cost(&regroup(1, false)),
@@ -287,53 +316,14 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             cost(&regroup(all, true)),
             cost(&oracle),
         ];
-        let base = groupings[0].0;
-        let ratio = |c: usize| {
-            if base == 0 {
-                String::from("-")
-            } else {
-                format!("{:.2}x", c as f64 / base as f64)
-            }
-        };
-        let eff = |(_, offered): (usize, usize)| {
-            if offered == 0 {
-                String::from("-")
-            } else {
-                format!("{:.1}%", 100.0 * needed as f64 / offered as f64)
-            }
-        };
-        let mut line = format!("{name:<22} {:>7} {base:>11}", segs.len());
-        for &g in &groupings[1..] {
-            line += &format!(" {:>11}", ratio(g.0));
-        }
-        println!("{line}");
-        let mut line = format!("{:<22} {:>7}", "  simd efficiency", "");
-        for &g in &groupings {
-            line += &format!(" {:>11}", eff(g));
-        }
-        println!("{line}");
+        print_rows(name, &segs.len().to_string(), &groupings, needed);
         for (t, g) in total.iter_mut().zip(groupings) {
             t.0 += g.0;
             t.1 += g.1;
         }
         total_needed += needed;
     }
-    let mut line = format!("{:<22} {:>7} {:>11}", "all rays", "", total[0].0);
-    for g in &total[1..] {
-        line += &format!(
-            " {:>11}",
-            format!("{:.2}x", g.0 as f64 / total[0].0.max(1) as f64)
-        );
-    }
-    println!("{line}");
-    let mut line = format!("{:<22} {:>7}", "  simd efficiency", "");
-    for g in &total {
-        line += &format!(
-            " {:>11}",
-            format!("{:.1}%", 100.0 * total_needed as f64 / g.1.max(1) as f64)
-        );
-    }
-    println!("{line}");
+    print_rows("all rays", "", &total, total_needed);
     Ok(())
 }
 

@@ -438,9 +438,9 @@ fn resident(mut w: W, tree: &Tree, node_at: &[usize]) -> (Vec<i32>, usize) {
 /// Leaf pieces: a leaf's records (grouped by type) cut into a first piece
 /// of at most `first` words, a second of at most `second` (where `second`
 /// is under `rest`), and what remains in as few pieces of at most `rest`
-/// words as hold it, of about equal words (the last no smaller than the
-/// others need be: a small piece moves fast, but the piece after it then
-/// waits for its DMA); a piece holds at least one record. Each piece is a
+/// words as hold it, of about equal words (rather than full pieces and a
+/// remainder: as many pieces, the longest shorter, so the longest wait
+/// for a piece's DMA is shorter); a piece holds at least one record. Each piece is a
 /// node record of its own, chained from the leaf (`PS_NEXT`). Per piece
 /// its (type index, slot) pairs and its place in its leaf (0 for the
 /// first), and per node the index of its first piece (`usize::MAX`: none).
@@ -466,7 +466,6 @@ fn pieces(
             .enumerate()
             .flat_map(|(j, qs)| qs.into_iter().map(move |q| (j, q)))
             .collect();
-        let words = |r: &[(usize, usize)]| -> usize { r.iter().map(|&(j, _)| types[j].size).sum() };
         // Up to `limit` words from `recs[*i..]`; the piece closes at the
         // first record that reaches `enough` words.
         let take = |i: &mut usize, limit: usize, enough: usize| {
@@ -490,7 +489,7 @@ fn pieces(
         if second < rest && i < recs.len() {
             leaf.push(take(&mut i, second, usize::MAX));
         }
-        let left = words(&recs[i..]);
+        let left: usize = recs[i..].iter().map(|&(j, _)| types[j].size).sum();
         if left > 0 {
             let n = left.div_ceil(rest);
             let even = left.div_ceil(n);
