@@ -30,6 +30,10 @@
 
 use crate::scene::Aabb;
 
+/// Deepest BSP the compiler builds (the packet traversal keeps one
+/// interval slot per level in every RC's RAM).
+pub const MAX_BSP_DEPTH: u32 = 32;
+
 /// How a node's splitting plane is chosen.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -253,7 +257,7 @@ impl Bsp {
 pub fn auto_depth(objects: usize) -> u32 {
     (8.0 + 1.3 * (objects.max(1) as f64).log2())
         .round()
-        .clamp(15.0, crate::scene_image::MAX_BSP_DEPTH as f64) as u32
+        .clamp(15.0, MAX_BSP_DEPTH as f64) as u32
 }
 
 fn child_box(b: Aabb, axis: usize, pos: f64, above: bool) -> Aabb {

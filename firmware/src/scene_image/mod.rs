@@ -49,9 +49,7 @@ pub const LIGHT_WORDS: usize = 6;
 pub const MATERIAL_WORDS: usize = 8;
 /// Child index of a leaf.
 pub const NO_CHILD: u16 = 0xFFFF;
-/// Deepest BSP the compiler builds (the packet traversal keeps one
-/// interval slot per level in every RC's RAM).
-pub const MAX_BSP_DEPTH: u32 = 32;
+pub use crate::bsp::MAX_BSP_DEPTH;
 /// Compact layout: object index bits of a list entry.
 pub const LIST_INDEX_BITS: u32 = 13;
 

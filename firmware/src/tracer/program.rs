@@ -49,7 +49,7 @@ pub fn program(
     if merged {
         shadows::routine(&mut t, lay);
     }
-    if shading::phong_in_runs(lay) {
+    if lay.phong_in_runs() {
         shading::phong_runs(&mut t, lay.shines.len());
     }
     match (lay.traversal, lay.stream.is_some()) {
@@ -131,7 +131,7 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
     ));
     v.push((
         names::PHONG.into(),
-        shading::shade(&lay.shines, shading::phong_in_runs(lay)),
+        shading::shade(&lay.shines, lay.phong_in_runs()),
     ));
     for i in 0..4 {
         v.push((names::out(i).into(), shading::out_word(i)));

@@ -677,16 +677,18 @@ pub fn out_word(i: u32) -> K {
 }
 
 /// Whether `k_phong` runs a material at a time ([`shade`]'s `runs`): the
-/// broadcast unit's `cut` contexts, and more than one material.
-pub fn phong_in_runs(lay: &super::layout::FbImage) -> bool {
-    lay.cut_runs && lay.shines.len() > 1
+/// broadcast unit's `cut` contexts (`cut_runs`), and more than one
+/// material.
+pub fn phong_in_runs(cut_runs: bool, materials: usize) -> bool {
+    cut_runs && materials > 1
 }
 
 /// TinyRISC code shading the light of Phong stream `stream` (an FB
-/// address): `k_phong` broadcast whole, or a call of the `phong` routine
-/// ([`phong_in_runs`]: clobbers r1..r3 and r15).
-pub fn broadcast_phong(t: &mut Code, lay: &super::layout::FbImage, stream: &str) {
-    if phong_in_runs(lay) {
+/// address): `k_phong` broadcast whole, or where it runs a material at a
+/// time (`runs`, [`phong_in_runs`]) a call of the `phong` routine
+/// (clobbers r1..r3 and r15).
+pub fn broadcast_phong(t: &mut Code, runs: bool, stream: &str) {
+    if runs {
         t.li(R3, stream)
             .jal("phong")
             .c("its Phong terms, a material at a time");

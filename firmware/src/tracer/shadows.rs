@@ -568,7 +568,7 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
             .sfb(R3, at(format!("SC_PARAM + {}", 5 * l + 4), R4))
             .addi(R3, R4, format!("SC_PARAM + {}", 5 * l));
         t.m("BCAST_AT", format!("{}, r3", names::SHADOW_LIT));
-        super::shading::broadcast_phong(t, lay, &format!("FB_SHADE{l}"));
+        super::shading::broadcast_phong(t, lay.phong_in_runs(), &format!("FB_SHADE{l}"));
     }
     t.lw(super::emit::R15, at("SC_RET", R0)).line("jr r15");
 }

@@ -140,7 +140,7 @@ pub fn macros(lay: &FbImage) -> Code {
                 .c("any hit")
                 .jal("trace")
                 .m("BCAST", names::WAKE);
-            super::shading::broadcast_phong(b, lay, "\\shade");
+            super::shading::broadcast_phong(b, lay.phong_in_runs(), "\\shade");
         }),
     );
     let packet = lay.traversal == super::Traversal::Packet;

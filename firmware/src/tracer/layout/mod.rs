@@ -24,10 +24,13 @@ pub mod packet_nodes;
 pub mod paper_nodes;
 
 use crate::scene::{PrimType, Scene, Shape, Vec3};
-use crate::scene_image::{SceneImage, Q_MATERIAL, Q_UNIT};
+use crate::scene_image::SceneImage;
 
-use super::math::{table_slots_for, word_max};
+use super::math::table_slots_for;
 pub use super::primitives::ChipType;
+pub use super::primitives::record::fb_word_bytes;
+pub(crate) use super::primitives::record::W;
+use super::primitives::record::{fit_shift_w, Fitter};
 use super::primitives::{aabox, cone, cylinder, planar, polygon, smooth_triangle, sphere, Fit};
 use super::shading::phong_exponent;
 use super::{NodeLayout, Options, Traversal};
@@ -92,7 +95,7 @@ pub struct FbImage {
     /// broadcast unit ends the run (`on`); else TinyRISC runs the parts.
     pub cut_runs: bool,
     /// Packet traversal: FB address of the root cell widened by
-    /// [`super::traversal::packet::P_TOL`] (6 words: per axis min, max).
+    /// [`packet_nodes::P_TOL`] (6 words: per axis min, max).
     pub root_box: usize,
     /// Packet traversal: the tree it walks is a single leaf.
     pub root_leaf: bool,
@@ -122,6 +125,14 @@ pub struct FbImage {
     /// The streamed layout (scenes that do not fit FB set 0), or `None`
     /// when the whole scene is resident in the FB.
     pub stream: Option<Stream>,
+}
+
+impl FbImage {
+    /// Whether `k_phong` runs a material at a time
+    /// ([`super::shading::phong_in_runs`]).
+    pub fn phong_in_runs(&self) -> bool {
+        super::shading::phong_in_runs(self.cut_runs, self.shines.len())
+    }
 }
 
 /// FB bank 1 (set 0): the streaming buffer of the streamed layout.
@@ -181,118 +192,6 @@ pub struct FansApart {
     pub word_shift: u32,
 }
 
-/// The FB image as it is written: words (16-bit values, or 32-bit on the
-/// 32-bit chip) in the order the kernels stream them.
-pub(crate) struct W {
-    pub(crate) fb: Vec<i32>,
-    /// LSBs per scene unit (`2^frac`).
-    pub(crate) s: f64,
-    /// Fraction bits of the scene format.
-    pub(crate) frac: u32,
-    /// Extra bits of the datapath (0 or 16).
-    pub(crate) x: u32,
-    /// Words that live in main memory only (streamed layouts): the banded
-    /// polygons' sub-edges ([`polygon::Form::Apart`]).
-    pub(crate) fans: Vec<i32>,
-    /// The most words of one polygon's sub-edges in `fans`.
-    pub(crate) fan_most: usize,
-}
-
-impl W {
-    /// Bytes of an FB word: 2 (16-bit chip) or 4.
-    pub(crate) fn word_bytes(&self) -> usize {
-        if self.x == 0 {
-            2
-        } else {
-            4
-        }
-    }
-    pub(crate) fn max(&self) -> f64 {
-        word_max(self.x)
-    }
-    /// Round and saturate to the word.
-    pub(crate) fn sat(&self, v: f64) -> i32 {
-        v.round().clamp(-self.max() - 1.0, self.max()) as i32
-    }
-    pub(crate) fn push(&mut self, v: f64) {
-        let v = self.sat(v);
-        self.fb.push(v);
-    }
-    /// A 16-bit structural word (flags, bit vectors), sign-extended.
-    pub(crate) fn word16(&mut self, v: u16) {
-        self.fb.push(v as i16 as i32);
-    }
-    /// One in Q1.14 (16-bit chip) or Q1.30.
-    pub(crate) fn one(&self) -> f64 {
-        ((14 + self.x) as f64).exp2()
-    }
-    pub(crate) fn coord(&mut self, x: f64) {
-        self.push(x * self.s);
-    }
-    pub(crate) fn point(&mut self, v: Vec3) {
-        for x in v.to_array() {
-            self.coord(x);
-        }
-    }
-    pub(crate) fn unit(&mut self, v: Vec3) {
-        let k = Q_UNIT.lsb().recip() * (self.x as f64).exp2();
-        for x in v.to_array() {
-            self.push(x * k);
-        }
-    }
-    /// One component of a unit vector (Q1.14).
-    pub(crate) fn unit_axis(&mut self, x: f64) {
-        self.push(x * Q_UNIT.lsb().recip() * (self.x as f64).exp2());
-    }
-    pub(crate) fn col(&mut self, x: f64) {
-        self.push(x * Q_MATERIAL.lsb().recip() * (self.x as f64).exp2());
-    }
-    pub(crate) fn raw(&mut self, x: i64) {
-        self.push(x as f64);
-    }
-    pub(crate) fn scaled(&mut self, v: Vec3, scale: f64) {
-        for x in v.to_array() {
-            self.push(x * scale);
-        }
-    }
-}
-
-/// FB words as the bytes DMA moves: 2 per word (16-bit chip, `x` = 0) or
-/// 4 (32-bit chip), little-endian.
-pub fn fb_word_bytes(words: &[i32], x: u32) -> Vec<u8> {
-    if x == 0 {
-        words
-            .iter()
-            .flat_map(|w| (*w as i16).to_le_bytes())
-            .collect()
-    } else {
-        words.iter().flat_map(|w| w.to_le_bytes()).collect()
-    }
-}
-
-/// The scale shifts of the kernels, fitted to the word of the datapath.
-pub(crate) struct Fitter {
-    /// Extra bits of the datapath (0 or 16).
-    pub(crate) x: u32,
-}
-
-impl Fitter {
-    /// Largest shift `k` with `m * 2^k` within the word, clamped to 0..=max.
-    pub(crate) fn shift(&self, m: f64, max: u32) -> u32 {
-        fit_shift_w(m, max, self.x)
-    }
-    /// `KS` of a kernel whose record holds `2^(14+KS) / v` for the smallest
-    /// `v` (LSB) of the scene: as large as keeps it in the word, at most 16
-    /// (plus the datapath's extra bits); 8 where there is none.
-    pub(crate) fn ks(&self, min: f64) -> u32 {
-        if min.is_finite() {
-            self.shift(((14 + self.x) as f64).exp2() / min, 16 + self.x)
-        } else {
-            8
-        }
-    }
-}
-
 /// The scene's distinct materials, and per scene material its index among
 /// them (materials equal in every field are one).
 fn distinct_materials(scene: &Scene) -> (Vec<usize>, Vec<crate::scene::Material>) {
@@ -315,16 +214,6 @@ fn distinct_materials(scene: &Scene) -> (Vec<usize>, Vec<crate::scene::Material>
         })
         .collect();
     (of, mats)
-}
-
-/// Largest shift `k` with `m * 2^k` within the word (`<= 2^(15+x) - 1`:
-/// 32767 on the 16-bit chip), clamped to 0..=max.
-pub(crate) fn fit_shift_w(m: f64, max: u32, x: u32) -> u32 {
-    if m <= 0.0 {
-        return max;
-    }
-    let k = (word_max(x) / m).log2().floor();
-    k.clamp(0.0, max as f64) as u32
 }
 
 /// Largest absolute coordinate of the eye and of every object's bounds.
@@ -548,7 +437,7 @@ fn build_as(
     let root_box = if packet {
         let at = w.fb.len();
         let b = image.bsp.nodes[0].bounds;
-        let tol = super::traversal::packet::P_TOL as f64;
+        let tol = packet_nodes::P_TOL as f64;
         for a in 0..3 {
             w.push((b.min.axis(a) * s).floor() - tol);
             w.push((b.max.axis(a) * s).ceil() + tol);

@@ -20,6 +20,10 @@ use super::{
 use crate::bsp::Node;
 use crate::scene::{PrimType, Scene, Shape};
 
+/// Widening of every split plane and of the root box in the packet
+/// traversal, in LSB of the scene format.
+pub const P_TOL: i32 = 4;
+
 /// Array cycles a packet spends on an inner node (its kernel and
 /// TinyRISC's decision), for [`super::super::Collapse::Auto`]. 43 to 45
 /// on the SPD scenes at 128x128 (`render --profile`); 48 here walks more

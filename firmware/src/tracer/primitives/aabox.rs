@@ -28,7 +28,7 @@ use super::super::math::divide;
 use super::super::memory_map::ram;
 use super::{self_margin, Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::W;
+use super::record::W;
 
 /// Words of one copy of the record.
 pub const WORDS: usize = 24;

@@ -51,7 +51,7 @@ use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
 use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::{Fitter, W};
+use super::record::{Fitter, W};
 
 /// Words of the body.
 pub const BODY_WORDS: usize = 40;

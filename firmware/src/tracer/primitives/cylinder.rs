@@ -47,7 +47,7 @@ use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
 use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::{Fitter, W};
+use super::record::{Fitter, W};
 
 /// The margin of the bound before the first cut, in LSB: the bound's
 /// rounding (under 2 LSB: `oc2` rounded, the products) and the exact

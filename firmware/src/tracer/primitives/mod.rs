@@ -27,6 +27,7 @@ pub mod cone;
 pub mod cylinder;
 pub mod planar;
 pub mod polygon;
+pub mod record;
 pub mod smooth_triangle;
 pub mod sphere;
 

@@ -34,7 +34,7 @@ use super::super::math::divide;
 use super::super::memory_map::ram;
 use super::{commit_streamed_normal, commit_streamed_normal_two, Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::W;
+use super::record::W;
 
 /// Record words.
 pub const WORDS: usize = 20;

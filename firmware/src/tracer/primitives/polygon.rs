@@ -76,7 +76,7 @@ use super::super::memory_map::ram;
 use super::planar::plane_hit;
 use super::{commit_streamed_normal, commit_streamed_normal_two, kaddr, klen, Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::W;
+use super::record::W;
 
 /// Words of the head, one edge and the tail.
 pub const HEAD_WORDS: usize = 15;

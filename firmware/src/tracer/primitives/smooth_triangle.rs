@@ -32,7 +32,7 @@ use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
 use super::{Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::W;
+use super::record::W;
 
 /// Record words: the planar record with the vertex normals.
 pub const WORDS: usize = planar::WORDS + 9;

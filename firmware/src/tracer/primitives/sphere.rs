@@ -40,7 +40,7 @@ use super::super::math::{perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::{self_margin, Fit, Gen, Sides};
 use crate::scene::Vec3;
-use crate::tracer::layout::{Fitter, W};
+use super::record::{Fitter, W};
 
 /// Record words, coarse and fine.
 pub const WORDS: usize = 8;

@@ -83,9 +83,7 @@ use super::super::primitives::{
 use super::child_order::{self, ChildOrder};
 use crate::tracer::kernel_names as names;
 
-/// Widening of every split plane and of the root box in the packet
-/// traversal, in LSB of the scene format.
-pub const P_TOL: i32 = 4;
+pub use super::super::layout::packet_nodes::P_TOL;
 
 /// The packet traversal's code by the items of its cost model
 /// ([`crate::tracer::layout::packet_nodes::chip_costs`]), for `render
