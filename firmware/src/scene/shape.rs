@@ -118,6 +118,11 @@ impl Shape {
         }
     }
 
+    /// A cylinder or cone with its end caps on.
+    pub fn capped(&self) -> bool {
+        matches!(self, Shape::Cone { caps: true, .. })
+    }
+
     /// The shape moved by `d` (directions, radii and normals unchanged).
     pub fn translated(&self, d: Vec3) -> Shape {
         let mut s = self.clone();

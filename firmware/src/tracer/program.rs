@@ -6,7 +6,7 @@
 
 use super::emit::{define, Code, K};
 use super::kernel_names as names;
-use super::layout::{FbImage, STREAM_BANK};
+use super::layout::{FbImage, TypeInfo, STREAM_BANK};
 use super::memory_map::{format_lines, ram_lines};
 use super::primitives::{self, ChipType, Gen};
 use super::{mem, shading, shadows, tiles, traversal, Numerics, Options, Traversal};
@@ -111,12 +111,7 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
         v.extend(traversal::paper::kernels());
     }
     // Smooth triangles: the shading normal and the reflection's fallback.
-    let smooth = lay.types.iter().any(|x| {
-        matches!(
-            x.ty,
-            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle
-        )
-    });
+    let smooth = lay.types.iter().any(|x| x.ty.primitive().smooth());
     v.push((names::EYE.into(), shading::eye(nm.approx(), lay.refract)));
     for (name, level0) in [(names::POST_EYE, true), (names::POST, false)] {
         let mut post = shading::post(level0, lay.materials, smooth, lay.refract);
@@ -280,36 +275,22 @@ fn header(
     block(&mut s, "the scene's fit", fit);
     block(&mut s, "main memory (byte addresses)", main_memory(lay));
     block(&mut s, "FB set 0 (word addresses)", fb(lay));
+    // Each primitive's record fields, for the sides of its types present;
+    // its records carry caps or not alike for both.
     let mut rec = Vec::new();
-    let sides = |a: ChipType, b: ChipType| -> Vec<primitives::Sides> {
-        [a, b]
-            .into_iter()
-            .filter(|t| types.contains(t))
-            .map(|t| t.sides())
-            .collect()
-    };
-    // Whether a family's records carry caps (the same for its opaque and
-    // glass type).
-    let caps = |a: ChipType, b: ChipType| {
-        lay.types
+    for p in primitives::PRIMITIVES {
+        let present: Vec<&TypeInfo> = lay
+            .types
             .iter()
-            .any(|ti| (ti.ty == a || ti.ty == b) && ti.caps)
-    };
-    let cyl = sides(ChipType::Cylinder, ChipType::GlassCylinder);
-    if !cyl.is_empty() {
-        let c = caps(ChipType::Cylinder, ChipType::GlassCylinder);
-        rec.extend(primitives::cylinder::header(&lay.fit, &cyl, c));
-    }
-    let cone = sides(ChipType::Cone, ChipType::GlassCone);
-    if !cone.is_empty() {
-        let c = caps(ChipType::Cone, ChipType::GlassCone);
-        rec.extend(primitives::cone::header(&cone, c));
-    }
-    if types
-        .iter()
-        .any(|t| matches!(t, ChipType::Polygon | ChipType::GlassPolygon))
-    {
-        rec.extend(primitives::polygon::header(lay.fit.polygon_form));
+            .filter(|ti| ti.ty.primitive().names() == p.names())
+            .collect();
+        if present.is_empty() {
+            continue;
+        }
+        let mut sides: Vec<primitives::Sides> = present.iter().map(|ti| ti.ty.sides()).collect();
+        sides.sort_by_key(|s| *s != primitives::Sides::Front);
+        let caps = present.iter().any(|ti| ti.caps);
+        rec.extend(p.record_header(&lay.fit, &sides, caps));
     }
     if !rec.is_empty() {
         block(

@@ -23,15 +23,15 @@
 pub mod packet_nodes;
 pub mod paper_nodes;
 
-use crate::scene::{PrimType, Scene, Shape, Vec3};
+use crate::scene::{Scene, Shape, Vec3};
 use crate::scene_image::SceneImage;
 
 use super::math::table_slots_for;
-pub use super::primitives::ChipType;
 pub use super::primitives::record::fb_word_bytes;
 pub(crate) use super::primitives::record::W;
 use super::primitives::record::{fit_shift_w, Fitter};
-use super::primitives::{aabox, cone, cylinder, planar, polygon, smooth_triangle, sphere, Fit};
+pub use super::primitives::ChipType;
+use super::primitives::{polygon, Fit, Geometry, Object, RecordError, PRIMITIVES};
 use super::shading::phong_exponent;
 use super::{NodeLayout, Options, Traversal};
 pub use packet_nodes::{PK_INNER, PK_LEAF_HEAD, PK_MAILBOX_BYTES};
@@ -350,17 +350,6 @@ pub fn build_packet(
         Err(_) if may_band => build(polygon::Form::Plain),
         r => r,
     }
-}
-
-/// The geometry a primitive's record is written from, computed once for
-/// the fit of the scale shifts and the records.
-enum Geometry {
-    /// Spheres, boxes, polygons: from the shape itself.
-    None,
-    /// Rectangles and triangles (one), a cylinder's caps (two).
-    Planars(Vec<planar::Planar>),
-    /// A cone: its fit and caps.
-    Cone(Box<(cone::ConeFit, [planar::Planar; 2])>),
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -719,94 +708,21 @@ fn fit_scene(
     let mut geo: Vec<Geometry> = Vec::with_capacity(scene.objects.len());
     let (fan, polygon_bands) = polygon_fan(scene, s, bands);
     for o in &scene.objects {
-        geo.push(match &o.shape {
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-                ..
-            } if o.shape.prim_type() == PrimType::Cone => {
-                let f = cone::ConeFit::of(*base, *base_radius, *apex, *apex_radius, s);
-                let caps = f.caps(*base, *base_radius, *apex, *apex_radius, s);
-                Geometry::Cone(Box::new((f, caps)))
-            }
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                ..
-            } => Geometry::Planars(cylinder::caps(*base, *apex, base_radius.abs()).to_vec()),
-            Shape::Rectangle {
-                corner,
-                edge1,
-                edge2,
-            } => Geometry::Planars(vec![planar::Planar::rectangle(
-                *corner,
-                *edge1,
-                *edge2,
-                edge1.cross(*edge2).normalized(),
-            )]),
-            Shape::Triangle { v, .. } => {
-                let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
-                Geometry::Planars(vec![planar::Planar::triangle(v[0], v[1], v[2], n)])
-            }
-            Shape::Polygon { .. } | Shape::Sphere { .. } | Shape::Box { .. } => Geometry::None,
-        });
+        geo.push(
+            ChipType::of_object(&o.shape, false)
+                .primitive()
+                .geometry(&o.shape, s),
+        );
     }
     let mut m = [0.0f64; 3];
     for g in &geo {
-        let ps: &[planar::Planar] = match g {
-            Geometry::Planars(p) => p,
-            Geometry::Cone(fc) => &fc.1,
-            Geometry::None => &[],
-        };
-        for p in ps {
+        for p in g.planars() {
             let k = p.kind.kt_index();
             m[k] = m[k].max(p.dual_max((14 + xb) as i32 - frac as i32));
         }
     }
     let kt = m.map(|m| fitter.shift(m, 24 + xb));
-    let radii = scene.objects.iter().filter_map(|o| match o.shape {
-        Shape::Sphere { radius, .. } => Some(radius.abs() * s),
-        _ => None,
-    });
-    let (ks_sphere, ep_sphere, sphere_fine) = sphere::fit(radii, &fitter);
-    let sphere_inside = scene
-        .objects
-        .iter()
-        .any(|o| matches!(o.shape, Shape::Sphere { inside: true, .. }));
-    let cyl_inside = scene.objects.iter().any(|o| {
-        matches!(o.shape, Shape::Cone { inside: true, .. })
-            && o.shape.prim_type() == PrimType::Cylinder
-    });
-    let cyl_radii = scene.objects.iter().filter_map(|o| match o.shape {
-        Shape::Cone { base_radius, .. } if o.shape.prim_type() == PrimType::Cylinder => {
-            Some(base_radius.abs() * s)
-        }
-        _ => None,
-    });
-    let base_radii = scene.objects.iter().filter_map(|o| match o.shape {
-        Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
-        _ => None,
-    });
-    let (ks_cyl, ep_cyl) = cylinder::fit(cyl_radii, base_radii, &fitter);
-    let cone_fits = geo.iter().filter_map(|g| match g {
-        Geometry::Cone(fc) => Some(fc.0),
-        _ => None,
-    });
-    let (ks_cone, ep_cone) = cone::fit(cone_fits, &fitter);
-    let fit = Fit {
-        ks_sphere,
-        ep_sphere,
-        sphere_fine,
-        sphere_inside,
-        cyl_inside,
-        cyl_bound: false,
-        ks_cyl,
-        ep_cyl,
-        ks_cone,
-        ep_cone,
+    let mut fit = Fit {
         kt,
         fine_normals,
         polygon_form: if polygon_bands {
@@ -814,8 +730,11 @@ fn fit_scene(
         } else {
             polygon::Form::Plain
         },
+        ..Fit::default()
     };
-
+    for p in PRIMITIVES {
+        p.fit(scene, &geo, s, &fitter, &mut fit);
+    }
     (geo, fan, fit)
 }
 
@@ -878,72 +797,21 @@ fn records(
             let o = &scene.objects[i];
             let mat = mat_of[o.material];
             let start = w.fb.len();
-            match (&o.shape, &geo[i]) {
-                (
-                    Shape::Cone {
-                        inside, caps: on, ..
-                    },
-                    Geometry::Cone(fc),
-                ) => cone::write(
-                    w,
-                    fit,
-                    t.sides(),
-                    &fc.0,
-                    *inside,
-                    caps.then_some((*on, &fc.1)),
-                    i,
-                    mat,
-                )
-                .map_err(|m| err(o.line, m))?,
-                (
-                    Shape::Sphere {
-                        center,
-                        radius,
-                        inside,
-                    },
-                    _,
-                ) => sphere::write(w, fit, unrounded, *center, *radius, *inside, i, mat),
-                (
-                    Shape::Cone {
-                        base,
-                        base_radius,
-                        apex,
-                        inside,
-                        caps: on,
-                        ..
-                    },
-                    Geometry::Planars(discs),
-                ) => cylinder::write(
-                    w,
-                    fit,
-                    t.sides(),
-                    *base,
-                    *apex,
-                    *base_radius,
-                    *inside,
-                    caps.then_some((*on, &[discs[0], discs[1]])),
-                    i,
-                    mat,
-                ),
-                (Shape::Box { min, max }, _) => aabox::write(w, t.sides(), *min, *max, i, mat),
-                (Shape::Polygon { v, .. }, _) => {
-                    polygon::write(w, v, size, fit.polygon_form, i, mat).map_err(|m| err(0, m))?
-                }
-                (
-                    Shape::Triangle {
-                        normals: Some(ns), ..
-                    },
-                    Geometry::Planars(p),
-                ) if matches!(t, ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle) => {
-                    smooth_triangle::write(w, &fit.kt, &p[0], *ns, i, mat)
-                }
-                (_, Geometry::Planars(ps)) => {
-                    for p in ps {
-                        planar::write(w, &fit.kt, p, i, mat);
-                    }
-                }
-                _ => {}
-            }
+            let record = Object {
+                shape: &o.shape,
+                geometry: &geo[i],
+                fit,
+                sides: t.sides(),
+                caps,
+                size,
+                unrounded,
+                id: i,
+                mat,
+            };
+            t.primitive().write(w, &record).map_err(|e| match e {
+                RecordError::Object(m) => err(o.line, m),
+                RecordError::Scene(m) => err(0, m),
+            })?;
             debug_assert_eq!(w.fb.len() - start, size, "{t:?}");
             if w.fb.len() - start != size {
                 return Err(format!(
@@ -977,15 +845,13 @@ fn records(
 /// as published), under the packet traversal where some cylinder (cone)
 /// of the scene, opaque or glass, has caps; other types never.
 pub(crate) fn records_carry_caps(scene: &Scene, t: ChipType, traversal: Traversal) -> bool {
-    let family = match t {
-        ChipType::Cylinder | ChipType::GlassCylinder => PrimType::Cylinder,
-        ChipType::Cone | ChipType::GlassCone => PrimType::Cone,
-        _ => return false,
-    };
-    traversal == Traversal::Paper
-        || scene.objects.iter().any(|o| {
-            matches!(o.shape, Shape::Cone { caps: true, .. }) && o.shape.prim_type() == family
-        })
+    let p = t.primitive();
+    p.disc_caps()
+        && (traversal == Traversal::Paper
+            || scene
+                .objects
+                .iter()
+                .any(|o| p.is_of(&o.shape) && o.shape.capped()))
 }
 
 /// The scene's objects by chip type (indexed by `ChipType as usize`, in

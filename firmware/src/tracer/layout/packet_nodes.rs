@@ -9,16 +9,14 @@
 //! `traversal/packet.rs`; the subtrees it walks as one leaf are chosen
 //! here ([`super::super::Collapse`]).
 
-use super::super::primitives::{
-    aabox, cone, cylinder, planar, polygon, sphere, Body, Fit, Gen, Sides,
-};
+use super::super::primitives::{of_shape, polygon, Fit, Gen, TestCost, PRIMITIVES};
 use super::super::{mem, Collapse};
 use super::{
     fb_word_bytes, FansApart, FbImage, Finish, Stream, TypeInfo, FB_LIMIT, NODE_BYTES, STREAM_BANK,
     W,
 };
 use crate::bsp::Node;
-use crate::scene::{PrimType, Scene, Shape};
+use crate::scene::Scene;
 
 /// Widening of every split plane and of the root box in the packet
 /// traversal, in LSB of the scene format.
@@ -51,38 +49,19 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
         test_cuts: true,
         published: false,
     };
-    // (contexts up to the first cut, contexts after it)
-    let parts = |k: &super::super::emit::K| (k.first_part(), k.len() - k.first_part());
-    let sphere = parts(&sphere::kernel(&g, fit, Sides::Front));
-    let disc = planar::kernel(&g, planar::Inside::Disc, Sides::Front).len();
-    let cyl = parts(&cylinder::kernel(&g, fit, Body::Opaque));
-    let cone = parts(&cone::kernel(&g, Body::Opaque));
-    let boxk = parts(&aabox::kernel(&g, Sides::Front));
-    let planar = parts(&planar::kernel(&g, planar::Inside::Triangle, Sides::Front));
-    let poly: Vec<usize> = polygon::kernels(&g, Sides::Front, polygon::Form::Plain)
-        .iter()
-        .map(|(_, k)| k.len())
-        .collect();
-    let (ph, pe, pt) = (poly[0], poly[1], poly[2]);
-    let cost = |(first, rest): (usize, usize), more: usize| {
-        first as f64 + PART_ON * (rest + more) as f64 + PK_OBJECT_RISC
-    };
+    let costs: Vec<TestCost> = PRIMITIVES.iter().map(|p| p.test_cost(&g, fit)).collect();
     scene
         .objects
         .iter()
-        .map(|o| match &o.shape {
-            Shape::Sphere { .. } => cost(sphere, 0),
-            Shape::Cone { caps, .. } => {
-                let body = if o.shape.prim_type() == PrimType::Cone {
-                    cone
-                } else {
-                    cyl
-                };
-                cost(body, if *caps { 2 * disc } else { 0 })
-            }
-            Shape::Box { .. } => cost(boxk, 0),
-            Shape::Rectangle { .. } | Shape::Triangle { .. } => cost(planar, 0),
-            Shape::Polygon { v, .. } => cost((ph, 0), pt + pe * polygon::edges(v, s).1.len()),
+        .map(|o| {
+            let p = of_shape(&o.shape);
+            let c = PRIMITIVES
+                .iter()
+                .zip(&costs)
+                .find(|(q, _)| q.names() == p.names())
+                .map_or(TestCost::default(), |(_, c)| *c);
+            let runs = p.cost_runs(&o.shape, s);
+            c.first as f64 + PART_ON * (c.rest + c.each * runs) as f64 + PK_OBJECT_RISC
         })
         .collect()
 }
@@ -156,15 +135,9 @@ pub fn chip_costs(
         .objects
         .iter()
         .map(|o| {
-            let fan = match &o.shape {
-                Shape::Polygon { v, .. } if fit.polygon_form.banded() => {
-                    polygon::band_edges(&polygon::edges(v, s).1)
-                }
-                Shape::Polygon { v, .. } => polygon::edges(v, s).1.len(),
-                _ => 0,
-            };
             let transmits = scene.materials[o.material].t > 0.0;
             let t = ChipType::of_object(&o.shape, transmits);
+            let fan = t.primitive().fan(&o.shape, s, fit.polygon_form.banded());
             t.record_words(&fit, fan, caps[t as usize])
         })
         .collect();

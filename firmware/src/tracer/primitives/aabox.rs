@@ -23,12 +23,12 @@
 //! **Error** against the f64 box (`tb/tests/kernels.rs`): `t` within 3 LSB,
 //! the normal exact (an axis).
 
-use super::super::emit::K;
+use super::super::emit::{Code, K};
 use super::super::math::divide;
 use super::super::memory_map::ram;
-use super::{self_margin, Gen, Sides};
-use crate::scene::Vec3;
 use super::record::W;
+use super::{self_margin, Fit, Gen, Object, RecordError, Sides, TestCost};
+use crate::scene::{Shape, Vec3};
 
 /// Words of one copy of the record.
 pub const WORDS: usize = 24;
@@ -169,4 +169,37 @@ fn face(k: &mut K, g: &Gen, a: u32, two: bool, exit: bool) {
         k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
     }
     k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
+}
+
+/// The axis-aligned box ([`super::ChipPrimitive`]).
+pub struct AaBox;
+
+impl super::ChipPrimitive for AaBox {
+    fn names(&self) -> [&'static str; 2] {
+        ["box", "glass_box"]
+    }
+
+    fn record_words(&self, sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> usize {
+        words(sides)
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
+        vec![(kernel_name(sides), kernel(g, sides))]
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, _at: &str, _fit: &Fit, _caps: bool) {
+        super::one(t, kernel_name(sides));
+    }
+
+    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
+        TestCost::of(&kernel(g, Sides::Front))
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        let Shape::Box { min, max } = *o.shape else {
+            return Err(RecordError::mismatch("box"));
+        };
+        write(w, o.sides, min, max, o.id, o.mat);
+        Ok(())
+    }
 }

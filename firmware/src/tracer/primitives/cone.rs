@@ -49,9 +49,12 @@ use super::super::emit::{define, Code, Reg, K, R7};
 use super::super::math::{divide_q13, normalize, sqrt_q14, Approx};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
-use crate::scene::Vec3;
 use super::record::{Fitter, W};
+use super::{
+    commit_obj_mat, perpendicular, self_margin, Body, CutTest, Fit, Gen, Geometry, Object,
+    RecordError, Sides, TestCost,
+};
+use crate::scene::{Scene, Shape, Vec3};
 
 /// Words of the body.
 pub const BODY_WORDS: usize = 40;
@@ -367,7 +370,7 @@ pub fn broadcast(t: &mut Code, lbl: &str, sides: Sides, caps_on: bool) {
 }
 
 /// An opaque cone's caps (record at `rec`), where its flag is set (after
-/// its body's run in parts, [`super::run_with_cuts`]).
+/// its body's run in parts, [`super::run_with_cut_contexts`]).
 pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
     let cap = planar::kernel_name(Inside::Disc, Sides::Front);
     super::caps(
@@ -595,5 +598,112 @@ fn normal(k: &mut K, nr: Approx) {
         .c("(f) mov r7, r14");
     for (i, x) in [11, 12, 13].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+}
+
+/// The cone ([`super::ChipPrimitive`]): an NFF or native cone of unequal
+/// radii.
+pub struct Cone;
+
+impl super::ChipPrimitive for Cone {
+    fn names(&self) -> [&'static str; 2] {
+        ["cone", "glass_cone"]
+    }
+
+    fn record_words(&self, sides: Sides, _fit: &Fit, _fan: usize, caps: bool) -> usize {
+        words(sides, caps)
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
+        kernels(g, sides)
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, at: &str, _fit: &Fit, caps: bool) {
+        broadcast(t, at, sides, caps)
+    }
+
+    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+        (sides == Sides::Front).then(|| CutTest {
+            kernel: body_name(Body::Opaque),
+            field: "CONE_BODY",
+            cuts: &CUTS,
+            then: None,
+        })
+    }
+
+    fn disc_caps(&self) -> bool {
+        true
+    }
+
+    fn broadcast_after_cut_test(&self, sides: Sides, t: &mut Code, at: &str, rec: Reg, caps: bool) {
+        if caps && sides == Sides::Front {
+            broadcast_caps(t, at, rec);
+        }
+    }
+
+    fn record_header(&self, _fit: &Fit, sides: &[Sides], caps: bool) -> Vec<String> {
+        header(sides, caps)
+    }
+
+    fn fit_header(&self, fit: &Fit) -> Vec<String> {
+        vec![
+            define("KS_CONE", fit.ks_cone, "cones: invS = 2^(Q14+KS_CONE) / S"),
+            define("EP_CONE", fit.ep_cone, "cones: extra fraction bits of p"),
+        ]
+    }
+
+    fn geometry(&self, shape: &Shape, s: f64) -> Geometry {
+        match *shape {
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                apex_radius,
+                ..
+            } => {
+                let f = ConeFit::of(base, base_radius, apex, apex_radius, s);
+                let caps = f.caps(base, base_radius, apex, apex_radius, s);
+                Geometry::Cone(Box::new((f, caps)))
+            }
+            _ => Geometry::None,
+        }
+    }
+
+    fn fit(&self, _scene: &Scene, geo: &[Geometry], _s: f64, f: &Fitter, fit: &mut Fit) {
+        let fits = geo.iter().filter_map(|g| match g {
+            Geometry::Cone(fc) => Some(fc.0),
+            _ => None,
+        });
+        (fit.ks_cone, fit.ep_cone) = self::fit(fits, f);
+    }
+
+    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
+        TestCost {
+            each: planar::kernel(g, Inside::Disc, Sides::Front).len(),
+            ..TestCost::of(&kernel(g, Body::Opaque))
+        }
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        let (
+            Shape::Cone {
+                inside, caps: on, ..
+            },
+            Geometry::Cone(fc),
+        ) = (o.shape, o.geometry)
+        else {
+            return Err(RecordError::mismatch("cone"));
+        };
+        write(
+            w,
+            o.fit,
+            o.sides,
+            &fc.0,
+            *inside,
+            o.caps.then_some((*on, &fc.1)),
+            o.id,
+            o.mat,
+        )
+        .map_err(RecordError::Object)
     }
 }

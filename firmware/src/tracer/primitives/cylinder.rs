@@ -45,9 +45,12 @@ use super::super::emit::{define, Code, Reg, K, R7};
 use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::{commit_obj_mat, perpendicular, self_margin, Body, Fit, Gen, Sides};
-use crate::scene::Vec3;
 use super::record::{Fitter, W};
+use super::{
+    commit_obj_mat, perpendicular, self_margin, Body, CutTest, Fit, Gen, Geometry, Object,
+    RecordError, Sides, TestCost,
+};
+use crate::scene::{PrimType, Scene, Shape, Vec3};
 
 /// The margin of the bound before the first cut, in LSB: the bound's
 /// rounding (under 2 LSB: `oc2` rounded, the products) and the exact
@@ -483,7 +486,7 @@ pub fn broadcast(t: &mut Code, lbl: &str, _fit: &Fit, sides: Sides, caps_on: boo
 }
 
 /// An opaque cylinder's caps (record at `rec`), where its flag is set
-/// (after its body's run in parts, [`super::run_with_cuts`]).
+/// (after its body's run in parts, [`super::run_with_cut_contexts`]).
 pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
     let cap = planar::kernel_name(Inside::Disc, Sides::Front);
     super::caps(
@@ -537,5 +540,129 @@ fn axial_and_normal(k: &mut K, cut: Option<&str>) {
     }
     for (i, x) in [13, 14, 15].into_iter().enumerate() {
         k.c(format!("(f) st r{x}, [#{}]", ram::HIT_N + i as u32));
+    }
+}
+
+/// The cylinder ([`super::ChipPrimitive`]): an NFF or native cone of
+/// equal radii.
+pub struct Cylinder;
+
+impl super::ChipPrimitive for Cylinder {
+    fn names(&self) -> [&'static str; 2] {
+        ["cylinder", "glass_cylinder"]
+    }
+
+    fn record_words(&self, sides: Sides, fit: &Fit, _fan: usize, caps: bool) -> usize {
+        words(fit, sides, caps)
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
+        kernels(g, fit, sides)
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, at: &str, fit: &Fit, caps: bool) {
+        broadcast(t, at, fit, sides, caps)
+    }
+
+    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+        (sides == Sides::Front).then(|| CutTest {
+            kernel: body_name(Body::Opaque),
+            field: "CYL_BODY",
+            cuts: &CUTS,
+            then: None,
+        })
+    }
+
+    fn disc_caps(&self) -> bool {
+        true
+    }
+
+    fn broadcast_after_cut_test(&self, sides: Sides, t: &mut Code, at: &str, rec: Reg, caps: bool) {
+        if caps && sides == Sides::Front {
+            broadcast_caps(t, at, rec);
+        }
+    }
+
+    fn record_header(&self, fit: &Fit, sides: &[Sides], caps: bool) -> Vec<String> {
+        header(fit, sides, caps)
+    }
+
+    fn fit_header(&self, fit: &Fit) -> Vec<String> {
+        vec![
+            define("KS_CYL", fit.ks_cyl, "cylinders: invr = 2^(Q14+KS_CYL) / r"),
+            define("EP_CYL", fit.ep_cyl, "cylinders: extra fraction bits of p"),
+        ]
+    }
+
+    fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
+        match *shape {
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                ..
+            } => Geometry::Planars(caps(base, apex, base_radius.abs()).to_vec()),
+            _ => Geometry::None,
+        }
+    }
+
+    fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
+        let cylinder = |o: &&crate::scene::Object| o.shape.prim_type() == PrimType::Cylinder;
+        let radii = scene
+            .objects
+            .iter()
+            .filter(cylinder)
+            .filter_map(|o| match o.shape {
+                Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
+                _ => None,
+            });
+        // Every cone-like object's base radius (cylinders' and cones').
+        let base_radii = scene.objects.iter().filter_map(|o| match o.shape {
+            Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
+            _ => None,
+        });
+        (fit.ks_cyl, fit.ep_cyl) = self::fit(radii, base_radii, f);
+        fit.cyl_inside = scene
+            .objects
+            .iter()
+            .filter(cylinder)
+            .any(|o| matches!(o.shape, Shape::Cone { inside: true, .. }));
+    }
+
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
+        TestCost {
+            each: planar::kernel(g, Inside::Disc, Sides::Front).len(),
+            ..TestCost::of(&kernel(g, fit, Body::Opaque))
+        }
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        let (
+            Shape::Cone {
+                base,
+                base_radius,
+                apex,
+                inside,
+                caps: on,
+                ..
+            },
+            Geometry::Planars(discs),
+        ) = (o.shape, o.geometry)
+        else {
+            return Err(RecordError::mismatch("cylinder"));
+        };
+        write(
+            w,
+            o.fit,
+            o.sides,
+            *base,
+            *apex,
+            *base_radius,
+            *inside,
+            o.caps.then_some((*on, &[discs[0], discs[1]])),
+            o.id,
+            o.mat,
+        );
+        Ok(())
     }
 }

@@ -1,4 +1,6 @@
-//! The chip's primitives, one module each: its FB record (the writer and
+//! The chip's primitives, one module each, behind one interface
+//! ([`ChipPrimitive`], listed in [`PRIMITIVES`]; an object's type is a
+//! primitive's opaque or glass [`ChipType`]): its FB record (the writer and
 //! the fields the TinyRISC code addresses), its RC kernel (one routine,
 //! parameterised by the sides it accepts, the normals and the datapath),
 //! the TinyRISC code that broadcasts one object's test, and the math in
@@ -28,15 +30,242 @@ pub mod cylinder;
 pub mod planar;
 pub mod polygon;
 pub mod record;
+
+mod parts;
+pub use parts::{
+    run_first_part, run_rest, run_with_cut_contexts, stream_field, tinyrisc_part, CutTest,
+};
 pub mod smooth_triangle;
 pub mod sphere;
 
 use rtl::rc::Datapath;
 
-use super::emit::{define, Code, Reg, K, R2, R3};
+use super::emit::{define, Code, Reg, K, R3};
 use super::math::Approx;
 use super::memory_map::ram;
-use crate::scene::{PrimType, Shape};
+use crate::scene::{PrimType, Scene, Shape};
+use record::{Fitter, W};
+
+/// One primitive of the chip: everything the tracer knows of it, for
+/// both its kinds (opaque, [`Sides::Front`]; glass, [`Sides::Both`]).
+/// Each module implements it once; [`PRIMITIVES`] lists them and
+/// [`ChipType::primitive`] finds an object type's. Adding a primitive is
+/// a module, its line in both and its tests (`docs/adding-a-primitive.md`).
+pub trait ChipPrimitive: Sync {
+    /// The opaque and the glass type's names (`sphere`, `glass_sphere`).
+    fn names(&self) -> [&'static str; 2];
+
+    /// Words of one object's record (`fan`: a polygon record's edges;
+    /// `caps`: a cylinder's or cone's record carries caps).
+    fn record_words(&self, sides: Sides, fit: &Fit, fan: usize, caps: bool) -> usize;
+
+    /// The kernels its test runs, in load order: (label, kernel). Each
+    /// reads from the FB stream exactly the words its record holds.
+    fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)>;
+
+    /// TinyRISC code broadcasting one object's whole test, its record at
+    /// r7 (labels begin with `at`; clobbers r1..r3).
+    fn broadcast(&self, sides: Sides, t: &mut Code, at: &str, fit: &Fit, caps: bool);
+
+    /// The test the packet traversal runs in parts, where it has one: its
+    /// first kernel's cuts ([`K::cut`]).
+    fn cut_test(&self, _sides: Sides) -> Option<CutTest> {
+        None
+    }
+
+    /// After a cut test's first kernel, where some awake RC has F
+    /// ([`CutTest::then`]): the test's further kernels, its record at
+    /// `rec` (a polygon's edges and tail).
+    fn broadcast_then(&self, _sides: Sides, _t: &mut Code, _at: &str, _rec: Reg, _fit: &Fit) {}
+
+    /// After a cut test's first kernel whatever F: what its record holds
+    /// besides (a cylinder's or cone's caps, where its records carry them).
+    fn broadcast_after_cut_test(
+        &self,
+        _sides: Sides,
+        _t: &mut Code,
+        _at: &str,
+        _rec: Reg,
+        _caps: bool,
+    ) {
+    }
+
+    /// Its records may carry caps, two discs (a cylinder's or cone's):
+    /// then a record that carries them starts with a caps flag, the body
+    /// after it (a cut test's stream starts at its field, else at the
+    /// record), the discs' scale shift `KT_DISC` and `INSIDE_TOL` are in
+    /// the header, and an object's caps cost two disc runs.
+    fn disc_caps(&self) -> bool {
+        false
+    }
+
+    /// The header lines naming the record's fields that the broadcast
+    /// addresses (`sides`: the sides of the scene's types of this
+    /// primitive; `caps`: its records carry caps).
+    fn record_header(&self, _fit: &Fit, _sides: &[Sides], _caps: bool) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// The header lines of its scale shifts in `fit`.
+    fn fit_header(&self, _fit: &Fit) -> Vec<String> {
+        Vec::new()
+    }
+
+    /// Its test includes a planar inside test (`INSIDE_TOL`; caps' discs
+    /// have one).
+    fn has_inside_test(&self) -> bool {
+        self.disc_caps()
+    }
+
+    /// Its glass kind ignores roots within `SELF_LSB` of a ray's start
+    /// (curved glass and boxes; planar glass skips the object a ray
+    /// leaves by its id instead).
+    fn glass_self_margin(&self) -> bool {
+        true
+    }
+
+    /// The geometry its record is written from, computed once per object
+    /// (`s`: LSBs per scene unit) for the scene's fit and the record.
+    fn geometry(&self, _shape: &Shape, _s: f64) -> Geometry {
+        Geometry::None
+    }
+
+    /// Its shading normal is interpolated (smooth shading's kernels).
+    fn smooth(&self) -> bool {
+        false
+    }
+
+    /// Its part of the scene's [`Fit`]: its kernels' scale shifts and
+    /// record variants, from the scene's objects (`geo`: their
+    /// [`ChipPrimitive::geometry`]; `s`: LSBs per scene unit).
+    fn fit(&self, _scene: &Scene, _geo: &[Geometry], _s: f64, _f: &Fitter, _fit: &mut Fit) {}
+
+    /// Whether `shape` is an object of this primitive.
+    fn is_of(&self, shape: &Shape) -> bool {
+        of_shape(shape).names() == self.names()
+    }
+
+    /// What the packet traversal's cost model prices its opaque test with
+    /// (`g`, `fit`: the kernels of tests in parts).
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost;
+
+    /// The further kernel runs an object's test takes beside
+    /// [`TestCost::first`] and [`TestCost::rest`], each of
+    /// [`TestCost::each`] contexts (a polygon's edges, a cylinder's caps;
+    /// `s`: LSBs per scene unit).
+    fn cost_runs(&self, shape: &Shape, _s: f64) -> usize {
+        if self.disc_caps() && shape.capped() {
+            2
+        } else {
+            0
+        }
+    }
+
+    /// The edges of an object's record (a polygon's, or its sub-edges in
+    /// `banded` records; others none): its record's words are
+    /// [`ChipPrimitive::record_words`] of it.
+    fn fan(&self, _shape: &Shape, _s: f64, _banded: bool) -> usize {
+        0
+    }
+
+    /// Write one object's record: exactly [`ChipPrimitive::record_words`]
+    /// words, in the order its kernels read them.
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError>;
+}
+
+/// The primitive of an object's shape.
+pub fn of_shape(shape: &Shape) -> &'static dyn ChipPrimitive {
+    ChipType::of_object(shape, false).primitive()
+}
+
+/// An opaque test's contexts as the cost model prices them.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct TestCost {
+    /// Up to the first cut (a kernel without cuts: the whole first kernel).
+    pub first: usize,
+    /// After it.
+    pub rest: usize,
+    /// Of each further run ([`ChipPrimitive::cost_runs`]).
+    pub each: usize,
+}
+
+impl TestCost {
+    /// The contexts of kernel `k` up to its first cut and after it.
+    pub fn of(k: &K) -> TestCost {
+        TestCost {
+            first: k.first_part(),
+            rest: k.len() - k.first_part(),
+            each: 0,
+        }
+    }
+}
+
+/// Every primitive, in the order their header lines come.
+pub const PRIMITIVES: [&dyn ChipPrimitive; 8] = [
+    &sphere::Sphere,
+    &cylinder::Cylinder,
+    &cone::Cone,
+    &aabox::AaBox,
+    &planar::RECTANGLE,
+    &planar::TRIANGLE,
+    &polygon::Polygon,
+    &smooth_triangle::SmoothTriangle,
+];
+
+/// The geometry a primitive's record is written from
+/// ([`ChipPrimitive::geometry`]).
+pub enum Geometry {
+    /// Spheres, boxes, polygons: from the shape itself.
+    None,
+    /// Rectangles and triangles (one), a cylinder's caps (two).
+    Planars(Vec<planar::Planar>),
+    /// A cone: its fit and caps.
+    Cone(Box<(cone::ConeFit, [planar::Planar; 2])>),
+}
+
+impl Geometry {
+    /// The planar records it holds (the scale shifts `KT_*` fit them).
+    pub fn planars(&self) -> &[planar::Planar] {
+        match self {
+            Geometry::Planars(p) => p,
+            Geometry::Cone(fc) => &fc.1,
+            Geometry::None => &[],
+        }
+    }
+}
+
+/// One object's record as [`ChipPrimitive::write`] writes it.
+pub struct Object<'a> {
+    pub shape: &'a Shape,
+    pub geometry: &'a Geometry,
+    pub fit: &'a Fit,
+    pub sides: Sides,
+    /// The record carries caps (cylinders and cones).
+    pub caps: bool,
+    /// The record's words (a polygon's: padded to the largest fan).
+    pub size: usize,
+    /// A sphere's `invr` of its unrounded radius (the streamed format).
+    pub unrounded: bool,
+    /// Object id and (distinct) material index.
+    pub id: usize,
+    pub mat: usize,
+}
+
+/// Why a record cannot be written.
+#[derive(Debug)]
+pub enum RecordError {
+    /// This object's (the scene file's line of the object).
+    Object(String),
+    /// The scene's (no one line).
+    Scene(String),
+}
+
+impl RecordError {
+    /// A shape of another primitive given to a primitive's writer.
+    fn mismatch(name: &str) -> RecordError {
+        RecordError::Scene(format!("internal: a {name} record of another shape"))
+    }
+}
 
 /// The chip's object types, in test order (object test reordering).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -113,25 +342,10 @@ impl ChipType {
         ChipType::GlassPolygon,
     ];
 
+    /// The type's name: its primitive's, `glass_` before it for the glass
+    /// type.
     pub fn name(self) -> &'static str {
-        match self {
-            ChipType::Sphere => "sphere",
-            ChipType::Cylinder => "cylinder",
-            ChipType::Box => "box",
-            ChipType::Rectangle => "rectangle",
-            ChipType::Triangle => "triangle",
-            ChipType::Polygon => "polygon",
-            ChipType::Cone => "cone",
-            ChipType::SmoothTriangle => "smooth_triangle",
-            ChipType::GlassSphere => "glass_sphere",
-            ChipType::GlassRectangle => "glass_rectangle",
-            ChipType::GlassTriangle => "glass_triangle",
-            ChipType::GlassPolygon => "glass_polygon",
-            ChipType::GlassBox => "glass_box",
-            ChipType::GlassCylinder => "glass_cylinder",
-            ChipType::GlassCone => "glass_cone",
-            ChipType::GlassSmoothTriangle => "glass_smooth_triangle",
-        }
+        self.primitive().names()[self.refracts() as usize]
     }
 
     /// The plural, in words: "spheres", "glass boxes", "smooth triangles".
@@ -200,54 +414,32 @@ impl ChipType {
         }
     }
 
+    /// The primitive this type is the opaque or the glass kind of.
+    pub fn primitive(self) -> &'static dyn ChipPrimitive {
+        match self {
+            ChipType::Sphere | ChipType::GlassSphere => &sphere::Sphere,
+            ChipType::Cylinder | ChipType::GlassCylinder => &cylinder::Cylinder,
+            ChipType::Cone | ChipType::GlassCone => &cone::Cone,
+            ChipType::Box | ChipType::GlassBox => &aabox::AaBox,
+            ChipType::Rectangle | ChipType::GlassRectangle => &planar::RECTANGLE,
+            ChipType::Triangle | ChipType::GlassTriangle => &planar::TRIANGLE,
+            ChipType::Polygon | ChipType::GlassPolygon => &polygon::Polygon,
+            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => {
+                &smooth_triangle::SmoothTriangle
+            }
+        }
+    }
+
     /// Words of one object's record (`fan`: the polygons' edges per record;
     /// `caps`: a cylinder's or cone's record carries caps).
     pub fn record_words(self, fit: &Fit, fan: usize, caps: bool) -> usize {
-        match self {
-            ChipType::Sphere | ChipType::GlassSphere => sphere::words(fit),
-            ChipType::Cylinder | ChipType::GlassCylinder => {
-                cylinder::words(fit, self.sides(), caps)
-            }
-            ChipType::Cone | ChipType::GlassCone => cone::words(self.sides(), caps),
-            ChipType::Box | ChipType::GlassBox => aabox::words(self.sides()),
-            ChipType::Rectangle
-            | ChipType::Triangle
-            | ChipType::GlassRectangle
-            | ChipType::GlassTriangle => planar::WORDS,
-            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => smooth_triangle::WORDS,
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::words(fan, fit.polygon_form),
-        }
+        self.primitive().record_words(self.sides(), fit, fan, caps)
     }
 
     /// The kernels this type's test runs, in their load order: (label,
     /// kernel). Types share some (the caps' discs, the polygons' edge).
     pub fn kernels(self, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
-        let s = self.sides();
-        match self {
-            ChipType::Sphere | ChipType::GlassSphere => {
-                vec![(sphere::kernel_name(s), sphere::kernel(g, fit, s))]
-            }
-            ChipType::Cylinder | ChipType::GlassCylinder => cylinder::kernels(g, fit, s),
-            ChipType::Cone | ChipType::GlassCone => cone::kernels(g, s),
-            ChipType::Box | ChipType::GlassBox => {
-                vec![(aabox::kernel_name(s), aabox::kernel(g, s))]
-            }
-            ChipType::Rectangle | ChipType::GlassRectangle => {
-                let i = planar::Inside::Rectangle;
-                vec![(planar::kernel_name(i, s), planar::kernel(g, i, s))]
-            }
-            ChipType::Triangle | ChipType::GlassTriangle => {
-                let i = planar::Inside::Triangle;
-                vec![(planar::kernel_name(i, s), planar::kernel(g, i, s))]
-            }
-            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => {
-                vec![(
-                    smooth_triangle::kernel_name(s),
-                    smooth_triangle::kernel(g, s),
-                )]
-            }
-            ChipType::Polygon | ChipType::GlassPolygon => polygon::kernels(g, s, fit.polygon_form),
-        }
+        self.primitive().kernels(self.sides(), g, fit)
     }
 
     /// TinyRISC code broadcasting the test of one object of this type,
@@ -255,117 +447,7 @@ impl ChipType {
     /// `at`; clobbers r1..r3; `caps`: a cylinder's or cone's record
     /// carries caps, whose flag is checked).
     pub fn broadcast(self, t: &mut Code, at: &str, fit: &Fit, caps: bool) {
-        let s = self.sides();
-        match self {
-            ChipType::Sphere | ChipType::GlassSphere => one(t, sphere::kernel_name(s)),
-            ChipType::Box | ChipType::GlassBox => one(t, aabox::kernel_name(s)),
-            ChipType::Rectangle | ChipType::GlassRectangle => {
-                one(t, planar::kernel_name(planar::Inside::Rectangle, s))
-            }
-            ChipType::Triangle | ChipType::GlassTriangle => {
-                one(t, planar::kernel_name(planar::Inside::Triangle, s))
-            }
-            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => {
-                one(t, smooth_triangle::kernel_name(s))
-            }
-            ChipType::Cylinder | ChipType::GlassCylinder => {
-                cylinder::broadcast(t, at, fit, s, caps)
-            }
-            ChipType::Cone | ChipType::GlassCone => cone::broadcast(t, at, s, caps),
-            ChipType::Polygon | ChipType::GlassPolygon => {
-                polygon::broadcast(t, at, s, fit.polygon_form)
-            }
-        }
-    }
-}
-
-/// A test whose first kernel has cuts ([`super::emit::K::cut`]): the
-/// packet traversal runs it in parts ([`run_with_cuts`]).
-#[derive(Clone, Copy, Debug)]
-pub struct CutTest {
-    /// The kernel.
-    pub kernel: &'static str,
-    /// The record field its stream starts at.
-    pub field: &'static str,
-    /// Its cuts, in order: name, and what F holds there.
-    pub cuts: &'static [(&'static str, &'static str)],
-    /// What F holds at its end, where the test goes on with further
-    /// kernels that run only if some awake RC has F then (a polygon's
-    /// edges and tail).
-    pub then: Option<&'static str>,
-}
-
-impl ChipType {
-    /// The test that runs in parts, for the types that have one (opaque
-    /// spheres, cylinders and cones, and the planar types opaque or glass:
-    /// most of their tests miss, and the miss is known early in the
-    /// kernel; a glass polygon's head decides its edges).
-    pub fn cut_test(self) -> Option<CutTest> {
-        match self {
-            ChipType::Sphere => Some(CutTest {
-                kernel: sphere::kernel_name(Sides::Front),
-                field: "0",
-                cuts: &sphere::CUTS,
-                then: None,
-            }),
-            ChipType::Cylinder => Some(CutTest {
-                kernel: "k_cylinder",
-                field: "CYL_BODY",
-                cuts: &cylinder::CUTS,
-                then: None,
-            }),
-            ChipType::Cone => Some(CutTest {
-                kernel: "k_cone",
-                field: "CONE_BODY",
-                cuts: &cone::CUTS,
-                then: None,
-            }),
-            ChipType::Rectangle
-            | ChipType::Triangle
-            | ChipType::GlassRectangle
-            | ChipType::GlassTriangle => Some(CutTest {
-                kernel: planar::kernel_name(planar_inside(self), self.sides()),
-                field: "0",
-                cuts: &planar::CUTS,
-                then: None,
-            }),
-            ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => Some(CutTest {
-                kernel: smooth_triangle::kernel_name(self.sides()),
-                field: "0",
-                cuts: &planar::CUTS,
-                then: None,
-            }),
-            ChipType::Polygon | ChipType::GlassPolygon => Some(CutTest {
-                kernel: polygon::head_name(self.sides()),
-                field: "POLY_HEAD",
-                cuts: &[],
-                then: Some("the plane hit before tbest"),
-            }),
-            _ => None,
-        }
-    }
-
-    /// What a cut test's object runs after its first kernel, its record
-    /// at `rec`, labels beginning with `at`: where some awake RC has F
-    /// ([`CutTest::then`]), a polygon's edges and tail.
-    fn broadcast_then(self, t: &mut Code, at: &str, rec: Reg, fit: &Fit) {
-        if matches!(self, ChipType::Polygon | ChipType::GlassPolygon) {
-            polygon::broadcast_edges(t, at, self.sides(), rec, fit.polygon_form);
-        }
-    }
-
-    /// What a cut test's object runs after its first kernel whatever F (a
-    /// cylinder's or cone's caps, where the scene has some: `caps`), its
-    /// record at `rec`; labels begin with `at`.
-    pub fn broadcast_after_cut_test(self, t: &mut Code, at: &str, rec: Reg, caps: bool) {
-        if !caps {
-            return;
-        }
-        match self {
-            ChipType::Cylinder => cylinder::broadcast_caps(t, at, rec),
-            ChipType::Cone => cone::broadcast_caps(t, at, rec),
-            _ => {}
-        }
+        self.primitive().broadcast(self.sides(), t, at, fit, caps)
     }
 }
 
@@ -378,144 +460,6 @@ fn caps(t: &mut Code, nocap: &str, rec: Reg, flag: &str, cap: &str, caps: [&str;
     }
     t.c("the caps");
     t.label(nocap);
-}
-
-fn planar_inside(t: ChipType) -> planar::Inside {
-    if matches!(t, ChipType::Triangle | ChipType::GlassTriangle) {
-        planar::Inside::Triangle
-    } else {
-        planar::Inside::Rectangle
-    }
-}
-
-/// Broadcast the first part of a test in parts ([`CutTest`] `c`) on the
-/// record at `first`: its kernel up to the first cut (`BCAST_UPTO`), or the
-/// whole kernel where it has no cut. TinyRISC's work while it runs comes
-/// next, then [`run_rest`].
-pub fn run_first_part(t: &mut Code, c: &CutTest, first: Reg) {
-    let (k, field) = (c.kernel, c.field);
-    match c.cuts.first() {
-        Some((name, holds)) => {
-            let cut = super::emit::cut_label(k, name);
-            t.m("BCAST_UPTO", format!("{k}, {cut}, {first}, {field}"))
-                .c(format!("up to F: {holds}"));
-        }
-        None => {
-            t.m("BCAST_REC", format!("{k}, {first}, {field}"));
-            if let Some(holds) = c.then {
-                t.c(format!("F: {holds}"));
-            }
-        }
-    }
-}
-
-/// Whether TinyRISC's parts (`--test-cuts tinyrisc`) end at the cut
-/// `name`. The cuts before a test's normal and commit (a cylinder's
-/// `height`, a planar test's `inside`) leave 6 to 54 contexts, less than
-/// the status read and second issue of a part cost TinyRISC there: only
-/// the broadcast unit's `cut` contexts end a run at them.
-pub fn tinyrisc_part(name: &str) -> bool {
-    name != cylinder::CUTS[3].0 && name != planar::CUTS[1].0
-}
-
-/// The rest of a test of type `ty` in parts ([`CutTest`] `c`) after
-/// [`run_first_part`], on the record at `rec`: each part after a cut, and
-/// then the further kernels (`then`), only where some awake RC has F
-/// (`rcany`), else on to `none`. Labels begin with `at`; `fit`: the
-/// records' variants. Clobbers r1..r3.
-pub fn run_rest(
-    t: &mut Code,
-    ty: ChipType,
-    c: &CutTest,
-    fit: &Fit,
-    rec: Reg,
-    at: &str,
-    none: &str,
-) {
-    let (k, field) = (c.kernel, c.field);
-    let run_from = |t: &mut Code, from: &str, to: &str| {
-        t.m(
-            "BCAST_FROM_ANY",
-            format!("{from}, {to}, {rec}, {field}, {none}"),
-        );
-    };
-    let parts: Vec<&(&str, &str)> = c.cuts.iter().filter(|(n, _)| tinyrisc_part(n)).collect();
-    let cuts: Vec<String> = parts
-        .iter()
-        .map(|(name, _)| super::emit::cut_label(k, name))
-        .collect();
-    for (i, (_, holds)) in parts.iter().enumerate().skip(1) {
-        run_from(t, &cuts[i - 1], &cuts[i]);
-        t.c(format!("up to F: {holds}"));
-    }
-    if let Some(last) = cuts.last() {
-        run_from(t, last, &format!("{k}_end"));
-        t.c("the rest, if some awake ray can still hit it");
-        if let Some(holds) = c.then {
-            t.c(format!("F: {holds}"));
-        }
-    }
-    if c.then.is_some() {
-        t.rcany(R3).beqz(R3, none).c("no awake ray can hit it");
-        ty.broadcast_then(t, at, rec, fit);
-    }
-}
-
-/// The record field a cut test's stream starts at ([`CutTest::field`]),
-/// `"0"` where that is the record itself: a cylinder's or cone's record
-/// without caps (`caps` false) is its body.
-pub fn stream_field(ty: ChipType, c: &CutTest, caps: bool) -> &'static str {
-    match ty {
-        ChipType::Cylinder | ChipType::Cone if !caps => "0",
-        _ => c.field,
-    }
-}
-
-/// A test in parts ([`CutTest`] `c`) of type `ty` as one run of its
-/// kernel, whose `cut` contexts end it where no awake RC has F
-/// ([`super::emit::K::text_with_cuts`]), on the record at `rec`, its
-/// stream from `field` ([`stream_field`]); then the further kernels
-/// (`then`) only where some awake RC has F (`rcany`), else on to `none`.
-/// `kernel`: a register that holds the kernel's address (a type loop
-/// sets it once), else the address is set here. Labels begin with `at`;
-/// `fit`: the records' variants. Clobbers r1..r3.
-#[allow(clippy::too_many_arguments)]
-pub fn run_with_cut_contexts(
-    t: &mut Code,
-    ty: ChipType,
-    c: &CutTest,
-    field: &str,
-    kernel: Option<Reg>,
-    fit: &Fit,
-    rec: Reg,
-    at: &str,
-    none: &str,
-) {
-    let k = c.kernel;
-    match (kernel, field) {
-        (None, "0") => {
-            t.m("BCAST_AT", format!("{k}, {rec}"));
-        }
-        (None, _) => {
-            t.m("BCAST_REC", format!("{k}, {rec}, {field}"));
-        }
-        (Some(kr), "0") => {
-            t.sbcb(kr, rec, klen(k));
-        }
-        (Some(kr), _) => {
-            t.addi(R2, rec, field).sbcb(kr, R2, klen(k));
-        }
-    }
-    if c.cuts.is_empty() {
-        t.c("the test");
-    } else {
-        t.c("the test; its cuts end the run where no awake ray can still hit it");
-    }
-    if let Some(holds) = c.then {
-        t.rcany(R3).c(format!("F: {holds}"));
-        t.beqz(R3, none).c("no awake ray can hit it");
-        ty.broadcast_then(t, at, rec, fit);
-    }
 }
 
 /// The kernels whose runs start an object test (their RCs at the first
@@ -646,89 +590,36 @@ pub struct Fit {
 }
 
 impl Fit {
-    /// The header lines of the shifts of the types present.
+    /// The header lines of the shifts of the types present: each
+    /// primitive's ([`ChipPrimitive::fit_header`], a line two primitives
+    /// share once), then the ones some primitives share.
     pub fn header(&self, types: &[ChipType]) -> Vec<String> {
         let has = |f: &dyn Fn(ChipType) -> bool| types.iter().any(|t| f(*t));
-        let mut v = Vec::new();
-        if has(&|t| matches!(t, ChipType::Sphere | ChipType::GlassSphere)) {
-            v.push(define(
-                "KS_SPHERE",
-                self.ks_sphere,
-                "spheres: invr = 2^(Q14+KS_SPHERE) / r",
-            ));
-            v.push(define(
-                "EP_SPHERE",
-                self.ep_sphere,
-                "spheres: extra fraction bits of the perpendicular vector",
-            ));
+        let mut v: Vec<String> = Vec::new();
+        for p in PRIMITIVES {
+            if has(&|t| t.primitive().names() == p.names()) {
+                for l in p.fit_header(self) {
+                    if !v.contains(&l) {
+                        v.push(l);
+                    }
+                }
+            }
         }
-        let cyl = has(&|t| matches!(t, ChipType::Cylinder | ChipType::GlassCylinder));
-        let cone = has(&|t| matches!(t, ChipType::Cone | ChipType::GlassCone));
-        if cyl {
-            v.push(define(
-                "KS_CYL",
-                self.ks_cyl,
-                "cylinders: invr = 2^(Q14+KS_CYL) / r",
-            ));
-            v.push(define(
-                "EP_CYL",
-                self.ep_cyl,
-                "cylinders: extra fraction bits of p",
-            ));
-        }
-        if cone {
-            v.push(define(
-                "KS_CONE",
-                self.ks_cone,
-                "cones: invS = 2^(Q14+KS_CONE) / S",
-            ));
-            v.push(define(
-                "EP_CONE",
-                self.ep_cone,
-                "cones: extra fraction bits of p",
-            ));
-        }
-        let rect = has(&|t| matches!(t, ChipType::Rectangle | ChipType::GlassRectangle));
-        let tri = has(&|t| {
-            matches!(
-                t,
-                ChipType::Triangle
-                    | ChipType::GlassTriangle
-                    | ChipType::SmoothTriangle
-                    | ChipType::GlassSmoothTriangle
-            )
-        });
-        if rect {
-            v.push(define(
-                "KT_RECT",
-                self.kt[0],
-                "rectangles: edge duals scaled by 2^KT_RECT",
-            ));
-        }
-        if tri {
-            v.push(define(
-                "KT_TRI",
-                self.kt[1],
-                "triangles: edge duals scaled by 2^KT_TRI",
-            ));
-        }
-        if cyl || cone {
+        if has(&|t| t.primitive().disc_caps()) {
             v.push(define(
                 "KT_DISC",
                 self.kt[2],
                 "discs (caps): axes scaled by 2^KT_DISC",
             ));
         }
-        if rect || tri || cyl || cone {
+        if has(&|t| t.primitive().has_inside_test()) {
             v.push(define(
                 "INSIDE_TOL",
                 planar::INSIDE_TOL,
                 "tolerance of the planar inside tests, Q.14",
             ));
         }
-        if types.iter().any(|t| {
-            t.refracts() && *t != ChipType::GlassRectangle && *t != ChipType::GlassTriangle
-        }) {
+        if has(&|t| t.refracts() && t.primitive().glass_self_margin()) {
             v.push(define(
                 "SELF_LSB",
                 SELF_LSB,
@@ -844,6 +735,24 @@ pub fn perpendicular(a: crate::scene::Vec3) -> crate::scene::Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Every chip type finds its primitive in the table, under its own
+    /// name, once; the glass type's name is the opaque one's with `glass_`.
+    #[test]
+    fn every_type_has_its_primitive_in_the_table() {
+        for t in ChipType::ALL {
+            let p = t.primitive();
+            let n = PRIMITIVES.iter().filter(|q| q.names() == p.names()).count();
+            assert_eq!(n, 1, "{t:?}");
+            assert_eq!(t.name(), p.names()[t.refracts() as usize]);
+            assert_eq!(p.names()[1], format!("glass_{}", p.names()[0]));
+        }
+        let mut names: Vec<&str> = ChipType::ALL.iter().map(|t| t.name()).collect();
+        names.sort();
+        names.dedup();
+        assert_eq!(names.len(), ChipType::ALL.len());
+        assert_eq!(ChipType::ALL.len(), 2 * PRIMITIVES.len());
+    }
 
     /// Every kernel reads exactly the words its record (or its part of the
     /// record) holds, in every variant: a kernel reading one word less or

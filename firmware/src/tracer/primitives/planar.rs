@@ -29,12 +29,15 @@
 //! errors at grazing incidence, where the Q1.14 rounding of the direction
 //! is amplified.
 
-use super::super::emit::K;
+use super::super::emit::{define, Code, K};
 use super::super::math::divide;
 use super::super::memory_map::ram;
-use super::{commit_streamed_normal, commit_streamed_normal_two, Gen, Sides};
-use crate::scene::Vec3;
 use super::record::W;
+use super::{
+    commit_streamed_normal, commit_streamed_normal_two, CutTest, Fit, Gen, Geometry, Object,
+    RecordError, Sides, TestCost,
+};
+use crate::scene::{Shape, Vec3};
 
 /// Record words.
 pub const WORDS: usize = 20;
@@ -310,4 +313,99 @@ pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
         Sides::Both => commit_streamed_normal_two(&mut k, 9),
     }
     k
+}
+
+/// The rectangle and the triangle ([`super::ChipPrimitive`]), by their
+/// inside test.
+pub struct PlanarPrimitive(Inside);
+
+/// The rectangle.
+pub const RECTANGLE: PlanarPrimitive = PlanarPrimitive(Inside::Rectangle);
+/// The triangle (flat shaded).
+pub const TRIANGLE: PlanarPrimitive = PlanarPrimitive(Inside::Triangle);
+
+impl super::ChipPrimitive for PlanarPrimitive {
+    fn names(&self) -> [&'static str; 2] {
+        match self.0 {
+            Inside::Triangle => ["triangle", "glass_triangle"],
+            _ => ["rectangle", "glass_rectangle"],
+        }
+    }
+
+    fn record_words(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> usize {
+        WORDS
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
+        vec![(kernel_name(self.0, sides), kernel(g, self.0, sides))]
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, _at: &str, _fit: &Fit, _caps: bool) {
+        super::one(t, kernel_name(self.0, sides));
+    }
+
+    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+        Some(CutTest {
+            kernel: kernel_name(self.0, sides),
+            field: "0",
+            cuts: &CUTS,
+            then: None,
+        })
+    }
+
+    fn fit_header(&self, fit: &Fit) -> Vec<String> {
+        let what = match self.0 {
+            Inside::Triangle => "triangles",
+            _ => "rectangles",
+        };
+        let name = self.0.kt_name();
+        vec![define(
+            name,
+            fit.kt[self.0.kt_index()],
+            &format!("{what}: edge duals scaled by 2^{name}"),
+        )]
+    }
+
+    fn has_inside_test(&self) -> bool {
+        true
+    }
+
+    fn glass_self_margin(&self) -> bool {
+        false
+    }
+
+    fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
+        match *shape {
+            Shape::Rectangle {
+                corner,
+                edge1,
+                edge2,
+            } => Geometry::Planars(vec![Planar::rectangle(
+                corner,
+                edge1,
+                edge2,
+                edge1.cross(edge2).normalized(),
+            )]),
+            Shape::Triangle { v, .. } => Geometry::Planars(vec![flat_triangle(v)]),
+            _ => Geometry::None,
+        }
+    }
+
+    /// Rectangles are priced as triangles (the cost model's kernels).
+    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
+        TestCost::of(&kernel(g, Inside::Triangle, Sides::Front))
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        for p in o.geometry.planars() {
+            write(w, &o.fit.kt, p, o.id, o.mat);
+        }
+        Ok(())
+    }
+}
+
+/// A triangle's planar record geometry, its normal from its vertices.
+pub fn flat_triangle(v: [Vec3; 3]) -> Planar {
+    let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+    Planar::triangle(v[0], v[1], v[2], n)
 }

@@ -74,9 +74,12 @@
 use super::super::emit::{define, Code, Reg, K, R0, R1, R2, R3, R7};
 use super::super::memory_map::ram;
 use super::planar::plane_hit;
-use super::{commit_streamed_normal, commit_streamed_normal_two, kaddr, klen, Gen, Sides};
-use crate::scene::Vec3;
 use super::record::W;
+use super::{
+    commit_streamed_normal, commit_streamed_normal_two, kaddr, klen, CutTest, Fit, Gen, Object,
+    RecordError, Sides, TestCost,
+};
+use crate::scene::{Shape, Vec3};
 
 /// Words of the head, one edge and the tail.
 pub const HEAD_WORDS: usize = 15;
@@ -676,4 +679,78 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
         .lw(R8, field(save(0), R0))
         .lw(R12, field(save(1), R0))
         .lw(R13, field(save(2), R0));
+}
+
+/// The polygon ([`super::ChipPrimitive`]): 4 or more coplanar vertices,
+/// convex or concave.
+pub struct Polygon;
+
+impl super::ChipPrimitive for Polygon {
+    fn names(&self) -> [&'static str; 2] {
+        ["polygon", "glass_polygon"]
+    }
+
+    fn record_words(&self, _sides: Sides, fit: &Fit, fan: usize, _caps: bool) -> usize {
+        words(fan, fit.polygon_form)
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
+        kernels(g, sides, fit.polygon_form)
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, at: &str, fit: &Fit, _caps: bool) {
+        broadcast(t, at, sides, fit.polygon_form)
+    }
+
+    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+        Some(CutTest {
+            kernel: head_name(sides),
+            field: "POLY_HEAD",
+            cuts: &[],
+            then: Some("the plane hit before tbest"),
+        })
+    }
+
+    fn broadcast_then(&self, sides: Sides, t: &mut Code, at: &str, rec: Reg, fit: &Fit) {
+        broadcast_edges(t, at, sides, rec, fit.polygon_form);
+    }
+
+    fn record_header(&self, fit: &Fit, _sides: &[Sides], _caps: bool) -> Vec<String> {
+        header(fit.polygon_form)
+    }
+
+    /// The head whole, the tail, an edge per edge (plain records).
+    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
+        let k: Vec<usize> = kernels(g, Sides::Front, Form::Plain)
+            .iter()
+            .map(|(_, k)| k.len())
+            .collect();
+        TestCost {
+            first: k[0],
+            rest: k[2],
+            each: k[1],
+        }
+    }
+
+    fn cost_runs(&self, shape: &Shape, s: f64) -> usize {
+        match shape {
+            Shape::Polygon { v, .. } => edges(v, s).1.len(),
+            _ => 0,
+        }
+    }
+
+    fn fan(&self, shape: &Shape, s: f64, banded: bool) -> usize {
+        match shape {
+            Shape::Polygon { v, .. } if banded => band_edges(&edges(v, s).1),
+            Shape::Polygon { v, .. } => edges(v, s).1.len(),
+            _ => 0,
+        }
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        let Shape::Polygon { v, .. } = o.shape else {
+            return Err(RecordError::mismatch("polygon"));
+        };
+        write(w, v, o.size, o.fit.polygon_form, o.id, o.mat).map_err(RecordError::Scene)
+    }
 }

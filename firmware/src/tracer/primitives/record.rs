@@ -10,7 +10,7 @@ use super::super::math::word_max;
 
 /// The FB image as it is written: words (16-bit values, or 32-bit on the
 /// 32-bit chip) in the order the kernels stream them.
-pub(crate) struct W {
+pub struct W {
     pub(crate) fb: Vec<i32>,
     /// LSBs per scene unit (`2^frac`).
     pub(crate) s: f64,
@@ -27,57 +27,57 @@ pub(crate) struct W {
 
 impl W {
     /// Bytes of an FB word: 2 (16-bit chip) or 4.
-    pub(crate) fn word_bytes(&self) -> usize {
+    pub fn word_bytes(&self) -> usize {
         if self.x == 0 {
             2
         } else {
             4
         }
     }
-    pub(crate) fn max(&self) -> f64 {
+    pub fn max(&self) -> f64 {
         word_max(self.x)
     }
     /// Round and saturate to the word.
-    pub(crate) fn sat(&self, v: f64) -> i32 {
+    pub fn sat(&self, v: f64) -> i32 {
         v.round().clamp(-self.max() - 1.0, self.max()) as i32
     }
-    pub(crate) fn push(&mut self, v: f64) {
+    pub fn push(&mut self, v: f64) {
         let v = self.sat(v);
         self.fb.push(v);
     }
     /// A 16-bit structural word (flags, bit vectors), sign-extended.
-    pub(crate) fn word16(&mut self, v: u16) {
+    pub fn word16(&mut self, v: u16) {
         self.fb.push(v as i16 as i32);
     }
     /// One in Q1.14 (16-bit chip) or Q1.30.
-    pub(crate) fn one(&self) -> f64 {
+    pub fn one(&self) -> f64 {
         ((14 + self.x) as f64).exp2()
     }
-    pub(crate) fn coord(&mut self, x: f64) {
+    pub fn coord(&mut self, x: f64) {
         self.push(x * self.s);
     }
-    pub(crate) fn point(&mut self, v: Vec3) {
+    pub fn point(&mut self, v: Vec3) {
         for x in v.to_array() {
             self.coord(x);
         }
     }
-    pub(crate) fn unit(&mut self, v: Vec3) {
+    pub fn unit(&mut self, v: Vec3) {
         let k = Q_UNIT.lsb().recip() * (self.x as f64).exp2();
         for x in v.to_array() {
             self.push(x * k);
         }
     }
     /// One component of a unit vector (Q1.14).
-    pub(crate) fn unit_axis(&mut self, x: f64) {
+    pub fn unit_axis(&mut self, x: f64) {
         self.push(x * Q_UNIT.lsb().recip() * (self.x as f64).exp2());
     }
-    pub(crate) fn col(&mut self, x: f64) {
+    pub fn col(&mut self, x: f64) {
         self.push(x * Q_MATERIAL.lsb().recip() * (self.x as f64).exp2());
     }
-    pub(crate) fn raw(&mut self, x: i64) {
+    pub fn raw(&mut self, x: i64) {
         self.push(x as f64);
     }
-    pub(crate) fn scaled(&mut self, v: Vec3, scale: f64) {
+    pub fn scaled(&mut self, v: Vec3, scale: f64) {
         for x in v.to_array() {
             self.push(x * scale);
         }
@@ -98,20 +98,20 @@ pub fn fb_word_bytes(words: &[i32], x: u32) -> Vec<u8> {
 }
 
 /// The scale shifts of the kernels, fitted to the word of the datapath.
-pub(crate) struct Fitter {
+pub struct Fitter {
     /// Extra bits of the datapath (0 or 16).
     pub(crate) x: u32,
 }
 
 impl Fitter {
     /// Largest shift `k` with `m * 2^k` within the word, clamped to 0..=max.
-    pub(crate) fn shift(&self, m: f64, max: u32) -> u32 {
+    pub fn shift(&self, m: f64, max: u32) -> u32 {
         fit_shift_w(m, max, self.x)
     }
     /// `KS` of a kernel whose record holds `2^(14+KS) / v` for the smallest
     /// `v` (LSB) of the scene: as large as keeps it in the word, at most 16
     /// (plus the datapath's extra bits); 8 where there is none.
-    pub(crate) fn ks(&self, min: f64) -> u32 {
+    pub fn ks(&self, min: f64) -> u32 {
         if min.is_finite() {
             self.shift(((14 + self.x) as f64).exp2() / min, 16 + self.x)
         } else {

@@ -26,13 +26,13 @@
 //! **Error** against the f64 interpolation (`tb/tests/kernels.rs`): `t`
 //! within 3 LSB, the shading normal within 0.01.
 
-use super::super::emit::K;
+use super::super::emit::{Code, K};
 use super::super::math::normalize;
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::{Gen, Sides};
-use crate::scene::Vec3;
 use super::record::W;
+use super::{CutTest, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
+use crate::scene::{Shape, Vec3};
 
 /// Record words: the planar record with the vertex normals.
 pub const WORDS: usize = planar::WORDS + 9;
@@ -178,5 +178,74 @@ pub fn shading_normal(k: &mut K) {
         .c("(f) cmp.gt r14, #0");
     for i in 0..3 {
         k.c(format!("(f) st r{}, [#{}]", 11 + i, ram::SH_N + i));
+    }
+}
+
+/// The smooth triangle ([`super::ChipPrimitive`]): a triangle with
+/// vertex normals (NFF `pp`).
+pub struct SmoothTriangle;
+
+impl super::ChipPrimitive for SmoothTriangle {
+    fn names(&self) -> [&'static str; 2] {
+        ["smooth_triangle", "glass_smooth_triangle"]
+    }
+
+    fn record_words(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> usize {
+        WORDS
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
+        vec![(kernel_name(sides), kernel(g, sides))]
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, _at: &str, _fit: &Fit, _caps: bool) {
+        super::one(t, kernel_name(sides));
+    }
+
+    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+        Some(CutTest {
+            kernel: kernel_name(sides),
+            field: "0",
+            cuts: &planar::CUTS,
+            then: None,
+        })
+    }
+
+    fn fit_header(&self, fit: &Fit) -> Vec<String> {
+        super::ChipPrimitive::fit_header(&planar::TRIANGLE, fit)
+    }
+
+    fn has_inside_test(&self) -> bool {
+        true
+    }
+
+    fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
+        match *shape {
+            Shape::Triangle { v, .. } => Geometry::Planars(vec![planar::flat_triangle(v)]),
+            _ => Geometry::None,
+        }
+    }
+
+    fn smooth(&self) -> bool {
+        true
+    }
+
+    /// Priced as the flat triangle's test (the cost model's kernels).
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
+        super::ChipPrimitive::test_cost(&planar::TRIANGLE, g, fit)
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        let (
+            Shape::Triangle {
+                normals: Some(ns), ..
+            },
+            [p],
+        ) = (o.shape, o.geometry.planars())
+        else {
+            return Err(RecordError::mismatch("smooth triangle"));
+        };
+        write(w, &o.fit.kt, p, *ns, o.id, o.mat);
+        Ok(())
     }
 }

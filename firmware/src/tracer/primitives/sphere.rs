@@ -35,12 +35,12 @@
 //! normal within 0.03; a sphere 6 LSB in radius with a fine record within
 //! 2 LSB and 0.1.
 
-use super::super::emit::K;
+use super::super::emit::{define, Code, K};
 use super::super::math::{perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
-use super::{self_margin, Fit, Gen, Sides};
-use crate::scene::Vec3;
 use super::record::{Fitter, W};
+use super::{self_margin, CutTest, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
+use crate::scene::{Scene, Shape, Vec3};
 
 /// Record words, coarse and fine.
 pub const WORDS: usize = 8;
@@ -269,4 +269,78 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     }
     k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
     k
+}
+
+/// The sphere ([`super::ChipPrimitive`]).
+pub struct Sphere;
+
+impl super::ChipPrimitive for Sphere {
+    fn names(&self) -> [&'static str; 2] {
+        ["sphere", "glass_sphere"]
+    }
+
+    fn record_words(&self, _sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> usize {
+        words(fit)
+    }
+
+    fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
+        vec![(kernel_name(sides), kernel(g, fit, sides))]
+    }
+
+    fn broadcast(&self, sides: Sides, t: &mut Code, _at: &str, _fit: &Fit, _caps: bool) {
+        super::one(t, kernel_name(sides));
+    }
+
+    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+        (sides == Sides::Front).then(|| CutTest {
+            kernel: kernel_name(sides),
+            field: "0",
+            cuts: &CUTS,
+            then: None,
+        })
+    }
+
+    fn fit_header(&self, fit: &Fit) -> Vec<String> {
+        vec![
+            define(
+                "KS_SPHERE",
+                fit.ks_sphere,
+                "spheres: invr = 2^(Q14+KS_SPHERE) / r",
+            ),
+            define(
+                "EP_SPHERE",
+                fit.ep_sphere,
+                "spheres: extra fraction bits of the perpendicular vector",
+            ),
+        ]
+    }
+
+    fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
+        let radii = scene.objects.iter().filter_map(|o| match o.shape {
+            Shape::Sphere { radius, .. } => Some(radius.abs() * s),
+            _ => None,
+        });
+        (fit.ks_sphere, fit.ep_sphere, fit.sphere_fine) = self::fit(radii, f);
+        fit.sphere_inside = scene
+            .objects
+            .iter()
+            .any(|o| matches!(o.shape, Shape::Sphere { inside: true, .. }));
+    }
+
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
+        TestCost::of(&kernel(g, fit, Sides::Front))
+    }
+
+    fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        let Shape::Sphere {
+            center,
+            radius,
+            inside,
+        } = *o.shape
+        else {
+            return Err(RecordError::mismatch("sphere"));
+        };
+        write(w, o.fit, o.unrounded, center, radius, inside, o.id, o.mat);
+        Ok(())
+    }
 }
