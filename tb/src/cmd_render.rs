@@ -146,7 +146,7 @@ pub struct RenderArgs {
     pub guard_bits: u32,
     /// Offset of spawned (shadow, reflected, refracted) rays along the
     /// normal, in LSBs of the coordinate format (0..=64).
-    #[arg(long, value_name = "N", default_value_t = firmware::tracer::shading::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
+    #[arg(long, value_name = "N", default_value_t = firmware::tracer::options::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
     pub ray_offset_lsb: i32,
     /// Normals of spheres and cylinders: fine (the eye moved onto the
     /// coordinate format's grid with the whole scene, and the

@@ -1,10 +1,17 @@
-//! Where the tracer keeps its data: the RC RAM map ([`ram`]), the number
-//! formats of the kernels ([`formats`]). The generator writes kernels
+//! Where the tracer keeps its data: the RC RAM map ([`ram`]), the FB's
+//! extent ([`FB_LIMIT`], [`STREAM_BANK`]), the number formats of the
+//! kernels ([`formats`]). The generator writes kernels
 //! with these names and the program's header defines them, one line and
 //! a comment each, so the emitted firmware reads `ld r8, [r0 + #C_ONE]`,
 //! not `ld r8, [r0 + #256]`.
 
 use super::emit::{define, Name};
+
+/// Words of FB set 0.
+pub const FB_LIMIT: usize = 0x8000;
+
+/// FB bank 1 (set 0): the streaming buffer of the streamed layout.
+pub const STREAM_BANK: usize = 0x4000;
 
 /// The RC RAM map: word addresses in every RC's 512-word RAM. The ray
 /// registers r1..r7 (origin, direction, `tbest`) live across kernels; what

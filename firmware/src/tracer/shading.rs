@@ -16,15 +16,6 @@ use super::math::{normalize, pow_q14, sqrt_q14, Approx};
 use super::memory_map::ram;
 use super::primitives::{kaddr, smooth_triangle};
 
-/// Offset of a spawned ray's origin along the normal, in LSBs. Default 0:
-/// every kernel is one-sided and its primitive convex (or planar), so a ray
-/// leaving the surface it starts on cannot hit that surface again however
-/// the hit point was rounded (the sphere's near root and a plane's
-/// back face are rejected), while an offset of a few LSB pushes the origin
-/// of a shadow ray off a small sphere into the neighbour it touches, whose
-/// kernel then rejects it (balls-4: 3 LSB cost 2 dB).
-pub const EPS_LSB: i32 = 0;
-
 /// The largest Phong exponent the shading kernel raises to (a larger one
 /// is clamped; `tracer::chip_warnings` names it where Ks > 0).
 pub const MAX_SHINE: f64 = 4096.0;

@@ -36,45 +36,7 @@ use super::layout::FbImage;
 use super::memory_map::ram;
 use super::{Options, Traversal};
 
-/// How the shadow rays of the reflection levels are packed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum ShadowPackets {
-    /// `render` runs both on a probe of the frame and keeps the faster;
-    /// a build without a probe ([`super::build`]) packs a packet per light.
-    #[default]
-    Auto,
-    /// One packet per light at every level: the rays stay in the RCs that
-    /// spawned them (the paper's).
-    PerLight,
-    /// From the first reflection level on, the rays of all the lights
-    /// packed into as few packets as hold them (packet traversal, 2 to
-    /// [`MAX_LIGHTS`] lights).
-    Merged,
-}
-
-impl std::fmt::Display for ShadowPackets {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            ShadowPackets::Auto => "auto",
-            ShadowPackets::PerLight => "light",
-            ShadowPackets::Merged => "merged",
-        })
-    }
-}
-
-impl std::str::FromStr for ShadowPackets {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(ShadowPackets::Auto),
-            "light" => Ok(ShadowPackets::PerLight),
-            "merged" => Ok(ShadowPackets::Merged),
-            _ => Err(format!(
-                "shadow packets '{s}': expected auto, light or merged"
-            )),
-        }
-    }
-}
+pub use super::options::ShadowPackets;
 
 /// The most lights whose rays are merged (their N.L and R.V take two
 /// words each of every RC's RAM, `SHADOW_SLOTS`); a scene with more keeps

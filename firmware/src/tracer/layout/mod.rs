@@ -27,6 +27,7 @@ use crate::scene::{Scene, Shape, Vec3};
 use crate::scene_image::SceneImage;
 
 use super::math::table_slots_for;
+pub use super::memory_map::{FB_LIMIT, STREAM_BANK};
 pub use super::primitives::record::fb_word_bytes;
 pub(crate) use super::primitives::record::W;
 use super::primitives::record::{fit_shift_w, Fitter};
@@ -36,9 +37,6 @@ use super::shading::phong_exponent;
 use super::{NodeLayout, Options, Traversal};
 pub use packet_nodes::{PK_INNER, PK_LEAF_HEAD, PK_MAILBOX_BYTES};
 pub use paper_nodes::{compact_head, COMPACT_INNER_HEAD, COMPACT_LEAF_HEAD, NODE_HEAD};
-
-/// Words of FB set 0.
-pub const FB_LIMIT: usize = 0x8000;
 
 /// One type present in the scene.
 #[derive(Clone, Debug)]
@@ -135,8 +133,6 @@ impl FbImage {
     }
 }
 
-/// FB bank 1 (set 0): the streaming buffer of the streamed layout.
-pub const STREAM_BANK: usize = 0x4000;
 /// Words at the start of a streamed leaf block: the cell bounds.
 pub const BLOCK_HEAD: usize = 6;
 /// Bytes of a node record in main memory (streamed layout).
