@@ -14,7 +14,7 @@
 use anyhow::{anyhow, Result};
 use firmware::asm::{self, Image};
 use firmware::scene::Scene;
-use firmware::tracer::{self, mem, Firmware, Numerics, Options};
+use firmware::tracer::{self, data, mem, Firmware, Numerics, Options};
 use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use rtl::chip::run_to_halt;
@@ -268,7 +268,8 @@ fn sub_stats(a: &mut Stats, b: &Stats) {
 /// traversal's `leaf_first` and `leaf_miss`), whose issues the simulator
 /// counts.
 fn leaf_watch(img: &Image) -> Option<(i64, i64)> {
-    img.symbol("leaf_first").zip(img.symbol("leaf_miss"))
+    img.symbol(data::LEAF_FIRST.0)
+        .zip(img.symbol(data::LEAF_MISS.0))
 }
 
 fn watch(img: &Image, fw: &Firmware) -> rtl::chip::Watch {
@@ -523,7 +524,7 @@ fn run_item<W: Word>(
     chip.watch = watch(img, fw);
     // The leaf pieces' waits for their DMA (the streamed packet traversal).
     chip.risc.dma_wait_watch = img
-        .symbol("leaf_load")
+        .symbol(data::LEAF_LOAD.0)
         .map(|a| a as u32)
         .into_iter()
         .collect();
@@ -543,14 +544,14 @@ fn run_item<W: Word>(
     let mut fed = feed(&mut chip, list, 0, output, fw.out_tile_bytes())?;
     // The tracer's output banks alternate by tile (`TL_BANK`, 0 at the
     // first): the list's first tile takes the bank it has in one chip.
-    if let Some(bank) = img.symbol("TL_BANK") {
+    if let Some(bank) = img.symbol(data::TL_BANK.name) {
         let first = (own.start - warm as usize) as u32;
         chip.mem.write(bank as u32, 4, first % 2);
     }
     // The pass number one chip has before the list's first tile, where it
     // matters ([`pass_seeds`]).
     if let Some(seed) = pass_seed {
-        chip.mem.write(sym(img, "PASS")?, 4, seed);
+        chip.mem.write(sym(img, data::PASS.name)?, 4, seed);
     }
     let mut sim = Sim::new(chip);
     let t0 = std::time::Instant::now();
@@ -561,7 +562,7 @@ fn run_item<W: Word>(
         sim.trace(cfg, "morphosys")
             .map_err(|e| anyhow!("creating {}: {e}", path.display()))?;
     }
-    let tile_pc = sym(img, "tile")?;
+    let tile_pc = sym(img, data::TILE.0)?;
     let m = |sim: &Sim<Chip<W>>, name: &str| -> Result<u64> {
         Ok(sim.top.mem.read(sym(img, name)?, 4) as u64)
     };
@@ -795,7 +796,7 @@ fn pass_seeds(
     items: &[std::ops::Range<usize>],
     results: &[(Result<Group>, f64)],
 ) -> Vec<(usize, u32)> {
-    let Some(wrap) = img.symbol("PASS_WRAP").map(|w| w as u64) else {
+    let Some(wrap) = img.symbol(data::PASS_WRAP.0).map(|w| w as u64) else {
         return Vec::new();
     };
     // Passes before each tile (one chip's count), as far as the items ran.
@@ -1367,10 +1368,7 @@ pub(crate) fn firmware_from_source(mut fw: Firmware, text: &str, name: &str) -> 
     }
     let gen = asm::assemble(&fw.source, "generated")
         .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
-    for sym in [
-        "FBIMG", "FBWORDS", "TILELIST", "FB_EYE", "FB_POST", "ROOT", "MAILBOX", "NOBJ", "ROOTBOX",
-        "SPLIT", "SBANK",
-    ] {
+    for data::Label(sym) in data::IMAGE_SYMBOLS {
         if gen.symbol(sym) != img.symbol(sym) {
             anyhow::bail!(
                 "{name}: {sym} is {:?} in the file and {:?} in the data image of these options: the file was generated for another scene or options",

@@ -25,6 +25,7 @@
 //! 128 entries (a knob: 16..=128) in every RC's RAM plus two Newton-Raphson
 //! steps.
 
+pub mod data;
 pub mod emit;
 pub mod kernel_names;
 pub mod layout;

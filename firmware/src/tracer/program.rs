@@ -9,7 +9,7 @@ use super::kernel_names as names;
 use super::layout::{FbImage, TypeInfo, STREAM_BANK};
 use super::memory_map::{format_lines, ram_lines};
 use super::primitives::{self, ChipType, Gen};
-use super::{mem, shading, shadows, tiles, traversal, Numerics, Options, Traversal};
+use super::{data, mem, shading, shadows, tiles, traversal, Numerics, Options, Traversal};
 use crate::scene::Scene;
 
 /// The program of one build.
@@ -339,6 +339,9 @@ fn header(
 }
 
 fn main_memory(lay: &FbImage) -> Vec<String> {
+    use super::data::{
+        AXIS_X, AXIS_Y, AXIS_Z, MASK_HI, TILE_BYTES, TILE_OUT, TILE_PX, TILE_PY, TL_COUNT, TL_FIRST,
+    };
     vec![
         define(
             "CTXBASE",
@@ -346,40 +349,41 @@ fn main_memory(lay: &FbImage) -> Vec<String> {
             "the kernels (loaded into context memory)",
         ),
         define(
-            "FBIMG",
+            data::FBIMG.0,
             format!("0x{:x}", mem::FB_IMAGE),
             "the FB image, loaded by the host",
         ),
-        define("FBWORDS", lay.fb.len(), "its words"),
+        define(data::FBWORDS.0, lay.fb.len(), "its words"),
         define(
-            "TILELIST",
+            data::TILELIST.0,
             format!("0x{:x}", mem::TILE_LIST),
             "the tile list, written by the host:",
         ),
-        define("TL_COUNT", 0, "  the number of tiles"),
-        define("TL_FIRST", 4, "  the first tile's entry:"),
-        define("TILE_PX", 0, "    its corner's pixel column"),
-        define("TILE_PY", 4, "    its corner's pixel row"),
-        define("TILE_OUT", 8, "    where its output goes in main memory"),
-        define("TILE_BYTES", 12, "  bytes of an entry"),
-        define("MASK_HI", 4, "the high word of a 64-bit mask (RCs 32..63)"),
-        define("AXIS_X", 0, "a per-axis table's words"),
-        define("AXIS_Y", 4, ""),
-        define("AXIS_Z", 8, ""),
+        TL_COUNT.define(),
+        TL_FIRST.define(),
+        TILE_PX.define(),
+        TILE_PY.define(),
+        TILE_OUT.define(),
+        TILE_BYTES.define(),
+        MASK_HI.define(),
+        AXIS_X.define(),
+        AXIS_Y.define(),
+        AXIS_Z.define(),
     ]
 }
 
 fn fb(lay: &FbImage) -> Vec<String> {
+    use super::data::{EYE_PX, EYE_PY};
     let mut v = vec![
         define(
-            "FB_EYE",
+            data::FB_EYE.0,
             lay.eye,
             "eye stream: px0, py0, eye.xyz, (A, B, C) per axis",
         ),
-        define("EYE_PX", 0, "  the tile's corner, written per tile"),
-        define("EYE_PY", 1, ""),
+        EYE_PX.define(),
+        EYE_PY.define(),
         define(
-            "FB_POST",
+            data::FB_POST.0,
             lay.post,
             "post-pass stream: background, (material, Ks) per material",
         ),
@@ -415,7 +419,7 @@ fn fb(lay: &FbImage) -> Vec<String> {
     }
     if lay.traversal == Traversal::Packet {
         v.push(define(
-            "ROOTBOX",
+            data::ROOTBOX.0,
             lay.root_box,
             "the root cell widened by P_TOL: per axis min, max",
         ));
@@ -437,12 +441,16 @@ fn fb(lay: &FbImage) -> Vec<String> {
         }
     }
     if resident {
-        v.push(define("ROOT", lay.root, "the BSP root node"));
+        v.push(define(data::ROOT.0, lay.root, "the BSP root node"));
     } else {
-        v.push(define("ROOT", lay.root, "the BSP root node (main memory)"));
+        v.push(define(
+            data::ROOT.0,
+            lay.root,
+            "the BSP root node (main memory)",
+        ));
     }
     v.push(define(
-        "MAILBOX",
+        data::MAILBOX.0,
         lay.mailbox,
         if resident && lay.traversal == Traversal::Paper {
             "the mailboxes: per object the pass that last tested it"
@@ -450,17 +458,17 @@ fn fb(lay: &FbImage) -> Vec<String> {
             "the mailboxes (main memory)"
         },
     ));
-    v.push(define("NOBJ", lay.objects, "objects in the scene"));
+    v.push(define(data::NOBJ.0, lay.objects, "objects in the scene"));
     if lay.traversal == Traversal::Paper {
         v.push(define(
-            "PASS_WRAP",
+            data::PASS_WRAP.0,
             "0x7fff",
             "pass numbers wrap here (16-bit mailboxes)",
         ));
     }
     if let Some(st) = &lay.stream {
         v.push(define(
-            "SPLIT",
+            data::SPLIT.0,
             st.split_slot,
             "the split of the node being classified",
         ));
@@ -472,7 +480,7 @@ fn fb(lay: &FbImage) -> Vec<String> {
             ));
         }
         v.push(define(
-            "SBANK",
+            data::SBANK.0,
             format!("0x{STREAM_BANK:x}"),
             "FB bank 1: the leaf blocks, by DMA",
         ));
@@ -521,127 +529,35 @@ fn nodes(lay: &FbImage) -> Vec<String> {
 
 /// TinyRISC's data.
 fn data(lay: &FbImage, merged_lanes: Option<&[u32]>) -> String {
-    let mut t = Code::new();
-    t.raw("\n; ==== TinyRISC data ====").directive(".data");
-    let d = |t: &mut Code, name: &str, what: &str, doc: &str| {
-        let head = format!("{:<16}{what}", format!("{name}:"));
-        t.raw(if doc.is_empty() {
-            head
-        } else {
-            format!("{head:<40}; {doc}")
-        });
+    use super::data::{
+        Var, AWAKE, BAND_SAVE, CUR_BLK, CUR_OUT, LEAF_TAGS, MODE, NEG, NEG_X, NEG_Y, NEG_Z, NF, NK,
+        NS, NSTACK, PASS, PASSES, PREV_GEN, SAVE_LR, TESTS, TILE_GEN, TL_BANK, TL_CNT, TL_PTR,
+        T_END, T_START, UPTR, USTK,
     };
-    d(
-        &mut t,
-        "PASS",
-        ".word 0",
-        "the ray pass's number (mailboxes)",
-    );
-    d(
-        &mut t,
-        "MODE",
-        ".word 0",
-        "0: closest hit, 1: any hit (shadow rays)",
-    );
-    d(&mut t, "SAVE_LR", ".word 0", "trace's return address");
+    let mut v = vec![PASS, MODE, SAVE_LR];
     if lay.fit.polygon_form.banded() {
-        d(
-            &mut t,
-            "BAND_SAVE",
-            ".word 0, 0, 0",
-            "r8, r12, r13 while a banded polygon's bands are found",
-        );
+        v.push(BAND_SAVE);
     }
-    d(
-        &mut t,
-        "AWAKE",
-        ".word 0, 0",
-        "the RCs awake (RCs 0..31, 32..63)",
-    );
-    t.raw("NEG:");
-    d(
-        &mut t,
-        "NEG_X",
-        ".word 0, 0",
-        "per axis, the rays going down along it",
-    );
-    d(&mut t, "NEG_Y", ".word 0, 0", "");
-    d(&mut t, "NEG_Z", ".word 0, 0", "");
-    d(
-        &mut t,
-        "T_START",
-        ".word 0",
-        "the cycle counter at the tile loop's start",
-    );
-    d(&mut t, "T_END", ".word 0", "... and at its end");
+    v.push(AWAKE);
+    let mut lines: Vec<String> = v.iter().map(Var::line).collect();
+    lines.push(format!("{NEG}:"));
+    let mut v = vec![NEG_X, NEG_Y, NEG_Z, T_START, T_END];
     if lay.traversal == Traversal::Paper {
         // (The packet traversal's tests are counted by the simulator.)
-        d(&mut t, "TESTS", ".word 0", "object tests broadcast");
+        v.push(TESTS);
     }
-    d(&mut t, "PASSES", ".word 0", "ray passes");
-    d(&mut t, "TL_PTR", ".word 0", "the tile list's current entry");
-    d(&mut t, "TL_CNT", ".word 0", "tiles left");
-    d(
-        &mut t,
-        "TL_BANK",
-        ".word 0",
-        "the output bank of this tile (0, 1)",
-    );
-    d(
-        &mut t,
-        "CUR_OUT",
-        ".word 0",
-        "where this tile's output goes",
-    );
-    d(&mut t, "NSTACK", ".space 256", "the node stack");
-    if lay.traversal == Traversal::Packet {
-        d(
-            &mut t,
-            "NK",
-            ".word 0, 0, 0",
-            "per axis: the node kernel of the pass's child order",
-        );
-        d(
-            &mut t,
-            "NF",
-            ".word 0, 0, 0",
-            "per axis: the first child's field in a node",
-        );
-        d(
-            &mut t,
-            "NS",
-            ".word 0, 0, 0",
-            "per axis: the second child's field",
-        );
-        if lay.stream.is_some() {
-            d(
-                &mut t,
-                "TILE_GEN",
-                ".word 0",
-                "the tile's number for the leaf cache: its corner, y << 12 | x",
-            );
-            d(
-                &mut t,
-                "PREV_GEN",
-                ".word 0",
-                "the tile before's number: its leaves in the cache are hits too",
-            );
-            d(
-                &mut t,
-                "LEAF_TAGS",
-                ".space 0x8000",
-                "leaf cache tags, at LEAF_TAGS + 2 (a - SBANK) for the slot at FB address a: its block and tile",
-            );
-        }
-    } else if lay.stream.is_some() {
-        d(
-            &mut t,
-            "UPTR",
-            ".word 0",
-            "the unordered-subtree stack's top",
-        );
-        d(&mut t, "USTK", ".space 160", "the unordered-subtree stack");
-        d(&mut t, "CUR_BLK", ".word 0", "the leaf block in SBANK");
+    v.extend([PASSES, TL_PTR, TL_CNT, TL_BANK, CUR_OUT, NSTACK]);
+    match (lay.traversal, lay.stream.is_some()) {
+        (Traversal::Packet, true) => v.extend([NK, NF, NS, TILE_GEN, PREV_GEN, LEAF_TAGS]),
+        (Traversal::Packet, false) => v.extend([NK, NF, NS]),
+        (Traversal::Paper, true) => v.extend([UPTR, USTK, CUR_BLK]),
+        (Traversal::Paper, false) => {}
+    }
+    lines.extend(v.iter().map(Var::line));
+    let mut t = Code::new();
+    t.raw("\n; ==== TinyRISC data ====").directive(".data");
+    for l in lines {
+        t.raw(l);
     }
     if let Some(lanes) = merged_lanes {
         shadows::data(&mut t, lay, lanes);

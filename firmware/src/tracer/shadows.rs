@@ -30,13 +30,19 @@
 //! copies by TinyRISC's `lfb` / `sfb`, one load kernel per ray, the masks
 //! back by `sfb` and one kernel per light.
 
-use super::emit::{at, Code, K, R0, R1, R10, R2, R3, R4, R5, R6, R7, R8, R9};
+use super::emit::{at, Code, Name, K, R0, R1, R10, R2, R3, R4, R5, R6, R7, R8, R9};
 use super::kernel_names as names;
 use super::layout::FbImage;
 use super::memory_map::ram;
 use super::{Options, Traversal};
 
+use super::data::{
+    DEBRUIJN, MODE, SC_BITS, SC_FB, SC_L, SC_LANES, SC_LIT, SC_N, SC_RET, SC_SRC, SC_VIS, TL_BANK,
+};
 pub use super::options::ShadowPackets;
+
+/// A ray's first word in the packet stream: the RC it goes to.
+pub const SC_RAY_RC: Name = Name::new("SC_RAY_RC", 0, "  the RC it goes to");
 
 /// The most lights whose rays are merged (their N.L and R.V take two
 /// words each of every RC's RAM, `SHADOW_SLOTS`); a scene with more keeps
@@ -94,7 +100,7 @@ pub fn header(lay: &FbImage) -> Vec<String> {
             ray_words(lay) + 1,
             "words of a ray in the packet stream:",
         ),
-        define("SC_RAY_RC", 0, "  the RC it goes to"),
+        SC_RAY_RC.define(),
         define("SC_RAY_W", 1, "  its words, r1..r7[, ORIG_OBJ]"),
         define(
             "SC_STAGE",
@@ -110,60 +116,18 @@ pub fn header(lay: &FbImage) -> Vec<String> {
 /// TinyRISC's data.
 pub fn data(t: &mut Code, lay: &FbImage, lanes: &[u32]) {
     let l = lay.lights.len();
-    let d = |t: &mut Code, name: &str, what: String, doc: &str| {
-        let head = format!("{:<16}{what}", format!("{name}:"));
-        t.raw(if doc.is_empty() {
-            head
-        } else {
-            format!("{head:<40}; {doc}")
-        });
+    use super::data::{
+        DEBRUIJN, SC_BITS, SC_FB, SC_L, SC_LANES, SC_LIT, SC_N, SC_RET, SC_SRC, SC_VIS,
     };
-    d(t, "SC_RET", ".word 0".into(), "shadows' return address");
-    d(
-        t,
-        "SC_FB",
-        ".word 0".into(),
-        "the tile's output bank (FB address)",
-    );
-    d(t, "SC_L", ".word 0".into(), "the light being packed");
-    d(
-        t,
-        "SC_BITS",
-        ".word 0, 0".into(),
-        "its lit RCs not packed yet (RCs 0..31, 32..63)",
-    );
-    d(t, "SC_N", ".word 0".into(), "rays in the packet");
-    d(
-        t,
-        "SC_LIT",
-        format!(".space {}", 8 * l),
-        "per light: the RCs lit by it (two words)",
-    );
-    d(
-        t,
-        "SC_VIS",
-        format!(".space {}", 8 * l),
-        "per light: the RCs whose shadow ray is unblocked",
-    );
-    d(
-        t,
-        "SC_SRC",
-        ".space 256".into(),
-        "per packet entry: light * 64 + the RC that spawned the ray",
-    );
+    for v in [SC_RET, SC_FB, SC_L, SC_BITS, SC_N] {
+        t.raw(v.line());
+    }
+    t.raw(SC_LIT.line_with(&format!(".space {}", 8 * l)));
+    t.raw(SC_VIS.line_with(&format!(".space {}", 8 * l)));
+    t.raw(SC_SRC.line());
     let list: Vec<String> = lanes.iter().map(|x| x.to_string()).collect();
-    d(
-        t,
-        "SC_LANES",
-        format!(".byte {}", list.join(", ")),
-        "the tile's RCs: packet entry n goes to RC SC_LANES[n]",
-    );
-    d(
-        t,
-        "DEBRUIJN",
-        ".byte 0, 1, 28, 2, 29, 14, 24, 3, 30, 22, 20, 15, 25, 17, 4, 8".into(),
-        "bit index of 2^i: DEBRUIJN[(2^i * 0x077CB531) >> 27]",
-    );
+    t.raw(SC_LANES.line_with(&format!(".byte {}", list.join(", "))));
+    t.raw(DEBRUIJN.line());
     t.raw(format!(
         "{:<16}.byte 31, 27, 13, 23, 21, 19, 16, 7, 26, 12, 18, 6, 11, 5, 10, 9",
         ""
@@ -365,12 +329,12 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
          the module's text in firmware/src/tracer/shadows.rs); then every light's Phong terms.",
     );
     t.label("shadows")
-        .sw(super::emit::R15, at("SC_RET", R0))
-        .lw(R5, at("TL_BANK", R0))
+        .sw(super::emit::R15, at(SC_RET, R0))
+        .lw(R5, at(TL_BANK, R0))
         .li(R4, "OUT_BANK0")
         .beqz(R5, "sc_bank")
         .li(R4, "OUT_BANK1");
-    t.label("sc_bank").sw(R4, at("SC_FB", R0));
+    t.label("sc_bank").sw(R4, at(SC_FB, R0));
     if lay.refract {
         cb(t, names::SHADOW_SAVE);
     }
@@ -398,21 +362,21 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         }
         cb(t, names::WAKE);
     }
-    t.lw(R6, at("SC_LIT", R0))
-        .lw(R7, at("SC_LIT + 4", R0))
-        .sw(R0, at("SC_L", R0))
-        .sw(R6, at("SC_BITS", R0))
-        .sw(R7, at("SC_BITS + 4", R0));
+    t.lw(R6, at(SC_LIT, R0))
+        .lw(R7, at(format!("{SC_LIT} + 4"), R0))
+        .sw(R0, at(SC_L, R0))
+        .sw(R6, at(SC_BITS, R0))
+        .sw(R7, at(format!("{SC_BITS} + 4"), R0));
     t.doc(
         "sc_packet: the next packet: entries from the lit RCs of the lights in turn (r5 the light,\n\
          r6, r7 its RCs not packed yet), each ray's words copied from the stage into the packet\n\
          stream (r9), up to the tile's ways (r10 entries).",
     );
     t.label("sc_packet")
-        .lw(R4, at("SC_FB", R0))
-        .lw(R5, at("SC_L", R0))
-        .lw(R6, at("SC_BITS", R0))
-        .lw(R7, at("SC_BITS + 4", R0))
+        .lw(R4, at(SC_FB, R0))
+        .lw(R5, at(SC_L, R0))
+        .lw(R6, at(SC_BITS, R0))
+        .lw(R7, at(format!("{SC_BITS} + 4"), R0))
         .addi(R9, R4, "SC_PACK")
         .li(R10, 0);
     t.label("sc_fill")
@@ -427,8 +391,8 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .slti(R1, R5, "LIGHTS")
         .beqz(R1, "sc_full")
         .slli(R1, R5, 3)
-        .lw(R6, at("SC_LIT", R1))
-        .lw(R7, at("SC_LIT + 4", R1))
+        .lw(R6, at(SC_LIT, R1))
+        .lw(R7, at(format!("{SC_LIT} + 4"), R1))
         .j("sc_next");
     t.label("sc_low")
         .sub(R1, R0, R6)
@@ -446,11 +410,11 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .li(R3, "0x077CB531")
         .mul(R1, R1, R3)
         .srli(R1, R1, 27)
-        .lbu(R1, at("DEBRUIJN", R1))
+        .lbu(R1, at(DEBRUIJN, R1))
         .add(R2, R2, R1)
         .c("r2: the RC that spawned the ray")
-        .lbu(R1, at("SC_LANES", R10))
-        .sfb(R1, at("SC_RAY_RC", R9))
+        .lbu(R1, at(SC_LANES, R10))
+        .sfb(R1, at(SC_RAY_RC, R9))
         .c("the RC it goes to")
         .slli(R3, R5, 9)
         .add(R3, R3, R2)
@@ -463,17 +427,17 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
     t.slli(R1, R5, 6)
         .add(R1, R1, R2)
         .slli(R3, R10, 2)
-        .sw(R1, at("SC_SRC", R3))
+        .sw(R1, at(SC_SRC, R3))
         .addi(R9, R9, "SC_REC")
         .addi(R10, R10, 1)
         .j("sc_fill");
     t.doc("sc_full: the packet's rays into their RCs, one pass (any hit), the unblocked ones into SC_VIS.");
     t.label("sc_full")
         .beqz(R10, "sc_shade")
-        .sw(R5, at("SC_L", R0))
-        .sw(R6, at("SC_BITS", R0))
-        .sw(R7, at("SC_BITS + 4", R0))
-        .sw(R10, at("SC_N", R0));
+        .sw(R5, at(SC_L, R0))
+        .sw(R6, at(SC_BITS, R0))
+        .sw(R7, at(format!("{SC_BITS} + 4"), R0))
+        .sw(R10, at(SC_N, R0));
     cb(t, names::SHADOW_CLEAR);
     t.addi(R3, R4, "SC_PACK");
     t.label("sc_load");
@@ -482,16 +446,16 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .addi(R10, R10, -1)
         .bnez(R10, "sc_load");
     cb(t, names::SHADOW_GO);
-    t.li(R1, 1).sw(R1, at("MODE", R0)).c("any hit").jal("trace");
+    t.li(R1, 1).sw(R1, at(MODE, R0)).c("any hit").jal("trace");
     cb(t, names::WAKE);
     cb(t, names::SHADOW_SEEN);
     t.rcfl(R8)
         .rcfh(R9)
         .c("F: unblocked")
-        .lw(R10, at("SC_N", R0))
+        .lw(R10, at(SC_N, R0))
         .li(R3, 0);
     t.label("sc_result")
-        .lbu(R4, at("SC_LANES", R3))
+        .lbu(R4, at(SC_LANES, R3))
         .slti(R5, R4, 32)
         .beqz(R5, "sc_result_high")
         .srl(R5, R8, R4)
@@ -501,16 +465,16 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .andi(R5, R5, 1)
         .beqz(R5, "sc_result_next")
         .slli(R5, R3, 2)
-        .lw(R5, at("SC_SRC", R5))
+        .lw(R5, at(SC_SRC, R5))
         .srli(R6, R5, 5)
         .slli(R6, R6, 2)
         .c("the light's SC_VIS word of the RC")
         .andi(R5, R5, 31)
         .li(R7, 1)
         .sll(R7, R7, R5)
-        .lw(R5, at("SC_VIS", R6))
+        .lw(R5, at(SC_VIS, R6))
         .or(R5, R5, R7)
-        .sw(R5, at("SC_VIS", R6));
+        .sw(R5, at(SC_VIS, R6));
     t.label("sc_result_next")
         .addi(R3, R3, 1)
         .bne(R3, R10, "sc_result")
@@ -532,5 +496,5 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         t.m("BCAST_AT", format!("{}, r3", names::SHADOW_LIT));
         super::shading::broadcast_phong(t, lay.phong_in_runs(), &format!("FB_SHADE{l}"));
     }
-    t.lw(super::emit::R15, at("SC_RET", R0)).line("jr r15");
+    t.lw(super::emit::R15, at(SC_RET, R0)).line("jr r15");
 }

@@ -22,6 +22,10 @@
 //! The tile loop keeps its state in memory (`TL_PTR`, `TL_CNT`, `TL_BANK`,
 //! `CUR_OUT`), so that `trace` may use r1..r14.
 
+use super::data::{
+    CUR_OUT, EYE_PX, EYE_PY, MODE, PREV_GEN, TILE, TILE_BYTES, TILE_GEN, TILE_OUT, TILE_PX,
+    TILE_PY, TL_BANK, TL_CNT, TL_COUNT, TL_FIRST, TL_PTR, T_END, T_START,
+};
 use super::emit::{at, Code, R0, R1, R2, R3, R4, R5, R6};
 use super::kernel_names as names;
 use super::layout::FbImage;
@@ -136,7 +140,7 @@ pub fn macros(lay: &FbImage) -> Code {
         body(&|b| {
             b.m("BCAST_FB", format!("{}, \\light", names::SHADOW))
                 .li(R1, 1)
-                .sw(R1, at("MODE", R0))
+                .sw(R1, at(MODE, R0))
                 .c("any hit")
                 .jal("trace")
                 .m("BCAST", names::WAKE);
@@ -160,7 +164,7 @@ pub fn macros(lay: &FbImage) -> Code {
             }
         ),
         body(&|b| {
-            b.sw(R0, at("MODE", R0))
+            b.sw(R0, at(MODE, R0))
                 .c("closest hit")
                 .jal("trace")
                 .m("BCAST", names::WAKE)
@@ -218,35 +222,35 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
     t.rcany(R1)
         .c("the array done")
         .rdcyc(R1)
-        .sw(R1, at("T_START", R0))
+        .sw(R1, at(T_START, R0))
         .li(R1, "TILELIST")
-        .lw(R2, at("TL_COUNT", R1))
-        .addi(R1, R1, "TL_FIRST")
-        .sw(R1, at("TL_PTR", R0))
-        .sw(R2, at("TL_CNT", R0));
+        .lw(R2, at(TL_COUNT, R1))
+        .addi(R1, R1, TL_FIRST)
+        .sw(R1, at(TL_PTR, R0))
+        .sw(R2, at(TL_CNT, R0));
     t.doc(
         "tile: one tile of the list (TL_PTR: its entry, TL_CNT: tiles left): eye rays, the ray\n\
          tree, the pixels out.",
     );
-    t.label("tile")
-        .lw(R2, at("TL_CNT", R0))
+    t.label(TILE)
+        .lw(R2, at(TL_CNT, R0))
         .beqz(R2, "finish")
-        .lw(R1, at("TL_PTR", R0))
-        .lw(R3, at("TILE_PX", R1))
-        .lw(R4, at("TILE_PY", R1))
-        .lw(R5, at("TILE_OUT", R1))
-        .sw(R5, at("CUR_OUT", R0));
+        .lw(R1, at(TL_PTR, R0))
+        .lw(R3, at(TILE_PX, R1))
+        .lw(R4, at(TILE_PY, R1))
+        .lw(R5, at(TILE_OUT, R1))
+        .sw(R5, at(CUR_OUT, R0));
     if lay.traversal == super::Traversal::Packet && lay.stream.is_some() {
-        t.lw(R2, at("TILE_GEN", R0))
-            .sw(R2, at("PREV_GEN", R0))
+        t.lw(R2, at(TILE_GEN, R0))
+            .sw(R2, at(PREV_GEN, R0))
             .slli(R6, R4, 12)
             .or(R6, R6, R3)
-            .sw(R6, at("TILE_GEN", R0))
+            .sw(R6, at(TILE_GEN, R0))
             .c("the leaf cache holds the leaves of this tile and of the one before");
     }
     t.li(R6, "FB_EYE")
-        .sfb(R3, at("EYE_PX", R6))
-        .sfb(R4, at("EYE_PY", R6))
+        .sfb(R3, at(EYE_PX, R6))
+        .sfb(R4, at(EYE_PY, R6))
         .c("the tile's corner into the eye stream");
     sb(t, names::EYE, "FB_EYE").c("eye rays");
     let mut skips = 0;
@@ -255,7 +259,7 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
     t.label("finish")
         .dwait()
         .rdcyc(R1)
-        .sw(R1, at("T_END", R0))
+        .sw(R1, at(T_END, R0))
         .halt();
 }
 
@@ -263,7 +267,7 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
 /// reflection level's shadow rays in merged packets (`jal shadows`).
 fn shade_level(t: &mut Code, level: u32, merged: bool, skips: &mut u32) {
     if merged && level > 0 {
-        t.sw(R0, at("MODE", R0))
+        t.sw(R0, at(MODE, R0))
             .c(format!("level {level}: trace (closest hit)"))
             .jal("trace");
         cb(t, names::WAKE);
@@ -329,7 +333,7 @@ fn tree(t: &mut Code, lay: &FbImage, level: u32, levels: u32, merged: bool, skip
 /// DMA to the tile's place in main memory; the next tile.
 fn output(t: &mut Code) {
     t.comment("the pixels: R, G, B, object id per RC into an output bank, then DMA out")
-        .lw(R5, at("TL_BANK", R0))
+        .lw(R5, at(TL_BANK, R0))
         .li(R4, "OUT_BANK0")
         .beqz(R5, "out_bank")
         .li(R4, "OUT_BANK1");
@@ -340,18 +344,18 @@ fn output(t: &mut Code) {
     {
         t.m("BCAST", names::out(i as u32)).wfb(R4, w);
     }
-    t.lw(R3, at("CUR_OUT", R0))
+    t.lw(R3, at(CUR_OUT, R0))
         .stfb(R3, R4, "OUT_WORDS")
         .c("DMA to main memory")
-        .lw(R5, at("TL_BANK", R0))
+        .lw(R5, at(TL_BANK, R0))
         .xori(R5, R5, 1)
-        .sw(R5, at("TL_BANK", R0))
+        .sw(R5, at(TL_BANK, R0))
         .c("the other bank next")
-        .lw(R1, at("TL_PTR", R0))
-        .addi(R1, R1, "TILE_BYTES")
-        .sw(R1, at("TL_PTR", R0))
-        .lw(R2, at("TL_CNT", R0))
+        .lw(R1, at(TL_PTR, R0))
+        .addi(R1, R1, TILE_BYTES)
+        .sw(R1, at(TL_PTR, R0))
+        .lw(R2, at(TL_CNT, R0))
         .addi(R2, R2, -1)
-        .sw(R2, at("TL_CNT", R0))
-        .j("tile");
+        .sw(R2, at(TL_CNT, R0))
+        .j(TILE);
 }

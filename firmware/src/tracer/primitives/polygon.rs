@@ -71,7 +71,7 @@
 //! **Error** against the f64 polygon (`tb/tests/kernels.rs`, a convex, a
 //! concave and a gear-like polygon): `t` within 3 LSB, no crack.
 
-use super::super::emit::{define, Code, Reg, K, R0, R1, R2, R3, R7};
+use super::super::emit::{define, Code, Name, Reg, K, R0, R1, R2, R3, R7};
 use super::super::memory_map::ram;
 use super::planar::plane_hit;
 use super::record::W;
@@ -80,6 +80,10 @@ use super::{
     RecordError, Sides, TestCost,
 };
 use crate::scene::{Shape, Vec3};
+
+/// A record's first word: its number of edges (sub-edges' bands where
+/// banded).
+pub const POLY_EDGES: Name = Name::new("POLY_EDGES", 0, "polygon record: number of edges (words)");
 
 /// Words of the head, one edge and the tail.
 pub const HEAD_WORDS: usize = 15;
@@ -192,7 +196,7 @@ pub fn header(form: Form) -> Vec<String> {
         ];
     }
     vec![
-        define("POLY_EDGES", 0, "polygon record: number of edges (words)"),
+        POLY_EDGES.define(),
         define("POLY_HEAD", 1, "polygon record: the head kernel's stream"),
         define(
             "POLY_FAN",
@@ -561,7 +565,7 @@ pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg, form: For
         broadcast_bands(t, at, sides, rec, form == Form::Apart);
         return;
     }
-    t.lfb(R3, super::super::emit::at("POLY_EDGES", rec))
+    t.lfb(R3, super::super::emit::at(POLY_EDGES, rec))
         .c("edges")
         .addi(R2, rec, "POLY_FAN")
         .li(R1, kaddr(EDGE));

@@ -22,6 +22,7 @@ pub mod packet;
 pub mod paper;
 pub mod streamed;
 
+use super::data::{AWAKE, MASK_HI};
 use super::emit::{Code, K, R0, R1, R2};
 use super::kernel_names as names;
 
@@ -47,7 +48,7 @@ pub fn read_awake(t: &mut Code) {
         .rcsh(R2)
         .nor(R1, R1, R0)
         .nor(R2, R2, R0)
-        .sw(R1, super::emit::at("AWAKE", R0))
-        .sw(R2, super::emit::at("AWAKE+MASK_HI", R0))
+        .sw(R1, super::emit::at(AWAKE, R0))
+        .sw(R2, super::emit::at(format!("{AWAKE}+{MASK_HI}"), R0))
         .ret();
 }

@@ -83,6 +83,14 @@ use super::super::primitives::{
 use super::child_order::{self, ChildOrder};
 use crate::tracer::kernel_names as names;
 
+use super::super::data::{
+    LEAF_FIRST, LEAF_LOAD, LEAF_MISS, LEAF_TAGS, MASK_HI, MODE, NF, NK, NS, NSTACK, PASS, PASSES,
+    PREV_GEN, SAVE_LR, SPLIT, TILE_GEN,
+};
+use super::super::layout::packet_nodes::fields::{
+    LE_MAILBOX, LE_RECORD, LE_WORDS, MB_PASS, MB_RAYS, PL_LISTS, PN_PARENT_SLOT, PN_SLOT, PN_SPLIT,
+    PS_BLOCK, PS_BLOCK_WORDS, PS_FB, PS_LIST, PS_NEXT, PS_OBJECTS, PS_SPLIT,
+};
 pub use super::super::layout::packet_nodes::P_TOL;
 
 /// The packet traversal's code by the items of its cost model
@@ -401,15 +409,15 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
         if streamed { "streamed" } else { "resident" }
     ));
     t.label("trace")
-        .sw(R15, at("SAVE_LR", R0))
-        .lw(R1, at("PASSES", R0))
+        .sw(R15, at(SAVE_LR, R0))
+        .lw(R1, at(PASSES, R0))
         .addi(R1, R1, 1)
-        .sw(R1, at("PASSES", R0))
+        .sw(R1, at(PASSES, R0))
         .c("ray passes, for the statistics")
-        .lw(R1, at("PASS", R0))
+        .lw(R1, at(PASS, R0))
         .addi(R1, R1, 1)
-        .sw(R1, at("PASS", R0))
-        .lw(R13, at("MODE", R0))
+        .sw(R1, at(PASS, R0))
+        .lw(R13, at(MODE, R0))
         .slli(R13, R13, 31)
         .or(R13, R13, R1)
         .c("r13: the pass's stamp, PASS | MODE << 31 (negative: any hit)");
@@ -430,7 +438,7 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
             .beqz(R1, "trace_done")
             .c("every ray asleep")
             .j(if f.streamed {
-                "leaf_first"
+                LEAF_FIRST.0
             } else {
                 "leaf_objects"
             });
@@ -443,7 +451,7 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
     );
     t.li(R14, 0).c("the node stack: empty").li(R5, "ROOT");
     if streamed {
-        t.li(R7, "SPLIT").c("r7 = SPLIT throughout the walk");
+        t.li(R7, SPLIT).c("r7 = SPLIT throughout the walk");
     }
     f.load(t, R6, at(flags, R5));
     dispatch_full(t, &f);
@@ -459,18 +467,18 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
     t.label("visit_first");
     dispatch_first(t, &f, false);
     t.comment("r5 = a node whose kernel runs: read its children, issue the first's kernel");
-    t.label("inner_node").lw(R8, at("NF", R6)).add(R8, R8, R5);
+    t.label("inner_node").lw(R8, at(NF, R6)).add(R8, R8, R5);
     f.load(t, R9, deref(R8));
     t.c("r9 = the first child");
-    t.lw(R10, at("NS", R6)).add(R10, R10, R5);
+    t.lw(R10, at(NS, R6)).add(R10, R10, R5);
     f.load(t, R10, deref(R10));
     t.c("r10 = the second child");
     f.load(t, R6, at(flags, R9));
     t.andi(R3, R6, 12)
-        .lw(R11, at("NK", R3))
+        .lw(R11, at(NK, R3))
         .c("r11 = its kernel, if inner");
     if streamed {
-        t.lw(R15, at("PS_SPLIT", R9)).c("r15 = its split");
+        t.lw(R15, at(PS_SPLIT, R9)).c("r15 = its split");
     }
     // The cases by how often they come (SPD scenes: all about 45%, none
     // 30%, some 25%), the commonest ways the shortest.
@@ -503,20 +511,20 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
         .beqz(R14, "trace_done")
         .c("the node stack empty")
         .addi(R14, R14, -4)
-        .lw(R5, at("NSTACK", R14))
+        .lw(R5, at(NSTACK, R14))
         .addi(R1, R0, kaddr(names::POP_NODE));
     if streamed {
         t.addi(R2, R14, "SLOTS").c("its slot: the stack entry's");
     } else {
-        t.addi(R2, R5, "PN_PARENT_SLOT");
+        t.addi(R2, R5, PN_PARENT_SLOT);
     }
     t.sbcb(R1, R2, klen(names::POP_NODE))
         .c("the rays take their intervals for it");
     t.comment("while they do: its kernel and split, if inner");
     f.load(t, R6, at(flags, R5));
-    t.andi(R3, R6, 12).lw(R11, at("NK", R3));
+    t.andi(R3, R6, 12).lw(R11, at(NK, R3));
     if streamed {
-        t.li(R7, "SPLIT").c("the leaf's code may have used r7");
+        t.li(R7, SPLIT).c("the leaf's code may have used r7");
     }
     let split = split_word(t, &f, None);
     t.rcany(R4)
@@ -526,14 +534,14 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
         .sbcb(R11, split, klen(&names::node(0, false)))
         .c("its node kernel")
         .j("inner_node");
-    t.label("trace_done").lw(R15, at("SAVE_LR", R0)).ret();
+    t.label("trace_done").lw(R15, at(SAVE_LR, R0)).ret();
     child_order::majority(t);
 }
 
 /// r5 = a node, r6 = its flags: a leaf, or its kernel issued (the split
 /// streamed), then `inner_node`.
 fn dispatch_full(t: &mut Code, f: &Fields) {
-    t.blt(R6, R0, "leaf").lw(R1, at("NK", R6));
+    t.blt(R6, R0, "leaf").lw(R1, at(NK, R6));
     let split = split_word(t, f, None);
     t.sbcb(R1, split, klen(&names::node(0, false)))
         .c("its node kernel")
@@ -547,13 +555,13 @@ fn dispatch_full(t: &mut Code, f: &Fields) {
 fn split_word(t: &mut Code, f: &Fields, held: Option<Reg>) -> Reg {
     if f.streamed {
         let split = held.unwrap_or_else(|| {
-            t.lw(R2, at("PS_SPLIT", R5));
+            t.lw(R2, at(PS_SPLIT, R5));
             R2
         });
-        t.sfb(split, at("SPLIT", R0));
+        t.sfb(split, at(SPLIT, R0));
         R7
     } else {
-        t.addi(R2, R5, "PN_SPLIT");
+        t.addi(R2, R5, PN_SPLIT);
         R2
     }
 }
@@ -579,11 +587,11 @@ fn push_second(t: &mut Code, f: &Fields) {
     if f.streamed {
         t.addi(R2, R14, "SLOTS").c("its slot: the stack entry's");
     } else {
-        t.addi(R2, R5, "PN_SLOT").c("its slot: the node's");
+        t.addi(R2, R5, PN_SLOT).c("its slot: the node's");
     }
     t.m("BCAST_AT", format!("{}, r2", names::PUSH_SECOND))
         .c("the rays' intervals for the second child")
-        .sw(R10, at("NSTACK", R14))
+        .sw(R10, at(NSTACK, R14))
         .addi(R14, R14, 4)
         .c("push it");
 }
@@ -601,14 +609,14 @@ fn mailbox_check(t: &mut Code, n: &str) {
 fn next_piece_dma(t: &mut Code, one_slot: bool, why: &str) {
     if one_slot {
         // The cache's one slot is the further pieces' buffer.
-        t.sw(R0, at("LEAF_TAGS", R0))
+        t.sw(R0, at(LEAF_TAGS, R0))
             .c("the cache's slot overwritten");
     }
     t.rcany(R2)
         .c("the array done with the other bank")
-        .lw(R2, at("PS_BLOCK", R1))
-        .lw(R3, at("PS_BLOCK_WORDS", R1))
-        .lw(R8, at("PS_FB", R1))
+        .lw(R2, at(PS_BLOCK, R1))
+        .lw(R3, at(PS_BLOCK_WORDS, R1))
+        .lw(R8, at(PS_FB, R1))
         .ldfb(R2, R8, R3)
         .c(why);
 }
@@ -660,36 +668,36 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             "the first piece: in its slot of the leaf cache since this tile or the one before",
         )
         .comment("moved or used it there, or its DMA starts");
-        t.label("leaf_first")
-            .lw(R1, at("PS_BLOCK", R5))
-            .lw(R7, at("PS_FB", R5))
+        t.label(LEAF_FIRST)
+            .lw(R1, at(PS_BLOCK, R5))
+            .lw(R7, at(PS_FB, R5))
             .c("r7: the piece's first record, through the scan")
             .add(R6, R7, R7)
-            .lw(R3, at("LEAF_TAGS - 2*SBANK + 4", R6))
-            .lw(R2, at("TILE_GEN", R0))
+            .lw(R3, at(format!("{LEAF_TAGS} - 2*SBANK + 4"), R6))
+            .lw(R2, at(TILE_GEN, R0))
             .beq(R3, R2, "leaf_this_tile")
             .c("moved or used in this tile")
-            .lw(R8, at("PREV_GEN", R0))
-            .bne(R3, R8, "leaf_miss")
+            .lw(R8, at(PREV_GEN, R0))
+            .bne(R3, R8, LEAF_MISS)
             .c("in neither this tile nor the one before (checked first: an older tag never costs more)")
-            .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
-            .bne(R1, R3, "leaf_miss")
-            .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .lw(R3, at(format!("{LEAF_TAGS} - 2*SBANK"), R6))
+            .bne(R1, R3, LEAF_MISS)
+            .sw(R2, at(format!("{LEAF_TAGS} - 2*SBANK + 4"), R6))
             .c("a hit on the tile before's block: this tile's now")
             .j(hit);
         t.label("leaf_this_tile")
-            .lw(R3, at("LEAF_TAGS - 2*SBANK", R6))
+            .lw(R3, at(format!("{LEAF_TAGS} - 2*SBANK"), R6))
             .beq(R1, R3, hit)
             .c("the slot holds the block: a hit");
-        t.label("leaf_miss");
+        t.label(LEAF_MISS);
         if late {
             t.bnez(R11, "leaf_awake").c("not yet: the scan first");
         }
-        t.lw(R3, at("PS_BLOCK_WORDS", R5))
+        t.lw(R3, at(PS_BLOCK_WORDS, R5))
             .ldfb(R1, R7, R3)
             .c("the first piece's DMA starts")
-            .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
-            .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
+            .sw(R1, at(format!("{LEAF_TAGS} - 2*SBANK"), R6))
+            .sw(R2, at(format!("{LEAF_TAGS} - 2*SBANK + 4"), R6))
             .c("r2 = TILE_GEN");
         // A first piece in the cache has no move to hide: its tests start
         // at once, each object's mailbox checked in the type loop (the
@@ -703,29 +711,29 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         // `leaf_next_piece` into `leaf_piece`.
         let mut scan = Code::new();
         scan.label("leaf_piece")
-            .lw(R6, at("PS_LIST", R5))
+            .lw(R6, at(PS_LIST, R5))
             .c("r5: a piece whose DMA has started")
-            .lw(R9, at("PS_OBJECTS", R5));
+            .lw(R9, at(PS_OBJECTS, R5));
         scan.comment("while the piece moves: is there an object some awake ray has not tested?");
         scan.label("leaf_scan")
             .lw(R8, deref(R6))
             .addi(R6, R6, 4)
             .beqz(R8, "leaf_go")
             .c("no mailbox: to be tested")
-            .lw(R1, at("MB_PASS", R8))
+            .lw(R1, at(MB_PASS, R8))
             .bne(R1, R13, "leaf_go")
-            .lw(R2, at("MB_RAYS", R8))
+            .lw(R2, at(MB_RAYS, R8))
             .or(R2, R2, R4)
             .bne(R2, R4, "leaf_go")
             .c("an awake ray has not tested it")
-            .lw(R3, at("MB_RAYS+MASK_HI", R8))
+            .lw(R3, at(format!("{MB_RAYS}+{MASK_HI}"), R8))
             .or(R3, R3, R10)
             .bne(R3, R10, "leaf_go")
             .addi(R9, R9, -1)
             .bnez(R9, "leaf_scan");
         scan.comment("every object of the piece tested by every awake ray");
         scan.label("leaf_skip")
-            .lw(R1, at("PS_NEXT", R5))
+            .lw(R1, at(PS_NEXT, R5))
             .bnez(R1, "leaf_skip_next")
             .andi(R1, R7, "SBANK")
             .bnez(R1, "leaf_done")
@@ -757,11 +765,11 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             t.bnez(R11, "leaf_late").c("a large first piece to move");
             t.label("leaf_go_moving");
         }
-        t.lw(R1, at("PS_NEXT", R5)).lw(R6, at("PS_LIST", R5));
+        t.lw(R1, at(PS_NEXT, R5)).lw(R6, at(PS_LIST, R5));
         if let Some(ti) = lay.types.first() {
             t.lw(R9, at(count_field(ti), R5));
         }
-        t.label("leaf_load")
+        t.label(LEAF_LOAD)
             .dwait()
             .c("the piece is in the FB")
             .beqz(R1, "leaf_tests");
@@ -790,22 +798,22 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             type_loop(t, lay, ti, &n, &fetch, &advance);
         }
         t.label("leaf_next_piece")
-            .lw(R5, at("PS_NEXT", R5))
+            .lw(R5, at(PS_NEXT, R5))
             .beqz(R5, "leaf_done")
-            .lw(R7, at("PS_FB", R5))
+            .lw(R7, at(PS_FB, R5))
             .c("r7: the piece's first record");
         t.extend(scan);
         if late {
             t.comment("a large first piece some awake ray has not tested: its DMA starts, the slot takes it");
             t.label("leaf_late")
                 .li(R11, 0)
-                .lw(R1, at("PS_BLOCK", R5))
-                .lw(R3, at("PS_BLOCK_WORDS", R5))
+                .lw(R1, at(PS_BLOCK, R5))
+                .lw(R3, at(PS_BLOCK_WORDS, R5))
                 .ldfb(R1, R7, R3)
                 .add(R6, R7, R7)
-                .lw(R2, at("TILE_GEN", R0))
-                .sw(R1, at("LEAF_TAGS - 2*SBANK", R6))
-                .sw(R2, at("LEAF_TAGS - 2*SBANK + 4", R6))
+                .lw(R2, at(TILE_GEN, R0))
+                .sw(R1, at(format!("{LEAF_TAGS} - 2*SBANK"), R6))
+                .sw(R2, at(format!("{LEAF_TAGS} - 2*SBANK + 4"), R6))
                 .j("leaf_go_moving");
             t.label("leaf_hit")
                 .li(R11, 0)
@@ -823,7 +831,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         awake(t);
         t.label("leaf_objects")
             .li(R12, "MAILBOX")
-            .addi(R6, R5, "PL_LISTS");
+            .addi(R6, R5, PL_LISTS);
         for ti in &lay.types {
             let n = format!("lo_{}", ti.ty.name());
             t.lfb(R9, deref(R6))
@@ -831,9 +839,9 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
                 .beqz(R9, format!("{n}_end"))
                 .c(format!("{} in the leaf", ti.ty.plural()));
             let fetch = |t: &mut Code, p: &str| {
-                t.lfb(R7, at("LE_RECORD", R6))
-                    .lfb(R8, at("LE_MAILBOX", R6))
-                    .addi(R6, R6, "LE_WORDS")
+                t.lfb(R7, at(LE_RECORD, R6))
+                    .lfb(R8, at(LE_MAILBOX, R6))
+                    .addi(R6, R6, LE_WORDS)
                     .blt(R8, R0, format!("{p}_go"))
                     .c("no mailbox")
                     .slli(R8, R8, "MB_SHIFT")
@@ -959,11 +967,11 @@ fn type_loop(
 pub fn macros() -> Code {
     let mut t = Code::new();
     let mut b = Code::new();
-    b.lw(R1, at("MB_PASS", R8))
+    b.lw(R1, at(MB_PASS, R8))
         .line("bne r1, r13, \\p\\()_fresh")
         .c("not tested in this pass yet")
-        .lw(R2, at("MB_RAYS", R8))
-        .lw(R3, at("MB_RAYS+MASK_HI", R8))
+        .lw(R2, at(MB_RAYS, R8))
+        .lw(R3, at(format!("{MB_RAYS}+{MASK_HI}"), R8))
         .or(R1, R2, R4)
         .line("bne r1, r4, \\p\\()_upd")
         .c("an awake ray has not tested it")
@@ -973,13 +981,13 @@ pub fn macros() -> Code {
     b.label("\\p\\()_upd")
         .and(R2, R2, R4)
         .and(R3, R3, R10)
-        .sw(R2, at("MB_RAYS", R8))
-        .sw(R3, at("MB_RAYS+MASK_HI", R8))
+        .sw(R2, at(MB_RAYS, R8))
+        .sw(R3, at(format!("{MB_RAYS}+{MASK_HI}"), R8))
         .line("j \\p\\()_go");
     b.label("\\p\\()_fresh")
-        .sw(R13, at("MB_PASS", R8))
-        .sw(R4, at("MB_RAYS", R8))
-        .sw(R10, at("MB_RAYS+MASK_HI", R8));
+        .sw(R13, at(MB_PASS, R8))
+        .sw(R4, at(MB_RAYS, R8))
+        .sw(R10, at(format!("{MB_RAYS}+{MASK_HI}"), R8));
     b.label("\\p\\()_go");
     t.define_macro(
         "MAILBOX_CHECK",

@@ -29,8 +29,14 @@
 //! TinyRISC registers: r5 the node, r11, r12 the awake mask, r14 the node
 //! stack pointer (`NSTACK`), r1..r4, r6..r10, r13 temporaries.
 
+use super::super::data::{
+    AWAKE, MASK_HI, MODE, NEG, NSTACK, PASS, PASSES, PASS_WRAP, SAVE_LR, TESTS,
+};
 use super::super::emit::{
     at, deref, Code, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
+};
+use super::super::layout::paper_nodes::fields::{
+    NC_INNER_LISTS, NC_LEAF_LISTS, N_FLAGS, N_LEFT, N_RIGHT, N_SPLIT,
 };
 use super::super::layout::FbImage;
 use super::super::memory_map::ram;
@@ -138,19 +144,19 @@ pub fn leaf_any() -> K {
 /// The start of every paper `trace`: the pass's number and the signs.
 pub fn pass_start(t: &mut Code) {
     t.label("trace")
-        .sw(R15, at("SAVE_LR", R0))
-        .lw(R1, at("PASSES", R0))
+        .sw(R15, at(SAVE_LR, R0))
+        .lw(R1, at(PASSES, R0))
         .addi(R1, R1, 1)
-        .sw(R1, at("PASSES", R0))
+        .sw(R1, at(PASSES, R0))
         .c("ray passes, for the statistics")
-        .lw(R1, at("PASS", R0))
+        .lw(R1, at(PASS, R0))
         .addi(R1, R1, 1)
-        .li(R2, "PASS_WRAP")
+        .li(R2, PASS_WRAP)
         .blt(R1, R2, "trace_numbered")
         .jal("clear_mailbox")
         .c("the mailboxes hold 16-bit pass numbers")
         .li(R1, 1);
-    t.label("trace_numbered").sw(R1, at("PASS", R0));
+    t.label("trace_numbered").sw(R1, at(PASS, R0));
     for (a, name) in ["NEG_X", "NEG_Y", "NEG_Z"].into_iter().enumerate() {
         t.m("BCAST", names::sign(a as u8))
             .rcfl(R2)
@@ -176,14 +182,14 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         }
     ));
     pass_start(t);
-    t.jal("read_awake").li(R14, "NSTACK").li(R5, "ROOT");
+    t.jal("read_awake").li(R14, NSTACK).li(R5, "ROOT");
     t.label("visit_node")
-        .lw(R11, at("AWAKE", R0))
-        .lw(R12, at("AWAKE+MASK_HI", R0))
+        .lw(R11, at(AWAKE, R0))
+        .lw(R12, at(format!("{AWAKE}+{MASK_HI}"), R0))
         .or(R1, R11, R12)
         .beqz(R1, "trace_done")
         .c("no ray awake")
-        .lfb(R6, at("N_FLAGS", R5))
+        .lfb(R6, at(N_FLAGS, R5))
         .blt(R6, R0, "leaf")
         .andi(R7, R6, 3)
         .c("the split's axis")
@@ -196,7 +202,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .bnez(R3, "classify")
         .li(R1, kaddr(&names::classify(2)));
     t.label("classify")
-        .addi(R2, R5, "N_SPLIT")
+        .addi(R2, R5, N_SPLIT)
         .sbcb(R1, R2, klen(&names::classify(0)))
         .c("the segments against the plane")
         .rcfl(R1)
@@ -215,13 +221,13 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .bnez(R9, "some_above")
         .or(R9, R1, R2)
         .beqz(R9, "pop_node")
-        .lfb(R5, at("N_LEFT", R5))
+        .lfb(R5, at(N_LEFT, R5))
         .c("all below")
         .j("visit_node");
     t.label("some_above")
         .or(R9, R1, R2)
         .bnez(R9, "both_sides")
-        .lfb(R5, at("N_RIGHT", R5))
+        .lfb(R5, at(N_RIGHT, R5))
         .c("all above")
         .j("visit_node");
     t.label("both_sides")
@@ -229,8 +235,8 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .bne(R2, R4, "incoherent")
         .c("every ray crosses the plane:")
         .slli(R9, R7, 3)
-        .lw(R10, at("NEG", R9))
-        .lw(R13, at("NEG+MASK_HI", R9))
+        .lw(R10, at(NEG, R9))
+        .lw(R13, at(format!("{NEG}+{MASK_HI}"), R9))
         .and(R10, R10, R11)
         .and(R13, R13, R12)
         .or(R9, R10, R13)
@@ -238,34 +244,34 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .c("all in the same direction?")
         .bne(R10, R11, "incoherent")
         .bne(R13, R12, "incoherent")
-        .lfb(R9, at("N_LEFT", R5))
+        .lfb(R9, at(N_LEFT, R5))
         .sw(R9, deref(R14))
         .addi(R14, R14, 4)
         .c("push below")
-        .lfb(R5, at("N_RIGHT", R5))
+        .lfb(R5, at(N_RIGHT, R5))
         .c("visit above first")
         .j("visit_node");
     t.label("positive_first")
-        .lfb(R9, at("N_RIGHT", R5))
+        .lfb(R9, at(N_RIGHT, R5))
         .sw(R9, deref(R14))
         .addi(R14, R14, 4)
         .c("push above")
-        .lfb(R5, at("N_LEFT", R5))
+        .lfb(R5, at(N_LEFT, R5))
         .c("visit below first")
         .j("visit_node");
     t.label("incoherent");
     if compact {
-        t.addi(R6, R5, "NC_INNER_LISTS");
+        t.addi(R6, R5, NC_INNER_LISTS);
     }
     t.jal("test_objects")
         .c("every object under the node")
         .j("pop_node");
     t.label("leaf");
     if compact {
-        t.addi(R6, R5, "NC_LEAF_LISTS");
+        t.addi(R6, R5, NC_LEAF_LISTS);
     }
     t.jal("test_objects")
-        .lw(R1, at("MODE", R0))
+        .lw(R1, at(MODE, R0))
         .bnez(R1, "leaf_any_hit")
         .m(
             "BCAST_REC",
@@ -286,12 +292,12 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .c("the rays with a hit sleep");
     t.label("leaf_done").jal("read_awake");
     t.label("pop_node")
-        .li(R9, "NSTACK")
+        .li(R9, NSTACK)
         .beq(R14, R9, "trace_done")
         .addi(R14, R14, -4)
         .lw(R5, deref(R14))
         .j("visit_node");
-    t.label("trace_done").lw(R15, at("SAVE_LR", R0)).ret();
+    t.label("trace_done").lw(R15, at(SAVE_LR, R0)).ret();
     read_awake(t);
     clear_mailbox(t);
     test_objects(t, lay, compact);
@@ -320,7 +326,7 @@ fn test_objects(t: &mut Code, lay: &FbImage, compact: bool) {
          Clobbers r1..r4, r6..r10, r12, r13; counts TESTS.",
         if compact { "; r6 = its lists" } else { "" }
     ));
-    t.label("test_objects").lw(R13, at("PASS", R0));
+    t.label("test_objects").lw(R13, at(PASS, R0));
     for ti in &lay.types {
         let n = format!("to_{}", ti.ty.name());
         let up = ti.ty.name().to_uppercase();
@@ -369,9 +375,9 @@ fn test_objects(t: &mut Code, lay: &FbImage, compact: bool) {
                 .c("tested in this pass")
                 .sfb(R13, deref(R8));
         }
-        t.lw(R1, at("TESTS", R0))
+        t.lw(R1, at(TESTS, R0))
             .addi(R1, R1, 1)
-            .sw(R1, at("TESTS", R0));
+            .sw(R1, at(TESTS, R0));
         ti.ty.broadcast(t, &n, &lay.fit, ti.caps);
         if compact {
             t.label(format!("{n}_next"))

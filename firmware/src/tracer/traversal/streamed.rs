@@ -29,8 +29,15 @@
 //! TinyRISC registers: r5 the node, r11, r12 the awake mask, r14 the node
 //! stack pointer (`NSTACK`), `UPTR` the unordered-subtree stack (`USTK`).
 
+use super::super::data::{
+    AWAKE, CUR_BLK, MASK_HI, MODE, NEG, NSTACK, PASS, SAVE_LR, SPLIT, TESTS, UPTR, USTK,
+};
 use super::super::emit::{
     at, deref, Code, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
+};
+use super::super::layout::paper_nodes::fields::{
+    SN_BLOCK, SN_BLOCK_WORDS, SN_FLAGS, SN_LEFT, SN_LIST, SN_OBJECTS, SN_RIGHT, SN_SPLIT, U_AXIS,
+    U_FRAME, U_NSTACK,
 };
 use super::super::layout::FbImage;
 use super::super::memory_map::ram;
@@ -106,26 +113,26 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     );
     pass_start(t);
     t.jal("read_awake")
-        .li(R9, "USTK")
-        .sw(R9, at("UPTR", R0))
+        .li(R9, USTK)
+        .sw(R9, at(UPTR, R0))
         .m("BCAST", names::UNORDERED_NONE)
-        .li(R14, "NSTACK")
+        .li(R14, NSTACK)
         .li(R5, "ROOT");
     t.label("visit_node")
-        .lw(R11, at("AWAKE", R0))
-        .lw(R12, at("AWAKE+MASK_HI", R0))
+        .lw(R11, at(AWAKE, R0))
+        .lw(R12, at(format!("{AWAKE}+{MASK_HI}"), R0))
         .or(R1, R11, R12)
         .beqz(R1, "trace_done")
         .c("no ray awake")
-        .lw(R6, at("SN_FLAGS", R5))
+        .lw(R6, at(SN_FLAGS, R5))
         .blt(R6, R0, "leaf")
-        .lw(R1, at("SN_SPLIT", R5))
-        .sfb(R1, at("SPLIT", R0))
+        .lw(R1, at(SN_SPLIT, R5))
+        .sfb(R1, at(SPLIT, R0))
         .c("the split for the kernel's stream")
         .andi(R7, R6, 3);
     kernel_of_axis(t, names::classify, "classify");
     t.label("classify")
-        .li(R2, "SPLIT")
+        .li(R2, SPLIT)
         .sbcb(R1, R2, klen(&names::classify(0)))
         .rcfl(R1)
         .rcfh(R2)
@@ -143,59 +150,59 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .bnez(R9, "some_above")
         .or(R9, R1, R2)
         .beqz(R9, "pop_node")
-        .lw(R5, at("SN_LEFT", R5))
+        .lw(R5, at(SN_LEFT, R5))
         .c("all below")
         .j("visit_node");
     t.label("some_above")
         .or(R9, R1, R2)
         .bnez(R9, "both_sides")
-        .lw(R5, at("SN_RIGHT", R5))
+        .lw(R5, at(SN_RIGHT, R5))
         .c("all above")
         .j("visit_node");
     t.label("both_sides")
         .slli(R9, R7, 3)
-        .lw(R10, at("NEG", R9))
-        .lw(R13, at("NEG+MASK_HI", R9))
+        .lw(R10, at(NEG, R9))
+        .lw(R13, at(format!("{NEG}+{MASK_HI}"), R9))
         .and(R10, R10, R11)
         .and(R13, R13, R12)
         .or(R9, R10, R13)
         .beqz(R9, "positive_first")
         .bne(R10, R11, "mixed")
         .bne(R13, R12, "mixed")
-        .lw(R9, at("SN_LEFT", R5))
+        .lw(R9, at(SN_LEFT, R5))
         .sw(R9, deref(R14))
         .addi(R14, R14, 4)
         .c("push below")
-        .lw(R5, at("SN_RIGHT", R5))
+        .lw(R5, at(SN_RIGHT, R5))
         .c("all going down: above first")
         .j("visit_node");
     t.label("mixed")
-        .lw(R9, at("UPTR", R0))
-        .sw(R14, at("U_NSTACK", R9))
-        .sw(R7, at("U_AXIS", R9))
-        .addi(R9, R9, "U_FRAME")
-        .sw(R9, at("UPTR", R0))
+        .lw(R9, at(UPTR, R0))
+        .sw(R14, at(U_NSTACK, R9))
+        .sw(R7, at(U_AXIS, R9))
+        .addi(R9, R9, U_FRAME)
+        .sw(R9, at(UPTR, R0))
         .c("an unordered subtree: where it ends, its axis");
     kernel_of_axis(t, names::unordered_enter, "mixed_count");
     t.label("mixed_count")
         .cbcast(R1, klen(&names::unordered_enter(0)))
         .c("the rays going down count it");
     t.label("positive_first")
-        .lw(R9, at("SN_RIGHT", R5))
+        .lw(R9, at(SN_RIGHT, R5))
         .sw(R9, deref(R14))
         .addi(R14, R14, 4)
         .c("push above")
-        .lw(R5, at("SN_LEFT", R5))
+        .lw(R5, at(SN_LEFT, R5))
         .c("visit below first")
         .j("visit_node");
     t.label("leaf")
-        .lw(R1, at("SN_BLOCK_WORDS", R5))
+        .lw(R1, at(SN_BLOCK_WORDS, R5))
         .beqz(R1, "pop_node")
         .c("an empty leaf")
         .jal("test_objects")
         .beqz(R4, "pop_node")
         .c("nothing tested")
-        .lw(R1, at("MODE", R0))
+        .lw(R1, at(MODE, R0))
         .bnez(R1, "leaf_any_hit")
         .m("BCAST_AT", format!("{}, r4", names::LEAF_CLOSEST_ORDERED))
         .c("the rays with a hit in the cell sleep")
@@ -203,25 +210,25 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     t.label("leaf_any_hit").m("BCAST", names::LEAF_ANY);
     t.label("leaf_done").jal("read_awake");
     t.label("pop_node")
-        .lw(R9, at("UPTR", R0))
-        .li(R8, "USTK")
+        .lw(R9, at(UPTR, R0))
+        .li(R8, USTK)
         .beq(R9, R8, "pop_stack")
-        .lw(R10, at("U_NSTACK-U_FRAME", R9))
+        .lw(R10, at(format!("{U_NSTACK}-{U_FRAME}"), R9))
         .bne(R10, R14, "pop_stack")
         .c("leaving an unordered subtree?")
-        .lw(R7, at("U_AXIS-U_FRAME", R9))
+        .lw(R7, at(format!("{U_AXIS}-{U_FRAME}"), R9))
         .addi(R9, R9, "-U_FRAME")
-        .sw(R9, at("UPTR", R0));
+        .sw(R9, at(UPTR, R0));
     kernel_of_axis(t, names::unordered_leave, "pop_count");
     t.label("pop_count")
         .cbcast(R1, klen(&names::unordered_enter(0)));
     t.label("pop_stack")
-        .li(R9, "NSTACK")
+        .li(R9, NSTACK)
         .beq(R14, R9, "trace_done")
         .addi(R14, R14, -4)
         .lw(R5, deref(R14))
         .j("visit_node");
-    t.label("trace_done").lw(R15, at("SAVE_LR", R0)).ret();
+    t.label("trace_done").lw(R15, at(SAVE_LR, R0)).ret();
     t.doc(
         "clear_mailbox: every mailbox (main memory, a half-word per object) to 0. Clobbers r2, r3.",
     );
@@ -247,9 +254,9 @@ fn test_objects(t: &mut Code, lay: &FbImage) {
          Out: r4 = the block's bounds in the FB (0: nothing tested). Clobbers r1..r3, r6..r9, r13.",
     );
     t.label("test_objects")
-        .lw(R9, at("SN_OBJECTS", R5))
-        .lw(R6, at("SN_LIST", R5))
-        .lw(R13, at("PASS", R0));
+        .lw(R9, at(SN_OBJECTS, R5))
+        .lw(R6, at(SN_LIST, R5))
+        .lw(R13, at(PASS, R0));
     t.label("to_scan")
         .lw(R2, deref(R6))
         .addi(R6, R6, 4)
@@ -262,19 +269,19 @@ fn test_objects(t: &mut Code, lay: &FbImage) {
         .ret();
     t.label("to_need")
         .li(R4, "SBANK")
-        .lw(R1, at("SN_BLOCK", R5))
-        .lw(R3, at("SN_BLOCK_WORDS", R5))
-        .lw(R2, at("CUR_BLK", R0))
+        .lw(R1, at(SN_BLOCK, R5))
+        .lw(R3, at(SN_BLOCK_WORDS, R5))
+        .lw(R2, at(CUR_BLK, R0))
         .beq(R1, R2, "to_have")
         .rcany(R2)
         .c("the array done with the bank")
         .li(R2, "SBANK")
         .ldfb(R1, R2, R3)
         .dwait()
-        .sw(R1, at("CUR_BLK", R0));
+        .sw(R1, at(CUR_BLK, R0));
     t.label("to_have")
-        .lw(R6, at("SN_LIST", R5))
-        .lw(R13, at("PASS", R0))
+        .lw(R6, at(SN_LIST, R5))
+        .lw(R13, at(PASS, R0))
         .li(R7, "SBANK + BLOCK_HEAD")
         .c("r7: the first record");
     for ti in &lay.types {
@@ -289,9 +296,9 @@ fn test_objects(t: &mut Code, lay: &FbImage) {
             .beq(R1, R13, format!("{n}_next"))
             .c("tested in this pass")
             .sh(R13, deref(R2))
-            .lw(R1, at("TESTS", R0))
+            .lw(R1, at(TESTS, R0))
             .addi(R1, R1, 1)
-            .sw(R1, at("TESTS", R0));
+            .sw(R1, at(TESTS, R0));
         ti.ty.broadcast(t, &n, &lay.fit, ti.caps);
         t.label(format!("{n}_next"))
             .addi(R7, R7, format!("{up}_WORDS"))
