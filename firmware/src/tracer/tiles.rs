@@ -23,8 +23,9 @@
 //! `CUR_OUT`), so that `trace` may use r1..r14.
 
 use super::data::{
-    CUR_OUT, EYE_PX, EYE_PY, MODE, PREV_GEN, TILE, TILE_BYTES, TILE_GEN, TILE_OUT, TILE_PX,
-    TILE_PY, TL_BANK, TL_CNT, TL_COUNT, TL_FIRST, TL_PTR, T_END, T_START,
+    CUR_OUT, EYE_PX, EYE_PY, FBIMG, FBWORDS, FB_EYE, FB_POST, MODE, PREV_GEN, TILE, TILELIST,
+    TILE_BYTES, TILE_GEN, TILE_OUT, TILE_PX, TILE_PY, TL_BANK, TL_CNT, TL_COUNT, TL_FIRST, TL_PTR,
+    T_END, T_START,
 };
 use super::emit::{at, Code, R0, R1, R2, R3, R4, R5, R6};
 use super::kernel_names as names;
@@ -37,7 +38,7 @@ fn cb<'a>(t: &'a mut Code, k: &str) -> &'a mut Code {
 }
 
 /// `BCAST_FB k, stream`: broadcast a kernel with its FB stream.
-fn sb<'a>(t: &'a mut Code, k: &str, stream: &str) -> &'a mut Code {
+fn sb<'a>(t: &'a mut Code, k: &str, stream: impl std::fmt::Display) -> &'a mut Code {
     t.m("BCAST_FB", format!("{k}, {stream}"))
 }
 
@@ -194,9 +195,9 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
          then the tile loop; T_START, T_END: the cycle counter around it.",
     );
     t.label("_start")
-        .li(R1, "FBIMG")
+        .li(R1, FBIMG)
         .li(R2, 0)
-        .li(R3, "FBWORDS")
+        .li(R3, FBWORDS)
         .ldfb(R1, R2, R3)
         .c("the FB image into FB set 0")
         .dwait()
@@ -223,7 +224,7 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
         .c("the array done")
         .rdcyc(R1)
         .sw(R1, at(T_START, R0))
-        .li(R1, "TILELIST")
+        .li(R1, TILELIST)
         .lw(R2, at(TL_COUNT, R1))
         .addi(R1, R1, TL_FIRST)
         .sw(R1, at(TL_PTR, R0))
@@ -248,11 +249,11 @@ pub fn main(t: &mut Code, lay: &FbImage, depth: u32, merged: bool) {
             .sw(R6, at(TILE_GEN, R0))
             .c("the leaf cache holds the leaves of this tile and of the one before");
     }
-    t.li(R6, "FB_EYE")
+    t.li(R6, FB_EYE)
         .sfb(R3, at(EYE_PX, R6))
         .sfb(R4, at(EYE_PY, R6))
         .c("the tile's corner into the eye stream");
-    sb(t, names::EYE, "FB_EYE").c("eye rays");
+    sb(t, names::EYE, FB_EYE).c("eye rays");
     let mut skips = 0;
     tree(t, lay, 0, depth.max(1), merged, &mut skips);
     output(t);
@@ -271,7 +272,7 @@ fn shade_level(t: &mut Code, level: u32, merged: bool, skips: &mut u32) {
             .c(format!("level {level}: trace (closest hit)"))
             .jal("trace");
         cb(t, names::WAKE);
-        sb(t, names::POST, "FB_POST");
+        sb(t, names::POST, FB_POST);
         *skips += 1;
         let skip = format!("no_hit{}", *skips);
         t.rcany(R1).beqz(R1, &skip).c("no ray hit: no shadow pass");

@@ -27,7 +27,7 @@
 //! and keeps that order only where the probe of the frame runs it in
 //! fewer cycles than `majority`.
 
-use super::super::emit::{at, Code, R0, R1, R11, R12, R13, R2, R3, R4, R5, R6, R8, R9};
+use super::super::emit::{at, Code, Name, R0, R1, R11, R12, R13, R2, R3, R4, R5, R6, R8, R9};
 use super::super::kernel_names as names;
 use super::super::primitives::kaddr;
 
@@ -43,7 +43,7 @@ pub use super::super::options::{AxisOrder, ChildOrder, EndCounts, SIGNIFICANT};
 /// the awake rays after the start). Where the awake rays do not all go
 /// the same way along an axis, `order`'s rule for the pass's kind (r13's
 /// sign: any hit) decides. `left`, `right`: the node's child fields.
-pub fn pass_start(t: &mut Code, order: ChildOrder, left: &str, right: &str) {
+pub fn pass_start(t: &mut Code, order: ChildOrder, left: Name, right: Name) {
     let (closest, any) = order.rules();
     // Each axis's masks stay in registers until the pass start is issued.
     let masks = [(R3, R4), (R5, R6), (R8, R9)];

@@ -71,7 +71,8 @@
 //! and misses (the issues at `leaf_first` and `leaf_miss`).
 
 use super::super::emit::{
-    at, deref, Code, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
+    at, deref, Code, Name, Reg, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7,
+    R8, R9,
 };
 use super::super::layout::packet_nodes::{LEAF_AWAKE, LEAF_EMPTY, LEAF_LATE};
 use super::super::layout::{FbImage, TypeInfo};
@@ -84,12 +85,13 @@ use super::child_order::{self, ChildOrder};
 use crate::tracer::kernel_names as names;
 
 use super::super::data::{
-    LEAF_FIRST, LEAF_LOAD, LEAF_MISS, LEAF_TAGS, MASK_HI, MODE, NF, NK, NS, NSTACK, PASS, PASSES,
-    PREV_GEN, SAVE_LR, SPLIT, TILE_GEN,
+    LEAF_FIRST, LEAF_LOAD, LEAF_MISS, LEAF_TAGS, MAILBOX, MASK_HI, MODE, NF, NK, NS, NSTACK, PASS,
+    PASSES, PREV_GEN, ROOT, SAVE_LR, SBANK, SPLIT, TILE_GEN,
 };
 use super::super::layout::packet_nodes::fields::{
-    LE_MAILBOX, LE_RECORD, LE_WORDS, MB_PASS, MB_RAYS, PL_LISTS, PN_PARENT_SLOT, PN_SLOT, PN_SPLIT,
-    PS_BLOCK, PS_BLOCK_WORDS, PS_FB, PS_LIST, PS_NEXT, PS_OBJECTS, PS_SPLIT,
+    LE_MAILBOX, LE_RECORD, LE_WORDS, MB_PASS, MB_RAYS, MB_SHIFT, PL_LISTS, PN_FLAGS, PN_LEFT,
+    PN_PARENT_SLOT, PN_RIGHT, PN_SLOT, PN_SPLIT, PS_BLOCK, PS_BLOCK_WORDS, PS_FB, PS_FLAGS,
+    PS_LEFT, PS_LIST, PS_NEXT, PS_OBJECTS, PS_RIGHT, PS_SPLIT,
 };
 pub use super::super::layout::packet_nodes::P_TOL;
 
@@ -379,7 +381,7 @@ struct Fields {
 }
 
 impl Fields {
-    fn n(&self, resident: &'static str, streamed: &'static str) -> &'static str {
+    fn n(&self, resident: Name, streamed: Name) -> Name {
         if self.streamed {
             streamed
         } else {
@@ -401,7 +403,7 @@ impl Fields {
 pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
     let streamed = lay.stream.is_some();
     let f = Fields { streamed };
-    let flags = f.n("PN_FLAGS", "PS_FLAGS");
+    let flags = f.n(PN_FLAGS, PS_FLAGS);
     t.doc(&format!(
         "trace: one ray pass, the packet traversal of a {} scene. In: the rays in r1..r7 of\n\
          every RC, MODE (0: closest hit, 1: any hit). Out: the hits in HIT_*, r7.\n\
@@ -429,7 +431,7 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
         t.comment("the tree is one leaf: its objects, tested by the awake rays")
             .m("BCAST", names::sign(0))
             .li(R14, 0)
-            .li(R5, "ROOT")
+            .li(R5, ROOT)
             .rcsl(R4)
             .rcsh(R10)
             .c("r4, r10: the sleeping rays")
@@ -443,13 +445,8 @@ pub fn trace(t: &mut Code, lay: &FbImage, order: ChildOrder) {
                 "leaf_objects"
             });
     }
-    child_order::pass_start(
-        t,
-        order,
-        f.n("PN_LEFT", "PS_LEFT"),
-        f.n("PN_RIGHT", "PS_RIGHT"),
-    );
-    t.li(R14, 0).c("the node stack: empty").li(R5, "ROOT");
+    child_order::pass_start(t, order, f.n(PN_LEFT, PS_LEFT), f.n(PN_RIGHT, PS_RIGHT));
+    t.li(R14, 0).c("the node stack: empty").li(R5, ROOT);
     if streamed {
         t.li(R7, SPLIT).c("r7 = SPLIT throughout the walk");
     }
@@ -735,7 +732,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
         scan.label("leaf_skip")
             .lw(R1, at(PS_NEXT, R5))
             .bnez(R1, "leaf_skip_next")
-            .andi(R1, R7, "SBANK")
+            .andi(R1, R7, SBANK)
             .bnez(R1, "leaf_done")
             .c("a piece in bank 1 may move on: the array reads it only after a leaf's dwait")
             .dwait()
@@ -830,7 +827,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
             .c("no mailbox to check");
         awake(t);
         t.label("leaf_objects")
-            .li(R12, "MAILBOX")
+            .li(R12, MAILBOX)
             .addi(R6, R5, PL_LISTS);
         for ti in &lay.types {
             let n = format!("lo_{}", ti.ty.name());
@@ -844,7 +841,7 @@ fn leaf(t: &mut Code, lay: &FbImage, f: &Fields) {
                     .addi(R6, R6, LE_WORDS)
                     .blt(R8, R0, format!("{p}_go"))
                     .c("no mailbox")
-                    .slli(R8, R8, "MB_SHIFT")
+                    .slli(R8, R8, MB_SHIFT)
                     .add(R8, R8, R12)
                     .c("r8: its mailbox");
             };

@@ -30,13 +30,14 @@
 //! stack pointer (`NSTACK`), r1..r4, r6..r10, r13 temporaries.
 
 use super::super::data::{
-    AWAKE, MASK_HI, MODE, NEG, NSTACK, PASS, PASSES, PASS_WRAP, SAVE_LR, TESTS,
+    AWAKE, MAILBOX, MASK_HI, MODE, NEG, NEG_X, NEG_Y, NEG_Z, NOBJ, NSTACK, PASS, PASSES, PASS_WRAP,
+    ROOT, SAVE_LR, TESTS,
 };
 use super::super::emit::{
     at, deref, Code, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
 };
 use super::super::layout::paper_nodes::fields::{
-    NC_INNER_LISTS, NC_LEAF_LISTS, N_FLAGS, N_LEFT, N_RIGHT, N_SPLIT,
+    NC_INNER_LISTS, NC_LEAF_BOUNDS, NC_LEAF_LISTS, N_BOUNDS, N_FLAGS, N_LEFT, N_RIGHT, N_SPLIT,
 };
 use super::super::layout::FbImage;
 use super::super::memory_map::ram;
@@ -157,7 +158,7 @@ pub fn pass_start(t: &mut Code) {
         .c("the mailboxes hold 16-bit pass numbers")
         .li(R1, 1);
     t.label("trace_numbered").sw(R1, at(PASS, R0));
-    for (a, name) in ["NEG_X", "NEG_Y", "NEG_Z"].into_iter().enumerate() {
+    for (a, name) in [NEG_X, NEG_Y, NEG_Z].into_iter().enumerate() {
         t.m("BCAST", names::sign(a as u8))
             .rcfl(R2)
             .rcfh(R3)
@@ -182,7 +183,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         }
     ));
     pass_start(t);
-    t.jal("read_awake").li(R14, NSTACK).li(R5, "ROOT");
+    t.jal("read_awake").li(R14, NSTACK).li(R5, ROOT);
     t.label("visit_node")
         .lw(R11, at(AWAKE, R0))
         .lw(R12, at(format!("{AWAKE}+{MASK_HI}"), R0))
@@ -278,11 +279,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
             format!(
                 "{}, r5, {}",
                 names::LEAF_CLOSEST,
-                if compact {
-                    "NC_LEAF_BOUNDS"
-                } else {
-                    "N_BOUNDS"
-                }
+                if compact { NC_LEAF_BOUNDS } else { N_BOUNDS }
             ),
         )
         .c("the rays with a hit in the cell sleep")
@@ -307,8 +304,8 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
 fn clear_mailbox(t: &mut Code) {
     t.doc("clear_mailbox: every mailbox (FB, one word per object) to 0. Clobbers r2, r3.");
     t.label("clear_mailbox")
-        .li(R2, "MAILBOX")
-        .li(R3, "NOBJ")
+        .li(R2, MAILBOX)
+        .li(R3, NOBJ)
         .beqz(R3, "clear_mailbox_done");
     t.label("clear_mailbox_loop")
         .sfb(R0, deref(R2))

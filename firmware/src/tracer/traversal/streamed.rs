@@ -30,7 +30,8 @@
 //! stack pointer (`NSTACK`), `UPTR` the unordered-subtree stack (`USTK`).
 
 use super::super::data::{
-    AWAKE, CUR_BLK, MASK_HI, MODE, NEG, NSTACK, PASS, SAVE_LR, SPLIT, TESTS, UPTR, USTK,
+    AWAKE, CUR_BLK, MAILBOX, MASK_HI, MODE, NEG, NOBJ, NSTACK, PASS, ROOT, SAVE_LR, SBANK, SPLIT,
+    TESTS, UPTR, USTK,
 };
 use super::super::emit::{
     at, deref, Code, K, R0, R1, R10, R11, R12, R13, R14, R15, R2, R3, R4, R5, R6, R7, R8, R9,
@@ -117,7 +118,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .sw(R9, at(UPTR, R0))
         .m("BCAST", names::UNORDERED_NONE)
         .li(R14, NSTACK)
-        .li(R5, "ROOT");
+        .li(R5, ROOT);
     t.label("visit_node")
         .lw(R11, at(AWAKE, R0))
         .lw(R12, at(format!("{AWAKE}+{MASK_HI}"), R0))
@@ -233,8 +234,8 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         "clear_mailbox: every mailbox (main memory, a half-word per object) to 0. Clobbers r2, r3.",
     );
     t.label("clear_mailbox")
-        .li(R2, "MAILBOX")
-        .li(R3, "NOBJ")
+        .li(R2, MAILBOX)
+        .li(R3, NOBJ)
         .beqz(R3, "clear_mailbox_done");
     t.label("clear_mailbox_loop")
         .sh(R0, deref(R2))
@@ -268,14 +269,14 @@ fn test_objects(t: &mut Code, lay: &FbImage) {
         .li(R4, 0)
         .ret();
     t.label("to_need")
-        .li(R4, "SBANK")
+        .li(R4, SBANK)
         .lw(R1, at(SN_BLOCK, R5))
         .lw(R3, at(SN_BLOCK_WORDS, R5))
         .lw(R2, at(CUR_BLK, R0))
         .beq(R1, R2, "to_have")
         .rcany(R2)
         .c("the array done with the bank")
-        .li(R2, "SBANK")
+        .li(R2, SBANK)
         .ldfb(R1, R2, R3)
         .dwait()
         .sw(R1, at(CUR_BLK, R0));
