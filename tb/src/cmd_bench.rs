@@ -86,7 +86,6 @@ fn pool(threads: usize) -> Result<rayon::ThreadPool> {
 }
 
 pub fn command(a: BenchArgs) -> Result<()> {
-    rtl::chip::set_plain(a.plain);
     if let Some(j) = &a.json {
         crate::output::Files::new()
             .input(
@@ -196,6 +195,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
                     &crate::render::RenderSettings {
                         trace: cfg,
                         timing,
+                        plain: a.plain,
                         ..Default::default()
                     },
                 )

@@ -568,7 +568,6 @@ fn impossible_value(j: &serde_json::Value) -> Option<String> {
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {
-    rtl::chip::set_plain(a.plain);
     let scene = load_scene(a.scene.as_deref())?;
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     let firmware_text = match &a.firmware {
@@ -735,6 +734,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             profile: a.profile,
             timing,
             item_tiles: None,
+            plain: a.plain,
         },
         Some(built),
     )?;

@@ -59,17 +59,21 @@ pub fn run_image(
     max_cycles: u64,
     trace: Option<rtl::trace::TraceConfig>,
 ) -> anyhow::Result<Outcome> {
-    run_image_on(img, timing, max_cycles, trace)
+    run_image_on(img, timing, max_cycles, trace, false)
 }
 
-/// Load `img` into a fresh chip of datapath `W` and run it to halt.
+/// Load `img` into a fresh chip of datapath `W` and run it to halt
+/// (`plain`: stepping every cycle through the plain model,
+/// [`rtl::Chip::plain`]).
 pub fn run_image_on<W: Word>(
     img: &Image,
     timing: Timing,
     max_cycles: u64,
     trace: Option<rtl::trace::TraceConfig>,
+    plain: bool,
 ) -> anyhow::Result<Outcome<W>> {
     let mut chip = Chip::<W>::build(timing, DEFAULT_MEMORY);
+    chip.plain = plain;
     img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
     let mut sim = Sim::new(chip);
     if let Some(cfg) = trace {
@@ -163,7 +167,6 @@ pub(crate) fn parse_expect(s: &str) -> Result<(u8, u32), String> {
 }
 
 pub fn command(a: RunArgs) -> anyhow::Result<()> {
-    rtl::chip::set_plain(a.plain);
     let mut files = crate::output::Files::new();
     files.input(&a.file, "FILE");
     if let Some(t) = &a.timing {
@@ -218,7 +221,7 @@ fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyho
         c
     });
     let t0 = std::time::Instant::now();
-    let out = run_image_on::<W>(&img, timing, a.max_cycles, trace)?;
+    let out = run_image_on::<W>(&img, timing, a.max_cycles, trace, a.plain)?;
     let secs = t0.elapsed().as_secs_f64();
     for f in &out.files {
         crate::note!("wrote {}", f.display());

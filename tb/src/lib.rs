@@ -2,6 +2,7 @@
 //! pieces of the `morphosys` command.
 #![recursion_limit = "256"] // the `json!` of a render report
 
+pub mod autotune;
 pub mod charts;
 pub mod cli;
 pub mod cmd_asm;

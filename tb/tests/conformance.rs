@@ -149,7 +149,7 @@ const WIDE: &[&str] = &["wide.s"];
 #[test]
 fn wide_datapath_on_the_32_bit_chip() {
     let img = load_program(&dir().join("wide.s")).unwrap();
-    let out = run_image_on::<i32>(&img, Timing::default(), 100_000, None).unwrap();
+    let out = run_image_on::<i32>(&img, Timing::default(), 100_000, None, false).unwrap();
     out.result.as_ref().unwrap();
     assert_eq!(out.reg(1), 1, "failed check {}", out.reg(2));
     // The same program on the 16-bit chip fails its first check: `ldfb`

@@ -211,6 +211,11 @@ pub struct Chip<W: Word = i16> {
     /// The fast loops stop before a cycle in which TinyRISC's PC is this
     /// ([`run_to_pc`]; `NO_STOP`: never).
     stop_pc: u32,
+    /// [`run_to_halt`] and [`run_to_pc`] step every cycle through the
+    /// plain model: one [`Clocked::eval`] and [`Clocked::commit`] per cycle
+    /// (`Sim::step`), no fast path. Slower, and the same cycles, states,
+    /// statistics and waveforms (`--plain` on `render`, `run` and `bench`).
+    pub plain: bool,
 }
 
 /// [`Chip::stop_pc`] when no run stops at a PC (no instruction is fetched
@@ -342,6 +347,7 @@ impl<W: Word> Chip<W> {
             idle_control: 0,
             watch: Watch::default(),
             stop_pc: NO_STOP,
+            plain: false,
         }
     }
 
@@ -590,23 +596,6 @@ impl std::fmt::Display for RunError {
 
 impl std::error::Error for RunError {}
 
-/// Runs to `halt` step by step through the plain model instead of the
-/// fast paths, for every run of this process ([`set_plain`]).
-static PLAIN: std::sync::atomic::AtomicBool = std::sync::atomic::AtomicBool::new(false);
-
-/// Make [`run_to_halt`] step every cycle through the plain model: one
-/// [`Clocked::eval`] and [`Clocked::commit`] per cycle (`Sim::step`), no
-/// fast path. Slower, and the same cycles, states, statistics and
-/// waveforms (`--plain` on `render`, `run` and `bench`).
-pub fn set_plain(plain: bool) {
-    PLAIN.store(plain, std::sync::atomic::Ordering::Relaxed);
-}
-
-/// Whether [`run_to_halt`] steps through the plain model ([`set_plain`]).
-pub fn plain() -> bool {
-    PLAIN.load(std::sync::atomic::Ordering::Relaxed)
-}
-
 /// Run to `halt` through the plain model alone, one [`Sim::step`] a cycle:
 /// what the fast paths of [`run_to_halt`] are held to.
 pub fn run_to_halt_plain<W: Word>(
@@ -624,15 +613,15 @@ pub fn run_to_halt_plain<W: Word>(
 
 /// Run until TinyRISC's PC is `pc` before a cycle (that cycle not run;
 /// at once when it already is) or it halts; returns whether it stopped at
-/// `pc`. Through the fast paths unless [`set_plain`] asked for the plain
-/// model: the same cycles, states and statistics as stepping
+/// `pc`. Through the fast paths unless the chip asks for the plain model
+/// ([`Chip::plain`]): the same cycles, states and statistics as stepping
 /// ([`Sim::step`]) until the PC is `pc`.
 pub fn run_to_pc<W: Word>(
     sim: &mut Sim<Chip<W>>,
     pc: u32,
     max_cycles: u64,
 ) -> Result<bool, RunError> {
-    if plain() {
+    if sim.top.plain {
         while !sim.top.halted() {
             if sim.top.risc.pc == pc {
                 return Ok(true);
@@ -652,15 +641,15 @@ pub fn run_to_pc<W: Word>(
 }
 
 /// Run to `halt`; returns the cycles used (the halt's cycle included).
-/// Through the fast paths ([`fast`]) unless [`set_plain`] asked for the
-/// plain model.
+/// Through the fast paths ([`fast`]) unless the chip asks for the plain
+/// model ([`Chip::plain`]).
 ///
 /// Both datapaths run through a copy of the loop compiled in this crate
 /// ([`run_to_halt16`], [`run_to_halt32`]), not instantiated in the caller's:
 /// the cycle loop of the 16-bit chip is then compiled as it was before the
 /// 32-bit variant existed (measured: 5% faster than a caller's instance).
 pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
-    if plain() {
+    if sim.top.plain {
         return run_to_halt_plain(sim, max_cycles);
     }
     let any: &mut dyn std::any::Any = sim;
