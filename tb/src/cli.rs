@@ -46,6 +46,7 @@ fn parse_scope(s: &str) -> Result<String, String> {
 impl TraceWindow {
     pub fn config(&self, path: std::path::PathBuf) -> rtl::trace::TraceConfig {
         let mut c = rtl::trace::TraceConfig::new(path);
+        c.partial_files = Some(crate::output::PARTIAL_FILES);
         c.first = self.trace_from;
         c.count = self.trace_cycles;
         c.scope = self.trace_scope.clone().unwrap_or_default();

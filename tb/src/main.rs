@@ -159,7 +159,6 @@ fn main() -> ExitCode {
         Err(e) => return usage_error(e),
     };
     tb::output::set_quiet(cli.quiet);
-    rtl::trace::set_partial_files(tb::output::PARTIAL_FILES);
     // The instruction set of the per-cycle path: checked before any work.
     if let Err(e) = rtl::simd::Simd::from_env().and_then(rtl::simd::set) {
         eprintln!("morphosys: error: {}", printable(&e));

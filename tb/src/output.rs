@@ -122,7 +122,8 @@ pub fn remove_temporaries() {
 }
 
 /// What the tracer does with a waveform's temporary file
-/// ([`rtl::trace::set_partial_files`], set by `main`): listed with the
+/// ([`rtl::trace::TraceConfig::partial_files`], set by the command line's
+/// trace window, `cli.rs`): listed with the
 /// run's other temporaries, and those a killed run left removed.
 pub const PARTIAL_FILES: rtl::trace::PartialFiles = rtl::trace::PartialFiles {
     clean_stale: remove_stale_partials,

@@ -12,10 +12,10 @@ use super::*;
 /// file (`.<name>.<pid>.<random>.partial` beside the waveform, renamed onto
 /// it when finished): the `morphosys` command keeps the list its signal
 /// handler empties and removes what a killed run left
-/// (`tb::output::PARTIAL_FILES`). Without it ([`set_partial_files`] never
-/// called, as in a library's tests) the tracer only makes and renames the
-/// file.
-#[derive(Clone, Copy)]
+/// (`tb::output::PARTIAL_FILES`), given in
+/// [`TraceConfig::partial_files`]. Without it (as in a library's tests)
+/// the tracer only makes and renames the file.
+#[derive(Clone, Copy, Debug)]
 pub struct PartialFiles {
     /// Before a waveform named `name` is begun in `dir`: remove the
     /// temporary files of it that a run killed outright left.
@@ -27,27 +27,20 @@ pub struct PartialFiles {
     pub done: fn(&Path),
 }
 
-static PARTIAL_FILES: std::sync::OnceLock<PartialFiles> = std::sync::OnceLock::new();
-
-/// Tell the tracer what to do with its temporary files (once per process).
-pub fn set_partial_files(p: PartialFiles) {
-    let _ = PARTIAL_FILES.set(p);
-}
-
-pub(super) fn clean_stale_partials(dir: &Path, name: &str) {
-    if let Some(p) = PARTIAL_FILES.get() {
+pub(super) fn clean_stale_partials(p: Option<PartialFiles>, dir: &Path, name: &str) {
+    if let Some(p) = p {
         (p.clean_stale)(dir, name);
     }
 }
 
-pub(super) fn partial_created(path: &Path) {
-    if let Some(p) = PARTIAL_FILES.get() {
+pub(super) fn partial_created(p: Option<PartialFiles>, path: &Path) {
+    if let Some(p) = p {
         (p.created)(path);
     }
 }
 
-pub(super) fn forget_partial(path: &Path) {
-    if let Some(p) = PARTIAL_FILES.get() {
+pub(super) fn forget_partial(p: Option<PartialFiles>, path: &Path) {
+    if let Some(p) = p {
         (p.done)(path);
     }
 }

@@ -48,7 +48,7 @@ mod sink;
 mod tracer;
 
 pub(crate) use self::files::side_files;
-pub use self::files::{check_scope_patterns, set_partial_files, PartialFiles};
+pub use self::files::{check_scope_patterns, PartialFiles};
 pub use self::tracer::Tracer;
 
 #[cfg(test)]
@@ -324,6 +324,9 @@ pub struct TraceConfig {
     /// address are shown as `label+offset` (filter files beside the
     /// waveform).
     pub labels: Option<std::sync::Arc<Labels>>,
+    /// What the program does with the waveform's temporary file
+    /// ([`PartialFiles`]; `None`: only made and renamed).
+    pub partial_files: Option<PartialFiles>,
 }
 
 /// Whether a waveform path asks for FST (`.fst`) rather than VCD.
@@ -362,6 +365,7 @@ impl TraceConfig {
             max_bytes: MAX_TRACE_BYTES,
             fst_section_bytes: FST_SECTION_BYTES,
             labels: None,
+            partial_files: None,
         }
     }
 }

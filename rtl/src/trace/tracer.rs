@@ -149,7 +149,7 @@ impl Drop for Tracer {
         // Not finished: the temporary file goes (TempPath removes it), and
         // leaves the list of partial files.
         if let Some(t) = &self.tmp_path {
-            forget_partial(t);
+            forget_partial(self.cfg.partial_files, t);
         }
         // The writing thread, if any, is told there is no more and waited
         // for (it writes what it has into the file that goes and ends
@@ -204,7 +204,7 @@ impl Tracer {
                 let name = target
                     .file_name()
                     .map_or_else(|| "waveform".into(), |n| n.to_string_lossy().into_owned());
-                clean_stale_partials(&dir, &name);
+                clean_stale_partials(cfg.partial_files, &dir, &name);
                 let tmp = output_tempfile(
                     tempfile::Builder::new()
                         .prefix(&format!(".{name}.{}.", std::process::id()))
@@ -213,7 +213,7 @@ impl Tracer {
                     &target,
                 )?;
                 let (file, tmp_path) = tmp.into_parts();
-                partial_created(&tmp_path);
+                partial_created(cfg.partial_files, &tmp_path);
                 (file, Some(tmp_path), target)
             }
         };
@@ -549,7 +549,7 @@ impl Tracer {
         save.persist(&files.gtkw).map_err(|e| e.error)?;
         let partial = tmp_path.to_path_buf();
         let done = tmp_path.persist(&self.target).map_err(|e| e.error);
-        forget_partial(&partial);
+        forget_partial(self.cfg.partial_files, &partial);
         done?;
         let mut written = vec![self.cfg.path.clone(), files.gtkw];
         written.extend(files.filters.into_iter().map(|(_, p)| p));
