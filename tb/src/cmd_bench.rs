@@ -207,7 +207,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
                 let k = run - 3;
                 if k == 0 && r.render_seconds < chip_render[0] {
                     serial = (r.render_seconds - r.item_seconds.iter().sum::<f64>()).max(0.0);
-                    frame = r.work();
+                    frame = crate::schedule::FrameWork::of(&r);
                 }
                 chip_render[k] = chip_render[k].min(r.render_seconds);
             }

@@ -946,7 +946,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
                         task,
                         step,
                         prep,
-                        frame: chip.work(),
+                        frame: crate::schedule::FrameWork::of(&chip),
                     });
                 }
             }

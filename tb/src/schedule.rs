@@ -56,6 +56,15 @@ pub struct FrameWork {
 }
 
 impl FrameWork {
+    /// A chip render's host work as measured: its tiles' seconds and a
+    /// work item's own.
+    pub fn of(r: &crate::render::ChipRender) -> FrameWork {
+        FrameWork {
+            tiles: r.tile_seconds.clone(),
+            item: r.item_own_seconds,
+        }
+    }
+
     /// The work items `workers` threads run the frame as, in order: each
     /// the item's own work, its tiles and the warm-up tile before them.
     pub fn items(&self, workers: usize) -> Vec<f64> {

@@ -2,11 +2,10 @@
 //! tracks its temporary file, the GTKWave save file, translate filters and
 //! Surfer decoders beside it, and the scope patterns of `--trace-scope`.
 
+use super::tracer::output_tempfile;
+use super::LabelKind;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
-
-use super::tracer::*;
-use super::*;
 
 /// What the program around the tracer does with a waveform's temporary
 /// file (`.<name>.<pid>.<random>.partial` beside the waveform, renamed onto

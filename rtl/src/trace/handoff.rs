@@ -1,10 +1,9 @@
 //! The hand-over between the simulating thread and the waveform's writing
 //! thread: the packed messages and the batches they travel in.
 
+use super::sink::Sink;
 use std::collections::BTreeSet;
 use std::io;
-
-use super::sink::*;
 
 /// What the writing thread hands back: the sink, closed, and how writing
 /// went.

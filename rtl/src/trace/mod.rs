@@ -38,8 +38,6 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use vcd::TimescaleUnit;
-
 mod files;
 mod format;
 mod handoff;

@@ -3,8 +3,14 @@
 
 use std::io;
 
-use super::*;
-use super::{format::*, handoff::*, sink::*, tracer::*};
+use super::format::SigId;
+use super::handoff::MSG_CHUNK;
+use super::scope_runs;
+use super::sink::changed_mask;
+use super::tracer::{Decl, SigInfo, Tracer, NOT_TRACED};
+use super::Probe;
+use super::{Display, Field};
+use std::fmt;
 
 /// The declaration's walk ([`Tracer::create`]): each [`Probe`] call
 /// declares what it reports and records in the tracer's tables what the

@@ -1,11 +1,15 @@
 //! Where value changes go (a VCD stream or an FST file), and the writing
 //! thread's loop that formats each batch of changes into it.
 
+use super::format::{fst_err, Clock, SigId, Slot, VcdBody};
+use super::handoff::{
+    copy_streaming, Closing, Handoff, WriterGone, Written, MSG_CHUNK, MSG_LONG, MSG_VALUE,
+    SPARE_BATCHES,
+};
+use super::tracer::NOT_TRACED;
 use std::collections::BTreeSet;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
-
-use super::{format::*, handoff::*, tracer::*};
 
 /// Where value changes go: a VCD text stream, or an FST file (header
 /// while declaring, body while sampling).

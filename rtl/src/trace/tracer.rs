@@ -5,8 +5,18 @@ use std::collections::BTreeSet;
 use std::io::{self, BufWriter};
 use std::path::{Path, PathBuf};
 
-use super::*;
-use super::{files::*, format::*, handoff::*, sampler::*, sink::*};
+use super::files::{
+    check_scope_patterns, clean_stale_partials, decoder_path, filter_path, forget_partial, glob,
+    partial_created, save_file_path, stage, SideFiles,
+};
+use super::format::{fst_err, Clock, SigId, VcdBody};
+use super::handoff::{queue_cycle, BATCH};
+use super::label_text;
+use super::sampler::{Declaring, Progress, Sampler};
+use super::sink::Sink;
+use super::Traced;
+use super::{is_fst, Display, Filter, LabelKind, TraceConfig, BYTES_PER_SIGNAL_CYCLE, FST_SMALLER};
+use vcd::TimescaleUnit;
 
 /// [`Tracer::slot_decl`] of a signal call that is not traced.
 pub(super) const NOT_TRACED: u32 = u32::MAX;

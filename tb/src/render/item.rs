@@ -682,11 +682,7 @@ fn advance<W: Word>(
 /// A chip's error in a span of its work item, named by the frame's tile
 /// (`None`: the start-up) and the cycle within it, `at` (not the chip's
 /// own count, which depends on where the frame was cut).
-fn span_error(
-    e: rtl::chip::RunError,
-    tile: Option<(usize, (u32, u32))>,
-    at: u64,
-) -> anyhow::Error {
+fn span_error(e: rtl::chip::RunError, tile: Option<(usize, (u32, u32))>, at: u64) -> anyhow::Error {
     let span = match tile {
         None => "the start-up (before the tile loop)".to_string(),
         Some((k, (x, y))) => format!("tile {k} (pixels from ({x}, {y}))"),

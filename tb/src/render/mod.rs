@@ -137,13 +137,6 @@ impl ChipRender {
             )
         })
     }
-    /// The chip render's host work ([`crate::schedule::FrameWork`]).
-    pub fn work(&self) -> crate::schedule::FrameWork {
-        crate::schedule::FrameWork {
-            tiles: self.tile_seconds.clone(),
-            item: self.item_own_seconds,
-        }
-    }
     pub fn fps_at(&self, clock_hz: u64) -> f64 {
         if self.cycles == 0 {
             0.0

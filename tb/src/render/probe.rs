@@ -87,12 +87,7 @@ pub(crate) fn faster(
 
 /// [`probe`] on the tile rows and columns `k` with `k % PROBE_STRIDE ==
 /// phase`.
-fn probe_at(
-    fw: &Firmware,
-    opt: &Options,
-    timing: &Timing,
-    phase: u32,
-) -> Result<ProbeRender> {
+fn probe_at(fw: &Firmware, opt: &Options, timing: &Timing, phase: u32) -> Result<ProbeRender> {
     let (tw, th) = (fw.tile_w, fw.tile_h);
     let (nx, ny) = (opt.width.div_ceil(tw), opt.height.div_ceil(th));
     let pick = |n: u32| -> Vec<u32> {
