@@ -19,6 +19,7 @@
 
 pub mod child_order;
 pub mod packet;
+pub mod packet_kernels;
 pub mod paper;
 pub mod streamed;
 
