@@ -724,7 +724,13 @@ const DOCUMENTS: &[&str] = &[
     "docs/cluster.md",
     "docs/performance.md",
     "docs/silicon.md",
+    "docs/adding-a-primitive.md",
 ];
+
+#[test]
+fn adding_a_primitive_commands_run_as_written() {
+    check_document("docs/adding-a-primitive.md");
+}
 
 #[test]
 fn readme_commands_run_as_written() {
