@@ -386,9 +386,10 @@ fn run_loop<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, Run
     cycles::<W, false>(sim, max_cycles)
 }
 
-/// [`run_loop`] with a waveform: out of line, so that the untraced loop's
-/// code is what it was before tracing could take the fast path (the
-/// inliner had left the cycle's parts out of line: 8% slower).
+/// [`run_loop`] with a waveform: out of line, so that the untraced loop
+/// is compiled without the tracing's code in it (inlined together, the
+/// inliner leaves the cycle's parts out of line, and the untraced loop
+/// runs slower).
 #[inline(never)]
 fn run_loop_traced<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
     cycles::<W, true>(sim, max_cycles)

@@ -646,8 +646,8 @@ pub fn run_to_pc<W: Word>(
 ///
 /// Both datapaths run through a copy of the loop compiled in this crate
 /// ([`run_to_halt16`], [`run_to_halt32`]), not instantiated in the caller's:
-/// the cycle loop of the 16-bit chip is then compiled as it was before the
-/// 32-bit variant existed (measured: 5% faster than a caller's instance).
+/// each width's cycle loop is then compiled on its own, with this crate's
+/// inlining decisions (a caller's instance runs slower).
 pub fn run_to_halt<W: Word>(sim: &mut Sim<Chip<W>>, max_cycles: u64) -> Result<u64, RunError> {
     if sim.top.plain {
         return run_to_halt_plain(sim, max_cycles);

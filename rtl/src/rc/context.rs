@@ -307,8 +307,8 @@ impl Cond {
 ///
 /// Aligned to 16 bytes so a copy is one 16-byte move: the broadcast unit
 /// stores a context and the array loads it in the same cycle, and a load
-/// that spans several smaller stores cannot be forwarded (measured: a
-/// 17% stall in the array's eval before this).
+/// that spans several smaller stores cannot be forwarded (the array's eval
+/// then stalls on it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 #[repr(align(16))]
 pub struct Context {

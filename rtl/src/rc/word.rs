@@ -1,8 +1,8 @@
 //! The datapath word: the RC is generic over [`Word`], implemented by `i16`
 //! (the paper's 16-bit chip) and `i32` (the 32-bit variant the paper
 //! announces for the next chip). Every unit's operations are monomorphised,
-//! so the 16-bit datapath compiles to the same code as before the variant
-//! existed.
+//! so the 16-bit datapath compiles to code of its own width, with nothing of
+//! the 32-bit one in it.
 //!
 //! | | `i16` | `i32` |
 //! |---|---|---|
