@@ -115,7 +115,7 @@ impl Firmware {
     /// The FB image as main memory holds it for `ldfb`: 2 bytes per word on
     /// the 16-bit chip, 4 on the 32-bit chip.
     pub fn fb_bytes(&self) -> Vec<u8> {
-        layout::fb_word_bytes(&self.fb, self.datapath.bits() - 16)
+        layout::fb_word_bytes(&self.fb, self.datapath.extra_bits())
     }
 
     /// Bytes of one FB word.
@@ -272,7 +272,7 @@ fn build_as(
     // compiler's fit refined by the layout's), else built, moved and
     // built again.
     let foreseen = crate::scene_image::fitted_frac(scene, nm.guard_bits)
-        .map(|c| layout::fit_frac(scene, c, nm.guard_bits) + opt.datapath.bits() - 16);
+        .map(|c| layout::fit_frac(scene, c, nm.guard_bits) + opt.datapath.extra_bits());
     if let Some(frac) = foreseen {
         let d = to_grid(frac);
         if let Ok(fw) = build_any_bsp(&scene.translated(d), opt, nm, force_stream) {
@@ -359,7 +359,7 @@ fn build_one(
         chip_costs,
         layout: Some(crate::scene_image::NodeFormat::BitVectors),
         guard_bits: nm.guard_bits,
-        target_extra_frac: opt.datapath.bits() - 16,
+        target_extra_frac: opt.datapath.extra_bits(),
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
@@ -422,7 +422,7 @@ fn build_one(
     };
     lay.fb[..256].copy_from_slice(&math::table_slots_for(
         nm.table_entries as usize,
-        opt.datapath.bits() - 16,
+        opt.datapath.extra_bits(),
     ));
     let prog = program::program(scene, &lay, opt, nm, tw, th)?;
     let shadows = if shadows::merged(opt, &lay) {

@@ -243,7 +243,7 @@ fn header(
          ; and kernel is headed by what it does, its inputs and its outputs.\n",
     );
     let types: Vec<ChipType> = lay.types.iter().map(|t| t.ty).collect();
-    let mut f = format_lines(opt.datapath.bits() - 16);
+    let mut f = format_lines(opt.datapath.extra_bits());
     f.extend(nm.approx().header());
     block(
         &mut s,

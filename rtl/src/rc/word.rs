@@ -37,6 +37,12 @@ impl Datapath {
         }
     }
 
+    /// The extra fraction bits every number format gets on this datapath
+    /// over the paper's 16-bit chip: 0, or 16 on the 32-bit chip.
+    pub fn extra_bits(self) -> u32 {
+        self.bits() - 16
+    }
+
     /// From a bit count (16 or 32).
     pub fn from_bits(bits: u32) -> Option<Datapath> {
         match bits {

@@ -215,7 +215,7 @@ impl ChipRender {
 
 /// A colour channel in Q3.12 (16-bit chip) or Q3.28 (32-bit chip) to 8 bits.
 fn to8(v: i32, datapath: Datapath) -> u8 {
-    let one = ((12 + datapath.bits() - 16) as f64).exp2();
+    let one = ((12 + datapath.extra_bits()) as f64).exp2();
     ((v as f64 / one).clamp(0.0, 1.0) * 255.0).round() as u8
 }
 

@@ -299,7 +299,7 @@ fn build_as(
     let bands = form != polygon::Form::Plain;
     let streamed = streamed || form == polygon::Form::Apart;
     // The 32-bit chip: every format gets `xb` more fraction bits.
-    let xb = opt.datapath.bits() - 16;
+    let xb = opt.datapath.extra_bits();
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
     let s = (frac as f64).exp2();
     let err = |line: usize, m: String| {
