@@ -18,29 +18,8 @@ use serde::Deserialize;
 struct File {
     clock_hz: Option<u64>,
     issue: Option<String>,
-    risc: Option<Risc>,
+    risc: Option<toml::Table>,
     dma: Option<Dma>,
-}
-
-#[derive(Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-struct Risc {
-    alu: Option<u32>,
-    mul: Option<u32>,
-    load: Option<u32>,
-    store: Option<u32>,
-    branch_taken: Option<u32>,
-    branch_not_taken: Option<u32>,
-    jump: Option<u32>,
-    fb_load: Option<u32>,
-    fb_store: Option<u32>,
-    dma_issue: Option<u32>,
-    dwait: Option<u32>,
-    broadcast_issue: Option<u32>,
-    wfb: Option<u32>,
-    rcrisc: Option<u32>,
-    status: Option<u32>,
-    halt: Option<u32>,
 }
 
 #[derive(Deserialize, Default)]
@@ -58,53 +37,45 @@ struct Field {
     why: &'static str,
 }
 
-const FIELDS: &[Field] = &[
-    Field { table: "", key: "clock_hz", why: "the paper: \"MorphoSys is designed to be running at 300MHz\" (section IX); only frames/s and waveform time use it" },
-    Field { table: "", key: "issue", why: "ours (docs/isa.md, section 4): \"run\", one instruction streams a run of up to 4095 contexts while TinyRISC goes on; \"instruction\" is the M1 chip's, where TinyRISC issues each context by an instruction and the array waits while it does anything else" },
-    Field { table: "risc", key: "alu", why: "ours: a MIPS-like TinyRISC with a short pipeline (the M1 literature): one cycle for ALU, shift, lui, nop, rdcyc" },
-    Field { table: "risc", key: "mul", why: "ours: a 32x32 multiply in two cycles" },
-    Field { table: "risc", key: "load", why: "ours: main-memory loads (lw, lh, lhu, lb, lbu) with one load-use cycle" },
-    Field { table: "risc", key: "store", why: "ours: stores (sw, sh, sb) retire into a write buffer" },
-    Field { table: "risc", key: "branch_taken", why: "ours: one bubble for a taken branch (no delay slot, no prediction)" },
-    Field { table: "risc", key: "branch_not_taken", why: "ours: a not-taken branch falls through" },
-    Field { table: "risc", key: "jump", why: "ours: j, jal, jr, jalr, one bubble" },
-    Field { table: "risc", key: "fb_load", why: "ours: lfb reads the frame buffer like a load" },
-    Field { table: "risc", key: "fb_store", why: "ours: sfb writes the frame buffer like a store" },
-    Field { table: "risc", key: "dma_issue", why: "ours: ldctxt, ldfb, stfb issue a transfer that then runs on its own" },
-    Field { table: "risc", key: "dwait", why: "ours: dwait, once the channel is free" },
-    Field { table: "risc", key: "broadcast_issue", why: "ours: cbcast, sbcb, dbcb, cbcr, cbcc issue a run (with issue = \"instruction\": at least this, and one cycle per context)" },
-    Field { table: "risc", key: "wfb", why: "ours: 64 RC outputs into the FB, one row of 8 per cycle" },
-    Field { table: "risc", key: "rcrisc", why: "ours: one RC's output into a TinyRISC register, like a load" },
-    Field { table: "risc", key: "status", why: "ours: rcany, rcall, rcst, rcfl, rcfh, rcsl, rcsh: a 64-input reduction in two cycles (the paper: the status of all rays is sent to TinyRISC)" },
-    Field { table: "risc", key: "halt", why: "ours" },
-    Field { table: "dma", key: "setup_cycles", why: "ours: from a transfer's issue to its first word (an external memory's latency)" },
-    Field { table: "dma", key: "bytes_per_cycle", why: "ours: a 32-bit external bus, 2 FB words or 1 context word per cycle" },
-];
+/// Every field in the order `morphosys timing` prints them: the top
+/// level's, TinyRISC's cycle counts (from [`RiscTiming::CYCLES`]), the
+/// DMA's.
+fn fields() -> Vec<Field> {
+    let mut v = vec![
+        Field { table: "", key: "clock_hz", why: "the paper: \"MorphoSys is designed to be running at 300MHz\" (section IX); only frames/s and waveform time use it" },
+        Field { table: "", key: "issue", why: "ours (docs/isa.md, section 4): \"run\", one instruction streams a run of up to 4095 contexts while TinyRISC goes on; \"instruction\" is the M1 chip's, where TinyRISC issues each context by an instruction and the array waits while it does anything else" },
+    ];
+    v.extend(RiscTiming::CYCLES.iter().map(|c| Field {
+        table: "risc",
+        key: c.key,
+        why: c.why,
+    }));
+    v.extend([
+        Field {
+            table: "dma",
+            key: "setup_cycles",
+            why: "ours: from a transfer's issue to its first word (an external memory's latency)",
+        },
+        Field {
+            table: "dma",
+            key: "bytes_per_cycle",
+            why: "ours: a 32-bit external bus, 2 FB words or 1 context word per cycle",
+        },
+    ]);
+    v
+}
 
 /// The value of a field in `t`, as TOML.
 fn value(t: &Timing, table: &str, key: &str) -> String {
-    let r = &t.risc;
     let n = match (table, key) {
         ("", "clock_hz") => t.clock_hz,
-        ("", "issue") => return format!("\"{}\"", r.issue.name()),
-        ("risc", "alu") => r.alu as u64,
-        ("risc", "mul") => r.mul as u64,
-        ("risc", "load") => r.load as u64,
-        ("risc", "store") => r.store as u64,
-        ("risc", "branch_taken") => r.branch_taken as u64,
-        ("risc", "branch_not_taken") => r.branch_not_taken as u64,
-        ("risc", "jump") => r.jump as u64,
-        ("risc", "fb_load") => r.fb_load as u64,
-        ("risc", "fb_store") => r.fb_store as u64,
-        ("risc", "dma_issue") => r.dma_issue as u64,
-        ("risc", "dwait") => r.dwait as u64,
-        ("risc", "broadcast_issue") => r.broadcast_issue as u64,
-        ("risc", "wfb") => r.wfb as u64,
-        ("risc", "rcrisc") => r.rcrisc as u64,
-        ("risc", "status") => r.status as u64,
-        ("risc", "halt") => r.halt as u64,
+        ("", "issue") => return format!("\"{}\"", t.risc.issue.name()),
         ("dma", "setup_cycles") => t.dma.setup_cycles as u64,
         ("dma", "bytes_per_cycle") => t.dma.bytes_per_cycle as u64,
+        ("risc", k) => match RiscTiming::CYCLES.iter().find(|c| c.key == k) {
+            Some(c) => (c.get)(&t.risc) as u64,
+            None => unreachable!("timing field risc.{k}"),
+        },
         _ => unreachable!("timing field {table}.{key}"),
     };
     n.to_string()
@@ -121,7 +92,7 @@ pub fn to_toml(t: &Timing) -> String {
          # cycle whatever the file says (docs/isa.md, section 4).\n",
     );
     let mut table = "";
-    for f in FIELDS {
+    for f in fields() {
         if f.table != table {
             table = f.table;
             s.push_str(&format!("\n[{table}]\n"));
@@ -139,7 +110,7 @@ pub fn to_toml(t: &Timing) -> String {
 /// `t` as JSON (the render report's `timing`).
 pub(crate) fn to_json(t: &Timing) -> serde_json::Value {
     let mut top = serde_json::Map::new();
-    for f in FIELDS {
+    for f in fields() {
         let v: serde_json::Value = match (f.table, f.key) {
             ("", "issue") => t.risc.issue.name().into(),
             _ => value(t, f.table, f.key)
@@ -216,39 +187,28 @@ pub fn parse(text: &str, name: &str) -> Result<Timing> {
             .map_err(|e| anyhow!("{}: {e}", at("", "issue")))?;
     }
     if let Some(r) = f.risc {
-        let set = |v: Option<u32>, key: &str, slot: &mut u32| -> Result<()> {
-            if let Some(v) = v {
-                if v == 0 || v > 1_000_000 {
+        for (key, v) in &r {
+            let Some(c) = RiscTiming::CYCLES.iter().find(|c| c.key == key) else {
+                let known: Vec<String> = RiscTiming::CYCLES
+                    .iter()
+                    .map(|c| format!("`{}`", c.key))
+                    .collect();
+                return Err(anyhow!(
+                    "{}: unknown field `{key}` in [risc], expected one of {}",
+                    at("risc", key),
+                    known.join(", ")
+                ));
+            };
+            match v.as_integer() {
+                Some(n @ 1..=1_000_000) => (c.set)(&mut t.risc, n as u32),
+                _ => {
                     return Err(anyhow!(
                         "{}: risc.{key} = {v}: a cycle count must be 1..=1000000",
                         at("risc", key)
-                    ));
+                    ))
                 }
-                *slot = v;
             }
-            Ok(())
-        };
-        let x: &mut RiscTiming = &mut t.risc;
-        set(r.alu, "alu", &mut x.alu)?;
-        set(r.mul, "mul", &mut x.mul)?;
-        set(r.load, "load", &mut x.load)?;
-        set(r.store, "store", &mut x.store)?;
-        set(r.branch_taken, "branch_taken", &mut x.branch_taken)?;
-        set(
-            r.branch_not_taken,
-            "branch_not_taken",
-            &mut x.branch_not_taken,
-        )?;
-        set(r.jump, "jump", &mut x.jump)?;
-        set(r.fb_load, "fb_load", &mut x.fb_load)?;
-        set(r.fb_store, "fb_store", &mut x.fb_store)?;
-        set(r.dma_issue, "dma_issue", &mut x.dma_issue)?;
-        set(r.dwait, "dwait", &mut x.dwait)?;
-        set(r.broadcast_issue, "broadcast_issue", &mut x.broadcast_issue)?;
-        set(r.wfb, "wfb", &mut x.wfb)?;
-        set(r.rcrisc, "rcrisc", &mut x.rcrisc)?;
-        set(r.status, "status", &mut x.status)?;
-        set(r.halt, "halt", &mut x.halt)?;
+        }
     }
     if let Some(d) = f.dma {
         if let Some(v) = d.setup_cycles {
@@ -295,6 +255,19 @@ mod tests {
         assert_eq!(t.risc, Timing::default().risc);
         assert_eq!(t.dma, Timing::default().dma);
         assert_eq!(t.clock_hz, Timing::default().clock_hz);
+    }
+
+    /// Each TinyRISC key sets its own field and no other: the struct's
+    /// Debug text names the field with the value the file gave.
+    #[test]
+    fn every_risc_key_sets_its_own_field() {
+        for c in RiscTiming::CYCLES {
+            let t = parse(&format!("[risc]\n{} = 777\n", c.key), "t.toml").unwrap();
+            let debug = format!("{:?}", t.risc);
+            assert!(debug.contains(&format!("{}: 777", c.key)), "{debug}");
+            assert_eq!(debug.matches(": 777").count(), 1, "{debug}");
+            assert_eq!(value(&t, "risc", c.key), "777");
+        }
     }
 
     #[test]

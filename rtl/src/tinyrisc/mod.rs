@@ -22,33 +22,76 @@ pub use register_file::RegisterFile;
 
 use crate::trace::{Display, Field, LabelKind, Probe, Traced};
 
-/// Cycle cost of each instruction class (see `docs/isa.md`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct RiscTiming {
-    pub alu: u32,
-    pub mul: u32,
-    pub load: u32,
-    pub store: u32,
-    pub branch_taken: u32,
-    pub branch_not_taken: u32,
+/// One instruction class's cycle count in [`RiscTiming`]: its key (the
+/// field's name and its TOML key in `--timing` files), where its default
+/// comes from (`morphosys timing` prints it), and the field.
+#[derive(Clone, Copy)]
+pub struct CycleField {
+    pub key: &'static str,
+    pub why: &'static str,
+    pub get: fn(&RiscTiming) -> u32,
+    pub set: fn(&mut RiscTiming, u32),
+}
+
+/// The instruction classes' cycle counts, declared once: the struct's
+/// fields, their defaults and [`RiscTiming::CYCLES`] come from this list.
+macro_rules! risc_timing {
+    ($( $(#[doc = $doc:literal])* $name:ident = $default:literal, $why:literal; )*) => {
+        /// Cycle cost of each instruction class (see `docs/isa.md`).
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        pub struct RiscTiming {
+            $( $(#[doc = $doc])* pub $name: u32, )*
+            /// How contexts reach the array (`docs/isa.md`, section 4).
+            pub issue: IssueModel,
+        }
+
+        impl Default for RiscTiming {
+            fn default() -> Self {
+                RiscTiming {
+                    $( $name: $default, )*
+                    issue: IssueModel::Run,
+                }
+            }
+        }
+
+        impl RiscTiming {
+            /// Every instruction class's cycle count, in the order
+            /// `morphosys timing` prints them.
+            pub const CYCLES: &'static [CycleField] = &[
+                $( CycleField {
+                    key: stringify!($name),
+                    why: $why,
+                    get: |t| t.$name,
+                    set: |t, v| t.$name = v,
+                }, )*
+            ];
+        }
+    };
+}
+
+risc_timing! {
+    alu = 1, "ours: a MIPS-like TinyRISC with a short pipeline (the M1 literature): one cycle for ALU, shift, lui, nop, rdcyc";
+    mul = 2, "ours: a 32x32 multiply in two cycles";
+    load = 2, "ours: main-memory loads (lw, lh, lhu, lb, lbu) with one load-use cycle";
+    store = 1, "ours: stores (sw, sh, sb) retire into a write buffer";
+    branch_taken = 2, "ours: one bubble for a taken branch (no delay slot, no prediction)";
+    branch_not_taken = 1, "ours: a not-taken branch falls through";
     /// `j`, `jal`, `jr`, `jalr`.
-    pub jump: u32,
-    pub fb_load: u32,
-    pub fb_store: u32,
+    jump = 2, "ours: j, jal, jr, jalr, one bubble";
+    fb_load = 2, "ours: lfb reads the frame buffer like a load";
+    fb_store = 1, "ours: sfb writes the frame buffer like a store";
     /// `ldctxt`, `ldfb`, `stfb` (the transfer then runs on its own).
-    pub dma_issue: u32,
+    dma_issue = 1, "ours: ldctxt, ldfb, stfb issue a transfer that then runs on its own";
     /// `dwait` once the channel is free.
-    pub dwait: u32,
+    dwait = 1, "ours: dwait, once the channel is free";
     /// `cbcast`, `sbcb`, `dbcb`, `cbcr`, `cbcc` (the run then streams on its own).
-    pub broadcast_issue: u32,
+    broadcast_issue = 1, "ours: cbcast, sbcb, dbcb, cbcr, cbcc issue a run (with issue = \"instruction\": at least this, and one cycle per context)";
     /// `wfb`: 64 words, one row of 8 per cycle.
-    pub wfb: u32,
-    pub rcrisc: u32,
+    wfb = 8, "ours: 64 RC outputs into the FB, one row of 8 per cycle";
+    rcrisc = 2, "ours: one RC's output into a TinyRISC register, like a load";
     /// `rcany`, `rcall`, `rcst`, `rcfl`, `rcfh`, `rcsl`, `rcsh`.
-    pub status: u32,
-    pub halt: u32,
-    /// How contexts reach the array (`docs/isa.md`, section 4).
-    pub issue: IssueModel,
+    status = 2, "ours: rcany, rcall, rcst, rcfl, rcfh, rcsl, rcsh: a 64-input reduction in two cycles (the paper: the status of all rays is sent to TinyRISC)";
+    halt = 1, "ours";
 }
 
 /// How TinyRISC issues contexts to the array.
@@ -85,30 +128,6 @@ impl std::str::FromStr for IssueModel {
             .into_iter()
             .find(|m| m.name() == s)
             .ok_or_else(|| format!("unknown issue model '{s}': expected run or instruction"))
-    }
-}
-
-impl Default for RiscTiming {
-    fn default() -> Self {
-        RiscTiming {
-            alu: 1,
-            mul: 2,
-            load: 2,
-            store: 1,
-            branch_taken: 2,
-            branch_not_taken: 1,
-            jump: 2,
-            fb_load: 2,
-            fb_store: 1,
-            dma_issue: 1,
-            dwait: 1,
-            broadcast_issue: 1,
-            wfb: 8,
-            rcrisc: 2,
-            status: 2,
-            halt: 1,
-            issue: IssueModel::Run,
-        }
     }
 }
 
