@@ -2,7 +2,6 @@
 //! tracks its temporary file, the GTKWave save file, translate filters and
 //! Surfer decoders beside it, and the scope patterns of `--trace-scope`.
 
-use super::tracer::output_tempfile;
 use super::LabelKind;
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
@@ -42,6 +41,27 @@ pub(super) fn forget_partial(p: Option<PartialFiles>, path: &Path) {
     if let Some(p) = p {
         (p.done)(path);
     }
+}
+
+/// Temporary files are created 0600; outputs are ordinary files (0644).
+/// A temporary file in `dir` (named by `b`) that becomes `target`: with
+/// the mode `target` has when it exists, else as any new file (0666 less
+/// the umask), not tempfile's private 0600.
+pub(super) fn output_tempfile(
+    b: &mut tempfile::Builder,
+    dir: &Path,
+    target: &Path,
+) -> io::Result<tempfile::NamedTempFile> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        b.permissions(std::fs::Permissions::from_mode(0o666));
+    }
+    let tmp = b.tempfile_in(dir)?;
+    if let Ok(m) = std::fs::metadata(target) {
+        tmp.as_file().set_permissions(m.permissions())?;
+    }
+    Ok(tmp)
 }
 
 /// Write a small text file through a temporary file and a rename.

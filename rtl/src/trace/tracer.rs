@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use super::files::{
     check_scope_patterns, clean_stale_partials, decoder_path, filter_path, forget_partial, glob,
-    partial_created, save_file_path, stage, SideFiles,
+    output_tempfile, partial_created, save_file_path, stage, SideFiles,
 };
 use super::format::{fst_err, Clock, SigId, VcdBody};
 use super::handoff::{queue_cycle, BATCH};
@@ -131,27 +131,6 @@ pub(super) fn human_bytes(b: f64) -> String {
         u += 1;
     }
     format!("{v:.1} {}", units[u])
-}
-
-/// Temporary files are created 0600; outputs are ordinary files (0644).
-/// A temporary file in `dir` (named by `b`) that becomes `target`: with
-/// the mode `target` has when it exists, else as any new file (0666 less
-/// the umask), not tempfile's private 0600.
-pub(super) fn output_tempfile(
-    b: &mut tempfile::Builder,
-    dir: &Path,
-    target: &Path,
-) -> io::Result<tempfile::NamedTempFile> {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        b.permissions(std::fs::Permissions::from_mode(0o666));
-    }
-    let tmp = b.tempfile_in(dir)?;
-    if let Ok(m) = std::fs::metadata(target) {
-        tmp.as_file().set_permissions(m.permissions())?;
-    }
-    Ok(tmp)
 }
 
 impl Drop for Tracer {
