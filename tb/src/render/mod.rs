@@ -72,7 +72,7 @@ pub struct ChipRender {
     /// The host seconds of each tile (in the chip's order) within its
     /// item, and an item's mean seconds apart from its tiles: the frame as
     /// `bench`'s schedule model cuts it for any thread count
-    /// ([`ChipRender::work`]).
+    /// ([`crate::schedule::FrameWork::of`]).
     pub tile_seconds: Vec<f64>,
     pub item_own_seconds: f64,
     /// Host seconds of the chip render: from assembling the firmware to
