@@ -287,8 +287,7 @@ fn header(
         if present.is_empty() {
             continue;
         }
-        let mut sides: Vec<primitives::Sides> = present.iter().map(|ti| ti.ty.sides()).collect();
-        sides.sort_by_key(|s| *s != primitives::Sides::Front);
+        let sides: Vec<primitives::Sides> = present.iter().map(|ti| ti.ty.sides()).collect();
         let caps = present.iter().any(|ti| ti.caps);
         rec.extend(p.record_header(&lay.fit, &sides, caps));
     }
