@@ -3,7 +3,7 @@
 //! against a brute-force walk of the planes stored in the image.
 
 use firmware::bsp::{BspParams, SplitRule};
-use firmware::scene::{native, Aabb, Scene, Shape, Vec3};
+use firmware::scene::{native, Aabb, Scene, Shape, Sphere, Triangle, Vec3};
 use firmware::scene_image::{compile, CompileOptions, NodeFormat, MAGIC, NO_CHILD};
 
 const HEAD: &str = "[camera]\nfrom = [0, 0, 10]\nat = [0, 0, 0]\nup = [0, 1, 0]\nangle = 45\n\
@@ -289,7 +289,7 @@ fn may_overlap_is_conservative_and_rejects_clear_misses() {
             Vec3::new(rnd(), rnd(), rnd()),
             Vec3::new(rnd(), rnd(), rnd()),
         ];
-        let t = Shape::Triangle { v, normals: None };
+        let t = Shape::from(Triangle { v, normals: None });
         let inside =
             |p: Vec3| (0..3).all(|a| p.axis(a) >= b.min.axis(a) && p.axis(a) <= b.max.axis(a));
         let n = 40;
@@ -317,24 +317,26 @@ fn may_overlap_is_conservative_and_rejects_clear_misses() {
     );
     // A triangle whose bounding box covers the box but which passes 0.2
     // beside it (the plane x + y + z = 2.2 against the unit cube).
-    let t = Shape::Triangle {
+    let t = Shape::from(Triangle {
         v: [
             Vec3::new(2.2, 0.0, 0.0),
             Vec3::new(0.0, 2.2, 0.0),
             Vec3::new(0.0, 0.0, 2.2),
         ],
         normals: None,
-    };
+    });
     let unit = Aabb {
         min: Vec3::new(0.0, 0.0, 0.0),
         max: Vec3::ONE * 0.7,
     };
     assert!(t.bounds().overlaps(&unit) && !t.may_overlap(&unit));
     // Spheres: the exact distance test.
-    let s = |x: f64| Shape::Sphere {
-        center: Vec3::new(x, 0.35, 0.35),
-        radius: 0.3,
-        inside: false,
+    let s = |x: f64| {
+        Shape::from(Sphere {
+            center: Vec3::new(x, 0.35, 0.35),
+            radius: 0.3,
+            inside: false,
+        })
     };
     assert!(s(0.95).may_overlap(&unit) && !s(1.05).may_overlap(&unit));
 }

@@ -12,7 +12,9 @@
 //! the 32-bit chip run there against the same shapes.
 
 use firmware::asm;
-use firmware::scene::{Object, Scene, Shape, Vec3};
+use firmware::scene::{
+    AaBox, Cone, Object, Polygon, Rectangle, Scene, Shape, Sphere, Triangle, Vec3,
+};
 use firmware::tracer::emit::{Code, R1, R2, R7};
 use firmware::tracer::layout::{ChipType, TypeInfo};
 use firmware::tracer::memory_map::ram;
@@ -296,7 +298,7 @@ fn errors<W: Word>(name: &str, shape: Shape, two_sided: bool) -> Errors {
         if two_sided
             && matches!(
                 shape,
-                Shape::Sphere { .. } | Shape::Box { .. } | Shape::Cone { .. }
+                Shape::Sphere(Sphere { .. }) | Shape::Box(AaBox { .. }) | Shape::Cone(Cone { .. })
             )
         {
             // Half the rays from inside a solid: from the centre region
@@ -351,11 +353,11 @@ fn errors<W: Word>(name: &str, shape: Shape, two_sided: bool) -> Errors {
 }
 
 fn shape_sphere() -> Shape {
-    Shape::Sphere {
+    Shape::from(Sphere {
         center: Vec3::new(0.5, -0.3, 1.0),
         radius: 1.1,
         inside: false,
-    }
+    })
 }
 
 /// A sphere 6.3 LSB in radius with its centre off the LSB grid (a
@@ -364,11 +366,11 @@ fn shape_sphere() -> Shape {
 /// the true sphere's, not the rounded one's.
 #[test]
 fn tiny_sphere_kernel_vs_float_sphere() {
-    let s = Shape::Sphere {
+    let s = Shape::from(Sphere {
         center: Vec3::new(0.470715, 0.470715, 0.598245),
         radius: 0.00617284,
         inside: false,
-    };
+    });
     measure("tiny sphere", s, 2.0, 0.1);
 }
 
@@ -394,14 +396,14 @@ fn glass_sphere_kernel_vs_float_two_sided_sphere() {
 }
 
 fn shape_cylinder() -> Shape {
-    Shape::Cone {
+    Shape::from(Cone {
         base: Vec3::new(-0.5, 0.2, 0.0),
         base_radius: 0.6,
         apex: Vec3::new(0.3, 0.6, 2.0),
         apex_radius: 0.6,
         inside: false,
         caps: true,
-    }
+    })
 }
 
 #[test]
@@ -418,14 +420,14 @@ fn cylinder_kernel_vs_float_cone() {
 /// A thin cylinder, 38 LSB in radius in the test scene's format (like SPD
 /// jacks').
 fn shape_thin_cylinder() -> Shape {
-    Shape::Cone {
+    Shape::from(Cone {
         base: Vec3::new(-0.3013, 0.2071, -0.1187),
         base_radius: 0.0371,
         apex: Vec3::new(0.4029, 0.5237, 0.6101),
         apex_radius: 0.0371,
         inside: false,
         caps: false,
-    }
+    })
 }
 
 /// A thin cylinder (38 LSB in radius, like SPD jacks') seen from 2,000 to
@@ -516,12 +518,12 @@ fn hit_lanes(shape: &Shape, rays: &[Ray; 64], wide: bool) -> u64 {
 fn cylinder_bound_keeps_every_ray_the_line_test_keeps() {
     let thin = shape_thin_cylinder();
     let grazing = |shape: &Shape, seed: u64| -> [Ray; 64] {
-        let Shape::Cone {
+        let Shape::Cone(Cone {
             base,
             apex,
             base_radius: r,
             ..
-        } = *shape
+        }) = *shape
         else {
             unreachable!()
         };
@@ -613,7 +615,7 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
     };
     let first_cut = |shape: &Shape, rays: &[Ray; 64], wide: bool| {
         let at = match shape {
-            Shape::Sphere { .. } => ("k_sphere", "0", "line"),
+            Shape::Sphere(Sphere { .. }) => ("k_sphere", "0", "line"),
             _ => ("k_cylinder", "CYL_BODY", "near"),
         };
         flags_at_cut(shape, rays, at, wide)
@@ -629,7 +631,7 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
     };
     // The open cylinder: caps are tests of their own.
     let open = |mut s: Shape| {
-        if let Shape::Cone { caps, .. } = &mut s {
+        if let Shape::Cone(Cone { caps, .. }) = &mut s {
             *caps = false;
         }
         s
@@ -678,16 +680,16 @@ fn first_parts_keep_every_hit_and_stop_objects_behind() {
 #[test]
 fn a_cone_hit_ahead_of_a_centre_behind_is_kept() {
     let mut shape = shape_cone();
-    if let Shape::Cone { caps, .. } = &mut shape {
+    if let Shape::Cone(Cone { caps, .. }) = &mut shape {
         *caps = false;
     }
-    let Shape::Cone {
+    let Shape::Cone(Cone {
         base,
         base_radius,
         apex,
         apex_radius,
         ..
-    } = shape
+    }) = shape
     else {
         unreachable!()
     };
@@ -724,49 +726,49 @@ fn a_cone_hit_ahead_of_a_centre_behind_is_kept() {
 }
 
 fn shape_box() -> Shape {
-    Shape::Box {
+    Shape::from(AaBox {
         min: Vec3::new(-1.0, -0.5, 0.0),
         max: Vec3::new(0.8, 1.0, 1.2),
-    }
+    })
 }
 
 /// A tapered branch as the SPD tree's (half-angle 11 degrees), open.
 fn shape_cone() -> Shape {
-    Shape::Cone {
+    Shape::from(Cone {
         base: Vec3::new(-0.5, 0.2, 0.0),
         base_radius: 0.7,
         apex: Vec3::new(0.3, 0.6, 2.0),
         apex_radius: 0.3,
         inside: false,
         caps: false,
-    }
+    })
 }
 
 /// A pointed cone, half-angle 63 degrees (radius 1.2 over height 0.6):
 /// many rays run steeper than its surface (A < 0) and hit the inside
 /// (back side, not seen) or the outside from below; capped.
 fn shape_steep_cone() -> Shape {
-    Shape::Cone {
+    Shape::from(Cone {
         base: Vec3::new(0.1, -0.2, 0.3),
         base_radius: 1.2,
         apex: Vec3::new(0.2, 0.0, 0.9),
         apex_radius: 0.0,
         inside: false,
         caps: true,
-    }
+    })
 }
 
 /// Radii 0.5 and 0.49 over 2.5: the root formulas meet rays parallel to
 /// the surface (A near 0); `inside`: inside-visible (NFF negative radii).
 fn shape_nearly_cylindrical_cone(inside: bool) -> Shape {
-    Shape::Cone {
+    Shape::from(Cone {
         base: Vec3::new(0.0, -1.0, 0.2),
         base_radius: 0.5,
         apex: Vec3::new(0.4, 1.4, 0.0),
         apex_radius: 0.49,
         inside,
         caps: false,
-    }
+    })
 }
 
 #[test]
@@ -810,11 +812,11 @@ fn box_kernel_vs_float_aabox() {
 }
 
 fn shape_rectangle() -> Shape {
-    Shape::Rectangle {
+    Shape::from(Rectangle {
         corner: Vec3::new(-1.0, -1.0, 0.2),
         edge1: Vec3::new(2.0, 0.0, 0.5),
         edge2: Vec3::new(0.0, 1.5, 0.0),
-    }
+    })
 }
 
 #[test]
@@ -823,14 +825,14 @@ fn rectangle_kernel_vs_float_rectangle() {
 }
 
 fn shape_triangle() -> Shape {
-    Shape::Triangle {
+    Shape::from(Triangle {
         v: [
             Vec3::new(-1.0, -1.0, 0.0),
             Vec3::new(1.2, -0.8, 0.3),
             Vec3::new(0.1, 1.1, 0.9),
         ],
         normals: None,
-    }
+    })
 }
 
 #[test]
@@ -841,7 +843,7 @@ fn triangle_kernel_vs_float_triangle() {
 /// The triangle with vertex normals tilted up to `tilt` off its face
 /// normal, from `seed`.
 fn shape_smooth_triangle(seed: u64, tilt: f64) -> Shape {
-    let Shape::Triangle { v, .. } = shape_triangle() else {
+    let Shape::Triangle(Triangle { v, .. }) = shape_triangle() else {
         unreachable!()
     };
     let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
@@ -851,10 +853,10 @@ fn shape_smooth_triangle(seed: u64, tilt: f64) -> Shape {
         // Unnormalised on purpose: the compiler normalises, as the reference.
         (n + d * tilt) * g.range(0.5, 2.0)
     });
-    Shape::Triangle {
+    Shape::from(Triangle {
         v,
         normals: Some(normals),
-    }
+    })
 }
 
 /// Barycentric interpolation of the vertex normals (NFF `pp`) in the
@@ -949,7 +951,7 @@ fn glass_planar_kernels_vs_float_two_sided() {
 }
 
 fn shape_polygon() -> Shape {
-    Shape::Polygon {
+    Shape::from(Polygon {
         v: vec![
             Vec3::new(-1.0, -1.0, 0.0),
             Vec3::new(1.0, -1.0, 0.0),
@@ -958,7 +960,7 @@ fn shape_polygon() -> Shape {
             Vec3::new(-1.2, 0.4, 0.0),
         ],
         normals: None,
-    }
+    })
 }
 
 #[test]
@@ -968,7 +970,7 @@ fn polygon_kernel_vs_float_polygon() {
 
 fn shape_concave_polygon() -> Shape {
     // An L shape: the fan from v0 covers the notch twice (even-odd rule).
-    Shape::Polygon {
+    Shape::from(Polygon {
         v: vec![
             Vec3::new(-1.0, -1.0, 0.0),
             Vec3::new(1.0, -1.0, 0.0),
@@ -978,7 +980,7 @@ fn shape_concave_polygon() -> Shape {
             Vec3::new(-1.0, 1.0, 0.0),
         ],
         normals: None,
-    }
+    })
 }
 
 #[test]
@@ -998,7 +1000,7 @@ fn shape_gear_like_concave_polygon() -> Shape {
             v.push(Vec3::new(r * a.cos(), r * a.sin(), 0.0));
         }
     }
-    Shape::Polygon { v, normals: None }
+    Shape::from(Polygon { v, normals: None })
 }
 
 #[test]
@@ -1116,7 +1118,7 @@ fn banded_polygon_is_the_plain_polygon_bit_for_bit() {
         (t, fw.frac)
     }
     fn on<W: Word>(glass: bool) {
-        let Shape::Polygon { v, .. } = shape_gear_like_concave_polygon() else {
+        let Shape::Polygon(Polygon { v, .. }) = shape_gear_like_concave_polygon() else {
             unreachable!()
         };
         // The format's scale, from a first run.

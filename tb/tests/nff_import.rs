@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use firmware::scene::{PrimType, Scene, Shape};
+use firmware::scene::{PrimType, Rectangle, Scene, Shape};
 
 fn spd(name: &str) -> Scene {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -50,7 +50,10 @@ fn spd_scenes_import_with_published_counts() {
         (count(&b, PrimType::Sphere), b.objects.len(), b.lights.len()),
         (7381, 7382, 3)
     );
-    assert!(matches!(b.objects[0].shape, Shape::Rectangle { .. }));
+    assert!(matches!(
+        b.objects[0].shape,
+        Shape::Rectangle(Rectangle { .. })
+    ));
     assert_eq!(b.materials[b.objects[1].material].ks, 0.5);
     assert_eq!(b.background.z, 0.753);
     // tetra-6: 4096 triangles, 1 light.

@@ -646,23 +646,23 @@ fn a_far_light_keeps_the_fine_format() {
 /// cones.
 #[test]
 fn all_seven_chip_types_resident_compact_and_streamed() {
-    use firmware::scene::{Object, Shape, Vec3};
+    use firmware::scene::{Cone, Object, Polygon, Shape, Vec3};
     use firmware::tracer::NodeLayout;
     let mut scene = load("default.toml");
     scene.objects.push(Object {
-        shape: Shape::Cone {
+        shape: Shape::from(Cone {
             base: Vec3::new(-1.5, -1.0, 0.0),
             base_radius: 0.45,
             apex: Vec3::new(-1.3, -0.8, 1.3),
             apex_radius: 0.15,
             inside: false,
             caps: true,
-        },
+        }),
         material: 2,
         line: 0,
     });
     scene.objects.push(Object {
-        shape: Shape::Polygon {
+        shape: Shape::from(Polygon {
             v: vec![
                 Vec3::new(1.6, -4.4, 0.02),
                 Vec3::new(2.8, -4.4, 0.02),
@@ -671,7 +671,7 @@ fn all_seven_chip_types_resident_compact_and_streamed() {
                 Vec3::new(1.6, -3.2, 0.02),
             ],
             normals: None,
-        },
+        }),
         material: 0,
         line: 0,
     });

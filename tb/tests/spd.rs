@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use firmware::scene::{spd, PrimType, Scene, Shape};
+use firmware::scene::{spd, PrimType, Rectangle, Scene, Shape};
 
 fn bundled(name: &str) -> String {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -181,5 +181,8 @@ fn generated_scenes_are_what_the_files_describe() {
     f.source = s.source.clone();
     assert_eq!(s, f);
     // and the floor of balls is the rectangle the NFF reader makes of it.
-    assert!(matches!(s.objects[0].shape, Shape::Rectangle { .. }));
+    assert!(matches!(
+        s.objects[0].shape,
+        Shape::Rectangle(Rectangle { .. })
+    ));
 }

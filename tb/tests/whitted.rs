@@ -248,7 +248,9 @@ fn smooth_shading_of_a_pp_mesh() {
     assert_eq!(smooth.json["warnings"].as_array().map(|w| w.len()), Some(0));
     let mut flat = scene.clone();
     for o in &mut flat.objects {
-        if let firmware::scene::Shape::Triangle { normals, .. } = &mut o.shape {
+        if let firmware::scene::Shape::Triangle(firmware::scene::Triangle { normals, .. }) =
+            &mut o.shape
+        {
             *normals = None;
         }
     }

@@ -88,6 +88,10 @@ impl Vec3 {
     pub fn to_array(self) -> [f64; 3] {
         [self.x, self.y, self.z]
     }
+    /// Each coordinate passed through `f`.
+    pub fn map(self, f: impl Fn(f64) -> f64) -> Vec3 {
+        Vec3::new(f(self.x), f(self.y), f(self.z))
+    }
 }
 
 impl Add for Vec3 {

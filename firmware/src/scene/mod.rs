@@ -15,11 +15,13 @@
 mod geometry;
 pub mod native;
 pub mod nff;
-mod shape;
+pub mod shape;
 pub mod spd;
 
 pub use geometry::{Aabb, Vec3};
-pub use shape::{PrimType, Shape};
+pub use shape::{
+    AaBox, Cone, Polygon, PrimType, Ray, Rectangle, Shape, Sphere, Surface, SurfaceHit, Triangle,
+};
 
 use std::fmt;
 use std::path::Path;
@@ -415,14 +417,14 @@ mod tests {
 
     #[test]
     fn cone_bounds_of_axis_aligned_cylinder() {
-        let s = Shape::Cone {
+        let s = Shape::from(Cone {
             base: Vec3::new(0.0, 0.0, 0.0),
             base_radius: 1.0,
             apex: Vec3::new(0.0, 0.0, 2.0),
             apex_radius: 1.0,
             inside: false,
             caps: false,
-        };
+        });
         let b = s.bounds();
         assert_eq!(b.min, Vec3::new(-1.0, -1.0, 0.0));
         assert_eq!(b.max, Vec3::new(1.0, 1.0, 2.0));
@@ -431,22 +433,22 @@ mod tests {
 
     #[test]
     fn degenerate_shapes_are_named() {
-        let t = Shape::Triangle {
+        let t = Shape::from(Triangle {
             v: [Vec3::ZERO, Vec3::ONE, Vec3::ONE * 2.0],
             normals: None,
-        };
+        });
         assert!(t.degeneracy().unwrap().contains("collinear"));
-        let s = Shape::Sphere {
+        let s = Shape::from(Sphere {
             center: Vec3::ZERO,
             radius: 0.0,
             inside: false,
-        };
+        });
         assert!(s.degeneracy().unwrap().contains("radius"));
-        let s = Shape::Sphere {
+        let s = Shape::from(Sphere {
             center: Vec3::new(f64::NAN, 0.0, 0.0),
             radius: 1.0,
             inside: false,
-        };
+        });
         assert!(s.degeneracy().unwrap().contains("non-finite"));
     }
 }

@@ -31,7 +31,10 @@ use std::collections::BTreeMap;
 use serde::Deserialize;
 use toml::Spanned;
 
-use super::{Camera, Light, Material, Object, Scene, SceneError, Shape, Vec3};
+use super::{
+    AaBox, Camera, Cone, Light, Material, Object, Rectangle, Scene, SceneError, Shape, Sphere,
+    Triangle, Vec3,
+};
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -175,43 +178,43 @@ fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
     let u = |v: Option<Vec3>| v.unwrap_or_default();
     let f = |v: Option<f64>| v.unwrap_or_default();
     Ok(match o.kind.as_str() {
-        "sphere" => Shape::Sphere {
+        "sphere" => Shape::from(Sphere {
             center: u(o.center),
             radius: f(o.radius),
             inside,
-        },
-        "cylinder" => Shape::Cone {
+        }),
+        "cylinder" => Shape::from(Cone {
             base: u(o.base),
             base_radius: f(o.radius),
             apex: u(o.apex),
             apex_radius: f(o.radius),
             inside,
             caps,
-        },
-        "cone" => Shape::Cone {
+        }),
+        "cone" => Shape::from(Cone {
             base: u(o.base),
             base_radius: f(o.base_radius),
             apex: u(o.apex),
             apex_radius: f(o.apex_radius),
             inside,
             caps,
-        },
-        "box" => Shape::Box {
+        }),
+        "box" => Shape::from(AaBox {
             min: u(o.min),
             max: u(o.max),
-        },
-        "rectangle" => Shape::Rectangle {
+        }),
+        "rectangle" => Shape::from(Rectangle {
             corner: u(o.corner),
             edge1: u(o.edge1),
             edge2: u(o.edge2),
-        },
+        }),
         kind => {
             let v = o.vertices.clone().unwrap_or_default();
             match (kind, v.len()) {
-                ("triangle", 3) | ("polygon", 3) => Shape::Triangle {
+                ("triangle", 3) | ("polygon", 3) => Shape::from(Triangle {
                     v: [v[0], v[1], v[2]],
                     normals: None,
-                },
+                }),
                 ("triangle", n) => return Err(format!("a triangle needs 3 vertices, found {n}")),
                 (_, n) if n < 3 => {
                     return Err(format!("a polygon needs at least 3 vertices, found {n}"))

@@ -6,14 +6,16 @@
 //! (the SPD writes `c` both ways). A `#` starts a comment to the end of the
 //! line. Conversions:
 //! - `p`/`pp` with 3 vertices become triangles; `p` with 4 vertices that
-//!   form a rectangle becomes a [`Shape::Rectangle`] (same visible side);
-//!   everything else is a [`Shape::Polygon`].
-//! - `c` becomes an open [`Shape::Cone`] (a cylinder when the radii are
+//!   form a rectangle becomes a [`Rectangle`] (same visible side);
+//!   everything else is a [`Polygon`](super::Polygon).
+//! - `c` becomes an open [`Cone`] (a cylinder when the radii are
 //!   equal); negative radii (both) and negative sphere radii mean "only the
 //!   inside is visible".
 //! - Objects before the first `f` get the default material (white, Kd 1).
 
-use super::{Camera, Light, Material, Object, Scene, SceneError, Shape, Vec3};
+use super::{
+    Camera, Cone, Light, Material, Object, Rectangle, Scene, SceneError, Shape, Sphere, Vec3,
+};
 
 struct Token<'a> {
     text: &'a str,
@@ -300,11 +302,11 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                 }
                 add(
                     &mut scene,
-                    Shape::Sphere {
+                    Shape::from(Sphere {
                         center,
                         radius: radius.abs(),
                         inside: radius < 0.0,
-                    },
+                    }),
                 );
             }
             "c" => {
@@ -336,14 +338,14 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                 }
                 add(
                     &mut scene,
-                    Shape::Cone {
+                    Shape::from(Cone {
                         base,
                         base_radius: base_radius.abs(),
                         apex,
                         apex_radius: apex_radius.abs(),
                         inside,
                         caps: false,
-                    },
+                    }),
                 );
             }
             "p" | "pp" => {
@@ -410,11 +412,11 @@ fn polygon_shape(v: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Shape {
         let closes = (v[0] + e1 + e2 - v[2]).length() <= 1e-9 * scale;
         let square = e1.dot(e2).abs() <= 1e-9 * e1.length() * e2.length();
         if scale > 0.0 && closes && square && e1.cross(e2).length() > 0.0 {
-            return Shape::Rectangle {
+            return Shape::from(Rectangle {
                 corner: v[0],
                 edge1: e1,
                 edge2: e2,
-            };
+            });
         }
     }
     Shape::polygon(v, normals)
@@ -423,6 +425,7 @@ fn polygon_shape(v: Vec<Vec3>, normals: Option<Vec<Vec3>>) -> Shape {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::scene::Polygon;
 
     const HEAD: &str =
         "v\nfrom 0 0 10\nat 0 0 0\nup 0 1 0\nangle 45\nhither 0.01\nresolution 8 8\n";
@@ -442,24 +445,15 @@ mod tests {
         assert_eq!(s.lights[1].color, Some(Vec3::new(0.5, 0.5, 0.5)));
         assert_eq!(s.objects.len(), 7);
         assert!(
-            matches!(s.objects[0].shape, Shape::Sphere { radius, inside: true, .. } if radius == 1.0)
+            matches!(s.objects[0].shape.as_sphere(), Some(Sphere { radius, inside: true, .. }) if *radius == 1.0)
         );
         assert!(
-            matches!(s.objects[2].shape, Shape::Cone { inside: true, apex_radius, .. } if apex_radius == 0.5)
+            matches!(s.objects[2].shape.as_cone(), Some(Cone { inside: true, apex_radius, .. }) if *apex_radius == 0.5)
         );
-        assert!(matches!(
-            s.objects[3].shape,
-            Shape::Triangle { normals: None, .. }
-        ));
-        assert!(matches!(s.objects[4].shape, Shape::Rectangle { .. }));
-        assert!(matches!(s.objects[5].shape, Shape::Polygon { ref v, .. } if v.len() == 5));
-        assert!(matches!(
-            s.objects[6].shape,
-            Shape::Triangle {
-                normals: Some(_),
-                ..
-            }
-        ));
+        assert!(s.objects[3].shape.as_triangle().unwrap().normals.is_none());
+        assert!(s.objects[4].shape.as_rectangle().is_some());
+        assert_eq!(s.objects[5].shape.as_polygon().unwrap().v.len(), 5);
+        assert!(s.objects[6].shape.as_triangle().unwrap().normals.is_some());
         assert_eq!(s.objects[6].line, 23);
     }
 
@@ -507,16 +501,14 @@ mod tests {
         let s = parse(&text, "l.nff").unwrap();
         assert!(s.warnings.is_empty());
         for o in &s.objects {
-            let Shape::Polygon { v, .. } = &o.shape else {
+            let Some(Polygon { v, .. }) = o.shape.as_polygon() else {
                 panic!("{:?}", o.shape)
             };
             let n = (v[1] - v[0]).cross(v[2] - v[0]);
             assert!(n.z > 0.0, "line {}: {v:?}", o.line);
         }
         // The outline is unchanged: the same vertices in the same cyclic order.
-        let Shape::Polygon { v, .. } = &s.objects[0].shape else {
-            unreachable!()
-        };
+        let v = &s.objects[0].shape.as_polygon().unwrap().v;
         let i = v
             .iter()
             .position(|p| *p == Vec3::new(1.0, 1.0, 0.0))

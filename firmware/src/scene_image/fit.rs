@@ -2,7 +2,7 @@
 //! the largest of them, the smallest feature, and the shape as the chip
 //! sees it once rounded.
 
-use crate::scene::{Scene, SceneError, Shape, Vec3};
+use crate::scene::{Scene, SceneError, Shape};
 
 use super::{CompileOptions, QFormat};
 
@@ -10,96 +10,12 @@ use super::{CompileOptions, QFormat};
 /// segments x 8 rings (224), cylinders and cones 16 segments (32, plus 16
 /// per cap), boxes 12, rectangles 2, polygons n - 2.
 pub fn tessellated_triangles(s: &Shape) -> usize {
-    match s {
-        Shape::Sphere { .. } => 224,
-        Shape::Cone {
-            caps,
-            base_radius,
-            apex_radius,
-            ..
-        } => {
-            let capn = if *caps {
-                16 * ((*base_radius > 0.0) as usize + (*apex_radius > 0.0) as usize)
-            } else {
-                0
-            };
-            32 + capn
-        }
-        Shape::Box { .. } => 12,
-        Shape::Rectangle { .. } => 2,
-        Shape::Triangle { .. } => 1,
-        Shape::Polygon { v, .. } => v.len() - 2,
-    }
+    s.surface().tessellated_triangles()
 }
 
 /// The smallest length that defines a shape.
 pub fn smallest_feature(s: &Shape) -> f64 {
-    fn edges_and_height(v: &[Vec3]) -> f64 {
-        let mut m = f64::INFINITY;
-        let mut longest: f64 = 0.0;
-        for k in 0..v.len() {
-            let e = (v[(k + 1) % v.len()] - v[k]).length();
-            m = m.min(e);
-            longest = longest.max(e);
-        }
-        let area2 = (v[1] - v[0]).cross(v[2] - v[0]).length();
-        m.min(area2 / longest)
-    }
-    match s {
-        Shape::Sphere { radius, .. } => *radius,
-        Shape::Cone {
-            base,
-            base_radius,
-            apex,
-            apex_radius,
-            ..
-        } => {
-            let r = base_radius.max(*apex_radius);
-            r.min((*apex - *base).length())
-        }
-        Shape::Box { min, max } => {
-            let e = *max - *min;
-            e.x.min(e.y).min(e.z)
-        }
-        Shape::Rectangle { edge1, edge2, .. } => edge1.length().min(edge2.length()),
-        Shape::Triangle { v, .. } => edges_and_height(v),
-        Shape::Polygon { v, .. } => edges_and_height(v),
-    }
-}
-
-/// The scene-coordinate values (points and radii) a shape's record holds.
-fn coordinates(s: &Shape) -> Vec<f64> {
-    let mut out = Vec::new();
-    let mut p = |v: Vec3| out.extend_from_slice(&v.to_array());
-    match s {
-        Shape::Sphere { center, .. } => p(*center),
-        Shape::Cone { base, apex, .. } => {
-            p(*base);
-            p(*apex)
-        }
-        Shape::Box { min, max } => {
-            p(*min);
-            p(*max)
-        }
-        // The edges are differences of two points: the guard bit covers them
-        // (checked in `fit`).
-        Shape::Rectangle { corner, .. } => p(*corner),
-        Shape::Triangle { v, .. } => v.iter().for_each(|v| p(*v)),
-        Shape::Polygon { v, .. } => v.iter().for_each(|v| p(*v)),
-    }
-    match s {
-        Shape::Sphere { radius, .. } => out.push(*radius),
-        Shape::Cone {
-            base_radius,
-            apex_radius,
-            ..
-        } => {
-            out.push(*base_radius);
-            out.push(*apex_radius)
-        }
-        _ => {}
-    }
-    out
+    s.surface().smallest_feature()
 }
 
 /// The fraction bits of the format [`compile`](super::compile) fits to `scene` with
@@ -129,7 +45,9 @@ pub(super) fn fit(scene: &Scene, opt: &CompileOptions) -> Result<(QFormat, f64),
         }
     };
     for o in &scene.objects {
-        coordinates(&o.shape)
+        o.shape
+            .surface()
+            .coordinates()
             .into_iter()
             .for_each(|x| see(x, o.line));
     }
@@ -158,21 +76,20 @@ pub(super) fn fit(scene: &Scene, opt: &CompileOptions) -> Result<(QFormat, f64),
     };
     let q = QFormat { frac };
     for o in &scene.objects {
-        if let Shape::Rectangle { edge1, edge2, .. } = &o.shape {
-            if edge1
-                .to_array()
-                .into_iter()
-                .chain(edge2.to_array())
-                .any(|x| q.quantize(x).is_none())
-            {
-                return Err(err(
-                    o.line,
-                    format!(
-                        "rectangle edge does not fit in {} (use a guard bit)",
-                        q.name()
-                    ),
-                ));
-            }
+        let edges = o.shape.surface().edges();
+        if edges
+            .iter()
+            .flat_map(|e| e.to_array())
+            .any(|x| q.quantize(x).is_none())
+        {
+            return Err(err(
+                o.line,
+                format!(
+                    "{} edge does not fit in {} (use a guard bit)",
+                    o.shape.prim_type().name(),
+                    q.name()
+                ),
+            ));
         }
     }
     Ok((q, max_abs))
@@ -228,55 +145,8 @@ pub(super) fn smallest(
     Ok(small)
 }
 
-/// The shape as the chip sees it: every coordinate rounded to `q`.
+/// The shape as the chip sees it: every coordinate rounded to `q`
+/// (vertex normals dropped).
 pub fn dequantized(s: &Shape, q: QFormat) -> Shape {
-    let r = |x: f64| q.quantize(x).map_or(x, |v| q.value(v));
-    let p = |v: Vec3| Vec3::new(r(v.x), r(v.y), r(v.z));
-    match s {
-        Shape::Sphere {
-            center,
-            radius,
-            inside,
-        } => Shape::Sphere {
-            center: p(*center),
-            radius: r(*radius),
-            inside: *inside,
-        },
-        Shape::Cone {
-            base,
-            base_radius,
-            apex,
-            apex_radius,
-            inside,
-            caps,
-        } => Shape::Cone {
-            base: p(*base),
-            base_radius: r(*base_radius),
-            apex: p(*apex),
-            apex_radius: r(*apex_radius),
-            inside: *inside,
-            caps: *caps,
-        },
-        Shape::Box { min, max } => Shape::Box {
-            min: p(*min),
-            max: p(*max),
-        },
-        Shape::Rectangle {
-            corner,
-            edge1,
-            edge2,
-        } => Shape::Rectangle {
-            corner: p(*corner),
-            edge1: p(*edge1),
-            edge2: p(*edge2),
-        },
-        Shape::Triangle { v, .. } => Shape::Triangle {
-            v: v.map(p),
-            normals: None,
-        },
-        Shape::Polygon { v, .. } => Shape::Polygon {
-            v: v.iter().map(|v| p(*v)).collect(),
-            normals: None,
-        },
-    }
+    s.quantized(&|x: f64| q.quantize(x).map_or(x, |v| q.value(v)))
 }

@@ -31,7 +31,7 @@ mod sections;
 use bitvec::prelude::*;
 
 use crate::bsp::{Bsp, BspParams};
-use crate::scene::{Aabb, PrimType, Scene, SceneError, Shape, Vec3};
+use crate::scene::{Aabb, Polygon, PrimType, Scene, SceneError, Vec3};
 
 pub use fit::{dequantized, fitted_frac, smallest_feature, tessellated_triangles};
 pub use report::{Report, TriangleOnly};
@@ -320,7 +320,7 @@ impl Groups {
             }
         }
         for o in &scene.objects {
-            if let Shape::Polygon { v, .. } = &o.shape {
+            if let Some(Polygon { v, .. }) = o.shape.as_polygon() {
                 if v.len() > FIELD {
                     return Err(error(
                         scene,

@@ -3,7 +3,9 @@
 //! Word by word in `docs/scenes.md`.
 
 use crate::bsp::{Bsp, Node};
-use crate::scene::{PrimType, Scene, SceneError, Shape, Vec3};
+use crate::scene::{
+    AaBox, Cone, Polygon, PrimType, Rectangle, Scene, SceneError, Shape, Sphere, Triangle, Vec3,
+};
 
 use super::fit::dequantized;
 use super::{
@@ -170,7 +172,7 @@ pub(super) fn objects(
             let start = w.words.len();
             if let Some(fixup) = record(w, t, &o.shape, o.material) {
                 polygon_fixups.push((fixup, polygon_vertices.len()));
-                if let Shape::Polygon { v, .. } = &o.shape {
+                if let Some(Polygon { v, .. }) = o.shape.as_polygon() {
                     polygon_vertices.extend_from_slice(v);
                 }
             }
@@ -212,24 +214,24 @@ pub(super) fn objects(
 fn record(w: &mut Writer, t: PrimType, shape: &Shape, material: usize) -> Option<usize> {
     let mat = material.min(u16::MAX as usize) as u16;
     match shape {
-        Shape::Sphere {
+        Shape::Sphere(Sphere {
             center,
             radius,
             inside,
-        } => {
+        }) => {
             w.point(*center);
             w.coord(*radius);
             w.word(mat);
             w.word(*inside as u16);
         }
-        Shape::Cone {
+        Shape::Cone(Cone {
             base,
             base_radius,
             apex,
             apex_radius,
             inside,
             caps,
-        } => {
+        }) => {
             w.point(*base);
             w.point(*apex);
             w.coord(*base_radius);
@@ -239,26 +241,26 @@ fn record(w: &mut Writer, t: PrimType, shape: &Shape, material: usize) -> Option
             w.word(mat);
             w.word(*inside as u16 | (*caps as u16) << 1);
         }
-        Shape::Box { min, max } => {
+        Shape::Box(AaBox { min, max }) => {
             w.point(*min);
             w.point(*max);
             w.word(mat);
         }
-        Shape::Rectangle {
+        Shape::Rectangle(Rectangle {
             corner,
             edge1,
             edge2,
-        } => {
+        }) => {
             w.point(*corner);
             w.point(*edge1);
             w.point(*edge2);
             w.word(mat);
         }
-        Shape::Triangle { v, .. } => {
+        Shape::Triangle(Triangle { v, .. }) => {
             v.iter().for_each(|v| w.point(*v));
             w.word(mat);
         }
-        Shape::Polygon { v, .. } => {
+        Shape::Polygon(Polygon { v, .. }) => {
             w.word(mat);
             w.word(v.len() as u16); // checked before
             let fixup = w.words.len();

@@ -252,12 +252,7 @@ fn build_as(
     nm: &Numerics,
     force_stream: bool,
 ) -> Result<Firmware, String> {
-    let curved = scene.objects.iter().any(|o| {
-        matches!(
-            o.shape,
-            crate::scene::Shape::Sphere { .. } | crate::scene::Shape::Cone { .. }
-        )
-    });
+    let curved = scene.objects.iter().any(|o| o.shape.surface().curved());
     if !nm.normals.fine_on(opt.datapath) || !curved {
         return build_any_bsp(scene, opt, nm, force_stream);
     }

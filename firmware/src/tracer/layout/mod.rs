@@ -25,7 +25,7 @@ pub mod packet_nodes;
 pub mod paper_nodes;
 mod streams;
 
-use crate::scene::{Scene, Shape};
+use crate::scene::Scene;
 use crate::scene_image::SceneImage;
 
 use super::math::table_slots_for;
@@ -259,7 +259,8 @@ pub fn build_packet(
     let may_band = scene
         .objects
         .iter()
-        .any(|o| matches!(&o.shape, Shape::Polygon { v, .. } if v.len() >= polygon::BANDED_FROM));
+        .filter_map(|o| o.shape.as_polygon())
+        .any(|p| p.v.len() >= polygon::BANDED_FROM);
     let build = |form| build_as(scene, image, opt, g, fine_normals, fine, force_stream, form);
     let large = |lay: &FbImage| {
         lay.types.iter().any(|t| {
@@ -568,10 +569,8 @@ pub(crate) fn polygon_fan(scene: &Scene, s: f64, bands: bool) -> (usize, bool) {
     let edges: Vec<Vec<[i64; 5]>> = scene
         .objects
         .iter()
-        .filter_map(|o| match &o.shape {
-            Shape::Polygon { v, .. } => Some(polygon::edges(v, s).1),
-            _ => None,
-        })
+        .filter_map(|o| o.shape.as_polygon())
+        .map(|p| polygon::edges(&p.v, s).1)
         .collect();
     let banded = bands && edges.iter().any(|e| e.len() >= polygon::BANDED_FROM);
     let fan = edges

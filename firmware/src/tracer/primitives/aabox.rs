@@ -1,4 +1,4 @@
-//! Axis-aligned box (`tb/src/reference/shapes.rs`: `aabox`), by the slab
+//! Axis-aligned box (`scene/shape/aabox.rs`), by the slab
 //! method, one section per axis.
 //!
 //! **Record** (24 words): per axis `a` (b, c the two others): `min_a,
@@ -28,7 +28,7 @@ use super::super::math::divide;
 use super::super::memory_map::ram;
 use super::record::W;
 use super::{self_margin, Fit, Gen, Object, RecordError, Sides, TestCost};
-use crate::scene::{Shape, Vec3};
+use crate::scene::Vec3;
 
 /// Words of one copy of the record.
 pub const WORDS: usize = 24;
@@ -196,10 +196,10 @@ impl super::ChipPrimitive for AaBox {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        let Shape::Box { min, max } = *o.shape else {
+        let Some(b) = o.shape.as_box() else {
             return Err(RecordError::mismatch("box"));
         };
-        write(w, o.sides, min, max, o.id, o.mat);
+        write(w, o.sides, b.min, b.max, o.id, o.mat);
         Ok(())
     }
 }

@@ -1,5 +1,5 @@
 //! Open cone with unequal radii and optional end caps
-//! (`tb/src/reference/shapes.rs`: `cone`; the caps `disc`).
+//! (`scene/shape/cone.rs`; the caps `disc`).
 //!
 //! **Record**: a caps flag (`CONE_CAPS`), the body (`CONE_BODY`, 40
 //! words), the two caps as disc records (`CONE_CAP0`, `CONE_CAP1`; a cap
@@ -653,20 +653,13 @@ impl super::ChipPrimitive for Cone {
     }
 
     fn geometry(&self, shape: &Shape, s: f64) -> Geometry {
-        match *shape {
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                apex_radius,
-                ..
-            } => {
-                let f = ConeFit::of(base, base_radius, apex, apex_radius, s);
-                let caps = f.caps(base, base_radius, apex, apex_radius, s);
-                Geometry::Cone(Box::new((f, caps)))
-            }
-            _ => Geometry::None,
-        }
+        let Some(c) = shape.as_cone() else {
+            return Geometry::None;
+        };
+        let (base, base_radius, apex, apex_radius) = (c.base, c.base_radius, c.apex, c.apex_radius);
+        let f = ConeFit::of(base, base_radius, apex, apex_radius, s);
+        let caps = f.caps(base, base_radius, apex, apex_radius, s);
+        Geometry::Cone(Box::new((f, caps)))
     }
 
     fn fit(&self, _scene: &Scene, geo: &[Geometry], _s: f64, f: &Fitter, fit: &mut Fit) {
@@ -685,13 +678,7 @@ impl super::ChipPrimitive for Cone {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        let (
-            Shape::Cone {
-                inside, caps: on, ..
-            },
-            Geometry::Cone(fc),
-        ) = (o.shape, o.geometry)
-        else {
+        let (Some(c), Geometry::Cone(fc)) = (o.shape.as_cone(), o.geometry) else {
             return Err(RecordError::mismatch("cone"));
         };
         write(
@@ -699,8 +686,8 @@ impl super::ChipPrimitive for Cone {
             o.fit,
             o.sides,
             &fc.0,
-            *inside,
-            o.caps.then_some((*on, &fc.1)),
+            c.inside,
+            o.caps.then_some((c.caps, &fc.1)),
             o.id,
             o.mat,
         )

@@ -1,5 +1,5 @@
-//! Open cylinder with optional end caps (`tb/src/reference/shapes.rs`:
-//! `cone` with equal radii; the caps `disc`).
+//! Open cylinder with optional end caps (`scene/shape/cone.rs`
+//! with equal radii; the caps `disc`).
 //!
 //! **Record**: a caps flag (`CYL_CAPS`), the body (`CYL_BODY`), then the
 //! two caps as disc records ([`super::planar`], `CYL_CAP0`, `CYL_CAP1`)
@@ -50,7 +50,7 @@ use super::{
     commit_obj_mat, perpendicular, self_margin, Body, CutTest, Fit, Gen, Geometry, Object,
     RecordError, Sides, TestCost,
 };
-use crate::scene::{PrimType, Scene, Shape, Vec3};
+use crate::scene::{Scene, Shape, Vec3};
 
 /// The margin of the bound before the first cut, in LSB: the bound's
 /// rounding (under 2 LSB: `oc2` rounded, the products) and the exact
@@ -595,38 +595,20 @@ impl super::ChipPrimitive for Cylinder {
     }
 
     fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
-        match *shape {
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                ..
-            } => Geometry::Planars(caps(base, apex, base_radius.abs()).to_vec()),
-            _ => Geometry::None,
+        match shape.as_cone() {
+            Some(c) => Geometry::Planars(caps(c.base, c.apex, c.base_radius.abs()).to_vec()),
+            None => Geometry::None,
         }
     }
 
     fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
-        let cylinder = |o: &&crate::scene::Object| o.shape.prim_type() == PrimType::Cylinder;
-        let radii = scene
-            .objects
-            .iter()
-            .filter(cylinder)
-            .filter_map(|o| match o.shape {
-                Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
-                _ => None,
-            });
-        // Every cone-like object's base radius (cylinders' and cones').
-        let base_radii = scene.objects.iter().filter_map(|o| match o.shape {
-            Shape::Cone { base_radius, .. } => Some(base_radius.abs() * s),
-            _ => None,
-        });
+        // Every cone-like object (cylinders and cones), and the cylinders.
+        let cones = || scene.objects.iter().filter_map(|o| o.shape.as_cone());
+        let cylinders = || cones().filter(|c| c.base_radius == c.apex_radius);
+        let radii = cylinders().map(|c| c.base_radius.abs() * s);
+        let base_radii = cones().map(|c| c.base_radius.abs() * s);
         (fit.ks_cyl, fit.ep_cyl) = self::fit(radii, base_radii, f);
-        fit.cyl_inside = scene
-            .objects
-            .iter()
-            .filter(cylinder)
-            .any(|o| matches!(o.shape, Shape::Cone { inside: true, .. }));
+        fit.cyl_inside = cylinders().any(|c| c.inside);
     }
 
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
@@ -637,29 +619,18 @@ impl super::ChipPrimitive for Cylinder {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        let (
-            Shape::Cone {
-                base,
-                base_radius,
-                apex,
-                inside,
-                caps: on,
-                ..
-            },
-            Geometry::Planars(discs),
-        ) = (o.shape, o.geometry)
-        else {
+        let (Some(c), Geometry::Planars(discs)) = (o.shape.as_cone(), o.geometry) else {
             return Err(RecordError::mismatch("cylinder"));
         };
         write(
             w,
             o.fit,
             o.sides,
-            *base,
-            *apex,
-            *base_radius,
-            *inside,
-            o.caps.then_some((*on, &[discs[0], discs[1]])),
+            c.base,
+            c.apex,
+            c.base_radius,
+            c.inside,
+            o.caps.then_some((c.caps, &[discs[0], discs[1]])),
             o.id,
             o.mat,
         );

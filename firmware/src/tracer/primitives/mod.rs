@@ -5,7 +5,8 @@
 //! parameterised by the sides it accepts, the normals and the datapath),
 //! the TinyRISC code that broadcasts one object's test, and the math in
 //! its doc comment beside the error against the f64 shape of the same
-//! name in `tb/src/reference/shapes.rs` (measured by `tb/tests/kernels.rs`).
+//! name in `crate::scene::shape` (its `Surface::intersect`, measured by
+//! `tb/tests/kernels.rs`).
 //!
 //! | module | chip types | kernels |
 //! |---|---|---|
@@ -361,31 +362,24 @@ impl ChipType {
     /// The chip type of an object: its primitive's, with smooth triangles
     /// and transmitting (two-sided) objects apart.
     pub fn of_object(s: &Shape, transmits: bool) -> ChipType {
-        match s {
-            Shape::Triangle {
-                normals: Some(_), ..
-            } if transmits => ChipType::GlassSmoothTriangle,
-            Shape::Triangle {
-                normals: Some(_), ..
-            } => ChipType::SmoothTriangle,
-            Shape::Sphere { .. } if transmits => ChipType::GlassSphere,
-            Shape::Rectangle { .. } if transmits => ChipType::GlassRectangle,
-            Shape::Triangle { .. } if transmits => ChipType::GlassTriangle,
-            Shape::Polygon { .. } if transmits => ChipType::GlassPolygon,
-            Shape::Box { .. } if transmits => ChipType::GlassBox,
-            Shape::Cone { .. } if transmits && s.prim_type() == PrimType::Cylinder => {
-                ChipType::GlassCylinder
-            }
-            Shape::Cone { .. } if transmits => ChipType::GlassCone,
-            _ => match s.prim_type() {
-                PrimType::Sphere => ChipType::Sphere,
-                PrimType::Cylinder => ChipType::Cylinder,
-                PrimType::Cone => ChipType::Cone,
-                PrimType::Box => ChipType::Box,
-                PrimType::Rectangle => ChipType::Rectangle,
-                PrimType::Triangle => ChipType::Triangle,
-                PrimType::Polygon => ChipType::Polygon,
-            },
+        let smooth = s.as_triangle().is_some_and(|t| t.normals.is_some());
+        match (s.prim_type(), smooth, transmits) {
+            (PrimType::Triangle, true, true) => ChipType::GlassSmoothTriangle,
+            (PrimType::Triangle, true, false) => ChipType::SmoothTriangle,
+            (PrimType::Sphere, _, true) => ChipType::GlassSphere,
+            (PrimType::Rectangle, _, true) => ChipType::GlassRectangle,
+            (PrimType::Triangle, _, true) => ChipType::GlassTriangle,
+            (PrimType::Polygon, _, true) => ChipType::GlassPolygon,
+            (PrimType::Box, _, true) => ChipType::GlassBox,
+            (PrimType::Cylinder, _, true) => ChipType::GlassCylinder,
+            (PrimType::Cone, _, true) => ChipType::GlassCone,
+            (PrimType::Sphere, _, false) => ChipType::Sphere,
+            (PrimType::Cylinder, _, false) => ChipType::Cylinder,
+            (PrimType::Cone, _, false) => ChipType::Cone,
+            (PrimType::Box, _, false) => ChipType::Box,
+            (PrimType::Rectangle, _, false) => ChipType::Rectangle,
+            (PrimType::Triangle, _, false) => ChipType::Triangle,
+            (PrimType::Polygon, _, false) => ChipType::Polygon,
         }
     }
 

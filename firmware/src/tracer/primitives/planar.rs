@@ -1,6 +1,6 @@
 //! The planar primitives: rectangle, triangle and disc (the caps of
-//! cylinders and cones), in `tb/src/reference/shapes.rs`: `rectangle`,
-//! `triangle`, `disc`. The polygon and the smooth triangle start with the
+//! cylinders and cones), held to `scene/shape/rectangle.rs`,
+//! `triangle.rs` and the caps of `cone.rs`. The polygon and the smooth triangle start with the
 //! same plane test ([`plane_hit`]).
 //!
 //! **Record** (20 words): `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz,
@@ -375,19 +375,13 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
-        match *shape {
-            Shape::Rectangle {
-                corner,
-                edge1,
-                edge2,
-            } => Geometry::Planars(vec![Planar::rectangle(
-                corner,
-                edge1,
-                edge2,
-                edge1.cross(edge2).normalized(),
-            )]),
-            Shape::Triangle { v, .. } => Geometry::Planars(vec![flat_triangle(v)]),
-            _ => Geometry::None,
+        if let Some(r) = shape.as_rectangle() {
+            let n = r.edge1.cross(r.edge2).normalized();
+            Geometry::Planars(vec![Planar::rectangle(r.corner, r.edge1, r.edge2, n)])
+        } else if let Some(t) = shape.as_triangle() {
+            Geometry::Planars(vec![flat_triangle(t.v)])
+        } else {
+            Geometry::None
         }
     }
 

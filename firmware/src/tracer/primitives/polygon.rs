@@ -1,5 +1,5 @@
 //! Polygon, convex or concave, by the even-odd rule as the reference
-//! (`tb/src/reference/shapes.rs`: `polygon`), by the crossing test in
+//! (`scene/shape/polygon.rs`), by the crossing test in
 //! exact integer arithmetic: three kernels, the edge one run once per edge.
 //!
 //! **Record** (`1 + 15 + 5 fan + 5` words, `fan` the scene's largest
@@ -737,24 +737,25 @@ impl super::ChipPrimitive for Polygon {
     }
 
     fn cost_runs(&self, shape: &Shape, s: f64) -> usize {
-        match shape {
-            Shape::Polygon { v, .. } => edges(v, s).1.len(),
-            _ => 0,
-        }
+        shape.as_polygon().map_or(0, |p| edges(&p.v, s).1.len())
     }
 
     fn fan(&self, shape: &Shape, s: f64, banded: bool) -> usize {
-        match shape {
-            Shape::Polygon { v, .. } if banded => band_edges(&edges(v, s).1),
-            Shape::Polygon { v, .. } => edges(v, s).1.len(),
-            _ => 0,
+        let Some(p) = shape.as_polygon() else {
+            return 0;
+        };
+        let e = edges(&p.v, s).1;
+        if banded {
+            band_edges(&e)
+        } else {
+            e.len()
         }
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        let Shape::Polygon { v, .. } = o.shape else {
+        let Some(p) = o.shape.as_polygon() else {
             return Err(RecordError::mismatch("polygon"));
         };
-        write(w, v, o.size, o.fit.polygon_form, o.id, o.mat).map_err(RecordError::Scene)
+        write(w, &p.v, o.size, o.fit.polygon_form, o.id, o.mat).map_err(RecordError::Scene)
     }
 }

@@ -1,5 +1,5 @@
 //! A triangle with vertex normals (NFF `pp`), shaded smoothly as the
-//! reference shades it (`tb/src/reference/shapes.rs`: `triangle`, with
+//! reference shades it (`scene/shape/triangle.rs`, with
 //! the interpolated shading normal).
 //!
 //! **Record** (29 words): `n.xyz, v0.xyz, v0.xyz, eu.xyz, ew.xyz, (n0, n1,
@@ -220,9 +220,9 @@ impl super::ChipPrimitive for SmoothTriangle {
     }
 
     fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
-        match *shape {
-            Shape::Triangle { v, .. } => Geometry::Planars(vec![planar::flat_triangle(v)]),
-            _ => Geometry::None,
+        match shape.as_triangle() {
+            Some(t) => Geometry::Planars(vec![planar::flat_triangle(t.v)]),
+            None => Geometry::None,
         }
     }
 
@@ -236,13 +236,10 @@ impl super::ChipPrimitive for SmoothTriangle {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        let (
-            Shape::Triangle {
-                normals: Some(ns), ..
-            },
-            [p],
-        ) = (o.shape, o.geometry.planars())
-        else {
+        let (Some(ns), [p]) = (
+            o.shape.as_triangle().and_then(|t| t.normals.as_ref()),
+            o.geometry.planars(),
+        ) else {
             return Err(RecordError::mismatch("smooth triangle"));
         };
         write(w, &o.fit.kt, p, *ns, o.id, o.mat);

@@ -1,4 +1,4 @@
-//! Sphere (`tb/src/reference/shapes.rs`: `sphere`).
+//! Sphere (`scene/shape/sphere.rs`).
 //!
 //! **Record** (8 words): `c.xyz, invr, r, sg, obj, mat`, with `invr =
 //! 2^(14+KS_SPHERE) / r` (scene LSBs) and `sg` = +1 (Q1.14) for a sphere
@@ -40,7 +40,7 @@ use super::super::math::{perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::record::{Fitter, W};
 use super::{self_margin, CutTest, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
-use crate::scene::{Scene, Shape, Vec3};
+use crate::scene::{Scene, Vec3};
 
 /// Record words, coarse and fine.
 pub const WORDS: usize = 8;
@@ -316,15 +316,10 @@ impl super::ChipPrimitive for Sphere {
     }
 
     fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
-        let radii = scene.objects.iter().filter_map(|o| match o.shape {
-            Shape::Sphere { radius, .. } => Some(radius.abs() * s),
-            _ => None,
-        });
+        let spheres = || scene.objects.iter().filter_map(|o| o.shape.as_sphere());
+        let radii = spheres().map(|sp| sp.radius.abs() * s);
         (fit.ks_sphere, fit.ep_sphere, fit.sphere_fine) = self::fit(radii, f);
-        fit.sphere_inside = scene
-            .objects
-            .iter()
-            .any(|o| matches!(o.shape, Shape::Sphere { inside: true, .. }));
+        fit.sphere_inside = spheres().any(|sp| sp.inside);
     }
 
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
@@ -332,15 +327,19 @@ impl super::ChipPrimitive for Sphere {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        let Shape::Sphere {
-            center,
-            radius,
-            inside,
-        } = *o.shape
-        else {
+        let Some(sp) = o.shape.as_sphere() else {
             return Err(RecordError::mismatch("sphere"));
         };
-        write(w, o.fit, o.unrounded, center, radius, inside, o.id, o.mat);
+        write(
+            w,
+            o.fit,
+            o.unrounded,
+            sp.center,
+            sp.radius,
+            sp.inside,
+            o.id,
+            o.mat,
+        );
         Ok(())
     }
 }
