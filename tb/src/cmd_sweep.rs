@@ -921,7 +921,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
             ..Default::default()
         };
         let inputs = crate::inputs::inputs(scene, &c.timing, None);
-        let earlier = crate::cmd_render::render_json(&json_path, &argv, &inputs);
+        let earlier = crate::render::render_json(&json_path, &argv, &inputs);
         if let Err(why) = &earlier {
             if why.starts_with("made before") {
                 bar.suspend(|| eprintln!("{name}: {why}: rendering again"));
@@ -931,7 +931,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
             count(&resumed);
             return Ok(j);
         }
-        crate::cmd_render::render(scene, &c.opt, &host).and_then(|(chip, mut rep)| {
+        crate::render::render(scene, &c.opt, &host).and_then(|(chip, mut rep)| {
             rep.json["argv"] = argv.clone().into();
             rep.json["inputs"] = inputs.clone();
             crate::output::write(

@@ -3,8 +3,8 @@
 
 use firmware::tracer::Options;
 use rtl::trace::TraceConfig;
-use tb::cmd_render::render;
 use tb::cmd_scene::load_scene;
+use tb::render::render;
 
 fn in_pool<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
     rayon::ThreadPoolBuilder::new()

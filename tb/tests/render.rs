@@ -8,7 +8,7 @@ use std::path::PathBuf;
 
 use firmware::scene::Scene;
 use firmware::tracer::Options;
-use tb::cmd_render::render;
+use tb::render::render;
 
 fn scene_path(name: &str) -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
@@ -468,7 +468,7 @@ fn the_32_bit_chip_renders_the_small_scenes_closer_to_the_reference() {
         let (_, r16) = render(&scene, &o16, &Default::default()).unwrap();
         let (c32, r32) = render(&scene, &o32, &Default::default()).unwrap();
         assert_eq!(c32.firmware.datapath, Datapath::W32);
-        let f = |r: &tb::cmd_render::RenderReport, k: &str| r.json[k].as_f64().unwrap();
+        let f = |r: &tb::render::RenderReport, k: &str| r.json[k].as_f64().unwrap();
         let (p16, p32) = (f(&r16, "psnr_db"), f(&r32, "psnr_db"));
         let (h16, h32) = (f(&r16, "hit_agreement"), f(&r32, "hit_agreement"));
         eprintln!(
@@ -743,7 +743,7 @@ fn every_table_size_reaches_every_kernel() {
             table_entries,
             ..Numerics::default()
         };
-        let (_, rep) = tb::cmd_render::render(
+        let (_, rep) = tb::render::render(
             &scene,
             &opts(64, 64),
             &tb::render::RenderSettings {

@@ -18,7 +18,7 @@ use std::path::PathBuf;
 
 use firmware::scene::Scene;
 use firmware::tracer::Options;
-use tb::cmd_render::render;
+use tb::render::render;
 
 fn check(name: &str) {
     check_on(name, rtl::rc::Datapath::W16);

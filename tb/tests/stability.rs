@@ -11,7 +11,7 @@
 
 use firmware::scene::{native, Scene};
 use firmware::tracer::Options;
-use tb::cmd_render::render;
+use tb::render::render;
 
 const HEAD: &str = r#"
 background = [0.1, 0.1, 0.2]

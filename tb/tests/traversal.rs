@@ -277,7 +277,7 @@ fn a_leaf_larger_than_the_bank_is_streamed_in_pieces() {
     let scene = Scene::load(&path).unwrap();
     let mut o = opts(8, 8, Traversal::Packet);
     o.bsp.max_depth = 1;
-    let (chip, rep) = tb::cmd_render::render(&scene, &o, &Default::default()).unwrap();
+    let (chip, rep) = tb::render::render(&scene, &o, &Default::default()).unwrap();
     let st = chip.firmware.layout.stream.as_ref().expect("streamed");
     assert!(st.extra_pieces >= 2, "{} extra pieces", st.extra_pieces);
     assert!(st.largest_block <= firmware::tracer::layout::STREAM_BANK);

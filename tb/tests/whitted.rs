@@ -243,7 +243,7 @@ fn smooth_shading_of_a_pp_mesh() {
         height: 96,
         ..Default::default()
     };
-    let (_, smooth) = tb::cmd_render::render(&scene, &opt, &Default::default()).unwrap();
+    let (_, smooth) = tb::render::render(&scene, &opt, &Default::default()).unwrap();
     let psnr_smooth = smooth.json["psnr_db"].as_f64().unwrap();
     assert_eq!(smooth.json["warnings"].as_array().map(|w| w.len()), Some(0));
     let mut flat = scene.clone();
@@ -254,7 +254,7 @@ fn smooth_shading_of_a_pp_mesh() {
             *normals = None;
         }
     }
-    let (chip_flat, _) = tb::cmd_render::render(&flat, &opt, &Default::default()).unwrap();
+    let (chip_flat, _) = tb::render::render(&flat, &opt, &Default::default()).unwrap();
     let psnr_flat = tb::metrics::psnr(&chip_flat.rgb8, &smooth.reference_rgb8);
     eprintln!("torus-pp 96x96: smooth {psnr_smooth:.2} dB, face normals {psnr_flat:.2} dB");
     assert!(psnr_smooth >= 33.0, "smooth: {psnr_smooth:.2} dB");

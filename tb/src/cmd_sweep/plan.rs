@@ -311,7 +311,7 @@ pub fn merge(dir: &Path, out_dir: &Path) -> Result<()> {
         let argv = render_argv(pdir, &plan.scene[p.scene].file, &p.cfg, &job.name);
         let json = dir.join("points").join(format!("{}.json", job.name));
         let inputs = crate::inputs::inputs(&scenes[p.scene], &p.cfg.timing, None);
-        let j = match crate::cmd_render::render_json(&json, &argv, &inputs) {
+        let j = match crate::render::render_json(&json, &argv, &inputs) {
             Ok(j) => Some(j),
             Err(why) => {
                 missing.push(format!("{} ({why})", job.name));

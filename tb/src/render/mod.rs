@@ -22,6 +22,7 @@ use rtl::{Stats, Timing};
 use crate::reference::NO_HIT;
 
 mod item;
+mod measure;
 mod probe;
 mod source;
 
@@ -30,6 +31,8 @@ pub(crate) use crate::autotune::choose_firmware_probed;
 pub use item::TRACED_TILES;
 use item::{add_stats, leaf_watch, run_item, run_items, Frame};
 pub(crate) use item::{work_items, MAX_CYCLES_PER_TILE};
+pub use measure::{render, RenderReport};
+pub(crate) use measure::{render_and_measure, render_json};
 pub(crate) use probe::faster;
 pub use probe::{probe, ProbeRender};
 pub(crate) use source::{firmware_from_source, source_datapath};
