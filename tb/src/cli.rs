@@ -169,14 +169,6 @@ pub(crate) fn parse_table_entries(s: &str) -> Result<u32, String> {
     }
 }
 
-pub(crate) fn parse_normals(s: &str) -> Result<firmware::tracer::Normals, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_layout(s: &str) -> Result<firmware::tracer::NodeLayout, String> {
-    s.parse()
-}
-
 /// `--ways`: 4, 8, 16, 32 or 64 rays in flight (a tile of 2x2 .. 8x8).
 pub(crate) fn parse_ways(s: &str) -> Result<u32, String> {
     match s.parse::<u32>() {
@@ -196,34 +188,6 @@ pub(crate) fn parse_depth(s: &str) -> Result<u32, String> {
             firmware::scene_image::MAX_BSP_DEPTH
         )),
     }
-}
-
-pub(crate) fn parse_collapse(s: &str) -> Result<firmware::tracer::Collapse, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_leaf_pieces(s: &str) -> Result<firmware::tracer::LeafPieces, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_shadow_packets(s: &str) -> Result<firmware::tracer::ShadowPackets, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_sub_edges(s: &str) -> Result<firmware::tracer::SubEdges, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_test_cuts(s: &str) -> Result<firmware::tracer::TestCuts, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_child_order(s: &str) -> Result<firmware::tracer::ChildOrder, String> {
-    s.parse()
-}
-
-pub(crate) fn parse_traversal(s: &str) -> Result<firmware::tracer::Traversal, String> {
-    s.parse()
 }
 
 /// The largest image side any command renders (host memory grows with the

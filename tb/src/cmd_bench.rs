@@ -56,7 +56,7 @@ pub struct BenchArgs {
     /// median BSP, the simulator's workload since the first bench) or
     /// packet (what `render` runs by default, its BSP chosen as `render`
     /// chooses it).
-    #[arg(long, value_name = "paper|packet", default_value = "paper", value_parser = crate::cli::parse_traversal)]
+    #[arg(long, value_name = "paper|packet", default_value = "paper")]
     pub traversal: firmware::tracer::Traversal,
     /// Also run `morphosys sweep` of these scenes (comma-separated; its
     /// knobs and its size sweep of the SPD families) on one thread and on

@@ -63,18 +63,18 @@ pub struct RenderArgs {
     pub split: String,
     /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
     /// or compact (index lists); the same image either way.
-    #[arg(long, value_name = "fig5|compact", default_value = "fig5", value_parser = crate::cli::parse_layout)]
+    #[arg(long, value_name = "fig5|compact", default_value = "fig5")]
     pub layout: firmware::tracer::NodeLayout,
     /// BSP traversal: paper (the paper's: where the rays disagree, test
     /// every object under the node) or packet (per-ray intervals; a
     /// child is visited only by the rays that reach it).
-    #[arg(long, value_name = "packet|paper", default_value = "packet", value_parser = crate::cli::parse_traversal)]
+    #[arg(long, value_name = "packet|paper", default_value = "packet")]
     pub traversal: firmware::tracer::Traversal,
     /// Packet traversal: which BSP subtrees to walk as one leaf of all
     /// their objects: auto (where that costs less than walking them, by
     /// the cells' surface areas and the kernels' lengths) or N (those
     /// with at most N objects; 0: none).
-    #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_collapse)]
+    #[arg(long, value_name = "auto|N", default_value = "auto")]
     pub collapse: firmware::tracer::Collapse,
     /// Streamed packet traversal: the words of the pieces a leaf's records
     /// are moved in by DMA, FIRST,SECOND,REST (or FIRST,REST: the second
@@ -85,7 +85,7 @@ pub struct RenderArgs {
     /// <= SECOND <= REST, a piece holds at least one record. SECOND auto
     /// (`auto` = 64,auto,256): 2 x FIRST or REST, whichever runs the probe
     /// faster.
-    #[arg(long, value_name = "auto|FIRST,[SECOND,]REST", default_value = "auto", value_parser = crate::cli::parse_leaf_pieces)]
+    #[arg(long, value_name = "auto|FIRST,[SECOND,]REST", default_value = "auto")]
     pub leaf_pieces: firmware::tracer::LeafPieces,
     /// Packet traversal: the shadow rays of the reflection levels (depth 2
     /// and more): light (a packet per light, the rays in the RCs that
@@ -93,7 +93,7 @@ pub struct RenderArgs {
     /// packets as hold them, the answers moved back; scenes of 2 to 12
     /// lights) or auto (both run on a probe of the frame, the faster
     /// kept). The eye rays' level keeps a packet per light.
-    #[arg(long, value_name = "auto|light|merged", default_value = "auto", value_parser = crate::cli::parse_shadow_packets)]
+    #[arg(long, value_name = "auto|light|merged", default_value = "auto")]
     pub shadow_packets: firmware::tracer::ShadowPackets,
     /// Streamed packet traversal: where a banded polygon's sub-edges are
     /// (polygons of 16 edges or more): apart (where a record would be
@@ -101,7 +101,7 @@ pub struct RenderArgs {
     /// packet's points lie in moved by DMA once they are known) or records
     /// (in the record, moved with every leaf piece that holds it, as the
     /// resident layout keeps them). The same image.
-    #[arg(long, value_name = "apart|records", default_value = "apart", value_parser = crate::cli::parse_sub_edges)]
+    #[arg(long, value_name = "apart|records", default_value = "apart")]
     pub sub_edges: firmware::tracer::SubEdges,
     /// Packet traversal: run each object test in parts, at the cuts of its
     /// kernels, the rest skipped where no awake ray can still hit the
@@ -110,7 +110,7 @@ pub struct RenderArgs {
     /// part after a status read), off (whole), or auto (on; tinyrisc
     /// under the timing's instruction issue model, where TinyRISC issues
     /// every context itself). The same image every way.
-    #[arg(long, value_name = "auto|on|tinyrisc|off", default_value = "auto", value_parser = crate::cli::parse_test_cuts)]
+    #[arg(long, value_name = "auto|on|tinyrisc|off", default_value = "auto")]
     pub test_cuts: firmware::tracer::TestCuts,
     /// Packet traversal: which child of a node a packet visits first where
     /// its awake rays go both ways along the node's axis: majority (the
@@ -122,7 +122,7 @@ pub struct RenderArgs {
     /// go, kept where faster than majority on a probe of the frame; then
     /// each closest-hit axis left to the majority tried on the probe with
     /// the way its sampled rays that hit lean). The same image either way.
-    #[arg(long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto", value_parser = crate::cli::parse_child_order)]
+    #[arg(long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto")]
     pub child_order: firmware::tracer::ChildOrder,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
     /// variant the paper announces; every format gets 16 more fraction
@@ -154,7 +154,7 @@ pub struct RenderArgs {
     /// per cylinder test), coarse (the kernels as first written, with
     /// which the comparison with the paper was made) or auto (fine on
     /// the 16-bit chip, coarse on the 32-bit one)
-    #[arg(long, value_name = "auto|fine|coarse", default_value = "auto", value_parser = crate::cli::parse_normals)]
+    #[arg(long, value_name = "auto|fine|coarse", default_value = "auto")]
     pub normals: firmware::tracer::Normals,
     /// With --json: when that file already holds a complete render made
     /// with these same arguments from the same scene, timing file,

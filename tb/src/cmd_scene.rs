@@ -251,7 +251,7 @@ pub struct CompileArgs {
     /// How BSP nodes name their objects: fig5 (the paper's bit
     /// vectors) or compact (index lists), as `render --layout`
     /// (default: the smaller).
-    #[arg(long, value_name = "fig5|compact", value_parser = crate::cli::parse_layout)]
+    #[arg(long, value_name = "fig5|compact")]
     pub layout: Option<firmware::tracer::NodeLayout>,
 }
 

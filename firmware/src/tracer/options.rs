@@ -17,6 +17,60 @@ pub use rtl::rc::Datapath;
 /// kernel then rejects it (balls-4: 3 LSB cost 2 dB).
 pub const EPS_LSB: i32 = 0;
 
+/// A fieldless option type from one list of its values and their
+/// spellings: the enum, `ALL`, `name()`, and the `Display` and `FromStr`
+/// the command line and the JSON use (a bad spelling names the option and
+/// every value).
+macro_rules! spelled {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident ($what:literal) {
+            $($(#[$vmeta:meta])* $variant:ident = $text:literal,)*
+        }
+    ) => {
+        $(#[$meta])*
+        pub enum $name {
+            $($(#[$vmeta])* $variant,)*
+        }
+
+        impl $name {
+            /// Every value, in the order the help lists them.
+            pub const ALL: [$name; [$($text,)*].len()] = [$($name::$variant,)*];
+
+            /// Its spelling on the command line and in the JSON.
+            pub fn name(self) -> &'static str {
+                match self {
+                    $($name::$variant => $text,)*
+                }
+            }
+        }
+
+        impl std::fmt::Display for $name {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                f.write_str(self.name())
+            }
+        }
+
+        impl std::str::FromStr for $name {
+            type Err = String;
+            fn from_str(s: &str) -> Result<Self, String> {
+                $name::ALL.into_iter().find(|v| v.name() == s).ok_or_else(|| {
+                    format!("{} '{s}': expected {}", $what, spellings(&[$($text,)*]))
+                })
+            }
+        }
+    };
+}
+
+/// `a, b or c`.
+fn spellings(names: &[&str]) -> String {
+    match names {
+        [] => String::new(),
+        [one] => one.to_string(),
+        [init @ .., last] => format!("{} or {last}", init.join(", ")),
+    }
+}
+
 /// Generator options.
 #[derive(Clone, Copy, Debug)]
 pub struct Options {
@@ -62,37 +116,19 @@ pub struct Options {
     pub sub_edges: SubEdges,
 }
 
-/// Streamed packet traversal: where a banded polygon's sub-edges are
-/// (`primitives::polygon::Form`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum SubEdges {
-    /// In main memory apart from the record where a record would be
-    /// over [`super::primitives::polygon::APART_FROM`] words, a packet's bands
-    /// of them moved by DMA once its points are known.
-    #[default]
-    Apart,
-    /// In the record, moved with every leaf piece that holds it (the
-    /// resident layout's form).
-    InRecords,
-}
-
-impl std::fmt::Display for SubEdges {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            SubEdges::Apart => "apart",
-            SubEdges::InRecords => "records",
-        })
-    }
-}
-
-impl std::str::FromStr for SubEdges {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "apart" => Ok(SubEdges::Apart),
-            "records" => Ok(SubEdges::InRecords),
-            _ => Err(format!("sub-edges '{s}': expected apart or records")),
-        }
+spelled! {
+    /// Streamed packet traversal: where a banded polygon's sub-edges are
+    /// (`primitives::polygon::Form`).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+    pub enum SubEdges ("sub-edges") {
+        /// In main memory apart from the record where a record would be
+        /// over [`super::primitives::polygon::APART_FROM`] words, a packet's bands
+        /// of them moved by DMA once its points are known.
+        #[default]
+        Apart = "apart",
+        /// In the record, moved with every leaf piece that holds it (the
+        /// resident layout's form).
+        InRecords = "records",
     }
 }
 
@@ -121,23 +157,25 @@ impl Default for Options {
     }
 }
 
-/// Packet traversal: whether an object test runs in parts at its kernels'
-/// cuts ([`super::primitives::CutTest`]), the rest skipped where no awake ray can
-/// still hit the object, and who skips it: the broadcast unit, at a `cut`
-/// context in the kernel's run (`on`), or TinyRISC, which broadcasts each
-/// part after a status read (`tinyrisc`); or whole (`off`). `auto` (the
-/// default) is `on` under the run issue model and `tinyrisc` under the M1
-/// chip's instruction issue, where TinyRISC issues every context itself
-/// and would be held for the contexts a cut skips
-/// ([`TestCuts::for_issue`]; the firmware built without a timing takes
-/// `on`). The same image every way.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum TestCuts {
-    #[default]
-    Auto,
-    On,
-    Tinyrisc,
-    Off,
+spelled! {
+    /// Packet traversal: whether an object test runs in parts at its kernels'
+    /// cuts ([`super::primitives::CutTest`]), the rest skipped where no awake ray can
+    /// still hit the object, and who skips it: the broadcast unit, at a `cut`
+    /// context in the kernel's run (`on`), or TinyRISC, which broadcasts each
+    /// part after a status read (`tinyrisc`); or whole (`off`). `auto` (the
+    /// default) is `on` under the run issue model and `tinyrisc` under the M1
+    /// chip's instruction issue, where TinyRISC issues every context itself
+    /// and would be held for the contexts a cut skips
+    /// ([`TestCuts::for_issue`]; the firmware built without a timing takes
+    /// `on`). The same image every way.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum TestCuts ("test cuts") {
+        #[default]
+        Auto = "auto",
+        On = "on",
+        Tinyrisc = "tinyrisc",
+        Off = "off",
+    }
 }
 
 impl TestCuts {
@@ -158,32 +196,6 @@ impl TestCuts {
     /// The kernels hold `cut` contexts (`on`, and `auto` unresolved).
     pub fn cut_contexts(self) -> bool {
         matches!(self, TestCuts::On | TestCuts::Auto)
-    }
-}
-
-impl std::fmt::Display for TestCuts {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            TestCuts::Auto => "auto",
-            TestCuts::On => "on",
-            TestCuts::Tinyrisc => "tinyrisc",
-            TestCuts::Off => "off",
-        })
-    }
-}
-
-impl std::str::FromStr for TestCuts {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(TestCuts::Auto),
-            "on" => Ok(TestCuts::On),
-            "tinyrisc" => Ok(TestCuts::Tinyrisc),
-            "off" => Ok(TestCuts::Off),
-            _ => Err(format!(
-                "test cuts '{s}': expected auto, on, tinyrisc or off"
-            )),
-        }
     }
 }
 
@@ -376,88 +388,40 @@ mod leaf_pieces_tests {
     }
 }
 
-/// How the 64 rays of a packet walk the BSP tree (`docs/tracer.md`,
-/// "Traversal").
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum Traversal {
-    /// The paper's: the packet's segments `[o, o + tbest d]` are classified
-    /// against each split plane; where the rays disagree, every object
-    /// under the node is tested (resident) or both children are visited
-    /// with every ray awake (streamed).
-    Paper,
-    /// Masked packet traversal: each ray keeps its parametric interval
-    /// inside the current cell; a child is visited only by the rays whose
-    /// interval reaches it (the others sleep), near child first, the far
-    /// child pushed with every ray's interval; a ray whose hit lies before
-    /// a popped cell drops out. The default.
-    #[default]
-    Packet,
-}
-
-impl Traversal {
-    pub const ALL: [Traversal; 2] = [Traversal::Paper, Traversal::Packet];
-    pub fn name(self) -> &'static str {
-        match self {
-            Traversal::Paper => "paper",
-            Traversal::Packet => "packet",
-        }
+spelled! {
+    /// How the 64 rays of a packet walk the BSP tree (`docs/tracer.md`,
+    /// "Traversal").
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum Traversal ("traversal") {
+        /// The paper's: the packet's segments `[o, o + tbest d]` are classified
+        /// against each split plane; where the rays disagree, every object
+        /// under the node is tested (resident) or both children are visited
+        /// with every ray awake (streamed).
+        Paper = "paper",
+        /// Masked packet traversal: each ray keeps its parametric interval
+        /// inside the current cell; a child is visited only by the rays whose
+        /// interval reaches it (the others sleep), near child first, the far
+        /// child pushed with every ray's interval; a ray whose hit lies before
+        /// a popped cell drops out. The default.
+        #[default]
+        Packet = "packet",
     }
 }
 
-impl std::fmt::Display for Traversal {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for Traversal {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        Traversal::ALL
-            .into_iter()
-            .find(|t| t.name() == s)
-            .ok_or_else(|| format!("unknown traversal '{s}': expected paper or packet"))
-    }
-}
-
-/// How the BSP nodes of the resident layout name the objects under them
-/// (`layout.rs`; the streamed layout has no per-node object sets, only
-/// per-leaf lists, whichever is chosen).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum NodeLayout {
-    /// The paper's Fig. 5: per node, per type present, a membership bit
-    /// vector over all objects of that type, walked by the Fig. 6 loop.
-    #[default]
-    Fig5,
-    /// Per node, per type present, a count and the ascending slot indices
-    /// of the node's objects of that type (the set bits of the Fig. 5
-    /// vector, as a list): the same objects in the same order.
-    Compact,
-}
-
-impl NodeLayout {
-    pub const ALL: [NodeLayout; 2] = [NodeLayout::Fig5, NodeLayout::Compact];
-    pub fn name(self) -> &'static str {
-        match self {
-            NodeLayout::Fig5 => "fig5",
-            NodeLayout::Compact => "compact",
-        }
-    }
-}
-
-impl std::fmt::Display for NodeLayout {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for NodeLayout {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        NodeLayout::ALL
-            .into_iter()
-            .find(|l| l.name() == s)
-            .ok_or_else(|| format!("unknown node layout '{s}': expected fig5 or compact"))
+spelled! {
+    /// How the BSP nodes of the resident layout name the objects under them
+    /// (`layout.rs`; the streamed layout has no per-node object sets, only
+    /// per-leaf lists, whichever is chosen).
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum NodeLayout ("node layout") {
+        /// The paper's Fig. 5: per node, per type present, a membership bit
+        /// vector over all objects of that type, walked by the Fig. 6 loop.
+        #[default]
+        Fig5 = "fig5",
+        /// Per node, per type present, a count and the ascending slot indices
+        /// of the node's objects of that type (the set bits of the Fig. 5
+        /// vector, as a list): the same objects in the same order.
+        Compact = "compact",
     }
 }
 
@@ -480,23 +444,25 @@ pub struct Numerics {
     pub normals: Normals,
 }
 
-/// Normals of spheres and cylinders. Fine: the eye on the coordinate
-/// format's grid (the scene moved by less than an LSB), and the sphere
-/// and cylinder tests' perpendicular vector formed from unrounded
-/// quantities and made perpendicular to the ray
-/// ([`super::primitives::sphere::kernel`], [`super::primitives::cylinder::kernel`]): 9 more cycles per
-/// sphere test, 19 per cylinder test. Coarse: the kernels as first
-/// written (the cycle counts the comparison with the paper was made
-/// with). Auto: fine on the 16-bit chip, whose accuracy they decide
-/// (jacks-2: 29.5 to 33.2 dB), coarse on the 32-bit chip, whose 16 more
-/// fraction bits leave nothing to gain that shows (jacks-2: 56.0 dB
-/// coarse, 66.6 fine, for 5% of the frame rate).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum Normals {
-    #[default]
-    Auto,
-    Fine,
-    Coarse,
+spelled! {
+    /// Normals of spheres and cylinders. Fine: the eye on the coordinate
+    /// format's grid (the scene moved by less than an LSB), and the sphere
+    /// and cylinder tests' perpendicular vector formed from unrounded
+    /// quantities and made perpendicular to the ray
+    /// ([`super::primitives::sphere::kernel`], [`super::primitives::cylinder::kernel`]): 9 more cycles per
+    /// sphere test, 19 per cylinder test. Coarse: the kernels as first
+    /// written (the cycle counts the comparison with the paper was made
+    /// with). Auto: fine on the 16-bit chip, whose accuracy they decide
+    /// (jacks-2: 29.5 to 33.2 dB), coarse on the 32-bit chip, whose 16 more
+    /// fraction bits leave nothing to gain that shows (jacks-2: 56.0 dB
+    /// coarse, 66.6 fine, for 5% of the frame rate).
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+    pub enum Normals ("normals") {
+        #[default]
+        Auto = "auto",
+        Fine = "fine",
+        Coarse = "coarse",
+    }
 }
 
 impl Normals {
@@ -506,26 +472,6 @@ impl Normals {
             Normals::Auto => datapath == rtl::rc::Datapath::W16,
             Normals::Fine => true,
             Normals::Coarse => false,
-        }
-    }
-
-    pub fn name(self) -> &'static str {
-        match self {
-            Normals::Auto => "auto",
-            Normals::Fine => "fine",
-            Normals::Coarse => "coarse",
-        }
-    }
-}
-
-impl std::str::FromStr for Normals {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Normals, String> {
-        match s {
-            "auto" => Ok(Normals::Auto),
-            "fine" => Ok(Normals::Fine),
-            "coarse" => Ok(Normals::Coarse),
-            _ => Err(format!("expected auto, fine or coarse, found '{s}'")),
         }
     }
 }
@@ -552,43 +498,21 @@ impl Default for Numerics {
     }
 }
 
-/// How the shadow rays of the reflection levels are packed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
-pub enum ShadowPackets {
-    /// `render` runs both on a probe of the frame and keeps the faster;
-    /// a build without a probe ([`super::build`]) packs a packet per light.
-    #[default]
-    Auto,
-    /// One packet per light at every level: the rays stay in the RCs that
-    /// spawned them (the paper's).
-    PerLight,
-    /// From the first reflection level on, the rays of all the lights
-    /// packed into as few packets as hold them (packet traversal, 2 to
-    /// [`super::shadows::MAX_LIGHTS`] lights).
-    Merged,
-}
-
-impl std::fmt::Display for ShadowPackets {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            ShadowPackets::Auto => "auto",
-            ShadowPackets::PerLight => "light",
-            ShadowPackets::Merged => "merged",
-        })
-    }
-}
-
-impl std::str::FromStr for ShadowPackets {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        match s {
-            "auto" => Ok(ShadowPackets::Auto),
-            "light" => Ok(ShadowPackets::PerLight),
-            "merged" => Ok(ShadowPackets::Merged),
-            _ => Err(format!(
-                "shadow packets '{s}': expected auto, light or merged"
-            )),
-        }
+spelled! {
+    /// How the shadow rays of the reflection levels are packed.
+    #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+    pub enum ShadowPackets ("shadow packets") {
+        /// `render` runs both on a probe of the frame and keeps the faster;
+        /// a build without a probe ([`super::build`]) packs a packet per light.
+        #[default]
+        Auto = "auto",
+        /// One packet per light at every level: the rays stay in the RCs that
+        /// spawned them (the paper's).
+        PerLight = "light",
+        /// From the first reflection level on, the rays of all the lights
+        /// packed into as few packets as hold them (packet traversal, 2 to
+        /// [`super::shadows::MAX_LIGHTS`] lights).
+        Merged = "merged",
     }
 }
 
