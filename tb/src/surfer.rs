@@ -23,7 +23,7 @@
 
 use std::fmt::Write;
 
-use rtl::rc::context::{Context, Op, ALL_CONDS, ALL_OPS};
+use rtl::rc::context::{Context, Form, Op, ALL_CONDS, ALL_OPS};
 use rtl::tinyrisc::decode::{Format, ALL_OPCODES};
 
 /// One format of a decoder file: its name, type, template and
@@ -298,157 +298,134 @@ pub(crate) fn context_toml() -> String {
         Vec<Op>,
         Option<bool>,
     );
-    use Op::*;
-    let binary: Vec<Op> = ALL_OPS
-        .iter()
-        .copied()
-        .filter(|o| {
-            !matches!(
-                o,
-                Nop | Sleep
-                    | Wake
-                    | Cmp
-                    | St
-                    | Ld
-                    | Not
-                    | Mov
-                    | Abs
-                    | Neg
-                    | Clz
-                    | Movb
-                    | Acc
-                    | Acch
-                    | Accl
-                    | Ldacc
-                    | Mul
-                    | Mac
-                    | Msu
-            )
-        })
-        .collect();
-    let classes: Vec<Class> = vec![
+    // Per operand form, its formats: (format, type, template, operand-B
+    // form). The operations of each are the table's of that form.
+    type Formats = &'static [(&'static str, &'static str, &'static str, Option<bool>)];
+    let forms: [(Form, Formats); 11] = [
+        (Form::None, &[("c_none", "ri", "%guard%$name$", None)]),
         (
-            "c_none",
-            "ri",
-            "%guard%$name$",
-            vec![Nop, Sleep, Wake],
-            None,
+            Form::Compare,
+            &[
+                (
+                    "c_cmp_r",
+                    "cmp_r",
+                    "%guard%$name$.%cond% %a%, r%rb%",
+                    Some(false),
+                ),
+                (
+                    "c_cmp_i",
+                    "cmp_i",
+                    "%guard%$name$.%cond% %a%, #%imm%",
+                    Some(true),
+                ),
+            ],
         ),
         (
-            "c_cmp_r",
-            "cmp_r",
-            "%guard%$name$.%cond% %a%, r%rb%",
-            vec![Cmp],
-            Some(false),
+            Form::Store,
+            &[
+                ("c_st_r", "rr", "%guard%$name$ %a%, [r%rb%]", Some(false)),
+                ("c_st_i", "ri", "%guard%$name$ %a%, [#%imm%]", Some(true)),
+            ],
         ),
         (
-            "c_cmp_i",
-            "cmp_i",
-            "%guard%$name$.%cond% %a%, #%imm%",
-            vec![Cmp],
-            Some(true),
+            Form::Load,
+            &[
+                (
+                    "c_ld_r",
+                    "rr",
+                    "%guard%$name$ %d%, [%a% + r%rb%]",
+                    Some(false),
+                ),
+                (
+                    "c_ld_i",
+                    "ri",
+                    "%guard%$name$ %d%, [%a% + #%imm%]",
+                    Some(true),
+                ),
+            ],
         ),
         (
-            "c_st_r",
-            "rr",
-            "%guard%$name$ %a%, [r%rb%]",
-            vec![St],
-            Some(false),
+            Form::Unary,
+            &[("c_unary", "ri", "%guard%$name$ %d%, %a%", None)],
         ),
         (
-            "c_st_i",
-            "ri",
-            "%guard%$name$ %a%, [#%imm%]",
-            vec![St],
-            Some(true),
+            Form::MoveB,
+            &[
+                ("c_movb_r", "rr", "%guard%$name$ %d%, r%rb%", Some(false)),
+                ("c_movb_i", "ri", "%guard%$name$ %d%, #%imm%", Some(true)),
+            ],
         ),
         (
-            "c_ld_r",
-            "rr",
-            "%guard%$name$ %d%, [%a% + r%rb%]",
-            vec![Ld],
-            Some(false),
+            Form::AccRead,
+            &[
+                ("c_acc_r", "rr", "%guard%$name$%t% %d%%sh%", Some(false)),
+                ("c_acc_i", "ri", "%guard%$name$ %d%", Some(true)),
+            ],
         ),
         (
-            "c_ld_i",
-            "ri",
-            "%guard%$name$ %d%, [%a% + #%imm%]",
-            vec![Ld],
-            Some(true),
+            Form::AccPart,
+            &[("c_accp", "ri", "%guard%$name$ %d%", None)],
         ),
         (
-            "c_unary",
-            "ri",
-            "%guard%$name$ %d%, %a%",
-            vec![Not, Mov, Abs, Neg, Clz],
-            None,
+            Form::AccLoad,
+            &[
+                (
+                    "c_ldacc_r",
+                    "ldacc_r",
+                    "%guard%$name$%t% %a%%lsh%",
+                    Some(false),
+                ),
+                ("c_ldacc_i", "ri", "%guard%$name$ %a%", Some(true)),
+            ],
         ),
         (
-            "c_movb_r",
-            "rr",
-            "%guard%$name$ %d%, r%rb%",
-            vec![Movb],
-            Some(false),
+            Form::Binary,
+            &[
+                (
+                    "c_bin_r",
+                    "rr",
+                    "%guard%$name$ %d%, %a%, r%rb%",
+                    Some(false),
+                ),
+                (
+                    "c_bin_i",
+                    "ri",
+                    "%guard%$name$ %d%, %a%, #%imm%",
+                    Some(true),
+                ),
+            ],
         ),
         (
-            "c_movb_i",
-            "ri",
-            "%guard%$name$ %d%, #%imm%",
-            vec![Movb],
-            Some(true),
-        ),
-        (
-            "c_acc_r",
-            "rr",
-            "%guard%$name$%t% %d%%sh%",
-            vec![Acc],
-            Some(false),
-        ),
-        ("c_acc_i", "ri", "%guard%$name$ %d%", vec![Acc], Some(true)),
-        ("c_accp", "ri", "%guard%$name$ %d%", vec![Acch, Accl], None),
-        (
-            "c_ldacc_r",
-            "ldacc_r",
-            "%guard%$name$%t% %a%%lsh%",
-            vec![Ldacc],
-            Some(false),
-        ),
-        (
-            "c_ldacc_i",
-            "ri",
-            "%guard%$name$ %a%",
-            vec![Ldacc],
-            Some(true),
-        ),
-        (
-            "c_bin_r",
-            "rr",
-            "%guard%$name$ %d%, %a%, r%rb%",
-            binary.clone(),
-            Some(false),
-        ),
-        (
-            "c_bin_i",
-            "ri",
-            "%guard%$name$ %d%, %a%, #%imm%",
-            binary,
-            Some(true),
-        ),
-        (
-            "c_mul_r",
-            "rr",
-            "%guard%$name$%t% %d%, %a%, r%rb%%sh%",
-            vec![Mul, Mac, Msu],
-            Some(false),
-        ),
-        (
-            "c_mul_i",
-            "ri",
-            "%guard%$name$ %d%, %a%, #%imm%",
-            vec![Mul, Mac, Msu],
-            Some(true),
+            Form::Multiply,
+            &[
+                (
+                    "c_mul_r",
+                    "rr",
+                    "%guard%$name$%t% %d%, %a%, r%rb%%sh%",
+                    Some(false),
+                ),
+                (
+                    "c_mul_i",
+                    "ri",
+                    "%guard%$name$ %d%, %a%, #%imm%",
+                    Some(true),
+                ),
+            ],
         ),
     ];
+    let classes: Vec<Class> = forms
+        .iter()
+        .flat_map(|&(form, formats)| {
+            let ops: Vec<Op> = ALL_OPS
+                .iter()
+                .copied()
+                .filter(|o| o.form() == form)
+                .collect();
+            formats
+                .iter()
+                .map(move |&(name, ty, repr, imm)| (name, ty, repr, ops.clone(), imm))
+        })
+        .collect();
     // Every operation in exactly one class per operand form.
     for &op in ALL_OPS {
         for imm in [false, true] {

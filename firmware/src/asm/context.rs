@@ -12,7 +12,7 @@
 //!   ldacc A [, <<SH]  nop  sleep  wake
 //! ```
 
-use rtl::rc::context::{ASrc, BSrc, Context, Guard, Op, ALL_CONDS, ALL_OPS};
+use rtl::rc::context::{ASrc, BSrc, Context, Form, Guard, Op, ALL_CONDS, ALL_OPS};
 
 use super::lexer::{Tok, Token};
 use super::tinyrisc::register;
@@ -204,23 +204,22 @@ pub(crate) fn context(asm: &Asm, lc: &LineCtx, mut i: usize) -> Result<u32, AsmE
         guard,
         ..Context::NOP
     };
-    use Op::*;
-    match op {
-        Nop | Sleep | Wake => want(0, "no operands")?,
-        Cmp => {
+    match op.form() {
+        Form::None => want(0, "no operands")?,
+        Form::Compare => {
             want(2, "`A, B`")?;
             (c.asrc, c.ra) = a_of(ops[0])?;
             c.b = b_of(ops[1])?;
             c.rd = cond.map_or(0, |x| x as u8);
         }
-        St => {
+        Form::Store => {
             want(2, "`A, [B]`")?;
             (c.asrc, c.ra) = a_of(ops[0])?;
             let inner =
                 bracket(ops[1]).ok_or_else(|| lc.err_at(Some(ops[1].0), "expected `[B]`"))?;
             c.b = b_of(inner)?;
         }
-        Ld => {
+        Form::Load => {
             want(2, "`D, [A + B]`")?;
             (c.we, c.rd) = d_of(ops[0])?;
             let inner =
@@ -232,25 +231,25 @@ pub(crate) fn context(asm: &Asm, lc: &LineCtx, mut i: usize) -> Result<u32, AsmE
             (c.asrc, c.ra) = a_of((inner.0, p))?;
             c.b = b_of((p + 1, inner.1))?;
         }
-        Not | Mov | Abs | Neg | Clz => {
+        Form::Unary => {
             want(2, "`D, A`")?;
             (c.we, c.rd) = d_of(ops[0])?;
             (c.asrc, c.ra) = a_of(ops[1])?;
         }
-        Movb => {
+        Form::MoveB => {
             want(2, "`D, B`")?;
             (c.we, c.rd) = d_of(ops[0])?;
             c.b = b_of(ops[1])?;
         }
-        Acc | Acch | Accl => {
+        Form::AccRead | Form::AccPart => {
             want(1, "`D`")?;
             (c.we, c.rd) = d_of(ops[0])?;
         }
-        Ldacc => {
+        Form::AccLoad => {
             want(1, "`A`")?;
             (c.asrc, c.ra) = a_of(ops[0])?;
         }
-        _ => {
+        Form::Binary | Form::Multiply => {
             want(3, "`D, A, B`")?;
             (c.we, c.rd) = d_of(ops[0])?;
             (c.asrc, c.ra) = a_of(ops[1])?;
@@ -267,7 +266,7 @@ pub(crate) fn context(asm: &Asm, lc: &LineCtx, mut i: usize) -> Result<u32, AsmE
                 "a shift or `.t` needs operand B in a register (the immediate form has no shift field)",
             ));
         }
-        if !matches!(op, Mul | Mac | Msu | Acc | Ldacc) && shift != 0 {
+        if !op.uses_shift() && shift != 0 {
             return Err(lc.err_at(shift_at, format!("`{base}` takes no shift")));
         }
     }

@@ -28,155 +28,147 @@
 
 use std::fmt;
 
-/// Operations of the RC datapath. The numeric value is the `op` field.
+/// What an operation's operands are, as the assembler writes them (the
+/// disassembler, the Surfer decoder and the docs' syntax column follow
+/// it).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum Op {
-    Nop = 0x00,
-    // ALU
-    Add = 0x01,
-    Adc = 0x02,
-    Sub = 0x03,
-    Sbc = 0x04,
-    Rsb = 0x05,
-    Adds = 0x06,
-    Subs = 0x07,
-    And = 0x08,
-    Or = 0x09,
-    Xor = 0x0A,
-    Not = 0x0B,
-    Mov = 0x0C,
-    Movb = 0x0D,
-    Min = 0x0E,
-    Max = 0x0F,
-    Abs = 0x10,
-    Absd = 0x11,
-    Neg = 0x12,
-    Cmp = 0x13,
-    Sel = 0x14,
-    Clz = 0x15,
-    // Shifter
-    Sll = 0x18,
-    Srl = 0x19,
-    Sra = 0x1A,
-    Asl = 0x1B,
-    // Multiplier
-    Mul = 0x20,
-    Mac = 0x21,
-    Msu = 0x22,
-    Acc = 0x23,
-    Acch = 0x24,
-    Accl = 0x25,
-    Ldacc = 0x26,
-    // RAM
-    Ld = 0x28,
-    St = 0x29,
-    // Power
-    Sleep = 0x30,
-    Wake = 0x31,
+pub enum Form {
+    /// `nop`, `sleep`, `wake`: no operands, no result.
+    None,
+    /// `cmp.COND A, B`: sets F, no result.
+    Compare,
+    /// `st A, [B]`: no result.
+    Store,
+    /// `ld D, [A + B]`.
+    Load,
+    /// `op D, A`.
+    Unary,
+    /// `movb D, B`.
+    MoveB,
+    /// `op D, A, B`.
+    Binary,
+    /// `op[.t] D, A, B [, >>SH]`: the multiplier's product, shifted.
+    Multiply,
+    /// `acc[.t] D [, >>SH]`: the accumulator, shifted.
+    AccRead,
+    /// `acch D`, `accl D`: a half of the accumulator.
+    AccPart,
+    /// `ldacc[.t] A [, <<SH]`: the accumulator loaded, no result.
+    AccLoad,
 }
 
-/// Every operation, in opcode order; the disassembler and docs tests walk it.
-pub const ALL_OPS: &[Op] = &[
-    Op::Nop,
-    Op::Add,
-    Op::Adc,
-    Op::Sub,
-    Op::Sbc,
-    Op::Rsb,
-    Op::Adds,
-    Op::Subs,
-    Op::And,
-    Op::Or,
-    Op::Xor,
-    Op::Not,
-    Op::Mov,
-    Op::Movb,
-    Op::Min,
-    Op::Max,
-    Op::Abs,
-    Op::Absd,
-    Op::Neg,
-    Op::Cmp,
-    Op::Sel,
-    Op::Clz,
-    Op::Sll,
-    Op::Srl,
-    Op::Sra,
-    Op::Asl,
-    Op::Mul,
-    Op::Mac,
-    Op::Msu,
-    Op::Acc,
-    Op::Acch,
-    Op::Accl,
-    Op::Ldacc,
-    Op::Ld,
-    Op::St,
-    Op::Sleep,
-    Op::Wake,
-];
+/// The RC unit an operation runs on (`docs/isa.md`; the Verilog unit
+/// files `rc_alu.v`, `rc_shifter.v`, `rc_multiplier.v`, `rc_ram.v`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Unit {
+    /// No unit: `nop`.
+    None,
+    Alu,
+    Shifter,
+    Multiplier,
+    Ram,
+    /// The sleep flag.
+    Power,
+}
+
+/// The operation set from one table: each row's variant, opcode (the `op`
+/// field), mnemonic, operand form and unit. Every operation takes one
+/// cycle. The enum, [`ALL_OPS`], the mnemonics, the assembler's and the
+/// Surfer decoder's operand forms and the Verilog `rc_isa.vh`
+/// ([`super::isa_vh`]) all come from it.
+macro_rules! rc_ops {
+    ($($variant:ident = $code:literal, $mn:literal, $form:ident, $unit:ident;)*) => {
+        /// Operations of the RC datapath. The numeric value is the `op` field.
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[repr(u8)]
+        pub enum Op {
+            $($variant = $code,)*
+        }
+
+        /// Every operation, in opcode order; the disassembler and docs tests walk it.
+        pub const ALL_OPS: &[Op] = &[$(Op::$variant,)*];
+
+        impl Op {
+            pub fn mnemonic(self) -> &'static str {
+                match self {
+                    $(Op::$variant => $mn,)*
+                }
+            }
+
+            /// Its operands, as the assembler writes them.
+            pub fn form(self) -> Form {
+                match self {
+                    $(Op::$variant => Form::$form,)*
+                }
+            }
+
+            /// The unit it runs on.
+            pub fn unit(self) -> Unit {
+                match self {
+                    $(Op::$variant => Unit::$unit,)*
+                }
+            }
+        }
+    };
+}
+
+rc_ops! {
+    Nop    = 0x00, "nop", None, None;
+    Add    = 0x01, "add", Binary, Alu;
+    Adc    = 0x02, "adc", Binary, Alu;
+    Sub    = 0x03, "sub", Binary, Alu;
+    Sbc    = 0x04, "sbc", Binary, Alu;
+    Rsb    = 0x05, "rsb", Binary, Alu;
+    Adds   = 0x06, "adds", Binary, Alu;
+    Subs   = 0x07, "subs", Binary, Alu;
+    And    = 0x08, "and", Binary, Alu;
+    Or     = 0x09, "or", Binary, Alu;
+    Xor    = 0x0A, "xor", Binary, Alu;
+    Not    = 0x0B, "not", Unary, Alu;
+    Mov    = 0x0C, "mov", Unary, Alu;
+    Movb   = 0x0D, "movb", MoveB, Alu;
+    Min    = 0x0E, "min", Binary, Alu;
+    Max    = 0x0F, "max", Binary, Alu;
+    Abs    = 0x10, "abs", Unary, Alu;
+    Absd   = 0x11, "absd", Binary, Alu;
+    Neg    = 0x12, "neg", Unary, Alu;
+    Cmp    = 0x13, "cmp", Compare, Alu;
+    Sel    = 0x14, "sel", Binary, Alu;
+    Clz    = 0x15, "clz", Unary, Alu;
+    Sll    = 0x18, "sll", Binary, Shifter;
+    Srl    = 0x19, "srl", Binary, Shifter;
+    Sra    = 0x1A, "sra", Binary, Shifter;
+    Asl    = 0x1B, "asl", Binary, Shifter;
+    Mul    = 0x20, "mul", Multiply, Multiplier;
+    Mac    = 0x21, "mac", Multiply, Multiplier;
+    Msu    = 0x22, "msu", Multiply, Multiplier;
+    Acc    = 0x23, "acc", AccRead, Multiplier;
+    Acch   = 0x24, "acch", AccPart, Multiplier;
+    Accl   = 0x25, "accl", AccPart, Multiplier;
+    Ldacc  = 0x26, "ldacc", AccLoad, Multiplier;
+    Ld     = 0x28, "ld", Load, Ram;
+    St     = 0x29, "st", Store, Ram;
+    Sleep  = 0x30, "sleep", None, Power;
+    Wake   = 0x31, "wake", None, Power;
+}
 
 impl Op {
     pub fn from_bits(v: u8) -> Option<Op> {
         ALL_OPS.iter().copied().find(|o| *o as u8 == v)
     }
 
-    pub fn mnemonic(self) -> &'static str {
-        use Op::*;
-        match self {
-            Nop => "nop",
-            Add => "add",
-            Adc => "adc",
-            Sub => "sub",
-            Sbc => "sbc",
-            Rsb => "rsb",
-            Adds => "adds",
-            Subs => "subs",
-            And => "and",
-            Or => "or",
-            Xor => "xor",
-            Not => "not",
-            Mov => "mov",
-            Movb => "movb",
-            Min => "min",
-            Max => "max",
-            Abs => "abs",
-            Absd => "absd",
-            Neg => "neg",
-            Cmp => "cmp",
-            Sel => "sel",
-            Clz => "clz",
-            Sll => "sll",
-            Srl => "srl",
-            Sra => "sra",
-            Asl => "asl",
-            Mul => "mul",
-            Mac => "mac",
-            Msu => "msu",
-            Acc => "acc",
-            Acch => "acch",
-            Accl => "accl",
-            Ldacc => "ldacc",
-            Ld => "ld",
-            St => "st",
-            Sleep => "sleep",
-            Wake => "wake",
-        }
-    }
-
     /// Does the operation produce a 16-bit result (written to `out`, and to
     /// `rd` when `we` is set)?
     pub fn has_result(self) -> bool {
         !matches!(
-            self,
-            Op::Nop | Op::Cmp | Op::St | Op::Sleep | Op::Wake | Op::Ldacc
+            self.form(),
+            Form::None | Form::Compare | Form::Store | Form::AccLoad
         )
     }
 
     /// Operations that use the multiplier's shift field.
     pub fn uses_shift(self) -> bool {
-        matches!(self, Op::Mul | Op::Mac | Op::Msu | Op::Acc | Op::Ldacc)
+        matches!(self.form(), Form::Multiply | Form::AccRead | Form::AccLoad)
     }
 }
 
@@ -496,7 +488,7 @@ impl fmt::Display for Context {
             Guard::IfNotF => write!(f, "(!f) ")?,
         }
         write!(f, "{}", self.op.mnemonic())?;
-        if self.op == Op::Cmp {
+        if self.op.form() == Form::Compare {
             write!(f, ".{}", self.cond().mnemonic())?;
         }
         if self.op.uses_shift() && self.trunc {
@@ -526,18 +518,17 @@ impl fmt::Display for Context {
         } else {
             String::new()
         };
-        use Op::*;
-        match self.op {
-            Nop | Sleep | Wake => Ok(()),
-            Cmp => write!(f, " {a}, {b}"),
-            St => write!(f, " {a}, [{b}]"),
-            Ld => write!(f, " {d}, [{a} + {b}]"),
-            Not | Mov | Abs | Neg | Clz => write!(f, " {d}, {a}"),
-            Movb => write!(f, " {d}, {b}"),
-            Acc | Acch | Accl => write!(f, " {d}{sh}"),
-            Ldacc if self.shift != 0 => write!(f, " {a}, <<{}", self.shift),
-            Ldacc => write!(f, " {a}"),
-            _ => write!(f, " {d}, {a}, {b}{sh}"),
+        match self.op.form() {
+            Form::None => Ok(()),
+            Form::Compare => write!(f, " {a}, {b}"),
+            Form::Store => write!(f, " {a}, [{b}]"),
+            Form::Load => write!(f, " {d}, [{a} + {b}]"),
+            Form::Unary => write!(f, " {d}, {a}"),
+            Form::MoveB => write!(f, " {d}, {b}"),
+            Form::AccRead | Form::AccPart => write!(f, " {d}{sh}"),
+            Form::AccLoad if self.shift != 0 => write!(f, " {a}, <<{}", self.shift),
+            Form::AccLoad => write!(f, " {a}"),
+            Form::Binary | Form::Multiply => write!(f, " {d}, {a}, {b}{sh}"),
         }
     }
 }

@@ -11,6 +11,7 @@
 pub mod alu;
 pub mod context;
 pub mod flags;
+pub mod isa_vh;
 pub mod lanes;
 pub mod multiplier;
 pub mod ram;
