@@ -103,10 +103,9 @@ pub enum DatapathChoice {
 
 /// The project's quality bar (every bundled scene meets it): the PSNR and
 /// hit agreement against the f64 reference under which `--datapath auto`
-/// tries the 32-bit chip. Measured, not guessed from feature sizes: tree-1,
-/// whose smallest parts are 8.6 LSB of its format, renders at 41.6 dB on
-/// the 16-bit chip, while SPD rings at its default size (cylinders of 38
-/// LSB) reaches 29 dB there and 59 dB on the 32-bit chip.
+/// tries the 32-bit chip. Measured, not guessed from feature sizes: a
+/// scene's smallest parts in LSB do not tell how it renders
+/// (`docs/results.md` has both chips on the bundled and SPD scenes).
 pub(crate) const AUTO_MIN_PSNR: f64 = 30.0;
 pub(crate) const AUTO_MIN_HITS: f64 = 0.99;
 
@@ -196,9 +195,8 @@ pub(crate) const MAX_SIDE: u64 = 4096;
 
 /// `w` x `h` if each side is 1..=[`MAX_SIDE`]; otherwise what the request
 /// would cost: about 40 bytes of host memory per pixel (images, hit maps,
-/// f64 colours) and, on the chip, about 140 cycles per pixel for the
-/// default scene (9.08 M cycles at 256x256) simulated at about 15 M cycles
-/// per host second.
+/// f64 colours) and, on the chip, the frame's cycles at the simulator's
+/// speed (`morphosys bench` measures both).
 pub(crate) fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
     if (1..=MAX_SIDE).contains(&w) && (1..=MAX_SIDE).contains(&h) {
         return Ok((w as u32, h as u32));

@@ -237,15 +237,16 @@ pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
 /// LSB per axis, the same shift for the whole frame; the picture barely
 /// moves, but the normal a ray finds on a sphere a few dozen LSB across
 /// turns by that shift over the radius, and a reflection in it by twice
-/// that over the distance the reflected ray travels: on SPD balls (size
-/// 2, 256x256, 16-bit) 30.0 dB against 33.3 dB with the eye on the grid.
+/// that over the distance the reflected ray travels, which on SPD balls
+/// on the 16-bit chip costs dB that show (`--normals coarse` renders
+/// without the move).
 /// The scene's images are the same in exact arithmetic (objects, eye and
 /// lights move together). Where the move would change the format (an
 /// extent within an LSB of a format's limit), the unmoved build is kept.
 /// Scenes without curved objects (spheres, cylinders, cones) are not
 /// moved: a plane's normal does not turn with the ray, and the move would
-/// only round every vertex afresh (gears-1 lost 0.3 dB to it, the pp torus
-/// 0.4 dB, tetra-2's median tree changed shape).
+/// only round every vertex afresh (and may change the median tree's
+/// shape).
 fn build_as(
     scene: &Scene,
     opt: &Options,

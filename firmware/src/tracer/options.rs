@@ -14,7 +14,7 @@ pub use rtl::rc::Datapath;
 /// the hit point was rounded (the sphere's near root and a plane's
 /// back face are rejected), while an offset of a few LSB pushes the origin
 /// of a shadow ray off a small sphere into the neighbour it touches, whose
-/// kernel then rejects it (balls-4: 3 LSB cost 2 dB).
+/// kernel then rejects it (`sweep`'s `ray_offset_lsb` knob measures it).
 pub const EPS_LSB: i32 = 0;
 
 /// A fieldless option type from one list of its values and their
@@ -452,10 +452,10 @@ spelled! {
     /// ([`super::primitives::sphere::kernel`], [`super::primitives::cylinder::kernel`]): 9 more cycles per
     /// sphere test, 19 per cylinder test. Coarse: the kernels as first
     /// written (the cycle counts the comparison with the paper was made
-    /// with). Auto: fine on the 16-bit chip, whose accuracy they decide
-    /// (jacks-2: 29.5 to 33.2 dB), coarse on the 32-bit chip, whose 16 more
-    /// fraction bits leave nothing to gain that shows (jacks-2: 56.0 dB
-    /// coarse, 66.6 fine, for 5% of the frame rate).
+    /// with). Auto: fine on the 16-bit chip, whose accuracy they decide,
+    /// coarse on the 32-bit chip, whose 16 more fraction bits leave nothing
+    /// to gain that shows for the cycles (`sweep`'s `normals` knob
+    /// measures both).
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
     pub enum Normals ("normals") {
         #[default]

@@ -8,10 +8,10 @@ use super::super::primitives::{of_shape, polygon, Fit, Gen, TestCost, PRIMITIVES
 use super::STREAM_BANK;
 use crate::scene::Scene;
 /// Array cycles a packet spends on an inner node (its kernel and
-/// TinyRISC's decision), for [`super::super::Collapse::Auto`]. 43 to 45
-/// on the SPD scenes at 128x128 (`render --profile`); 48 here walks more
-/// nodes and costs balls, rings and tree 0.4-1.1% more cycles
-/// (`docs/tracer.md`, "The tree it walks").
+/// TinyRISC's decision), for [`super::super::Collapse::Auto`]: set above
+/// what `render --profile` measures (its "cost model" rows print both),
+/// since a value nearer the measurement walks more nodes and costs the
+/// SPD scenes cycles (`docs/tracer.md`, "The tree it walks").
 pub const PK_NODE_COST: f64 = 60.0;
 
 /// Per scene object, the array cycles a packet's test of it costs: the
@@ -60,11 +60,10 @@ pub(super) fn object_costs(scene: &Scene, s: f64, fit: &Fit) -> Vec<f64> {
 const PART_ON: f64 = 0.3;
 
 /// TinyRISC cycles per object test that the array waits for (the mailbox
-/// check and the issue; the test's cuts end its run without TinyRISC): 1.2
-/// (shells) to 7.9 (lattice) on the SPD scenes at 128x128 (`render
-/// --profile`, the `lo_*` rows over the object tests). 7 here costs
-/// rings, lattice and tree 0.2-1% more cycles; 12 and 16 agree within
-/// 0.3% (`docs/tracer.md`, "The tree it walks").
+/// check and the issue; the test's cuts end its run without TinyRISC):
+/// set above what `render --profile` measures on the SPD scenes (the
+/// `lo_*` rows over the object tests), where the frames are fastest
+/// (`docs/tracer.md`, "The tree it walks").
 pub const PK_OBJECT_RISC: f64 = 12.0;
 
 /// Array cycles a packet spends on a leaf besides its objects: TinyRISC's
