@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use firmware::bsp::BspParams;
-use firmware::tracer::Options;
+use firmware::tracer::{Numerics, Options};
 use serde_json::json;
 
 use crate::cmd_scene::{load_scene, png_bytes};
@@ -225,136 +225,14 @@ pub fn command(a: RenderArgs) -> Result<()> {
             Err(_) => {}
         }
     }
-    // Every output checked before the frame is rendered.
-    let out_path = a
-        .out
-        .clone()
-        .unwrap_or_else(|| default_out(Path::new(&scene.source)));
-    let mut files = crate::output::Files::new();
-    files.input(
-        &a.scene
-            .clone()
-            .unwrap_or_else(crate::cmd_scene::default_scene),
-        "SCENE",
-    );
-    for (p, what) in [(&a.firmware, "--firmware"), (&a.timing, "--timing")] {
-        if let Some(p) = p {
-            files.input(p, what);
-        }
-    }
-    files.output(&out_path, "--out");
-    for (p, what) in [
-        (&a.json, "--json"),
-        (&a.hits, "--hits"),
-        (&a.emit_asm, "--emit-asm"),
-    ] {
-        if let Some(p) = p {
-            files.output(p, what);
-        }
-    }
-    if let Some(v) = &a.vcd {
-        files.waveform(v, "--vcd");
-    }
-    files.check()?;
-    let (width, height) = a.size.unwrap_or((256, 256));
-    let opt = Options {
-        width,
-        height,
-        ways: a.ways,
-        depth: a.depth,
-        bsp: BspParams {
-            max_depth: a.max_depth,
-            max_leaf: a.max_leaf,
-            rule: match a.split.as_str() {
-                "sah" => firmware::bsp::SplitRule::Sah,
-                "chip" => firmware::bsp::SplitRule::Chip,
-                "median" => firmware::bsp::SplitRule::Median,
-                _ => firmware::bsp::SplitRule::Auto,
-            },
-            ..BspParams::default()
-        },
-        layout: a.layout,
-        datapath: rtl::rc::Datapath::W16,
-        traversal: a.traversal,
-        collapse: a.collapse,
-        pieces: a.leaf_pieces,
-        shadows: a.shadow_packets,
-        test_cuts: a.test_cuts.for_issue(timing.risc.issue),
-        child_order: a.child_order,
-        sub_edges: a.sub_edges,
-    };
-    if a.newton_steps > 3 {
-        anyhow::bail!("--newton-steps {}: must be 0..=3", a.newton_steps);
-    }
-    if !firmware::tracer::math::TABLE_SIZES.contains(&a.table_entries) {
-        anyhow::bail!(
-            "--table-entries {}: must be 16, 32, 64 or 128 (each table has a 128-word slot of the RC's 512-word RAM)",
-            a.table_entries
-        );
-    }
-    let nm = firmware::tracer::Numerics {
-        newton_steps: a.newton_steps,
-        table_entries: a.table_entries,
-        guard_bits: a.guard_bits,
-        eps_lsb: a.ray_offset_lsb,
-        normals: a.normals,
-    };
-    let mut opt = opt;
+    let out = a.check_files(&scene)?;
+    let (mut opt, nm) = a.options(&timing);
     // --firmware: the file's program on the chip its `.datapath` names.
     let program = match (&a.firmware, firmware_text) {
         (Some(p), Some(text)) => Some((p.display().to_string(), text)),
         _ => None,
     };
-    let mut choice = a.datapath;
-    if let Some((name, text)) = &program {
-        let d = crate::render::source_datapath(text);
-        match choice {
-            crate::cli::DatapathChoice::Fixed(f) if f != d => anyhow::bail!(
-                "{name}: the firmware is for the {}-bit datapath (`.datapath`), --datapath {} asks for {}",
-                d.bits(),
-                f.bits(),
-                f.bits()
-            ),
-            _ => choice = crate::cli::DatapathChoice::Fixed(d),
-        }
-    }
-    let (datapath, mut datapath_reason, built) =
-        choose_datapath(&scene, &opt, &nm, choice, &timing)?;
-    opt.datapath = datapath;
-    let mut built = match built {
-        Some(fw) => fw,
-        None => crate::render::choose_firmware(&scene, &opt, &nm, &timing)?,
-    };
-    if let Some((name, text)) = &program {
-        built = crate::render::firmware_from_source(built, text, name)?;
-        datapath_reason = format!("{name}: .datapath {}", datapath.bits());
-    }
-    for w in firmware::tracer::chip_warnings(&scene, &built.report.notes) {
-        eprintln!("{w}");
-    }
-    if let Some(p) = &a.emit_asm {
-        crate::output::write(p, built.source.as_bytes())?;
-        crate::note!("wrote {}", p.display());
-    }
-    let trace = a.vcd.map(|p| {
-        let mut c = a.window.config(p);
-        if a.window.trace_scope.is_none() {
-            c.scope = crate::cli::RENDER_SCOPE.to_string();
-        }
-        // A frame runs for millions of cycles: without --trace-cycles the
-        // waveform covers a window of the first work item's chip, not the whole
-        // frame (whose size would be refused anyway).
-        if c.count.is_none() {
-            c.count = Some(DEFAULT_TRACE_CYCLES);
-            c.max_bytes = rtl::trace::MAX_TRACE_BYTES;
-            eprintln!(
-                "tracing cycles {}..{} of the chip on the first 32 tiles (--trace-from / --trace-cycles to change)",
-                c.first,
-                c.first + DEFAULT_TRACE_CYCLES
-            );
-        }
-        c
-    });
+    let (built, datapath_reason) = build(&a, &scene, &mut opt, &nm, &timing, program.as_ref())?;
     let (chip, mut rep) = crate::render::render_and_measure(
         &scene,
         &opt,
@@ -362,7 +240,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             numerics: nm,
             streamed: false,
             progress: true,
-            trace,
+            trace: a.trace_config(),
             profile: a.profile,
             timing,
             item_tiles: None,
@@ -411,7 +289,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
     rep.json["argv"] = a.argv.clone().into();
     rep.json["stepping"] = if a.plain { "plain" } else { "fast" }.into();
     rep.json["inputs"] = inputs;
-    let out = out_path;
+    let (width, height) = (opt.width, opt.height);
     if let Some(h) = &a.hits {
         crate::output::write(
             h,
@@ -422,7 +300,179 @@ pub fn command(a: RenderArgs) -> Result<()> {
     crate::output::write(&out, &png_bytes(width, height, &chip.rgb8)?)
         .with_context(|| format!("writing {}", out.display()))?;
     crate::note!("wrote {}", out.display());
-    let j = &rep.json;
+    print_report(&scene, &opt, &chip, &rep.json, &timing, &datapath_reason);
+    if let Some(p) = &chip.profile {
+        let c = crate::profile::causes(p, &chip);
+        crate::profile::print_profile(p, &c, crate::profile::CostCheck::of(p, &c, &chip));
+    }
+    if let Some(p) = &a.json {
+        let text = serde_json::to_string_pretty(&rep.json)?;
+        crate::output::write(p, text.as_bytes())?;
+        crate::note!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+impl RenderArgs {
+    /// Every file the render reads and writes, checked before the frame
+    /// is rendered; the image's path.
+    fn check_files(&self, scene: &firmware::scene::Scene) -> Result<PathBuf> {
+        let out_path = self
+            .out
+            .clone()
+            .unwrap_or_else(|| default_out(Path::new(&scene.source)));
+        let mut files = crate::output::Files::new();
+        files.input(
+            &self
+                .scene
+                .clone()
+                .unwrap_or_else(crate::cmd_scene::default_scene),
+            "SCENE",
+        );
+        for (p, what) in [(&self.firmware, "--firmware"), (&self.timing, "--timing")] {
+            if let Some(p) = p {
+                files.input(p, what);
+            }
+        }
+        files.output(&out_path, "--out");
+        for (p, what) in [
+            (&self.json, "--json"),
+            (&self.hits, "--hits"),
+            (&self.emit_asm, "--emit-asm"),
+        ] {
+            if let Some(p) = p {
+                files.output(p, what);
+            }
+        }
+        if let Some(v) = &self.vcd {
+            files.waveform(v, "--vcd");
+        }
+        files.check()?;
+        Ok(out_path)
+    }
+
+    /// The tracer's options and the RC arithmetic's knobs this command
+    /// line asks for, in one place (clap has checked every range; the
+    /// datapath is the 16-bit chip's until `--datapath` is decided, and
+    /// `--test-cuts auto` is resolved for the timing's issue model).
+    pub fn options(&self, timing: &rtl::Timing) -> (Options, Numerics) {
+        let (width, height) = self.size.unwrap_or((256, 256));
+        let opt = Options {
+            width,
+            height,
+            ways: self.ways,
+            depth: self.depth,
+            bsp: BspParams {
+                max_depth: self.max_depth,
+                max_leaf: self.max_leaf,
+                rule: match self.split.as_str() {
+                    "sah" => firmware::bsp::SplitRule::Sah,
+                    "chip" => firmware::bsp::SplitRule::Chip,
+                    "median" => firmware::bsp::SplitRule::Median,
+                    _ => firmware::bsp::SplitRule::Auto,
+                },
+                ..BspParams::default()
+            },
+            layout: self.layout,
+            datapath: rtl::rc::Datapath::W16,
+            traversal: self.traversal,
+            collapse: self.collapse,
+            pieces: self.leaf_pieces,
+            shadows: self.shadow_packets,
+            test_cuts: self.test_cuts.for_issue(timing.risc.issue),
+            child_order: self.child_order,
+            sub_edges: self.sub_edges,
+        };
+        let nm = Numerics {
+            newton_steps: self.newton_steps,
+            table_entries: self.table_entries,
+            guard_bits: self.guard_bits,
+            eps_lsb: self.ray_offset_lsb,
+            normals: self.normals,
+        };
+        (opt, nm)
+    }
+
+    /// The waveform asked for (`--vcd`), a window of the first work
+    /// item's chip unless `--trace-cycles` says otherwise.
+    fn trace_config(&self) -> Option<rtl::trace::TraceConfig> {
+        self.vcd.clone().map(|p| {
+            let mut c = self.window.config(p);
+            if self.window.trace_scope.is_none() {
+                c.scope = crate::cli::RENDER_SCOPE.to_string();
+            }
+            // A frame runs for millions of cycles: without --trace-cycles the
+            // waveform covers a window of the first work item's chip, not the whole
+            // frame (whose size would be refused anyway).
+            if c.count.is_none() {
+                c.count = Some(DEFAULT_TRACE_CYCLES);
+                c.max_bytes = rtl::trace::MAX_TRACE_BYTES;
+                eprintln!(
+                    "tracing cycles {}..{} of the chip on the first 32 tiles (--trace-from / --trace-cycles to change)",
+                    c.first,
+                    c.first + DEFAULT_TRACE_CYCLES
+                );
+            }
+            c
+        })
+    }
+}
+
+/// The chip (`--datapath`) and the firmware for it: generated, or the
+/// `--firmware` file's program on the chip its `.datapath` names; why
+/// that chip. Writes `--emit-asm`.
+fn build(
+    a: &RenderArgs,
+    scene: &firmware::scene::Scene,
+    opt: &mut Options,
+    nm: &Numerics,
+    timing: &rtl::Timing,
+    program: Option<&(String, String)>,
+) -> Result<(firmware::tracer::Firmware, String)> {
+    let mut choice = a.datapath;
+    if let Some((name, text)) = program {
+        let d = crate::render::source_datapath(text);
+        match choice {
+            crate::cli::DatapathChoice::Fixed(f) if f != d => anyhow::bail!(
+                "{name}: the firmware is for the {}-bit datapath (`.datapath`), --datapath {} asks for {}",
+                d.bits(),
+                f.bits(),
+                f.bits()
+            ),
+            _ => choice = crate::cli::DatapathChoice::Fixed(d),
+        }
+    }
+    let (datapath, mut datapath_reason, built) = choose_datapath(scene, opt, nm, choice, timing)?;
+    opt.datapath = datapath;
+    let mut built = match built {
+        Some(fw) => fw,
+        None => crate::render::choose_firmware(scene, opt, nm, timing)?,
+    };
+    if let Some((name, text)) = program {
+        built = crate::render::firmware_from_source(built, text, name)?;
+        datapath_reason = format!("{name}: .datapath {}", datapath.bits());
+    }
+    for w in firmware::tracer::chip_warnings(scene, &built.report.notes) {
+        eprintln!("{w}");
+    }
+    if let Some(p) = &a.emit_asm {
+        crate::output::write(p, built.source.as_bytes())?;
+        crate::note!("wrote {}", p.display());
+    }
+    Ok((built, datapath_reason))
+}
+
+/// The render's figures as `morphosys render` prints them: what was
+/// rendered and how, then what it measured.
+fn print_report(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    chip: &crate::render::ChipRender,
+    j: &serde_json::Value,
+    timing: &rtl::Timing,
+    datapath_reason: &str,
+) {
+    let (width, height) = (opt.width, opt.height);
     crate::report!("scene                    {}", scene.source);
     crate::report!(
         "size                     {width}x{height}, {} ways, depth {}",
@@ -493,6 +543,17 @@ pub fn command(a: RenderArgs) -> Result<()> {
             }
         );
     }
+    print_figures(opt, chip, j, timing);
+}
+
+/// The render's measurements: cycles and frame rate, image quality, rays,
+/// the array's use, the streamed scene's traffic, host speed.
+fn print_figures(
+    opt: &Options,
+    chip: &crate::render::ChipRender,
+    j: &serde_json::Value,
+    timing: &rtl::Timing,
+) {
     crate::report!("cycles                   {}", j["cycles"]);
     crate::report!(
         "fps at 300 MHz           {:.2}",
@@ -601,16 +662,6 @@ pub fn command(a: RenderArgs) -> Result<()> {
         "array cycles / host s    {:.3e}",
         j["array_cycles_per_host_second"].as_f64().unwrap_or(0.0)
     );
-    if let Some(p) = &chip.profile {
-        let c = crate::profile::causes(p, &chip);
-        crate::profile::print_profile(p, &c, crate::profile::CostCheck::of(p, &c, &chip));
-    }
-    if let Some(p) = &a.json {
-        let text = serde_json::to_string_pretty(j)?;
-        crate::output::write(p, text.as_bytes())?;
-        crate::note!("wrote {}", p.display());
-    }
-    Ok(())
 }
 
 /// The chip `--datapath` asks for, why (printed and in the JSON), and the
