@@ -225,6 +225,16 @@ struct Row {
     resident_node_words: u64,
 }
 
+/// The knob sweep's points (every knob on the default timing), for the
+/// render options' round-trip test.
+#[cfg(test)]
+pub(crate) fn knob_points(width: u32, height: u32) -> Vec<(Options, Numerics)> {
+    knobs::knobs(width, height)
+        .into_iter()
+        .map(|k| (k.opt, k.nm))
+        .collect()
+}
+
 fn key(o: &Options, n: &Numerics) -> String {
     format!(
         "{}x{} w{} d{} bd{} bl{} {:?} {:?} {} {} {} {} {} {}",

@@ -23,6 +23,7 @@ pub mod output;
 pub mod profile;
 pub mod reference;
 pub mod render;
+pub mod render_options;
 pub mod schedule;
 pub mod surfer;
 pub mod testbench;

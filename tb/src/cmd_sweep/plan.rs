@@ -3,7 +3,6 @@
 //! from the plan's renders).
 
 use anyhow::{Context as _, Result};
-use firmware::bsp::SplitRule;
 use rtl::Timing;
 use std::path::{Path, PathBuf};
 
@@ -87,45 +86,12 @@ pub(super) fn shell_word(w: &str) -> String {
 /// The arguments of the `morphosys render` that measures `c` on `scene`,
 /// writing `points/NAME.{png,json}` under `dir`.
 pub(super) fn render_argv(dir: &Path, scene: &Path, c: &Config, name: &str) -> Vec<String> {
-    let (o, n) = (&c.opt, &c.nm);
-    let auto0 = |d: u32| {
-        if d == 0 {
-            "auto".to_string()
-        } else {
-            d.to_string()
-        }
-    };
-    let split = match o.bsp.rule {
-        SplitRule::Median => "median",
-        SplitRule::Sah => "sah",
-        SplitRule::Chip => "chip",
-        SplitRule::Auto => "auto",
-    };
     let mut v: Vec<String> = vec!["render".into(), scene.display().to_string()];
+    v.extend(crate::render_options::argv(&c.opt, &c.nm));
     let mut arg = |k: &str, val: String| {
         v.push(k.into());
         v.push(val);
     };
-    arg("--size", format!("{}x{}", o.width, o.height));
-    arg("--ways", o.ways.to_string());
-    arg("--depth", o.depth.to_string());
-    arg("--traversal", o.traversal.name().into());
-    arg("--split", split.into());
-    arg("--max-depth", auto0(o.bsp.max_depth));
-    arg("--max-leaf", o.bsp.max_leaf.to_string());
-    arg("--collapse", o.collapse.to_string());
-    arg("--leaf-pieces", o.pieces.to_string());
-    arg("--shadow-packets", o.shadows.to_string());
-    arg("--sub-edges", o.sub_edges.to_string());
-    arg("--test-cuts", o.test_cuts.to_string());
-    arg("--child-order", o.child_order.to_string());
-    arg("--layout", o.layout.name().into());
-    arg("--datapath", o.datapath.bits().to_string());
-    arg("--newton-steps", n.newton_steps.to_string());
-    arg("--table-entries", n.table_entries.to_string());
-    arg("--guard-bits", n.guard_bits.to_string());
-    arg("--ray-offset-lsb", n.eps_lsb.to_string());
-    arg("--normals", n.normals.name().into());
     match (c.timing_file, c.timing_name.as_str()) {
         (Some(i), t) => arg(
             "--timing",
