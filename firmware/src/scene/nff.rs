@@ -143,6 +143,201 @@ impl<'a> Reader<'a> {
     }
 }
 
+/// The entities, each read after its keyword (at `line`, `col`).
+impl Reader<'_> {
+    /// `v`: the viewpoint.
+    fn viewpoint(&mut self, line: usize, col: usize) -> Result<Camera, SceneError> {
+        let r = self;
+        r.keyword("from")?;
+        let from = r.vec3("'from'")?;
+        r.keyword("at")?;
+        let at = r.vec3("'at'")?;
+        r.keyword("up")?;
+        let up = r.vec3("'up'")?;
+        r.keyword("angle")?;
+        let angle = r.number("the view angle in degrees")?;
+        r.keyword("hither")?;
+        let hither = r.number("the hither distance")?;
+        r.keyword("resolution")?;
+        let xres = r.count("the x resolution")?;
+        let yres = r.count("the y resolution")?;
+        if xres == 0 || yres == 0 || xres > 16384 || yres > 16384 {
+            return Err(r.err_at(
+                line,
+                col,
+                format!("resolution {xres}x{yres}: each must be between 1 and 16384"),
+            ));
+        }
+        if (at - from).length() == 0.0 {
+            return Err(r.err_at(line, col, "viewpoint 'from' and 'at' coincide".into()));
+        }
+        if (at - from).cross(up).length() == 0.0 {
+            return Err(r.err_at(
+                line,
+                col,
+                "viewpoint 'up' is zero or parallel to the view direction".into(),
+            ));
+        }
+        if !(angle > 0.0 && angle < 180.0) {
+            return Err(r.err_at(
+                line,
+                col,
+                format!("view angle {angle} must be in (0, 180) degrees"),
+            ));
+        }
+        Ok(Camera {
+            from,
+            at,
+            up,
+            angle,
+            hither,
+            resolution: (xres as u32, yres as u32),
+        })
+    }
+
+    /// `l`: a light, its colour optional.
+    fn light(&mut self, line: usize) -> Result<Light, SceneError> {
+        let r = self;
+        let position = r.vec3("light position")?;
+        // An optional colour: three more numbers on the same line
+        // (a keyword there starts the next entity: a whole scene
+        // may be written on one line).
+        let number = |r: &Reader, k: usize| {
+            r.tokens
+                .get(r.pos + k)
+                .is_some_and(|t| t.line == line && t.text.parse::<f64>().is_ok())
+        };
+        let color = if number(&r, 0) {
+            if !(number(&r, 1) && number(&r, 2)) {
+                let t = r.peek().map(|t| (t.line, t.col)).unwrap_or((line, 0));
+                return Err(r.err_at(
+                    t.0,
+                    t.1,
+                    "expected a light colour of 3 numbers (R G B) or nothing".into(),
+                ));
+            }
+            Some(r.vec3("light colour")?)
+        } else {
+            None
+        };
+        Ok(Light { position, color })
+    }
+
+    /// `f`: a material.
+    fn material(&mut self, line: usize, col: usize) -> Result<Material, SceneError> {
+        let r = self;
+        let color = r.vec3("material colour")?;
+        let kd = r.number("Kd")?;
+        let ks = r.number("Ks")?;
+        let shine = r.number("Shine")?;
+        let t = r.number("T (transmittance)")?;
+        let ior = r.number("index of refraction")?;
+        if t > 0.0 && ior <= 0.0 {
+            return Err(r.err_at(
+                line,
+                col,
+                format!("index of refraction {ior} must be > 0 for a transmitting material"),
+            ));
+        }
+        if shine < 0.0 {
+            return Err(r.err_at(
+                line,
+                col,
+                format!("Phong exponent (Shine) {shine} must be >= 0"),
+            ));
+        }
+        Ok(Material {
+            color,
+            kd,
+            ks,
+            shine,
+            t,
+            ior,
+        })
+    }
+
+    /// `s`: a sphere (a negative radius: only its inside visible).
+    fn sphere(&mut self, line: usize, col: usize) -> Result<Shape, SceneError> {
+        let r = self;
+        let center = r.vec3("sphere centre")?;
+        let radius = r.number("sphere radius")?;
+        if radius == 0.0 {
+            return Err(r.err_at(line, col, "sphere has radius 0".into()));
+        }
+        Ok(Shape::from(Sphere {
+            center,
+            radius: radius.abs(),
+            inside: radius < 0.0,
+        }))
+    }
+
+    /// `c`: a cone or cylinder, open.
+    fn cone(&mut self, line: usize, col: usize) -> Result<Shape, SceneError> {
+        let r = self;
+        let base = r.vec3("cone base point")?;
+        let base_radius = r.number("cone base radius")?;
+        let apex = r.vec3("cone apex point")?;
+        let apex_radius = r.number("cone apex radius")?;
+        let inside = base_radius < 0.0 || apex_radius < 0.0;
+        if inside && !(base_radius <= 0.0 && apex_radius <= 0.0) {
+            return Err(r.err_at(
+                line,
+                col,
+                "cone radii must both be negative (inside visible) or both >= 0".into(),
+            ));
+        }
+        if (apex - base).length() == 0.0 {
+            return Err(r.err_at(
+                line,
+                col,
+                "cone/cylinder base and apex are coincident".into(),
+            ));
+        }
+        if base_radius == 0.0 && apex_radius == 0.0 {
+            return Err(r.err_at(line, col, "cone/cylinder has radius 0 at both ends".into()));
+        }
+        Ok(Shape::from(Cone {
+            base,
+            base_radius: base_radius.abs(),
+            apex,
+            apex_radius: apex_radius.abs(),
+            inside,
+            caps: false,
+        }))
+    }
+
+    /// `p` or `pp` (`patch`: with vertex normals): a polygon, triangle or
+    /// rectangle.
+    fn polygon(&mut self, patch: bool, line: usize, col: usize) -> Result<Shape, SceneError> {
+        let r = self;
+        let n = r.count("the number of vertices")?;
+        if n < 3 {
+            return Err(r.err_at(
+                line,
+                col,
+                format!("polygon with {n} vertices: it needs at least 3"),
+            ));
+        }
+        if n > 1 << 20 {
+            return Err(r.err_at(line, col, format!("polygon with {n} vertices is too large")));
+        }
+        let mut v = Vec::with_capacity(n);
+        let mut normals = Vec::new();
+        for i in 0..n {
+            v.push(r.vec3(&format!("vertex {} of {n}", i + 1))?);
+            if patch {
+                normals.push(r.vec3(&format!("normal of vertex {} of {n}", i + 1))?);
+            }
+        }
+        let shape = polygon_shape(v, if patch { Some(normals) } else { None });
+        // zero area: skipped after reading, with one warning
+        if let Some(msg) = shape.degeneracy().filter(|_| shape.zero_area().is_none()) {
+            return Err(r.err_at(line, col, msg));
+        }
+        Ok(shape)
+    }
+}
+
 /// Parse NFF text; `file` names it in messages. The result is validated.
 pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
     let mut r = Reader::new(text, file);
@@ -187,197 +382,29 @@ pub fn parse(text: &str, file: &str) -> Result<Scene, SceneError> {
                 }
                 seen_view = true;
                 scene.lines.camera = line;
-                r.keyword("from")?;
-                let from = r.vec3("'from'")?;
-                r.keyword("at")?;
-                let at = r.vec3("'at'")?;
-                r.keyword("up")?;
-                let up = r.vec3("'up'")?;
-                r.keyword("angle")?;
-                let angle = r.number("the view angle in degrees")?;
-                r.keyword("hither")?;
-                let hither = r.number("the hither distance")?;
-                r.keyword("resolution")?;
-                let xres = r.count("the x resolution")?;
-                let yres = r.count("the y resolution")?;
-                if xres == 0 || yres == 0 || xres > 16384 || yres > 16384 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        format!("resolution {xres}x{yres}: each must be between 1 and 16384"),
-                    ));
-                }
-                if (at - from).length() == 0.0 {
-                    return Err(r.err_at(line, col, "viewpoint 'from' and 'at' coincide".into()));
-                }
-                if (at - from).cross(up).length() == 0.0 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        "viewpoint 'up' is zero or parallel to the view direction".into(),
-                    ));
-                }
-                if !(angle > 0.0 && angle < 180.0) {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        format!("view angle {angle} must be in (0, 180) degrees"),
-                    ));
-                }
-                scene.camera = Camera {
-                    from,
-                    at,
-                    up,
-                    angle,
-                    hither,
-                    resolution: (xres as u32, yres as u32),
-                };
+                scene.camera = r.viewpoint(line, col)?;
             }
             "b" => scene.background = r.vec3("background colour")?,
             "l" => {
-                let position = r.vec3("light position")?;
-                // An optional colour: three more numbers on the same line
-                // (a keyword there starts the next entity: a whole scene
-                // may be written on one line).
-                let number = |r: &Reader, k: usize| {
-                    r.tokens
-                        .get(r.pos + k)
-                        .is_some_and(|t| t.line == line && t.text.parse::<f64>().is_ok())
-                };
-                let color = if number(&r, 0) {
-                    if !(number(&r, 1) && number(&r, 2)) {
-                        let t = r.peek().map(|t| (t.line, t.col)).unwrap_or((line, 0));
-                        return Err(r.err_at(
-                            t.0,
-                            t.1,
-                            "expected a light colour of 3 numbers (R G B) or nothing".into(),
-                        ));
-                    }
-                    Some(r.vec3("light colour")?)
-                } else {
-                    None
-                };
-                scene.lights.push(Light { position, color });
+                let light = r.light(line)?;
+                scene.lights.push(light);
                 scene.lines.lights.push(line);
             }
             "f" => {
-                let color = r.vec3("material colour")?;
-                let kd = r.number("Kd")?;
-                let ks = r.number("Ks")?;
-                let shine = r.number("Shine")?;
-                let t = r.number("T (transmittance)")?;
-                let ior = r.number("index of refraction")?;
-                if t > 0.0 && ior <= 0.0 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        format!(
-                            "index of refraction {ior} must be > 0 for a transmitting material"
-                        ),
-                    ));
-                }
-                if shine < 0.0 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        format!("Phong exponent (Shine) {shine} must be >= 0"),
-                    ));
-                }
-                scene.materials.push(Material {
-                    color,
-                    kd,
-                    ks,
-                    shine,
-                    t,
-                    ior,
-                });
+                scene.materials.push(r.material(line, col)?);
                 scene.lines.materials.push(line);
                 material = Some(scene.materials.len() - 1);
             }
             "s" => {
-                let center = r.vec3("sphere centre")?;
-                let radius = r.number("sphere radius")?;
-                if radius == 0.0 {
-                    return Err(r.err_at(line, col, "sphere has radius 0".into()));
-                }
-                add(
-                    &mut scene,
-                    Shape::from(Sphere {
-                        center,
-                        radius: radius.abs(),
-                        inside: radius < 0.0,
-                    }),
-                );
+                let shape = r.sphere(line, col)?;
+                add(&mut scene, shape);
             }
             "c" => {
-                let base = r.vec3("cone base point")?;
-                let base_radius = r.number("cone base radius")?;
-                let apex = r.vec3("cone apex point")?;
-                let apex_radius = r.number("cone apex radius")?;
-                let inside = base_radius < 0.0 || apex_radius < 0.0;
-                if inside && !(base_radius <= 0.0 && apex_radius <= 0.0) {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        "cone radii must both be negative (inside visible) or both >= 0".into(),
-                    ));
-                }
-                if (apex - base).length() == 0.0 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        "cone/cylinder base and apex are coincident".into(),
-                    ));
-                }
-                if base_radius == 0.0 && apex_radius == 0.0 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        "cone/cylinder has radius 0 at both ends".into(),
-                    ));
-                }
-                add(
-                    &mut scene,
-                    Shape::from(Cone {
-                        base,
-                        base_radius: base_radius.abs(),
-                        apex,
-                        apex_radius: apex_radius.abs(),
-                        inside,
-                        caps: false,
-                    }),
-                );
+                let shape = r.cone(line, col)?;
+                add(&mut scene, shape);
             }
             "p" | "pp" => {
-                let patch = kw == "pp";
-                let n = r.count("the number of vertices")?;
-                if n < 3 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        format!("polygon with {n} vertices: it needs at least 3"),
-                    ));
-                }
-                if n > 1 << 20 {
-                    return Err(r.err_at(
-                        line,
-                        col,
-                        format!("polygon with {n} vertices is too large"),
-                    ));
-                }
-                let mut v = Vec::with_capacity(n);
-                let mut normals = Vec::new();
-                for i in 0..n {
-                    v.push(r.vec3(&format!("vertex {} of {n}", i + 1))?);
-                    if patch {
-                        normals.push(r.vec3(&format!("normal of vertex {} of {n}", i + 1))?);
-                    }
-                }
-                let shape = polygon_shape(v, if patch { Some(normals) } else { None });
-                // zero area: skipped after reading, with one warning
-                if let Some(msg) = shape.degeneracy().filter(|_| shape.zero_area().is_none()) {
-                    return Err(r.err_at(line, col, msg));
-                }
+                let shape = r.polygon(kw == "pp", line, col)?;
                 add(&mut scene, shape);
             }
             _ => {
