@@ -77,6 +77,17 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
         opt: base,
         nm,
     }];
+    numerics_knobs(&mut v, base, nm);
+    ray_knobs(&mut v, base, nm);
+    tree_knobs(&mut v, base, nm);
+    packet_knobs(&mut v, width, height, nm);
+    chip_knobs(&mut v, base, width, height, nm);
+    v
+}
+
+/// The RC arithmetic's knobs on the paper's configuration: Newton steps,
+/// guard bits, table sizes, normals, the ray offset.
+fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     for newton_steps in [0, 1, 2, 3] {
         v.push(Knob {
             knob: "newton_steps",
@@ -128,6 +139,10 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm: Numerics { eps_lsb, ..nm },
         });
     }
+}
+
+/// The rays in flight and the recursion depth.
+fn ray_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     for ways in [4, 8, 16, 32, 64] {
         v.push(Knob {
             knob: "ways",
@@ -144,6 +159,10 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
+}
+
+/// The paper's BSP: its depth limit, leaf size and split rule.
+fn tree_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     for max_depth in [2, 4, 8, 15] {
         v.push(Knob {
             knob: "bsp_depth",
@@ -184,6 +203,10 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
         },
         nm,
     });
+}
+
+/// The packet traversal's choices, each forced (its defaults probe them).
+fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
     // The packet traversal's trees, each forced (its default probes all
     // three and keeps the fastest).
     for rule in [SplitRule::Median, SplitRule::Sah, SplitRule::Chip] {
@@ -278,6 +301,10 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
             nm,
         });
     }
+}
+
+/// The chip: the datapath, the traversal, the node layout.
+fn chip_knobs(v: &mut Vec<Knob>, base: Options, width: u32, height: u32, nm: Numerics) {
     for datapath in [Datapath::W16, Datapath::W32] {
         v.push(Knob {
             knob: "datapath",
@@ -301,7 +328,6 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
         },
         nm,
     });
-    v
 }
 
 /// The knob sweep's configurations: every knob on the default timing,
