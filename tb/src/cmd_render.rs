@@ -506,7 +506,7 @@ fn print_report(
         j["bsp_nodes"],
         j["bsp_max_depth"]
     );
-    if firmware::tracer::shadows::applies(&opt, &chip.firmware.layout) {
+    if firmware::tracer::shadows::applies(opt, &chip.firmware.layout) {
         crate::report!(
             "shadow packets           {} (the reflection levels' shadow rays: {}{})",
             chip.firmware.shadows,

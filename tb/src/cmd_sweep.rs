@@ -508,47 +508,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
     } else {
         vec![]
     };
-    // The scenes, loaded (or generated) up front: a bad one stops the sweep
-    // before any render.
-    let mut scenes: Vec<(SceneRef, firmware::scene::Scene)> = Vec::new();
-    if a.knobs {
-        let asked: Vec<Option<&Path>> = if a.scenes.is_empty() {
-            vec![None]
-        } else {
-            a.scenes.iter().map(|p| Some(p.as_path())).collect()
-        };
-        for p in asked {
-            let scene = load_scene(p)?;
-            let file = p.map_or_else(crate::cmd_scene::default_scene, Path::to_path_buf);
-            scenes.push((
-                SceneRef {
-                    name: scene.source.clone(),
-                    primitives: scene.objects.len(),
-                    file,
-                    family: None,
-                    size: None,
-                },
-                scene,
-            ));
-        }
-    }
-    for f in &a.families {
-        firmware::scene::spd::default_size(f).map_err(|e| anyhow::anyhow!("--families: {e}"))?;
-        for size in 1..=a.max_size {
-            let s = firmware::scene::spd::scene(f, size)
-                .map_err(|e| anyhow::anyhow!("--max-size {}: {}", a.max_size, e.message))?;
-            scenes.push((
-                SceneRef {
-                    name: s.source.clone(),
-                    primitives: s.objects.len(),
-                    file: PathBuf::from(&s.source),
-                    family: Some(f.clone()),
-                    size: Some(size),
-                },
-                s,
-            ));
-        }
-    }
+    let scenes = sweep_scenes(&a)?;
     let refs: Vec<SceneRef> = scenes.iter().map(|s| s.0.clone()).collect();
     let (pts, jobs) = points(&refs, &cfgs, a.family_size);
     if let Some(dir) = &a.plan {
@@ -627,15 +587,187 @@ pub fn command(a: SweepArgs) -> Result<()> {
     for p in &pts {
         per_job[p.job] += 1;
     }
-    // What runs: each render of the knob sweep on its own, and each chain
-    // of the size sweep (a family with one traversal, its sizes in order)
-    // as one task that renders one size after the other and stops once a
-    // render's chips took longer than --size-seconds (summed over
-    // the threads, so about one thread's time, whatever runs beside it).
-    // The tasks run concurrently on the thread pool, the chains first
-    // (each render's work items share the pool), and the table takes
-    // the renders in its own order: it is the one a render after another
-    // gives.
+    let tasks = sweep_tasks(&jobs, &pts, &scenes);
+    {
+        use rayon::prelude::*;
+        let measured: Vec<Vec<(usize, Option<serde_json::Value>)>> = tasks
+            .par_iter()
+            .enumerate()
+            .map(|(task, chain)| {
+                let run = ChainRun {
+                    pts: &pts,
+                    jobs: &jobs,
+                    scenes: &scenes,
+                    per_job: &per_job,
+                    bar: &bar,
+                    skipped: &skipped,
+                    size_seconds: a.size_seconds,
+                };
+                run.chain(chain, task, &measure)
+            })
+            .collect();
+        done.extend(measured.into_iter().flatten());
+    }
+    for p in &pts {
+        if let Some(Some(j)) = done.get(&p.job) {
+            rows.push(point_row(&refs, p, j));
+        }
+    }
+    bar.finish_and_clear();
+    report_counts(resumed.into_inner(), skipped.into_inner(), &points_dir);
+    if rows.is_empty() {
+        anyhow::bail!("no configuration of the sweep could be rendered (see above)");
+    }
+    write_results(&rows, &a.out_dir)
+}
+
+/// What the sweep took from an earlier run and what it skipped.
+fn report_counts(resumed: usize, skipped: usize, points_dir: &Path) {
+    if resumed > 0 {
+        eprintln!(
+            "{resumed} renders taken from an earlier run ({}/NAME.json, same arguments)",
+            points_dir.display()
+        );
+    }
+    if skipped > 0 {
+        eprintln!("{skipped} configurations skipped (see above)");
+    }
+}
+
+/// What a task of the sweep reads as it renders its chain.
+struct ChainRun<'a> {
+    pts: &'a [Point],
+    jobs: &'a [Job],
+    scenes: &'a [(SceneRef, firmware::scene::Scene)],
+    /// Points per job (the progress bar's steps).
+    per_job: &'a [u64],
+    bar: &'a indicatif::ProgressBar,
+    skipped: &'a std::sync::atomic::AtomicUsize,
+    size_seconds: f64,
+}
+
+impl ChainRun<'_> {
+    /// The renders of one task's chain in order, by `measure` (a point,
+    /// the task, the step): a render that fails is reported and skipped,
+    /// and the sizes after one that took longer than --size-seconds are
+    /// skipped.
+    fn chain(
+        &self,
+        chain: &[usize],
+        task: usize,
+        measure: &(dyn Fn(&Point, usize, usize) -> Result<serde_json::Value> + Sync),
+    ) -> Vec<(usize, Option<serde_json::Value>)> {
+        let mut out = Vec::new();
+        // A size that took longer than --size-seconds: (size, seconds).
+        let mut slow: Option<(u32, f64)> = None;
+        for (step, &k) in chain.iter().enumerate() {
+            let p = &self.pts[self.jobs[k].point];
+            let sc = &self.scenes[p.scene].0;
+            let c = &p.cfg;
+            if let Some((size, t)) = slow {
+                self.bar.suspend(|| {
+                    eprintln!(
+                        "skipped {} with the {} traversal: size {size} took {t:.0} s (--size-seconds {})",
+                        sc.name,
+                        c.opt.traversal.name(),
+                        self.size_seconds
+                    )
+                });
+                self.skipped
+                    .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                self.bar.inc(self.per_job[k]);
+                out.push((k, None));
+                continue;
+            }
+            let r = match measure(p, task, step) {
+                Ok(j) => Some(j),
+                Err(e) => {
+                    // A configuration the chip cannot run (for
+                    // example a BSP too large for the FB) is
+                    // reported and skipped.
+                    self.bar.suspend(|| {
+                        eprintln!("skipped {} with {}={}: {e:#}", sc.name, c.knob, c.value)
+                    });
+                    self.skipped
+                        .fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                    None
+                }
+            };
+            if let (Some(j), Some(_)) = (&r, &sc.family) {
+                let t = j["host_chip_seconds"]
+                    .as_f64()
+                    .or_else(|| j["host_seconds"].as_f64())
+                    .unwrap_or(0.0);
+                if c.knob == SCENE_SIZE && t > self.size_seconds {
+                    slow = Some((sc.size.unwrap_or(0), t));
+                }
+            }
+            self.bar.inc(self.per_job[k]);
+            out.push((k, r));
+        }
+        out
+    }
+}
+
+/// The sweep's scenes, loaded (or generated) up front: a bad one stops the
+/// sweep before any render.
+fn sweep_scenes(a: &SweepArgs) -> Result<Vec<(SceneRef, firmware::scene::Scene)>> {
+    let mut scenes: Vec<(SceneRef, firmware::scene::Scene)> = Vec::new();
+    if a.knobs {
+        let asked: Vec<Option<&Path>> = if a.scenes.is_empty() {
+            vec![None]
+        } else {
+            a.scenes.iter().map(|p| Some(p.as_path())).collect()
+        };
+        for p in asked {
+            let scene = load_scene(p)?;
+            let file = p.map_or_else(crate::cmd_scene::default_scene, Path::to_path_buf);
+            scenes.push((
+                SceneRef {
+                    name: scene.source.clone(),
+                    primitives: scene.objects.len(),
+                    file,
+                    family: None,
+                    size: None,
+                },
+                scene,
+            ));
+        }
+    }
+    for f in &a.families {
+        firmware::scene::spd::default_size(f).map_err(|e| anyhow::anyhow!("--families: {e}"))?;
+        for size in 1..=a.max_size {
+            let s = firmware::scene::spd::scene(f, size)
+                .map_err(|e| anyhow::anyhow!("--max-size {}: {}", a.max_size, e.message))?;
+            scenes.push((
+                SceneRef {
+                    name: s.source.clone(),
+                    primitives: s.objects.len(),
+                    file: PathBuf::from(&s.source),
+                    family: Some(f.clone()),
+                    size: Some(size),
+                },
+                s,
+            ));
+        }
+    }
+    Ok(scenes)
+}
+
+/// What runs: each render of the knob sweep on its own, and each chain
+/// of the size sweep (a family with one traversal, its sizes in order)
+/// as one task that renders one size after the other and stops once a
+/// render's chips took longer than --size-seconds (summed over
+/// the threads, so about one thread's time, whatever runs beside it).
+/// The tasks run concurrently on the thread pool, the chains first
+/// (each render's work items share the pool), and the table takes
+/// the renders in its own order: it is the one a render after another
+/// gives.
+fn sweep_tasks(
+    jobs: &[Job],
+    pts: &[Point],
+    scenes: &[(SceneRef, firmware::scene::Scene)],
+) -> Vec<Vec<usize>> {
     let mut chains: Vec<((String, &str), Vec<usize>)> = Vec::new();
     let mut knob_jobs: Vec<usize> = Vec::new();
     for (k, job) in jobs.iter().enumerate() {
@@ -652,88 +784,11 @@ pub fn command(a: SweepArgs) -> Result<()> {
             None => knob_jobs.push(k),
         }
     }
-    let tasks: Vec<Vec<usize>> = chains
+    chains
         .into_iter()
         .map(|c| c.1)
         .chain(knob_jobs.into_iter().map(|k| vec![k]))
-        .collect();
-    {
-        use rayon::prelude::*;
-        let measured: Vec<Vec<(usize, Option<serde_json::Value>)>> = tasks
-            .par_iter()
-            .enumerate()
-            .map(|(task, chain)| {
-                let mut out = Vec::new();
-                // A size that took longer than --size-seconds: (size, seconds).
-                let mut slow: Option<(u32, f64)> = None;
-                for (step, &k) in chain.iter().enumerate() {
-                    let p = &pts[jobs[k].point];
-                    let sc = &scenes[p.scene].0;
-                    let c = &p.cfg;
-                    if let Some((size, t)) = slow {
-                        bar.suspend(|| {
-                            eprintln!(
-                                "skipped {} with the {} traversal: size {size} took {t:.0} s (--size-seconds {})",
-                                sc.name,
-                                c.opt.traversal.name(),
-                                a.size_seconds
-                            )
-                        });
-                        count(&skipped);
-                        bar.inc(per_job[k]);
-                        out.push((k, None));
-                        continue;
-                    }
-                    let r = match measure(p, task, step) {
-                        Ok(j) => Some(j),
-                        Err(e) => {
-                            // A configuration the chip cannot run (for
-                            // example a BSP too large for the FB) is
-                            // reported and skipped.
-                            bar.suspend(|| {
-                                eprintln!("skipped {} with {}={}: {e:#}", sc.name, c.knob, c.value)
-                            });
-                            count(&skipped);
-                            None
-                        }
-                    };
-                    if let (Some(j), Some(_)) = (&r, &sc.family) {
-                        let t = j["host_chip_seconds"]
-                            .as_f64()
-                            .or_else(|| j["host_seconds"].as_f64())
-                            .unwrap_or(0.0);
-                        if c.knob == SCENE_SIZE && t > a.size_seconds {
-                            slow = Some((sc.size.unwrap_or(0), t));
-                        }
-                    }
-                    bar.inc(per_job[k]);
-                    out.push((k, r));
-                }
-                out
-            })
-            .collect();
-        done.extend(measured.into_iter().flatten());
-    }
-    for p in &pts {
-        if let Some(Some(j)) = done.get(&p.job) {
-            rows.push(point_row(&refs, p, j));
-        }
-    }
-    bar.finish_and_clear();
-    let (resumed, skipped) = (resumed.into_inner(), skipped.into_inner());
-    if resumed > 0 {
-        eprintln!(
-            "{resumed} renders taken from an earlier run ({}/NAME.json, same arguments)",
-            points_dir.display()
-        );
-    }
-    if skipped > 0 {
-        eprintln!("{skipped} configurations skipped (see above)");
-    }
-    if rows.is_empty() {
-        anyhow::bail!("no configuration of the sweep could be rendered (see above)");
-    }
-    write_results(&rows, &a.out_dir)
+        .collect()
 }
 
 /// Write `results.csv` and the charts into `dir`.

@@ -207,8 +207,8 @@ impl Reader<'_> {
                 .get(r.pos + k)
                 .is_some_and(|t| t.line == line && t.text.parse::<f64>().is_ok())
         };
-        let color = if number(&r, 0) {
-            if !(number(&r, 1) && number(&r, 2)) {
+        let color = if number(r, 0) {
+            if !(number(r, 1) && number(r, 2)) {
                 let t = r.peek().map(|t| (t.line, t.col)).unwrap_or((line, 0));
                 return Err(r.err_at(
                     t.0,
