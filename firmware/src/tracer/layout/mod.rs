@@ -339,6 +339,7 @@ fn build_as(
         x: xb,
         fans: Vec::new(),
         fan_most: 0,
+        marks: Vec::new(),
     };
     // Init stream.
     w.fb.extend(table_slots_for(128, xb));

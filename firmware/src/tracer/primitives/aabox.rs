@@ -26,19 +26,33 @@
 use super::super::emit::{Code, K};
 use super::super::math::divide;
 use super::super::memory_map::ram;
-use super::record::W;
+use super::record::{Field, Layout, W};
 use super::{self_margin, Fit, Gen, Object, RecordError, Sides, TestCost};
 use crate::scene::Vec3;
 
 /// Words of one copy of the record.
 pub const WORDS: usize = 24;
 
+/// The record's fields: a section per axis, entry faces (and for a glass
+/// box exit faces), each `face_a, face_a', slab_b, slab_c, obj, mat`.
+pub const SECTIONS: [Field; 6] = [
+    Field::part("x", "the x faces and the y, z slabs"),
+    Field::part("y", "the y faces and the z, x slabs"),
+    Field::part("z", "the z faces and the x, y slabs"),
+    Field::part("exit x", "a glass box's x exit faces"),
+    Field::part("exit y", "a glass box's y exit faces"),
+    Field::part("exit z", "a glass box's z exit faces"),
+];
+
+/// The record of a box of `s`: 8 words per section.
+pub fn layout(s: Sides) -> Layout {
+    let n = if s == Sides::Both { 6 } else { 3 };
+    Layout::new(SECTIONS[..n].iter().map(|&f| (f, WORDS / 3)))
+}
+
 /// Words of a record.
 pub fn words(s: Sides) -> usize {
-    match s {
-        Sides::Front => WORDS,
-        Sides::Both => 2 * WORDS,
-    }
+    layout(s).words()
 }
 
 pub fn kernel_name(s: Sides) -> &'static str {
@@ -53,7 +67,8 @@ pub(crate) fn write(w: &mut W, sides: Sides, min: Vec3, max: Vec3, id: usize, ma
     let s = w.s;
     let q = |x: f64| (x * s).round() as i64;
     let copies = words(sides) / WORDS;
-    for a in (0..3).cycle().take(3 * copies) {
+    for (k, a) in (0..3).cycle().take(3 * copies).enumerate() {
+        w.field(SECTIONS[k]);
         let (b, c) = ((a + 1) % 3, (a + 2) % 3);
         w.raw(q(min.axis(a)));
         w.raw(q(max.axis(a)));
@@ -179,8 +194,8 @@ impl super::ChipPrimitive for AaBox {
         ["box", "glass_box"]
     }
 
-    fn record_words(&self, sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> usize {
-        words(sides)
+    fn layout(&self, sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        layout(sides)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {

@@ -49,7 +49,7 @@ use super::super::emit::{define, Code, Reg, K, R7};
 use super::super::math::{divide_q13, normalize, sqrt_q14, Approx};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::record::{Fitter, W};
+use super::record::{Field, Fitter, Layout, W};
 use super::{
     commit_obj_mat, perpendicular, self_margin, Body, CutTest, Fit, Gen, Geometry, Object,
     RecordError, Sides, TestCost,
@@ -59,65 +59,37 @@ use crate::scene::{Scene, Shape, Vec3};
 /// Words of the body.
 pub const BODY_WORDS: usize = 40;
 
-/// Words of a record: caps flag, body (twice for a glass cone), caps;
-/// without `caps` (records that carry none) the body alone.
-pub fn words(s: Sides, caps: bool) -> usize {
-    let bodies = if s == Sides::Both { 2 } else { 1 };
-    if caps {
-        1 + bodies * BODY_WORDS + 2 * planar::WORDS
-    } else {
-        bodies * BODY_WORDS
-    }
-}
+/// The record's fields: the caps flag, the body (twice for a glass cone:
+/// the second seen from inside), the caps' discs.
+pub const CONE_CAPS: Field = Field::named("CONE_CAPS", "cone record: caps flag");
+pub const CONE_BODY: Field = Field::named("CONE_BODY", "cone record: the body's stream");
+pub const GCONE_INNER: Field = Field::named("GCONE_INNER", "glass cone record: the inner body");
+pub const CONE_CAP0: Field = Field::named("CONE_CAP0", "cone record: base cap (a disc)");
+pub const CONE_CAP1: Field = Field::named("CONE_CAP1", "cone record: apex cap");
+pub const GCONE_CAP0: Field = Field::named("GCONE_CAP0", "glass cone record: base cap");
+pub const GCONE_CAP1: Field = Field::named("GCONE_CAP1", "glass cone record: apex cap");
 
-/// The record's fields the broadcast addresses (header lines); `caps`:
-/// the records carry caps.
-pub fn header(types_sides: &[Sides], caps: bool) -> Vec<String> {
-    if !caps {
-        let mut v = vec![define("CONE_BODY", 0, "cone record: the body's stream")];
-        if types_sides.contains(&Sides::Both) {
-            v.push(define(
-                "GCONE_INNER",
-                BODY_WORDS,
-                "glass cone record: the inner body",
-            ));
-        }
-        return v;
+/// The record of `s`: caps flag, body (twice for a glass cone), caps;
+/// without `caps` (records that carry none) the body alone.
+pub fn layout(s: Sides, caps: bool) -> Layout {
+    let glass = s == Sides::Both;
+    let mut l = Vec::new();
+    if caps {
+        l.push((CONE_CAPS, 1));
     }
-    let mut v = vec![
-        define("CONE_CAPS", 0, "cone record: caps flag"),
-        define("CONE_BODY", 1, "cone record: the body's stream"),
-    ];
-    if types_sides.contains(&Sides::Front) {
-        v.push(define(
-            "CONE_CAP0",
-            1 + BODY_WORDS,
-            "cone record: base cap (a disc)",
-        ));
-        v.push(define(
-            "CONE_CAP1",
-            1 + BODY_WORDS + planar::WORDS,
-            "cone record: apex cap",
-        ));
+    l.push((CONE_BODY, BODY_WORDS));
+    if glass {
+        l.push((GCONE_INNER, BODY_WORDS));
     }
-    if types_sides.contains(&Sides::Both) {
-        v.push(define(
-            "GCONE_INNER",
-            1 + BODY_WORDS,
-            "glass cone record: the inner body",
-        ));
-        v.push(define(
-            "GCONE_CAP0",
-            1 + 2 * BODY_WORDS,
-            "glass cone record: base cap",
-        ));
-        v.push(define(
-            "GCONE_CAP1",
-            1 + 2 * BODY_WORDS + planar::WORDS,
-            "glass cone record: apex cap",
-        ));
+    if caps {
+        let (c0, c1) = if glass {
+            (GCONE_CAP0, GCONE_CAP1)
+        } else {
+            (CONE_CAP0, CONE_CAP1)
+        };
+        l.extend([(c0, planar::WORDS), (c1, planar::WORDS)]);
     }
-    v
+    Layout(l)
 }
 
 fn body_name(b: Body) -> &'static str {
@@ -249,6 +221,7 @@ pub(crate) fn write(
     let sg = if inside { -1.0 } else { 1.0 };
     let one = w.one();
     if let Some((on, _)) = caps {
+        w.field(CONE_CAPS);
         w.raw(on as i64);
     }
     // A transmitting cone: the body twice, the second seen from the other
@@ -258,7 +231,8 @@ pub(crate) fn write(
     } else {
         &[1.0]
     };
-    for &side in copies {
+    for (&side, field) in copies.iter().zip([CONE_BODY, GCONE_INNER]) {
+        w.field(field);
         let sg = sg * side;
         w.push(cf.m_q.x);
         w.push(cf.m_q.y);
@@ -284,7 +258,13 @@ pub(crate) fn write(
         w.raw(id as i64);
         w.raw(mat as i64);
     }
-    for p in caps.into_iter().flat_map(|(_, c)| c) {
+    let cap_fields = if sides == Sides::Both {
+        [GCONE_CAP0, GCONE_CAP1]
+    } else {
+        [CONE_CAP0, CONE_CAP1]
+    };
+    for (p, field) in caps.into_iter().flat_map(|(_, c)| c).zip(cap_fields) {
+        w.field(field);
         let mut p = *p;
         p.n = p.n * sg;
         planar::write(w, &fit.kt, &p, id, mat);
@@ -610,8 +590,8 @@ impl super::ChipPrimitive for Cone {
         ["cone", "glass_cone"]
     }
 
-    fn record_words(&self, sides: Sides, _fit: &Fit, _fan: usize, caps: bool) -> usize {
-        words(sides, caps)
+    fn layout(&self, sides: Sides, _fit: &Fit, _fan: usize, caps: bool) -> Layout {
+        layout(sides, caps)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
@@ -625,7 +605,7 @@ impl super::ChipPrimitive for Cone {
     fn cut_test(&self, sides: Sides) -> Option<CutTest> {
         (sides == Sides::Front).then(|| CutTest {
             kernel: body_name(Body::Opaque),
-            field: "CONE_BODY",
+            field: CONE_BODY.name,
             cuts: &CUTS,
             then: None,
         })
@@ -639,10 +619,6 @@ impl super::ChipPrimitive for Cone {
         if caps && sides == Sides::Front {
             broadcast_caps(t, at, rec);
         }
-    }
-
-    fn record_header(&self, _fit: &Fit, sides: &[Sides], caps: bool) -> Vec<String> {
-        header(sides, caps)
     }
 
     fn fit_header(&self, fit: &Fit) -> Vec<String> {

@@ -45,7 +45,7 @@ use super::super::emit::{define, Code, Reg, K, R7};
 use super::super::math::{divide, normalize, perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::record::{Fitter, W};
+use super::record::{Field, Fitter, Layout, W};
 use super::{
     commit_obj_mat, perpendicular, self_margin, Body, CutTest, Fit, Gen, Geometry, Object,
     RecordError, Sides, TestCost,
@@ -70,67 +70,38 @@ pub const fn body_words(fine_normals: bool) -> usize {
     }
 }
 
-/// Words of a record: caps flag, body (twice for a glass cylinder), caps;
-/// without `caps` (records that carry none) the body alone.
-pub fn words(fit: &Fit, s: Sides, caps: bool) -> usize {
-    let bodies = if s == Sides::Both { 2 } else { 1 };
-    let b = bodies * body_words(fit.fine_normals);
-    if caps {
-        1 + b + 2 * planar::WORDS
-    } else {
-        b
-    }
-}
+/// The record's fields: the caps flag, the body (twice for a glass
+/// cylinder: the second seen from inside), the caps' discs.
+pub const CYL_CAPS: Field = Field::named("CYL_CAPS", "cylinder record: caps flag");
+pub const CYL_BODY: Field = Field::named("CYL_BODY", "cylinder record: the body's stream");
+pub const GCYL_INNER: Field = Field::named("GCYL_INNER", "glass cylinder record: the inner body");
+pub const CYL_CAP0: Field = Field::named("CYL_CAP0", "cylinder record: base cap (a disc)");
+pub const CYL_CAP1: Field = Field::named("CYL_CAP1", "cylinder record: apex cap");
+pub const GCYL_CAP0: Field = Field::named("GCYL_CAP0", "glass cylinder record: base cap");
+pub const GCYL_CAP1: Field = Field::named("GCYL_CAP1", "glass cylinder record: apex cap");
 
-/// The record's fields the broadcast addresses (header lines); `caps`:
-/// the records carry caps.
-pub fn header(fit: &Fit, types_sides: &[Sides], caps: bool) -> Vec<String> {
+/// The record of `s`: caps flag, body (twice for a glass cylinder), caps;
+/// without `caps` (records that carry none) the body alone.
+pub fn layout(fit: &Fit, s: Sides, caps: bool) -> Layout {
     let body = body_words(fit.fine_normals);
-    if !caps {
-        let mut v = vec![define("CYL_BODY", 0, "cylinder record: the body's stream")];
-        if types_sides.contains(&Sides::Both) {
-            v.push(define(
-                "GCYL_INNER",
-                body,
-                "glass cylinder record: the inner body",
-            ));
-        }
-        return v;
+    let glass = s == Sides::Both;
+    let mut l = Vec::new();
+    if caps {
+        l.push((CYL_CAPS, 1));
     }
-    let mut v = vec![
-        define("CYL_CAPS", 0, "cylinder record: caps flag"),
-        define("CYL_BODY", 1, "cylinder record: the body's stream"),
-    ];
-    if types_sides.contains(&Sides::Front) {
-        v.push(define(
-            "CYL_CAP0",
-            1 + body,
-            "cylinder record: base cap (a disc)",
-        ));
-        v.push(define(
-            "CYL_CAP1",
-            1 + body + planar::WORDS,
-            "cylinder record: apex cap",
-        ));
+    l.push((CYL_BODY, body));
+    if glass {
+        l.push((GCYL_INNER, body));
     }
-    if types_sides.contains(&Sides::Both) {
-        v.push(define(
-            "GCYL_INNER",
-            1 + body,
-            "glass cylinder record: the inner body",
-        ));
-        v.push(define(
-            "GCYL_CAP0",
-            1 + 2 * body,
-            "glass cylinder record: base cap",
-        ));
-        v.push(define(
-            "GCYL_CAP1",
-            1 + 2 * body + planar::WORDS,
-            "glass cylinder record: apex cap",
-        ));
+    if caps {
+        let (c0, c1) = if glass {
+            (GCYL_CAP0, GCYL_CAP1)
+        } else {
+            (CYL_CAP0, CYL_CAP1)
+        };
+        l.extend([(c0, planar::WORDS), (c1, planar::WORDS)]);
     }
-    v
+    Layout(l)
 }
 
 fn body_name(b: Body) -> &'static str {
@@ -213,6 +184,7 @@ pub(crate) fn write(
     let brem = base * s - bq;
     let sg = if inside { -1.0 } else { 1.0 };
     if let Some((on, _)) = caps {
+        w.field(CYL_CAPS);
         w.raw(on as i64);
     }
     // A transmitting cylinder: the body twice, the second seen from the
@@ -222,7 +194,8 @@ pub(crate) fn write(
     } else {
         &[1.0]
     };
-    for &side in copies {
+    for (&side, field) in copies.iter().zip([CYL_BODY, GCYL_INNER]) {
+        w.field(field);
         let sg = sg * side;
         w.point(base);
         w.unit(e1);
@@ -260,7 +233,13 @@ pub(crate) fn write(
         w.raw(id as i64);
         w.raw(mat as i64);
     }
-    for p in caps.into_iter().flat_map(|(_, c)| c) {
+    let cap_fields = if sides == Sides::Both {
+        [GCYL_CAP0, GCYL_CAP1]
+    } else {
+        [CYL_CAP0, CYL_CAP1]
+    };
+    for (p, field) in caps.into_iter().flat_map(|(_, c)| c).zip(cap_fields) {
+        w.field(field);
         let mut p = *p;
         p.n = p.n * sg;
         planar::write(w, &fit.kt, &p, id, mat);
@@ -552,8 +531,8 @@ impl super::ChipPrimitive for Cylinder {
         ["cylinder", "glass_cylinder"]
     }
 
-    fn record_words(&self, sides: Sides, fit: &Fit, _fan: usize, caps: bool) -> usize {
-        words(fit, sides, caps)
+    fn layout(&self, sides: Sides, fit: &Fit, _fan: usize, caps: bool) -> Layout {
+        layout(fit, sides, caps)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
@@ -567,7 +546,7 @@ impl super::ChipPrimitive for Cylinder {
     fn cut_test(&self, sides: Sides) -> Option<CutTest> {
         (sides == Sides::Front).then(|| CutTest {
             kernel: body_name(Body::Opaque),
-            field: "CYL_BODY",
+            field: CYL_BODY.name,
             cuts: &CUTS,
             then: None,
         })
@@ -581,10 +560,6 @@ impl super::ChipPrimitive for Cylinder {
         if caps && sides == Sides::Front {
             broadcast_caps(t, at, rec);
         }
-    }
-
-    fn record_header(&self, fit: &Fit, sides: &[Sides], caps: bool) -> Vec<String> {
-        header(fit, sides, caps)
     }
 
     fn fit_header(&self, fit: &Fit) -> Vec<String> {

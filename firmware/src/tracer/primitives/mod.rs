@@ -45,7 +45,7 @@ use super::emit::{define, Code, Reg, K, R3};
 use super::math::Approx;
 use super::memory_map::ram;
 use crate::scene::{PrimType, Scene, Shape};
-use record::{Fitter, W};
+use record::{Fitter, Layout, W};
 
 /// One primitive of the chip: everything the tracer knows of it, for
 /// both its kinds (opaque, [`Sides::Front`]; glass, [`Sides::Both`]).
@@ -56,9 +56,16 @@ pub trait ChipPrimitive: Sync {
     /// The opaque and the glass type's names (`sphere`, `glass_sphere`).
     fn names(&self) -> [&'static str; 2];
 
-    /// Words of one object's record (`fan`: a polygon record's edges;
-    /// `caps`: a cylinder's or cone's record carries caps).
-    fn record_words(&self, sides: Sides, fit: &Fit, fan: usize, caps: bool) -> usize;
+    /// One object's record, declared once: its fields in stream order and
+    /// their words (`fan`: a polygon record's edges; `caps`: a cylinder's
+    /// or cone's record carries caps). The record's words, the header's
+    /// field names and the check of the writer come from it.
+    fn layout(&self, sides: Sides, fit: &Fit, fan: usize, caps: bool) -> Layout;
+
+    /// Words of one object's record: its [`ChipPrimitive::layout`]'s.
+    fn record_words(&self, sides: Sides, fit: &Fit, fan: usize, caps: bool) -> usize {
+        self.layout(sides, fit, fan, caps).words()
+    }
 
     /// The kernels its test runs, in load order: (label, kernel). Each
     /// reads from the FB stream exactly the words its record holds.
@@ -103,8 +110,13 @@ pub trait ChipPrimitive: Sync {
     /// The header lines naming the record's fields that the broadcast
     /// addresses (`sides`: the sides of the scene's types of this
     /// primitive; `caps`: its records carry caps).
-    fn record_header(&self, _fit: &Fit, _sides: &[Sides], _caps: bool) -> Vec<String> {
-        Vec::new()
+    fn record_header(&self, fit: &Fit, sides: &[Sides], caps: bool) -> Vec<String> {
+        let layouts: Vec<Layout> = [Sides::Front, Sides::Both]
+            .into_iter()
+            .filter(|s| sides.contains(s))
+            .map(|s| self.layout(s, fit, 0, caps))
+            .collect();
+        Layout::header(&layouts)
     }
 
     /// The header lines of its scale shifts in `fit`.

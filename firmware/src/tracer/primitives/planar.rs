@@ -32,15 +32,36 @@
 use super::super::emit::{define, Code, K};
 use super::super::math::divide;
 use super::super::memory_map::ram;
-use super::record::W;
+use super::record::{total, Field, Layout, W};
 use super::{
     commit_streamed_normal, commit_streamed_normal_two, CutTest, Fit, Gen, Geometry, Object,
     RecordError, Sides, TestCost,
 };
 use crate::scene::{Shape, Vec3};
 
+/// The record's fields, in stream order.
+pub const NORMAL: Field = Field::part("n.xyz", "the plane's unit normal (Q1.14)");
+pub const VERTEX: Field = Field::part("v0.xyz", "a vertex, for the plane's offset");
+pub const VERTEX_AGAIN: Field =
+    Field::part("v0.xyz'", "the vertex again, for the hit's coordinates");
+pub const EDGE_U: Field = Field::part("eu.xyz", "the first edge dual, scaled by 2^KT");
+pub const EDGE_W: Field = Field::part("ew.xyz", "the second edge dual, scaled by 2^KT");
+pub const NORMAL_AGAIN: Field = Field::part("n.xyz'", "the normal again, for the hit");
+pub const OBJ: Field = Field::part("obj", "the object's id");
+pub const MAT: Field = Field::part("mat", "its material");
+pub const FIELDS: [(Field, usize); 8] = [
+    (NORMAL, 3),
+    (VERTEX, 3),
+    (VERTEX_AGAIN, 3),
+    (EDGE_U, 3),
+    (EDGE_W, 3),
+    (NORMAL_AGAIN, 3),
+    (OBJ, 1),
+    (MAT, 1),
+];
+
 /// Record words.
-pub const WORDS: usize = 20;
+pub const WORDS: usize = total(&FIELDS);
 
 /// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
 pub const INSIDE_TOL: i32 = 2;
@@ -167,13 +188,21 @@ impl Planar {
 pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize) {
     let k = kt[p.kind.kt_index()];
     let sc = ((14 + w.x) as f64 - w.frac as f64 + k as f64).exp2();
+    w.field(NORMAL);
     w.unit(p.n);
+    w.field(VERTEX);
     w.point(p.v0);
+    w.field(VERTEX_AGAIN);
     w.point(p.v0);
+    w.field(EDGE_U);
     w.scaled(p.eu, sc);
+    w.field(EDGE_W);
     w.scaled(p.ew, sc);
+    w.field(NORMAL_AGAIN);
     w.unit(p.n);
+    w.field(OBJ);
     w.raw(id as i64);
+    w.field(MAT);
     w.raw(mat as i64);
 }
 
@@ -332,8 +361,8 @@ impl super::ChipPrimitive for PlanarPrimitive {
         }
     }
 
-    fn record_words(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> usize {
-        WORDS
+    fn layout(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        Layout::new(FIELDS)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {

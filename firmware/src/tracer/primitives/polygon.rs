@@ -71,19 +71,55 @@
 //! **Error** against the f64 polygon (`tb/tests/kernels.rs`, a convex, a
 //! concave and a gear-like polygon): `t` within 3 LSB, no crack.
 
-use super::super::emit::{define, Code, Name, Reg, K, R0, R1, R2, R3, R7};
+use super::super::emit::{Code, Name, Reg, K, R0, R1, R2, R3, R7};
 use super::super::memory_map::ram;
 use super::planar::plane_hit;
-use super::record::W;
+use super::record::{Field, Layout, W};
 use super::{
     commit_streamed_normal, commit_streamed_normal_two, kaddr, klen, CutTest, Fit, Gen, Object,
     RecordError, Sides, TestCost,
 };
 use crate::scene::{Shape, Vec3};
 
-/// A record's first word: its number of edges (sub-edges' bands where
-/// banded).
-pub const POLY_EDGES: Name = Name::new("POLY_EDGES", 0, "polygon record: number of edges (words)");
+/// The record's fields. A plain record: the edge count, the head, the
+/// edges, the tail; a banded one: the band count, the head, the bands'
+/// table (bounds, starts, the tail's offset), the sub-edges (or, apart,
+/// where they are in main memory), the tail.
+pub const POLY_EDGES: Field = Field::named("POLY_EDGES", "polygon record: number of edges (words)");
+pub const POLY_NB: Field = Field::named("POLY_NB", "banded polygon record: number of bands");
+pub const POLY_HEAD: Field = Field::named("POLY_HEAD", "polygon record: the head kernel's stream");
+pub const POLY_BOUNDS: Field = Field::named("POLY_BOUNDS", "  the bands' bounds Y_0..Y_nb");
+pub const POLY_STARTS: Field = Field::named(
+    "POLY_STARTS",
+    "  per band its first sub-edge (words from POLY_FAN), and the end",
+);
+pub const POLY_STARTS_APART: Field = Field::named(
+    "POLY_STARTS",
+    "  per band its first sub-edge (words from the first), and the end",
+);
+pub const POLY_TAIL: Field = Field::named("POLY_TAIL", "  the tail's offset");
+pub const POLY_FANS_AT: Field = Field::named(
+    "POLY_FANS_AT",
+    "  its sub-edges in main memory: FAN_UNIT-byte units from FANS",
+);
+pub const POLY_FAN: Field = Field::named("POLY_FAN", "polygon record: the first edge's stream");
+pub const POLY_BAND_FAN: Field = Field::named("POLY_FAN", "  the first sub-edge's stream");
+pub const TAIL: Field = Field::part(
+    "tail",
+    "the face normal, obj, mat (the tail kernel's stream)",
+);
+
+/// The words of an edge's and a sub-edge's stream (header constants).
+pub const POLY_EDGE_WORDS: Name = Name::new(
+    "POLY_EDGE_WORDS",
+    EDGE_WORDS as u32,
+    "words of an edge's stream",
+);
+pub const POLY_BAND_EDGE_WORDS: Name = Name::new(
+    "POLY_BAND_EDGE_WORDS",
+    BAND_EDGE_WORDS as u32,
+    "words of a sub-edge's stream",
+);
 
 /// Words of the head, one edge and the tail.
 pub const HEAD_WORDS: usize = 15;
@@ -145,66 +181,52 @@ pub fn keeps_apart(banded_words: usize) -> bool {
     banded_words > APART_FROM
 }
 
-/// Words of a record with room for `fan` edges (sub-edges where banded;
-/// none where they are apart).
-pub fn words(fan: usize, form: Form) -> usize {
+/// The record with room for `fan` edges (sub-edges where banded; none
+/// where they are apart).
+pub fn layout(fan: usize, form: Form) -> Layout {
+    let table = [(POLY_BOUNDS, BANDS + 1), (POLY_TAIL, 1)];
     match form {
-        Form::Plain => 1 + HEAD_WORDS + fan * EDGE_WORDS + TAIL_WORDS,
-        Form::Banded => 1 + HEAD_WORDS + TABLE_WORDS + fan * BAND_EDGE_WORDS + TAIL_WORDS,
-        Form::Apart => 1 + HEAD_WORDS + TABLE_WORDS + 1 + TAIL_WORDS,
+        Form::Plain => Layout::new([
+            (POLY_EDGES, 1),
+            (POLY_HEAD, HEAD_WORDS),
+            (POLY_FAN, fan * EDGE_WORDS),
+            (TAIL, TAIL_WORDS),
+        ]),
+        Form::Banded => Layout::new([
+            (POLY_NB, 1),
+            (POLY_HEAD, HEAD_WORDS),
+            table[0],
+            (POLY_STARTS, BANDS + 1),
+            table[1],
+            (POLY_BAND_FAN, fan * BAND_EDGE_WORDS),
+            (TAIL, TAIL_WORDS),
+        ]),
+        Form::Apart => Layout::new([
+            (POLY_NB, 1),
+            (POLY_HEAD, HEAD_WORDS),
+            table[0],
+            (POLY_STARTS_APART, BANDS + 1),
+            table[1],
+            (POLY_FANS_AT, 1),
+            (TAIL, TAIL_WORDS),
+        ]),
     }
 }
 
-/// The record's fields the broadcast addresses (header lines).
+/// Words of a record with room for `fan` edges.
+pub fn words(fan: usize, form: Form) -> usize {
+    layout(fan, form).words()
+}
+
+/// The header lines of the record's fields and of an edge's words.
 pub fn header(form: Form) -> Vec<String> {
-    if form.banded() {
-        let bounds = 1 + HEAD_WORDS;
-        let starts = bounds + BANDS + 1;
-        let apart = form == Form::Apart;
-        return vec![
-            define("POLY_NB", 0, "banded polygon record: number of bands"),
-            define("POLY_HEAD", 1, "polygon record: the head kernel's stream"),
-            define("POLY_BOUNDS", bounds, "  the bands' bounds Y_0..Y_nb"),
-            define(
-                "POLY_STARTS",
-                starts,
-                if apart {
-                    "  per band its first sub-edge (words from the first), and the end"
-                } else {
-                    "  per band its first sub-edge (words from POLY_FAN), and the end"
-                },
-            ),
-            define("POLY_TAIL", starts + BANDS + 1, "  the tail's offset"),
-            if apart {
-                define(
-                    "POLY_FANS_AT",
-                    starts + BANDS + 2,
-                    "  its sub-edges in main memory: FAN_UNIT-byte units from FANS",
-                )
-            } else {
-                define(
-                    "POLY_FAN",
-                    1 + HEAD_WORDS + TABLE_WORDS,
-                    "  the first sub-edge's stream",
-                )
-            },
-            define(
-                "POLY_BAND_EDGE_WORDS",
-                BAND_EDGE_WORDS,
-                "words of a sub-edge's stream",
-            ),
-        ];
-    }
-    vec![
-        POLY_EDGES.define(),
-        define("POLY_HEAD", 1, "polygon record: the head kernel's stream"),
-        define(
-            "POLY_FAN",
-            1 + HEAD_WORDS,
-            "polygon record: the first edge's stream",
-        ),
-        define("POLY_EDGE_WORDS", EDGE_WORDS, "words of an edge's stream"),
-    ]
+    let mut v = Layout::header(&[layout(0, form)]);
+    v.push(if form.banded() {
+        POLY_BAND_EDGE_WORDS.define()
+    } else {
+        POLY_EDGE_WORDS.define()
+    });
+    v
 }
 
 pub fn head_name(s: Sides) -> &'static str {
@@ -332,10 +354,12 @@ pub(crate) fn write(
     let n = normal(v);
     let ((ua, va), edges) = edges(v, w.s);
     let banded = form.banded().then(|| bands(&edges));
+    w.field(if form.banded() { POLY_NB } else { POLY_EDGES });
     w.raw(match &banded {
         Some((bounds, _)) => bounds.len() as i64 - 1,
         None => edges.len() as i64,
     });
+    w.field(POLY_HEAD);
     w.unit(n);
     w.point(v[0]);
     w.point(v[0]);
@@ -354,16 +378,23 @@ pub(crate) fn write(
                 w.raw(*xs.get(k).unwrap_or(&0));
             }
         };
+        w.field(POLY_BOUNDS);
         row(w, bounds, BANDS + 1);
         let mut at = vec![0i64];
         for b in sub {
             at.push(at.last().unwrap() + (b.len() * BAND_EDGE_WORDS) as i64);
         }
+        w.field(if form == Form::Apart {
+            POLY_STARTS_APART
+        } else {
+            POLY_STARTS
+        });
         row(w, &at, BANDS + 1);
         let fan = 1 + HEAD_WORDS + TABLE_WORDS;
         if form == Form::Apart {
             // The tail after the sub-edges' place; the sub-edges on a
             // unit of their own in main memory.
+            w.field(POLY_TAIL);
             w.raw(fan as i64 + 1);
             let unit = FAN_UNIT / w.word_bytes();
             let units = w.fans.len() / unit;
@@ -373,6 +404,7 @@ pub(crate) fn write(
                     units * FAN_UNIT / 1024
                 ));
             }
+            w.field(POLY_FANS_AT);
             w.raw(units as i64);
             w.fan_most = w.fan_most.max(*at.last().unwrap() as usize);
             for x in sub.iter().flatten().flat_map(sub_edge_words) {
@@ -381,18 +413,24 @@ pub(crate) fn write(
             }
             w.fans.resize(w.fans.len().next_multiple_of(unit), 0);
         } else {
+            w.field(POLY_TAIL);
             w.raw(fan as i64 + at.last().unwrap());
+            w.field(POLY_BAND_FAN);
             for x in sub.iter().flatten().flat_map(sub_edge_words) {
                 w.raw(x);
             }
         }
     } else {
+        w.field(POLY_FAN);
         for e in &edges {
             for x in e {
                 w.raw(*x);
             }
         }
     }
+    // The tail after the record's own edges; the record padded to its
+    // layout's room for the scene's most edges.
+    w.field(TAIL);
     w.unit(n);
     w.raw(id as i64);
     w.raw(mat as i64);
@@ -552,8 +590,11 @@ fn tail(sides: Sides) -> K {
 /// Broadcast a polygon's test (record at r7): the head, one edge run per
 /// edge, the tail. Labels begin with `at`.
 pub fn broadcast(t: &mut Code, at: &str, sides: Sides, form: Form) {
-    t.m("BCAST_REC", format!("{}, r7, POLY_HEAD", head_name(sides)))
-        .c("the plane");
+    t.m(
+        "BCAST_REC",
+        format!("{}, r7, {POLY_HEAD}", head_name(sides)),
+    )
+    .c("the plane");
     broadcast_edges(t, at, sides, R7, form);
 }
 
@@ -567,13 +608,13 @@ pub fn broadcast_edges(t: &mut Code, at: &str, sides: Sides, rec: Reg, form: For
     }
     t.lfb(R3, super::super::emit::at(POLY_EDGES, rec))
         .c("edges")
-        .addi(R2, rec, "POLY_FAN")
+        .addi(R2, rec, POLY_FAN)
         .li(R1, kaddr(EDGE));
     t.label(format!("{at}_fan"))
         .beqz(R3, format!("{at}_tail"))
         .sbcb(R1, R2, klen(EDGE))
         .c("one edge of the crossing test")
-        .addi(R2, R2, "POLY_EDGE_WORDS")
+        .addi(R2, R2, POLY_EDGE_WORDS)
         .addi(R3, R3, -1)
         .j(format!("{at}_fan"));
     t.label(format!("{at}_tail"))
@@ -596,7 +637,7 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
         .sw(R12, field(save(1), R0))
         .sw(R13, field(save(2), R0))
         .c("r8, r12, r13 kept")
-        .lfb(R3, field("POLY_NB", rec))
+        .lfb(R3, field(POLY_NB, rec))
         .addi(R3, R3, -1)
         .li(R1, 0)
         .c("r1, r3: the bands the lowest can be");
@@ -605,7 +646,7 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
         .add(R8, R1, R3)
         .srli(R8, R8, 1)
         .add(R12, rec, R8)
-        .addi(R12, R12, "POLY_BOUNDS+1")
+        .addi(R12, R12, format!("{POLY_BOUNDS}+1"))
         .addi(R2, R0, kaddr(BELOW))
         .sbcb(R2, R12, klen(BELOW))
         .c("some point below Y_mid+1?")
@@ -618,9 +659,9 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
         .j(format!("{at}_blo"));
     t.label(format!("{at}_blo_end"))
         .add(R12, rec, R1)
-        .lfb(R13, field("POLY_STARTS", R12))
+        .lfb(R13, field(POLY_STARTS, R12))
         .c("r13: the lowest band's first sub-edge")
-        .lfb(R3, field("POLY_NB", rec))
+        .lfb(R3, field(POLY_NB, rec))
         .addi(R3, R3, -1)
         .c("r1, r3: the bands the highest can be");
     t.label(format!("{at}_bhi"))
@@ -629,7 +670,7 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
         .addi(R8, R8, 1)
         .srli(R8, R8, 1)
         .add(R12, rec, R8)
-        .addi(R12, R12, "POLY_BOUNDS")
+        .addi(R12, R12, POLY_BOUNDS)
         .addi(R2, R0, kaddr(ABOVE))
         .sbcb(R2, R12, klen(ABOVE))
         .c("some point at or above Y_mid?")
@@ -642,14 +683,14 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
         .j(format!("{at}_bhi"));
     t.label(format!("{at}_bhi_end"))
         .add(R12, rec, R1)
-        .lfb(R3, field("POLY_STARTS+1", R12))
+        .lfb(R3, field(format!("{POLY_STARTS}+1"), R12))
         .sub(R3, R3, R13)
         .c("r3: words of the sub-edges to run");
     if apart {
         t.beqz(R3, format!("{at}_tail"))
             .rcany(R2)
             .c("the array done with the bank (no probe runs before a record of one band)")
-            .lfb(R2, field("POLY_FANS_AT", rec))
+            .lfb(R2, field(POLY_FANS_AT, rec))
             .slli(R2, R2, "FAN_UNIT_SHIFT")
             .slli(R13, R13, "FB_WORD_SHIFT")
             .add(R2, R2, R13)
@@ -665,18 +706,18 @@ fn broadcast_bands(t: &mut Code, at: &str, sides: Sides, rec: Reg, apart: bool) 
             .addi(R1, R0, kaddr(BAND_EDGE));
     } else {
         t.add(R2, rec, R13)
-            .addi(R2, R2, "POLY_FAN")
+            .addi(R2, R2, POLY_BAND_FAN)
             .addi(R1, R0, kaddr(BAND_EDGE));
     }
     t.label(format!("{at}_fan"))
         .beqz(R3, format!("{at}_tail"))
         .sbcb(R1, R2, klen(BAND_EDGE))
         .c("one sub-edge of the crossing test")
-        .addi(R2, R2, "POLY_BAND_EDGE_WORDS")
+        .addi(R2, R2, POLY_BAND_EDGE_WORDS)
         .addi(R3, R3, -(BAND_EDGE_WORDS as i64))
         .j(format!("{at}_fan"));
     t.label(format!("{at}_tail"))
-        .lfb(R2, field("POLY_TAIL", rec))
+        .lfb(R2, field(POLY_TAIL, rec))
         .add(R2, R2, rec)
         .m("BCAST_AT", format!("{}, r2", tail_name(sides)))
         .c("commit where the parity is odd")
@@ -694,8 +735,8 @@ impl super::ChipPrimitive for Polygon {
         ["polygon", "glass_polygon"]
     }
 
-    fn record_words(&self, _sides: Sides, fit: &Fit, fan: usize, _caps: bool) -> usize {
-        words(fan, fit.polygon_form)
+    fn layout(&self, _sides: Sides, fit: &Fit, fan: usize, _caps: bool) -> Layout {
+        layout(fan, fit.polygon_form)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
@@ -709,7 +750,7 @@ impl super::ChipPrimitive for Polygon {
     fn cut_test(&self, sides: Sides) -> Option<CutTest> {
         Some(CutTest {
             kernel: head_name(sides),
-            field: "POLY_HEAD",
+            field: POLY_HEAD.name,
             cuts: &[],
             then: Some("the plane hit before tbest"),
         })

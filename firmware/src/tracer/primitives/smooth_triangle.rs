@@ -30,12 +30,29 @@ use super::super::emit::{Code, K};
 use super::super::math::normalize;
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
-use super::record::W;
+use super::record::{total, Field, Layout, W};
 use super::{CutTest, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
 use crate::scene::{Shape, Vec3};
 
 /// Record words: the planar record with the vertex normals.
-pub const WORDS: usize = planar::WORDS + 9;
+/// The record's fields: the planar record's up to its edge duals, the
+/// unit vertex normals by axis, then the planar record's last three.
+pub const VERTEX_NORMALS: Field =
+    Field::part("(n0, n1, n2).xyz", "the unit vertex normals, by axis");
+pub const FIELDS: [(Field, usize); 9] = [
+    planar::FIELDS[0],
+    planar::FIELDS[1],
+    planar::FIELDS[2],
+    planar::FIELDS[3],
+    planar::FIELDS[4],
+    (VERTEX_NORMALS, 9),
+    planar::FIELDS[5],
+    planar::FIELDS[6],
+    planar::FIELDS[7],
+];
+
+/// Record words.
+pub const WORDS: usize = total(&FIELDS);
 
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
@@ -50,15 +67,19 @@ pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, ns: [Vec3; 3], id: usi
     // The planar record up to its face normal, the unit vertex normals by
     // axis (the kernel's read order), then the face normal, obj, mat.
     planar::write(w, kt, p, id, mat);
-    w.fb.truncate(w.fb.len() - 5);
+    w.truncate(w.fb.len() - 5);
+    w.field(VERTEX_NORMALS);
     let ns = ns.map(|n| n.normalized());
     for c in 0..3 {
         for n in &ns {
             w.unit_axis(n.axis(c));
         }
     }
+    w.field(planar::NORMAL_AGAIN);
     w.unit(p.n);
+    w.field(planar::OBJ);
     w.raw(id as i64);
+    w.field(planar::MAT);
     w.raw(mat as i64);
 }
 
@@ -190,8 +211,8 @@ impl super::ChipPrimitive for SmoothTriangle {
         ["smooth_triangle", "glass_smooth_triangle"]
     }
 
-    fn record_words(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> usize {
-        WORDS
+    fn layout(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        Layout::new(FIELDS)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {

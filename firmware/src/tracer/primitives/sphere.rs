@@ -38,13 +38,30 @@
 use super::super::emit::{define, Code, K};
 use super::super::math::{perpendicular_to, sqrt_q14};
 use super::super::memory_map::ram;
-use super::record::{Fitter, W};
+use super::record::{Field, Fitter, Layout, W};
 use super::{self_margin, CutTest, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
 use crate::scene::{Scene, Vec3};
 
-/// Record words, coarse and fine.
-pub const WORDS: usize = 8;
-pub const FINE_WORDS: usize = 11;
+/// The record's fields (the fine record has the centre's remainder).
+pub const CENTRE: Field = Field::part("c.xyz", "the centre");
+pub const CENTRE_REM: Field = Field::part("cl.xyz", "the centre's rounding remainder, 2^-14 LSB");
+pub const INV_R: Field = Field::part("invr", "2^(14+KS_SPHERE) / r");
+pub const RADIUS: Field = Field::part("r", "the radius (fine: EP_SPHERE extra bits)");
+pub const SIGN: Field = Field::part("sg", "+1 seen from outside, -1 inside-visible");
+pub const OBJ: Field = Field::part("obj", "the object's id");
+pub const MAT: Field = Field::part("mat", "its material");
+
+/// The record of `fit`'s spheres.
+pub fn layout(fit: &Fit) -> Layout {
+    let fine = fit.sphere_fine.then_some((CENTRE_REM, 3));
+    Layout::new([(CENTRE, 3)].into_iter().chain(fine).chain([
+        (INV_R, 1),
+        (RADIUS, 1),
+        (SIGN, 1),
+        (OBJ, 1),
+        (MAT, 1),
+    ]))
+}
 
 /// Spheres get the fine record when the smallest is under this many LSB in
 /// radius (the rounding of the centre, up to 0.87 LSB, is then over 1.4% of
@@ -53,11 +70,7 @@ pub const FINE_BELOW_LSB: f64 = 64.0;
 
 /// Words of a record.
 pub fn words(fit: &Fit) -> usize {
-    if fit.sphere_fine {
-        FINE_WORDS
-    } else {
-        WORDS
-    }
+    layout(fit).words()
 }
 
 /// The opaque kernel's cut ([`K::cut`]) and what F holds there.
@@ -106,8 +119,10 @@ pub(crate) fn write(
             rq
         };
     let sg = if inside { -1.0 } else { 1.0 };
+    w.field(CENTRE);
     w.point(center);
     if fit.sphere_fine {
+        w.field(CENTRE_REM);
         for x in center.to_array() {
             let hi = w.sat(x * s) as f64;
             w.push((x * s - hi) * w.one());
@@ -115,14 +130,19 @@ pub(crate) fn write(
     }
     // invr before r: the packet traversal's kernel needs only invr before
     // its cut, and reads r straight from the stream after it.
+    w.field(INV_R);
     w.push(invr);
+    w.field(RADIUS);
     if fit.sphere_fine {
         w.push(radius.abs() * s * (fit.ep_sphere as f64).exp2());
     } else {
         w.push(rq);
     }
+    w.field(SIGN);
     w.push(sg * w.one());
+    w.field(OBJ);
     w.raw(id as i64);
+    w.field(MAT);
     w.raw(mat as i64);
 }
 
@@ -279,8 +299,8 @@ impl super::ChipPrimitive for Sphere {
         ["sphere", "glass_sphere"]
     }
 
-    fn record_words(&self, _sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> usize {
-        words(fit)
+    fn layout(&self, _sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        layout(fit)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {

@@ -1,6 +1,7 @@
 //! The primitives' records, kernels and table held against each other.
 
 use super::*;
+use record::{Layout, W};
 
 /// Every chip type finds its primitive in the table, under its own
 /// name, once; the glass type's name is the opaque one's with `glass_`.
@@ -85,19 +86,169 @@ fn every_kernel_reads_exactly_its_record() {
                             ]
                         );
                     }
-                    // Caps flag (read by TinyRISC), the body runs, two
-                    // caps; without caps, the body runs alone.
-                    let cyl: usize = cylinder::kernels(&g, &fit, s)
-                        .iter()
-                        .map(|(_, k)| k.fb_reads)
-                        .sum();
-                    assert_eq!(1 + cyl + planar::WORDS, cylinder::words(&fit, s, true));
-                    assert_eq!(cyl - planar::WORDS, cylinder::words(&fit, s, false));
-                    let cone: usize = cone::kernels(&g, s).iter().map(|(_, k)| k.fb_reads).sum();
-                    assert_eq!(1 + cone + planar::WORDS, cone::words(s, true));
-                    assert_eq!(cone - planar::WORDS, cone::words(s, false));
+                    // Each run of a cylinder's or cone's test reads
+                    // exactly its field of the record: the body (twice
+                    // for glass), a cap's disc.
+                    let glass = s == Sides::Both;
+                    let l = cylinder::layout(&fit, s, true);
+                    let fields = if glass {
+                        vec![
+                            cylinder::CYL_BODY,
+                            cylinder::GCYL_INNER,
+                            cylinder::GCYL_CAP0,
+                        ]
+                    } else {
+                        vec![cylinder::CYL_BODY, cylinder::CYL_CAP0]
+                    };
+                    let k = cylinder::kernels(&g, &fit, s);
+                    assert_eq!(k.len(), fields.len());
+                    for ((name, k), f) in k.iter().zip(&fields) {
+                        assert_eq!(Some(k.fb_reads), l.words_of(*f), "{name} reads {f}");
+                    }
+                    let l = cone::layout(s, true);
+                    let fields = if glass {
+                        vec![cone::CONE_BODY, cone::GCONE_INNER, cone::GCONE_CAP0]
+                    } else {
+                        vec![cone::CONE_BODY, cone::CONE_CAP0]
+                    };
+                    let k = cone::kernels(&g, s);
+                    assert_eq!(k.len(), fields.len());
+                    for ((name, k), f) in k.iter().zip(&fields) {
+                        assert_eq!(Some(k.fb_reads), l.words_of(*f), "{name} reads {f}");
+                    }
                 }
             }
         }
+    }
+}
+
+/// A record writer of the 16-bit chip's scene format Q5.10.
+fn writer() -> W {
+    W {
+        fb: Vec::new(),
+        s: 1024.0,
+        frac: 10,
+        x: 0,
+        fans: Vec::new(),
+        fan_most: 0,
+        marks: Vec::new(),
+    }
+}
+
+/// The record written from `start` holds `layout`'s words, and each of its
+/// fields begins where the layout puts it.
+fn holds_to(w: &W, start: usize, layout: &Layout, what: &str) {
+    assert_eq!(w.fb.len() - start, layout.words(), "{what}: words");
+    for &(f, n) in &layout.0 {
+        if n == 0 {
+            continue;
+        }
+        let at = layout.offset(f).unwrap();
+        let mark = w.marks.iter().find(|m| m.0 == f && m.1 >= start);
+        assert_eq!(
+            mark.map(|m| m.1 - start),
+            Some(at),
+            "{what}: {f} written at another offset than its layout's"
+        );
+    }
+}
+
+/// Every primitive's writer writes its fields in its layout's order, at
+/// its layout's offsets, in every variant: a field moved in the writer
+/// and not in the layout (or the header TinyRISC addresses it by) fails.
+#[test]
+fn every_writer_follows_its_layout() {
+    use crate::scene::Vec3;
+    let v = |x: f64, y: f64, z: f64| Vec3::new(x, y, z);
+    for sphere_fine in [false, true] {
+        for fine_normals in [false, true] {
+            let fit = Fit {
+                sphere_fine,
+                fine_normals,
+                ..Fit::default()
+            };
+            let mut w = writer();
+            sphere::write(&mut w, &fit, false, v(1.0, 2.0, 3.0), 0.5, false, 7, 1);
+            holds_to(&w, 0, &sphere::layout(&fit), "sphere");
+            for s in [Sides::Front, Sides::Both] {
+                let mut w = writer();
+                aabox::write(&mut w, s, v(0.0, 0.0, 0.0), v(1.0, 2.0, 3.0), 7, 1);
+                holds_to(&w, 0, &aabox::layout(s), "box");
+                let (base, apex) = (v(0.0, 0.0, 0.0), v(0.0, 0.0, 2.0));
+                for caps in [false, true] {
+                    let discs = cylinder::caps(base, apex, 0.5);
+                    let mut w = writer();
+                    w.raw(5);
+                    let on = caps.then_some((true, &discs));
+                    cylinder::write(&mut w, &fit, s, base, apex, 0.5, false, on, 7, 1);
+                    holds_to(&w, 1, &cylinder::layout(&fit, s, caps), "cylinder");
+                    let cf = cone::ConeFit::of(base, 0.5, apex, 0.25, w.s);
+                    let discs = cf.caps(base, 0.5, apex, 0.25, w.s);
+                    let fit = Fit { ks_cone: 6, ..fit };
+                    let mut w = writer();
+                    let on = caps.then_some((true, &discs));
+                    cone::write(&mut w, &fit, s, &cf, false, on, 7, 1).unwrap();
+                    holds_to(&w, 0, &cone::layout(s, caps), "cone");
+                }
+            }
+        }
+    }
+    let tri = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
+    let mut w = writer();
+    planar::write(&mut w, &[0; 3], &planar::flat_triangle(tri), 7, 1);
+    holds_to(&w, 0, &Layout::new(planar::FIELDS), "triangle");
+    let mut w = writer();
+    let ns = [v(0.0, 0.0, 1.0); 3];
+    smooth_triangle::write(&mut w, &[0; 3], &planar::flat_triangle(tri), ns, 7, 1);
+    holds_to(
+        &w,
+        0,
+        &Layout::new(smooth_triangle::FIELDS),
+        "smooth triangle",
+    );
+    // A polygon with room for exactly its own edges (a record with room
+    // for more is padded after its tail).
+    let star: Vec<Vec3> = (0..40)
+        .map(|k| {
+            let a = k as f64 / 40.0 * std::f64::consts::TAU;
+            let r = if k % 2 == 0 { 4.0 } else { 2.0 };
+            v(r * a.cos(), r * a.sin(), 0.0)
+        })
+        .collect();
+    let w0 = writer();
+    let (_, edges) = polygon::edges(&star, w0.s);
+    let fan = edges.len();
+    let size = polygon::words(fan, polygon::Form::Plain);
+    let mut w = writer();
+    polygon::write(&mut w, &star, size, polygon::Form::Plain, 7, 1).unwrap();
+    holds_to(
+        &w,
+        0,
+        &polygon::layout(fan, polygon::Form::Plain),
+        "polygon",
+    );
+    for form in [polygon::Form::Banded, polygon::Form::Apart] {
+        let mut w = writer();
+        let size = polygon::words(0, form) + 4096;
+        polygon::write(&mut w, &star, size, form, 7, 1).unwrap();
+        // Up to the sub-edges, whose room is the scene's most.
+        let l = polygon::layout(0, form);
+        let named: Vec<_> = l.0.iter().filter(|f| f.0.named).copied().collect();
+        holds_to_prefix(&w, &Layout(named), form);
+    }
+}
+
+/// The banded record's named fields before its sub-edges begin where its
+/// layout puts them.
+fn holds_to_prefix(w: &W, named: &Layout, form: polygon::Form) {
+    let full = polygon::layout(0, form);
+    for &(f, _) in &named.0 {
+        let at = full.offset(f).unwrap();
+        let mark = w.marks.iter().find(|m| m.0 == f).map(|m| m.1);
+        assert_eq!(
+            mark,
+            Some(at),
+            "{form:?}: {f} written at another offset than its layout's"
+        );
     }
 }
