@@ -137,8 +137,11 @@ pub struct W {
 impl W {
     /// Mark the start of `field` (the next word written), for the check
     /// of the writer's order against the record's [`Layout`].
+    /// (Kept in the unit tests' builds only.)
     pub fn field(&mut self, field: Field) {
-        self.marks.push((field, self.fb.len()));
+        if cfg!(test) {
+            self.marks.push((field, self.fb.len()));
+        }
     }
 
     /// Drop the words from `len` on, and the marks there.
