@@ -39,6 +39,25 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
     let rows = &rows[..];
     let mut scenes: Vec<&str> = rows.iter().map(|r| r.scene.as_str()).collect();
     scenes.dedup();
+    let size = rows.first().map_or((256, 256), |r| (r.width, r.height));
+    out.extend(fig8_charts(rows, &scenes, size, dir)?);
+    out.extend(pareto_charts(rows, &scenes, dir)?);
+    out.extend(normals_chart(rows, &scenes, size, dir)?);
+    if sizes.is_empty() {
+        out.extend(knob_scenes_chart(rows, size, dir)?);
+    }
+    Ok(out)
+}
+
+/// The paper's Fig. 8 (frame rate against rays in parallel) and the ray
+/// lanes' use.
+fn fig8_charts(
+    rows: &[Row],
+    scenes: &[&str],
+    size: (u32, u32),
+    dir: &Path,
+) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
     let per = |knob: &str, y: &dyn Fn(&Row) -> f64| -> Vec<Series> {
         scenes
             .iter()
@@ -53,7 +72,6 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             })
             .collect()
     };
-    let size = rows.first().map_or((256, 256), |r| (r.width, r.height));
     out.extend(charts::write(
         &dir.join("fig8"),
         &Chart {
@@ -89,6 +107,13 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             log_y: false,
         },
     )?);
+    Ok(out)
+}
+
+/// Speed against accuracy over every configuration, and the same with the
+/// silicon's price on the speed axis.
+fn pareto_charts(rows: &[Row], scenes: &[&str], dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
     let pareto: Vec<Series> = scenes
         .iter()
         .map(|s| Series {
@@ -195,6 +220,17 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             log_y: false,
         },
     )?);
+    Ok(out)
+}
+
+/// Coarse against fine normals per scene.
+fn normals_chart(
+    rows: &[Row],
+    scenes: &[&str],
+    size: (u32, u32),
+    dir: &Path,
+) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
     // Coarse against fine normals: PSNR against cycles per scene, the
     // arrow's tail the kernels as first written.
     let normals: Vec<Series> = scenes
@@ -231,13 +267,20 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
             },
         )?);
     }
+    Ok(out)
+}
+
+/// Without a size sweep: cycles against the primitives of the knob
+/// sweep's scenes (two at least).
+fn knob_scenes_chart(rows: &[Row], size: (u32, u32), dir: &Path) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
     let knob_scenes = rows
         .iter()
         .filter(|r| r.knob == "paper")
         .map(|r| r.scene.as_str())
         .collect::<std::collections::BTreeSet<_>>()
         .len();
-    if sizes.is_empty() && knob_scenes >= 2 {
+    if knob_scenes >= 2 {
         // No size sweep: the scenes of the knob sweep, paper configuration
         // (a line needs two scenes at least; one is no chart).
         let scaling = vec![Series {
