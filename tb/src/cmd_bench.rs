@@ -104,131 +104,36 @@ pub fn command(a: BenchArgs) -> Result<()> {
     }
     let timing = crate::timing::load_or_default(a.timing.as_deref())?;
     let (width, height) = a.size;
-    // The paper's configuration (its traversal and BSP): the workload the
-    // simulator's speed has been measured on since the first bench.
-    let opt = match a.traversal {
-        firmware::tracer::Traversal::Paper => Options {
-            width,
-            height,
-            ways: 64,
-            depth: 2,
-            bsp: BspParams::default(),
-            layout: Default::default(),
-            datapath: Default::default(),
-            traversal: firmware::tracer::Traversal::Paper,
-            collapse: Default::default(),
-            pieces: Default::default(),
-            shadows: Default::default(),
-            test_cuts: Default::default(),
-            child_order: Default::default(),
-            sub_edges: Default::default(),
-        },
-        firmware::tracer::Traversal::Packet => Options {
-            width,
-            height,
-            traversal: firmware::tracer::Traversal::Packet,
-            ..Options::default()
-        },
-    };
+    let opt = bench_options(a.traversal, width, height);
     let repeat = a.repeat.max(1);
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     let tmp = tempfile::tempdir().context("cannot create a temporary directory")?;
     crate::output::register_temporary(tmp.path());
 
-    // Throughput: a frame on one thread (start-up amortised). Tracing on: a
-    // smaller frame, all of it traced, against the same frame untraced.
-    // Speed-up: a 256x256 frame on every core against one core.
-    let traced_opt = Options {
-        width: 64,
-        height: 32,
-        ..opt
-    };
-    let big = Options {
-        width: 256,
-        height: 256,
-        ..opt
-    };
-    // (frame, host threads, traced)
-    let runs = [
-        (&opt, 1, false),
-        (&traced_opt, 1, true),
-        (&traced_opt, 1, false),
-        (&big, 1, false),
-        (&big, cores, false),
-    ];
     // One pool per thread count, kept for all the rounds.
     let one_thread = pool(1)?;
     let every_core = pool(cores)?;
-    // Each measurement: (chip cycles, best host seconds, best host seconds
-    // of the chips alone). The measurements are taken in turn,
-    // one run of each per round, so that the two sides of a ratio see the
-    // same phases of the host: one after the other, a slow spell of the
-    // machine could fall on all the repeats of one side (a traced frame
-    // once measured 3.6x its untraced one where the runs around it gave
-    // 2.7-2.8x).
-    let mut best = [(0u64, f64::INFINITY, f64::INFINITY); 5];
-    // The schedule model's measurements: the tiles and an item's own work
-    // of the fastest 256x256 frame on one thread and the rest of its chip
-    // render (the serial part), and the fastest chip render (the
-    // firmware's generation and probe aside) on one thread and on every
-    // core.
-    let mut frame = crate::schedule::FrameWork::default();
-    let mut serial = 0.0;
-    let mut chip_render = [f64::INFINITY; 2];
-    for k in 0..repeat {
-        for (run, (&(opt, threads, trace), b)) in runs.iter().zip(&mut best).enumerate() {
-            let cfg = trace.then(|| {
-                let mut c = rtl::trace::TraceConfig::new(tmp.path().join(format!("bench{k}.vcd")));
-                c.scope = "tinyrisc,broadcast,array.rc_r0_c0".into();
-                c
-            });
-            let p = if threads == 1 {
-                &one_thread
-            } else {
-                &every_core
-            };
-            let t0 = Instant::now();
-            let r = p.install(|| {
-                crate::render::render_chip(
-                    &scene,
-                    opt,
-                    &crate::render::RenderSettings {
-                        trace: cfg,
-                        timing,
-                        plain: a.plain,
-                        ..Default::default()
-                    },
-                )
-            })?;
-            let s = t0.elapsed().as_secs_f64();
-            // Runs 3 and 4: the 256x256 frame on one thread and on every
-            // core.
-            if run >= 3 {
-                let k = run - 3;
-                if k == 0 && r.render_seconds < chip_render[0] {
-                    serial = (r.render_seconds - r.item_seconds.iter().sum::<f64>()).max(0.0);
-                    frame = crate::schedule::FrameWork::of(&r);
-                }
-                chip_render[k] = chip_render[k].min(r.render_seconds);
-            }
-            *b = (r.cycles, b.1.min(s), b.2.min(r.chip_seconds));
-        }
-    }
+    let Measured {
+        best,
+        frame,
+        serial,
+        chip_render,
+    } = measure(
+        &scene,
+        &opt,
+        &a,
+        &timing,
+        tmp.path(),
+        [&one_thread, &every_core],
+        cores,
+    )?;
     let [(cycles, one, _), (traced_cycles, traced, traced_chip), (_, untraced_small, untraced_small_chip), (big_cycles, big_one, _), (_, all, _)] =
         best;
     let off = cycles as f64 / one;
     let on = traced_cycles as f64 / traced;
     let speedup = big_one / all;
     // What the figures were measured on: the fastest of `repeat` runs each.
-    let cpu = std::fs::read_to_string("/proc/cpuinfo")
-        .ok()
-        .and_then(|t| {
-            t.lines()
-                .find(|l| l.starts_with("model name"))
-                .and_then(|l| l.split(':').nth(1))
-                .map(|m| m.trim().to_string())
-        })
-        .unwrap_or_else(|| std::env::consts::ARCH.to_string());
+    let cpu = host_cpu();
     let traced_slowdown = traced / untraced_small;
     // The same without the frame's setup and the image's assembly (the
     // same in both runs): the chip alone, from the waveform's creation to
@@ -333,6 +238,151 @@ pub fn command(a: BenchArgs) -> Result<()> {
         crate::note!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The bench's workload: the paper's configuration (its traversal and
+/// BSP), the workload the simulator's speed has been measured on since the
+/// first bench, or the packet traversal with its defaults.
+fn bench_options(traversal: firmware::tracer::Traversal, width: u32, height: u32) -> Options {
+    match traversal {
+        firmware::tracer::Traversal::Paper => Options {
+            width,
+            height,
+            ways: 64,
+            depth: 2,
+            bsp: BspParams::default(),
+            layout: Default::default(),
+            datapath: Default::default(),
+            traversal: firmware::tracer::Traversal::Paper,
+            collapse: Default::default(),
+            pieces: Default::default(),
+            shadows: Default::default(),
+            test_cuts: Default::default(),
+            child_order: Default::default(),
+            sub_edges: Default::default(),
+        },
+        firmware::tracer::Traversal::Packet => Options {
+            width,
+            height,
+            traversal: firmware::tracer::Traversal::Packet,
+            ..Options::default()
+        },
+    }
+}
+
+/// The host's CPU, as /proc/cpuinfo names it (else the architecture).
+fn host_cpu() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split(':').nth(1))
+                .map(|m| m.trim().to_string())
+        })
+        .unwrap_or_else(|| std::env::consts::ARCH.to_string())
+}
+
+/// The bench's measurements: per run (chip cycles, best host seconds, best
+/// host seconds of the chips alone), the schedule model's frame and serial
+/// part, and the fastest chip render on one thread and on every core.
+struct Measured {
+    best: [(u64, f64, f64); 5],
+    frame: crate::schedule::FrameWork,
+    serial: f64,
+    chip_render: [f64; 2],
+}
+
+/// Run the bench's frames `a.repeat` times each, in turn, on the pools of
+/// one thread and of every core.
+fn measure(
+    scene: &firmware::scene::Scene,
+    opt: &Options,
+    a: &BenchArgs,
+    timing: &rtl::Timing,
+    tmp: &std::path::Path,
+    pools: [&rayon::ThreadPool; 2],
+    cores: usize,
+) -> Result<Measured> {
+    let repeat = a.repeat.max(1);
+    // Throughput: a frame on one thread (start-up amortised). Tracing on: a
+    // smaller frame, all of it traced, against the same frame untraced.
+    // Speed-up: a 256x256 frame on every core against one core.
+    let traced_opt = Options {
+        width: 64,
+        height: 32,
+        ..*opt
+    };
+    let big = Options {
+        width: 256,
+        height: 256,
+        ..*opt
+    };
+    // (frame, host threads, traced)
+    let runs = [
+        (opt, 1, false),
+        (&traced_opt, 1, true),
+        (&traced_opt, 1, false),
+        (&big, 1, false),
+        (&big, cores, false),
+    ];
+    // Each measurement: (chip cycles, best host seconds, best host seconds
+    // of the chips alone). The measurements are taken in turn,
+    // one run of each per round, so that the two sides of a ratio see the
+    // same phases of the host: one after the other, a slow spell of the
+    // machine could fall on all the repeats of one side (a traced frame
+    // once measured 3.6x its untraced one where the runs around it gave
+    // 2.7-2.8x).
+    let mut best = [(0u64, f64::INFINITY, f64::INFINITY); 5];
+    // The schedule model's measurements: the tiles and an item's own work
+    // of the fastest 256x256 frame on one thread and the rest of its chip
+    // render (the serial part), and the fastest chip render (the
+    // firmware's generation and probe aside) on one thread and on every
+    // core.
+    let mut frame = crate::schedule::FrameWork::default();
+    let mut serial = 0.0;
+    let mut chip_render = [f64::INFINITY; 2];
+    for k in 0..repeat {
+        for (run, (&(opt, threads, trace), b)) in runs.iter().zip(&mut best).enumerate() {
+            let cfg = trace.then(|| {
+                let mut c = rtl::trace::TraceConfig::new(tmp.join(format!("bench{k}.vcd")));
+                c.scope = "tinyrisc,broadcast,array.rc_r0_c0".into();
+                c
+            });
+            let p = if threads == 1 { pools[0] } else { pools[1] };
+            let t0 = Instant::now();
+            let r = p.install(|| {
+                crate::render::render_chip(
+                    scene,
+                    opt,
+                    &crate::render::RenderSettings {
+                        trace: cfg,
+                        timing: *timing,
+                        plain: a.plain,
+                        ..Default::default()
+                    },
+                )
+            })?;
+            let s = t0.elapsed().as_secs_f64();
+            // Runs 3 and 4: the 256x256 frame on one thread and on every
+            // core.
+            if run >= 3 {
+                let k = run - 3;
+                if k == 0 && r.render_seconds < chip_render[0] {
+                    serial = (r.render_seconds - r.item_seconds.iter().sum::<f64>()).max(0.0);
+                    frame = crate::schedule::FrameWork::of(&r);
+                }
+                chip_render[k] = chip_render[k].min(r.render_seconds);
+            }
+            *b = (r.cycles, b.1.min(s), b.2.min(r.chip_seconds));
+        }
+    }
+    Ok(Measured {
+        best,
+        frame,
+        serial,
+        chip_render,
+    })
 }
 
 /// `--sweep`: the sweep of `a.sweep` on one thread (its renders' work

@@ -277,94 +277,22 @@ pub(crate) fn run_item<W: Word>(
         img,
         fw,
         tiles,
-        timing,
-        plain,
         say_files,
+        ..
     } = *frame;
     let t_item = std::time::Instant::now();
     let warm = own.start > 0;
     let list = &tiles[own.start - warm as usize..own.end];
     let last = own.end == tiles.len();
-    // Main memory as large as the program touches (its segments, the tile
-    // list, the output tiles and the streamed scene image), not the
-    // 16 MiB default: a fresh instance per item must not zero-fill memory
-    // nobody reads.
-    let wb = fw.fb_word_bytes();
-    // What lies above `mem::OUTPUT`: the streamed scene image and its
-    // mailboxes, the packet traversal's mailboxes.
-    let above = fw
-        .layout
-        .stream
-        .as_ref()
-        // the image, then the mailboxes (a half-word per object)
-        .map(|st| {
-            (st.base as usize + st.image.len()).max(st.mailbox as usize + 2 * fw.layout.objects)
-        })
-        .into_iter()
-        .chain(
-            // the packet traversal's mailboxes (main memory, resident or
-            // streamed)
-            (fw.layout.traversal == tracer::Traversal::Packet)
-                .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
-        )
-        .max()
-        .unwrap_or(0);
-    // The tiles' pixels: at `mem::OUTPUT`, or past that data where an
-    // item's tiles would reach it (each tile's address is in the list).
-    let out_bytes = list.len() * fw.out_tile_bytes() as usize;
-    let output = if above > mem::OUTPUT as usize
-        && mem::OUTPUT as usize + out_bytes > mem::STREAM as usize
-    {
-        above.next_multiple_of(1 << 12) as u32
-    } else {
-        mem::OUTPUT
-    };
-    let ends = img
-        .segments
-        .iter()
-        .map(|s| s.addr as usize + s.data.len())
-        .chain([
-            mem::FB_IMAGE as usize + wb as usize * fw.fb.len(),
-            mem::TILE_LIST as usize + 4 + 12 * list.len().min(LIST_CHUNK),
-            output as usize + out_bytes,
-            above,
-        ]);
-    let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
-    let mut chip = Chip::<W>::build(*timing, mem_bytes);
-    chip.plain = plain;
-    img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
-    chip.watch = watch(img, fw);
-    // The leaf pieces' waits for their DMA (the streamed packet traversal).
-    chip.risc.dma_wait_watch = img
-        .symbol(data::LEAF_LOAD.0)
-        .map(|a| a as u32)
-        .into_iter()
-        .collect();
-    // The leaf cache's lookups and misses (the streamed packet traversal):
-    // counted by the simulator, at no cycle of the program's.
-    if let Some((first, miss)) = leaf_watch(img) {
-        chip.risc.issue_watch = [Some(first as u32), Some(miss as u32)];
-    }
-    let fb = fw.fb_bytes();
-    chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
-    if let Some(st) = &fw.layout.stream {
-        chip.load(st.base, &st.image).map_err(|f| anyhow!("{f}"))?;
-    }
-    // The tile list, in chunks of what fits below `mem::OUTPUT`: the next
-    // chunk goes in when the program has taken the last tile of one
-    // ([`feed`]).
-    let mut fed = feed(&mut chip, list, 0, output, fw.out_tile_bytes())?;
-    // The tracer's output banks alternate by tile (`TL_BANK`, 0 at the
-    // first): the list's first tile takes the bank it has in one chip.
-    if let Some(bank) = img.symbol(data::TL_BANK.name) {
-        let first = (own.start - warm as usize) as u32;
-        chip.mem.write(bank as u32, 4, first % 2);
-    }
-    // The pass number one chip has before the list's first tile, where it
-    // matters ([`pass_seeds`]).
-    if let Some(seed) = pass_seed {
-        chip.mem.write(sym(img, data::PASS.name)?, 4, seed);
-    }
+    let (output, mem_bytes) = item_memory(img, fw, list.len());
+    let (chip, mut fed) = item_chip::<W>(
+        frame,
+        list,
+        own.start - warm as usize,
+        output,
+        mem_bytes,
+        pass_seed,
+    )?;
     let mut sim = Sim::new(chip);
     let t0 = std::time::Instant::now();
     if let Some(mut cfg) = trace {
@@ -509,21 +437,7 @@ pub(crate) fn run_item<W: Word>(
     sub_stats(&mut counted, &from);
     let mem = &sim.top.mem;
     let t_out = std::time::Instant::now();
-    let out: Vec<Vec<i32>> = (warm as usize..list.len())
-        .map(|k| {
-            let base = output + k as u32 * fw.out_tile_bytes();
-            (0..256)
-                .map(|i| {
-                    let v = mem.read(base + wb * i, wb);
-                    if wb == 2 {
-                        v as u16 as i16 as i32
-                    } else {
-                        v as i32
-                    }
-                })
-                .collect()
-        })
-        .collect();
+    let out = read_tiles(mem, fw, output, warm as usize..list.len());
     // Reading a tile's pixels back is that tile's work.
     let per_tile = t_out.elapsed().as_secs_f64() / own.len().max(1) as f64;
     tile_seconds.iter_mut().for_each(|t| *t += per_tile);
@@ -541,6 +455,139 @@ pub(crate) fn run_item<W: Word>(
         profile: prof,
         seconds,
     })
+}
+
+/// Where an item's chip puts its tiles' pixels, and the main memory it
+/// needs: as large as the program touches (its segments, the tile list of
+/// `tiles` tiles, the output tiles and the streamed scene image), not the
+/// 16 MiB default: a fresh instance per item must not zero-fill memory
+/// nobody reads.
+fn item_memory(img: &Image, fw: &Firmware, tiles: usize) -> (u32, usize) {
+    let wb = fw.fb_word_bytes();
+    // What lies above `mem::OUTPUT`: the streamed scene image and its
+    // mailboxes, the packet traversal's mailboxes.
+    let above = fw
+        .layout
+        .stream
+        .as_ref()
+        // the image, then the mailboxes (a half-word per object)
+        .map(|st| {
+            (st.base as usize + st.image.len()).max(st.mailbox as usize + 2 * fw.layout.objects)
+        })
+        .into_iter()
+        .chain(
+            // the packet traversal's mailboxes (main memory, resident or
+            // streamed)
+            (fw.layout.traversal == tracer::Traversal::Packet)
+                .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
+        )
+        .max()
+        .unwrap_or(0);
+    // The tiles' pixels: at `mem::OUTPUT`, or past that data where an
+    // item's tiles would reach it (each tile's address is in the list).
+    let out_bytes = tiles * fw.out_tile_bytes() as usize;
+    let output = if above > mem::OUTPUT as usize
+        && mem::OUTPUT as usize + out_bytes > mem::STREAM as usize
+    {
+        above.next_multiple_of(1 << 12) as u32
+    } else {
+        mem::OUTPUT
+    };
+    let ends = img
+        .segments
+        .iter()
+        .map(|s| s.addr as usize + s.data.len())
+        .chain([
+            mem::FB_IMAGE as usize + wb as usize * fw.fb.len(),
+            mem::TILE_LIST as usize + 4 + 12 * tiles.min(LIST_CHUNK),
+            output as usize + out_bytes,
+            above,
+        ]);
+    let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
+    (output, mem_bytes)
+}
+
+/// An item's chip, built and loaded: the program and its watches, the FB
+/// image and the streamed scene, the first chunk of the tile list `list`
+/// (whose first tile is the frame's `first`), the output bank and the
+/// pass number one chip has there. Returns the chip and how much of the
+/// list it holds.
+fn item_chip<W: Word>(
+    frame: &Frame,
+    list: &[(u32, u32)],
+    first: usize,
+    output: u32,
+    mem_bytes: usize,
+    pass_seed: Option<u32>,
+) -> Result<(Chip<W>, usize)> {
+    let Frame {
+        img,
+        fw,
+        timing,
+        plain,
+        ..
+    } = *frame;
+    let mut chip = Chip::<W>::build(*timing, mem_bytes);
+    chip.plain = plain;
+    img.load(&mut chip).map_err(|f| anyhow!("{f}"))?;
+    chip.watch = watch(img, fw);
+    // The leaf pieces' waits for their DMA (the streamed packet traversal).
+    chip.risc.dma_wait_watch = img
+        .symbol(data::LEAF_LOAD.0)
+        .map(|a| a as u32)
+        .into_iter()
+        .collect();
+    // The leaf cache's lookups and misses (the streamed packet traversal):
+    // counted by the simulator, at no cycle of the program's.
+    if let Some((first, miss)) = leaf_watch(img) {
+        chip.risc.issue_watch = [Some(first as u32), Some(miss as u32)];
+    }
+    let fb = fw.fb_bytes();
+    chip.load(mem::FB_IMAGE, &fb).map_err(|f| anyhow!("{f}"))?;
+    if let Some(st) = &fw.layout.stream {
+        chip.load(st.base, &st.image).map_err(|f| anyhow!("{f}"))?;
+    }
+    // The tile list, in chunks of what fits below `mem::OUTPUT`: the next
+    // chunk goes in when the program has taken the last tile of one
+    // ([`feed`]).
+    let fed = feed(&mut chip, list, 0, output, fw.out_tile_bytes())?;
+    // The tracer's output banks alternate by tile (`TL_BANK`, 0 at the
+    // first): the list's first tile takes the bank it has in one chip.
+    if let Some(bank) = img.symbol(data::TL_BANK.name) {
+        chip.mem.write(bank as u32, 4, first as u32 % 2);
+    }
+    // The pass number one chip has before the list's first tile, where it
+    // matters ([`pass_seeds`]).
+    if let Some(seed) = pass_seed {
+        chip.mem.write(sym(img, data::PASS.name)?, 4, seed);
+    }
+    Ok((chip, fed))
+}
+
+/// The pixels of the tiles `tiles` of the item's list, read back from
+/// main memory at `output`.
+fn read_tiles(
+    mem: &rtl::memory::MainMemory,
+    fw: &Firmware,
+    output: u32,
+    tiles: std::ops::Range<usize>,
+) -> Vec<Vec<i32>> {
+    let wb = fw.fb_word_bytes();
+    tiles
+        .map(|k| {
+            let base = output + k as u32 * fw.out_tile_bytes();
+            (0..256)
+                .map(|i| {
+                    let v = mem.read(base + wb * i, wb);
+                    if wb == 2 {
+                        v as u16 as i16 as i32
+                    } else {
+                        v as i32
+                    }
+                })
+                .collect()
+        })
+        .collect()
 }
 
 /// Tile-list entries a chip's list holds (below `mem::OUTPUT`, 12 bytes

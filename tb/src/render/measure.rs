@@ -61,40 +61,69 @@ pub(crate) fn render_and_measure(
     let psnr = metrics::psnr(&chip.rgb8, &ref8);
     let agree = metrics::hit_agreement(&chip.hits, &refimg.hits);
     let r = &chip.firmware.report;
-    let idle_on_control = if chip.stats.cycles > 0 {
-        chip.stats.array_idle_control_cycles as f64 / chip.stats.cycles as f64
-    } else {
-        0.0
-    };
-    let census = chip.ray_census();
     let warnings: Vec<firmware::scene::Warning> = scene
         .warnings
         .iter()
         .cloned()
         .chain(firmware::tracer::chip_warnings(scene, &r.notes))
         .collect();
-    let json = json!({
+    let mut json = json!({
         "scene": scene.source,
         "objects": scene.objects.len(),
         "warnings": warnings,
-        "cycles": chip.cycles,
-        "firmware_cycles": chip.firmware_cycles,
-        "fps_at_300mhz": chip.fps_at(300_000_000),
         "width": opt.width,
         "height": opt.height,
         "ways": opt.ways,
         "depth": opt.depth,
         "newton_steps": nm.newton_steps,
         "table_entries": nm.table_entries,
-        "normals": if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
         "psnr_db": if psnr.is_finite() { psnr } else { 99.0 },
         "hit_agreement": agree,
         "eye_misclassified": 1.0 - agree,
+        "reference_rays": refimg.stats,
+        "host_seconds": host,
+        // The work items' host seconds summed over the threads: about
+        // the chip render's time on one thread, whatever else runs beside
+        // it (the sweep's --size-seconds).
+        "host_chip_seconds": chip.item_seconds.iter().sum::<f64>(),
+        "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
+        "compiler_format": r.format,
+        "format_note": "format: the tracer's, the finest in which every object and the eye fit with the guard bits (lights are scaled apart, never coarser than compiler_format); compiler_format: the scene image's (morphosys compile), which also spans the lights and the camera's target",
+        "bsp_nodes": r.bsp.nodes,
+        "bsp_max_depth": r.bsp.max_depth,
+        "child_order": chip.firmware.child_order.to_string(),
+    });
+    if let (Some(j), serde_json::Value::Object(figures)) =
+        (json.as_object_mut(), chip_json(&chip, opt))
+    {
+        j.extend(figures);
+    }
+    let rep = RenderReport {
+        json,
+        rgb8: chip.rgb8.clone(),
+        reference_rgb8: ref8,
+    };
+    Ok((chip, rep))
+}
+
+/// The chip's figures of a render: its cycles and frame rate, its rays,
+/// the array's and the DMA's use, the firmware and the options it ran.
+fn chip_json(chip: &crate::render::ChipRender, opt: &Options) -> serde_json::Value {
+    let idle_on_control = if chip.stats.cycles > 0 {
+        chip.stats.array_idle_control_cycles as f64 / chip.stats.cycles as f64
+    } else {
+        0.0
+    };
+    let census = chip.ray_census();
+    json!({
+        "cycles": chip.cycles,
+        "firmware_cycles": chip.firmware_cycles,
+        "fps_at_300mhz": chip.fps_at(300_000_000),
+        "normals": if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
         "eye_rays": census[crate::render::RAY_EYE],
         "shadow_rays": census[crate::render::RAY_SHADOW],
         "reflect_rays": census[crate::render::RAY_REFLECT],
         "refract_rays": census[crate::render::RAY_REFRACT],
-        "reference_rays": refimg.stats,
         "active_rc_fraction": chip.stats.active_rc_fraction(),
         "dma_stall_cycles": chip.stats.dma_stall_cycles,
         "dma_stall_share": chip.dma_stall_share(),
@@ -110,12 +139,6 @@ pub(crate) fn render_and_measure(
         "object_tests_offered": chip.stats.watched_offered,
         "rays_traced": chip.stats.watched_rcs[1],
         "ray_object_tests": chip.stats.watched_rcs[0],
-        "host_seconds": host,
-        // The work items' host seconds summed over the threads: about
-        // the chip render's time on one thread, whatever else runs beside
-        // it (the sweep's --size-seconds).
-        "host_chip_seconds": chip.item_seconds.iter().sum::<f64>(),
-        "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
         "startup_cycles": chip.startup_cycles,
         "tiles": chip.tiles,
         "passes": chip.passes,
@@ -124,12 +147,8 @@ pub(crate) fn render_and_measure(
         "dma_busy_cycles": chip.stats.dma_busy_cycles,
         "datapath_bits": opt.datapath.bits(),
         "format": chip.firmware.format(),
-        "compiler_format": r.format,
-        "format_note": "format: the tracer's, the finest in which every object and the eye fit with the guard bits (lights are scaled apart, never coarser than compiler_format); compiler_format: the scene image's (morphosys compile), which also spans the lights and the camera's target",
-        "bsp_nodes": r.bsp.nodes,
         "bsp_split": chip.firmware.bsp.rule,
         "bsp_depth_limit": chip.firmware.bsp.max_depth,
-        "bsp_max_depth": r.bsp.max_depth,
         "context_words": chip.firmware.context_words,
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
         "fb_words": chip.firmware.fb.len(),
@@ -139,7 +158,6 @@ pub(crate) fn render_and_measure(
         "leaf_pieces": chip.firmware.pieces.to_string(),
         "shadow_packets": chip.firmware.shadows.to_string(),
         "sub_edges": opt.sub_edges.to_string(),
-        "child_order": chip.firmware.child_order.to_string(),
         "test_cuts": opt.test_cuts.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
@@ -152,13 +170,8 @@ pub(crate) fn render_and_measure(
             "misses": c.misses,
             "stalls": chip.stats.dma_waits_watched,
         })),
-    });
-    let rep = RenderReport {
-        json,
-        rgb8: chip.rgb8.clone(),
-        reference_rgb8: ref8,
-    };
-    Ok((chip, rep))
+
+    })
 }
 
 /// A render's JSON at `path` when it is complete, made with `argv` from

@@ -249,6 +249,66 @@ pub(crate) fn render_built(
     render_firmware(fw, opt, host)
 }
 
+/// The frame's work items: `host.item_tiles` tiles each where asked, else
+/// as [`work_items`] cuts the `tiles` for the host's threads.
+fn frame_items(host: &RenderSettings, tiles: usize) -> Vec<std::ops::Range<usize>> {
+    match host.item_tiles {
+        Some(n) => {
+            let n = n.max(1);
+            (0..tiles.div_ceil(n))
+                .map(|i| i * n..(i + 1).saturating_mul(n).min(tiles))
+                .collect()
+        }
+        None => work_items(tiles, rayon::current_num_threads(), host.trace.is_some()),
+    }
+}
+
+/// The frame's progress bar of `tiles` tiles (hidden without `progress`
+/// or for one tile).
+fn tile_bar(progress: bool, tiles: usize) -> ProgressBar {
+    if !(progress && tiles > 1) {
+        return ProgressBar::hidden();
+    }
+    let b = crate::output::progress_bar(tiles as u64);
+    b.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} tiles, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    b.set_message("chip");
+    b
+}
+
+/// One tile's output words (per lane: red, green, blue, the hit object)
+/// into the frame's image and hit map, the tile of `tile` pixels at
+/// `corner`, its lanes outside the frame of `frame` pixels left out.
+fn place_tile(
+    out: &[i32],
+    corner: (u32, u32),
+    tile: (u32, u32),
+    fw: &Firmware,
+    frame: (u32, u32),
+    rgb8: &mut [u8],
+    hits: &mut [u32],
+) {
+    let ((x0, y0), (tw, th), (w, h)) = (corner, tile, frame);
+    for lane in 0..64u32 {
+        let (row, col) = (lane / 8, lane % 8);
+        if row >= th || col >= tw {
+            continue;
+        }
+        let (x, y) = (x0 + col, y0 + row);
+        if x >= w || y >= h {
+            continue;
+        }
+        let p = (y * w + x) as usize;
+        for c in 0..3 {
+            rgb8[3 * p + c] = to8(out[c * 64 + lane as usize], fw.datapath);
+        }
+        let id = out[192 + lane as usize];
+        hits[p] = if id < 0 { NO_HIT } else { id as u32 };
+    }
+}
+
 fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
     let t0 = std::time::Instant::now();
     let progress = host.progress;
@@ -262,30 +322,8 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             tiles.push((tx * tw, ty * th));
         }
     }
-    let items = match host.item_tiles {
-        Some(n) => {
-            let n = n.max(1);
-            (0..tiles.len().div_ceil(n))
-                .map(|i| i * n..(i + 1).saturating_mul(n).min(tiles.len()))
-                .collect()
-        }
-        None => work_items(
-            tiles.len(),
-            rayon::current_num_threads(),
-            host.trace.is_some(),
-        ),
-    };
-    let bar = if progress && tiles.len() > 1 {
-        let b = crate::output::progress_bar(tiles.len() as u64);
-        b.set_style(
-            ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} tiles, {eta} left")
-                .unwrap_or_else(|_| ProgressStyle::default_bar()),
-        );
-        b.set_message("chip");
-        b
-    } else {
-        ProgressBar::hidden()
-    };
+    let items = frame_items(host, tiles.len());
+    let bar = tile_bar(progress, tiles.len());
     // Each work item with the host seconds of all its work (building the
     // chip and loading it, running it, reading its pixels back).
     let frame = Frame {
@@ -351,23 +389,8 @@ fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result
             add_stats(&mut stats, &g.counted);
         }
         for (k, out) in g.out.iter().enumerate() {
-            let (x0, y0) = tiles[items[gi].start + k];
-            for lane in 0..64u32 {
-                let (row, col) = (lane / 8, lane % 8);
-                if row >= th || col >= tw {
-                    continue;
-                }
-                let (x, y) = (x0 + col, y0 + row);
-                if x >= w || y >= h {
-                    continue;
-                }
-                let p = (y * w + x) as usize;
-                for c in 0..3 {
-                    rgb8[3 * p + c] = to8(out[c * 64 + lane as usize], fw.datapath);
-                }
-                let id = out[192 + lane as usize];
-                hits[p] = if id < 0 { NO_HIT } else { id as u32 };
-            }
+            let corner = tiles[items[gi].start + k];
+            place_tile(out, corner, (tw, th), &fw, (w, h), &mut rgb8, &mut hits);
         }
     }
     Ok(ChipRender {
