@@ -19,7 +19,7 @@
 use crate::reference::{eye_ray, shapes::Ray, Tracer};
 use anyhow::{anyhow, Result};
 use firmware::bsp::{auto_depth, Bsp, BspParams, SplitRule};
-use firmware::scene::Vec3;
+use firmware::scene::{Aabb, Scene, Vec3};
 use std::collections::{BTreeMap, HashSet};
 use std::path::PathBuf;
 
@@ -147,24 +147,10 @@ fn morton(x: u32, y: u32, z: u32, bits: u32) -> u64 {
 }
 
 /// `morphosys regroup`.
-pub fn command(a: RegroupArgs) -> Result<()> {
-    let scene = crate::cmd_scene::load_scene(a.scene.as_deref())?;
-    let size = a.size;
-    let path = scene.source.clone();
-    let tracer = Tracer::new(&scene);
-    let bounds: Vec<_> = scene.objects.iter().map(|o| o.shape.bounds()).collect();
-    let sb = scene.bounds();
-    if sb.is_empty() || scene.objects.is_empty() {
-        return Err(anyhow!("{path}: nothing to trace"));
-    }
-    let params = BspParams {
-        max_depth: auto_depth(bounds.len()),
-        max_leaf: 5,
-        rule: SplitRule::Sah,
-        snap: 0.0,
-    };
-    let bsp = Bsp::build(&bounds, sb, params);
-    let eps = 1e-6 * sb.min.max_abs().max(sb.max.max_abs());
+/// The frame's ray segments at `size` x `size`, depth 2, by kind: the eye
+/// rays, the shadow rays of their hits, the mirror rays, the shadow rays
+/// of the mirror rays' hits; each to its first hit (or the light).
+fn segments(scene: &Scene, tracer: &Tracer, size: u32, eps: f64) -> [Vec<Seg>; 4] {
     // The segment to the first occluder, or to the light.
     let shadow = |pixel, p: Vec3, n: Vec3, out: &mut Vec<Seg>| {
         for (light, l) in scene.lights.iter().enumerate() {
@@ -185,12 +171,11 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             }
         }
     };
-    let names = ["eye", "shadow (eye hits)", "mirror", "shadow (mirror hits)"];
     let mut kinds: [Vec<Seg>; 4] = Default::default();
     for py in 0..size {
         for px in 0..size {
             let pixel = (px, py);
-            let r = eye_ray(&scene, size, size, px, py);
+            let r = eye_ray(scene, size, size, px, py);
             let hit = tracer.closest(&r);
             let tmax = hit.map_or(f64::INFINITY, |h| h.1.t);
             kinds[0].push(Seg {
@@ -223,10 +208,110 @@ pub fn command(a: RegroupArgs) -> Result<()> {
             }
         }
     }
+    kinds
+}
+
+/// The object tests broadcast under each grouping of `segs` into packets
+/// (and the tests the rays need), on the tree `bsp` of the scene's bounds
+/// `sb`.
+fn groupings(segs: &[Seg], bsp: &Bsp, sb: Aabb, size: u32) -> ([(usize, usize); GROUPINGS], usize) {
     let cell = |v: f64, lo: f64, hi: f64| {
         (((v - lo) / (hi - lo).max(1e-300)).clamp(0.0, 0.9999) * 1024.0) as u32
     };
     let dir = |v: f64| ((v * 0.5 + 0.5).clamp(0.0, 0.9999) * 32.0) as u32;
+    let reach: Vec<Vec<u32>> = segs
+        .iter()
+        .map(|s| {
+            let mut l = Vec::new();
+            leaves(bsp, s, &mut l);
+            l
+        })
+        .collect();
+    let objects = |l: u32| bsp.nodes[l as usize].objects.len();
+    let needed = needed_tests(&reach, objects);
+    let cost = |packets: &[Vec<usize>]| broadcast(packets, &reach, objects);
+    let tile = |s: &Seg| (s.pixel.1 / 8) * (size / 8) + s.pixel.0 / 8;
+    let mut chip: BTreeMap<(u32, usize), Vec<usize>> = BTreeMap::new();
+    for (k, s) in segs.iter().enumerate() {
+        chip.entry((tile(s), s.light)).or_default().push(k);
+    }
+    let chip: Vec<Vec<usize>> = chip.into_values().collect();
+    // Each of those packets split into its 4x4 quadrants, traced one
+    // after another.
+    let mut quads: BTreeMap<(u32, usize, u32), Vec<usize>> = BTreeMap::new();
+    for (k, s) in segs.iter().enumerate() {
+        let q = (s.pixel.1 % 8 / 4) * 2 + s.pixel.0 % 8 / 4;
+        quads.entry((tile(s), s.light, q)).or_default().push(k);
+    }
+    let quads: Vec<Vec<usize>> = quads.into_values().collect();
+    let regroup = |group: u32, with_dir: bool| -> Vec<Vec<usize>> {
+        // Ties (eye rays share their origin) keep the tiles' order.
+        let mut groups: BTreeMap<u32, Vec<(u64, u32, usize)>> = BTreeMap::new();
+        for (k, s) in segs.iter().enumerate() {
+            let (x, y, z) = (
+                cell(s.o.x, sb.min.x, sb.max.x),
+                cell(s.o.y, sb.min.y, sb.max.y),
+                cell(s.o.z, sb.min.z, sb.max.z),
+            );
+            let key = if with_dir {
+                morton(x >> 5, y >> 5, z >> 5, 5) << 15
+                    | morton(dir(s.d.x), dir(s.d.y), dir(s.d.z), 5)
+            } else {
+                morton(x, y, z, 10)
+            };
+            groups
+                .entry(tile(s) / group)
+                .or_default()
+                .push((key, tile(s), k));
+        }
+        let mut packets = Vec::new();
+        for (_, mut g) in groups {
+            g.sort_unstable();
+            packets.extend(g.chunks(64).map(|c| c.iter().map(|x| x.2).collect()));
+        }
+        packets
+    };
+    // An oracle no firmware has: the frame's rays sorted by the
+    // leaves they reach (front to back, leaves numbered in tree
+    // order), which only tracing them tells.
+    let oracle = {
+        let mut order: Vec<usize> = (0..segs.len()).collect();
+        order.sort_by(|&a, &b| reach[a].cmp(&reach[b]).then(a.cmp(&b)));
+        order.chunks(64).map(|c| c.to_vec()).collect::<Vec<_>>()
+    };
+    let all = u32::MAX;
+    let groupings: [(usize, usize); GROUPINGS] = [
+        cost(&chip),
+        cost(&quads),
+        cost(&regroup(1, false)),
+        cost(&regroup(4, false)),
+        cost(&regroup(all, false)),
+        cost(&regroup(all, true)),
+        cost(&oracle),
+    ];
+    (groupings, needed)
+}
+
+pub fn command(a: RegroupArgs) -> Result<()> {
+    let scene = crate::cmd_scene::load_scene(a.scene.as_deref())?;
+    let size = a.size;
+    let path = scene.source.clone();
+    let tracer = Tracer::new(&scene);
+    let bounds: Vec<_> = scene.objects.iter().map(|o| o.shape.bounds()).collect();
+    let sb = scene.bounds();
+    if sb.is_empty() || scene.objects.is_empty() {
+        return Err(anyhow!("{path}: nothing to trace"));
+    }
+    let params = BspParams {
+        max_depth: auto_depth(bounds.len()),
+        max_leaf: 5,
+        rule: SplitRule::Sah,
+        snap: 0.0,
+    };
+    let bsp = Bsp::build(&bounds, sb, params);
+    let eps = 1e-6 * sb.min.max_abs().max(sb.max.max_abs());
+    let names = ["eye", "shadow (eye hits)", "mirror", "shadow (mirror hits)"];
+    let kinds = segments(&scene, &tracer, size, eps);
     println!(
         "{path} at {size}x{size}, depth 2; pbrt SAH tree of {} nodes; object tests broadcast (fewer is better)",
         bsp.nodes.len()
@@ -246,76 +331,7 @@ pub fn command(a: RegroupArgs) -> Result<()> {
     let mut total = [(0usize, 0usize); GROUPINGS];
     let mut total_needed = 0usize;
     for (name, segs) in names.iter().zip(&kinds) {
-        let reach: Vec<Vec<u32>> = segs
-            .iter()
-            .map(|s| {
-                let mut l = Vec::new();
-                leaves(&bsp, s, &mut l);
-                l
-            })
-            .collect();
-        let objects = |l: u32| bsp.nodes[l as usize].objects.len();
-        let needed = needed_tests(&reach, objects);
-        let cost = |packets: &[Vec<usize>]| broadcast(packets, &reach, objects);
-        let tile = |s: &Seg| (s.pixel.1 / 8) * (size / 8) + s.pixel.0 / 8;
-        let mut chip: BTreeMap<(u32, usize), Vec<usize>> = BTreeMap::new();
-        for (k, s) in segs.iter().enumerate() {
-            chip.entry((tile(s), s.light)).or_default().push(k);
-        }
-        let chip: Vec<Vec<usize>> = chip.into_values().collect();
-        // Each of those packets split into its 4x4 quadrants, traced one
-        // after another.
-        let mut quads: BTreeMap<(u32, usize, u32), Vec<usize>> = BTreeMap::new();
-        for (k, s) in segs.iter().enumerate() {
-            let q = (s.pixel.1 % 8 / 4) * 2 + s.pixel.0 % 8 / 4;
-            quads.entry((tile(s), s.light, q)).or_default().push(k);
-        }
-        let quads: Vec<Vec<usize>> = quads.into_values().collect();
-        let regroup = |group: u32, with_dir: bool| -> Vec<Vec<usize>> {
-            // Ties (eye rays share their origin) keep the tiles' order.
-            let mut groups: BTreeMap<u32, Vec<(u64, u32, usize)>> = BTreeMap::new();
-            for (k, s) in segs.iter().enumerate() {
-                let (x, y, z) = (
-                    cell(s.o.x, sb.min.x, sb.max.x),
-                    cell(s.o.y, sb.min.y, sb.max.y),
-                    cell(s.o.z, sb.min.z, sb.max.z),
-                );
-                let key = if with_dir {
-                    morton(x >> 5, y >> 5, z >> 5, 5) << 15
-                        | morton(dir(s.d.x), dir(s.d.y), dir(s.d.z), 5)
-                } else {
-                    morton(x, y, z, 10)
-                };
-                groups
-                    .entry(tile(s) / group)
-                    .or_default()
-                    .push((key, tile(s), k));
-            }
-            let mut packets = Vec::new();
-            for (_, mut g) in groups {
-                g.sort_unstable();
-                packets.extend(g.chunks(64).map(|c| c.iter().map(|x| x.2).collect()));
-            }
-            packets
-        };
-        // An oracle no firmware has: the frame's rays sorted by the
-        // leaves they reach (front to back, leaves numbered in tree
-        // order), which only tracing them tells.
-        let oracle = {
-            let mut order: Vec<usize> = (0..segs.len()).collect();
-            order.sort_by(|&a, &b| reach[a].cmp(&reach[b]).then(a.cmp(&b)));
-            order.chunks(64).map(|c| c.to_vec()).collect::<Vec<_>>()
-        };
-        let all = u32::MAX;
-        let groupings: [(usize, usize); GROUPINGS] = [
-            cost(&chip),
-            cost(&quads),
-            cost(&regroup(1, false)),
-            cost(&regroup(4, false)),
-            cost(&regroup(all, false)),
-            cost(&regroup(all, true)),
-            cost(&oracle),
-        ];
+        let (groupings, needed) = groupings(segs, &bsp, sb, size);
         print_rows(name, &segs.len().to_string(), &groupings, needed);
         for (t, g) in total.iter_mut().zip(groupings) {
             t.0 += g.0;
