@@ -205,6 +205,139 @@ fn legend_corner(
         .unwrap_or(SeriesLabelPosition::UpperLeft)
 }
 
+/// What every chart draws on its axes (one body for each pair of linear
+/// and logarithmic axes, whose coordinate types differ): the mesh, the
+/// series with their markers and labels, the Pareto fronts, the marks,
+/// the legend.
+macro_rules! body {
+    ($chart:expr, $c:expr, $corner:expr) => {{
+        let (mut chart, c, corner) = ($chart, $c, $corner);
+        chart
+            .configure_mesh()
+            .x_desc(&c.x_label)
+            .y_desc(&c.y_label)
+            .x_label_formatter(&|x| tick(*x))
+            .y_label_formatter(&|y| tick(*y))
+            .label_style(("sans-serif", 14))
+            .axis_desc_style(("sans-serif", 16))
+            .draw()
+            .map_err(|e| anyhow!("{e:?}"))?;
+        for (k, s) in c.series.iter().enumerate() {
+            let col = COLORS[s.style.color.unwrap_or(k) % COLORS.len()];
+            let marker = |(i, &p): (usize, &(f64, f64))| {
+                if s.style.hollow.get(i).copied().unwrap_or(false) {
+                    Circle::new(p, 4, col.stroke_width(2))
+                } else {
+                    Circle::new(p, 4, col.filled())
+                }
+            };
+            if c.lines && s.style.dashed {
+                chart
+                    .draw_series(DashedLineSeries::new(
+                        s.points.iter().copied(),
+                        8,
+                        5,
+                        col.stroke_width(2),
+                    ))
+                    .map_err(|e| anyhow!("{e:?}"))?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        plotters::element::DashedPathElement::new(
+                            vec![(x, y), (x + 18, y)],
+                            5,
+                            3,
+                            col.stroke_width(2),
+                        )
+                    });
+                chart
+                    .draw_series(s.points.iter().enumerate().map(marker))
+                    .map_err(|e| anyhow!("{e:?}"))?;
+            } else if c.lines {
+                chart
+                    .draw_series(LineSeries::new(
+                        s.points.iter().copied(),
+                        col.stroke_width(2),
+                    ))
+                    .map_err(|e| anyhow!("{e:?}"))?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
+                    });
+                chart
+                    .draw_series(s.points.iter().enumerate().map(marker))
+                    .map_err(|e| anyhow!("{e:?}"))?;
+            } else {
+                chart
+                    .draw_series(s.points.iter().enumerate().map(marker))
+                    .map_err(|e| anyhow!("{e:?}"))?
+                    .label(s.name.clone())
+                    .legend(move |(x, y)| Circle::new((x + 9, y), 4, col.filled()));
+            }
+        }
+        for (k, s) in c.series.iter().enumerate() {
+            let col = COLORS[s.style.color.unwrap_or(k) % COLORS.len()];
+            for (p, l) in s.points.iter().zip(&s.style.labels) {
+                if l.is_empty() {
+                    continue;
+                }
+                chart
+                    .draw_series(std::iter::once(Text::new(
+                        l.clone(),
+                        *p,
+                        ("sans-serif", 13)
+                            .into_font()
+                            .color(&col)
+                            .pos(Pos::new(HPos::Left, VPos::Bottom)),
+                    )))
+                    .map_err(|e| anyhow!("{e:?}"))?;
+            }
+        }
+        if c.pareto {
+            // One front per series: configurations of one scene compete.
+            for (k, s) in c.series.iter().enumerate() {
+                let col = COLORS[k % COLORS.len()];
+                let front = pareto_front(&s.points);
+                let e = chart
+                    .draw_series(LineSeries::new(front.into_iter(), col.stroke_width(1)))
+                    .map_err(|e| anyhow!("{e:?}"))?;
+                if k == 0 {
+                    e.label("Pareto front (per scene)").legend(|(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1))
+                    });
+                }
+            }
+        }
+        for m in &c.marks {
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new(
+                    (m.x, m.y),
+                    8,
+                    RED.filled(),
+                )))
+                .map_err(|e| anyhow!("{e:?}"))?;
+            chart
+                .draw_series(std::iter::once(Text::new(
+                    // beside the marker, not over it
+                    format!("{}   ", m.label),
+                    (m.x, m.y),
+                    ("sans-serif", 14)
+                        .into_font()
+                        .color(&RED)
+                        .pos(Pos::new(HPos::Right, VPos::Center)),
+                )))
+                .map_err(|e| anyhow!("{e:?}"))?;
+        }
+        chart
+            .configure_series_labels()
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK.mix(0.4))
+            .label_font(("sans-serif", 14))
+            .position(corner)
+            .draw()
+            .map_err(|e| anyhow!("{e:?}"))?;
+    }};
+}
+
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
     c: &Chart,
@@ -227,134 +360,6 @@ where
         .margin(14)
         .x_label_area_size(42)
         .y_label_area_size(62);
-    macro_rules! body {
-        ($chart:expr) => {{
-            let mut chart = $chart;
-            chart
-                .configure_mesh()
-                .x_desc(&c.x_label)
-                .y_desc(&c.y_label)
-                .x_label_formatter(&|x| tick(*x))
-                .y_label_formatter(&|y| tick(*y))
-                .label_style(("sans-serif", 14))
-                .axis_desc_style(("sans-serif", 16))
-                .draw()
-                .map_err(|e| anyhow!("{e:?}"))?;
-            for (k, s) in c.series.iter().enumerate() {
-                let col = COLORS[s.style.color.unwrap_or(k) % COLORS.len()];
-                let marker = |(i, &p): (usize, &(f64, f64))| {
-                    if s.style.hollow.get(i).copied().unwrap_or(false) {
-                        Circle::new(p, 4, col.stroke_width(2))
-                    } else {
-                        Circle::new(p, 4, col.filled())
-                    }
-                };
-                if c.lines && s.style.dashed {
-                    chart
-                        .draw_series(DashedLineSeries::new(
-                            s.points.iter().copied(),
-                            8,
-                            5,
-                            col.stroke_width(2),
-                        ))
-                        .map_err(|e| anyhow!("{e:?}"))?
-                        .label(s.name.clone())
-                        .legend(move |(x, y)| {
-                            plotters::element::DashedPathElement::new(
-                                vec![(x, y), (x + 18, y)],
-                                5,
-                                3,
-                                col.stroke_width(2),
-                            )
-                        });
-                    chart
-                        .draw_series(s.points.iter().enumerate().map(marker))
-                        .map_err(|e| anyhow!("{e:?}"))?;
-                } else if c.lines {
-                    chart
-                        .draw_series(LineSeries::new(
-                            s.points.iter().copied(),
-                            col.stroke_width(2),
-                        ))
-                        .map_err(|e| anyhow!("{e:?}"))?
-                        .label(s.name.clone())
-                        .legend(move |(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 18, y)], col.stroke_width(2))
-                        });
-                    chart
-                        .draw_series(s.points.iter().enumerate().map(marker))
-                        .map_err(|e| anyhow!("{e:?}"))?;
-                } else {
-                    chart
-                        .draw_series(s.points.iter().enumerate().map(marker))
-                        .map_err(|e| anyhow!("{e:?}"))?
-                        .label(s.name.clone())
-                        .legend(move |(x, y)| Circle::new((x + 9, y), 4, col.filled()));
-                }
-            }
-            for (k, s) in c.series.iter().enumerate() {
-                let col = COLORS[s.style.color.unwrap_or(k) % COLORS.len()];
-                for (p, l) in s.points.iter().zip(&s.style.labels) {
-                    if l.is_empty() {
-                        continue;
-                    }
-                    chart
-                        .draw_series(std::iter::once(Text::new(
-                            l.clone(),
-                            *p,
-                            ("sans-serif", 13)
-                                .into_font()
-                                .color(&col)
-                                .pos(Pos::new(HPos::Left, VPos::Bottom)),
-                        )))
-                        .map_err(|e| anyhow!("{e:?}"))?;
-                }
-            }
-            if c.pareto {
-                // One front per series: configurations of one scene compete.
-                for (k, s) in c.series.iter().enumerate() {
-                    let col = COLORS[k % COLORS.len()];
-                    let front = pareto_front(&s.points);
-                    let e = chart
-                        .draw_series(LineSeries::new(front.into_iter(), col.stroke_width(1)))
-                        .map_err(|e| anyhow!("{e:?}"))?;
-                    if k == 0 {
-                        e.label("Pareto front (per scene)").legend(|(x, y)| {
-                            PathElement::new(vec![(x, y), (x + 18, y)], BLACK.stroke_width(1))
-                        });
-                    }
-                }
-            }
-            for m in &c.marks {
-                chart
-                    .draw_series(std::iter::once(TriangleMarker::new(
-                        (m.x, m.y),
-                        8,
-                        RED.filled(),
-                    )))
-                    .map_err(|e| anyhow!("{e:?}"))?;
-                chart
-                    .draw_series(std::iter::once(Text::new(
-                        // beside the marker, not over it
-                        format!("{}   ", m.label),
-                        (m.x, m.y),
-                        ("sans-serif", 14)
-                            .into_font()
-                            .color(&RED)
-                            .pos(Pos::new(HPos::Right, VPos::Center)),
-                    )))
-                    .map_err(|e| anyhow!("{e:?}"))?;
-            }
-            chart
-                .configure_series_labels()
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK.mix(0.4))
-                .label_font(("sans-serif", 14))
-                .position(corner)
-                .draw()
-                .map_err(|e| anyhow!("{e:?}"))?;
-        }};
-    }
     let (y0, y1) = if c.log_y {
         (y0.max(1e-9), y1)
     } else {
@@ -363,21 +368,33 @@ where
     // Logarithmic axes tick where the data's scale does ([`log_ticks`]).
     let (xt, yt) = (log_ticks(x0, x1), log_ticks(y0, y1));
     match (c.log_x, c.log_y) {
-        (true, true) => body!(b
-            .build_cartesian_2d(
+        (true, true) => body!(
+            b.build_cartesian_2d(
                 (x0..x1).log_scale().with_key_points(xt),
                 (y0..y1).log_scale().with_key_points(yt)
             )
-            .map_err(|e| anyhow!("{e:?}"))?),
-        (true, false) => body!(b
-            .build_cartesian_2d((x0..x1).log_scale().with_key_points(xt), y0..y1)
-            .map_err(|e| anyhow!("{e:?}"))?),
-        (false, true) => body!(b
-            .build_cartesian_2d(x0..x1, (y0..y1).log_scale().with_key_points(yt))
-            .map_err(|e| anyhow!("{e:?}"))?),
-        (false, false) => body!(b
-            .build_cartesian_2d(x0..x1, y0..y1)
-            .map_err(|e| anyhow!("{e:?}"))?),
+            .map_err(|e| anyhow!("{e:?}"))?,
+            c,
+            corner
+        ),
+        (true, false) => body!(
+            b.build_cartesian_2d((x0..x1).log_scale().with_key_points(xt), y0..y1)
+                .map_err(|e| anyhow!("{e:?}"))?,
+            c,
+            corner
+        ),
+        (false, true) => body!(
+            b.build_cartesian_2d(x0..x1, (y0..y1).log_scale().with_key_points(yt))
+                .map_err(|e| anyhow!("{e:?}"))?,
+            c,
+            corner
+        ),
+        (false, false) => body!(
+            b.build_cartesian_2d(x0..x1, y0..y1)
+                .map_err(|e| anyhow!("{e:?}"))?,
+            c,
+            corner
+        ),
     }
     root.present().map_err(|e| anyhow!("{e:?}"))?;
     Ok(())
