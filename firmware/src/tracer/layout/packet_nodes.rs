@@ -370,71 +370,18 @@ fn streamed_image(
     let types = tree.types;
     let nodes = &tree.nodes;
     let records = w.fb.split_off(records_start);
-    let split_slot = w.fb.len();
-    // `SPLIT`, then `SLOTS`: a pushed node's RAM slot by its place on the
-    // node stack, every 4th word (the stack's entries are 4 bytes apart,
-    // so TinyRISC finds the slot of the top at a constant offset from its
-    // stack pointer).
-    w.raw(0);
-    for d in 0..super::super::memory_map::ram::P_SLOTS {
-        w.raw(pk_slot(d));
-        if d + 1 < super::super::memory_map::ram::P_SLOTS {
-            for _ in 0..3 {
-                w.raw(0);
-            }
-        }
-    }
-    if w.fb.len() > STREAM_BANK {
-        return Err(err(
-            0,
-            format!(
-                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
-                w.fb.len()
-            ),
-        ));
-    }
+    let split_slot = resident_part(&mut w, err)?;
     let base = mem::STREAM as usize;
-    // A leaf's pieces alternate between FB bank 1 and the top of bank 0,
-    // above the resident words.
-    let largest_record = types.iter().map(|t| t.size).max().unwrap_or(0);
-    let room = STREAM_BANK - w.fb.len();
-    if largest_record > room {
-        return Err(err(
-            0,
-            format!(
-                "a {}-word record does not fit the {room} words bank 0 has above the streamed layout's resident part",
-                largest_record
-            ),
-        ));
-    }
-    let rest = fin.pieces.rest.max(largest_record).min(room);
-    let first = fin.pieces.first.min(rest);
-    let second = fin.pieces.second_or_rest().clamp(first, rest);
-    let bank0_buf = STREAM_BANK - rest;
-    // Bank 1: the further pieces' buffer (even places), then the cache's
-    // slots for first pieces (one per leaf, direct-mapped by the leaf's
-    // order, neighbouring leaves in different slots); with no room for a
-    // slot beside the buffer, one slot that is the buffer.
-    let slot_words = first.max(largest_record).next_multiple_of(4);
-    let buffer = rest.next_multiple_of(4);
-    // The top of bank 1: the buffer a packet's bands of a polygon's
-    // sub-edges are moved into (sub-edges apart).
-    let fan_buf = w.fan_most.next_multiple_of(4);
-    if buffer + fan_buf > STREAM_BANK {
-        return Err(err(
-            0,
-            format!(
-                "a banded polygon's {} words of sub-edges and the leaf pieces' {buffer}-word buffer do not fit FB bank 1 ({STREAM_BANK} words)",
-                w.fan_most
-            ),
-        ));
-    }
-    let bank1 = STREAM_BANK - fan_buf;
-    let (cache_slots, slots_at) = if buffer + slot_words <= bank1 {
-        ((bank1 - buffer) / slot_words, STREAM_BANK + buffer)
-    } else {
-        (1, STREAM_BANK)
-    };
+    let Banks {
+        rest,
+        first,
+        second,
+        bank0_buf,
+        slot_words,
+        cache_slots,
+        slots_at,
+        fan_buf,
+    } = banks(&w, fin, types, err)?;
     let (pieces, first_piece, in_leaf) = pieces(tree, first, second, rest);
     let nn = nodes.len();
     let lists_at = NODE_BYTES * (nn + pieces.len());
@@ -517,37 +464,14 @@ fn streamed_image(
         };
         img[lists_at + 4 * i..lists_at + 4 * i + 4].copy_from_slice(&a.to_le_bytes());
     }
-    let mut late_leaves = 0usize;
-    for (k, n) in nodes.iter().enumerate() {
-        let mut f = [0i32; 16];
-        match n.split {
-            Some(sp) => {
-                f[word(PS_FLAGS)] = 4 * sp.axis as i32;
-                f[word(PS_SPLIT)] = w.sat(sp.position * w.s);
-                f[word(PS_LEFT)] = (base + NODE_BYTES * sp.children[0] as usize) as i32;
-                f[word(PS_RIGHT)] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
-            }
-            None => {
-                f[word(PS_FLAGS)] = -32768 | LEAF_EMPTY;
-                if first_piece[k] != usize::MAX {
-                    // The leaf's record is its first piece's (its list,
-                    // block, next piece, counts).
-                    let p = piece_rec[first_piece[k]];
-                    f[word(PS_LIST)] = p[word(PS_LIST)];
-                    f[word(PS_FB)] = p[word(PS_FB)];
-                    f[word(PS_BLOCK)..].copy_from_slice(&p[word(PS_BLOCK)..]);
-                    let awake = p[word(PS_SHARED)] != 0 || p[word(PS_NEXT)] != 0;
-                    let late = p[word(PS_BLOCK_WORDS)] as usize > fin.pieces.rest
-                        && p[word(PS_SHARED)] == p[word(PS_OBJECTS)];
-                    late_leaves += late as usize;
-                    f[word(PS_FLAGS)] = -32768
-                        | if awake { LEAF_AWAKE } else { 0 }
-                        | if late { LEAF_LATE } else { 0 };
-                }
-            }
-        }
-        put(&mut img, k, &f);
-    }
+    let late_leaves = node_records(
+        &mut img,
+        nodes,
+        &piece_rec,
+        &first_piece,
+        &w,
+        fin.pieces.rest,
+    );
     for (p, f) in piece_rec.iter().enumerate() {
         put(&mut img, nn + p, f);
     }
@@ -579,6 +503,156 @@ fn streamed_image(
         fans,
     };
     Ok((w.fb, st))
+}
+
+/// The resident words after the records' place: `SPLIT`, then `SLOTS`: a
+/// pushed node's RAM slot by its place on the node stack, every 4th word
+/// (the stack's entries are 4 bytes apart, so TinyRISC finds the slot of
+/// the top at a constant offset from its stack pointer). Returns where
+/// `SPLIT` is.
+fn resident_part(w: &mut W, err: &dyn Fn(usize, String) -> String) -> Result<usize, String> {
+    let split_slot = w.fb.len();
+    w.raw(0);
+    for d in 0..super::super::memory_map::ram::P_SLOTS {
+        w.raw(pk_slot(d));
+        if d + 1 < super::super::memory_map::ram::P_SLOTS {
+            for _ in 0..3 {
+                w.raw(0);
+            }
+        }
+    }
+    if w.fb.len() > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                w.fb.len()
+            ),
+        ));
+    }
+    Ok(split_slot)
+}
+
+/// Where a streamed leaf's pieces go in the FB: the pieces' limits, the
+/// buffer at the top of bank 0, the leaf cache's slots in bank 1, the
+/// sub-edges' buffer at its top.
+struct Banks {
+    rest: usize,
+    first: usize,
+    second: usize,
+    bank0_buf: usize,
+    slot_words: usize,
+    cache_slots: usize,
+    slots_at: usize,
+    fan_buf: usize,
+}
+
+/// The FB's banks for the streamed pieces of `types`' records, above the
+/// resident words `w` holds.
+fn banks(
+    w: &W,
+    fin: &Finish,
+    types: &[TypeInfo],
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<Banks, String> {
+    // A leaf's pieces alternate between FB bank 1 and the top of bank 0,
+    // above the resident words.
+    let largest_record = types.iter().map(|t| t.size).max().unwrap_or(0);
+    let room = STREAM_BANK - w.fb.len();
+    if largest_record > room {
+        return Err(err(
+            0,
+            format!(
+                "a {}-word record does not fit the {room} words bank 0 has above the streamed layout's resident part",
+                largest_record
+            ),
+        ));
+    }
+    let rest = fin.pieces.rest.max(largest_record).min(room);
+    let first = fin.pieces.first.min(rest);
+    let second = fin.pieces.second_or_rest().clamp(first, rest);
+    let bank0_buf = STREAM_BANK - rest;
+    // Bank 1: the further pieces' buffer (even places), then the cache's
+    // slots for first pieces (one per leaf, direct-mapped by the leaf's
+    // order, neighbouring leaves in different slots); with no room for a
+    // slot beside the buffer, one slot that is the buffer.
+    let slot_words = first.max(largest_record).next_multiple_of(4);
+    let buffer = rest.next_multiple_of(4);
+    // The top of bank 1: the buffer a packet's bands of a polygon's
+    // sub-edges are moved into (sub-edges apart).
+    let fan_buf = w.fan_most.next_multiple_of(4);
+    if buffer + fan_buf > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "a banded polygon's {} words of sub-edges and the leaf pieces' {buffer}-word buffer do not fit FB bank 1 ({STREAM_BANK} words)",
+                w.fan_most
+            ),
+        ));
+    }
+    let bank1 = STREAM_BANK - fan_buf;
+    let (cache_slots, slots_at) = if buffer + slot_words <= bank1 {
+        ((bank1 - buffer) / slot_words, STREAM_BANK + buffer)
+    } else {
+        (1, STREAM_BANK)
+    };
+    Ok(Banks {
+        rest,
+        first,
+        second,
+        bank0_buf,
+        slot_words,
+        cache_slots,
+        slots_at,
+        fan_buf,
+    })
+}
+
+/// The node records: inner nodes their split, leaves their first piece's
+/// record and flags (`LEAF_AWAKE`, `LEAF_LATE` for a first piece over
+/// `rest` words of shared objects). Returns the late leaves.
+fn node_records(
+    img: &mut [u8],
+    nodes: &[Node],
+    piece_rec: &[[i32; 16]],
+    first_piece: &[usize],
+    w: &W,
+    rest: usize,
+) -> usize {
+    use fields::*;
+    let base = mem::STREAM as usize;
+    let mut late_leaves = 0usize;
+    for (k, n) in nodes.iter().enumerate() {
+        let mut f = [0i32; 16];
+        match n.split {
+            Some(sp) => {
+                f[word(PS_FLAGS)] = 4 * sp.axis as i32;
+                f[word(PS_SPLIT)] = w.sat(sp.position * w.s);
+                f[word(PS_LEFT)] = (base + NODE_BYTES * sp.children[0] as usize) as i32;
+                f[word(PS_RIGHT)] = (base + NODE_BYTES * sp.children[1] as usize) as i32;
+            }
+            None => {
+                f[word(PS_FLAGS)] = -32768 | LEAF_EMPTY;
+                if first_piece[k] != usize::MAX {
+                    // The leaf's record is its first piece's (its list,
+                    // block, next piece, counts).
+                    let p = piece_rec[first_piece[k]];
+                    f[word(PS_LIST)] = p[word(PS_LIST)];
+                    f[word(PS_FB)] = p[word(PS_FB)];
+                    f[word(PS_BLOCK)..].copy_from_slice(&p[word(PS_BLOCK)..]);
+                    let awake = p[word(PS_SHARED)] != 0 || p[word(PS_NEXT)] != 0;
+                    let late = p[word(PS_BLOCK_WORDS)] as usize > rest
+                        && p[word(PS_SHARED)] == p[word(PS_OBJECTS)];
+                    late_leaves += late as usize;
+                    f[word(PS_FLAGS)] = -32768
+                        | if awake { LEAF_AWAKE } else { 0 }
+                        | if late { LEAF_LATE } else { 0 };
+                }
+            }
+        }
+        put(img, k, &f);
+    }
+    late_leaves
 }
 
 /// The node fields the packet traversal reads (named in the program's
