@@ -324,6 +324,15 @@ fn cb(t: &mut Code, k: &str) {
 pub fn routine(t: &mut Code, lay: &FbImage) {
     let nl = lay.lights.len() as u32;
     let w = ray_words(lay);
+    stage(t, lay, nl, w);
+    pack(t, w);
+    trace_packet(t);
+    shade(t, lay, nl);
+    t.lw(super::emit::R15, at(SC_RET, R0)).line("jr r15");
+}
+
+/// Each light's rays, its lit RCs and the rays' `w` words into the stage.
+fn stage(t: &mut Code, lay: &FbImage, nl: u32, w: u32) {
     t.doc(
         "shadows: a reflection level's shadow rays of every light, merged into full packets (see\n\
          the module's text in firmware/src/tracer/shadows.rs); then every light's Phong terms.",
@@ -362,6 +371,11 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         }
         cb(t, names::WAKE);
     }
+}
+
+/// `sc_packet`: the next packet of entries from the lit RCs of the lights
+/// in turn, each ray's `w` words copied into the packet stream.
+fn pack(t: &mut Code, w: u32) {
     t.lw(R6, at(SC_LIT, R0))
         .lw(R7, at(format!("{SC_LIT} + 4"), R0))
         .sw(R0, at(SC_L, R0))
@@ -431,6 +445,11 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .addi(R9, R9, "SC_REC")
         .addi(R10, R10, 1)
         .j("sc_fill");
+}
+
+/// `sc_full`: the packet's rays into their RCs, one any-hit pass, the
+/// unblocked ones into `SC_VIS`.
+fn trace_packet(t: &mut Code) {
     t.doc("sc_full: the packet's rays into their RCs, one pass (any hit), the unblocked ones into SC_VIS.");
     t.label("sc_full")
         .beqz(R10, "sc_shade")
@@ -479,6 +498,11 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         .addi(R3, R3, 1)
         .bne(R3, R10, "sc_result")
         .j("sc_packet");
+}
+
+/// `sc_shade`: per light, its answers back to the RCs that spawned the
+/// rays, and its Phong terms.
+fn shade(t: &mut Code, lay: &FbImage, nl: u32) {
     t.doc("sc_shade: per light, its answers back to the RCs that spawned the rays, and its Phong terms.");
     t.label("sc_shade");
     for l in 0..nl {
@@ -496,5 +520,4 @@ pub fn routine(t: &mut Code, lay: &FbImage) {
         t.m("BCAST_AT", format!("{}, r3", names::SHADOW_LIT));
         super::shading::broadcast_phong(t, lay.phong_in_runs(), &format!("FB_SHADE{l}"));
     }
-    t.lw(super::emit::R15, at(SC_RET, R0)).line("jr r15");
 }
