@@ -268,37 +268,10 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
             ", HIT_BACK_OBJ"
         },
     ));
-    k.comment("oc = B - o, projected on e1, e2");
-    k.c("sub r8, fb0, r1")
-        .c("sub r9, fb0, r2")
-        .c("sub r10, fb0, r3");
-    // oc2 = (oc.e1, oc.e2) rounded to LSB, and what the rounding left (in
-    // 2^-14 LSB, the accumulator's low half minus the rounded value's, exact
-    // below 2^13): added back when the perpendicular vector is formed, whose
-    // half-LSB error over a radius of a few dozen LSB would tilt the normal.
-    for (x, rem, t, tmp) in [(11, 14, 15, ram::TMP5), (12, 15, 13, ram::TMP6)] {
-        k.c("mul out, fb0, r8")
-            .c("mac out, fb0, r9")
-            .c(format!("mac r{x}, fb0, r10, >>Q14"));
-        if fine {
-            k.c(format!("accl r{rem}"))
-                .c(format!("sll r{t}, r{x}, #Q14"))
-                .c(format!("sub r{rem}, r{rem}, r{t}"))
-                .c(format!("add r{rem}, fb0, r{rem}"))
-                .c(format!("st r{rem}, [#{tmp}]"))
-                .note("the projection's remainder, plus B's");
-        }
-    }
+    origin_across(&mut k, fine);
     // The record's order says whether the opaque kernel has the bound.
     let bound = body == Body::Opaque && fit.cyl_bound;
     let er = if fine { "+EP_CYL" } else { "" };
-    // oc2 goes to RAM for after the normalisation; with the bound, only
-    // once the test goes on past it (a test cut there spends no store).
-    let store_oc2 = |k: &mut K| {
-        k.c(format!("st r11, [#{}]", ram::TMP0))
-            .c(format!("st r12, [#{}]", ram::TMP1))
-            .note("oc2");
-    };
     if !bound {
         store_oc2(&mut k);
     }
@@ -310,84 +283,9 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
         .c("mac r9, fb0, r6, >>Q14")
         .note("d2 = (d.e1, d.e2)");
     if bound {
-        // |oc2 x d2| = |p2| |d2| <= r |d2| <= r |d2|_1 where the line
-        // meets the cylinder: a cheap bound before the normalisation, with
-        // a margin for its rounding and the exact test's (a few LSB each).
-        // r stays in r14 up to the cut; invr comes from the stream after it.
-        k.comment("bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1")
-            .c("mov r14, fb0")
-            .note("r")
-            .c("abs r10, r8")
-            .c("abs r15, r9")
-            .c("add r15, r10, r15")
-            .note("|d2|_1")
-            .c(format!("mul r15, r14, r15, >>Q14{er}"))
-            .c(format!("add r15, r15, #{BOUND_MARGIN_LSB}"))
-            .c("mul out, r11, r9")
-            .c("msu r10, r12, r8, >>Q14")
-            .note("oc2 x d2")
-            .c("abs r10, r10")
-            .c("cmp.le r10, r15")
-            .note("F: the line may meet it");
-        if !g.published && !fit.cyl_inside {
-            // Seen from outside (sg = +1), tau = b - h with h >= 0 and
-            // b = oc2.d2 / |d2|: no root ahead where oc2.d2 <= 0. The
-            // margin covers b's rounding after the normalisation.
-            k.c("mul out, r11, r8")
-                .c("mac r10, r12, r9, >>Q14")
-                .c(format!("(f) cmp.gt r10, #-{BOUND_MARGIN_LSB}"))
-                .note("and the axis lies ahead across it");
-        }
-        k.cut(CUTS[0].0);
-        store_oc2(&mut k);
-        k.c(format!("st r14, [#{}]", ram::TMP8)).note("r");
+        line_bound(&mut k, g, fit, er);
     }
-    if g.published {
-        k.c("movb r10, #0");
-        normalize(&mut k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
-        k.c("mov r10, r11").note("|d2|, Q.14");
-    } else {
-        normalize(&mut k, &[8, 9], [10, 11, 12, 13, 14], true, nr);
-        k.note("|d2| in r10, Q.14");
-    }
-    k.c(format!("st r8, [#{}]", ram::TMP2))
-        .c(format!("st r9, [#{}]", ram::TMP3))
-        .note("d2n");
-    k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
-        .c(format!("ld r12, [r0 + #{}]", ram::TMP1));
-    k.c("mul out, r11, r8")
-        .c("mac r13, r12, r9, >>Q14")
-        .note("b = oc2.d2n");
-    if fine {
-        k.c(format!("ld r14, [r0 + #{}]", ram::TMP5))
-            .c(format!("ld r15, [r0 + #{}]", ram::TMP6));
-    }
-    for (x, rem, d) in [(11, 14, 8), (12, 15, 9)] {
-        k.c(format!("ldacc r{x}, <<Q14"));
-        if fine {
-            k.c(format!("mac out, r{rem}, #1"));
-        }
-        k.c(format!("msu r{x}, r13, r{d}, >>Q14-EP_CYL"));
-    }
-    k.note("p2 = oc2 - b d2n");
-    if fine {
-        // p2 perpendicular to the 2D direction d2n
-        perpendicular_to(&mut k, &[11, 12], &[8, 9], 14);
-    }
-    k.c("mov r14, fb0")
-        .note("invr")
-        .c("mul r11, r11, r14, >>KS_CYL+EP_CYL")
-        .c("mul r12, r12, r14, >>KS_CYL+EP_CYL")
-        .c(format!("st r11, [#{}]", ram::TMP0))
-        .c(format!("st r12, [#{}]", ram::TMP1))
-        .note("p2/r");
-    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
-        .c("ldacc r14, <<Q14")
-        .c("msu out, r11, r11")
-        .c("msu r15, r12, r12, >>Q14")
-        .note("s = 1 - |p2/r|^2")
-        .c("cmp.gt r15, #0")
-        .c("(f) cmp.gt r10, #0");
+    across_axis(&mut k, g, nr);
     if body == Body::Opaque {
         k.cut(CUTS[1].0);
     }
@@ -421,6 +319,128 @@ pub fn kernel(g: &Gen, fit: &Fit, body: Body) -> K {
     axial_and_normal(&mut k, (body == Body::Opaque).then_some(CUTS[3].0));
     commit_obj_mat(&mut k, body);
     k
+}
+
+/// `oc = B - o` projected on e1, e2: `oc2` rounded to LSB in r11, r12,
+/// and (fine normals) what the rounding left, in 2^-14 LSB, to RAM: added
+/// back when the perpendicular vector is formed, whose half-LSB error over
+/// a radius of a few dozen LSB would tilt the normal.
+fn origin_across(k: &mut K, fine: bool) {
+    k.comment("oc = B - o, projected on e1, e2");
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    // The remainder: the accumulator's low half minus the rounded value's,
+    // exact below 2^13.
+    for (x, rem, t, tmp) in [(11, 14, 15, ram::TMP5), (12, 15, 13, ram::TMP6)] {
+        k.c("mul out, fb0, r8")
+            .c("mac out, fb0, r9")
+            .c(format!("mac r{x}, fb0, r10, >>Q14"));
+        if fine {
+            k.c(format!("accl r{rem}"))
+                .c(format!("sll r{t}, r{x}, #Q14"))
+                .c(format!("sub r{rem}, r{rem}, r{t}"))
+                .c(format!("add r{rem}, fb0, r{rem}"))
+                .c(format!("st r{rem}, [#{tmp}]"))
+                .note("the projection's remainder, plus B's");
+        }
+    }
+}
+
+/// `oc2` to RAM for after the normalisation; with the bound, only once the
+/// test goes on past it (a test cut there spends no store).
+fn store_oc2(k: &mut K) {
+    k.c(format!("st r11, [#{}]", ram::TMP0))
+        .c(format!("st r12, [#{}]", ram::TMP1))
+        .note("oc2");
+}
+
+/// The opaque kernel's bound before the normalisation and its cut:
+/// `|oc2 x d2| = |p2| |d2| <= r |d2| <= r |d2|_1` where the line meets the
+/// cylinder, with a margin for its rounding and the exact test's (a few
+/// LSB each); r stays in r14 up to the cut, invr comes from the stream
+/// after it.
+fn line_bound(k: &mut K, g: &Gen, fit: &Fit, er: &str) {
+    k.comment("bound: the line can meet the cylinder only where |oc2 x d2| <= r |d2|_1")
+        .c("mov r14, fb0")
+        .note("r")
+        .c("abs r10, r8")
+        .c("abs r15, r9")
+        .c("add r15, r10, r15")
+        .note("|d2|_1")
+        .c(format!("mul r15, r14, r15, >>Q14{er}"))
+        .c(format!("add r15, r15, #{BOUND_MARGIN_LSB}"))
+        .c("mul out, r11, r9")
+        .c("msu r10, r12, r8, >>Q14")
+        .note("oc2 x d2")
+        .c("abs r10, r10")
+        .c("cmp.le r10, r15")
+        .note("F: the line may meet it");
+    if !g.published && !fit.cyl_inside {
+        // Seen from outside (sg = +1), tau = b - h with h >= 0 and
+        // b = oc2.d2 / |d2|: no root ahead where oc2.d2 <= 0. The
+        // margin covers b's rounding after the normalisation.
+        k.c("mul out, r11, r8")
+            .c("mac r10, r12, r9, >>Q14")
+            .c(format!("(f) cmp.gt r10, #-{BOUND_MARGIN_LSB}"))
+            .note("and the axis lies ahead across it");
+    }
+    k.cut(CUTS[0].0);
+    store_oc2(k);
+    k.c(format!("st r14, [#{}]", ram::TMP8)).note("r");
+}
+
+/// Across the axis: `d2` normalised (`|d2|` in r10), `b = oc2.d2n`,
+/// `p2 = oc2 - b d2n` (fine normals: made perpendicular to `d2n`), `p2/r`
+/// to RAM, `s = 1 - |p2/r|^2` in r15 and F where `s > 0` and `|d2| > 0`.
+fn across_axis(k: &mut K, g: &Gen, nr: super::super::math::Approx) {
+    let fine = g.fine_normals;
+    if g.published {
+        k.c("movb r10, #0");
+        normalize(k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
+        k.c("mov r10, r11").note("|d2|, Q.14");
+    } else {
+        normalize(k, &[8, 9], [10, 11, 12, 13, 14], true, nr);
+        k.note("|d2| in r10, Q.14");
+    }
+    k.c(format!("st r8, [#{}]", ram::TMP2))
+        .c(format!("st r9, [#{}]", ram::TMP3))
+        .note("d2n");
+    k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
+        .c(format!("ld r12, [r0 + #{}]", ram::TMP1));
+    k.c("mul out, r11, r8")
+        .c("mac r13, r12, r9, >>Q14")
+        .note("b = oc2.d2n");
+    if fine {
+        k.c(format!("ld r14, [r0 + #{}]", ram::TMP5))
+            .c(format!("ld r15, [r0 + #{}]", ram::TMP6));
+    }
+    for (x, rem, d) in [(11, 14, 8), (12, 15, 9)] {
+        k.c(format!("ldacc r{x}, <<Q14"));
+        if fine {
+            k.c(format!("mac out, r{rem}, #1"));
+        }
+        k.c(format!("msu r{x}, r13, r{d}, >>Q14-EP_CYL"));
+    }
+    k.note("p2 = oc2 - b d2n");
+    if fine {
+        // p2 perpendicular to the 2D direction d2n
+        perpendicular_to(k, &[11, 12], &[8, 9], 14);
+    }
+    k.c("mov r14, fb0")
+        .note("invr")
+        .c("mul r11, r11, r14, >>KS_CYL+EP_CYL")
+        .c("mul r12, r12, r14, >>KS_CYL+EP_CYL")
+        .c(format!("st r11, [#{}]", ram::TMP0))
+        .c(format!("st r12, [#{}]", ram::TMP1))
+        .note("p2/r");
+    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("ldacc r14, <<Q14")
+        .c("msu out, r11, r11")
+        .c("msu r15, r12, r12, >>Q14")
+        .note("s = 1 - |p2/r|^2")
+        .c("cmp.gt r15, #0")
+        .c("(f) cmp.gt r10, #0");
 }
 
 /// The opaque body kernel's cuts ([`K::cut`]; the first with [`Fit::cyl_bound`])
