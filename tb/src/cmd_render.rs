@@ -9,6 +9,8 @@ use firmware::tracer::{Numerics, Options};
 use serde_json::json;
 
 use crate::cmd_scene::{load_scene, png_bytes};
+
+mod profile_report;
 use crate::metrics;
 use crate::reference;
 
@@ -255,9 +257,9 @@ pub fn command(a: RenderArgs) -> Result<()> {
         None => "generated".into(),
     };
     if let Some(p) = &chip.profile {
-        let c = crate::profile::causes(p, &chip);
-        rep.json["profile"] = crate::profile::profile_json(p, &c);
-        if let Some(check) = crate::profile::CostCheck::of(p, &c, &chip) {
+        let c = profile_report::causes(p, &chip);
+        rep.json["profile"] = profile_report::profile_json(p, &c);
+        if let Some(check) = profile_report::CostCheck::of(p, &c, &chip) {
             rep.json["profile"]["cost_model"] = json!({
                 "node_visit": check.node_visit,
                 "leaf_loop": check.leaf_loop,
@@ -302,8 +304,8 @@ pub fn command(a: RenderArgs) -> Result<()> {
     crate::note!("wrote {}", out.display());
     print_report(&scene, &opt, &chip, &rep.json, &timing, &datapath_reason);
     if let Some(p) = &chip.profile {
-        let c = crate::profile::causes(p, &chip);
-        crate::profile::print_profile(p, &c, crate::profile::CostCheck::of(p, &c, &chip));
+        let c = profile_report::causes(p, &chip);
+        profile_report::print_profile(p, &c, profile_report::CostCheck::of(p, &c, &chip));
     }
     if let Some(p) = &a.json {
         let text = serde_json::to_string_pretty(&rep.json)?;

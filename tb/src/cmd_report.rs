@@ -15,6 +15,7 @@
 //! `<!-- /report: ID -->`; `--only ID,...` rewrites those and leaves the
 //! rest of the file as it is.
 
+use crate::output::thousands;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -500,19 +501,6 @@ fn u(j: &Value, k: &str) -> u64 {
 
 fn f(j: &Value, k: &str) -> f64 {
     j[k].as_f64().unwrap_or(f64::NAN)
-}
-
-/// 12,345,678
-pub(crate) fn thousands(n: u64) -> String {
-    let s = n.to_string();
-    let mut out = String::new();
-    for (i, c) in s.chars().enumerate() {
-        if i > 0 && (s.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
 }
 
 /// Three significant digits (288, 45.4, 4.63, 0.155).

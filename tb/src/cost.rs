@@ -25,7 +25,7 @@ use anyhow::{bail, Context as _};
 use rtl::rc::Datapath;
 use serde::{Deserialize, Serialize};
 
-use crate::cmd_report::thousands;
+use crate::output::thousands;
 
 /// The committed synthesis results.
 pub const COMMITTED: &str = include_str!("../../rtl/verilog/synth/cost.json");

@@ -2,7 +2,7 @@
 //! tracks its temporary file, the GTKWave save file, translate filters and
 //! Surfer decoders beside it, and the scope patterns of `--trace-scope`.
 
-use super::LabelKind;
+use super::{is_fst, LabelKind, TraceConfig};
 use std::io::{self, Write};
 use std::path::{Path, PathBuf};
 
@@ -175,4 +175,54 @@ pub fn check_scope_patterns(s: &str) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// The file a waveform is written to: a regular file goes to a temporary
+/// file beside it, renamed into place by finish(), so an interrupted run
+/// never leaves a truncated waveform under the requested name; a symbolic
+/// link is followed (its target replaced, the link kept); a device or FIFO
+/// (`/dev/null`, a named pipe) is written through. Returns the file, the
+/// temporary's path and the target.
+pub(super) fn open_output(
+    cfg: &TraceConfig,
+) -> io::Result<(std::fs::File, Option<tempfile::TempPath>, PathBuf)> {
+    let through = matches!(std::fs::metadata(&cfg.path), Ok(m) if !m.is_file() && !m.is_dir());
+    if through && is_fst(&cfg.path) {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{}: an FST waveform needs a regular file (it is written out of order); \
+                 give a path ending in .vcd to write through a device or pipe",
+                cfg.path.display()
+            ),
+        ));
+    }
+    Ok(match std::fs::metadata(&cfg.path) {
+        Ok(m) if !m.is_file() && !m.is_dir() => (
+            std::fs::OpenOptions::new().write(true).open(&cfg.path)?,
+            None,
+            cfg.path.clone(),
+        ),
+        _ => {
+            let target = std::fs::canonicalize(&cfg.path).unwrap_or_else(|_| cfg.path.clone());
+            let dir = match target.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                _ => PathBuf::from("."),
+            };
+            let name = target
+                .file_name()
+                .map_or_else(|| "waveform".into(), |n| n.to_string_lossy().into_owned());
+            clean_stale_partials(cfg.partial_files, &dir, &name);
+            let tmp = output_tempfile(
+                tempfile::Builder::new()
+                    .prefix(&format!(".{name}.{}.", std::process::id()))
+                    .suffix(".partial"),
+                &dir,
+                &target,
+            )?;
+            let (file, tmp_path) = tmp.into_parts();
+            partial_created(cfg.partial_files, &tmp_path);
+            (file, Some(tmp_path), target)
+        }
+    })
 }

@@ -7,9 +7,11 @@ use super::handoff::{
     SPARE_BATCHES,
 };
 use super::tracer::NOT_TRACED;
+use super::{is_fst, TraceConfig};
 use std::collections::BTreeSet;
 use std::fs::File;
 use std::io::{self, BufWriter, Write};
+use vcd::TimescaleUnit;
 
 /// Where value changes go: a VCD text stream, or an FST file (header
 /// while declaring, body while sampling).
@@ -509,4 +511,32 @@ crate::simd::versions! {
         }
         Ok(())
 }
+}
+
+/// The writer of the waveform's header: FST where the path ends in `.fst`,
+/// else VCD (`partial`: written to a temporary file).
+pub(super) fn header_sink(
+    cfg: &TraceConfig,
+    file: std::fs::File,
+    partial: bool,
+) -> io::Result<Sink> {
+    let out = BufWriter::with_capacity(1 << 16, file);
+    let version = concat!("morphosys ", env!("CARGO_PKG_VERSION"));
+    Ok(if is_fst(&cfg.path) {
+        let info = fst_writer::FstInfo {
+            // FST files start at 0 (the writer's first frame): signals
+            // are undefined (x) up to the window, as in the VCD.
+            start_time: 0,
+            timescale_exponent: -12,
+            version: version.to_string(),
+            date: String::new(),
+            file_type: fst_writer::FstFileType::Verilog,
+        };
+        Sink::FstHeader(fst_writer::FstHeaderWriter::new(out, &info).map_err(fst_err)?)
+    } else {
+        let mut w = vcd::Writer::new(out);
+        w.version(version)?;
+        w.timescale(1, TimescaleUnit::PS)?;
+        Sink::Vcd(w, VcdBody::unallocated(partial))
+    })
 }

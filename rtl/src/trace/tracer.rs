@@ -2,21 +2,20 @@
 //! chip, sampled each traced cycle, finished into its file.
 
 use std::collections::BTreeSet;
-use std::io::{self, BufWriter};
+use std::io;
 use std::path::{Path, PathBuf};
 
 use super::files::{
-    check_scope_patterns, clean_stale_partials, decoder_path, filter_path, forget_partial, glob,
-    output_tempfile, partial_created, save_file_path, stage, SideFiles,
+    check_scope_patterns, decoder_path, filter_path, forget_partial, glob, open_output,
+    save_file_path, stage, SideFiles,
 };
-use super::format::{fst_err, Clock, SigId, VcdBody};
+use super::format::{Clock, SigId};
 use super::handoff::{queue_cycle, BATCH};
 use super::label_text;
 use super::sampler::{Declaring, Progress, Sampler};
-use super::sink::Sink;
+use super::sink::{header_sink, Sink};
 use super::Traced;
 use super::{is_fst, Display, Filter, LabelKind, TraceConfig, BYTES_PER_SIGNAL_CYCLE, FST_SMALLER};
-use vcd::TimescaleUnit;
 
 /// [`Tracer::slot_decl`] of a signal call that is not traced.
 pub(super) const NOT_TRACED: u32 = u32::MAX;
@@ -162,85 +161,12 @@ impl Tracer {
                 std::fs::create_dir_all(dir)?;
             }
         }
-        // A regular file is written to a temporary file beside it and
-        // renamed into place by finish(), so an interrupted run never leaves
-        // a truncated waveform under the requested name; a symbolic link is
-        // followed (its target replaced, the link kept); a device or FIFO
-        // (`/dev/null`, a named pipe) is written through.
-        let through = matches!(std::fs::metadata(&cfg.path), Ok(m) if !m.is_file() && !m.is_dir());
-        if through && is_fst(&cfg.path) {
-            return Err(io::Error::new(
-                io::ErrorKind::InvalidInput,
-                format!(
-                    "{}: an FST waveform needs a regular file (it is written out of order); \
-                     give a path ending in .vcd to write through a device or pipe",
-                    cfg.path.display()
-                ),
-            ));
-        }
-        let (file, tmp_path, target) = match std::fs::metadata(&cfg.path) {
-            Ok(m) if !m.is_file() && !m.is_dir() => (
-                std::fs::OpenOptions::new().write(true).open(&cfg.path)?,
-                None,
-                cfg.path.clone(),
-            ),
-            _ => {
-                let target = std::fs::canonicalize(&cfg.path).unwrap_or_else(|_| cfg.path.clone());
-                let dir = match target.parent() {
-                    Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-                    _ => PathBuf::from("."),
-                };
-                let name = target
-                    .file_name()
-                    .map_or_else(|| "waveform".into(), |n| n.to_string_lossy().into_owned());
-                clean_stale_partials(cfg.partial_files, &dir, &name);
-                let tmp = output_tempfile(
-                    tempfile::Builder::new()
-                        .prefix(&format!(".{name}.{}.", std::process::id()))
-                        .suffix(".partial"),
-                    &dir,
-                    &target,
-                )?;
-                let (file, tmp_path) = tmp.into_parts();
-                partial_created(cfg.partial_files, &tmp_path);
-                (file, Some(tmp_path), target)
-            }
-        };
-        let out = BufWriter::with_capacity(1 << 16, file);
-        let version = concat!("morphosys ", env!("CARGO_PKG_VERSION"));
-        let mut w = if is_fst(&cfg.path) {
-            let info = fst_writer::FstInfo {
-                // FST files start at 0 (the writer's first frame): signals
-                // are undefined (x) up to the window, as in the VCD.
-                start_time: 0,
-                timescale_exponent: -12,
-                version: version.to_string(),
-                date: String::new(),
-                file_type: fst_writer::FstFileType::Verilog,
-            };
-            Sink::FstHeader(fst_writer::FstHeaderWriter::new(out, &info).map_err(fst_err)?)
-        } else {
-            let mut w = vcd::Writer::new(out);
-            w.version(version)?;
-            w.timescale(1, TimescaleUnit::PS)?;
-            Sink::Vcd(w, VcdBody::unallocated(tmp_path.is_some()))
-        };
+        let (file, tmp_path, target) = open_output(&cfg)?;
+        let mut w = header_sink(&cfg, file, tmp_path.is_some())?;
         w.add_module(top_name)?;
         let clk = w.add_wire(1, "clk")?;
         let cycle_id = w.add_wire(64, "cycle")?;
-        let patterns = cfg
-            .scope
-            .split(',')
-            .map(str::trim)
-            .filter(|p| !p.is_empty())
-            .map(|p| {
-                let mut c: Vec<String> = p.split('.').map(String::from).collect();
-                if c.len() > 1 && c[0] == top_name {
-                    c.remove(0);
-                }
-                c
-            })
-            .collect();
+        let patterns = scope_patterns(&cfg.scope, top_name);
         let mut t = Tracer {
             cfg,
             tmp_path,
@@ -298,7 +224,16 @@ impl Tracer {
                 ),
             ));
         }
-        // Refuse up front a trace that would fill the disk.
+        t.refuse_too_large()?;
+        t.start_body()?;
+        Ok(t)
+    }
+
+    /// Refuse up front a trace that would fill the disk: the signals over
+    /// the cycles it may run, as VCD (or FST, compressed), against the
+    /// limit.
+    fn refuse_too_large(&self) -> io::Result<()> {
+        let t = self;
         let cycles = match (t.cfg.count, t.cfg.budget_cycles) {
             (Some(n), Some(b)) => Some(n.min(b.saturating_sub(t.cfg.first))),
             (Some(n), None) => Some(n),
@@ -327,6 +262,13 @@ impl Tracer {
                 ));
             }
         }
+        Ok(())
+    }
+
+    /// The declarations ended: the writer's thread started on the traced
+    /// slots, the per-cycle state laid out.
+    fn start_body(&mut self) -> io::Result<()> {
+        let t = self;
         t.w.upscope()?;
         t.w.end_definitions()?;
         let slots = t
@@ -364,7 +306,7 @@ impl Tracer {
         // A change costs about its width in digits and 6 bytes more.
         t.costs = t.masks.iter().map(|m| m.count_ones() as u8 + 6).collect();
         t.batch = Vec::with_capacity(batch_words);
-        Ok(t)
+        Ok(())
     }
 
     /// Number of signals that passed the scope filter.
@@ -778,4 +720,20 @@ impl Tracer {
             prefix_ok && (!complete || pat.len() <= path.len())
         })
     }
+}
+/// The scope patterns of `--trace-scope`: each a path of names, the top's
+/// own name dropped.
+fn scope_patterns(scope: &str, top_name: &str) -> Vec<Vec<String>> {
+    scope
+        .split(',')
+        .map(str::trim)
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let mut c: Vec<String> = p.split('.').map(String::from).collect();
+            if c.len() > 1 && c[0] == top_name {
+                c.remove(0);
+            }
+            c
+        })
+        .collect()
 }

@@ -24,7 +24,7 @@ use anyhow::{bail, Context as _};
 use rtl::rc::context::{Context, Op};
 use rtl::rc::{Datapath, LaneNames, RcArray, Word};
 
-use crate::cmd_report::thousands;
+use crate::output::thousands;
 
 mod array;
 mod bench;
