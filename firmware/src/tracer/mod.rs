@@ -320,29 +320,10 @@ fn build_one(
     nm: &Numerics,
     force_stream: bool,
 ) -> Result<Firmware, String> {
-    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(0..=64).contains(&nm.eps_lsb) {
-        return Err(format!(
-            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 0..=64"
-        ));
-    }
-    if !math::TABLE_SIZES.contains(&nm.table_entries) {
-        return Err(format!(
-            "table size {}: must be 16, 32, 64 or 128 entries (each table has a 128-word slot of the RC's 512-word RAM)",
-            nm.table_entries
-        ));
-    }
-    let (tw, th) = tile_shape(opt.ways)
-        .ok_or_else(|| format!("--ways {}: must be 4, 8, 16, 32 or 64", opt.ways))?;
-    if opt.depth == 0 || opt.depth > MAX_RAY_DEPTH {
-        return Err(format!(
-            "--depth {}: must be 1..={MAX_RAY_DEPTH}",
-            opt.depth
-        ));
-    }
+    let (tw, th) = checked(opt, nm)?;
     let chip_costs = (opt.bsp.rule == SplitRule::Chip).then(|| {
         let frac = crate::scene_image::fitted_frac(scene, nm.guard_bits).unwrap_or(9)
-            + opt.datapath.bits()
-            - 16;
+            + opt.datapath.extra_bits();
         std::sync::Arc::new(layout::packet_nodes::chip_costs(
             scene,
             opt.datapath,
@@ -369,42 +350,7 @@ fn build_one(
             force_stream,
         )?,
         Traversal::Packet => {
-            // The format of the paper's layout of this scene (its tree):
-            // the streamed one's where the paper's layout streams.
-            let fine = force_stream || {
-                let paper = CompileOptions {
-                    bsp: resolve_bsp(
-                        &Options {
-                            traversal: Traversal::Paper,
-                            bsp: BspParams {
-                                max_depth: 0,
-                                rule: SplitRule::Auto,
-                                ..opt.bsp
-                            },
-                            ..*opt
-                        },
-                        scene.objects.len(),
-                    )[0],
-                    ..copt
-                };
-                let paper_opt = Options {
-                    traversal: Traversal::Paper,
-                    bsp: paper.bsp,
-                    ..*opt
-                };
-                match compile(scene, &paper) {
-                    Ok(pi) => layout::build(
-                        scene,
-                        &pi,
-                        &paper_opt,
-                        nm.guard_bits,
-                        nm.normals.fine_on(opt.datapath),
-                        false,
-                    )
-                    .map_or(true, |l| l.stream.is_some()),
-                    Err(_) => true,
-                }
-            };
+            let fine = force_stream || paper_layout_streams(scene, opt, nm, &copt);
             layout::build_packet(
                 scene,
                 &image,
@@ -445,6 +391,73 @@ fn build_one(
             ..opt.pieces
         },
     })
+}
+
+/// The options' and numerics' ranges (what the library is given, whoever
+/// calls it); the tile of `opt.ways` rays.
+fn checked(opt: &Options, nm: &Numerics) -> Result<(u32, u32), String> {
+    if nm.newton_steps > 3 || !(2..=4).contains(&nm.guard_bits) || !(0..=64).contains(&nm.eps_lsb) {
+        return Err(format!(
+            "numerics {nm:?}: newton_steps must be 0..=3, guard_bits 2..=4, eps_lsb 0..=64"
+        ));
+    }
+    if !math::TABLE_SIZES.contains(&nm.table_entries) {
+        return Err(format!(
+            "table size {}: must be 16, 32, 64 or 128 entries (each table has a 128-word slot of the RC's 512-word RAM)",
+            nm.table_entries
+        ));
+    }
+    let tile = tile_shape(opt.ways)
+        .ok_or_else(|| format!("--ways {}: must be 4, 8, 16, 32 or 64", opt.ways))?;
+    if opt.depth == 0 || opt.depth > MAX_RAY_DEPTH {
+        return Err(format!(
+            "--depth {}: must be 1..={MAX_RAY_DEPTH}",
+            opt.depth
+        ));
+    }
+    Ok(tile)
+}
+
+/// Whether the paper's layout of this scene (its tree) streams: the packet
+/// traversal takes the format of the streamed layout where it does.
+fn paper_layout_streams(
+    scene: &Scene,
+    opt: &Options,
+    nm: &Numerics,
+    copt: &CompileOptions,
+) -> bool {
+    let paper = CompileOptions {
+        bsp: resolve_bsp(
+            &Options {
+                traversal: Traversal::Paper,
+                bsp: BspParams {
+                    max_depth: 0,
+                    rule: SplitRule::Auto,
+                    ..opt.bsp
+                },
+                ..*opt
+            },
+            scene.objects.len(),
+        )[0],
+        ..copt.clone()
+    };
+    let paper_opt = Options {
+        traversal: Traversal::Paper,
+        bsp: paper.bsp,
+        ..*opt
+    };
+    match compile(scene, &paper) {
+        Ok(pi) => layout::build(
+            scene,
+            &pi,
+            &paper_opt,
+            nm.guard_bits,
+            nm.normals.fine_on(opt.datapath),
+            false,
+        )
+        .map_or(true, |l| l.stream.is_some()),
+        Err(_) => true,
+    }
 }
 
 /// What the chip does not render as `scene` asks, one [`Warning`] per

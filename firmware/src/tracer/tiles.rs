@@ -133,6 +133,18 @@ pub fn macros(lay: &FbImage) -> Code {
             }),
         );
     }
+    shading_macros(&mut t, lay);
+    t
+}
+
+/// The macros of a level's shading: one light's shadow pass, and a
+/// level's trace, shading state and shadow passes.
+fn shading_macros(t: &mut Code, lay: &FbImage) {
+    let body = |f: &dyn Fn(&mut Code)| {
+        let mut b = Code::new();
+        f(&mut b);
+        b
+    };
     t.define_macro(
         "SHADOW_PASS",
         "light, shade",
@@ -184,7 +196,6 @@ pub fn macros(lay: &FbImage) -> Code {
             }
         }),
     );
-    t
 }
 
 /// The main program: `_start`, the tile loop, `finish`; `merged`: the

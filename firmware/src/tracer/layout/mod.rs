@@ -145,7 +145,7 @@ pub const NODE_BYTES: usize = 64;
 /// The streamed layout: the scene lives in main memory and TinyRISC moves
 /// each leaf's block (cell bounds, then the records of its objects grouped
 /// by type) into FB bank 1 by DMA when the traversal reaches it (the node
-/// records: `traversal/streamed.rs`, `traversal/packet.rs`).
+/// records: `traversal/streamed.rs`, `traversal/packet/`).
 #[derive(Clone, Debug)]
 pub struct Stream {
     /// Main-memory byte address of [`Stream::image`].
@@ -285,6 +285,37 @@ pub fn build_packet(
     }
 }
 
+/// `file:line: m`, or `file: m` without a line.
+fn located(file: &str, line: usize, m: String) -> String {
+    if line > 0 {
+        format!("{file}:{line}: {m}")
+    } else {
+        format!("{file}: {m}")
+    }
+}
+
+/// The most distinct materials and lights a layout holds.
+fn check_counts(materials: usize, lights: usize) -> Result<(), String> {
+    if materials > 1000 || lights > 64 {
+        return Err("more than 1000 distinct materials or 64 lights".into());
+    }
+    Ok(())
+}
+
+/// Packet traversal: the root cell widened by the traversal's tolerance
+/// (the stream of its pass-start kernel), resident in either layout;
+/// returns where it is.
+fn root_box(w: &mut W, image: &SceneImage) -> usize {
+    let at = w.fb.len();
+    let b = image.bsp.nodes[0].bounds;
+    let tol = packet_nodes::P_TOL as f64;
+    for a in 0..3 {
+        w.push((b.min.axis(a) * w.s).floor() - tol);
+        w.push((b.max.axis(a) * w.s).ceil() + tol);
+    }
+    at
+}
+
 #[allow(clippy::too_many_arguments)]
 fn build_as(
     scene: &Scene,
@@ -303,25 +334,14 @@ fn build_as(
     let xb = opt.datapath.extra_bits();
     let frac = fit_frac(scene, image.report.frac_bits, guard_bits) + xb;
     let s = (frac as f64).exp2();
-    let err = |line: usize, m: String| {
-        if line > 0 {
-            format!("{}:{line}: {m}", scene.source)
-        } else {
-            format!("{}: {m}", scene.source)
-        }
-    };
+    let err = |line: usize, m: String| located(&scene.source, line, m);
 
     let (by, slot) = by_type(scene);
     // Materials: identical ones are one (an NFF file repeats its `f` line
     // for every object: SPD rings, 841 lines, 7 materials); the kernels
     // shade per distinct material.
     let (mat_of, mats) = distinct_materials(scene);
-    if mats.len() > 1000 || scene.lights.len() > 64 {
-        return Err(err(
-            0,
-            "more than 1000 distinct materials or 64 lights".into(),
-        ));
-    }
+    check_counts(mats.len(), scene.lights.len()).map_err(|m| err(0, m))?;
 
     let packet = opt.traversal == Traversal::Packet;
     let (geo, fan, mut fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
@@ -332,15 +352,7 @@ fn build_as(
     if fit.polygon_form.banded() {
         fit.polygon_form = form;
     }
-    let mut w = W {
-        fb: Vec::new(),
-        s,
-        frac,
-        x: xb,
-        fans: Vec::new(),
-        fan_most: 0,
-        marks: Vec::new(),
-    };
+    let mut w = W::new(s, frac, xb);
     // Init stream.
     w.fb.extend(table_slots_for(128, xb));
     w.push(w.one());
@@ -355,20 +367,7 @@ fn build_as(
         lights(&mut w, scene, &mats, frac, xb, packet).map_err(|m| err(0, m))?;
     let shines: Vec<(u32, f64)> = mats.iter().map(|m| phong_exponent(m, packet)).collect();
 
-    // Packet traversal: the root cell widened by the traversal's tolerance
-    // (the stream of its pass-start kernel), resident in either layout.
-    let root_box = if packet {
-        let at = w.fb.len();
-        let b = image.bsp.nodes[0].bounds;
-        let tol = packet_nodes::P_TOL as f64;
-        for a in 0..3 {
-            w.push((b.min.axis(a) * s).floor() - tol);
-            w.push((b.max.axis(a) * s).ceil() + tol);
-        }
-        at
-    } else {
-        0
-    };
+    let root_box = if packet { root_box(&mut w, image) } else { 0 };
 
     let records_start = w.fb.len();
     let (types, bv_offset, mailbox_slots) = records(

@@ -6,7 +6,7 @@
 //! main memory, each leaf's records a block moved into FB bank 1, a block
 //! larger than the bank cut into pieces). The fields are named in the
 //! program's header (`PN_*`, `PL_*`, `LE_*`, `PS_*`, `MB_*`) and read by
-//! `traversal/packet.rs`; the subtrees it walks as one leaf are chosen
+//! `traversal/packet/`; the subtrees it walks as one leaf are chosen
 //! here ([`super::super::Collapse`]).
 
 use super::super::{mem, Collapse};

@@ -135,6 +135,20 @@ pub struct W {
 }
 
 impl W {
+    /// An empty FB image of `s` LSBs per scene unit (`frac` fraction bits;
+    /// `x` the datapath's extra bits).
+    pub fn new(s: f64, frac: u32, x: u32) -> W {
+        W {
+            fb: Vec::new(),
+            s,
+            frac,
+            x,
+            fans: Vec::new(),
+            fan_most: 0,
+            marks: Vec::new(),
+        }
+    }
+
     /// Mark the start of `field` (the next word written), for the check
     /// of the writer's order against the record's [`Layout`].
     /// (Kept in the unit tests' builds only.)

@@ -228,6 +228,16 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     }
     k.note("p/r in TMP0..2");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
+    root(&mut k, g, two, r, er);
+    normal_and_commit(&mut k, two);
+    k
+}
+
+/// The root: `h = r sqrt(s)` (`r` the register or stream that holds r,
+/// `er` its extra bits), `t = b - sg h` in r9, F where a hit lies ahead,
+/// nearer than tbest; two-sided (`two`), the far root where the near one
+/// is not ahead (TMP3 = 1 then), r10 the sign turned to the ray.
+fn root(k: &mut K, g: &Gen, two: bool, r: &str, er: &str) {
     if two {
         k.c(format!("mul r9, {r}, r8, >>Q14{er}"))
             .note("h = r sqrt(s)")
@@ -239,7 +249,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
             .c("movb r15, #0")
             .c("(f) movb r15, #1")
             .c("movb r12, #0");
-        self_margin(&mut k, 13, g.datapath);
+        self_margin(k, 13, g.datapath);
         k.c("cmp.le r9, r13")
             .c("(f) add r9, r11, r14")
             .note("not ahead: t2 = b + sg h, the far side")
@@ -262,6 +272,11 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
             .c("(f) cmp.lt r9, r7")
             .note("F: a hit ahead, nearer than tbest");
     }
+}
+
+/// The normal `-(sg p/r + sqrt(s) d)` and, where F, the hit: t, HIT_N,
+/// HIT_OBJ (two-sided: HIT_BACK_OBJ), HIT_MAT.
+fn normal_and_commit(k: &mut K, two: bool) {
     k.comment("normal = -(sg p/r + sqrt(s) d)");
     for (i, (x, d)) in [(11, 4), (12, 5), (13, 6)].into_iter().enumerate() {
         k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP0 + i as u32))
@@ -288,7 +303,6 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         k.c(format!("(f) st fb0, [#{}]", ram::HIT_OBJ));
     }
     k.c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
-    k
 }
 
 /// The sphere ([`super::ChipPrimitive`]).

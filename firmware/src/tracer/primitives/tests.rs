@@ -124,15 +124,7 @@ fn every_kernel_reads_exactly_its_record() {
 
 /// A record writer of the 16-bit chip's scene format Q5.10.
 fn writer() -> W {
-    W {
-        fb: Vec::new(),
-        s: 1024.0,
-        frac: 10,
-        x: 0,
-        fans: Vec::new(),
-        fan_most: 0,
-        marks: Vec::new(),
-    }
+    W::new(1024.0, 10, 0)
 }
 
 /// The record written from `start` holds `layout`'s words, and each of its
