@@ -144,16 +144,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
         if a.plain { "; the plain model (--plain)" } else { "" }
     );
     let simd = rtl::simd::level();
-    println!(
-        "simd path                      {} ({}; the widest this CPU has: {})",
-        simd.name(),
-        if std::env::var_os(rtl::simd::ENV).is_some_and(|v| !v.is_empty()) {
-            "forced by MORPHOSYS_SIMD"
-        } else {
-            "chosen at run time"
-        },
-        rtl::simd::Simd::best().name()
-    );
+    println!("simd path                      {}", simd_path(simd));
     println!(
         "workload                       {} at {width}x{height}, 64 ways: {cycles} chip cycles",
         scene.source
@@ -175,23 +166,7 @@ pub fn command(a: BenchArgs) -> Result<()> {
         chip_render[0],
         model(cores)
     );
-    let (shortest, longest) = frame
-        .tiles
-        .iter()
-        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
-            (lo.min(t), hi.max(t))
-        });
-    println!(
-        "schedule model                 the 256x256 chip render on one thread: {} tiles of {:.2} to {:.2} ms, {:.2} ms a work item's own, {serial:.4} s serial; predicted speed-up {:.1}x on 16 cores ({} items), {:.1}x on 64 ({} items)",
-        frame.tiles.len(),
-        shortest * 1e3,
-        longest * 1e3,
-        frame.item * 1e3,
-        model(16),
-        frame.items(16).len(),
-        model(64),
-        frame.items(64).len()
-    );
+    print_schedule(&frame, serial);
     let sweep = if a.sweep.is_empty() {
         serde_json::Value::Null
     } else {
@@ -222,22 +197,71 @@ pub fn command(a: BenchArgs) -> Result<()> {
             "host_seconds_traced": traced,
             "host_seconds_untraced_small": untraced_small,
             "traversal": opt.traversal.name(),
-            "schedule": {
-                "model": "the chip render of the 256x256 frame: its serial part, then its tiles cut into the work items N threads run (each an item's own work, its tiles and a warm-up tile), in order, each taken by the first free thread",
-                "chip_render_seconds_1_thread": chip_render[0],
-                "chip_render_seconds_all_threads": chip_render[1],
-                "chip_render_speedup": chip_speedup,
-                "serial_seconds": serial,
-                "tile_seconds": frame.tiles,
-                "item_own_seconds": frame.item,
-                "predicted_speedup": predicted,
-            },
+            "schedule": schedule_json(&frame, serial, chip_render, predicted),
             "sweep": sweep,
         });
         crate::output::write(p, (serde_json::to_string_pretty(&v)? + "\n").as_bytes())?;
         crate::note!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// The per-cycle path's instruction set, how it was chosen, and the
+/// widest this CPU has.
+fn simd_path(simd: rtl::simd::Simd) -> String {
+    format!(
+        "{} ({}; the widest this CPU has: {})",
+        simd.name(),
+        if std::env::var_os(rtl::simd::ENV).is_some_and(|v| !v.is_empty()) {
+            "forced by MORPHOSYS_SIMD"
+        } else {
+            "chosen at run time"
+        },
+        rtl::simd::Simd::best().name()
+    )
+}
+
+/// The schedule model's measurements of the 256x256 chip render on one
+/// thread, and its predictions for 16 and 64 cores.
+fn print_schedule(frame: &crate::schedule::FrameWork, serial: f64) {
+    let model = |n: usize| crate::schedule::frame_speedup(serial, frame, n);
+    let (shortest, longest) = frame
+        .tiles
+        .iter()
+        .fold((f64::INFINITY, 0.0f64), |(lo, hi), &t| {
+            (lo.min(t), hi.max(t))
+        });
+    println!(
+        "schedule model                 the 256x256 chip render on one thread: {} tiles of {:.2} to {:.2} ms, {:.2} ms a work item's own, {serial:.4} s serial; predicted speed-up {:.1}x on 16 cores ({} items), {:.1}x on 64 ({} items)",
+        frame.tiles.len(),
+        shortest * 1e3,
+        longest * 1e3,
+        frame.item * 1e3,
+        model(16),
+        frame.items(16).len(),
+        model(64),
+        frame.items(64).len()
+    );
+}
+
+/// The JSON of the schedule model: the chip render's seconds on one thread
+/// and on every core, its serial part and tiles, the predictions.
+fn schedule_json(
+    frame: &crate::schedule::FrameWork,
+    serial: f64,
+    chip_render: [f64; 2],
+    predicted: serde_json::Map<String, serde_json::Value>,
+) -> serde_json::Value {
+    json!({
+        "model": "the chip render of the 256x256 frame: its serial part, then its tiles cut into the work items N threads run (each an item's own work, its tiles and a warm-up tile), in order, each taken by the first free thread",
+        "chip_render_seconds_1_thread": chip_render[0],
+        "chip_render_seconds_all_threads": chip_render[1],
+        "chip_render_speedup": chip_render[0] / chip_render[1],
+        "serial_seconds": serial,
+        "tile_seconds": frame.tiles,
+        "item_own_seconds": frame.item,
+        "predicted_speedup": predicted,
+    })
 }
 
 /// The bench's workload: the paper's configuration (its traversal and

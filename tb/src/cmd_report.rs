@@ -46,6 +46,7 @@ pub struct ReportArgs {
 }
 
 /// One section of `docs/results.md`.
+#[derive(Clone, Copy)]
 pub struct Section {
     pub id: &'static str,
     title: &'static str,
@@ -88,145 +89,148 @@ const FAMILIES: &[&str] = &[
     "balls", "gears", "jacks", "lattice", "mount", "rings", "shells", "tetra", "tree",
 ];
 
+/// The report's sections, in order: the tables `docs/results.md` holds.
+const SECTIONS: &[Section] = &[
+    Section {
+        id: "headline",
+        title: "The bundled scenes",
+        about: "Every scene under `scenes/` at 256x256, 64 ways, ray depth 2, on the chip \
+                `--datapath auto` picks (the 16-bit chip unless it cannot hold the scene or \
+                renders 1/16 of the tiles measurably worse than the 32-bit one): the paper's \
+                BSP traversal (`--traversal paper`) and the default, the packet traversal. \
+                Frames/s at the paper's 300 MHz; PSNR and hit agreement (eye rays that hit the \
+                same object) against the f64 reference renderer at the same settings. The \
+                paper reports 13.3 frames/s for 256x256 images.",
+        checked: true,
+        write: headline,
+    },
+    Section {
+        id: "traversal",
+        title: "The two traversals",
+        about: "Where the packet traversal's speed comes from, on the same renders: \
+                `broadcast` is objects broadcast per packet pass (the paper's measure), \
+                `tests per ray` the ray-object tests the RCs executed per ray traced, `idle` \
+                the share of cycles the array waits for TinyRISC (`array_idle_on_control`).",
+        checked: true,
+        write: traversal,
+    },
+    Section {
+        id: "large",
+        title: "Thousands of objects",
+        about: "The two bundled scenes too large for the frame buffer: BSP nodes and each \
+                leaf's object records stay in main memory, and TinyRISC moves a leaf's block \
+                into an FB bank by DMA when a packet reaches it (`docs/tracer.md`, \"Large \
+                scenes\"). `DMA stall` is the share of cycles TinyRISC waits for the DMA.",
+        checked: false,
+        write: large,
+    },
+    Section {
+        id: "datapath",
+        title: "The 16-bit and the 32-bit chip",
+        about: "The same firmware on the paper's 16-bit datapath and on the 32-bit one the \
+                paper announces for the next chip (`docs/isa.md`, section 1a): 16 more \
+                fraction bits, the same context word, TinyRISC and timing, in the same \
+                cycles. What the 16 more bits cost in silicon comes from the RC in Verilog \
+                synthesized by Yosys (`morphosys cost`, `docs/silicon.md`): the 32-bit RC's \
+                longest path sets an estimated clock (300 MHz for the 16-bit RC, scaled by \
+                path depth), and its array of 64 RCs with their RAM has more transistors; \
+                the last frame-rate column divides the frame rate at the estimated clock \
+                by the array's transistors in millions. Relative estimates, not a sign-off.",
+        checked: true,
+        write: datapath,
+    },
+    Section {
+        id: "normals",
+        title: "Coarse and fine normals",
+        about: "On the 16-bit chip a sphere's or cylinder's normal turns with the rounding \
+                of the ray; fine normals (the default there, `--normals auto`) put the eye \
+                on the format's grid and compute normals from unrounded centres and axes \
+                (`docs/tracer.md`, \"Fine normals\"). Two scenes one size up, where it \
+                shows, on the 16-bit chip.",
+        checked: false,
+        write: normals,
+    },
+    Section {
+        id: "ways",
+        title: "Frames/s against rays in parallel (the paper's Fig. 8)",
+        about: "The paper's traversal with 4 to 64 rays per packet (one per RC; the other \
+                RCs sleep). A wider packet keeps fewer of its RCs busy and tests more objects \
+                per ray, the paper's growing overhead, so the frame rate grows a little less \
+                than the ways.",
+        checked: true,
+        write: ways,
+    },
+    Section {
+        id: "layouts",
+        title: "Node layouts",
+        about: "The paper's traversal walks a node's objects from Fig. 5's bit vectors \
+                (`--layout fig5`) or from index lists (`--layout compact`); the images are \
+                the same. `FB words` is the scene's resident footprint in that layout, BSP \
+                nodes in brackets (`docs/tracer.md`, \"Node layouts\").",
+        checked: true,
+        write: layouts,
+    },
+    Section {
+        id: "issue",
+        title: "Run broadcast against the M1 chip's issue",
+        about: "The run broadcast is ours (`docs/isa.md`, section 4): one TinyRISC \
+                instruction streams a run of contexts while TinyRISC goes on, walking the \
+                next node or mailbox. The M1 chip issues each context by an instruction and \
+                the array waits while TinyRISC does anything else (`issue = \"instruction\"` \
+                in a timing file); there the packet traversal's object tests run in parts \
+                TinyRISC steers (`--test-cuts auto`), since a `cut` would not free it. \
+                Frames/s under each, and the share the M1 issue keeps.",
+        checked: false,
+        write: issue,
+    },
+    Section {
+        id: "whitted",
+        title: "One size up, at the paper's and the SPD's ray depth",
+        about: "Each SPD generator one size above the bundled scenes, at ray depth 2 (the \
+                paper's) and 5 (the SPD's): eye, shadow, reflected and refracted rays \
+                (mount's and gears' glass) and smooth triangles on the chip.",
+        checked: false,
+        write: whitted,
+    },
+    Section {
+        id: "spd",
+        title: "The SPD scenes at their default size",
+        about: "Each SPD generator at the size it makes without `-s` (thousands of \
+                objects, but jacks' single jack), 256x256, depth 2, the packet traversal, `--datapath auto`. \
+                `SIMD efficiency` is the share of the object tests the array ran lanes for \
+                (each test broadcast times the rays of its pass) whose ray needed them \
+                (`simd_efficiency`); `active RCs` the share of RC-cycles that executed a \
+                context, `DMA stall` and `idle` as above.",
+        checked: false,
+        write: spd,
+    },
+    Section {
+        id: "published",
+        title: "The paper's traversal as published",
+        about: "The paper's traversal with the kernels the comparison with the paper was \
+                made with (`--normals coarse`). `firmware` is the program's own count \
+                (`rdcyc` around the tile loop), which `tb/tests/traversal.rs` holds for the \
+                first three scenes; `cycles` is the simulator's, a few cycles apart.",
+        checked: true,
+        write: published,
+    },
+    Section {
+        id: "charts",
+        title: "Charts: speed against accuracy",
+        about: "One sweep over the paper's configuration on three scenes, one knob at a \
+                time (ways, recursion depth, BSP depth, leaf size, split rule, Newton-Raphson \
+                steps, table entries, guard bits, ray offset, node layout, normals, \
+                datapath, traversal, issue model; on the packet traversal its split rule, \
+                leaf pieces, shadow packets and test cuts), with each scene's Pareto front, and the \
+                SPD families at growing sizes under both traversals. The whole table is \
+                `results/results.csv`.",
+        checked: false,
+        write: charts,
+    },
+];
+
 pub fn sections() -> Vec<Section> {
-    vec![
-        Section {
-            id: "headline",
-            title: "The bundled scenes",
-            about: "Every scene under `scenes/` at 256x256, 64 ways, ray depth 2, on the chip \
-                    `--datapath auto` picks (the 16-bit chip unless it cannot hold the scene or \
-                    renders 1/16 of the tiles measurably worse than the 32-bit one): the paper's \
-                    BSP traversal (`--traversal paper`) and the default, the packet traversal. \
-                    Frames/s at the paper's 300 MHz; PSNR and hit agreement (eye rays that hit the \
-                    same object) against the f64 reference renderer at the same settings. The \
-                    paper reports 13.3 frames/s for 256x256 images.",
-            checked: true,
-            write: headline,
-        },
-        Section {
-            id: "traversal",
-            title: "The two traversals",
-            about: "Where the packet traversal's speed comes from, on the same renders: \
-                    `broadcast` is objects broadcast per packet pass (the paper's measure), \
-                    `tests per ray` the ray-object tests the RCs executed per ray traced, `idle` \
-                    the share of cycles the array waits for TinyRISC (`array_idle_on_control`).",
-            checked: true,
-            write: traversal,
-        },
-        Section {
-            id: "large",
-            title: "Thousands of objects",
-            about: "The two bundled scenes too large for the frame buffer: BSP nodes and each \
-                    leaf's object records stay in main memory, and TinyRISC moves a leaf's block \
-                    into an FB bank by DMA when a packet reaches it (`docs/tracer.md`, \"Large \
-                    scenes\"). `DMA stall` is the share of cycles TinyRISC waits for the DMA.",
-            checked: false,
-            write: large,
-        },
-        Section {
-            id: "datapath",
-            title: "The 16-bit and the 32-bit chip",
-            about: "The same firmware on the paper's 16-bit datapath and on the 32-bit one the \
-                    paper announces for the next chip (`docs/isa.md`, section 1a): 16 more \
-                    fraction bits, the same context word, TinyRISC and timing, in the same \
-                    cycles. What the 16 more bits cost in silicon comes from the RC in Verilog \
-                    synthesized by Yosys (`morphosys cost`, `docs/silicon.md`): the 32-bit RC's \
-                    longest path sets an estimated clock (300 MHz for the 16-bit RC, scaled by \
-                    path depth), and its array of 64 RCs with their RAM has more transistors; \
-                    the last frame-rate column divides the frame rate at the estimated clock \
-                    by the array's transistors in millions. Relative estimates, not a sign-off.",
-            checked: true,
-            write: datapath,
-        },
-        Section {
-            id: "normals",
-            title: "Coarse and fine normals",
-            about: "On the 16-bit chip a sphere's or cylinder's normal turns with the rounding \
-                    of the ray; fine normals (the default there, `--normals auto`) put the eye \
-                    on the format's grid and compute normals from unrounded centres and axes \
-                    (`docs/tracer.md`, \"Fine normals\"). Two scenes one size up, where it \
-                    shows, on the 16-bit chip.",
-            checked: false,
-            write: normals,
-        },
-        Section {
-            id: "ways",
-            title: "Frames/s against rays in parallel (the paper's Fig. 8)",
-            about: "The paper's traversal with 4 to 64 rays per packet (one per RC; the other \
-                    RCs sleep). A wider packet keeps fewer of its RCs busy and tests more objects \
-                    per ray, the paper's growing overhead, so the frame rate grows a little less \
-                    than the ways.",
-            checked: true,
-            write: ways,
-        },
-        Section {
-            id: "layouts",
-            title: "Node layouts",
-            about: "The paper's traversal walks a node's objects from Fig. 5's bit vectors \
-                    (`--layout fig5`) or from index lists (`--layout compact`); the images are \
-                    the same. `FB words` is the scene's resident footprint in that layout, BSP \
-                    nodes in brackets (`docs/tracer.md`, \"Node layouts\").",
-            checked: true,
-            write: layouts,
-        },
-        Section {
-            id: "issue",
-            title: "Run broadcast against the M1 chip's issue",
-            about: "The run broadcast is ours (`docs/isa.md`, section 4): one TinyRISC \
-                    instruction streams a run of contexts while TinyRISC goes on, walking the \
-                    next node or mailbox. The M1 chip issues each context by an instruction and \
-                    the array waits while TinyRISC does anything else (`issue = \"instruction\"` \
-                    in a timing file); there the packet traversal's object tests run in parts \
-                    TinyRISC steers (`--test-cuts auto`), since a `cut` would not free it. \
-                    Frames/s under each, and the share the M1 issue keeps.",
-            checked: false,
-            write: issue,
-        },
-        Section {
-            id: "whitted",
-            title: "One size up, at the paper's and the SPD's ray depth",
-            about: "Each SPD generator one size above the bundled scenes, at ray depth 2 (the \
-                    paper's) and 5 (the SPD's): eye, shadow, reflected and refracted rays \
-                    (mount's and gears' glass) and smooth triangles on the chip.",
-            checked: false,
-            write: whitted,
-        },
-        Section {
-            id: "spd",
-            title: "The SPD scenes at their default size",
-            about: "Each SPD generator at the size it makes without `-s` (thousands of \
-                    objects, but jacks' single jack), 256x256, depth 2, the packet traversal, `--datapath auto`. \
-                    `SIMD efficiency` is the share of the object tests the array ran lanes for \
-                    (each test broadcast times the rays of its pass) whose ray needed them \
-                    (`simd_efficiency`); `active RCs` the share of RC-cycles that executed a \
-                    context, `DMA stall` and `idle` as above.",
-            checked: false,
-            write: spd,
-        },
-        Section {
-            id: "published",
-            title: "The paper's traversal as published",
-            about: "The paper's traversal with the kernels the comparison with the paper was \
-                    made with (`--normals coarse`). `firmware` is the program's own count \
-                    (`rdcyc` around the tile loop), which `tb/tests/traversal.rs` holds for the \
-                    first three scenes; `cycles` is the simulator's, a few cycles apart.",
-            checked: true,
-            write: published,
-        },
-        Section {
-            id: "charts",
-            title: "Charts: speed against accuracy",
-            about: "One sweep over the paper's configuration on three scenes, one knob at a \
-                    time (ways, recursion depth, BSP depth, leaf size, split rule, Newton-Raphson \
-                    steps, table entries, guard bits, ray offset, node layout, normals, \
-                    datapath, traversal, issue model; on the packet traversal its split rule, \
-                    leaf pieces, shadow packets and test cuts), with each scene's Pareto front, and the \
-                    SPD families at growing sizes under both traversals. The whole table is \
-                    `results/results.csv`.",
-            checked: false,
-            write: charts,
-        },
-    ]
+    SECTIONS.to_vec()
 }
 
 /// Renders as `morphosys render` processes, each once.

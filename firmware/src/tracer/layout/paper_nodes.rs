@@ -121,17 +121,7 @@ fn streamed_image(
     // Streamed: only the tables, camera, lights and shading stay in the
     // FB (bank 0); objects, nodes and mailboxes go to main memory.
     let records = w.fb.split_off(records_start);
-    let split_slot = w.fb.len();
-    w.raw(0);
-    if w.fb.len() > STREAM_BANK {
-        return Err(err(
-            0,
-            format!(
-                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
-                w.fb.len()
-            ),
-        ));
-    }
+    let split_slot = resident_split(w, err)?;
     let base = super::super::mem::STREAM;
     let nn = nodes.len();
     let lists_at = NODE_BYTES * nn;
@@ -160,26 +150,15 @@ fn streamed_image(
             None => {
                 f[word(SN_FLAGS)] = -32768;
                 let list_addr = base as usize + lists_at + 4 * list_objs.len();
-                let mut words: Vec<i32> = Vec::new();
-                for v in n.bounds.min.to_array() {
-                    words.push(w.sat((v * w.s).floor() - 2.0));
-                }
-                for v in n.bounds.max.to_array() {
-                    words.push(w.sat((v * w.s).ceil() + 2.0));
-                }
-                for (j, ti) in types.iter().enumerate() {
-                    let mut cnt = 0;
-                    for &o in &n.objects {
-                        let (t, q) = slot[o as usize];
-                        if t == ti.ty as usize {
-                            let at = ti.first - records_start + q * ti.size;
-                            words.extend_from_slice(&records[at..at + ti.size]);
-                            list_objs.push(o as usize);
-                            cnt += 1;
-                        }
-                    }
-                    f[SN_COUNTS as usize / 4 + j] = cnt;
-                }
+                let words = leaf_block(
+                    w,
+                    n,
+                    types,
+                    slot,
+                    (&records, records_start),
+                    &mut f,
+                    &mut list_objs,
+                );
                 if !n.objects.is_empty() {
                     if words.len() > STREAM_BANK {
                         return Err(err(
@@ -200,9 +179,9 @@ fn streamed_image(
                 }
             }
         }
-        for (i, x) in f.iter().enumerate() {
-            node_img[NODE_BYTES * k + 4 * i..NODE_BYTES * k + 4 * i + 4]
-                .copy_from_slice(&x.to_le_bytes());
+        let at = NODE_BYTES * k;
+        for (d, x) in node_img[at..at + NODE_BYTES].chunks_mut(4).zip(f) {
+            d.copy_from_slice(&x.to_le_bytes());
         }
     }
     let mb_at = (blocks_at + blocks.len()).next_multiple_of(4);
@@ -240,6 +219,59 @@ fn streamed_image(
         slots_at: 0,
         fans: None,
     })
+}
+
+/// The split word after the resident part (the node being classified);
+/// returns where it is.
+fn resident_split(w: &mut W, err: &dyn Fn(usize, String) -> String) -> Result<usize, String> {
+    let split_slot = w.fb.len();
+    w.raw(0);
+    if w.fb.len() > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                w.fb.len()
+            ),
+        ));
+    }
+    Ok(split_slot)
+}
+
+/// A leaf's block: its cell's bounds widened by 2 LSB, then its objects'
+/// records by type (`records` from `records_start` on; their ids pushed
+/// to `list_objs`), each type's count in the node record `f`.
+fn leaf_block(
+    w: &W,
+    n: &crate::bsp::Node,
+    types: &[TypeInfo],
+    slot: &[(usize, usize)],
+    (records, records_start): (&[i32], usize),
+    f: &mut [i32; 16],
+    list_objs: &mut Vec<usize>,
+) -> Vec<i32> {
+    use fields::SN_COUNTS;
+    let mut words: Vec<i32> = Vec::new();
+    for v in n.bounds.min.to_array() {
+        words.push(w.sat((v * w.s).floor() - 2.0));
+    }
+    for v in n.bounds.max.to_array() {
+        words.push(w.sat((v * w.s).ceil() + 2.0));
+    }
+    for (j, ti) in types.iter().enumerate() {
+        let mut cnt = 0;
+        for &o in &n.objects {
+            let (t, q) = slot[o as usize];
+            if t == ti.ty as usize {
+                let at = ti.first - records_start + q * ti.size;
+                words.extend_from_slice(&records[at..at + ti.size]);
+                list_objs.push(o as usize);
+                cnt += 1;
+            }
+        }
+        f[SN_COUNTS as usize / 4 + j] = cnt;
+    }
+    words
 }
 
 /// The resident nodes after the records (Fig. 5's or compact).

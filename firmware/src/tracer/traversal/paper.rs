@@ -231,35 +231,7 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .lfb(R5, at(N_RIGHT, R5))
         .c("all above")
         .j("visit_node");
-    t.label("both_sides")
-        .bne(R1, R3, "incoherent")
-        .bne(R2, R4, "incoherent")
-        .c("every ray crosses the plane:")
-        .slli(R9, R7, 3)
-        .lw(R10, at(NEG, R9))
-        .lw(R13, at(format!("{NEG}+{MASK_HI}"), R9))
-        .and(R10, R10, R11)
-        .and(R13, R13, R12)
-        .or(R9, R10, R13)
-        .beqz(R9, "positive_first")
-        .c("all in the same direction?")
-        .bne(R10, R11, "incoherent")
-        .bne(R13, R12, "incoherent")
-        .lfb(R9, at(N_LEFT, R5))
-        .sw(R9, deref(R14))
-        .addi(R14, R14, 4)
-        .c("push below")
-        .lfb(R5, at(N_RIGHT, R5))
-        .c("visit above first")
-        .j("visit_node");
-    t.label("positive_first")
-        .lfb(R9, at(N_RIGHT, R5))
-        .sw(R9, deref(R14))
-        .addi(R14, R14, 4)
-        .c("push above")
-        .lfb(R5, at(N_LEFT, R5))
-        .c("visit below first")
-        .j("visit_node");
+    both_sides(t);
     t.label("incoherent");
     if compact {
         t.addi(R6, R5, NC_INNER_LISTS);
@@ -298,6 +270,41 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
     read_awake(t);
     clear_mailbox(t);
     test_objects(t, lay, compact);
+}
+
+/// `both_sides`: rays reach both children: every ray crossing the plane
+/// the same way, the near child first (the far one pushed); otherwise
+/// `incoherent`.
+fn both_sides(t: &mut Code) {
+    t.label("both_sides")
+        .bne(R1, R3, "incoherent")
+        .bne(R2, R4, "incoherent")
+        .c("every ray crosses the plane:")
+        .slli(R9, R7, 3)
+        .lw(R10, at(NEG, R9))
+        .lw(R13, at(format!("{NEG}+{MASK_HI}"), R9))
+        .and(R10, R10, R11)
+        .and(R13, R13, R12)
+        .or(R9, R10, R13)
+        .beqz(R9, "positive_first")
+        .c("all in the same direction?")
+        .bne(R10, R11, "incoherent")
+        .bne(R13, R12, "incoherent")
+        .lfb(R9, at(N_LEFT, R5))
+        .sw(R9, deref(R14))
+        .addi(R14, R14, 4)
+        .c("push below")
+        .lfb(R5, at(N_RIGHT, R5))
+        .c("visit above first")
+        .j("visit_node");
+    t.label("positive_first")
+        .lfb(R9, at(N_RIGHT, R5))
+        .sw(R9, deref(R14))
+        .addi(R14, R14, 4)
+        .c("push above")
+        .lfb(R5, at(N_LEFT, R5))
+        .c("visit below first")
+        .j("visit_node");
 }
 
 /// `clear_mailbox`: every object's mailbox (FB) to 0.

@@ -160,6 +160,17 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .lw(R5, at(SN_RIGHT, R5))
         .c("all above")
         .j("visit_node");
+    both_sides(t);
+    leaf_and_pop(t);
+    clear_mailbox(t);
+    test_objects(t, lay);
+    read_awake(t);
+}
+
+/// `both_sides`: rays reach both children: the near child first where
+/// every awake ray goes one way along the axis, else the subtree
+/// unordered (its rays count it, its end and axis on the stack).
+fn both_sides(t: &mut Code) {
     t.label("both_sides")
         .slli(R9, R7, 3)
         .lw(R10, at(NEG, R9))
@@ -196,6 +207,12 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .lw(R5, at(SN_LEFT, R5))
         .c("visit below first")
         .j("visit_node");
+}
+
+/// `leaf`: its objects tested, the rays with a hit in the cell asleep
+/// (closest hit) or done (any hit); `pop_node`: the stack's next node,
+/// leaving an unordered subtree where it ends.
+fn leaf_and_pop(t: &mut Code) {
     t.label("leaf")
         .lw(R1, at(SN_BLOCK_WORDS, R5))
         .beqz(R1, "pop_node")
@@ -230,6 +247,10 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .lw(R5, deref(R14))
         .j("visit_node");
     t.label("trace_done").lw(R15, at(SAVE_LR, R0)).ret();
+}
+
+/// `clear_mailbox`: every mailbox to 0.
+fn clear_mailbox(t: &mut Code) {
     t.doc(
         "clear_mailbox: every mailbox (main memory, a half-word per object) to 0. Clobbers r2, r3.",
     );
@@ -243,8 +264,6 @@ pub fn trace(t: &mut Code, lay: &FbImage) {
         .addi(R3, R3, -1)
         .bnez(R3, "clear_mailbox_loop");
     t.label("clear_mailbox_done").ret();
-    test_objects(t, lay);
-    read_awake(t);
 }
 
 /// `test_objects` of a streamed leaf.
