@@ -50,7 +50,7 @@ use super::{
     commit_obj_mat, perpendicular, self_margin, Body, CutTest, Fit, Gen, Geometry, Object,
     RecordError, Sides, TestCost,
 };
-use crate::scene::{Scene, Shape, Vec3};
+use crate::scene::{PrimType, Scene, Shape, Surface, Vec3};
 
 /// The margin of the bound before the first cut, in LSB: the bound's
 /// rounding (under 2 LSB: `oc2` rounded, the products) and the exact
@@ -599,7 +599,7 @@ impl super::ChipPrimitive for Cylinder {
     fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
         // Every cone-like object (cylinders and cones), and the cylinders.
         let cones = || scene.objects.iter().filter_map(|o| o.shape.as_cone());
-        let cylinders = || cones().filter(|c| c.base_radius == c.apex_radius);
+        let cylinders = || cones().filter(|c| c.prim_type() == PrimType::Cylinder);
         let radii = cylinders().map(|c| c.base_radius.abs() * s);
         let base_radii = cones().map(|c| c.base_radius.abs() * s);
         (fit.ks_cyl, fit.ep_cyl) = self::fit(radii, base_radii, f);
