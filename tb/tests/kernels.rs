@@ -13,14 +13,14 @@
 
 use firmware::asm;
 use firmware::scene::{
-    AaBox, Cone, Object, Polygon, Rectangle, Scene, Shape, Sphere, Triangle, Vec3,
+    AaBox, Cone, Disc, Object, Polygon, Rectangle, Scene, Shape, Sphere, Triangle, Vec3,
 };
 use firmware::tracer::emit::{Code, R1, R2, R7};
 use firmware::tracer::layout::{ChipType, TypeInfo};
 use firmware::tracer::memory_map::ram;
-use firmware::tracer::primitives::{kaddr, klen, polygon};
+use firmware::tracer::primitives::{self, kaddr, klen, polygon, ErrorBound};
 use firmware::tracer::{self, Firmware, Options};
-use rtl::rc::Word;
+use rtl::rc::{Datapath, Word};
 use rtl::{Chip, Sim, Timing};
 use tb::reference::shapes::{intersect, Ray};
 
@@ -216,17 +216,24 @@ fn rays(shape: &Shape, seed: u64) -> [Ray; 64] {
     })
 }
 
+/// The kernel of `shape`'s primitive against its f64 shape on both chips,
+/// held to the primitive's [`ErrorBound`] (`two_sided`: the object
+/// transmits).
+fn held(name: &str, shape: Shape, two_sided: bool) {
+    let b: ErrorBound = primitives::of_shape(&shape).error_bound();
+    let (t, mean, n) = b.on(Datapath::W16);
+    measure_sides::<i16>(name, shape.clone(), two_sided, t, mean, n);
+    let (t, mean, n) = b.on(Datapath::W32);
+    measure_sides::<i32>(name, shape, two_sided, t, mean, n);
+}
+
+/// The 16-bit chip's kernel of `shape` within a bound of its own.
 fn measure(name: &str, shape: Shape, max_t_lsb: f64, max_n: f64) {
-    measure_on::<i16>(name, shape, max_t_lsb, 1.5, max_n);
+    measure_sides::<i16>(name, shape, false, max_t_lsb, 1.5, max_n);
 }
 
-/// Measure the kernel on the chip of datapath `W`: errors of `t` in LSBs of
-/// that chip's scene format.
-fn measure_on<W: Word>(name: &str, shape: Shape, max_t_lsb: f64, max_mean: f64, max_n: f64) {
-    measure_sides::<W>(name, shape, false, max_t_lsb, max_mean, max_n)
-}
-
-/// [`measure_on`]; `two_sided`: the object transmits (its kernel and the
+/// Measure the kernel on the chip of datapath `W` (errors of `t` in LSBs
+/// of that chip's scene format); `two_sided`: the object transmits (its kernel and the
 /// reference test both sides) and half the rays start inside it if it is
 /// a solid.
 fn measure_sides<W: Word>(
@@ -376,7 +383,7 @@ fn tiny_sphere_kernel_vs_float_sphere() {
 
 #[test]
 fn sphere_kernel_vs_float_sphere() {
-    measure("sphere", shape_sphere(), 12.0, 0.02);
+    held("sphere", shape_sphere(), false);
 }
 
 /// The transmitting sphere's two-sided kernel: rays from outside hit the
@@ -384,15 +391,7 @@ fn sphere_kernel_vs_float_sphere() {
 /// inwards, as the reference's two-sided test; on both datapaths.
 #[test]
 fn glass_sphere_kernel_vs_float_two_sided_sphere() {
-    measure_sides::<i16>("glass sphere", shape_sphere(), true, 12.0, 1.5, 0.02);
-    measure_sides::<i32>(
-        "glass sphere",
-        shape_sphere(),
-        true,
-        12.0 * 65536.0,
-        1.5 * 65536.0,
-        1e-4,
-    );
+    held("glass sphere", shape_sphere(), true);
 }
 
 fn shape_cylinder() -> Shape {
@@ -414,7 +413,7 @@ fn cylinder_kernel_vs_float_cone() {
     // 6,000 LSB the ray travels, moves its `t` by that much. The coarse
     // kernel (`--normals coarse`) missed that ray (a hit/miss
     // disagreement) and erred by up to 8.4 LSB on the others.
-    measure("cylinder", shape_cylinder(), 18.0, 0.025);
+    held("cylinder", shape_cylinder(), false);
 }
 
 /// A thin cylinder, 38 LSB in radius in the test scene's format (like SPD
@@ -778,7 +777,7 @@ fn cone_kernel_vs_float_cone() {
     // along a generator (A = 0.006, 4D = 6 LSB of Q.14): t is
     // ill-conditioned there (half an LSB of the direction's Q1.14 moves it
     // by 0.5 LSB, the rounding of 4D by 17); every other ray is within 6.
-    measure("cone", s, 24.0, 0.02);
+    held("cone", s, false);
 }
 
 #[test]
@@ -786,29 +785,25 @@ fn steep_cone_kernel_vs_float_cone() {
     let s = shape_steep_cone();
     // Normals within 0.03: near the tip the radial direction of a hit a
     // few dozen LSB off the axis turns with the hit's error along the ray.
-    measure("steep cone", s, 12.0, 0.03);
+    held("steep cone", s, false);
 }
 
 #[test]
 fn nearly_cylindrical_cone_kernel_vs_float_cone() {
     for inside in [false, true] {
         let s = shape_nearly_cylindrical_cone(inside);
-        measure(
-            if inside {
-                "nearly cylindrical cone, inside"
-            } else {
-                "nearly cylindrical cone"
-            },
-            s,
-            12.0,
-            0.02,
-        );
+        let name = if inside {
+            "nearly cylindrical cone, inside"
+        } else {
+            "nearly cylindrical cone"
+        };
+        held(name, s, false);
     }
 }
 
 #[test]
 fn box_kernel_vs_float_aabox() {
-    measure("box", shape_box(), 12.0, 1e-3);
+    held("box", shape_box(), false);
 }
 
 fn shape_rectangle() -> Shape {
@@ -821,7 +816,20 @@ fn shape_rectangle() -> Shape {
 
 #[test]
 fn rectangle_kernel_vs_float_rectangle() {
-    measure("rectangle", shape_rectangle(), 12.0, 1e-3);
+    held("rectangle", shape_rectangle(), false);
+}
+
+fn shape_disc() -> Shape {
+    Shape::from(Disc {
+        center: Vec3::new(0.2, -0.3, 0.6),
+        normal: Vec3::new(0.4, -0.5, 1.0),
+        radius: 1.1,
+    })
+}
+
+#[test]
+fn disc_kernel_vs_float_disc() {
+    held("disc", shape_disc(), false);
 }
 
 fn shape_triangle() -> Shape {
@@ -837,7 +845,7 @@ fn shape_triangle() -> Shape {
 
 #[test]
 fn triangle_kernel_vs_float_triangle() {
-    measure("triangle", shape_triangle(), 12.0, 1e-3);
+    held("triangle", shape_triangle(), false);
 }
 
 /// The triangle with vertex normals tilted up to `tilt` off its face
@@ -866,8 +874,7 @@ fn shape_smooth_triangle(seed: u64, tilt: f64) -> Shape {
 fn smooth_triangle_kernel_vs_float_interpolation() {
     for seed in 1..=6 {
         let s = shape_smooth_triangle(seed, 0.6);
-        measure("smooth triangle", s.clone(), 12.0, 2e-3);
-        measure_on::<i32>("smooth triangle", s, 12.0 * 65536.0, 1.5 * 65536.0, 1e-6);
+        held("smooth triangle", s, false);
     }
 }
 
@@ -878,15 +885,7 @@ fn smooth_triangle_kernel_vs_float_interpolation() {
 #[test]
 fn glass_cylinder_kernel_vs_float_two_sided_cylinder() {
     // (the grazing ray of cylinder_kernel_vs_float_cone)
-    measure_sides::<i16>("glass cylinder", shape_cylinder(), true, 18.0, 1.5, 0.025);
-    measure_sides::<i32>(
-        "glass cylinder",
-        shape_cylinder(),
-        true,
-        12.0 * 65536.0,
-        1.5 * 65536.0,
-        1e-4,
-    );
+    held("glass cylinder", shape_cylinder(), true);
 }
 
 /// The transmitting cone (tapered, capped): its body from outside and
@@ -894,15 +893,7 @@ fn glass_cylinder_kernel_vs_float_two_sided_cylinder() {
 #[test]
 fn glass_cone_kernel_vs_float_two_sided_cone() {
     // (18 LSB: the grazing ray of cone_kernel_vs_float_cone)
-    measure_sides::<i16>("glass cone", shape_cone(), true, 24.0, 1.5, 0.02);
-    measure_sides::<i32>(
-        "glass cone",
-        shape_cone(),
-        true,
-        12.0 * 65536.0,
-        1.5 * 65536.0,
-        1e-3,
-    );
+    held("glass cone", shape_cone(), true);
 }
 
 /// The transmitting smooth triangle: both sides, the interpolated normal
@@ -911,15 +902,7 @@ fn glass_cone_kernel_vs_float_two_sided_cone() {
 fn glass_smooth_triangle_kernel_vs_float_two_sided() {
     for seed in 1..=3 {
         let s = shape_smooth_triangle(seed, 0.6);
-        measure_sides::<i16>("glass smooth triangle", s.clone(), true, 12.0, 1.5, 2e-3);
-        measure_sides::<i32>(
-            "glass smooth triangle",
-            s,
-            true,
-            12.0 * 65536.0,
-            1.5 * 65536.0,
-            1e-6,
-        );
+        held("glass smooth triangle", s, true);
     }
 }
 
@@ -927,15 +910,7 @@ fn glass_smooth_triangle_kernel_vs_float_two_sided() {
 /// (the normal turned to the ray), as the reference's two-sided box.
 #[test]
 fn glass_box_kernel_vs_float_two_sided_box() {
-    measure_sides::<i16>("glass box", shape_box(), true, 12.0, 1.5, 1e-6);
-    measure_sides::<i32>(
-        "glass box",
-        shape_box(),
-        true,
-        12.0 * 65536.0,
-        1.5 * 65536.0,
-        1e-6,
-    );
+    held("glass box", shape_box(), true);
 }
 
 #[test]
@@ -944,9 +919,9 @@ fn glass_planar_kernels_vs_float_two_sided() {
         ("glass rectangle", shape_rectangle()),
         ("glass triangle", shape_triangle()),
         ("glass polygon", shape_concave_polygon()),
+        ("glass disc", shape_disc()),
     ] {
-        measure_sides::<i16>(name, shape.clone(), true, 12.0, 1.5, 1e-3);
-        measure_sides::<i32>(name, shape, true, 12.0 * 65536.0, 1.5 * 65536.0, 1e-6);
+        held(name, shape, true);
     }
 }
 
@@ -965,7 +940,7 @@ fn shape_polygon() -> Shape {
 
 #[test]
 fn polygon_kernel_vs_float_polygon() {
-    measure("polygon", shape_polygon(), 12.0, 1e-3);
+    held("polygon", shape_polygon(), false);
 }
 
 fn shape_concave_polygon() -> Shape {
@@ -985,7 +960,7 @@ fn shape_concave_polygon() -> Shape {
 
 #[test]
 fn concave_polygon_kernel_vs_float_polygon() {
-    measure("concave polygon", shape_concave_polygon(), 12.0, 1e-3);
+    held("concave polygon", shape_concave_polygon(), false);
 }
 
 fn shape_gear_like_concave_polygon() -> Shape {
@@ -1005,12 +980,7 @@ fn shape_gear_like_concave_polygon() -> Shape {
 
 #[test]
 fn gear_like_concave_polygon_kernel_vs_float_polygon() {
-    measure(
-        "gear polygon",
-        shape_gear_like_concave_polygon(),
-        12.0,
-        1e-3,
-    );
+    held("gear polygon", shape_gear_like_concave_polygon(), false);
 }
 
 /// The gear face is a banded record under the packet traversal (160
@@ -1177,45 +1147,6 @@ fn banded_polygon_is_the_plain_polygon_bit_for_bit() {
 /// The cylinder's `t` goes through a
 /// second normalisation and a division by `|d2|`: up to 56 LSB at grazing
 /// incidence (mean 1.6), still 2^10 finer than the 16-bit chip's LSB.
-#[test]
-fn every_kernel_on_the_32_bit_chip() {
-    for (name, shape, max_t, max_mean, max_n) in [
-        ("sphere", shape_sphere(), 12.0, 1.5, 1e-6),
-        ("cylinder", shape_cylinder(), 64.0, 2.0, 1e-5),
-        ("box", shape_box(), 12.0, 1.5, 1e-6),
-        ("rectangle", shape_rectangle(), 12.0, 1.5, 1e-6),
-        ("triangle", shape_triangle(), 12.0, 1.5, 1e-6),
-        ("polygon", shape_polygon(), 12.0, 1.5, 1e-6),
-        ("concave polygon", shape_concave_polygon(), 12.0, 1.5, 1e-6),
-        (
-            "gear polygon",
-            shape_gear_like_concave_polygon(),
-            12.0,
-            1.5,
-            1e-6,
-        ),
-        // one ray grazing along a generator, as on the 16-bit chip
-        ("cone", shape_cone(), 24.0, 1.5, 1e-6),
-        ("steep cone", shape_steep_cone(), 12.0, 1.5, 1e-6),
-        (
-            "nearly cylindrical cone",
-            shape_nearly_cylindrical_cone(false),
-            12.0,
-            1.5,
-            1e-6,
-        ),
-        (
-            "inside cone",
-            shape_nearly_cylindrical_cone(true),
-            12.0,
-            1.5,
-            1e-6,
-        ),
-    ] {
-        measure_on::<i32>(name, shape, max_t, max_mean, max_n);
-    }
-}
-
 /// Snell's law in the RC (`shading::refract_prepare`, which `k_refract_prepare0`
 /// runs): for 64 random incident directions and normals facing them,
 /// entering (eta = 1/ior) or leaving (eta = ior) a material of index

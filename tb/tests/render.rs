@@ -68,6 +68,35 @@ fn tetra_matches_the_reference() {
     check_quality("tetra-1.nff", 48, 48, 30.0, 0.98);
 }
 
+/// The disc, the primitive `docs/adding-a-primitive.md` walks through
+/// (opaque, glass and mirror ones): its scene against the reference on
+/// both chips, under both traversals.
+#[test]
+fn discs_match_the_reference() {
+    use firmware::tracer::{Datapath, Traversal};
+    let scene = load("discs.toml");
+    for traversal in [Traversal::Packet, Traversal::Paper] {
+        for (datapath, min_psnr, min_hits) in
+            [(Datapath::W16, 38.0, 0.995), (Datapath::W32, 60.0, 0.999)]
+        {
+            let o = Options {
+                datapath,
+                traversal,
+                depth: 3,
+                ..opts(40, 40)
+            };
+            let (_, rep) = render(&scene, &o, &Default::default()).unwrap();
+            let psnr = rep.json["psnr_db"].as_f64().unwrap();
+            let hits = rep.json["hit_agreement"].as_f64().unwrap();
+            eprintln!("discs 40x40 {traversal:?} {datapath}: {psnr:.2} dB, hits {hits:.4}");
+            assert!(
+                psnr >= min_psnr && hits >= min_hits,
+                "{traversal:?} {datapath}: {psnr:.2} dB, hits {hits:.4}"
+            );
+        }
+    }
+}
+
 #[test]
 fn json_has_every_key_and_sane_figures() {
     let scene = load("default.toml");

@@ -20,7 +20,8 @@ pub mod spd;
 
 pub use geometry::{Aabb, Vec3};
 pub use shape::{
-    AaBox, Cone, Polygon, PrimType, Ray, Rectangle, Shape, Sphere, Surface, SurfaceHit, Triangle,
+    AaBox, Cone, Disc, Polygon, PrimType, Ray, Rectangle, Shape, Sphere, Surface, SurfaceHit,
+    Triangle,
 };
 
 use std::fmt;
@@ -402,8 +403,8 @@ impl Scene {
     }
 
     /// How many objects of each type, indexed by [`PrimType::index`].
-    pub fn type_counts(&self) -> [usize; 7] {
-        let mut n = [0; 7];
+    pub fn type_counts(&self) -> [usize; PrimType::ALL.len()] {
+        let mut n = [0; PrimType::ALL.len()];
         for o in &self.objects {
             n[o.shape.prim_type().index()] += 1;
         }

@@ -1,6 +1,6 @@
 //! The native scene format: TOML, for hand-written scenes. It adds to NFF
-//! axis-aligned boxes, rectangles, cylinders and cones with optional end
-//! caps, and named materials. See `docs/scenes.md` for the whole format;
+//! axis-aligned boxes, rectangles, discs, cylinders and cones with
+//! optional end caps, and named materials. See `docs/scenes.md` for the whole format;
 //! in short:
 //!
 //! ```toml
@@ -32,8 +32,8 @@ use serde::Deserialize;
 use toml::Spanned;
 
 use super::{
-    AaBox, Camera, Cone, Light, Material, Object, Rectangle, Scene, SceneError, Shape, Sphere,
-    Triangle, Vec3,
+    AaBox, Camera, Cone, Disc, Light, Material, Object, Rectangle, Scene, SceneError, Shape,
+    Sphere, Triangle, Vec3,
 };
 
 #[derive(Deserialize)]
@@ -107,6 +107,7 @@ struct ObjectDef {
     kind: String,
     material: String,
     center: Option<Vec3>,
+    normal: Option<Vec3>,
     radius: Option<f64>,
     base: Option<Vec3>,
     apex: Option<Vec3>,
@@ -122,12 +123,13 @@ struct ObjectDef {
     vertices: Option<Vec<Vec3>>,
 }
 
-const TYPES: &str = "sphere, cylinder, cone, box, rectangle, triangle, polygon";
+const TYPES: &str = "sphere, cylinder, cone, box, rectangle, triangle, polygon, disc";
 
 /// The shape an object table describes, or what is wrong with it.
 fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
     let keys: &[(&str, bool)] = &[
         ("center", o.center.is_some()),
+        ("normal", o.normal.is_some()),
         ("radius", o.radius.is_some()),
         ("base", o.base.is_some()),
         ("apex", o.apex.is_some()),
@@ -152,6 +154,7 @@ fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
         "box" => (&["min", "max"], &[]),
         "rectangle" => (&["corner", "edge1", "edge2"], &[]),
         "triangle" | "polygon" => (&["vertices"], &[]),
+        "disc" => (&["center", "normal", "radius"], &[]),
         k => {
             return Err(format!(
                 "unknown object type '{k}': expected one of {TYPES}"
@@ -207,6 +210,11 @@ fn shape_of(o: &ObjectDef) -> Result<Shape, String> {
             corner: u(o.corner),
             edge1: u(o.edge1),
             edge2: u(o.edge2),
+        }),
+        "disc" => Shape::from(Disc {
+            center: u(o.center),
+            normal: u(o.normal),
+            radius: f(o.radius),
         }),
         kind => {
             let v = o.vertices.clone().unwrap_or_default();

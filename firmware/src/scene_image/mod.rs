@@ -75,6 +75,7 @@ pub fn record_words(t: PrimType) -> usize {
         PrimType::Rectangle => 10,
         PrimType::Triangle => 10,
         PrimType::Polygon => 4,
+        PrimType::Disc => 8,
     }
 }
 
@@ -280,7 +281,7 @@ impl Groups {
     /// The groups, with every count the image holds in 16 bits checked,
     /// never wrapped.
     fn new(scene: &Scene) -> Result<Groups, SceneError> {
-        let mut by_type: Vec<Vec<usize>> = vec![Vec::new(); 7];
+        let mut by_type: Vec<Vec<usize>> = vec![Vec::new(); PrimType::ALL.len()];
         let mut object_slots = Vec::with_capacity(scene.objects.len());
         for (i, o) in scene.objects.iter().enumerate() {
             let t = o.shape.prim_type();

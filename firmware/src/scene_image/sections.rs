@@ -4,7 +4,8 @@
 
 use crate::bsp::{Bsp, Node};
 use crate::scene::{
-    AaBox, Cone, Polygon, PrimType, Rectangle, Scene, SceneError, Shape, Sphere, Triangle, Vec3,
+    AaBox, Cone, Disc, Polygon, PrimType, Rectangle, Scene, SceneError, Shape, Sphere, Triangle,
+    Vec3,
 };
 
 use super::fit::dequantized;
@@ -14,8 +15,9 @@ use super::{
 };
 
 /// Header words holding the 32-bit section addresses (high word first):
-/// camera, lights, materials, objects of each of the 7 types, polygon
-/// vertices, nodes, lists.
+/// camera, lights, materials, objects of each of the paper's 7 types,
+/// polygon vertices, nodes, lists; the disc's count and objects after
+/// them ([`count_word`], [`objects_word`]).
 const A_CAMERA: usize = 16;
 const A_LIGHTS: usize = 18;
 const A_MATERIALS: usize = 20;
@@ -23,6 +25,24 @@ const A_OBJECTS: usize = 22; // 7 pairs
 const A_VERTICES: usize = 36;
 const A_NODES: usize = 38;
 const A_LISTS: usize = 40;
+const N_DISCS: usize = 42;
+const A_DISCS: usize = 43;
+
+/// The header word of type `t`'s object count.
+fn count_word(t: PrimType) -> usize {
+    match t {
+        PrimType::Disc => N_DISCS,
+        t => 9 + t.index(),
+    }
+}
+
+/// The header word of the address of type `t`'s first object.
+fn objects_word(t: PrimType) -> usize {
+    match t {
+        PrimType::Disc => A_DISCS,
+        t => A_OBJECTS + 2 * t.index(),
+    }
+}
 
 /// The image being written, and the largest rounding error so far.
 pub(super) struct Writer {
@@ -89,7 +109,7 @@ pub(super) fn header(w: &mut Writer, scene: &Scene, g: &Groups, bsp: &Bsp, l: &L
     w.words[7] = scene.lights.len() as u16;
     w.words[8] = scene.materials.len() as u16;
     for t in PrimType::ALL {
-        w.words[9 + t.index()] = g.by_type[t.index()].len() as u16;
+        w.words[count_word(t)] = g.by_type[t.index()].len() as u16;
     }
 }
 
@@ -166,7 +186,7 @@ pub(super) fn objects(
     let at_objects = w.words.len();
     for t in PrimType::ALL {
         let here = w.words.len();
-        w.addr(A_OBJECTS + 2 * t.index(), here);
+        w.addr(objects_word(t), here);
         for &i in &g.by_type[t.index()] {
             let o = &scene.objects[i];
             let start = w.words.len();
@@ -267,6 +287,18 @@ fn record(w: &mut Writer, t: PrimType, shape: &Shape, material: usize) -> Option
             w.word(0);
             w.word(0);
             return Some(fixup);
+        }
+        Shape::Disc(Disc {
+            center,
+            normal,
+            radius,
+        }) => {
+            w.point(*center);
+            for x in normal.normalized().to_array() {
+                w.fixed(Q_UNIT, x);
+            }
+            w.coord(*radius);
+            w.word(mat);
         }
     }
     None

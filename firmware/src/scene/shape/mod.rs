@@ -10,6 +10,7 @@
 
 mod aabox;
 mod cone;
+mod disc;
 mod hit;
 mod polygon;
 mod rectangle;
@@ -18,6 +19,7 @@ mod triangle;
 
 pub use aabox::AaBox;
 pub use cone::Cone;
+pub use disc::Disc;
 pub use hit::{Ray, Span, SurfaceHit};
 pub use polygon::Polygon;
 pub use rectangle::Rectangle;
@@ -36,10 +38,11 @@ pub enum PrimType {
     Rectangle,
     Triangle,
     Polygon,
+    Disc,
 }
 
 impl PrimType {
-    pub const ALL: [PrimType; 7] = [
+    pub const ALL: [PrimType; 8] = [
         PrimType::Sphere,
         PrimType::Cylinder,
         PrimType::Cone,
@@ -47,6 +50,7 @@ impl PrimType {
         PrimType::Rectangle,
         PrimType::Triangle,
         PrimType::Polygon,
+        PrimType::Disc,
     ];
     pub fn name(self) -> &'static str {
         match self {
@@ -57,6 +61,7 @@ impl PrimType {
             PrimType::Rectangle => "rectangle",
             PrimType::Triangle => "triangle",
             PrimType::Polygon => "polygon",
+            PrimType::Disc => "disc",
         }
     }
     /// The plural: "spheres", "boxes".
@@ -69,6 +74,7 @@ impl PrimType {
             PrimType::Rectangle => "rectangles",
             PrimType::Triangle => "triangles",
             PrimType::Polygon => "polygons",
+            PrimType::Disc => "discs",
         }
     }
     pub fn index(self) -> usize {
@@ -194,6 +200,7 @@ shapes! {
     Rectangle(Rectangle) as_rectangle,
     Triangle(Triangle) as_triangle,
     Polygon(Polygon) as_polygon,
+    Disc(Disc) as_disc,
 }
 
 impl Shape {

@@ -182,3 +182,76 @@ fn box_rectangle_triangle_polygon() {
     };
     assert!(hit(1.0, 0.5) && hit(1.8, 1.5) && !hit(1.0, 1.5) && !hit(2.5, 0.5));
 }
+
+#[test]
+fn disc_front_back_rim_and_bounds() {
+    // The disc of radius 2 about (1, 0, 3) in the plane x + z = 4, its
+    // visible side towards +x +z.
+    let d = Shape::from(Disc {
+        center: Vec3::new(1.0, 0.0, 3.0),
+        normal: Vec3::new(3.0, 0.0, 3.0),
+        radius: 2.0,
+    });
+    // Straight down from (1, 1.5, 13): the plane at z = 3, 1.5 from the
+    // centre, inside.
+    let h = intersect(
+        &d,
+        &ray([1.0, 1.5, 13.0], [0.0, 0.0, -1.0]),
+        0.0,
+        INF,
+        false,
+    )
+    .unwrap();
+    assert!((h.t - 10.0).abs() < 1e-12, "{}", h.t);
+    let e = Vec3::new(1.0, 0.0, 1.0).normalized();
+    assert!((h.n - e).length() < 1e-12 && h.front, "{h:?}");
+    // 2.5 from the centre: off the rim.
+    assert!(intersect(
+        &d,
+        &ray([1.0, 2.5, 13.0], [0.0, 0.0, -1.0]),
+        0.0,
+        INF,
+        false
+    )
+    .is_none());
+    // From below: the back, seen only two-sided, its normal still the
+    // visible side's.
+    let up = ray([1.0, 0.5, -7.0], [0.0, 0.0, 1.0]);
+    assert!(intersect(&d, &up, 0.0, INF, false).is_none(), "back side");
+    let h = intersect(&d, &up, 0.0, INF, true).unwrap();
+    assert!((h.t - 10.0).abs() < 1e-12 && !h.front, "{h:?}");
+    // Parallel to the plane: no hit.
+    assert!(intersect(&d, &ray([0.0, 0.0, 4.0], [1.0, 0.0, -1.0]), 0.0, INF, true).is_none());
+    // Its bounds: the rim reaches 2 sin 45 deg along x and z, 2 along y.
+    let b = d.bounds();
+    let s = 2.0f64.sqrt();
+    for (got, want) in [
+        (b.min, Vec3::new(1.0 - s, -2.0, 3.0 - s)),
+        (b.max, Vec3::new(1.0 + s, 2.0, 3.0 + s)),
+    ] {
+        assert!((got - want).length() < 1e-12, "{got:?} {want:?}");
+    }
+    // A cell beside the disc's plane is not met, one it crosses is.
+    let far = Aabb {
+        min: Vec3::new(2.0, -1.0, 3.5),
+        max: Vec3::new(3.0, 1.0, 4.4),
+    };
+    let near = Aabb {
+        min: Vec3::new(0.5, -1.0, 3.0),
+        max: Vec3::new(1.5, 1.0, 3.5),
+    };
+    assert!(!d.may_overlap(&far) && d.may_overlap(&near));
+    // Degenerate: no radius, no normal.
+    let mut bad = Disc {
+        center: Vec3::ZERO,
+        normal: Vec3::ZERO,
+        radius: 1.0,
+    };
+    assert!(Shape::from(bad.clone())
+        .degeneracy()
+        .unwrap()
+        .contains("normal"));
+    bad.normal = Vec3::new(0.0, 0.0, 1.0);
+    bad.radius = -1.0;
+    assert!(Shape::from(bad).degeneracy().unwrap().contains("radius"));
+}

@@ -14,7 +14,7 @@
 //! | [`cylinder`] | cylinder, glass cylinder (caps: discs) | `k_cylinder`; `k_glass_cylinder_out`, `k_glass_cylinder_in` |
 //! | [`cone`] | cone, glass cone (caps: discs) | `k_cone`; `k_glass_cone_out`, `k_glass_cone_in` |
 //! | [`aabox`] | box, glass box | `k_box`, `k_glass_box` |
-//! | [`planar`] | rectangle, triangle, disc (the caps), glass ones | `k_rectangle`, `k_triangle`, `k_disc`, `k_glass_rectangle`, `k_glass_triangle`, `k_glass_disc` |
+//! | [`planar`] | rectangle, triangle, disc (native scenes), glass ones; the caps' discs | `k_rectangle`, `k_triangle`, `k_disc_object`, `k_glass_rectangle`, `k_glass_triangle`, `k_glass_disc_object`; `k_disc`, `k_glass_disc` |
 //! | [`polygon`] | polygon, glass polygon | `k_polygon_head`, `k_polygon_edge`, `k_polygon_tail`; `k_glass_polygon_head`, `k_glass_polygon_tail` |
 //! | [`smooth_triangle`] | triangle with vertex normals (NFF `pp`), glass one | `k_smooth_triangle`, `k_glass_smooth_triangle` |
 //!
@@ -184,6 +184,43 @@ pub trait ChipPrimitive: Sync {
     /// Write one object's record: exactly [`ChipPrimitive::record_words`]
     /// words, in the order its kernels read them.
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError>;
+
+    /// How far its kernels' hits may be from its f64 shape's
+    /// (`Surface::intersect`): `tb/tests/kernels.rs` holds every kernel,
+    /// opaque and glass, to it on both chips.
+    fn error_bound(&self) -> ErrorBound;
+}
+
+/// How far a primitive's kernel may be from the f64 reference, on 256
+/// rays from around the object (most of them hitting it, some grazing),
+/// per chip: `[16-bit, 32-bit]`.
+#[derive(Clone, Copy, Debug)]
+pub struct ErrorBound {
+    /// The largest error of `t`, in LSB of the chip's scene format.
+    pub t_lsb: [f64; 2],
+    /// The mean error of `t` over the hits, LSB.
+    pub mean_t_lsb: [f64; 2],
+    /// The largest error of the (shading) unit normal.
+    pub normal: [f64; 2],
+}
+
+impl ErrorBound {
+    /// `t` within `t_lsb` LSB on either chip, within 1.5 LSB on average;
+    /// the normal within `normal_16` on the 16-bit chip (its Q1.14
+    /// normals) and 1e-6 on the 32-bit one.
+    pub const fn lsb(t_lsb: f64, normal_16: f64) -> ErrorBound {
+        ErrorBound {
+            t_lsb: [t_lsb, t_lsb],
+            mean_t_lsb: [1.5, 1.5],
+            normal: [normal_16, 1e-6],
+        }
+    }
+
+    /// The bound on the chip of `dp`.
+    pub fn on(&self, dp: Datapath) -> (f64, f64, f64) {
+        let i = (dp.bits() > 16) as usize;
+        (self.t_lsb[i], self.mean_t_lsb[i], self.normal[i])
+    }
 }
 
 /// The primitive of an object's shape.
@@ -214,7 +251,7 @@ impl TestCost {
 }
 
 /// Every primitive, in the order their header lines come.
-pub const PRIMITIVES: [&dyn ChipPrimitive; 8] = [
+pub const PRIMITIVES: [&dyn ChipPrimitive; 9] = [
     &sphere::Sphere,
     &cylinder::Cylinder,
     &cone::Cone,
@@ -223,6 +260,7 @@ pub const PRIMITIVES: [&dyn ChipPrimitive; 8] = [
     &planar::TRIANGLE,
     &polygon::Polygon,
     &smooth_triangle::SmoothTriangle,
+    &planar::DISC,
 ];
 
 /// The geometry a primitive's record is written from
@@ -312,11 +350,15 @@ pub enum ChipType {
     GlassCone,
     /// Smooth triangles of a transmitting material.
     GlassSmoothTriangle,
+    /// Discs (native scenes): the planar test with the caps' inside test.
+    Disc,
+    /// Discs of a transmitting material (two-sided).
+    GlassDisc,
 }
 
 impl ChipType {
     /// Every type, in test order.
-    pub const ALL: [ChipType; 16] = [
+    pub const ALL: [ChipType; 18] = [
         ChipType::Sphere,
         ChipType::GlassSphere,
         ChipType::Cylinder,
@@ -333,10 +375,12 @@ impl ChipType {
         ChipType::GlassCylinder,
         ChipType::GlassCone,
         ChipType::GlassSmoothTriangle,
+        ChipType::Disc,
+        ChipType::GlassDisc,
     ];
 
     /// The order the types' kernels are loaded into context memory in.
-    pub const LOAD_ORDER: [ChipType; 16] = [
+    pub const LOAD_ORDER: [ChipType; 18] = [
         ChipType::Sphere,
         ChipType::GlassSphere,
         ChipType::Cylinder,
@@ -353,6 +397,8 @@ impl ChipType {
         ChipType::GlassSmoothTriangle,
         ChipType::GlassBox,
         ChipType::GlassPolygon,
+        ChipType::Disc,
+        ChipType::GlassDisc,
     ];
 
     /// The type's name: its primitive's, `glass_` before it for the glass
@@ -392,6 +438,8 @@ impl ChipType {
             (PrimType::Rectangle, _, false) => ChipType::Rectangle,
             (PrimType::Triangle, _, false) => ChipType::Triangle,
             (PrimType::Polygon, _, false) => ChipType::Polygon,
+            (PrimType::Disc, _, true) => ChipType::GlassDisc,
+            (PrimType::Disc, _, false) => ChipType::Disc,
         }
     }
 
@@ -408,6 +456,7 @@ impl ChipType {
                 | ChipType::GlassCylinder
                 | ChipType::GlassCone
                 | ChipType::GlassSmoothTriangle
+                | ChipType::GlassDisc
         )
     }
 
@@ -433,6 +482,7 @@ impl ChipType {
             ChipType::SmoothTriangle | ChipType::GlassSmoothTriangle => {
                 &smooth_triangle::SmoothTriangle
             }
+            ChipType::Disc | ChipType::GlassDisc => &planar::DISC,
         }
     }
 
@@ -470,7 +520,7 @@ fn caps(t: &mut Code, nocap: &str, rec: Reg, flag: &str, cap: &str, caps: [&str;
 
 /// The kernels whose runs start an object test (their RCs at the first
 /// context are the rays tested): the render's count of tests per ray.
-pub const TEST_KERNELS: [&str; 16] = [
+pub const TEST_KERNELS: [&str; 18] = [
     "k_sphere",
     "k_glass_sphere",
     "k_cylinder",
@@ -487,6 +537,8 @@ pub const TEST_KERNELS: [&str; 16] = [
     "k_glass_cylinder_out",
     "k_glass_cone_out",
     "k_glass_smooth_triangle",
+    "k_disc_object",
+    "k_glass_disc_object",
 ];
 
 /// Every kernel of every primitive's test (the first ones are
@@ -611,7 +663,8 @@ impl Fit {
                 }
             }
         }
-        if has(&|t| t.primitive().disc_caps()) {
+        let kt_disc = v.iter().any(|l| l.starts_with("KT_DISC "));
+        if has(&|t| t.primitive().disc_caps()) && !kt_disc {
             v.push(define(
                 "KT_DISC",
                 self.kt[2],

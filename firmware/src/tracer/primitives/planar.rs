@@ -1,7 +1,8 @@
-//! The planar primitives: rectangle, triangle and disc (the caps of
-//! cylinders and cones), held to `scene/shape/rectangle.rs`,
-//! `triangle.rs` and the caps of `cone.rs`. The polygon and the smooth triangle start with the
-//! same plane test ([`plane_hit`]).
+//! The planar primitives: rectangle, triangle and disc (an object of a
+//! native scene, and the caps of cylinders and cones), held to
+//! `scene/shape/rectangle.rs`, `triangle.rs`, `disc.rs` and the caps of
+//! `cone.rs`. The polygon and the smooth triangle start with the same
+//! plane test ([`plane_hit`]).
 //!
 //! **Record** (20 words): `n.xyz (Q1.14), v0.xyz, v0.xyz, eu.xyz, ew.xyz,
 //! n.xyz, obj, mat`, where `u = (P - v0).eu`, `w = (P - v0).ew` (the
@@ -24,18 +25,17 @@
 //! **Registers**: r1..r7 the ray (r7 the new `tbest` where F); r8..r15
 //! temporaries; RAM `TMP3` (two-sided: the back flag).
 //!
-//! **Error** against the f64 shapes (`tb/tests/kernels.rs`, 256 rays):
-//! `t` within 3 LSB (mean under 1.5), normal within 0.01; the largest `t`
-//! errors at grazing incidence, where the Q1.14 rounding of the direction
-//! is amplified.
+//! **Error** against the f64 shapes: their `error_bound` (below), which
+//! `tb/tests/kernels.rs` holds both chips to; the largest `t` errors at
+//! grazing incidence, where the rounding of the direction is amplified.
 
 use super::super::emit::{define, Code, K};
 use super::super::math::divide;
 use super::super::memory_map::ram;
 use super::record::{total, Field, Layout, W};
 use super::{
-    commit_streamed_normal, commit_streamed_normal_two, CutTest, Fit, Gen, Geometry, Object,
-    RecordError, Sides, TestCost,
+    commit_streamed_normal, commit_streamed_normal_two, CutTest, ErrorBound, Fit, Gen, Geometry,
+    Object, RecordError, Sides, TestCost,
 };
 use crate::scene::{Shape, Vec3};
 
@@ -307,14 +307,31 @@ pub fn inside_test(k: &mut K, inside: Inside) {
     }
 }
 
-/// The kernel of a planar primitive.
+/// The kernel of a disc object (a disc of a native scene): the caps'
+/// disc kernel with the rectangle's and triangle's cuts.
+pub fn disc_object_name(s: Sides) -> &'static str {
+    match s {
+        Sides::Front => "k_disc_object",
+        Sides::Both => "k_glass_disc_object",
+    }
+}
+
+/// The kernel of a cylinder's or cone's cap, or of a rectangle or a
+/// triangle.
 pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
+    let cuts = inside != Inside::Disc;
+    planar_kernel(g, inside, sides, kernel_name(inside, sides), cuts)
+}
+
+/// The kernel of a planar test named `name`, with the cuts of [`CUTS`]
+/// or without.
+fn planar_kernel(g: &Gen, inside: Inside, sides: Sides, name: &str, cuts: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
         "{}: the {} test of one record (the stream){}.\n\
          In: r1..r3 o, r4..r6 d, r7 tbest. Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT{}.\n\
          t = n.(v0 - o) / n.d, P = o + t d, u = (P - v0).eu, w = (P - v0).ew",
-        kernel_name(inside, sides),
+        name,
         match inside {
             Inside::Rectangle => "rectangle",
             Inside::Triangle => "triangle",
@@ -331,7 +348,7 @@ pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
             ""
         },
     ));
-    let cut = (inside != Inside::Disc).then_some(CUTS[0].0);
+    let cut = cuts.then_some(CUTS[0].0);
     plane_hit(&mut k, g, sides, cut);
     inside_test(&mut k, inside);
     if cut.is_some() {
@@ -344,20 +361,38 @@ pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
     k
 }
 
-/// The rectangle and the triangle ([`super::ChipPrimitive`]), by their
-/// inside test.
+/// The rectangle, the triangle and the disc ([`super::ChipPrimitive`]),
+/// by their inside test.
 pub struct PlanarPrimitive(Inside);
 
 /// The rectangle.
 pub const RECTANGLE: PlanarPrimitive = PlanarPrimitive(Inside::Rectangle);
 /// The triangle (flat shaded).
 pub const TRIANGLE: PlanarPrimitive = PlanarPrimitive(Inside::Triangle);
+/// The disc (native scenes).
+pub const DISC: PlanarPrimitive = PlanarPrimitive(Inside::Disc);
+
+impl PlanarPrimitive {
+    /// Its object test's kernel label.
+    fn label(&self, sides: Sides) -> &'static str {
+        match self.0 {
+            Inside::Disc => disc_object_name(sides),
+            i => kernel_name(i, sides),
+        }
+    }
+
+    /// Its object test's kernel (with cuts).
+    fn object_kernel(&self, g: &Gen, sides: Sides) -> K {
+        planar_kernel(g, self.0, sides, self.label(sides), true)
+    }
+}
 
 impl super::ChipPrimitive for PlanarPrimitive {
     fn names(&self) -> [&'static str; 2] {
         match self.0 {
             Inside::Triangle => ["triangle", "glass_triangle"],
-            _ => ["rectangle", "glass_rectangle"],
+            Inside::Rectangle => ["rectangle", "glass_rectangle"],
+            Inside::Disc => ["disc", "glass_disc"],
         }
     }
 
@@ -366,16 +401,16 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
-        vec![(kernel_name(self.0, sides), kernel(g, self.0, sides))]
+        vec![(self.label(sides), self.object_kernel(g, sides))]
     }
 
     fn broadcast(&self, sides: Sides, t: &mut Code, _at: &str, _fit: &Fit, _caps: bool) {
-        super::one(t, kernel_name(self.0, sides));
+        super::one(t, self.label(sides));
     }
 
     fn cut_test(&self, sides: Sides) -> Option<CutTest> {
         Some(CutTest {
-            kernel: kernel_name(self.0, sides),
+            kernel: self.label(sides),
             field: "0",
             cuts: &CUTS,
             then: None,
@@ -385,7 +420,8 @@ impl super::ChipPrimitive for PlanarPrimitive {
     fn fit_header(&self, fit: &Fit) -> Vec<String> {
         let what = match self.0 {
             Inside::Triangle => "triangles",
-            _ => "rectangles",
+            Inside::Rectangle => "rectangles",
+            Inside::Disc => "discs",
         };
         let name = self.0.kt_name();
         vec![define(
@@ -409,6 +445,10 @@ impl super::ChipPrimitive for PlanarPrimitive {
             Geometry::Planars(vec![Planar::rectangle(r.corner, r.edge1, r.edge2, n)])
         } else if let Some(t) = shape.as_triangle() {
             Geometry::Planars(vec![flat_triangle(t.v)])
+        } else if let Some(d) = shape.as_disc() {
+            let n = d.normal.normalized();
+            let e1 = super::perpendicular(n);
+            Geometry::Planars(vec![Planar::disc(d.center, e1, n.cross(e1), d.radius, n)])
         } else {
             Geometry::None
         }
@@ -416,7 +456,16 @@ impl super::ChipPrimitive for PlanarPrimitive {
 
     /// Rectangles are priced as triangles (the cost model's kernels).
     fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
-        TestCost::of(&kernel(g, Inside::Triangle, Sides::Front))
+        match self.0 {
+            Inside::Disc => TestCost::of(&self.object_kernel(g, Sides::Front)),
+            _ => TestCost::of(&kernel(g, Inside::Triangle, Sides::Front)),
+        }
+    }
+
+    /// The largest `t` errors at grazing incidence, where the rounding of the
+    /// direction is amplified.
+    fn error_bound(&self) -> ErrorBound {
+        ErrorBound::lsb(16.0, 1e-3)
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {

@@ -23,15 +23,15 @@
 //! **Registers**: r1..r7 the ray (r7 the new `tbest` where F); r8..r15
 //! temporaries; RAM `TMP2..TMP4`.
 //!
-//! **Error** against the f64 interpolation (`tb/tests/kernels.rs`): `t`
-//! within 3 LSB, the shading normal within 0.01.
+//! **Error** against the f64 interpolation: its `error_bound` (below),
+//! which `tb/tests/kernels.rs` holds both chips to.
 
 use super::super::emit::{Code, K};
 use super::super::math::normalize;
 use super::super::memory_map::ram;
 use super::planar::{self, Inside, Planar};
 use super::record::{total, Field, Layout, W};
-use super::{CutTest, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
+use super::{CutTest, ErrorBound, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost};
 use crate::scene::{Shape, Vec3};
 
 /// Record words: the planar record with the vertex normals.
@@ -254,6 +254,11 @@ impl super::ChipPrimitive for SmoothTriangle {
     /// Priced as the flat triangle's test (the cost model's kernels).
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
         super::ChipPrimitive::test_cost(&planar::TRIANGLE, g, fit)
+    }
+
+    /// The normal: the interpolated shading normal.
+    fn error_bound(&self) -> ErrorBound {
+        ErrorBound::lsb(6.0, 2e-3)
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {

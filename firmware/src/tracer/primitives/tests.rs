@@ -52,6 +52,11 @@ fn every_kernel_reads_exactly_its_record() {
                     ] {
                         assert_eq!(planar::kernel(&g, i, s).fb_reads, planar::WORDS);
                     }
+                    for p in [&planar::RECTANGLE, &planar::TRIANGLE, &planar::DISC] {
+                        for (name, k) in p.kernels(s, &g, &fit) {
+                            assert_eq!(k.fb_reads, p.record_words(s, &fit, 0, false), "{name}");
+                        }
+                    }
                     assert_eq!(
                         smooth_triangle::kernel(&g, s).fb_reads,
                         smooth_triangle::WORDS
@@ -184,6 +189,32 @@ fn every_writer_follows_its_layout() {
                 }
             }
         }
+    }
+    // The disc, through its primitive: its geometry, then its writer.
+    let disc = Shape::from(crate::scene::Disc {
+        center: v(1.0, 2.0, 3.0),
+        normal: v(0.0, 0.6, 0.8),
+        radius: 0.75,
+    });
+    let p = of_shape(&disc);
+    assert_eq!(p.names()[0], "disc");
+    let geometry = p.geometry(&disc, writer().s);
+    let fit = Fit::default();
+    for sides in [Sides::Front, Sides::Both] {
+        let o = Object {
+            shape: &disc,
+            geometry: &geometry,
+            fit: &fit,
+            sides,
+            caps: false,
+            size: p.record_words(sides, &fit, 0, false),
+            unrounded: false,
+            id: 7,
+            mat: 1,
+        };
+        let mut w = writer();
+        p.write(&mut w, &o).unwrap();
+        holds_to(&w, 0, &p.layout(sides, &fit, 0, false), "disc");
     }
     let tri = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
     let mut w = writer();

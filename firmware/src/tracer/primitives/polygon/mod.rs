@@ -68,8 +68,9 @@
 //! runs; r12..r15 temporaries; RAM `TMP0` (valid), `TMP3` (two-sided:
 //! back).
 //!
-//! **Error** against the f64 polygon (`tb/tests/kernels.rs`, a convex, a
-//! concave and a gear-like polygon): `t` within 3 LSB, no crack.
+//! **Error** against the f64 polygon: its `error_bound` (below), which
+//! `tb/tests/kernels.rs` holds both chips to on a convex, a concave and a
+//! gear-like polygon.
 
 mod broadcast;
 
@@ -80,8 +81,8 @@ use super::super::memory_map::ram;
 use super::planar::plane_hit;
 use super::record::{Field, Layout, W};
 use super::{
-    commit_streamed_normal, commit_streamed_normal_two, CutTest, Fit, Gen, Object, RecordError,
-    Sides, TestCost,
+    commit_streamed_normal, commit_streamed_normal_two, CutTest, ErrorBound, Fit, Gen, Object,
+    RecordError, Sides, TestCost,
 };
 use crate::scene::{Shape, Vec3};
 
@@ -656,6 +657,11 @@ impl super::ChipPrimitive for Polygon {
         } else {
             e.len()
         }
+    }
+
+    /// Concave outlines included; no crack between edges.
+    fn error_bound(&self) -> ErrorBound {
+        ErrorBound::lsb(12.0, 1e-3)
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
