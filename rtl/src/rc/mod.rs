@@ -25,10 +25,11 @@ use std::fmt;
 use crate::kernel::{Clocked, Fault};
 use context::{ASrc, BSrc, Cond, Context, Guard, Op};
 use flags::Flags;
-use lanes::{blend, expand, full, select_word, Mask, SignBits};
+use lanes::{full, Mask, SignBits};
 use ram::Ram;
 use register_file::RegisterFile;
 pub(crate) use waves::{CTX_FILTER, OP_FILTER};
+use word::{blend, expand, select_word};
 pub use word::{Datapath, Word};
 
 /// How lanes are named in waveforms.

@@ -5,8 +5,9 @@
 //! during the cycle; the write lands at the clock edge
 //! ([`RegisterFile::write`] is only called from the array's commit).
 
-use super::lanes::{blend, select_word, Mask};
+use super::lanes::Mask;
 use super::word::Word;
+use super::word::{blend, select_word};
 
 pub(crate) const REGS: usize = 16;
 
@@ -36,7 +37,7 @@ impl<const N: usize, W: Word> RegisterFile<N, W> {
     }
 
     /// [`RegisterFile::write`] with the mask already expanded to 0 / -1
-    /// lanes ([`super::lanes::expand`]).
+    /// lanes ([`super::word::expand`]).
     #[inline(always)]
     pub fn write_lanes(&mut self, k: u8, m: &[W; N], data: &[W; N]) {
         blend(&mut self.r[k as usize & 15], m, data);

@@ -16,7 +16,7 @@ use std::ops::{BitAnd, BitOr, BitXor, Not};
 
 use super::alu::{self, Flagged};
 use super::context::Cond;
-use super::lanes::SignBits;
+use super::lanes::{full, select, Mask, SignBits};
 use super::{multiplier, shifter};
 
 /// Which datapath a chip has.
@@ -296,3 +296,113 @@ impl_word!(i16, i32, w16, Datapath::W16, EXPAND16, |a: i16, b: i16| a
     + b as i32);
 impl_word!(i32, i64, w32, Datapath::W32, EXPAND32, |a: i32, b: i32| a
     .saturating_add(b));
+
+/// `select` for datapath words: the mask is expanded to 0 / -1 lanes by
+/// table ([`Word::expand8`]) and blended with bit operations, which
+/// vectorises.
+#[inline(always)]
+pub(crate) fn select_word<W: Word, const N: usize>(dst: &mut [W; N], mask: Mask, src: &[W; N]) {
+    if mask == full(N) {
+        *dst = *src;
+    } else if mask != 0 {
+        if !N.is_multiple_of(8) {
+            return select(dst, mask, src);
+        }
+        blend(dst, &expand(mask), src);
+    }
+}
+
+/// The 0 / -1 lanes of `mask` (`N` a multiple of 8), by table
+/// ([`Word::expand8`]), for [`blend`]: one expansion serves every array
+/// a commit writes under the same mask.
+#[inline(always)]
+pub fn expand<W: Word, const N: usize>(mask: Mask) -> [W; N] {
+    if let Some(m) = W::from_mask(mask) {
+        return m;
+    }
+    let mut m = [W::ZERO; N];
+    for c in 0..N / 8 {
+        m[c * 8..c * 8 + 8].copy_from_slice(W::expand8((mask >> (c * 8)) as usize & 255));
+    }
+    m
+}
+
+/// `dst[i] = src[i]` where `m[i]` is -1 (bit operations: vectorises).
+#[inline(always)]
+pub fn blend<W: Word, const N: usize>(dst: &mut [W; N], m: &[W; N], src: &[W; N]) {
+    for i in 0..N {
+        dst[i] = (src[i] & m[i]) | (dst[i] & !m[i]);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rc::lanes::pack_bools;
+
+    /// Words selected, masks expanded and accumulators selected under
+    /// random masks, against the masks' bits.
+    #[test]
+    fn selects_and_expansions_follow_the_mask_bits() {
+        let mut x: u64 = 0x9E37_79B9_7F4A_7C15;
+        for _ in 0..200 {
+            x ^= x << 13;
+            x ^= x >> 7;
+            x ^= x << 17;
+            let b: [bool; 64] = std::array::from_fn(|i| x >> i & 1 == 1);
+            let b12: [bool; 12] = std::array::from_fn(|i| b[i]);
+            assert_eq!(pack_bools(&b12), x & 0xFFF);
+            let mut d = [7i16; 64];
+            let src: [i16; 64] = std::array::from_fn(|i| i as i16 - 20);
+            select_word(&mut d, x, &src);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
+            let mut d = [7i32; 64];
+            let src: [i32; 64] = std::array::from_fn(|i| i as i32 * 100_000 - 2_000_000);
+            select_word(&mut d, x, &src);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
+            // Masks expanded to 0 / -1 lanes of every width (by AVX-512 on
+            // the AVX-512 path, else by table), against the bits.
+            let e16 = expand::<i16, 64>(x);
+            let e32 = expand::<i32, 64>(x);
+            let e8 = expand::<i16, 8>(x);
+            for i in 0..64 {
+                let want = -((x >> i & 1) as i64);
+                assert_eq!((e16[i] as i64, e32[i] as i64), (want, want));
+                if i < 8 {
+                    assert_eq!(e8[i] as i64, want);
+                }
+            }
+            if let Some(e64) = i64::from_mask::<64>(x) {
+                assert!((0..64).all(|i| e64[i] == -((x >> i & 1) as i64)));
+            }
+            // The accumulators of both datapaths (i32 and i64 lanes).
+            let mut d = [7i32; 64];
+            <i16 as Word>::select_acc(&mut d, x, &src);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src[i] } else { 7 });
+            }
+            let mut d = [-7i64; 64];
+            let src64: [i64; 64] = std::array::from_fn(|i| (i as i64 - 30) << 40);
+            <i32 as Word>::select_acc(&mut d, x, &src64);
+            for i in 0..64 {
+                assert_eq!(d[i], if x >> i & 1 == 1 { src64[i] } else { -7 });
+            }
+            let mut d = [7i32; 12];
+            <i16 as Word>::select_acc(&mut d, x, &b12.map(|b| b as i32 - 5));
+            for i in 0..12 {
+                assert_eq!(
+                    d[i],
+                    if x >> i & 1 == 1 {
+                        b12[i] as i32 - 5
+                    } else {
+                        7
+                    }
+                );
+            }
+        }
+    }
+}

@@ -4,6 +4,8 @@
 use std::fs::File;
 use std::io::{self, BufWriter, Seek, Write};
 
+use super::Display;
+
 /// A traced signal call's handle, width, whether its signal has a
 /// translate filter, and its signal's index in declaration order.
 pub(super) type Slot = (SigId, u32, bool, u32);
@@ -21,6 +23,23 @@ pub(super) fn fst_err(e: fst_writer::FstWriteError) -> io::Error {
         fst_writer::FstWriteError::Io(e) => e,
         e => io::Error::other(e.to_string()),
     }
+}
+
+/// `Tracer::slot_decl` of a signal call that is not traced.
+pub(super) const NOT_TRACED: u32 = u32::MAX;
+
+/// A traced signal's identifier, width and display.
+#[derive(Clone, Copy)]
+pub(super) struct SigInfo {
+    pub(super) id: SigId,
+    pub(super) width: u32,
+    pub(super) display: Display,
+}
+
+/// A traced signal's declaration: its scope path and what it is.
+pub(super) struct Decl {
+    pub(super) path: Vec<String>,
+    pub(super) info: SigInfo,
 }
 
 /// The times of clock edges in picoseconds: the rising edge of cycle `c`

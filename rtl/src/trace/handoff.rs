@@ -1,14 +1,6 @@
 //! The hand-over between the simulating thread and the waveform's writing
 //! thread: the packed messages and the batches they travel in.
 
-use super::sink::Sink;
-use std::collections::BTreeSet;
-use std::io;
-
-/// What the writing thread hands back: the sink, closed, and how writing
-/// went.
-pub(super) type Written = (Sink, io::Result<()>);
-
 /// What the sampling thread hands the writing thread, packed in 64-bit
 /// words (the messages are most of the traffic between the two cores):
 ///
@@ -144,36 +136,6 @@ impl Handoff {
         if e.len() < QUEUED_BATCHES + 2 {
             e.push(batch);
         }
-    }
-}
-
-/// A waveform its writing thread is finishing ([`Sink::hand_last`]).
-pub(super) struct Closing {
-    pub(super) worker: std::thread::JoinHandle<Written>,
-    pub(super) seen: std::sync::mpsc::Receiver<Vec<BTreeSet<u64>>>,
-    /// The last batch reached the thread.
-    pub(super) sent: bool,
-}
-
-impl Closing {
-    /// Per traced signal the values it took if it has a translate filter,
-    /// once every change is written; `None` when the thread ended without
-    /// sending them ([`Closing::join`] then says how).
-    pub(super) fn seen(&self) -> Option<Vec<BTreeSet<u64>>> {
-        self.seen.recv().ok()
-    }
-
-    /// Wait for the file to be closed; how writing went.
-    pub(super) fn join(self) -> io::Result<()> {
-        let (_sink, res) = self
-            .worker
-            .join()
-            .map_err(|_| io::Error::other("the waveform writer panicked"))?;
-        res?;
-        if !self.sent {
-            return Err(io::Error::other("the waveform writer stopped"));
-        }
-        Ok(())
     }
 }
 

@@ -41,7 +41,6 @@ use std::path::{Path, PathBuf};
 mod files;
 mod format;
 mod handoff;
-mod sampler;
 mod sink;
 mod tracer;
 

@@ -1,12 +1,11 @@
 //! Where value changes go (a VCD stream or an FST file), and the writing
 //! thread's loop that formats each batch of changes into it.
 
+use super::format::NOT_TRACED;
 use super::format::{fst_err, Clock, SigId, Slot, VcdBody};
 use super::handoff::{
-    copy_streaming, Closing, Handoff, WriterGone, Written, MSG_CHUNK, MSG_LONG, MSG_VALUE,
-    SPARE_BATCHES,
+    copy_streaming, Handoff, WriterGone, MSG_CHUNK, MSG_LONG, MSG_VALUE, SPARE_BATCHES,
 };
-use super::tracer::NOT_TRACED;
 use super::{is_fst, TraceConfig};
 use std::collections::BTreeSet;
 use std::fs::File;
@@ -35,6 +34,40 @@ pub(super) enum Sink {
     },
     /// Between the two FST phases, or after finishing.
     Gone,
+}
+
+/// What the writing thread hands back: the sink, closed, and how writing
+/// went.
+pub(super) type Written = (Sink, io::Result<()>);
+
+/// A waveform its writing thread is finishing ([`Sink::hand_last`]).
+pub(super) struct Closing {
+    pub(super) worker: std::thread::JoinHandle<Written>,
+    pub(super) seen: std::sync::mpsc::Receiver<Vec<BTreeSet<u64>>>,
+    /// The last batch reached the thread.
+    pub(super) sent: bool,
+}
+
+impl Closing {
+    /// Per traced signal the values it took if it has a translate filter,
+    /// once every change is written; `None` when the thread ended without
+    /// sending them ([`Closing::join`] then says how).
+    pub(super) fn seen(&self) -> Option<Vec<BTreeSet<u64>>> {
+        self.seen.recv().ok()
+    }
+
+    /// Wait for the file to be closed; how writing went.
+    pub(super) fn join(self) -> io::Result<()> {
+        let (_sink, res) = self
+            .worker
+            .join()
+            .map_err(|_| io::Error::other("the waveform writer panicked"))?;
+        res?;
+        if !self.sent {
+            return Err(io::Error::other("the waveform writer stopped"));
+        }
+        Ok(())
+    }
 }
 
 impl Sink {

@@ -1,4 +1,14 @@
-use super::{files::*, format::*, handoff::*, sampler::*};
+//! The waveform writers against hand-made signals and files.
+
+use super::files::glob;
+use super::format::{bin8, binary, binary_portable, Clock, VcdBody, DECIMAL_LIMIT, VCD_CHUNK};
+use super::handoff::{
+    copy_streaming, Handoff, WriterGone, BATCH, IDLE_POLLS, MSG_CHUNK, POLL, QUEUED_BATCHES,
+};
+use super::tracer::Chunk;
+use super::{Display, Field, LabelKind, Labels, Probe, TraceConfig, Traced};
+use crate::kernel::{Clocked, Fault, Sim};
+
 #[test]
 fn labels_name_an_address_by_the_label_at_or_before_it() {
     let l = Labels {
@@ -12,8 +22,7 @@ fn labels_name_an_address_by_the_label_at_or_before_it() {
     assert_eq!(l.locate(LabelKind::Context, 3).as_deref(), Some("k_a+3"));
 }
 
-use super::*;
-use crate::kernel::{Clocked, Fault, Sim};
+use std::path::Path;
 
 /// A counter reporting the same signals through blocks (of values
 /// given and filled in, and versioned ones) or through one call per

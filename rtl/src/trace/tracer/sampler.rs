@@ -3,19 +3,17 @@
 
 use std::io;
 
-use super::format::SigId;
-use super::handoff::MSG_CHUNK;
-use super::scope_runs;
-use super::sink::changed_mask;
-use super::tracer::{Decl, SigInfo, Tracer, NOT_TRACED};
-use super::Probe;
-use super::{Display, Field};
+use super::super::format::{Decl, SigId, SigInfo, NOT_TRACED};
+use super::super::handoff::MSG_CHUNK;
+use super::super::sink::changed_mask;
+use super::super::{scope_runs, Display, Field, Probe};
+use super::Tracer;
 use std::fmt;
 
 /// The declaration's walk ([`Tracer::create`]): each [`Probe`] call
 /// declares what it reports and records in the tracer's tables what the
 /// sampled walks ([`Sampler`]) replay.
-pub(super) struct Declaring<'a>(pub(super) &'a mut Tracer);
+pub(in crate::trace) struct Declaring<'a>(pub(in crate::trace) &'a mut Tracer);
 
 impl Probe for Declaring<'_> {
     fn block_versioned(
@@ -78,31 +76,31 @@ impl Probe for Declaring<'_> {
 /// processor cannot forward. Moved here from the tracer, the walk took as
 /// long; with the copy, the simulating thread's time for the bench's
 /// traced frame went from 0.0166 to 0.0155 s (docs/performance.md).
-pub(super) struct Sampler<'a> {
-    pub(super) scope_on: &'a [bool],
-    pub(super) open_masks: &'a [u64],
+pub(in crate::trace) struct Sampler<'a> {
+    pub(in crate::trace) scope_on: &'a [bool],
+    pub(in crate::trace) open_masks: &'a [u64],
     /// Per [`Probe::block_versioned`]: the version last sampled and the
     /// block's size.
-    pub(super) versions: &'a mut [(u64, usize)],
-    pub(super) block_n: &'a [u32],
-    pub(super) sections: &'a [Progress],
+    pub(in crate::trace) versions: &'a mut [(u64, usize)],
+    pub(in crate::trace) block_n: &'a [u32],
+    pub(in crate::trace) sections: &'a [Progress],
     /// A word per signal call: the value reported in this cycle (a block
     /// or section skipped leaves the last one).
-    pub(super) cur: &'a mut [u64],
+    pub(in crate::trace) cur: &'a mut [u64],
     /// Every call counts as changed (the first cycle sampled).
-    pub(super) first: bool,
+    pub(in crate::trace) first: bool,
     /// The calls of each table so far.
-    pub(super) at: Progress,
+    pub(in crate::trace) at: Progress,
     /// A block reported that was not declared.
-    pub(super) undeclared: bool,
+    pub(in crate::trace) undeclared: bool,
     /// [`Probe::unchanged`] of this sample.
-    pub(super) unchanged: u8,
+    pub(in crate::trace) unchanged: u8,
 }
 
 impl Sampler<'_> {
     /// The next signal calls reported `values`.
     #[inline]
-    pub(super) fn calls(&mut self, values: &[u64]) {
+    pub(in crate::trace) fn calls(&mut self, values: &[u64]) {
         let start = self.at.slots;
         self.at.slots += values.len();
         if let Some(cur) = self.cur.get_mut(start..start + values.len()) {
@@ -113,7 +111,7 @@ impl Sampler<'_> {
     /// The next answer of [`Probe::open_scopes`] or
     /// [`Probe::traced_signals`], in the order they were declared.
     #[inline]
-    pub(super) fn next_mask(&mut self) -> u64 {
+    pub(in crate::trace) fn next_mask(&mut self) -> u64 {
         let m = self.open_masks.get(self.at.masks).copied().unwrap_or(0);
         self.at.masks += 1;
         m
@@ -229,7 +227,11 @@ impl Probe for Sampler<'_> {
 impl Tracer {
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_versioned(&mut self, version: u64, fields: &dyn Fn() -> Vec<Field>) {
+    pub(in crate::trace) fn declare_versioned(
+        &mut self,
+        version: u64,
+        fields: &dyn Fn() -> Vec<Field>,
+    ) {
         let n = self.declare_block(fields, &vec![0; fields().len()]);
         self.versions.push((version, n));
     }
@@ -242,7 +244,7 @@ impl Tracer {
     /// from 68 calls to 52, two chunks of 64 to one). The slots it takes.
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_block(
+    pub(in crate::trace) fn declare_block(
         &mut self,
         fields: &dyn Fn() -> Vec<Field>,
         values: &[u64],
@@ -278,7 +280,7 @@ impl Tracer {
     }
 
     /// The calls of each table declared so far.
-    pub(super) fn progress(&self) -> Progress {
+    pub(in crate::trace) fn progress(&self) -> Progress {
         Progress {
             scopes: self.scope_on.len(),
             slots: self.masks.len(),
@@ -291,14 +293,14 @@ impl Tracer {
 
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_section(&mut self) {
+    pub(in crate::trace) fn declare_section(&mut self) {
         self.sections.push(Progress::default());
         self.open_sections.push(self.sections.len() - 1);
     }
 
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_end_section(&mut self) {
+    pub(in crate::trace) fn declare_end_section(&mut self) {
         let Some(i) = self.open_sections.pop() else {
             self.err.get_or_insert(io::Error::other(
                 "a module ended a section it did not begin",
@@ -310,7 +312,7 @@ impl Tracer {
 
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_scope(&mut self, name: fmt::Arguments<'_>) -> bool {
+    pub(in crate::trace) fn declare_scope(&mut self, name: fmt::Arguments<'_>) -> bool {
         let on = self.enter_scope(name.to_string());
         self.scope_on.push(on);
         on
@@ -319,7 +321,7 @@ impl Tracer {
     /// Enter scope `name` while declaring if the patterns may take in
     /// something under it (then the caller leaves it with
     /// [`Tracer::declare_end`]); whether it did.
-    pub(super) fn enter_scope(&mut self, name: String) -> bool {
+    pub(in crate::trace) fn enter_scope(&mut self, name: String) -> bool {
         self.stack.push(name);
         if self.stack.len() == 1 && !self.top_scopes.contains(&self.stack[0]) {
             self.top_scopes.push(self.stack[0].clone());
@@ -337,7 +339,7 @@ impl Tracer {
 
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_end(&mut self) {
+    pub(in crate::trace) fn declare_end(&mut self) {
         self.stack.pop();
         if let Err(e) = self.w.upscope() {
             self.err.get_or_insert(e);
@@ -352,7 +354,7 @@ impl Tracer {
     /// ([`Sampler::next_mask`]).
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_mask(
+    pub(in crate::trace) fn declare_mask(
         &mut self,
         n: usize,
         name: &mut dyn FnMut(usize) -> String,
@@ -375,7 +377,7 @@ impl Tracer {
 
     #[cold]
     #[inline(never)]
-    pub(super) fn declare_signal(&mut self, name: &str, width: u32, display: Display) {
+    pub(in crate::trace) fn declare_signal(&mut self, name: &str, width: u32, display: Display) {
         let mut path = self.stack.clone();
         path.push(name.to_string());
         if self.matches_prefix(&path, true) {
@@ -398,7 +400,7 @@ impl Tracer {
     }
 
     /// A signal call that is not traced: its value is masked to 0.
-    pub(super) fn untraced_slot(&mut self) {
+    pub(in crate::trace) fn untraced_slot(&mut self) {
         self.masks.push(0);
         self.slot_decl.push(NOT_TRACED);
     }
@@ -407,7 +409,7 @@ impl Tracer {
         /// Write the values of the cycle's walk that changed (all traced
         /// ones the first time): per chunk of 64 calls, the mask of those that
         /// changed and their values queued as one message ([`MSG_CHUNK`]).
-        pub(super) fn write_changes(&mut self) -> ();
+        pub(in crate::trace) fn write_changes(&mut self) -> ();
         versions write_changes_portable write_changes_avx2 write_changes_avx512;
         {
             let first = std::mem::take(&mut self.first_sample);
@@ -444,23 +446,23 @@ impl Tracer {
 /// The calls of each of the tracer's per-call tables made so far in a
 /// walk (or by the end of a [`Probe::section`]).
 #[derive(Clone, Copy, Default)]
-pub(super) struct Progress {
-    pub(super) scopes: usize,
-    pub(super) slots: usize,
-    pub(super) blocks: usize,
-    pub(super) masks: usize,
-    pub(super) versions: usize,
-    pub(super) sections: usize,
+pub(in crate::trace) struct Progress {
+    pub(in crate::trace) scopes: usize,
+    pub(in crate::trace) slots: usize,
+    pub(in crate::trace) blocks: usize,
+    pub(in crate::trace) masks: usize,
+    pub(in crate::trace) versions: usize,
+    pub(in crate::trace) sections: usize,
 }
 
 /// A chunk of 64 signal calls in a sampled cycle: the values the walk
 /// reported, the masks of their widths (0 for a call not traced), the
 /// values last written, and the bytes a change of each adds (about).
-pub(super) struct Chunk<'a> {
-    pub(super) c: &'a [u64; 64],
-    pub(super) m: &'a [u64; 64],
-    pub(super) l: &'a mut [u64; 64],
-    pub(super) cost: &'a [u8; 64],
+pub(in crate::trace) struct Chunk<'a> {
+    pub(in crate::trace) c: &'a [u64; 64],
+    pub(in crate::trace) m: &'a [u64; 64],
+    pub(in crate::trace) l: &'a mut [u64; 64],
+    pub(in crate::trace) cost: &'a [u8; 64],
 }
 
 impl Chunk<'_> {
@@ -477,7 +479,13 @@ impl Chunk<'_> {
     /// 0.0178-0.0180 s); compared first and packed in a second pass, no
     /// less than one at a time.
     #[inline(always)]
-    pub(super) fn changes(self, batch: &mut Vec<u64>, j: u64, first: bool, groups: usize) -> u64 {
+    pub(in crate::trace) fn changes(
+        self,
+        batch: &mut Vec<u64>,
+        j: u64,
+        first: bool,
+        groups: usize,
+    ) -> u64 {
         #[cfg(target_arch = "x86_64")]
         if crate::simd::avx512() {
             // SAFETY: the AVX-512 path runs only on a CPU that has it.
@@ -534,7 +542,12 @@ impl Chunk<'_> {
 
     /// [`Chunk::changes`] one change at a time (what other CPUs run).
     #[inline(always)]
-    pub(super) fn changes_portable(self, batch: &mut Vec<u64>, j: u64, first: bool) -> u64 {
+    pub(in crate::trace) fn changes_portable(
+        self,
+        batch: &mut Vec<u64>,
+        j: u64,
+        first: bool,
+    ) -> u64 {
         let Chunk { c, m, l, cost } = self;
         let mut bits = if first {
             changed_mask(m, &[u64::MAX; 64], &[0; 64])

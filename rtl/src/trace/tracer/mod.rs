@@ -1,6 +1,10 @@
 //! The [`Tracer`]: created with its file, declared by a first walk of the
 //! chip, sampled each traced cycle, finished into its file.
 
+mod sampler;
+#[cfg(test)]
+pub(super) use sampler::Chunk;
+
 use std::collections::BTreeSet;
 use std::io;
 use std::path::{Path, PathBuf};
@@ -9,28 +13,13 @@ use super::files::{
     check_scope_patterns, decoder_path, filter_path, forget_partial, glob, open_output,
     save_file_path, stage, SideFiles,
 };
-use super::format::{Clock, SigId};
+use super::format::{Clock, Decl, SigId, NOT_TRACED};
 use super::handoff::{queue_cycle, BATCH};
 use super::label_text;
-use super::sampler::{Declaring, Progress, Sampler};
 use super::sink::{header_sink, Sink};
 use super::Traced;
 use super::{is_fst, Display, Filter, LabelKind, TraceConfig, BYTES_PER_SIGNAL_CYCLE, FST_SMALLER};
-
-/// [`Tracer::slot_decl`] of a signal call that is not traced.
-pub(super) const NOT_TRACED: u32 = u32::MAX;
-
-#[derive(Clone, Copy)]
-pub(super) struct SigInfo {
-    pub(super) id: SigId,
-    pub(super) width: u32,
-    pub(super) display: Display,
-}
-
-pub(super) struct Decl {
-    pub(super) path: Vec<String>,
-    pub(super) info: SigInfo,
-}
+use sampler::{Declaring, Progress, Sampler};
 
 /// The VCD writer. Attach it to a [`crate::kernel::Sim`].
 pub struct Tracer {
