@@ -9,6 +9,7 @@ use rtl::chip::run_to_halt;
 use rtl::rc::Word;
 use rtl::{Chip, Sim, Stats, Timing};
 
+use super::memory::{feed, item_memory, read_tiles};
 use super::{RAY_EYE, RAY_REFLECT, RAY_REFRACT, RAY_SHADOW};
 
 pub(crate) fn add_stats(a: &mut Stats, b: &Stats) {
@@ -283,9 +284,8 @@ pub(crate) fn run_item<W: Word>(
     let t_item = std::time::Instant::now();
     let warm = own.start > 0;
     let list = &tiles[own.start - warm as usize..own.end];
-    let last = own.end == tiles.len();
     let (output, mem_bytes) = item_memory(img, fw, list.len());
-    let (chip, mut fed) = item_chip::<W>(
+    let (chip, fed) = item_chip::<W>(
         frame,
         list,
         own.start - warm as usize,
@@ -302,123 +302,24 @@ pub(crate) fn run_item<W: Word>(
         sim.trace(cfg, "morphosys")
             .map_err(|e| anyhow!("creating {}: {e}", path.display()))?;
     }
-    let tile_pc = sym(img, data::TILE.0)?;
-    let m = |sim: &Sim<Chip<W>>, name: &str| -> Result<u64> {
-        Ok(sim.top.mem.read(sym(img, name)?, 4) as u64)
+    let mut run = ItemRun {
+        frame,
+        own: own.clone(),
+        list,
+        fed,
+        output,
+        names: profile.then(|| crate::profile::Names::new(img, mem::CTX_BASE)),
+        prof: None,
+        s: Spans {
+            tile_passes: Vec::with_capacity(own.len()),
+            tile_seconds: Vec::with_capacity(own.len()),
+            own_seconds: t_item.elapsed().as_secs_f64(),
+            ..Spans::default()
+        },
     };
-    let names = profile.then(|| crate::profile::Names::new(img, mem::CTX_BASE));
-    let mut prof: Option<crate::profile::Profile> = None;
-    // The spans the chip runs: the start-up (to the first arrival at
-    // `tile`), the warm-up tile, the own tiles (each to the next arrival),
-    // and `halt`; each within its own cycle budget, an error naming it.
-    let mut startup = Stats::default();
-    let mut from = Stats::default();
-    let mut to: Option<Stats> = None;
-    let mut halted = false;
-    let (mut passes, mut t_end_tail) = (0, 0);
-    let mut t_end_raw = None;
-    let mut passes0 = 0;
-    // Each own tile's passes (the firmware's count).
-    let (mut tile_passes, mut last_passes) = (Vec::with_capacity(own.len()), 0);
-    let mut tile_seconds = Vec::with_capacity(own.len());
-    // The item's own work: building and loading the chip, the start-up,
-    // the run from the last tile to `halt`.
-    let mut own_seconds = 0.0;
-    let mut result: Result<()> = Ok(());
-    let spans = 1 + warm as usize + own.len();
-    own_seconds += t_item.elapsed().as_secs_f64();
-    for k in 0..spans {
-        // The frame's tile this span runs (none for the start-up).
-        let tile = (k > 0).then(|| own.start - warm as usize + k - 1);
-        let counting = k > warm as usize;
-        let begun = sim.cycle();
-        let t_span = std::time::Instant::now();
-        let r = advance(
-            &mut sim,
-            tile_pc,
-            k > 0,
-            names.as_ref().filter(|_| counting),
-            &mut prof,
-        );
-        let span_seconds = t_span.elapsed().as_secs_f64();
-        if counting {
-            tile_seconds.push(span_seconds);
-        } else if k == 0 {
-            own_seconds += span_seconds;
-        }
-        if let Err(e) = r {
-            result = Err(span_error(
-                e,
-                tile.map(|t| (t, tiles[t])),
-                sim.cycle() - begun,
-            ));
-            break;
-        }
-        if k == 0 {
-            startup = sim.top.stats();
-        }
-        if k == warm as usize {
-            from = sim.top.stats();
-            passes0 = m(&sim, "PASSES")?;
-            last_passes = passes0;
-        }
-        if counting {
-            let p = m(&sim, "PASSES")?;
-            tile_passes.push(p.wrapping_sub(last_passes) & 0xffff_ffff);
-            last_passes = p;
-        }
-        if sim.top.halted() {
-            halted = true;
-            break;
-        }
-        if fed < list.len() && m(&sim, "TL_CNT")? == 0 {
-            // At `tile` with the chunk taken: the next one, and the
-            // program's list state pointed at it (as a longer list would
-            // have it, at no cycle).
-            let n = feed(&mut sim.top, list, fed, output, fw.out_tile_bytes())?;
-            let at = |name: &str| sym(img, name);
-            sim.top.mem.write(at("TL_PTR")?, 4, mem::TILE_LIST + 4);
-            sim.top.mem.write(at("TL_CNT")?, 4, (n - fed) as u32);
-            fed = n;
-        }
-    }
+    let mut result = run.spans(&mut sim)?;
     if result.is_ok() {
-        to = Some(sim.top.stats());
-        passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
-        if !halted {
-            // On to `halt`: counted for the frame's last item (one chip
-            // ends there too), not for the others (one chip goes on to
-            // the next tile; this one's last pixels are still on their way
-            // out by DMA).
-            let t = (last && own.end > 0).then(|| own.end - 1);
-            let n = if last { names.as_ref() } else { None };
-            let begun = sim.cycle();
-            let t_end = std::time::Instant::now();
-            let r = advance(&mut sim, u32::MAX, false, n, &mut prof);
-            own_seconds += t_end.elapsed().as_secs_f64();
-            match r {
-                Ok(_) => {
-                    if last {
-                        to = Some(sim.top.stats());
-                        passes = m(&sim, "PASSES")?.wrapping_sub(passes0) & 0xffff_ffff;
-                        halted = true;
-                    }
-                }
-                Err(e) => {
-                    result = Err(span_error(e, t.map(|t| (t, tiles[t])), sim.cycle() - begun))
-                }
-            }
-        }
-        if halted {
-            // T_END as a reading of the counter after the span's start (as
-            // the tracer's is: then exactly one chip's reading); a value
-            // below it, not the counter at the end (a program's own
-            // arithmetic on its start-up's reading, the same in every
-            // item), is kept as it is ([`Group::t_end_tail`]).
-            let t_end = m(&sim, "T_END")?;
-            t_end_tail = t_end.wrapping_sub(from.cycles & 0xffff_ffff) as u32 as u64;
-            t_end_raw = (t_end < from.cycles & 0xffff_ffff).then_some(t_end);
-        }
+        result = run.to_halt(&mut sim)?;
     }
     let files = sim
         .finish_trace()
@@ -431,10 +332,13 @@ pub(crate) fn run_item<W: Word>(
         }
     }
     result?;
+    let ItemRun { s, prof, .. } = run;
+    let mut tile_seconds = s.tile_seconds;
+    let mut tile_passes = s.tile_passes;
     tile_seconds.resize(own.len(), 0.0);
     tile_passes.resize(own.len(), 0);
-    let mut counted = to.unwrap_or_default();
-    sub_stats(&mut counted, &from);
+    let mut counted = s.to.unwrap_or_default();
+    sub_stats(&mut counted, &s.from);
     let mem = &sim.top.mem;
     let t_out = std::time::Instant::now();
     let out = read_tiles(mem, fw, output, warm as usize..list.len());
@@ -442,69 +346,177 @@ pub(crate) fn run_item<W: Word>(
     let per_tile = t_out.elapsed().as_secs_f64() / own.len().max(1) as f64;
     tile_seconds.iter_mut().for_each(|t| *t += per_tile);
     Ok(Group {
-        startup,
+        startup: s.startup,
         counted,
-        passes,
-        halted,
-        t_end_tail,
-        t_end_raw,
+        passes: s.passes,
+        halted: s.halted,
+        t_end_tail: s.t_end_tail,
+        t_end_raw: s.t_end_raw,
         out,
         tile_seconds,
-        own_seconds,
+        own_seconds: s.own_seconds,
         tile_passes,
         profile: prof,
         seconds,
     })
 }
 
-/// Where an item's chip puts its tiles' pixels, and the main memory it
-/// needs: as large as the program touches (its segments, the tile list of
-/// `tiles` tiles, the output tiles and the streamed scene image), not the
-/// 16 MiB default: a fresh instance per item must not zero-fill memory
-/// nobody reads.
-fn item_memory(img: &Image, fw: &Firmware, tiles: usize) -> (u32, usize) {
-    let wb = fw.fb_word_bytes();
-    // What lies above `mem::OUTPUT`: the streamed scene image and its
-    // mailboxes, the packet traversal's mailboxes.
-    let above = fw
-        .layout
-        .stream
-        .as_ref()
-        // the image, then the mailboxes (a half-word per object)
-        .map(|st| {
-            (st.base as usize + st.image.len()).max(st.mailbox as usize + 2 * fw.layout.objects)
-        })
-        .into_iter()
-        .chain(
-            // the packet traversal's mailboxes (main memory, resident or
-            // streamed)
-            (fw.layout.traversal == tracer::Traversal::Packet)
-                .then(|| fw.layout.mailbox + tracer::layout::PK_MAILBOX_BYTES * fw.layout.objects),
-        )
-        .max()
-        .unwrap_or(0);
-    // The tiles' pixels: at `mem::OUTPUT`, or past that data where an
-    // item's tiles would reach it (each tile's address is in the list).
-    let out_bytes = tiles * fw.out_tile_bytes() as usize;
-    let output = if above > mem::OUTPUT as usize
-        && mem::OUTPUT as usize + out_bytes > mem::STREAM as usize
-    {
-        above.next_multiple_of(1 << 12) as u32
-    } else {
-        mem::OUTPUT
-    };
-    let ends = img
-        .segments
-        .iter()
-        .map(|s| s.addr as usize + s.data.len())
-        .chain([
-            mem::FB_IMAGE as usize + wb as usize * fw.fb.len(),
-            mem::TILE_LIST as usize + 4 + 12 * tiles.min(LIST_CHUNK),
-            output as usize + out_bytes,
-            above,
-        ]);
-    let mem_bytes = ends.max().unwrap_or(0).next_multiple_of(1 << 16);
-    (output, mem_bytes)
+/// What an item's spans measured ([`run_item`]).
+#[derive(Default)]
+struct Spans {
+    /// At the first arrival at `tile`.
+    startup: Stats,
+    /// At the arrival at the first own tile, and at the end.
+    from: Stats,
+    to: Option<Stats>,
+    halted: bool,
+    /// The firmware's pass count at the first own tile, and the passes
+    /// since.
+    passes0: u64,
+    passes: u64,
+    t_end_tail: u64,
+    t_end_raw: Option<u64>,
+    /// Each own tile's passes and host seconds.
+    tile_passes: Vec<u64>,
+    tile_seconds: Vec<f64>,
+    /// The item's own work: building and loading the chip, the start-up,
+    /// the run from the last tile to `halt`.
+    own_seconds: f64,
+}
+
+/// One work item's chip as it runs its spans.
+struct ItemRun<'a> {
+    frame: &'a Frame<'a>,
+    own: std::ops::Range<usize>,
+    /// The tiles it runs (the warm-up tile first, if any), and how many
+    /// of them its tile list holds so far.
+    list: &'a [(u32, u32)],
+    fed: usize,
+    output: u32,
+    names: Option<crate::profile::Names>,
+    prof: Option<crate::profile::Profile>,
+    s: Spans,
+}
+
+impl ItemRun<'_> {
+    /// A firmware variable's word in the chip's memory.
+    fn var<W: Word>(&self, sim: &Sim<Chip<W>>, v: &data::Var) -> Result<u64> {
+        Ok(sim.top.mem.read(sym(self.frame.img, v.name)?, 4) as u64)
+    }
+
+    /// The start-up, the warm-up tile and the own tiles, each to the next
+    /// arrival at `tile` within its own cycle budget; the error of the
+    /// span that failed (the outer error: reading the chip's memory).
+    fn spans<W: Word>(&mut self, sim: &mut Sim<Chip<W>>) -> Result<Result<()>> {
+        let (img, tiles) = (self.frame.img, self.frame.tiles);
+        let own = self.own.clone();
+        let warm = own.start > 0;
+        let tile_pc = sym(img, data::TILE.0)?;
+        let mut last_passes = 0;
+        for k in 0..1 + warm as usize + own.len() {
+            // The frame's tile this span runs (none for the start-up).
+            let tile = (k > 0).then(|| own.start - warm as usize + k - 1);
+            let counting = k > warm as usize;
+            let begun = sim.cycle();
+            let t_span = std::time::Instant::now();
+            let names = self.names.as_ref().filter(|_| counting);
+            let r = advance(sim, tile_pc, k > 0, names, &mut self.prof);
+            let span_seconds = t_span.elapsed().as_secs_f64();
+            if counting {
+                self.s.tile_seconds.push(span_seconds);
+            } else if k == 0 {
+                self.s.own_seconds += span_seconds;
+            }
+            if let Err(e) = r {
+                let at = tile.map(|t| (t, tiles[t]));
+                return Ok(Err(span_error(e, at, sim.cycle() - begun)));
+            }
+            if k == 0 {
+                self.s.startup = sim.top.stats();
+            }
+            if k == warm as usize {
+                self.s.from = sim.top.stats();
+                self.s.passes0 = self.var(sim, &data::PASSES)?;
+                last_passes = self.s.passes0;
+            }
+            if counting {
+                let p = self.var(sim, &data::PASSES)?;
+                self.s.tile_passes.push(p.wrapping_sub(last_passes) & 0xffff_ffff);
+                last_passes = p;
+            }
+            if sim.top.halted() {
+                self.s.halted = true;
+                break;
+            }
+            if self.fed < self.list.len() && self.var(sim, &data::TL_CNT)? == 0 {
+                self.feed_chunk(sim)?;
+            }
+        }
+        Ok(Ok(()))
+    }
+
+    /// At `tile` with the tile list's chunk taken: the next one, and the
+    /// program's list state pointed at it (as a longer list would have
+    /// it, at no cycle).
+    fn feed_chunk<W: Word>(&mut self, sim: &mut Sim<Chip<W>>) -> Result<()> {
+        let (img, fw) = (self.frame.img, self.frame.fw);
+        let n = feed(&mut sim.top, self.list, self.fed, self.output, fw.out_tile_bytes())?;
+        let at = |v: &data::Var| sym(img, v.name);
+        sim.top.mem.write(at(&data::TL_PTR)?, 4, mem::TILE_LIST + 4);
+        sim.top.mem.write(at(&data::TL_CNT)?, 4, (n - self.fed) as u32);
+        self.fed = n;
+        Ok(())
+    }
+
+    /// After the own tiles: the passes they ran, and on to `halt`,
+    /// counted for the frame's last item (one chip ends there too), not
+    /// for the others (one chip goes on to the next tile; this one's last
+    /// pixels are still on their way out by DMA); `T_END` where the chip
+    /// halted.
+    fn to_halt<W: Word>(&mut self, sim: &mut Sim<Chip<W>>) -> Result<Result<()>> {
+        let last = self.own.end == self.frame.tiles.len();
+        self.s.to = Some(sim.top.stats());
+        self.s.passes = self.passes_since(sim)?;
+        let mut result = Ok(());
+        if !self.s.halted {
+            let t = (last && self.own.end > 0).then(|| self.own.end - 1);
+            let n = if last { self.names.as_ref() } else { None };
+            let begun = sim.cycle();
+            let t_end = std::time::Instant::now();
+            let r = advance(sim, u32::MAX, false, n, &mut self.prof);
+            self.s.own_seconds += t_end.elapsed().as_secs_f64();
+            match r {
+                Ok(_) => {
+                    if last {
+                        self.s.to = Some(sim.top.stats());
+                        self.s.passes = self.passes_since(sim)?;
+                        self.s.halted = true;
+                    }
+                }
+                Err(e) => {
+                    let at = t.map(|t| (t, self.frame.tiles[t]));
+                    result = Err(span_error(e, at, sim.cycle() - begun))
+                }
+            }
+        }
+        if self.s.halted {
+            // T_END as a reading of the counter after the span's start (as
+            // the tracer's is: then exactly one chip's reading); a value
+            // below it, not the counter at the end (a program's own
+            // arithmetic on its start-up's reading, the same in every
+            // item), is kept as it is ([`Group::t_end_tail`]).
+            let t_end = self.var(sim, &data::T_END)?;
+            let from = self.s.from.cycles & 0xffff_ffff;
+            self.s.t_end_tail = t_end.wrapping_sub(from) as u32 as u64;
+            self.s.t_end_raw = (t_end < from).then_some(t_end);
+        }
+        Ok(result)
+    }
+
+    /// The firmware's passes since the first own tile.
+    fn passes_since<W: Word>(&self, sim: &Sim<Chip<W>>) -> Result<u64> {
+        Ok(self.var(sim, &data::PASSES)?.wrapping_sub(self.s.passes0) & 0xffff_ffff)
+    }
 }
 
 /// An item's chip, built and loaded: the program and its watches, the FB
@@ -562,59 +574,6 @@ fn item_chip<W: Word>(
         chip.mem.write(sym(img, data::PASS.name)?, 4, seed);
     }
     Ok((chip, fed))
-}
-
-/// The pixels of the tiles `tiles` of the item's list, read back from
-/// main memory at `output`.
-fn read_tiles(
-    mem: &rtl::memory::MainMemory,
-    fw: &Firmware,
-    output: u32,
-    tiles: std::ops::Range<usize>,
-) -> Vec<Vec<i32>> {
-    let wb = fw.fb_word_bytes();
-    tiles
-        .map(|k| {
-            let base = output + k as u32 * fw.out_tile_bytes();
-            (0..256)
-                .map(|i| {
-                    let v = mem.read(base + wb * i, wb);
-                    if wb == 2 {
-                        v as u16 as i16 as i32
-                    } else {
-                        v as i32
-                    }
-                })
-                .collect()
-        })
-        .collect()
-}
-
-/// Tile-list entries a chip's list holds (below `mem::OUTPUT`, 12 bytes
-/// each after the count).
-const LIST_CHUNK: usize = ((mem::OUTPUT - mem::TILE_LIST - 4) / 12) as usize;
-
-/// Write the tile list's chunk from `list[from]` (count, then per tile its
-/// corner and its pixels' address, `output` plus the tile's place in
-/// `list`); returns where the next chunk starts.
-fn feed<W: Word>(
-    chip: &mut Chip<W>,
-    list: &[(u32, u32)],
-    from: usize,
-    output: u32,
-    tile_bytes: u32,
-) -> Result<usize> {
-    let to = list.len().min(from + LIST_CHUNK);
-    let mut bytes = Vec::with_capacity(4 + 12 * (to - from));
-    bytes.extend(((to - from) as u32).to_le_bytes());
-    for (k, (x, y)) in list.iter().enumerate().take(to).skip(from) {
-        bytes.extend(x.to_le_bytes());
-        bytes.extend(y.to_le_bytes());
-        bytes.extend((output + k as u32 * tile_bytes).to_le_bytes());
-    }
-    chip.load(mem::TILE_LIST, &bytes)
-        .map_err(|f| anyhow!("{f}"))?;
-    Ok(to)
 }
 
 /// `run` (item index, pass seed) of every one of `items`, taken in order by

@@ -23,6 +23,7 @@ use crate::reference::NO_HIT;
 
 mod item;
 mod measure;
+mod memory;
 mod probe;
 mod source;
 
