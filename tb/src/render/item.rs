@@ -441,7 +441,9 @@ impl ItemRun<'_> {
             }
             if counting {
                 let p = self.var(sim, &data::PASSES)?;
-                self.s.tile_passes.push(p.wrapping_sub(last_passes) & 0xffff_ffff);
+                self.s
+                    .tile_passes
+                    .push(p.wrapping_sub(last_passes) & 0xffff_ffff);
                 last_passes = p;
             }
             if sim.top.halted() {
@@ -460,10 +462,18 @@ impl ItemRun<'_> {
     /// it, at no cycle).
     fn feed_chunk<W: Word>(&mut self, sim: &mut Sim<Chip<W>>) -> Result<()> {
         let (img, fw) = (self.frame.img, self.frame.fw);
-        let n = feed(&mut sim.top, self.list, self.fed, self.output, fw.out_tile_bytes())?;
+        let n = feed(
+            &mut sim.top,
+            self.list,
+            self.fed,
+            self.output,
+            fw.out_tile_bytes(),
+        )?;
         let at = |v: &data::Var| sym(img, v.name);
         sim.top.mem.write(at(&data::TL_PTR)?, 4, mem::TILE_LIST + 4);
-        sim.top.mem.write(at(&data::TL_CNT)?, 4, (n - self.fed) as u32);
+        sim.top
+            .mem
+            .write(at(&data::TL_CNT)?, 4, (n - self.fed) as u32);
         self.fed = n;
         Ok(())
     }
