@@ -143,11 +143,36 @@ impl Sink {
         let queue = std::sync::Arc::new(Handoff::new());
         let rx = WriterGone(queue.clone());
         let (seen_tx, seen_rx) = std::sync::mpsc::sync_channel(1);
+        // A VCD's handles, for its own loop ([`vcd_batch`]); an untraced
+        // call's never appears in a message.
+        let vcd_ids = match (clk, cycle_id) {
+            (SigId::Vcd(clk), SigId::Vcd(cycle)) => slots
+                .iter()
+                .map(|s| match *s {
+                    Some((SigId::Vcd(id), w, f, i)) => Some((id, w, f, i)),
+                    Some((SigId::Fst(_), ..)) => None,
+                    None => Some((0, 0, false, NOT_TRACED)),
+                })
+                .collect::<Option<Vec<_>>>()
+                .map(|s| (s, clk, cycle)),
+            _ => None,
+        };
+        let mut w = WritingThread {
+            sink: self,
+            slots,
+            seen: Seen::new(signals),
+            vcd_ids,
+            clock: Clock::new(clock_hz),
+            fall: None,
+            stepped: false,
+            clk,
+            cycle_id,
+            section_bytes,
+        };
         let worker = std::thread::Builder::new()
             .name("waveform writer".into())
             .spawn(move || {
-                let mut sink = self;
-                if let Sink::Vcd(_, body) = &mut sink {
+                if let Sink::Vcd(_, body) = &mut w.sink {
                     body.allocate();
                 }
                 // Batches for the simulating thread to copy its messages
@@ -158,126 +183,14 @@ impl Sink {
                     rx.0.give_back(b);
                 }
                 let mut res = Ok(());
-                // Values of the filtered signals, deduplicated whenever a
-                // list doubles (a set insertion per change cost more).
-                let mut seen = Seen::new(signals);
-                // A VCD's handles, for its own loop ([`vcd_batch`]); an
-                // untraced call's never appears in a message.
-                let vcd_ids = match (clk, cycle_id) {
-                    (SigId::Vcd(clk), SigId::Vcd(cycle)) => slots
-                        .iter()
-                        .map(|s| match *s {
-                            Some((SigId::Vcd(id), w, f, i)) => Some((id, w, f, i)),
-                            Some((SigId::Fst(_), ..)) => None,
-                            None => Some((0, 0, false, NOT_TRACED)),
-                        })
-                        .collect::<Option<Vec<_>>>()
-                        .map(|s| (s, clk, cycle)),
-                    _ => None,
-                };
-                let mut clock = Clock::new(clock_hz);
-                // The falling edge of the last cycle begun, written when
-                // the next one begins or the trace ends.
-                let mut fall: Option<u64> = None;
-                // A section can end only after a time step of its own (the
-                // FST writer cannot start one at the time it ended at).
-                let mut stepped = false;
-                let cycle = |sink: &mut Sink,
-                             c: u64,
-                             clock: &mut Clock,
-                             fall: &mut Option<u64>,
-                             stepped: &mut bool|
-                 -> io::Result<()> {
-                    if let Some(t) = fall.take() {
-                        sink.timestamp(t)?;
-                        sink.change(clk, 1, 0)?;
-                        *stepped = true;
-                    }
-                    if std::mem::take(stepped) {
-                        sink.fst_section(section_bytes)?;
-                    }
-                    let (rise, f) = clock.edges(c);
-                    *fall = Some(f);
-                    sink.timestamp(rise)?;
-                    sink.change(clk, 1, 1)?;
-                    sink.change(cycle_id, 64, c)
-                };
                 while let Some(batch) = rx.0.recv() {
                     if res.is_err() {
                         continue; // keep draining: the sender must not block
                     }
-                    if let (Sink::Vcd(w, body), Some((ids, clk, cycle))) = (&mut sink, &vcd_ids) {
-                        let edges = (&mut clock, &mut fall, *clk, *cycle);
-                        res = vcd_batch(w.writer(), body, &batch, ids, &mut seen, edges);
-                        rx.0.give_back(batch);
-                        continue;
-                    }
-                    let mut k = 0;
-                    while k < batch.len() {
-                        let m = batch[k];
-                        k += 1;
-                        let (tag, low) = (m >> 48, m & MSG_VALUE);
-                        let r = match tag {
-                            MSG_CHUNK => {
-                                let Some(&bits) = batch.get(k) else {
-                                    res = Err(io::Error::other("a change message cut short"));
-                                    break;
-                                };
-                                k += 1;
-                                let mut r = Ok(());
-                                for (s, v) in changes(low, bits, &batch, &mut k) {
-                                    let Some((id, w, filtered, i)) =
-                                        slots.get(s).copied().flatten()
-                                    else {
-                                        r = Err(io::Error::other(
-                                            "a change of a signal not declared",
-                                        ));
-                                        break;
-                                    };
-                                    if filtered {
-                                        seen.add(i as usize, v);
-                                    }
-                                    r = sink.change(id, w, v);
-                                    if r.is_err() {
-                                        break;
-                                    }
-                                }
-                                r
-                            }
-                            _ => {
-                                let c = if tag == MSG_LONG {
-                                    k += 1;
-                                    batch.get(k - 1).copied().unwrap_or(0)
-                                } else {
-                                    low
-                                };
-                                cycle(&mut sink, c, &mut clock, &mut fall, &mut stepped)
-                            }
-                        };
-                        if let Err(e) = r {
-                            res = Err(e);
-                            break;
-                        }
-                    }
+                    res = w.batch(&batch);
                     rx.0.give_back(batch);
                 }
-                if res.is_ok() {
-                    if let Some(t) = fall {
-                        res = sink.timestamp(t).and_then(|_| sink.change(clk, 1, 0));
-                    }
-                }
-                // The values first, so that the filter files are written
-                // while this thread closes the waveform.
-                let seen = seen.lists.into_iter().map(BTreeSet::from_iter).collect();
-                let _ = seen_tx.send(seen);
-                if res.is_ok() {
-                    let end = rx.0.end.lock().unwrap_or_else(|e| e.into_inner()).take();
-                    res = match end {
-                        Some((t, note)) => sink.close(t, note.as_deref()),
-                        None => Err(io::Error::other("the waveform ended without an end time")),
-                    };
-                }
-                (sink, res)
+                w.finish(res, &rx, seen_tx)
             })?;
         Ok(Sink::Threaded {
             queue,
@@ -420,6 +333,125 @@ pub(super) fn changed_mask(cur: &[u64; 64], mask: &[u64; 64], last: &[u64; 64]) 
         bits |= u64::from(cur[k] & mask[k] != last[k]) << k;
     }
     bits
+}
+
+/// The waveform's writing thread ([`Sink::threaded`]): the sink it owns
+/// and what it keeps between batches.
+struct WritingThread {
+    sink: Sink,
+    /// Per signal call, its [`Slot`] if traced.
+    slots: Vec<Option<Slot>>,
+    /// Values of the filtered signals, deduplicated whenever a list
+    /// doubles (a set insertion per change cost more).
+    seen: Seen,
+    /// A VCD's handles, for its own loop ([`vcd_batch`]).
+    vcd_ids: Option<(Vec<(u32, u32, bool, u32)>, u32, u32)>,
+    clock: Clock,
+    /// The falling edge of the last cycle begun, written when the next
+    /// one begins or the trace ends.
+    fall: Option<u64>,
+    /// A section can end only after a time step of its own (the FST
+    /// writer cannot start one at the time it ended at).
+    stepped: bool,
+    clk: SigId,
+    cycle_id: SigId,
+    section_bytes: usize,
+}
+
+impl WritingThread {
+    /// Write one batch of messages.
+    fn batch(&mut self, batch: &[u64]) -> io::Result<()> {
+        if let (Sink::Vcd(w, body), Some((ids, clk, cycle))) = (&mut self.sink, &self.vcd_ids) {
+            let edges = (&mut self.clock, &mut self.fall, *clk, *cycle);
+            return vcd_batch(w.writer(), body, batch, ids, &mut self.seen, edges);
+        }
+        let mut k = 0;
+        while k < batch.len() {
+            let m = batch[k];
+            k += 1;
+            let (tag, low) = (m >> 48, m & MSG_VALUE);
+            match tag {
+                MSG_CHUNK => {
+                    let Some(&bits) = batch.get(k) else {
+                        return Err(io::Error::other("a change message cut short"));
+                    };
+                    k += 1;
+                    for (s, v) in changes(low, bits, batch, &mut k) {
+                        let Some((id, w, filtered, i)) = self.slots.get(s).copied().flatten()
+                        else {
+                            return Err(io::Error::other("a change of a signal not declared"));
+                        };
+                        if filtered {
+                            self.seen.add(i as usize, v);
+                        }
+                        self.sink.change(id, w, v)?;
+                    }
+                }
+                _ => {
+                    let c = if tag == MSG_LONG {
+                        k += 1;
+                        batch.get(k - 1).copied().unwrap_or(0)
+                    } else {
+                        low
+                    };
+                    self.cycle(c)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Cycle `c` begins: the falling edge of the cycle before (if any),
+    /// then this cycle's rising edge, `clk` and the `cycle` counter.
+    fn cycle(&mut self, c: u64) -> io::Result<()> {
+        let sink = &mut self.sink;
+        if let Some(t) = self.fall.take() {
+            sink.timestamp(t)?;
+            sink.change(self.clk, 1, 0)?;
+            self.stepped = true;
+        }
+        if std::mem::take(&mut self.stepped) {
+            sink.fst_section(self.section_bytes)?;
+        }
+        let (rise, f) = self.clock.edges(c);
+        self.fall = Some(f);
+        sink.timestamp(rise)?;
+        sink.change(self.clk, 1, 1)?;
+        sink.change(self.cycle_id, 64, c)
+    }
+
+    /// After the last batch: the last falling edge, the filtered signals'
+    /// values (first, so that the filter files are written while this
+    /// thread closes the waveform), then the file closed at the end time
+    /// the simulating thread left.
+    fn finish(
+        mut self,
+        mut res: io::Result<()>,
+        rx: &WriterGone,
+        seen_tx: std::sync::mpsc::SyncSender<Vec<BTreeSet<u64>>>,
+    ) -> Written {
+        let sink = &mut self.sink;
+        if res.is_ok() {
+            if let Some(t) = self.fall {
+                res = sink.timestamp(t).and_then(|_| sink.change(self.clk, 1, 0));
+            }
+        }
+        let seen = self
+            .seen
+            .lists
+            .into_iter()
+            .map(BTreeSet::from_iter)
+            .collect();
+        let _ = seen_tx.send(seen);
+        if res.is_ok() {
+            let end = rx.0.end.lock().unwrap_or_else(|e| e.into_inner()).take();
+            res = match end {
+                Some((t, note)) => sink.close(t, note.as_deref()),
+                None => Err(io::Error::other("the waveform ended without an end time")),
+            };
+        }
+        (self.sink, res)
+    }
 }
 
 /// The values each signal with a translate filter took, gathered by the
