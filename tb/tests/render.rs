@@ -97,6 +97,70 @@ fn discs_match_the_reference() {
     }
 }
 
+/// A streamed scene's node records count at most `STREAMED_TYPES` object
+/// types: one with more (the default scene's five, discs, glass ones) is
+/// refused with the types named under both traversals, never a panic or
+/// a count written over the next field; resident, it renders.
+#[test]
+fn a_streamed_scene_of_too_many_types_is_refused() {
+    use firmware::scene::{AaBox, Disc, Object, Shape, Sphere, Vec3};
+    use firmware::tracer::layout::STREAMED_TYPES;
+    use firmware::tracer::Traversal;
+    let mut scene = load("default.toml");
+    let glass = scene.materials.len();
+    let mut m = scene.materials[0].clone();
+    (m.t, m.ior) = (0.7, 1.4);
+    scene.materials.push(m);
+    let disc = |z: f64| {
+        Shape::from(Disc {
+            center: Vec3::new(-2.0, 2.0, z),
+            normal: Vec3::new(0.0, -1.0, 0.3),
+            radius: 0.4,
+        })
+    };
+    let sphere = Shape::from(Sphere {
+        center: Vec3::new(2.0, 2.0, 0.5),
+        radius: 0.4,
+        inside: false,
+    });
+    let aabox = Shape::from(AaBox {
+        min: Vec3::new(-2.5, -2.0, 0.0),
+        max: Vec3::new(-2.0, -1.5, 0.5),
+    });
+    for (shape, material) in [
+        (disc(0.6), 0),
+        (disc(1.6), glass),
+        (sphere, glass),
+        (aabox, glass),
+    ] {
+        scene.objects.push(Object {
+            shape,
+            material,
+            line: 1,
+        });
+    }
+    for traversal in [Traversal::Packet, Traversal::Paper] {
+        let o = Options {
+            traversal,
+            ..opts(16, 16)
+        };
+        let streamed = tb::render::RenderSettings {
+            streamed: true,
+            ..Default::default()
+        };
+        let e = tb::render::render_chip(&scene, &o, &streamed)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!(
+                "at most {STREAMED_TYPES} object types; it has 9 ("
+            )) && e.contains("glass_disc"),
+            "{traversal:?}: {e}"
+        );
+        tb::render::render_chip(&scene, &o, &Default::default()).unwrap();
+    }
+}
+
 #[test]
 fn json_has_every_key_and_sane_figures() {
     let scene = load("default.toml");

@@ -42,6 +42,31 @@ pub use paper_nodes::{compact_head, COMPACT_INNER_HEAD, COMPACT_LEAF_HEAD, NODE_
 use streams::{camera, distinct_materials, lights, post_streams};
 pub use streams::{fit_frac, light_shift, light_shift_w};
 
+/// The object types a streamed scene's node records count: one word per
+/// type present, between the records' fields (`PS_COUNTS` and
+/// `SN_COUNTS`, 28 to 56 bytes).
+pub const STREAMED_TYPES: usize = 7;
+
+/// A streamed scene's types fit its node records' counts, or the error
+/// that names them.
+fn streamed_types_fit(
+    types: &[TypeInfo],
+    err: &dyn Fn(usize, String) -> String,
+) -> Result<(), String> {
+    if types.len() <= STREAMED_TYPES {
+        return Ok(());
+    }
+    let names: Vec<&str> = types.iter().map(|t| t.ty.name()).collect();
+    Err(err(
+        0,
+        format!(
+            "the scene is streamed from main memory, whose node records count at most {STREAMED_TYPES} object types; it has {} ({})",
+            types.len(),
+            names.join(", ")
+        ),
+    ))
+}
+
 /// One type present in the scene.
 #[derive(Clone, Debug)]
 pub struct TypeInfo {

@@ -368,6 +368,7 @@ fn streamed_image(
 ) -> Result<(Vec<i32>, Stream), String> {
     use fields::*;
     let types = tree.types;
+    super::streamed_types_fit(types, err)?;
     let nodes = &tree.nodes;
     let records = w.fb.split_off(records_start);
     let split_slot = resident_part(&mut w, err)?;

@@ -120,6 +120,7 @@ fn streamed_image(
     let word = |f: crate::tracer::emit::Name| f.at() / 4;
     // Streamed: only the tables, camera, lights and shading stay in the
     // FB (bank 0); objects, nodes and mailboxes go to main memory.
+    super::streamed_types_fit(types, err)?;
     let records = w.fb.split_off(records_start);
     let split_slot = resident_split(w, err)?;
     let base = super::super::mem::STREAM;
