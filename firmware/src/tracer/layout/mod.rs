@@ -11,7 +11,7 @@
 //! objects, grouped by type, fixed record size per type (one module per
 //!     primitive in `primitives/`; polygons padded to the largest fan)
 //! BSP nodes: the paper's traversal's (paper_nodes.rs) or the packet
-//!     traversal's (packet_nodes.rs), and the paper's mailboxes
+//!     traversal's (packet_nodes/), and the paper's mailboxes
 //! ```
 //!
 //! A scene whose image does not fit FB set 0 gets a streamed layout
