@@ -66,39 +66,12 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
             continue;
         }
         if c.is_ascii_digit() {
-            let s = i;
-            while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
-                i += 1;
-            }
-            // `_` separates digit groups anywhere; then `0x` or `0b` (any
-            // case) and at least one digit of the radix.
-            let digits: Vec<char> = chars[s..i].iter().filter(|c| **c != '_').copied().collect();
-            let (radix, body) = match digits.as_slice() {
-                ['0', 'x' | 'X', rest @ ..] => (16, rest),
-                ['0', 'b' | 'B', rest @ ..] => (2, rest),
-                d => (10, d),
-            };
-            let mut v: Result<i64, ()> = if body.is_empty() { Err(()) } else { Ok(0) };
-            for ch in body {
-                v = v.and_then(|acc| {
-                    let d = ch.to_digit(radix).ok_or(())?;
-                    acc.checked_mul(radix as i64)
-                        .and_then(|x| x.checked_add(d as i64))
-                        .ok_or(())
-                });
-            }
-            match v {
-                Ok(v) => out.push(Token {
-                    tok: Tok::Int(v),
-                    col,
-                }),
-                Err(_) => {
-                    return Err(mk(
-                        col,
-                        format!("bad number `{}`", chars[s..i].iter().collect::<String>()),
-                    ))
-                }
-            }
+            let (v, end) = number(&chars, i, mk)?;
+            out.push(Token {
+                tok: Tok::Int(v),
+                col,
+            });
+            i = end;
             continue;
         }
         if c == '\'' {
@@ -114,37 +87,12 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
             return Err(mk(col, "bad character literal (write 'a')".into()));
         }
         if c == '"' {
-            let mut s = String::new();
-            i += 1;
-            loop {
-                match chars.get(i) {
-                    None => return Err(mk(col, "unterminated string".into())),
-                    Some('"') => {
-                        i += 1;
-                        break;
-                    }
-                    Some('\\') => {
-                        let e = match chars.get(i + 1) {
-                            Some('n') => '\n',
-                            Some('t') => '\t',
-                            Some('0') => '\0',
-                            Some('\\') => '\\',
-                            Some('"') => '"',
-                            _ => return Err(mk(i + 1, "unknown escape in string".into())),
-                        };
-                        s.push(e);
-                        i += 2;
-                    }
-                    Some(ch) => {
-                        s.push(*ch);
-                        i += 1;
-                    }
-                }
-            }
+            let (s, end) = string(&chars, i, mk)?;
             out.push(Token {
                 tok: Tok::Str(s),
                 col,
             });
+            i = end;
             continue;
         }
         let next = chars.get(i + 1).copied();
@@ -170,4 +118,73 @@ pub fn lex(line: &str, mk: &dyn Fn(usize, String) -> AsmError) -> Result<Vec<Tok
         }
     }
     Ok(out)
+}
+
+/// The number at `chars[s]` (a digit) and where it ends: `_` separates
+/// digit groups anywhere; then `0x` or `0b` (any case) and at least one
+/// digit of the radix.
+fn number(
+    chars: &[char],
+    s: usize,
+    mk: &dyn Fn(usize, String) -> AsmError,
+) -> Result<(i64, usize), AsmError> {
+    let mut i = s;
+    while i < chars.len() && (chars[i].is_ascii_alphanumeric() || chars[i] == '_') {
+        i += 1;
+    }
+    let digits: Vec<char> = chars[s..i].iter().filter(|c| **c != '_').copied().collect();
+    let (radix, body) = match digits.as_slice() {
+        ['0', 'x' | 'X', rest @ ..] => (16, rest),
+        ['0', 'b' | 'B', rest @ ..] => (2, rest),
+        d => (10, d),
+    };
+    let mut v: Result<i64, ()> = if body.is_empty() { Err(()) } else { Ok(0) };
+    for ch in body {
+        v = v.and_then(|acc| {
+            let d = ch.to_digit(radix).ok_or(())?;
+            acc.checked_mul(radix as i64)
+                .and_then(|x| x.checked_add(d as i64))
+                .ok_or(())
+        });
+    }
+    match v {
+        Ok(v) => Ok((v, i)),
+        Err(_) => Err(mk(
+            s + 1,
+            format!("bad number `{}`", chars[s..i].iter().collect::<String>()),
+        )),
+    }
+}
+
+/// The string literal at `chars[s]` (its opening `"`), its escapes
+/// resolved, and where it ends.
+fn string(
+    chars: &[char],
+    s: usize,
+    mk: &dyn Fn(usize, String) -> AsmError,
+) -> Result<(String, usize), AsmError> {
+    let mut out = String::new();
+    let mut i = s + 1;
+    loop {
+        match chars.get(i) {
+            None => return Err(mk(s + 1, "unterminated string".into())),
+            Some('"') => return Ok((out, i + 1)),
+            Some('\\') => {
+                let e = match chars.get(i + 1) {
+                    Some('n') => '\n',
+                    Some('t') => '\t',
+                    Some('0') => '\0',
+                    Some('\\') => '\\',
+                    Some('"') => '"',
+                    _ => return Err(mk(i + 1, "unknown escape in string".into())),
+                };
+                out.push(e);
+                i += 2;
+            }
+            Some(ch) => {
+                out.push(*ch);
+                i += 1;
+            }
+        }
+    }
 }

@@ -97,6 +97,11 @@ fn labels(code: &str) -> (Vec<&str>, &str) {
 }
 
 /// Words that cannot name a macro: instructions and directives.
+/// The column (1-based, in characters) of `word` in `line`, or 1.
+fn col_of(line: &str, word: &str) -> usize {
+    line.find(word).map_or(1, |p| line[..p].chars().count() + 1)
+}
+
 fn reserved(name: &str, is_mnemonic: &dyn Fn(&str) -> bool) -> bool {
     name.starts_with('.') || is_mnemonic(name)
 }
@@ -116,8 +121,6 @@ pub(crate) fn expand(
         message: msg,
         text: text.to_string(),
     };
-    let col_of =
-        |line: &str, word: &str| line.find(word).map_or(1, |p| line[..p].chars().count() + 1);
     let mut macros: HashMap<String, Macro> = HashMap::new();
     let mut out = Vec::with_capacity(lines.len());
     let mut uses = 0usize;
@@ -145,78 +148,9 @@ pub(crate) fn expand(
             continue;
         }
         // A definition.
-        let rest = c[".macro".len()..].trim();
-        let (name, params) = match rest.split_once(char::is_whitespace) {
-            Some((n, p)) => (n.trim(), p.trim()),
-            None => (rest, ""),
-        };
-        if !is_ident(name) {
-            return Err(err(
-                no,
-                line,
-                col_of(line, ".macro") + 7,
-                "`.macro NAME [PARAM, ...]` needs a name".into(),
-            ));
-        }
-        if reserved(name, is_mnemonic) {
-            return Err(err(
-                no,
-                line,
-                col_of(line, name),
-                format!("`{name}` is an instruction or a directive: not a macro name"),
-            ));
-        }
-        if macros.contains_key(name) {
-            return Err(err(
-                no,
-                line,
-                col_of(line, name),
-                format!("macro `{name}` is defined twice"),
-            ));
-        }
-        let params: Vec<String> = if params.is_empty() {
-            Vec::new()
-        } else {
-            split_args(params)
-        };
-        for p in &params {
-            if !is_ident(p) || p.contains('.') {
-                return Err(err(
-                    no,
-                    line,
-                    col_of(line, p),
-                    format!("macro parameter `{p}`: a parameter is a name"),
-                ));
-            }
-        }
-        let mut body = Vec::new();
-        let mut j = k + 1;
-        loop {
-            let Some(l) = lines.get(j) else {
-                return Err(err(
-                    no,
-                    line,
-                    col_of(line, ".macro"),
-                    format!("`.macro {name}` without `.endm`"),
-                ));
-            };
-            let w = code(l).split_whitespace().next().unwrap_or("");
-            if w == ".endm" {
-                break;
-            }
-            if w == ".macro" {
-                return Err(err(
-                    j + 1,
-                    l,
-                    col_of(l, ".macro"),
-                    format!("`.macro` inside `.macro {name}` (end it with `.endm` first)"),
-                ));
-            }
-            body.push((j + 1, l.to_string()));
-            j += 1;
-        }
-        macros.insert(name.to_string(), Macro { params, body });
-        k = j + 1;
+        let (name, m, end) = definition(&lines, k, &macros, is_mnemonic, &err)?;
+        macros.insert(name, m);
+        k = end;
     }
     // Uses, depth first.
     let mut result = Vec::with_capacity(out.len());
@@ -224,6 +158,91 @@ pub(crate) fn expand(
         expand_line(l, &macros, &mut result, &mut uses, 0, file)?;
     }
     Ok(result)
+}
+
+/// The macro defined from line `k` (its `.macro` line): its name, the
+/// macro, and the line after its `.endm`.
+fn definition(
+    lines: &[&str],
+    k: usize,
+    macros: &HashMap<String, Macro>,
+    is_mnemonic: &dyn Fn(&str) -> bool,
+    err: &dyn Fn(usize, &str, usize, String) -> AsmError,
+) -> Result<(String, Macro, usize), AsmError> {
+    let line = lines[k];
+    let no = k + 1;
+    let c = code(line).trim();
+    let rest = c[".macro".len()..].trim();
+    let (name, params) = match rest.split_once(char::is_whitespace) {
+        Some((n, p)) => (n.trim(), p.trim()),
+        None => (rest, ""),
+    };
+    if !is_ident(name) {
+        return Err(err(
+            no,
+            line,
+            col_of(line, ".macro") + 7,
+            "`.macro NAME [PARAM, ...]` needs a name".into(),
+        ));
+    }
+    if reserved(name, is_mnemonic) {
+        return Err(err(
+            no,
+            line,
+            col_of(line, name),
+            format!("`{name}` is an instruction or a directive: not a macro name"),
+        ));
+    }
+    if macros.contains_key(name) {
+        return Err(err(
+            no,
+            line,
+            col_of(line, name),
+            format!("macro `{name}` is defined twice"),
+        ));
+    }
+    let params: Vec<String> = if params.is_empty() {
+        Vec::new()
+    } else {
+        split_args(params)
+    };
+    for p in &params {
+        if !is_ident(p) || p.contains('.') {
+            return Err(err(
+                no,
+                line,
+                col_of(line, p),
+                format!("macro parameter `{p}`: a parameter is a name"),
+            ));
+        }
+    }
+    let mut body = Vec::new();
+    let mut j = k + 1;
+    loop {
+        let Some(l) = lines.get(j) else {
+            return Err(err(
+                no,
+                line,
+                col_of(line, ".macro"),
+                format!("`.macro {name}` without `.endm`"),
+            ));
+        };
+        let w = code(l).split_whitespace().next().unwrap_or("");
+        if w == ".endm" {
+            break;
+        }
+        if w == ".macro" {
+            return Err(err(
+                j + 1,
+                l,
+                col_of(l, ".macro"),
+                format!("`.macro` inside `.macro {name}` (end it with `.endm` first)"),
+            ));
+        }
+        body.push((j + 1, l.to_string()));
+        j += 1;
+    }
+    Ok((name.to_string(), Macro { params, body }, j + 1))
 }
 
 fn expand_line(
@@ -305,40 +324,16 @@ fn expand_line(
     let mut order: Vec<usize> = (0..m.params.len()).collect();
     order.sort_by_key(|&i| std::cmp::Reverse(m.params[i].len()));
     for (bno, text) in &m.body {
-        let mut s = String::with_capacity(text.len());
-        let mut rest = text.as_str();
-        while let Some(p) = rest.find('\\') {
-            s.push_str(&rest[..p]);
-            let after = &rest[p + 1..];
-            if let Some(t) = after.strip_prefix("()") {
-                rest = t;
-            } else if let Some(t) = after.strip_prefix('@') {
-                s.push_str(&this.to_string());
-                rest = t;
-            } else if let Some(&i) = order
-                .iter()
-                .find(|&&i| after.starts_with(m.params[i].as_str()))
-            {
-                s.push_str(&args[i]);
-                rest = &after[m.params[i].len()..];
-            } else {
-                let word: String = after
-                    .chars()
-                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
-                    .collect();
-                return Err(AsmError {
-                    file: file.to_string(),
-                    line: *bno,
-                    col: text[..text.len() - rest.len() + p].chars().count() + 1,
-                    message: format!(
-                        "`\\{word}` is not a parameter of macro `{name}` ({}){from}",
-                        m.params.join(", ")
-                    ),
-                    text: text.clone(),
-                });
-            }
-        }
-        s.push_str(rest);
+        let use_ = Use {
+            name,
+            m,
+            args: &args,
+            order: &order,
+            this,
+            from: &from,
+            file,
+        };
+        let s = use_.substitute(*bno, text)?;
         let e = Expanded {
             no: *bno,
             text: s,
@@ -347,4 +342,63 @@ fn expand_line(
         expand_line(e, macros, out, uses, depth + 1, file)?;
     }
     Ok(())
+}
+
+/// One use of a macro, its body's lines being written out.
+struct Use<'a> {
+    name: &'a str,
+    m: &'a Macro,
+    args: &'a [String],
+    /// The parameters, longest names first (so `\pa` is not taken for
+    /// `\p` + `a`).
+    order: &'a [usize],
+    /// The use's number (`\@`).
+    this: usize,
+    /// Where it was used, for errors.
+    from: &'a str,
+    file: &'a str,
+}
+
+impl Use<'_> {
+    /// Body line `text` (line `bno`) with its parameters, `\@` and `\()`
+    /// replaced.
+    fn substitute(&self, bno: usize, text: &str) -> Result<String, AsmError> {
+        let (m, name, from) = (self.m, self.name, self.from);
+        let mut s = String::with_capacity(text.len());
+        let mut rest = text;
+        while let Some(p) = rest.find('\\') {
+            s.push_str(&rest[..p]);
+            let after = &rest[p + 1..];
+            if let Some(t) = after.strip_prefix("()") {
+                rest = t;
+            } else if let Some(t) = after.strip_prefix('@') {
+                s.push_str(&self.this.to_string());
+                rest = t;
+            } else if let Some(&i) = self
+                .order
+                .iter()
+                .find(|&&i| after.starts_with(m.params[i].as_str()))
+            {
+                s.push_str(&self.args[i]);
+                rest = &after[m.params[i].len()..];
+            } else {
+                let word: String = after
+                    .chars()
+                    .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                    .collect();
+                return Err(AsmError {
+                    file: self.file.to_string(),
+                    line: bno,
+                    col: text[..text.len() - rest.len() + p].chars().count() + 1,
+                    message: format!(
+                        "`\\{word}` is not a parameter of macro `{name}` ({}){from}",
+                        m.params.join(", ")
+                    ),
+                    text: text.to_string(),
+                });
+            }
+        }
+        s.push_str(rest);
+        Ok(s)
+    }
 }

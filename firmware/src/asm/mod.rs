@@ -600,6 +600,58 @@ impl Asm {
         Ok(())
     }
 
+    /// `.space N[, FILL]` (operands `ops`; the directive's token `i`).
+    fn space(&mut self, lc: &LineCtx, i: usize, ops: &[(usize, usize)]) -> Result<(), AsmError> {
+        let nops = ops.len();
+        if nops != 1 && nops != 2 {
+            return Err(lc.err_at(Some(i), "`.space N[, FILL]` takes 1 or 2 operands"));
+        }
+        let n = self.value_now(lc, ops[0].0, ops[0].1, "the size")?;
+        if !(0..=1 << 26).contains(&n) {
+            return Err(lc.err_at(
+                Some(ops[0].0),
+                format!(".space {n}: size outside 0..=64 MiB"),
+            ));
+        }
+        let fill = if nops == 2 {
+            self.value(lc, ops[1].0, ops[1].1)?.unwrap_or(0) as u8
+        } else {
+            0
+        };
+        self.emit(&vec![fill; n as usize]);
+        Ok(())
+    }
+
+    /// `.word`, `.half` or `.byte` (`d`) and its values, each checked to
+    /// fit.
+    fn values(
+        &mut self,
+        lc: &LineCtx,
+        i: usize,
+        d: &str,
+        ops: &[(usize, usize)],
+    ) -> Result<(), AsmError> {
+        if ops.is_empty() {
+            return Err(lc.err_at(Some(i), format!("`{d}` needs at least one value")));
+        }
+        let (size, lo, hi) = match d {
+            ".word" => (4usize, i32::MIN as i64, u32::MAX as i64),
+            ".half" => (2, i16::MIN as i64, u16::MAX as i64),
+            _ => (1, i8::MIN as i64, u8::MAX as i64),
+        };
+        for &(a, b) in ops {
+            let v = self.value(lc, a, b)?.unwrap_or(0);
+            if !(lo..=hi).contains(&v) {
+                return Err(lc.err_at(
+                    Some(a),
+                    format!("value {v} does not fit in {d} ({lo}..={hi})"),
+                ));
+            }
+            self.emit(&(v as u32).to_le_bytes()[..size]);
+        }
+        Ok(())
+    }
+
     fn directive(&mut self, lc: &LineCtx, li: usize, i: usize, d: &str) -> Result<(), AsmError> {
         let ops = split_operands(lc.toks, i + 1);
         let nops = ops.len();
@@ -643,44 +695,8 @@ impl Asm {
                 let pad = (n - here.rem_euclid(n)) % n;
                 self.emit(&vec![0u8; pad as usize]);
             }
-            ".space" => {
-                if nops != 1 && nops != 2 {
-                    return Err(lc.err_at(Some(i), "`.space N[, FILL]` takes 1 or 2 operands"));
-                }
-                let n = self.value_now(lc, ops[0].0, ops[0].1, "the size")?;
-                if !(0..=1 << 26).contains(&n) {
-                    return Err(lc.err_at(
-                        Some(ops[0].0),
-                        format!(".space {n}: size outside 0..=64 MiB"),
-                    ));
-                }
-                let fill = if nops == 2 {
-                    self.value(lc, ops[1].0, ops[1].1)?.unwrap_or(0) as u8
-                } else {
-                    0
-                };
-                self.emit(&vec![fill; n as usize]);
-            }
-            ".word" | ".half" | ".byte" => {
-                if nops == 0 {
-                    return Err(lc.err_at(Some(i), format!("`{d}` needs at least one value")));
-                }
-                let (size, lo, hi) = match d {
-                    ".word" => (4usize, i32::MIN as i64, u32::MAX as i64),
-                    ".half" => (2, i16::MIN as i64, u16::MAX as i64),
-                    _ => (1, i8::MIN as i64, u8::MAX as i64),
-                };
-                for &(a, b) in &ops {
-                    let v = self.value(lc, a, b)?.unwrap_or(0);
-                    if !(lo..=hi).contains(&v) {
-                        return Err(lc.err_at(
-                            Some(a),
-                            format!("value {v} does not fit in {d} ({lo}..={hi})"),
-                        ));
-                    }
-                    self.emit(&(v as u32).to_le_bytes()[..size]);
-                }
-            }
+            ".space" => self.space(lc, i, &ops)?,
+            ".word" | ".half" | ".byte" => self.values(lc, i, d, &ops)?,
             ".ascii" => {
                 want(1)?;
                 match lc.toks[ops[0].0..ops[0].1].first().map(|t| &t.tok) {
