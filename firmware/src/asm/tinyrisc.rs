@@ -158,36 +158,70 @@ pub(crate) fn instruction(
         ops: split_operands(lc.toks, head + 1),
         head,
     };
-    let p2 = asm.pass == 2;
-    // branch offset from `pc + 4` to a target, in words
-    let branch = |asm: &Asm, k: usize| -> Result<i32, AsmError> {
-        let (t, known) = imm(asm, &o, k)?;
-        if !known {
-            return Ok(0);
+    if let Some(v) = pseudo(asm, &o, li, m, here)? {
+        for i in v {
+            if i.op == Opcode::Jal && !(0..1 << 28).contains(&(i.imm as i64)) {
+                return Err(lc.err_at(Some(head), "call target out of range"));
+            }
+            emit(asm, lc, head, i)?;
         }
-        let d = t - (here + 4);
-        if d % 4 != 0 {
-            return Err(lc.err_at(
-                Some(o.ops[k].0),
-                format!("branch target 0x{t:x} not 4-aligned"),
-            ));
-        }
-        check(
-            lc,
-            o.ops[k].0,
-            d / 4,
-            IMM18_MIN as i64,
-            IMM18_MAX as i64,
-            "branch distance (words)",
-        )
+        return Ok(());
+    }
+    let Some(op) = Opcode::from_mnemonic(m) else {
+        return Err(lc.err_at(
+            Some(head),
+            format!(
+                "unknown instruction `{m}` (in .text: TinyRISC instructions; contexts go in .ctx)"
+            ),
+        ));
     };
+    let i = by_format(asm, &o, op, here)?;
+    emit(asm, lc, head, i)
+}
+
+/// The branch offset from `pc + 4` (`here + 4`) to operand `k`'s target,
+/// in words.
+fn branch(asm: &Asm, o: &Ops, here: i64, k: usize) -> Result<i32, AsmError> {
+    let lc = o.lc;
+    let (t, known) = imm(asm, o, k)?;
+    if !known {
+        return Ok(0);
+    }
+    let d = t - (here + 4);
+    if d % 4 != 0 {
+        return Err(lc.err_at(
+            Some(o.ops[k].0),
+            format!("branch target 0x{t:x} not 4-aligned"),
+        ));
+    }
+    check(
+        lc,
+        o.ops[k].0,
+        d / 4,
+        IMM18_MIN as i64,
+        IMM18_MAX as i64,
+        "branch distance (words)",
+    )
+}
+
+/// The instructions of pseudo-instruction `m` (line `li`, at `here`), or
+/// `None` if `m` is not one.
+fn pseudo(
+    asm: &mut Asm,
+    o: &Ops,
+    li: usize,
+    m: &str,
+    here: i64,
+) -> Result<Option<Vec<Instr>>, AsmError> {
     use Opcode::*;
-    // pseudo-instructions
-    let pseudo: Option<Vec<Instr>> = match m {
+    let lc = o.lc;
+    let p2 = asm.pass == 2;
+    let branch = |asm: &Asm, k: usize| branch(asm, o, here, k);
+    Ok(match m {
         "li" | "la" => {
             o.want(2, "li rd, EXPR")?;
             let rd = o.reg(0)?;
-            let (v, known) = imm(asm, &o, 1)?;
+            let (v, known) = imm(asm, o, 1)?;
             let v = if p2 || known {
                 check(lc, o.ops[1].0, v, i32::MIN as i64, u32::MAX as i64, "value")? as u32
             } else {
@@ -229,7 +263,7 @@ pub(crate) fn instruction(
         }
         "subi" => {
             o.want(3, "subi rd, rs, EXPR")?;
-            let (v, _) = imm(asm, &o, 2)?;
+            let (v, _) = imm(asm, o, 2)?;
             let v = check(
                 lc,
                 o.ops[2].0,
@@ -267,7 +301,7 @@ pub(crate) fn instruction(
         }
         "call" => {
             o.want(1, "call LABEL")?;
-            let (t, _) = imm(asm, &o, 0)?;
+            let (t, _) = imm(asm, o, 0)?;
             Some(vec![Instr::new(Jal, 0, 0, 0, t as i32)])
         }
         "ret" => {
@@ -275,25 +309,12 @@ pub(crate) fn instruction(
             Some(vec![Instr::new(Jr, 15, 0, 0, 0)])
         }
         _ => None,
-    };
-    if let Some(v) = pseudo {
-        for i in v {
-            if i.op == Jal && !(0..1 << 28).contains(&(i.imm as i64)) {
-                return Err(lc.err_at(Some(head), "call target out of range"));
-            }
-            emit(asm, lc, head, i)?;
-        }
-        return Ok(());
-    }
-    let Some(op) = Opcode::from_mnemonic(m) else {
-        return Err(lc.err_at(
-            Some(head),
-            format!(
-                "unknown instruction `{m}` (in .text: TinyRISC instructions; contexts go in .ctx)"
-            ),
-        ));
-    };
-    let syntax = match op.format() {
+    })
+}
+
+/// The operands a format takes, as its errors spell them.
+fn syntax(f: Format) -> &'static str {
+    match f {
         Format::None => "",
         Format::R3 => "rd, rs, rt",
         Format::RIs | Format::RIu => "rd, rs, EXPR",
@@ -308,8 +329,16 @@ pub(crate) fn instruction(
         Format::M3 => "ra, rb, rc, COUNT",
         Format::MI => "ra, OFFSET",
         Format::MRI => "rd, ra, OFFSET",
-    };
-    let i = match op.format() {
+    }
+}
+
+/// Real instruction `op` (at `here`), its operands by its format.
+fn by_format(asm: &Asm, o: &Ops, op: Opcode, here: i64) -> Result<Instr, AsmError> {
+    use Opcode::*;
+    let lc = o.lc;
+    let branch = |asm: &Asm, k: usize| branch(asm, o, here, k);
+    let syntax = syntax(op.format());
+    Ok(match op.format() {
         Format::None => {
             o.want(0, syntax)?;
             Instr::new(op, 0, 0, 0, 0)
@@ -320,7 +349,7 @@ pub(crate) fn instruction(
         }
         Format::RIs | Format::RIu => {
             o.want(3, syntax)?;
-            let (v, _) = imm(asm, &o, 2)?;
+            let (v, _) = imm(asm, o, 2)?;
             let (lo, hi) = if op.format() == Format::RIs {
                 (IMM18_MIN as i64, IMM18_MAX as i64)
             } else if matches!(op, Slli | Srli | Srai) {
@@ -333,13 +362,13 @@ pub(crate) fn instruction(
         }
         Format::LUi => {
             o.want(2, syntax)?;
-            let (v, _) = imm(asm, &o, 1)?;
+            let (v, _) = imm(asm, o, 1)?;
             let v = check(lc, o.ops[1].0, v, 0, (1 << 18) - 1, "immediate")?;
             Instr::new(op, o.reg(0)?, 0, 0, v)
         }
         Format::Mem => {
             o.want(2, syntax)?;
-            let (off, base) = mem(asm, &o, 1)?;
+            let (off, base) = mem(asm, o, 1)?;
             let off = check(
                 lc,
                 o.ops[1].0,
@@ -356,7 +385,7 @@ pub(crate) fn instruction(
         }
         Format::J => {
             o.want(1, syntax)?;
-            let (t, _) = imm(asm, &o, 0)?;
+            let (t, _) = imm(asm, o, 0)?;
             let t = check(lc, o.ops[0].0, t, 0, (1 << 28) - 4, "jump target")?;
             Instr::new(op, 0, 0, 0, t)
         }
@@ -370,13 +399,13 @@ pub(crate) fn instruction(
         }
         Format::M2 => {
             o.want(3, syntax)?;
-            let (c, n) = count(asm, &o, 2)?;
+            let (c, n) = count(asm, o, 2)?;
             let n = check(lc, o.ops[2].0, n, 0, (1 << 14) - 1, "count")?;
             Instr::new(op, o.reg(0)?, o.reg(1)?, c, n)
         }
         Format::M1 => {
             o.want(2, syntax)?;
-            let (c, n) = count(asm, &o, 1)?;
+            let (c, n) = count(asm, o, 1)?;
             let n = check(lc, o.ops[1].0, n, 0, (1 << 14) - 1, "count")?;
             Instr::new(op, o.reg(0)?, 0, c, n)
         }
@@ -392,24 +421,23 @@ pub(crate) fn instruction(
                 o.want(4, "ra, rb, rc, N[, row|col]")?;
                 0
             };
-            let (v, _) = imm(asm, &o, 3)?;
+            let (v, _) = imm(asm, o, 3)?;
             let n = check(lc, o.ops[3].0, v, 0, 4095, "count")?;
             Instr::new(op, o.reg(0)?, o.reg(1)?, o.reg(2)?, mode << 12 | n)
         }
         Format::MI => {
             o.want(2, syntax)?;
-            let (v, _) = imm(asm, &o, 1)?;
+            let (v, _) = imm(asm, o, 1)?;
             let n = check(lc, o.ops[1].0, v, 0, (1 << 14) - 1, "offset")?;
             Instr::new(op, o.reg(0)?, 0, 0, n)
         }
         Format::MRI => {
             o.want(3, syntax)?;
-            let (v, _) = imm(asm, &o, 2)?;
+            let (v, _) = imm(asm, o, 2)?;
             let n = check(lc, o.ops[2].0, v, 0, (1 << 14) - 1, "offset")?;
             Instr::new(op, o.reg(0)?, o.reg(1)?, 0, n)
         }
-    };
-    emit(asm, lc, head, i)
+    })
 }
 
 /// A TinyRISC instruction or pseudo-instruction's name.

@@ -152,27 +152,7 @@ impl RefRc {
                 result = Some((0..16).take_while(|k| u & (0x8000 >> k) == 0).count() as i64);
             }
             Op::Sel => result = Some(if self.f { a } else { b }),
-            Op::Cmp => {
-                let (ua, ub) = (u16of(a), u16of(b));
-                self.f = match c.cond() {
-                    Cond::Eq => a == b,
-                    Cond::Ne => a != b,
-                    Cond::Lt => a < b,
-                    Cond::Ge => a >= b,
-                    Cond::Le => a <= b,
-                    Cond::Gt => a > b,
-                    Cond::Ltu => ua < ub,
-                    Cond::Geu => ua >= ub,
-                    Cond::Leu => ua <= ub,
-                    Cond::Gtu => ua > ub,
-                    Cond::Cs => self.c,
-                    Cond::Vs => self.v,
-                    Cond::True => true,
-                    Cond::False => false,
-                    Cond::Bit => ua & ub != 0,
-                    Cond::Nbit => ua & ub == 0,
-                };
-            }
+            Op::Cmp => self.f = self.holds(c.cond(), a, b),
             Op::Sll => result = Some(if n >= 16 { 0 } else { wrap16(u16of(a) << n) }),
             Op::Srl => result = Some(if n >= 16 { 0 } else { wrap16(u16of(a) >> n) }),
             Op::Sra => result = Some(a.div_euclid(1i64 << n)),
@@ -219,5 +199,28 @@ impl RefRc {
             }
         }
         Outcome::Executed
+    }
+
+    /// Whether `cmp`'s condition `cond` holds of `a` and `b`.
+    fn holds(&self, cond: Cond, a: i64, b: i64) -> bool {
+        let (ua, ub) = (u16of(a), u16of(b));
+        match cond {
+            Cond::Eq => a == b,
+            Cond::Ne => a != b,
+            Cond::Lt => a < b,
+            Cond::Ge => a >= b,
+            Cond::Le => a <= b,
+            Cond::Gt => a > b,
+            Cond::Ltu => ua < ub,
+            Cond::Geu => ua >= ub,
+            Cond::Leu => ua <= ub,
+            Cond::Gtu => ua > ub,
+            Cond::Cs => self.c,
+            Cond::Vs => self.v,
+            Cond::True => true,
+            Cond::False => false,
+            Cond::Bit => ua & ub != 0,
+            Cond::Nbit => ua & ub == 0,
+        }
     }
 }
