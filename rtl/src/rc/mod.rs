@@ -8,8 +8,18 @@
 //! accumulator), [`register_file`], [`ram`], [`flags`], plus the output
 //! register `out` that the interconnect and the frame-buffer write path read.
 
+/// Apply a unary or binary lane function to every lane.
+macro_rules! map {
+    ($res:expr, |$i:ident| $e:expr) => {
+        for $i in 0..N {
+            $res[$i] = $e;
+        }
+    };
+}
+
 pub mod alu;
 pub mod context;
+mod execute;
 pub mod flags;
 pub mod isa_vh;
 pub mod lanes;
@@ -23,9 +33,9 @@ pub mod word;
 use std::fmt;
 
 use crate::kernel::{Clocked, Fault};
-use context::{ASrc, BSrc, Cond, Context, Guard, Op};
+use context::{ASrc, BSrc, Context, Guard, Op};
 use flags::Flags;
-use lanes::{full, Mask, SignBits};
+use lanes::{full, Mask};
 use ram::Ram;
 use register_file::RegisterFile;
 pub(crate) use waves::{CTX_FILTER, OP_FILTER};
@@ -197,150 +207,6 @@ impl<const N: usize, W: Word> RcArray<N, W> {
     }
 }
 
-/// Apply a unary or binary lane function to every lane.
-macro_rules! map {
-    ($res:expr, |$i:ident| $e:expr) => {
-        for $i in 0..N {
-            $res[$i] = $e;
-        }
-    };
-}
-
-/// Run a flag-producing ALU function over every lane. The flags are
-/// gathered as 0 / -1 lanes of the loop's own width and packed by their
-/// sign bits ([`SignBits::sign_mask`]).
-#[inline(always)]
-fn cv<W: Word, const N: usize>(
-    res: &mut [W; N],
-    f: impl Fn(usize) -> alu::Flagged<W>,
-) -> (Mask, Mask) {
-    let mut c = [W::ZERO; N];
-    let mut v = [W::ZERO; N];
-    for i in 0..N {
-        let r = f(i);
-        res[i] = r.value;
-        c[i] = W::flag(r.c);
-        v[i] = W::flag(r.v);
-    }
-    (W::sign_mask(&c), W::sign_mask(&v))
-}
-
-/// Is every lane of `x` alike? (An OR of differences: it vectorises,
-/// where a comparison that stops at the first difference did not.)
-#[inline(always)]
-fn same<W: Word, const N: usize>(x: &[W; N]) -> bool {
-    let x0 = x[0];
-    x.iter().fold(W::ZERO, |m, &v| m | (v ^ x0)) == W::ZERO
-}
-
-/// Run a multiplier lane function (lane `i`'s new accumulator, result and
-/// saturation) over every lane; returns the saturation mask. 32 lanes at a
-/// time, each chunk's flags gathered into the mask at once (one loop over
-/// all the lanes with the flags stored as a lane array and gathered after
-/// it: `mul` 13.3 ns a context in `rc_array_op`, this 10.0).
-#[inline(always)]
-fn mul_lanes<W: Word, const N: usize>(
-    res: &mut [W; N],
-    acc_d: &mut [W::Acc; N],
-    f: impl Fn(usize) -> (W::Acc, W, bool),
-) -> Mask {
-    const C: usize = 32;
-    if N.is_multiple_of(C) {
-        let mut m = 0;
-        for k in 0..N / C {
-            let mut r = [W::ZERO; C];
-            let mut s = [W::Acc::default(); C];
-            for j in 0..C {
-                let (n, x, v) = f(k * C + j);
-                acc_d[k * C + j] = n;
-                r[j] = x;
-                s[j] = W::Acc::flag(v);
-            }
-            res[k * C..k * C + C].copy_from_slice(&r);
-            m |= W::Acc::sign_mask(&s) << (k * C);
-        }
-        return m;
-    }
-    let mut s = [W::Acc::default(); N];
-    for i in 0..N {
-        let (n, x, v) = f(i);
-        acc_d[i] = n;
-        res[i] = x;
-        s[i] = W::Acc::flag(v);
-    }
-    W::Acc::sign_mask(&s)
-}
-
-/// Run a saturating function over every lane; returns the saturation mask.
-#[inline(always)]
-fn sat<W: Word, const N: usize>(res: &mut [W; N], f: impl Fn(usize) -> (W, bool)) -> Mask {
-    let mut v = [W::ZERO; N];
-    for i in 0..N {
-        let (r, s) = f(i);
-        res[i] = r;
-        v[i] = W::flag(s);
-    }
-    W::sign_mask(&v)
-}
-
-/// The multiplier's output stage over every lane: the accumulator shifted
-/// right by `sh` (rounded unless `trunc`) and saturated to the word;
-/// returns the saturated lanes. The rounding choice is made once, outside
-/// the lane loop (`sh = 0` has no rounding bit either way).
-#[inline(always)]
-fn scale_lanes<W: Word, const N: usize>(
-    acc: &[W::Acc; N],
-    sh: u32,
-    trunc: bool,
-    res: &mut [W; N],
-) -> Mask {
-    if trunc || sh & (2 * W::BITS - 1) == 0 {
-        sat(res, |i| W::scale(acc[i], sh, true))
-    } else {
-        sat(res, |i| W::scale(acc[i], sh, false))
-    }
-}
-
-/// The flag F of every lane for `cmp` (before the merge with the executing
-/// lanes): the condition chosen once, each arm a loop over the lanes (the
-/// condition inside the loop kept it from vectorising).
-#[inline(always)]
-fn cmp_mask<W: Word, const N: usize>(
-    cond: Cond,
-    a: &[W; N],
-    b: &[W; N],
-    cf: Mask,
-    vf: Mask,
-) -> Mask {
-    macro_rules! by {
-        ($k:expr) => {{
-            let mut f = [W::ZERO; N];
-            for i in 0..N {
-                f[i] = W::flag(W::cond($k, a[i], b[i], false, false));
-            }
-            W::sign_mask(&f)
-        }};
-    }
-    match cond {
-        Cond::Eq => by!(Cond::Eq),
-        Cond::Ne => by!(Cond::Ne),
-        Cond::Lt => by!(Cond::Lt),
-        Cond::Ge => by!(Cond::Ge),
-        Cond::Le => by!(Cond::Le),
-        Cond::Gt => by!(Cond::Gt),
-        Cond::Ltu => by!(Cond::Ltu),
-        Cond::Geu => by!(Cond::Geu),
-        Cond::Leu => by!(Cond::Leu),
-        Cond::Gtu => by!(Cond::Gtu),
-        Cond::Bit => by!(Cond::Bit),
-        Cond::Nbit => by!(Cond::Nbit),
-        Cond::Cs => cf & full(N),
-        Cond::Vs => vf & full(N),
-        Cond::True => full(N),
-        Cond::False => 0,
-    }
-}
-
 impl<const N: usize, W: Word> Clocked for RcArray<N, W> {
     fn eval(&mut self) -> Result<(), Fault> {
         self.eval_lanes()
@@ -452,7 +318,6 @@ impl<const N: usize, W: Word> RcArray<N, W> {
         };
         let res = &mut self.res;
         let (sh, trunc) = (c.shift as u32, c.trunc);
-        let cin = self.flags.c;
         match c.op {
             Op::Nop | Op::Sleep | Op::Wake => {
                 fin!(P_NONE);
@@ -460,69 +325,17 @@ impl<const N: usize, W: Word> RcArray<N, W> {
                     self.sleep_wake();
                 }
             }
-            Op::Add => {
-                (self.d_c, self.d_v) = cv(res, |i| W::add(a[i], b[i], false));
+            Op::Add | Op::Adc | Op::Sub | Op::Sbc | Op::Rsb | Op::Neg => {
+                (self.d_c, self.d_v) = execute::add_sub(c.op, a, b, self.flags.c, res);
                 fin!(P_CV);
             }
-            Op::Adc => {
-                (self.d_c, self.d_v) = cv(res, |i| W::add(a[i], b[i], cin >> i & 1 != 0));
-                fin!(P_CV);
-            }
-            Op::Sub => {
-                (self.d_c, self.d_v) = cv(res, |i| W::sub(a[i], b[i], false));
-                fin!(P_CV);
-            }
-            Op::Sbc => {
-                (self.d_c, self.d_v) = cv(res, |i| W::sub(a[i], b[i], cin >> i & 1 != 0));
-                fin!(P_CV);
-            }
-            Op::Rsb => {
-                (self.d_c, self.d_v) = cv(res, |i| W::sub(b[i], a[i], false));
-                fin!(P_CV);
-            }
-            Op::Neg => {
-                (self.d_c, self.d_v) = cv(res, |i| W::sub(W::ZERO, a[i], false));
-                fin!(P_CV);
-            }
-            Op::Adds => {
-                self.d_v = sat(res, |i| W::adds(a[i], b[i]));
+            Op::Adds | Op::Subs | Op::Abs | Op::Absd | Op::Asl => {
+                self.d_v = execute::saturating(c.op, a, b, res);
                 self.d_c = 0;
                 fin!(P_CV);
             }
-            Op::Subs => {
-                self.d_v = sat(res, |i| W::subs(a[i], b[i]));
-                self.d_c = 0;
-                fin!(P_CV);
-            }
-            Op::Abs => {
-                self.d_v = sat(res, |i| W::abs(a[i]));
-                self.d_c = 0;
-                fin!(P_CV);
-            }
-            Op::Absd => {
-                self.d_v = sat(res, |i| W::absd(a[i], b[i]));
-                self.d_c = 0;
-                fin!(P_CV);
-            }
-            Op::Asl => {
-                self.d_v = sat(res, |i| W::asl(a[i], W::amount(b[i])));
-                self.d_c = 0;
-                fin!(P_CV);
-            }
-            Op::And => {
-                map!(res, |i| a[i] & b[i]);
-                fin!(P_RES);
-            }
-            Op::Or => {
-                map!(res, |i| a[i] | b[i]);
-                fin!(P_RES);
-            }
-            Op::Xor => {
-                map!(res, |i| a[i] ^ b[i]);
-                fin!(P_RES);
-            }
-            Op::Not => {
-                map!(res, |i| !a[i]);
+            Op::And | Op::Or | Op::Xor | Op::Not | Op::Min | Op::Max | Op::Clz => {
+                execute::logic(c.op, a, b, res);
                 fin!(P_RES);
             }
             Op::Mov => {
@@ -533,172 +346,49 @@ impl<const N: usize, W: Word> RcArray<N, W> {
                 *res = *b;
                 fin!(P_RES);
             }
-            Op::Min => {
-                map!(res, |i| a[i].min(b[i]));
-                fin!(P_RES);
-            }
-            Op::Max => {
-                map!(res, |i| a[i].max(b[i]));
-                fin!(P_RES);
-            }
-            Op::Clz => {
-                map!(res, |i| W::clz(a[i]));
-                fin!(P_RES);
-            }
             Op::Sel => {
-                let f = self.flags.f;
-                if N.is_multiple_of(8) {
-                    // F expanded to 0 / -1 lanes and blended (the bit
-                    // tested lane by lane did not vectorise).
-                    let m = expand::<W, N>(f);
-                    map!(res, |i| (a[i] & m[i]) | (b[i] & !m[i]))
-                } else {
-                    map!(res, |i| if f >> i & 1 != 0 { a[i] } else { b[i] })
-                }
+                execute::select(self.flags.f, a, b, res);
                 fin!(P_RES);
             }
             Op::Cmp => {
-                self.d_f = cmp_mask(c.cond(), a, b, self.flags.c, self.flags.v);
+                self.d_f = execute::cmp_mask(c.cond(), a, b, self.flags.c, self.flags.v);
                 fin!(P_F);
             }
-            Op::Sll => {
-                map!(res, |i| W::sll(a[i], W::amount(b[i])));
-                fin!(P_RES);
-            }
-            Op::Srl => {
-                map!(res, |i| W::srl(a[i], W::amount(b[i])));
-                fin!(P_RES);
-            }
-            Op::Sra => {
-                map!(res, |i| W::sra(a[i], W::amount(b[i])));
+            Op::Sll | Op::Srl | Op::Sra => {
+                execute::shift(c.op, a, b, res);
                 fin!(P_RES);
             }
             Op::Mul | Op::Mac | Op::Msu => {
-                let acc = &self.acc;
-                let acc_d = &mut self.acc_d;
-                // One loop per operation and rounding choice (chosen once,
-                // outside the lanes; `sh = 0` has no rounding bit either
-                // way): the product is scaled while it is in a register,
-                // not stored and loaded back.
-                macro_rules! lanes {
-                    ($trunc:expr) => {
-                        match c.op {
-                            Op::Mul => mul_lanes(res, acc_d, |i| {
-                                let p = W::product(a[i], b[i]);
-                                let (r, s2) = W::scale(p, sh, $trunc);
-                                (p, r, s2)
-                            }),
-                            _ => {
-                                let sub = c.op == Op::Msu;
-                                mul_lanes(res, acc_d, |i| {
-                                    let p = W::product(a[i], b[i]);
-                                    let (n, s1) = W::accumulate(acc[i], p, sub);
-                                    let (r, s2) = W::scale(n, sh, $trunc);
-                                    (n, r, s1 | s2)
-                                })
-                            }
-                        }
-                    };
-                }
-                let v = if trunc || sh & (2 * W::BITS - 1) == 0 {
-                    lanes!(true)
-                } else {
-                    lanes!(false)
-                };
-                (self.d_v, self.d_c) = (v, 0);
+                let (acc, acc_d) = (&self.acc, &mut self.acc_d);
+                self.d_v = execute::multiply(c.op, a, b, acc, acc_d, res, (sh, trunc));
+                self.d_c = 0;
                 fin!(P_MUL);
             }
             Op::Acc => {
-                self.d_v = scale_lanes(&self.acc, sh, trunc, res);
+                self.d_v = execute::scale_lanes(&self.acc, sh, trunc, res);
                 self.d_c = 0;
                 fin!(P_CV);
             }
-            Op::Acch => {
-                map!(res, |i| W::acch(self.acc[i]));
-                fin!(P_RES);
-            }
-            Op::Accl => {
-                map!(res, |i| W::accl(self.acc[i]));
+            Op::Acch | Op::Accl => {
+                execute::acc_part(c.op, &self.acc, res);
                 fin!(P_RES);
             }
             Op::Ldacc => {
-                let acc_d = &mut self.acc_d;
-                // The shift the tracer uses (a Q.14 or Q.30 product's
-                // scale) cannot saturate: no clamp in a wider type.
-                let sh = sh & (2 * W::BITS - 1);
-                if sh < W::BITS {
-                    for i in 0..N {
-                        acc_d[i] = W::ldacc_narrow(a[i], sh);
-                    }
-                } else {
-                    for i in 0..N {
-                        acc_d[i] = W::ldacc(a[i], sh);
-                    }
-                }
+                execute::load_acc(a, sh, &mut self.acc_d);
                 fin!(P_ACC);
             }
             Op::Ld | Op::St => {
-                let store = c.op == Op::St;
-                // lane 0's address from its operands
-                let a0 = if store {
-                    W::addr1(b[0])
-                } else {
-                    W::addr(a[0], b[0])
-                };
-                // One address in every lane (constants, the stack, the hit
-                // record): a whole RAM row, one address to check and keep;
-                // otherwise one word per lane. Operands alike in every lane
-                // (an immediate, one base) give one address without
-                // computing 64; otherwise the addresses are compared.
-                let b_same = matches!(c.b, BSrc::Imm(_)) || same(b);
-                self.uniform = if b_same && (store || same(a)) {
-                    true
-                } else {
-                    let mut addr = [0i32; N];
-                    if store {
-                        map!(addr, |i| W::addr1(b[i]));
-                    } else {
-                        map!(addr, |i| W::addr(a[i], b[i]));
-                    }
-                    let uniform = addr.iter().fold(true, |u, &x| u & (x == a0));
-                    if !uniform {
-                        let mut bad = [false; N];
-                        for i in 0..N {
-                            bad[i] = !Ram::<N, W>::valid(addr[i]);
-                        }
-                        let bad = lanes::pack_bools(&bad) & en;
-                        if bad != 0 {
-                            let i = bad.trailing_zeros() as usize;
-                            let msg = format!("RAM address {} outside 0..=511", addr[i]);
-                            return Err(self.lane_fault(i, msg));
-                        }
-                        for i in 0..N {
-                            self.addr[i] = addr[i].clamp(0, 511) as u16;
-                        }
-                    }
-                    uniform
-                };
-                if self.uniform {
-                    if !Ram::<N, W>::valid(a0) {
-                        let i = en.trailing_zeros() as usize;
-                        let msg = format!("RAM address {a0} outside 0..=511");
-                        return Err(self.lane_fault(i, msg));
-                    }
-                    self.addr0 = a0 as u16;
+                let (store, at) = (c.op == Op::St, (&mut self.addr, &mut self.addr0));
+                match execute::ram_address(c, a, b, en, store, at) {
+                    Ok(uniform) => self.uniform = uniform,
+                    Err((i, msg)) => return Err(self.lane_fault(i, msg)),
                 }
                 if store {
                     // A store has no result: `res` carries its data to the edge.
                     *res = *a;
-                } else if self.uniform {
-                    *res = *self.ram.row(self.addr0 as usize);
-                } else {
-                    for i in 0..N {
-                        res[i] = self.ram.read(i, self.addr[i] as usize);
-                    }
-                }
-                if store {
                     fin!(P_ST);
                 } else {
+                    execute::load(&self.ram, self.uniform, self.addr0, &self.addr, res);
                     fin!(P_RES);
                 }
             }
