@@ -13,20 +13,21 @@ use crate::cmd_scene::{load_scene, png_bytes};
 mod profile_report;
 use crate::metrics;
 use crate::reference;
+use crate::render_options as ro;
 
 #[derive(clap::Args, Debug)]
 pub struct RenderArgs {
     /// Scene file (.nff or .toml); default scenes/default.toml.
     pub scene: Option<PathBuf>,
     /// Image size WIDTHxHEIGHT, each side 1..=4096 (default 256x256).
-    #[arg(long, value_name = "WxH", value_parser = crate::cli::parse_size)]
+    #[arg(long = ro::SIZE.long, value_name = "WxH", value_parser = crate::cli::parse_size)]
     pub size: Option<(u32, u32)>,
     /// Rays traced in parallel: 4, 8, 16, 32 or 64.
-    #[arg(long, value_name = "N", default_value_t = 64, value_parser = crate::cli::parse_ways)]
+    #[arg(long = ro::WAYS.long, value_name = "N", default_value_t = 64, value_parser = crate::cli::parse_ways)]
     pub ways: u32,
     /// Maximum ray depth 1..=8; the eye ray is depth 1 (default: the
     /// paper's recursion level 2; the SPD's is 5).
-    #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
+    #[arg(long = ro::DEPTH.long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(1..=firmware::tracer::MAX_RAY_DEPTH as i64))]
     pub depth: u32,
     /// Write the image here (default: <scene>-chip.png).
     #[arg(long, value_name = "PNG")]
@@ -51,32 +52,32 @@ pub struct RenderArgs {
     /// Maximum BSP depth: a number (1..=32) or auto (the paper's 15 for
     /// the paper's traversal; for the packet traversal 15 for a median
     /// tree and 8 + 1.3 log2(objects) for the SAH trees).
-    #[arg(long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_depth)]
+    #[arg(long = ro::MAX_DEPTH.long, value_name = "auto|N", default_value = "auto", value_parser = crate::cli::parse_depth)]
     pub max_depth: u32,
     /// Maximum objects per BSP leaf.
-    #[arg(long, value_name = "N", default_value_t = 5, value_parser = crate::cli::parse_count::<usize>)]
+    #[arg(long = ro::MAX_LEAF.long, value_name = "N", default_value_t = 5, value_parser = crate::cli::parse_count::<usize>)]
     pub max_leaf: usize,
     /// BSP split rule: median (the paper's spatial median, axes in turn),
     /// sah (surface area heuristic, pbrt's costs), chip (surface area
     /// heuristic with the chip's cycle costs, from its kernels, leaves that fit an
     /// FB bank) or auto (median for the paper's traversal; for the packet
     /// traversal the fastest of the three trees on a probe of the frame).
-    #[arg(long, value_name = "auto|median|sah|chip", default_value = "auto", value_parser = ["auto", "median", "sah", "chip"])]
+    #[arg(long = ro::SPLIT.long, value_name = "auto|median|sah|chip", default_value = "auto", value_parser = ["auto", "median", "sah", "chip"])]
     pub split: String,
     /// How BSP nodes name their objects: fig5 (the paper's bit vectors)
     /// or compact (index lists); the same image either way.
-    #[arg(long, value_name = "fig5|compact", default_value = "fig5")]
+    #[arg(long = ro::LAYOUT.long, value_name = "fig5|compact", default_value = "fig5")]
     pub layout: firmware::tracer::NodeLayout,
     /// BSP traversal: paper (the paper's: where the rays disagree, test
     /// every object under the node) or packet (per-ray intervals; a
     /// child is visited only by the rays that reach it).
-    #[arg(long, value_name = "packet|paper", default_value = "packet")]
+    #[arg(long = ro::TRAVERSAL.long, value_name = "packet|paper", default_value = "packet")]
     pub traversal: firmware::tracer::Traversal,
     /// Packet traversal: which BSP subtrees to walk as one leaf of all
     /// their objects: auto (where that costs less than walking them, by
     /// the cells' surface areas and the kernels' lengths) or N (those
     /// with at most N objects; 0: none).
-    #[arg(long, value_name = "auto|N", default_value = "auto")]
+    #[arg(long = ro::COLLAPSE.long, value_name = "auto|N", default_value = "auto")]
     pub collapse: firmware::tracer::Collapse,
     /// Streamed packet traversal: the words of the pieces a leaf's records
     /// are moved in by DMA, FIRST,SECOND,REST (or FIRST,REST: the second
@@ -87,7 +88,7 @@ pub struct RenderArgs {
     /// <= SECOND <= REST, a piece holds at least one record. SECOND auto
     /// (`auto` = 64,auto,256): 2 x FIRST or REST, whichever runs the probe
     /// faster.
-    #[arg(long, value_name = "auto|FIRST,[SECOND,]REST", default_value = "auto")]
+    #[arg(long = ro::LEAF_PIECES.long, value_name = "auto|FIRST,[SECOND,]REST", default_value = "auto")]
     pub leaf_pieces: firmware::tracer::LeafPieces,
     /// Packet traversal: the shadow rays of the reflection levels (depth 2
     /// and more): light (a packet per light, the rays in the RCs that
@@ -95,7 +96,7 @@ pub struct RenderArgs {
     /// packets as hold them, the answers moved back; scenes of 2 to 12
     /// lights) or auto (both run on a probe of the frame, the faster
     /// kept). The eye rays' level keeps a packet per light.
-    #[arg(long, value_name = "auto|light|merged", default_value = "auto")]
+    #[arg(long = ro::SHADOW_PACKETS.long, value_name = "auto|light|merged", default_value = "auto")]
     pub shadow_packets: firmware::tracer::ShadowPackets,
     /// Streamed packet traversal: where a banded polygon's sub-edges are
     /// (polygons of 16 edges or more): apart (where a record would be
@@ -103,7 +104,7 @@ pub struct RenderArgs {
     /// packet's points lie in moved by DMA once they are known) or records
     /// (in the record, moved with every leaf piece that holds it, as the
     /// resident layout keeps them). The same image.
-    #[arg(long, value_name = "apart|records", default_value = "apart")]
+    #[arg(long = ro::SUB_EDGES.long, value_name = "apart|records", default_value = "apart")]
     pub sub_edges: firmware::tracer::SubEdges,
     /// Packet traversal: run each object test in parts, at the cuts of its
     /// kernels, the rest skipped where no awake ray can still hit the
@@ -112,7 +113,7 @@ pub struct RenderArgs {
     /// part after a status read), off (whole), or auto (on; tinyrisc
     /// under the timing's instruction issue model, where TinyRISC issues
     /// every context itself). The same image every way.
-    #[arg(long, value_name = "auto|on|tinyrisc|off", default_value = "auto")]
+    #[arg(long = ro::TEST_CUTS.long, value_name = "auto|on|tinyrisc|off", default_value = "auto")]
     pub test_cuts: firmware::tracer::TestCuts,
     /// Packet traversal: which child of a node a packet visits first where
     /// its awake rays go both ways along the node's axis: majority (the
@@ -124,30 +125,30 @@ pub struct RenderArgs {
     /// go, kept where faster than majority on a probe of the frame; then
     /// each closest-hit axis left to the majority tried on the probe with
     /// the way its sampled rays that hit lean). The same image either way.
-    #[arg(long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto")]
+    #[arg(long = ro::CHILD_ORDER.long, value_name = "auto|majority|XYZ[,XYZ]", default_value = "auto")]
     pub child_order: firmware::tracer::ChildOrder,
     /// RC datapath width in bits: 16 (the paper's chip), 32 (the
     /// variant the paper announces; every format gets 16 more fraction
     /// bits), or auto: 16 unless the 16-bit chip cannot hold the scene or
     /// renders a probe of the frame (1/16 of the tiles) under 30 dB or
     /// 99% hit agreement against the reference where 32 bits do better.
-    #[arg(long, value_name = "auto|16|32", value_parser = crate::cli::parse_datapath_choice, default_value = "auto")]
+    #[arg(long = ro::DATAPATH.long, value_name = "auto|16|32", value_parser = crate::cli::parse_datapath_choice, default_value = "auto")]
     pub datapath: crate::cli::DatapathChoice,
     /// Newton-Raphson steps after each reciprocal / square-root table
     /// lookup (0..=3).
-    #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=3))]
+    #[arg(long = ro::NEWTON_STEPS.long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(0..=3))]
     pub newton_steps: u32,
     /// Entries of the reciprocal and reciprocal square-root tables in
     /// every RC's RAM: 16, 32, 64 or 128.
-    #[arg(long, value_name = "N", default_value_t = 128, value_parser = crate::cli::parse_table_entries)]
+    #[arg(long = ro::TABLE_ENTRIES.long, value_name = "N", default_value_t = 128, value_parser = crate::cli::parse_table_entries)]
     pub table_entries: u32,
     /// Guard bits of the coordinate format above the scene's largest
     /// object or eye coordinate (2..=4; more: a coarser format).
-    #[arg(long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=4))]
+    #[arg(long = ro::GUARD_BITS.long, value_name = "N", default_value_t = 2, value_parser = clap::value_parser!(u32).range(2..=4))]
     pub guard_bits: u32,
     /// Offset of spawned (shadow, reflected, refracted) rays along the
     /// normal, in LSBs of the coordinate format (0..=64).
-    #[arg(long, value_name = "N", default_value_t = firmware::tracer::options::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
+    #[arg(long = ro::RAY_OFFSET_LSB.long, value_name = "N", default_value_t = firmware::tracer::options::EPS_LSB, value_parser = clap::value_parser!(i32).range(0..=64))]
     pub ray_offset_lsb: i32,
     /// Normals of spheres and cylinders: fine (the eye moved onto the
     /// coordinate format's grid with the whole scene, and the
@@ -156,7 +157,7 @@ pub struct RenderArgs {
     /// per cylinder test), coarse (the kernels as first written, with
     /// which the comparison with the paper was made) or auto (fine on
     /// the 16-bit chip, coarse on the 32-bit one)
-    #[arg(long, value_name = "auto|fine|coarse", default_value = "auto")]
+    #[arg(long = ro::NORMALS.long, value_name = "auto|fine|coarse", default_value = "auto")]
     pub normals: firmware::tracer::Normals,
     /// With --json: when that file already holds a complete render made
     /// with these same arguments from the same scene, timing file,

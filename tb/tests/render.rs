@@ -182,6 +182,18 @@ fn json_has_every_key_and_sane_figures() {
     ] {
         assert!(!j[k].is_null(), "missing key {k}");
     }
+    // Every render option the JSON reports, under the table's key.
+    use tb::render_options::{Json, RENDER_OPTIONS};
+    for r in RENDER_OPTIONS {
+        if !matches!(r.json, Json::Apart) {
+            assert!(
+                !j[r.key()].is_null(),
+                "--{}: missing key {}",
+                r.long,
+                r.key()
+            );
+        }
+    }
     assert_eq!(j["width"], 24);
     assert_eq!(j["height"], 16);
     assert_eq!(j["ways"], 64);

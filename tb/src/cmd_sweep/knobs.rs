@@ -2,6 +2,7 @@
 //! configuration or the packet traversal's, and each on the default
 //! timing, the M1 chip's issue model and every `--timing` file.
 
+use crate::render_options as ro;
 use firmware::bsp::{BspParams, SplitRule};
 use firmware::tracer::{Datapath, NodeLayout, Numerics, Options, Traversal};
 use rtl::tinyrisc::IssueModel;
@@ -90,7 +91,7 @@ pub(super) fn knobs(width: u32, height: u32) -> Vec<Knob> {
 fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     for newton_steps in [0, 1, 2, 3] {
         v.push(Knob {
-            knob: "newton_steps",
+            knob: ro::NEWTON_STEPS.name,
             value: newton_steps.to_string(),
             opt: base,
             nm: Numerics { newton_steps, ..nm },
@@ -99,7 +100,7 @@ fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     // More guard bits: a coarser coordinate format (fewer fraction bits).
     for guard_bits in [2, 3, 4] {
         v.push(Knob {
-            knob: "guard_bits",
+            knob: ro::GUARD_BITS.name,
             value: guard_bits.to_string(),
             opt: base,
             nm: Numerics { guard_bits, ..nm },
@@ -109,7 +110,7 @@ fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     for table_entries in firmware::tracer::math::TABLE_SIZES {
         for newton_steps in [1, 2] {
             v.push(Knob {
-                knob: "table_entries",
+                knob: ro::TABLE_ENTRIES.name,
                 value: format!("{table_entries}/{newton_steps}"),
                 opt: base,
                 nm: Numerics {
@@ -123,7 +124,7 @@ fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     // The kernels as first written (`--normals coarse`): the paper
     // configuration's point before the fine normals, beside it.
     v.push(Knob {
-        knob: "normals",
+        knob: ro::NORMALS.name,
         value: "coarse".into(),
         opt: base,
         nm: Numerics {
@@ -133,7 +134,7 @@ fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     });
     for eps_lsb in [1, 3, 8] {
         v.push(Knob {
-            knob: "ray_offset_lsb",
+            knob: ro::RAY_OFFSET_LSB.name,
             value: eps_lsb.to_string(),
             opt: base,
             nm: Numerics { eps_lsb, ..nm },
@@ -145,7 +146,7 @@ fn numerics_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
 fn ray_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
     for ways in [4, 8, 16, 32, 64] {
         v.push(Knob {
-            knob: "ways",
+            knob: ro::WAYS.name,
             value: ways.to_string(),
             opt: Options { ways, ..base },
             nm,
@@ -192,7 +193,7 @@ fn tree_knobs(v: &mut Vec<Knob>, base: Options, nm: Numerics) {
         });
     }
     v.push(Knob {
-        knob: "split",
+        knob: ro::SPLIT.name,
         value: "sah".into(),
         opt: Options {
             bsp: BspParams {
@@ -239,7 +240,7 @@ fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
     ] {
         let packet = packet_config(width, height);
         v.push(Knob {
-            knob: "leaf_pieces",
+            knob: ro::LEAF_PIECES.name,
             value: pieces.to_string(),
             opt: Options { pieces, ..packet },
             nm,
@@ -253,7 +254,7 @@ fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
     ] {
         let packet = packet_config(width, height);
         v.push(Knob {
-            knob: "shadow_packets",
+            knob: ro::SHADOW_PACKETS.name,
             value: shadows.to_string(),
             opt: Options { shadows, ..packet },
             nm,
@@ -263,7 +264,7 @@ fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
     // (the default keeps them apart and moves a packet's bands).
     let packet = packet_config(width, height);
     v.push(Knob {
-        knob: "sub_edges",
+        knob: ro::SUB_EDGES.name,
         value: firmware::tracer::SubEdges::InRecords.to_string(),
         opt: Options {
             sub_edges: firmware::tracer::SubEdges::InRecords,
@@ -276,7 +277,7 @@ fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
     // that faster).
     let packet = packet_config(width, height);
     v.push(Knob {
-        knob: "child_order",
+        knob: ro::CHILD_ORDER.name,
         value: firmware::tracer::ChildOrder::MAJORITY.to_string(),
         opt: Options {
             child_order: firmware::tracer::ChildOrder::MAJORITY,
@@ -292,7 +293,7 @@ fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
         firmware::tracer::TestCuts::Off,
     ] {
         v.push(Knob {
-            knob: "test_cuts",
+            knob: ro::TEST_CUTS.name,
             value: test_cuts.to_string(),
             opt: Options {
                 test_cuts,
@@ -307,20 +308,20 @@ fn packet_knobs(v: &mut Vec<Knob>, width: u32, height: u32, nm: Numerics) {
 fn chip_knobs(v: &mut Vec<Knob>, base: Options, width: u32, height: u32, nm: Numerics) {
     for datapath in [Datapath::W16, Datapath::W32] {
         v.push(Knob {
-            knob: "datapath",
+            knob: ro::DATAPATH.name,
             value: datapath.bits().to_string(),
             opt: Options { datapath, ..base },
             nm,
         });
     }
     v.push(Knob {
-        knob: "traversal",
+        knob: ro::TRAVERSAL.name,
         value: Traversal::Packet.name().into(),
         opt: packet_config(width, height),
         nm,
     });
     v.push(Knob {
-        knob: "layout",
+        knob: ro::LAYOUT.name,
         value: NodeLayout::Compact.name().into(),
         opt: Options {
             layout: NodeLayout::Compact,

@@ -3,6 +3,7 @@
 //! scene-size chart with its fitted log-log slopes.
 
 use crate::charts::{self, Chart, Mark, Series, SeriesStyle};
+use crate::render_options as ro;
 use anyhow::Result;
 use firmware::tracer::Traversal;
 use std::path::{Path, PathBuf};
@@ -33,7 +34,7 @@ pub(super) fn charts_for(all_rows: &[Row], dir: &Path) -> Result<Vec<PathBuf>> {
         .filter(|r| !matches!(r.knob.as_str(), SCENE_SIZE | "broadcast" | "timing"))
         .cloned()
         .collect();
-    if !rows.iter().any(|r| r.knob == "ways") {
+    if !rows.iter().any(|r| r.knob == ro::WAYS.name) {
         return Ok(out);
     }
     let rows = &rows[..];
@@ -81,7 +82,7 @@ fn fig8_charts(
             ),
             x_label: "rays traced in parallel (ways)".into(),
             y_label: "frames/s at 300 MHz".into(),
-            series: per("ways", &|r| r.fps_at_300mhz),
+            series: per(ro::WAYS.name, &|r| r.fps_at_300mhz),
             marks: vec![Mark {
                 label: "paper: 13.3 frames/s".into(),
                 x: 64.0,
@@ -99,7 +100,9 @@ fn fig8_charts(
             title: "Utilisation of the ray lanes against rays in parallel".into(),
             x_label: "rays traced in parallel (ways)".into(),
             y_label: "active RCs / ways (while the array runs)".into(),
-            series: per("ways", &|r| r.active_rc_fraction * 64.0 / r.ways as f64),
+            series: per(ro::WAYS.name, &|r| {
+                r.active_rc_fraction * 64.0 / r.ways as f64
+            }),
             marks: vec![],
             lines: true,
             log_x: true,
@@ -147,7 +150,7 @@ fn pareto_charts(rows: &[Row], scenes: &[&str], dir: &Path) -> Result<Vec<PathBu
     // kernels' cost and gain.
     let normals = scenes.iter().map(|s| Series {
         name: format!("{} normals coarse, fine", short(s)),
-        points: ["normals", "paper"]
+        points: [ro::NORMALS.name, "paper"]
             .iter()
             .filter_map(|k| rows.iter().find(|r| r.scene == *s && r.knob == *k))
             .map(|r| (r.fps_at_300mhz, r.psnr_db))
@@ -237,7 +240,7 @@ fn normals_chart(
         .iter()
         .filter_map(|s| {
             let pick = |k: &str| rows.iter().find(|r| r.scene == *s && r.knob == k);
-            let (coarse, fine) = (pick("normals")?, pick("paper")?);
+            let (coarse, fine) = (pick(ro::NORMALS.name)?, pick("paper")?);
             Some(Series {
                 name: format!("{} ({}-bit)", short(s), fine.datapath_bits),
                 points: [coarse, fine]
@@ -326,7 +329,7 @@ pub(super) fn what_if_chart(rows: &[Row], dir: &Path, knob: &str) -> Result<[Pat
                 && b.traversal == r.traversal
                 && match r.traversal.as_str() {
                     "paper" => b.knob == "paper",
-                    _ => b.knob == "traversal",
+                    _ => b.knob == ro::TRAVERSAL.name,
                 }
         })
     };

@@ -2,6 +2,7 @@
 //! reference, as the JSON `morphosys render --json` writes; and the check
 //! that a JSON on disk is such a render (`--skip-done`, `sweep --merge`).
 
+use crate::render_options as ro;
 use std::path::Path;
 use std::time::Instant;
 
@@ -73,10 +74,10 @@ pub(crate) fn render_and_measure(
         "warnings": warnings,
         "width": opt.width,
         "height": opt.height,
-        "ways": opt.ways,
-        "depth": opt.depth,
-        "newton_steps": nm.newton_steps,
-        "table_entries": nm.table_entries,
+        ro::WAYS.key(): opt.ways,
+        ro::DEPTH.key(): opt.depth,
+        ro::NEWTON_STEPS.key(): nm.newton_steps,
+        ro::TABLE_ENTRIES.key(): nm.table_entries,
         "psnr_db": if psnr.is_finite() { psnr } else { 99.0 },
         "hit_agreement": agree,
         "eye_misclassified": 1.0 - agree,
@@ -91,7 +92,7 @@ pub(crate) fn render_and_measure(
         "format_note": "format: the tracer's, the finest in which every object and the eye fit with the guard bits (lights are scaled apart, never coarser than compiler_format); compiler_format: the scene image's (morphosys compile), which also spans the lights and the camera's target",
         "bsp_nodes": r.bsp.nodes,
         "bsp_max_depth": r.bsp.max_depth,
-        "child_order": chip.firmware.child_order.to_string(),
+        ro::CHILD_ORDER.key(): chip.firmware.child_order.to_string(),
     });
     if let (Some(j), serde_json::Value::Object(figures)) =
         (json.as_object_mut(), chip_json(&chip, opt))
@@ -119,7 +120,7 @@ fn chip_json(chip: &crate::render::ChipRender, opt: &Options) -> serde_json::Val
         "cycles": chip.cycles,
         "firmware_cycles": chip.firmware_cycles,
         "fps_at_300mhz": chip.fps_at(300_000_000),
-        "normals": if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
+        ro::NORMALS.key(): if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
         "eye_rays": census[crate::render::RAY_EYE],
         "shadow_rays": census[crate::render::RAY_SHADOW],
         "reflect_rays": census[crate::render::RAY_REFLECT],
@@ -145,20 +146,20 @@ fn chip_json(chip: &crate::render::ChipRender, opt: &Options) -> serde_json::Val
         "object_tests": chip.object_tests(),
         "array_busy_cycles": chip.stats.array_busy_cycles,
         "dma_busy_cycles": chip.stats.dma_busy_cycles,
-        "datapath_bits": opt.datapath.bits(),
+        ro::DATAPATH.key(): opt.datapath.bits(),
         "format": chip.firmware.format(),
-        "bsp_split": chip.firmware.bsp.rule,
-        "bsp_depth_limit": chip.firmware.bsp.max_depth,
+        ro::SPLIT.key(): chip.firmware.bsp.rule,
+        ro::MAX_DEPTH.key(): chip.firmware.bsp.max_depth,
         "context_words": chip.firmware.context_words,
         "kernels": chip.firmware.kernels.iter().map(|(n, l)| json!({"name": n, "contexts": l})).collect::<Vec<_>>(),
         "fb_words": chip.firmware.fb.len(),
         "node_layout": if opt.traversal == firmware::tracer::Traversal::Packet { "packet" } else { opt.layout.name() },
-        "traversal": opt.traversal.name(),
-        "collapse": opt.collapse.to_string(),
-        "leaf_pieces": chip.firmware.pieces.to_string(),
-        "shadow_packets": chip.firmware.shadows.to_string(),
-        "sub_edges": opt.sub_edges.to_string(),
-        "test_cuts": opt.test_cuts.to_string(),
+        ro::TRAVERSAL.key(): opt.traversal.name(),
+        ro::COLLAPSE.key(): opt.collapse.to_string(),
+        ro::LEAF_PIECES.key(): chip.firmware.pieces.to_string(),
+        ro::SHADOW_PACKETS.key(): chip.firmware.shadows.to_string(),
+        ro::SUB_EDGES.key(): opt.sub_edges.to_string(),
+        ro::TEST_CUTS.key(): opt.test_cuts.to_string(),
         "resident_fb_words": chip.firmware.layout.resident_words,
         "resident_node_words": chip.firmware.layout.resident_node_words,
         "fb_layout": if chip.firmware.layout.stream.is_some() { "streamed" } else { "resident" },
