@@ -38,9 +38,9 @@ pub(super) fn same<W: Word, const N: usize>(x: &[W; N]) -> bool {
 
 /// Run a multiplier lane function (lane `i`'s new accumulator, result and
 /// saturation) over every lane; returns the saturation mask. 32 lanes at a
-/// time, each chunk's flags gathered into the mask at once (one loop over
-/// all the lanes with the flags stored as a lane array and gathered after
-/// it: `mul` 13.3 ns a context in `rc_array_op`, this 10.0).
+/// time, each chunk's flags gathered into the mask at once (faster than
+/// one loop over all the lanes with the flags stored as a lane array and
+/// gathered after it).
 #[inline(always)]
 fn mul_lanes<W: Word, const N: usize>(
     res: &mut [W; N],

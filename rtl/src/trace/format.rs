@@ -260,8 +260,7 @@ impl Decimal {
 }
 
 /// Bytes of VCD body gathered before they are handed to the file: 256 KB
-/// (one `write` of 64 KB each took the kernel more in all: the bench's
-/// traced frame 0.027-0.028 s against 0.025-0.026 s).
+/// (smaller writes cost the kernel more in all).
 pub(super) const VCD_CHUNK: usize = 1 << 18;
 /// Room after the chunk for the longest line (a 64-bit value, its code).
 pub(super) const VCD_SLACK: usize = 128;
@@ -324,9 +323,9 @@ impl VcdBody {
     /// Allocate the file's blocks some megabytes ahead of the next `n`
     /// bytes (the header counted generously), without changing its
     /// length: the kernel then copies the writes into blocks it has
-    /// instead of reserving space page by page (30 MB written to ext4 in
-    /// 256 KB pieces: 4.8-5.1 ms, 2.7-2.8 ms allocated ahead). Where the
-    /// file system cannot allocate ahead, the file is simply written.
+    /// instead of reserving space page by page, which takes it about half
+    /// the time on ext4. Where the file system cannot allocate ahead, the
+    /// file is simply written.
     pub(super) fn reserve(&mut self, out: &BufWriter<File>, n: usize) {
         let Some(r) = self.reserved else { return };
         let end = self.written + n as u64 + (1 << 16);
@@ -361,10 +360,10 @@ impl VcdBody {
 
     /// `#t`: below 10^16 (about three hours of simulated time in
     /// picoseconds) carried forward in decimal from the time written
-    /// before ([`Decimal`]) and stored as one 16-byte word (a loop of
-    /// half-period steps: 6.1 against 7.0 ns a timestamp for `itoa` and
-    /// a copy of its digits, a call to `memcpy` of a length known only at
-    /// run time; the two were a sixth of the writing thread).
+    /// before ([`Decimal`]) and stored as one 16-byte word: cheaper than
+    /// `itoa` and a copy of its digits (a call to `memcpy` of a length
+    /// known only at run time), which were a large share of the writing
+    /// thread.
     #[inline(always)]
     pub(super) fn timestamp(&mut self, t: u64) {
         let dst = &mut self.buf[self.len..self.len + VCD_SLACK];

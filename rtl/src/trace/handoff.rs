@@ -28,8 +28,8 @@ pub(super) const SPARE_BATCHES: usize = 3;
 
 /// The batches between the two threads, handed over without a system
 /// call while both are busy. A channel woke the writing thread at every
-/// batch it waited for: a system call on the simulating thread each time
-/// (0.5-1 ms of the bench's traced frame). Here the writing thread polls
+/// batch it waited for: a system call on the simulating thread each time.
+/// Here the writing thread polls
 /// every [`POLL`] while batches come, and only after [`IDLE_POLLS`] empty
 /// polls says it is asleep and waits to be woken.
 pub(super) struct Handoff {

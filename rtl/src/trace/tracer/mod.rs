@@ -66,10 +66,8 @@ pub struct Tracer {
     /// mask of its width, and the value last written. One allocation,
     /// each array on whole cache lines, so that no vector access splits a
     /// line or a page: with the arrays wherever the heap put them (the
-    /// last values once straddled a 4 KB page), a throwaway allocation
-    /// before them moved the simulating thread's time for the bench's
-    /// frame by up to 0.8 ms; laid out here, 0.0173-0.0177 s against
-    /// 0.0176-0.0179 s (docs/performance.md).
+    /// last values once straddled a 4 KB page), the simulating thread's
+    /// time depended on where an unrelated allocation put them.
     pub(super) hot: Vec<u64>,
     pub(super) hot_at: usize,
     /// Signal calls declared (before the padding).
@@ -438,8 +436,8 @@ impl Tracer {
         // While the writing thread writes the last changes and closes the
         // file: the save file, then the filter files once the values are
         // all known, each in a temporary file beside its name, renamed
-        // into place only when the waveform is complete (the two threads'
-        // shares of the end in turn took 0.7 ms of the bench's frame).
+        // into place only when the waveform is complete (the two threads
+        // finish at once instead of in turn).
         let files = self.side_files()?;
         let save = stage(&files.gtkw, &self.save_file(&files))?;
         let Some(seen) = closing.seen() else {

@@ -73,9 +73,7 @@ impl Probe for Declaring<'_> {
 /// on to where it ends, a copy: when it added its counts, the compiler
 /// added the six indices with vector instructions that loaded them right
 /// after the calls before had stored them one by one, a store the
-/// processor cannot forward. Moved here from the tracer, the walk took as
-/// long; with the copy, the simulating thread's time for the bench's
-/// traced frame went from 0.0166 to 0.0155 s (docs/performance.md).
+/// processor cannot forward; the copy avoids it (docs/performance.md).
 pub(in crate::trace) struct Sampler<'a> {
     pub(in crate::trace) scope_on: &'a [bool],
     pub(in crate::trace) open_masks: &'a [u64],
@@ -474,10 +472,9 @@ impl Chunk<'_> {
     /// packed together by one instruction (`vpcompressq`) and stored as 8
     /// words wherever the last ones ended (the batch keeps room beyond a
     /// cycle's most for the last store), their costs summed by two more.
-    /// One change at a time (`changes_portable`), the sampling thread
-    /// took 1.5 ms more of the bench's traced frame (0.0194-0.0195 against
-    /// 0.0178-0.0180 s); compared first and packed in a second pass, no
-    /// less than one at a time.
+    /// One change at a time (`changes_portable`, what other CPUs run) is
+    /// slower, and comparing first and packing in a second pass is no
+    /// faster than that.
     #[inline(always)]
     pub(in crate::trace) fn changes(
         self,
