@@ -38,6 +38,33 @@ pub fn committed_path() -> PathBuf {
 
 /// The reporting clock of the 16-bit chip (the paper's).
 pub const CLOCK_MHZ_16: f64 = 300.0;
+
+/// The clock a chip's frame rate is quoted at, and where it comes from.
+#[derive(Clone, Copy, Debug)]
+pub struct ChipClock {
+    pub mhz: f64,
+    pub from: &'static str,
+}
+
+/// The clock of the chip of datapath `dp`: the timing file's `clock_hz`
+/// where it gives one, else the estimate from the synthesized RTL's path
+/// depths ([`Synthesis::clock_mhz`]: the 16-bit chip at the paper's 300
+/// MHz, the 32-bit one slower by its longer path).
+pub fn chip_clock(dp: Datapath, file_hz: Option<u64>) -> ChipClock {
+    match file_hz {
+        Some(hz) => ChipClock {
+            mhz: hz as f64 / 1e6,
+            from: "the timing file's clock_hz",
+        },
+        None => ChipClock {
+            mhz: Synthesis::committed().clock_mhz(dp),
+            from: match dp {
+                Datapath::W16 => "the 16-bit chip's clock, the paper's; `morphosys cost`",
+                Datapath::W32 => "the 32-bit chip's clock, by its longer path; `morphosys cost`",
+            },
+        },
+    }
+}
 /// Transistors of one SRAM bit (a 6T cell).
 pub const SRAM_TRANSISTORS_PER_BIT: u64 = 6;
 /// RCs in the array.

@@ -42,7 +42,7 @@ struct Field {
 /// DMA's.
 fn fields() -> Vec<Field> {
     let mut v = vec![
-        Field { table: "", key: "clock_hz", why: "the paper: \"MorphoSys is designed to be running at 300MHz\" (section IX); only frames/s and waveform time use it" },
+        Field { table: "", key: "clock_hz", why: "unset, each chip's frame rate is quoted at its own clock: the 16-bit chip's is the paper's (\"MorphoSys is designed to be running at 300MHz\", section IX), the 32-bit chip's the lower one its longer path allows (`morphosys cost`); set, every chip at this one; only frames/s and waveform time (300 MHz unset) use it" },
         Field { table: "", key: "issue", why: "ours (docs/isa.md, section 4): \"run\", one instruction streams a run of up to 4095 contexts while TinyRISC goes on; \"instruction\" is the M1 chip's, where TinyRISC issues each context by an instruction and the array waits while it does anything else" },
     ];
     v.extend(RiscTiming::CYCLES.iter().map(|c| Field {
@@ -97,9 +97,13 @@ pub fn to_toml(t: &Timing) -> String {
             table = f.table;
             s.push_str(&format!("\n[{table}]\n"));
         }
+        // The clock commented out where it is the default: a file written
+        // from the defaults leaves each chip at its own.
+        let unset = f.key == "clock_hz" && t.clock_hz == Timing::default().clock_hz;
         s.push_str(&format!(
-            "# {}\n{} = {}\n",
+            "# {}\n{}{} = {}\n",
             f.why,
+            if unset { "# " } else { "" },
             f.key,
             value(t, f.table, f.key)
         ));
@@ -238,6 +242,16 @@ pub fn load(path: &Path) -> Result<Timing> {
     let text = firmware::input::read_to_string(path)
         .map_err(|e| anyhow!("{}: cannot read the timing file: {e}", path.display()))?;
     parse(&text, &path.display().to_string())
+}
+
+/// The clock a timing file sets (`clock_hz`), if it sets one.
+pub(crate) fn clock_in_file(path: Option<&Path>) -> Result<Option<u64>> {
+    let Some(path) = path else { return Ok(None) };
+    let text = firmware::input::read_to_string(path)
+        .map_err(|e| anyhow!("{}: cannot read the timing file: {e}", path.display()))?;
+    let f: File =
+        toml::from_str(&text).map_err(|e| toml_error(&e, &text, &path.display().to_string()))?;
+    Ok(f.clock_hz)
 }
 
 /// `--timing FILE`, or the defaults.

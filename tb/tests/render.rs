@@ -161,6 +161,56 @@ fn a_streamed_scene_of_too_many_types_is_refused() {
     }
 }
 
+/// Each chip's frame rate at its own clock: the 16-bit chip at the
+/// paper's 300 MHz, the 32-bit one at the slower clock its synthesized
+/// path allows (the committed synthesis: `morphosys cost`), a timing
+/// file's `clock_hz` where it sets one; the paper's 300 MHz figure beside.
+#[test]
+fn each_chip_is_quoted_at_its_own_clock() {
+    use firmware::tracer::Datapath;
+    let scene = load("default.toml");
+    let cost = tb::cost::Synthesis::committed();
+    let mut clocks = Vec::new();
+    for (datapath, given) in [
+        (Datapath::W16, None),
+        (Datapath::W32, None),
+        (Datapath::W32, Some(250_000_000u64)),
+    ] {
+        let o = Options {
+            datapath,
+            ..opts(16, 16)
+        };
+        let mut s = tb::render::RenderSettings::default();
+        if let Some(hz) = given {
+            s.timing.clock_hz = hz;
+            s.clock_given = true;
+        }
+        let (_, rep) = render(&scene, &o, &s).unwrap();
+        let j = &rep.json;
+        let (clock, cycles) = (
+            j["clock_mhz"].as_f64().unwrap(),
+            j["cycles"].as_f64().unwrap(),
+        );
+        let want = given.map_or(cost.clock_mhz(datapath), |hz| hz as f64 / 1e6);
+        assert_eq!(clock, want, "{datapath}");
+        let fps = j["fps"].as_f64().unwrap();
+        assert!(
+            (fps - clock * 1e6 / cycles).abs() < 1e-9 * fps,
+            "{datapath}: {fps}"
+        );
+        let paper = j["fps_at_300mhz"].as_f64().unwrap();
+        assert!((paper - 300e6 / cycles).abs() < 1e-9 * paper);
+        assert!(j["clock"].as_str().unwrap().contains(if given.is_some() {
+            "timing file"
+        } else {
+            "chip's clock"
+        }));
+        clocks.push(clock);
+    }
+    assert_eq!(clocks[0], 300.0);
+    assert!(clocks[1] < 250.0 && clocks[1] > 100.0, "{clocks:?}");
+}
+
 #[test]
 fn json_has_every_key_and_sane_figures() {
     let scene = load("default.toml");

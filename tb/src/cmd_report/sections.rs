@@ -148,7 +148,7 @@ pub(super) fn datapath(r: &mut Runner) -> Result<String> {
                 bits.into(),
                 j["format"].as_str().unwrap_or("?").into(),
                 thousands(u(&j, "cycles")),
-                fps(&j),
+                fps_at_300mhz(&j),
                 format!("{clock:.0}"),
                 sig3(at_clock),
                 format!(

@@ -33,9 +33,10 @@ pub fn render(
 pub(crate) fn render_and_measure(
     scene: &firmware::scene::Scene,
     opt: &Options,
-    host: &crate::render::RenderSettings,
+    settings: &crate::render::RenderSettings,
     built: Option<firmware::tracer::Firmware>,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
+    let host = settings;
     let progress = host.progress;
     let nm = host.numerics;
     let opt = &Options {
@@ -95,7 +96,7 @@ pub(crate) fn render_and_measure(
         ro::CHILD_ORDER.key(): chip.firmware.child_order.to_string(),
     });
     if let (Some(j), serde_json::Value::Object(figures)) =
-        (json.as_object_mut(), chip_json(&chip, opt))
+        (json.as_object_mut(), chip_json(&chip, opt, settings))
     {
         j.extend(figures);
     }
@@ -109,7 +110,13 @@ pub(crate) fn render_and_measure(
 
 /// The chip's figures of a render: its cycles and frame rate, its rays,
 /// the array's and the DMA's use, the firmware and the options it ran.
-fn chip_json(chip: &crate::render::ChipRender, opt: &Options) -> serde_json::Value {
+fn chip_json(
+    chip: &crate::render::ChipRender,
+    opt: &Options,
+    host: &crate::render::RenderSettings,
+) -> serde_json::Value {
+    let file_hz = host.clock_given.then_some(host.timing.clock_hz);
+    let clock = crate::cost::chip_clock(chip.firmware.datapath, file_hz);
     let idle_on_control = if chip.stats.cycles > 0 {
         chip.stats.array_idle_control_cycles as f64 / chip.stats.cycles as f64
     } else {
@@ -119,6 +126,9 @@ fn chip_json(chip: &crate::render::ChipRender, opt: &Options) -> serde_json::Val
     json!({
         "cycles": chip.cycles,
         "firmware_cycles": chip.firmware_cycles,
+        "fps": chip.fps_at((clock.mhz * 1e6).round() as u64),
+        "clock_mhz": clock.mhz,
+        "clock": clock.from,
         "fps_at_300mhz": chip.fps_at(300_000_000),
         ro::NORMALS.key(): if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
         "eye_rays": census[crate::render::RAY_EYE],

@@ -117,6 +117,9 @@ pub struct RenderSettings {
     pub profile: bool,
     /// The chip's timing (`--timing FILE.toml`).
     pub timing: Timing,
+    /// The timing file sets the clock (`clock_hz`): the frame rate is
+    /// quoted at it, else at the chip's own ([`crate::cost::chip_clock`]).
+    pub clock_given: bool,
     /// Tiles per host work item ([`work_items`]; `None`: sized by the
     /// thread count). Any size gives the same frame.
     pub item_tiles: Option<usize>,
