@@ -380,8 +380,14 @@ fn row(scene: &str, primitives: usize, c: &Config, j: &serde_json::Value) -> Row
     let f = |n: &str| j[n].as_f64().unwrap_or(f64::NAN);
     let s = |n: &str| j[n].as_str().unwrap_or("?").to_string();
     let cost = crate::cost::Synthesis::committed();
-    let clock = cost.clock_mhz(opt.datapath);
-    let fps_at_clock = f("fps_at_300mhz") * clock / crate::cost::CLOCK_MHZ_16;
+    // The chip's clock and frame rate as the render gave them (a timing
+    // file's clock where it set one), else from the synthesis.
+    let clock = j["clock_mhz"]
+        .as_f64()
+        .unwrap_or_else(|| cost.clock_mhz(opt.datapath));
+    let fps_at_clock = j["fps"]
+        .as_f64()
+        .unwrap_or_else(|| f("fps_at_300mhz") * clock / crate::cost::CLOCK_MHZ_16);
     let array = cost.array_transistors(opt.datapath);
     Row {
         scene: scene.into(),
@@ -505,6 +511,7 @@ fn asked_configs(
 
 pub fn command(a: SweepArgs) -> Result<()> {
     let files = timing_files(&a.timing)?;
+    let file_clocks = file_clocks(&a.timing)?;
     let cfgs = if a.knobs {
         asked_configs(a.size, a.broadcast_only, &files)
     } else {
@@ -528,12 +535,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
     let count = |n: &std::sync::atomic::AtomicUsize| {
         n.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
     };
-    let bar = crate::output::progress_bar(pts.len() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
+    let bar = sweep_bar(pts.len());
     // The measured renders by job; a job that failed or was skipped is
     // None.
     let mut done: BTreeMap<usize, Option<serde_json::Value>> = BTreeMap::new();
@@ -550,6 +552,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
         let host = crate::render::RenderSettings {
             numerics: c.nm,
             timing: c.timing,
+            clock_given: c.timing_file.is_some_and(|i| file_clocks[i]),
             ..Default::default()
         };
         let inputs = crate::inputs::inputs(scene, &c.timing, None);
@@ -621,6 +624,26 @@ pub fn command(a: SweepArgs) -> Result<()> {
         anyhow::bail!("no configuration of the sweep could be rendered (see above)");
     }
     write_results(&rows, &a.out_dir)
+}
+
+/// Which of the timing files `paths` set the clock (their points are
+/// quoted at it, not at the chip's own).
+fn file_clocks(paths: &[PathBuf]) -> Result<Vec<bool>> {
+    paths
+        .iter()
+        .map(|p| Ok(crate::timing::clock_in_file(Some(p))?.is_some()))
+        .collect()
+}
+
+/// The sweep's progress bar over `n` renders.
+fn sweep_bar(n: usize) -> indicatif::ProgressBar {
+    let bar = crate::output::progress_bar(n as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("sweep [{bar:40}] {pos}/{len} renders {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar())
+            .progress_chars("=> "),
+    );
+    bar
 }
 
 /// What the sweep took from an earlier run and what it skipped.
