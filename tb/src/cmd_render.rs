@@ -204,7 +204,7 @@ fn default_out(scene: &Path) -> PathBuf {
 
 pub fn command(a: RenderArgs) -> Result<()> {
     let scene = load_scene(a.scene.as_deref())?;
-    let timing = crate::timing::load_or_default(a.timing.as_deref())?;
+    let (timing, clock_given) = crate::timing::load_or_default_file(a.timing.as_deref())?;
     let firmware_text = match &a.firmware {
         Some(p) => Some(
             firmware::input::read_to_string(p)
@@ -246,7 +246,7 @@ pub fn command(a: RenderArgs) -> Result<()> {
             trace: a.trace_config(),
             profile: a.profile,
             timing,
-            clock_given: crate::timing::clock_in_file(a.timing.as_deref())?.is_some(),
+            clock_given,
             item_tiles: None,
             plain: a.plain,
         },

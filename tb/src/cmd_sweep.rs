@@ -631,7 +631,7 @@ pub fn command(a: SweepArgs) -> Result<()> {
 fn file_clocks(paths: &[PathBuf]) -> Result<Vec<bool>> {
     paths
         .iter()
-        .map(|p| Ok(crate::timing::clock_in_file(Some(p))?.is_some()))
+        .map(|p| Ok(crate::timing::load_file(p)?.1))
         .collect()
 }
 

@@ -159,7 +159,13 @@ pub(crate) fn toml_error(e: &toml::de::Error, text: &str, name: &str) -> anyhow:
 
 /// Parse a timing file's text (`name` for the messages).
 pub fn parse(text: &str, name: &str) -> Result<Timing> {
+    parse_file(text, name).map(|(t, _)| t)
+}
+
+/// [`parse`], and whether the file sets the clock (`clock_hz`).
+fn parse_file(text: &str, name: &str) -> Result<(Timing, bool)> {
     let f: File = toml::from_str(text).map_err(|e| toml_error(&e, text, name))?;
+    let sets_clock = f.clock_hz.is_some();
     // Where a key is written, for the range errors below.
     let at = |table: &str, key: &str| -> String {
         let mut cur = "";
@@ -234,29 +240,30 @@ pub fn parse(text: &str, name: &str) -> Result<Timing> {
             t.dma.bytes_per_cycle = v;
         }
     }
-    Ok(t)
+    Ok((t, sets_clock))
 }
 
 /// Read a timing file.
 pub fn load(path: &Path) -> Result<Timing> {
-    let text = firmware::input::read_to_string(path)
-        .map_err(|e| anyhow!("{}: cannot read the timing file: {e}", path.display()))?;
-    parse(&text, &path.display().to_string())
+    load_file(path).map(|(t, _)| t)
 }
 
-/// The clock a timing file sets (`clock_hz`), if it sets one.
-pub(crate) fn clock_in_file(path: Option<&Path>) -> Result<Option<u64>> {
-    let Some(path) = path else { return Ok(None) };
+/// [`load`], and whether the file sets the clock (`clock_hz`: then every
+/// chip's frame rate is quoted at it).
+pub(crate) fn load_file(path: &Path) -> Result<(Timing, bool)> {
     let text = firmware::input::read_to_string(path)
         .map_err(|e| anyhow!("{}: cannot read the timing file: {e}", path.display()))?;
-    let f: File =
-        toml::from_str(&text).map_err(|e| toml_error(&e, &text, &path.display().to_string()))?;
-    Ok(f.clock_hz)
+    parse_file(&text, &path.display().to_string())
 }
 
 /// `--timing FILE`, or the defaults.
 pub(crate) fn load_or_default(path: Option<&Path>) -> Result<Timing> {
     path.map_or_else(|| Ok(Timing::default()), load)
+}
+
+/// [`load_or_default`], and whether a file sets the clock.
+pub(crate) fn load_or_default_file(path: Option<&Path>) -> Result<(Timing, bool)> {
+    path.map_or_else(|| Ok((Timing::default(), false)), load_file)
 }
 
 #[cfg(test)]

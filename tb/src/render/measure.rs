@@ -33,10 +33,9 @@ pub fn render(
 pub(crate) fn render_and_measure(
     scene: &firmware::scene::Scene,
     opt: &Options,
-    settings: &crate::render::RenderSettings,
+    host: &crate::render::RenderSettings,
     built: Option<firmware::tracer::Firmware>,
 ) -> Result<(crate::render::ChipRender, RenderReport)> {
-    let host = settings;
     let progress = host.progress;
     let nm = host.numerics;
     let opt = &Options {
@@ -48,7 +47,7 @@ pub(crate) fn render_and_measure(
         Some(fw) => super::render_built(fw, opt, host)?,
         None => super::render_chip(scene, opt, host)?,
     };
-    let host = t0.elapsed().as_secs_f64();
+    let seconds = t0.elapsed().as_secs_f64();
     let refimg = reference::render(
         scene,
         &reference::Options {
@@ -83,12 +82,12 @@ pub(crate) fn render_and_measure(
         "hit_agreement": agree,
         "eye_misclassified": 1.0 - agree,
         "reference_rays": refimg.stats,
-        "host_seconds": host,
+        "host_seconds": seconds,
         // The work items' host seconds summed over the threads: about
         // the chip render's time on one thread, whatever else runs beside
         // it (the sweep's --size-seconds).
         "host_chip_seconds": chip.item_seconds.iter().sum::<f64>(),
-        "array_cycles_per_host_second": if host > 0.0 { chip.stats.cycles as f64 / host } else { 0.0 },
+        "array_cycles_per_host_second": if seconds > 0.0 { chip.stats.cycles as f64 / seconds } else { 0.0 },
         "compiler_format": r.format,
         "format_note": "format: the tracer's, the finest in which every object and the eye fit with the guard bits (lights are scaled apart, never coarser than compiler_format); compiler_format: the scene image's (morphosys compile), which also spans the lights and the camera's target",
         "bsp_nodes": r.bsp.nodes,
@@ -96,7 +95,7 @@ pub(crate) fn render_and_measure(
         ro::CHILD_ORDER.key(): chip.firmware.child_order.to_string(),
     });
     if let (Some(j), serde_json::Value::Object(figures)) =
-        (json.as_object_mut(), chip_json(&chip, opt, settings))
+        (json.as_object_mut(), chip_json(&chip, opt, host))
     {
         j.extend(figures);
     }

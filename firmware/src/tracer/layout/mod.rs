@@ -47,6 +47,21 @@ pub use streams::{fit_frac, light_shift, light_shift_w};
 /// `SN_COUNTS`, 28 to 56 bytes).
 pub const STREAMED_TYPES: usize = 7;
 
+/// The resident part of a streamed layout (`w` so far) fits FB bank 0,
+/// or the error that says by how much it does not.
+fn resident_fits(w: &W, err: &dyn Fn(usize, String) -> String) -> Result<(), String> {
+    if w.fb.len() > STREAM_BANK {
+        return Err(err(
+            0,
+            format!(
+                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
+                w.fb.len()
+            ),
+        ));
+    }
+    Ok(())
+}
+
 /// A streamed scene's types fit its node records' counts, or the error
 /// that names them.
 fn streamed_types_fit(

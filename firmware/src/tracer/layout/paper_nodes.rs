@@ -227,15 +227,7 @@ fn streamed_image(
 fn resident_split(w: &mut W, err: &dyn Fn(usize, String) -> String) -> Result<usize, String> {
     let split_slot = w.fb.len();
     w.raw(0);
-    if w.fb.len() > STREAM_BANK {
-        return Err(err(
-            0,
-            format!(
-                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
-                w.fb.len()
-            ),
-        ));
-    }
+    super::resident_fits(w, err)?;
     Ok(split_slot)
 }
 

@@ -293,23 +293,15 @@ fn chain_pieces(piece_rec: &mut [[i32; 16]], first_piece: &[usize], nn: usize, b
 fn resident_part(w: &mut W, err: &dyn Fn(usize, String) -> String) -> Result<usize, String> {
     let split_slot = w.fb.len();
     w.raw(0);
-    for d in 0..super::super::super::memory_map::ram::P_SLOTS {
+    for d in 0..crate::tracer::memory_map::ram::P_SLOTS {
         w.raw(pk_slot(d));
-        if d + 1 < super::super::super::memory_map::ram::P_SLOTS {
+        if d + 1 < crate::tracer::memory_map::ram::P_SLOTS {
             for _ in 0..3 {
                 w.raw(0);
             }
         }
     }
-    if w.fb.len() > STREAM_BANK {
-        return Err(err(
-            0,
-            format!(
-                "the resident part of the streamed layout needs {} FB words; bank 0 holds {STREAM_BANK}",
-                w.fb.len()
-            ),
-        ));
-    }
+    super::super::resident_fits(w, err)?;
     Ok(split_slot)
 }
 
