@@ -284,6 +284,7 @@ fn bench_options(traversal: firmware::tracer::Traversal, width: u32, height: u32
             test_cuts: Default::default(),
             child_order: Default::default(),
             sub_edges: Default::default(),
+            positions: Default::default(),
         },
         firmware::tracer::Traversal::Packet => Options {
             width,

@@ -159,6 +159,14 @@ pub struct RenderArgs {
     /// the 16-bit chip, coarse on the 32-bit one)
     #[arg(long = ro::NORMALS.long, value_name = "auto|fine|coarse", default_value = "auto")]
     pub normals: firmware::tracer::Normals,
+    /// Where the 16-bit chip holds positions: global (one fixed-point
+    /// format for the whole scene) or local (ray origins with a remainder
+    /// of 2^-14 LSB; each sphere tested in a frame of its own, its LSB
+    /// fitted to its radius, its hit point brought back with the
+    /// remainder). Local: the packet traversal on the 16-bit chip,
+    /// without refraction, shadow rays a packet per light
+    #[arg(long = ro::POSITIONS.long, value_name = "global|local", default_value = "global")]
+    pub positions: firmware::tracer::Positions,
     /// With --json: when that file already holds a complete render made
     /// with these same arguments from the same scene, timing file,
     /// firmware and build (their SHA-256 digests, `inputs` in the
@@ -386,6 +394,7 @@ impl RenderArgs {
             test_cuts: self.test_cuts.for_issue(timing.risc.issue),
             child_order: self.child_order,
             sub_edges: self.sub_edges,
+            positions: self.positions,
         };
         let nm = Numerics {
             newton_steps: self.newton_steps,
@@ -483,9 +492,14 @@ fn print_report(
         opt.depth
     );
     crate::report!(
-        "datapath                 {} bits ({datapath_reason}), format {}",
+        "datapath                 {} bits ({datapath_reason}), format {}{}",
         opt.datapath.bits(),
-        j["format"].as_str().unwrap_or("?")
+        j["format"].as_str().unwrap_or("?"),
+        if j["positions"] == "local" {
+            ", local positions (spheres in frames of their own; origins and eye-ray directions with remainders)"
+        } else {
+            ""
+        }
     );
     crate::report!(
         "node layout              {} ({} FB words of BSP nodes, {} in all{})",

@@ -190,6 +190,12 @@ pub const NORMALS: RenderOption = RenderOption {
     json: Json::Name,
     value: |_, n| n.normals.name().into(),
 };
+pub const POSITIONS: RenderOption = RenderOption {
+    long: "positions",
+    name: "positions",
+    json: Json::Name,
+    value: |o, _| o.positions.name().into(),
+};
 
 /// Every render option that sets the tracer, in the order a planned
 /// command line lists them.
@@ -214,6 +220,7 @@ pub const RENDER_OPTIONS: &[RenderOption] = &[
     GUARD_BITS,
     RAY_OFFSET_LSB,
     NORMALS,
+    POSITIONS,
 ];
 
 /// The flags and values that ask `morphosys render` for `opt` and `nm`.

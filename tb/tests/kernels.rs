@@ -124,9 +124,15 @@ fn run_with<W: Word>(
         material: 0,
         line: 1,
     }];
+    let local = LOCAL.with(|l| l.get());
     let opt = Options {
         datapath: W::DATAPATH,
         traversal: TRAVERSAL.with(|t| t.get()),
+        positions: if local {
+            tracer::Positions::Local
+        } else {
+            tracer::Positions::Global
+        },
         ..Options::default()
     };
     let nm = tracer::Numerics {
@@ -170,6 +176,19 @@ fn run_with<W: Word>(
     ] {
         let v: [W; 64] = std::array::from_fn(|i| f(&rays[i]));
         regs.write(reg, u64::MAX, &v);
+    }
+    // Local positions: each origin's remainder below the LSB, in 2^-14 LSB.
+    if local {
+        for (i, r) in rays.iter().enumerate() {
+            for (k, x) in r.o.to_array().into_iter().enumerate() {
+                let rem = (x / lsb - (x / lsb).round()) * 16384.0;
+                sim.top
+                    .array
+                    .rc
+                    .ram
+                    .write(i, ram::RAY_OL.at() + k, W::wrap(rem.round() as i64));
+            }
+        }
     }
     // Rays that leave no object (two-sided planar kernels skip the one
     // their rays leave).
@@ -294,6 +313,9 @@ thread_local! {
     /// polygons' plain records).
     static TRAVERSAL: std::cell::Cell<tracer::Traversal> =
         const { std::cell::Cell::new(tracer::Traversal::Packet) };
+    /// Local positions ([`tracer::Positions::Local`]) in the firmware
+    /// [`run_with`] builds, the rays' origins with their remainders.
+    static LOCAL: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
 
 fn errors<W: Word>(name: &str, shape: Shape, two_sided: bool) -> Errors {
@@ -1257,5 +1279,89 @@ fn snell_refraction_kernel_vs_f64() {
         assert_eq!((dis16, dis32), (0, 0), "ior {ior}");
         assert!(w16 < 4e-3, "ior {ior}: 16-bit direction error {w16}");
         assert!(w32 < 1e-5, "ior {ior}: 32-bit direction error {w32}");
+    }
+}
+
+/// Local positions: spheres from a fifth of an LSB to a thousand LSB in
+/// radius, their centres off the grid, hit by rays from a few thousand LSB
+/// away (an eye's distance): the hit point the kernel leaves (`HIT_PH` +
+/// `HIT_PL` 2^-14) against the f64 sphere's on the line the chip traces
+/// (the origin to 2^-14 LSB, the Q1.14 direction the RCs hold), in LSB of the scene's
+/// format, and against the same sphere tested in the scene's format.
+#[test]
+fn local_sphere_hit_points_vs_float_sphere() {
+    LOCAL.with(|l| l.set(true));
+    let lsb = 2f64.powi(-10);
+    for radius in [0.2f64, 0.7, 3.0, 40.0, 1000.0] {
+        let mut g = Lcg(radius.to_bits());
+        let c = Vec3::new(
+            0.3 + g.next() * lsb,
+            -0.2 + g.next() * lsb,
+            0.1 + g.next() * lsb,
+        );
+        let shape = Shape::Sphere(Sphere {
+            center: c,
+            radius: radius * lsb,
+            inside: false,
+        });
+        let rs: [Ray; 64] = std::array::from_fn(|_| {
+            let dir =
+                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+            let o = c + dir * (g.range(1500.0, 3000.0) * lsb);
+            let target = c + Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0))
+                * (0.9 * radius * lsb);
+            Ray {
+                o,
+                d: (target - o).normalized(),
+            }
+        });
+        let (sim, fw) = run_with::<i16>(shape.clone(), &rs, false, |t, ti, fit| {
+            ti.ty.broadcast(t, "test", fit, ti.caps)
+        });
+        assert_eq!(fw.frac, 10, "the test's format");
+        let rc = &sim.top.array.rc;
+        let (mut worst, mut hits, mut disagree) = (0.0f64, 0, 0);
+        for (i, r) in rs.iter().enumerate() {
+            let o = Vec3::new(
+                (r.o.x / lsb * 16384.0).round() / 16384.0 * lsb,
+                (r.o.y / lsb * 16384.0).round() / 16384.0 * lsb,
+                (r.o.z / lsb * 16384.0).round() / 16384.0 * lsb,
+            );
+            // The line the chip traces: its Q1.14 direction as the RCs hold it.
+            let d = Vec3::new(
+                rc.regs.read(4)[i] as f64,
+                rc.regs.read(5)[i] as f64,
+                rc.regs.read(6)[i] as f64,
+            )
+            .normalized();
+            let f = intersect(&shape, &Ray { o, d }, 0.0, f64::INFINITY, false);
+            let t = rc.regs.read(7)[i] as f64;
+            match (f, t < 32767.0) {
+                (Some(f), true) => {
+                    assert_eq!(rc.ram.read(i, ram::HIT_TL.at()) as f64, t, "tagged");
+                    let p = Vec3::new(0.0, 0.0, 0.0);
+                    let mut p = p.to_array();
+                    for (k, x) in p.iter_mut().enumerate() {
+                        *x = rc.ram.read(i, ram::HIT_PH.at() + k) as f64
+                            + rc.ram.read(i, ram::HIT_PL.at() + k) as f64 / 16384.0;
+                    }
+                    let want = o + d * f.t;
+                    let e = (Vec3::new(p[0], p[1], p[2]) - want * (1.0 / lsb)).length();
+                    worst = worst.max(e);
+                    hits += 1;
+                }
+                (None, false) => {}
+                _ => disagree += 1,
+            }
+        }
+        eprintln!("local sphere r = {radius} LSB: {hits} hits, {disagree} disagreements, worst hit point {worst:.4} LSB");
+        assert!(hits >= 40, "r = {radius}: {hits} hits");
+        assert!(disagree <= 2, "r = {radius}: {disagree} disagreements");
+        // Within 0.6% of the radius (the Q1.14 normal, the square root's
+        // approximation) and a few 2^-14 LSB.
+        assert!(
+            worst <= 0.002 + 0.006 * radius,
+            "r = {radius}: hit point off by {worst} LSB"
+        );
     }
 }

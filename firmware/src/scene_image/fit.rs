@@ -116,6 +116,17 @@ pub(super) fn smallest(
         line: 0,
         what: "",
     };
+    // The smallest feature against the least a record holds (in LSB of
+    // the chip's precision): spheres in frames of their own
+    // (`sphere_extra_frac`) hold features that much finer.
+    let finer = |s: &Shape| match s {
+        Shape::Sphere(_) => opt.sphere_extra_frac,
+        _ => 0,
+    };
+    let least = |s: &Shape| {
+        opt.min_feature_lsb * lsb * (-((opt.target_extra_frac + finer(s)) as f64)).exp2()
+    };
+    let mut worst: Option<(&crate::scene::Object, f64)> = None;
     for o in &scene.objects {
         let f = smallest_feature(&o.shape);
         if f < small.size {
@@ -125,19 +136,28 @@ pub(super) fn smallest(
                 what: o.shape.prim_type().name(),
             };
         }
+        let ratio = f / least(&o.shape);
+        if worst.is_none_or(|(_, r)| ratio < r) {
+            worst = Some((o, ratio));
+        }
     }
-    if small.size < opt.min_feature_lsb * lsb * (-(opt.target_extra_frac as f64)).exp2() {
+    if let Some((o, ratio)) = worst.filter(|(_, r)| *r < 1.0) {
+        let f = ratio * least(&o.shape);
+        let held = match finer(&o.shape) {
+            0 => String::new(),
+            e => format!(" (its frame holds 2^-{e} LSB)"),
+        };
         return Err(SceneError {
             file: scene.source.clone(),
-            line: small.line,
+            line: o.line,
             col: 0,
             message: format!(
                 "cannot represent the scene in 16-bit fixed point: it spans +-{max_abs}, so the format is {} (LSB {lsb}), \
-                 and this {} has a feature of {} = {:.2} LSB, below the {} LSB minimum",
+                 and this {} has a feature of {} = {:.2} LSB, below the {} LSB minimum{held}",
                 q.name(),
-                small.what,
-                small.size,
-                small.size / lsb,
+                o.shape.prim_type().name(),
+                f,
+                f / lsb,
                 opt.min_feature_lsb
             ),
         });

@@ -107,6 +107,11 @@ pub struct CompileOptions {
     /// again with 16 more): the smallest-feature and degeneracy checks then
     /// apply at the chip's precision, not at the 16-bit image's.
     pub target_extra_frac: u32,
+    /// Fraction bits the chip's sphere records carry beyond the scene's
+    /// format (local positions: a sphere's frame, up to
+    /// `tracer::primitives::sphere::E_MAX`): spheres' features are checked
+    /// at that precision.
+    pub sphere_extra_frac: u32,
 }
 
 impl Default for CompileOptions {
@@ -118,6 +123,7 @@ impl Default for CompileOptions {
             guard_bits: 1,
             min_feature_lsb: 2.0,
             target_extra_frac: 0,
+            sphere_extra_frac: 0,
         }
     }
 }

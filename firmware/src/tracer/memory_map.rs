@@ -88,6 +88,23 @@ pub mod ram {
     /// Fields of a stack frame.
     pub const FR_COL: Name = Name::new("FR_COL", 0, "frame: colour so far, 3 words");
     pub const FR_KS: Name = Name::new("FR_KS", 3, "frame: reflection weight");
+    /// Local positions ([`crate::tracer::Positions::Local`]), past the
+    /// deepest recursion's stack frames (`STACK + 7 * STACK_FRAME`): the
+    /// remainder of the current rays' origins, of the hit point being
+    /// shaded, and the closest local hit's point (its `t` tags it: the
+    /// pass's hit is local where `tbest` equals `HIT_TL`).
+    pub const RAY_OL: Name = Name::new(
+        "RAY_OL",
+        328,
+        "local positions: the ray origin's remainder, 3 words, 2^-14 LSB",
+    );
+    pub const SH_PL: Name = Name::new("SH_PL", 331, "the remainder of SH_P, 3 words");
+    pub const HIT_PH: Name = Name::new(
+        "HIT_PH",
+        334,
+        "closest local hit: its point, 3 words (remainder in HIT_PL)",
+    );
+    pub const HIT_PL: Name = Name::new("HIT_PL", 337, "its point's remainder, 3 words");
     /// Streamed layout: number of unordered BSP subtrees the ray is in
     /// whose visiting order goes against its direction (it may only sleep
     /// at a leaf when this is 0).
@@ -133,6 +150,19 @@ pub mod ram {
     pub const RF_O: Name = Name::new("RF_O", 0, "refraction frame: origin, 3 words");
     pub const RF_D: Name = Name::new("RF_D", 3, "refraction frame: direction, 3 words");
     pub const RF_T: Name = Name::new("RF_T", 6, "refraction frame: weight T (0: no ray)");
+    /// Local positions: the closest local hit's `t` (past the deepest
+    /// recursion's refraction frames, `REFR + 7 * REFR_FRAME`).
+    pub const HIT_TL: Name = Name::new(
+        "HIT_TL",
+        399,
+        "the closest local hit's t (-1: none this pass)",
+    );
+    /// Local positions: the closest local hit's `t` below the LSB.
+    pub const HIT_TLL: Name = Name::new(
+        "HIT_TLL",
+        401,
+        "the closest local hit's t's remainder, 2^-14 LSB",
+    );
     /// Packet traversal: 1 while the ray takes part in the current pass (it
     /// may be woken at a pop).
     pub const P_ALIVE: Name = Name::new("P_ALIVE", 400, "1 while the ray takes part in the pass");
@@ -172,6 +202,14 @@ pub mod ram {
         "ORIG_STACK",
         480,
         "per recursion level: the object its refracted ray leaves",
+    );
+    /// Local positions: the ray direction's remainder, in the words of
+    /// the merged shadow packets' slots (local positions run without
+    /// them, [`crate::tracer::shadows::applies`]).
+    pub const RAY_DL: Name = Name::new(
+        "RAY_DL",
+        488,
+        "local positions: the ray direction's remainder, 3 words, 2^-27 (SHADOW_SLOTS' words)",
     );
     pub const SHADOW_SLOTS: Name = Name::new(
         "SHADOW_SLOTS",
@@ -215,6 +253,10 @@ pub mod ram {
         TMP8,
         ORIG_OBJ,
         STACK,
+        RAY_OL,
+        SH_PL,
+        HIT_PH,
+        HIT_PL,
         UNORD,
         HIT_NS,
         HIT_NS_OBJ,
@@ -222,7 +264,9 @@ pub mod ram {
         HIT_BACK_OBJ,
         SH_BACK,
         REFR,
+        HIT_TL,
         P_ALIVE,
+        HIT_TLL,
         P_Z,
         P_R,
         P_DT,
@@ -231,6 +275,7 @@ pub mod ram {
         SHADOW_ORIG,
         P_SLOT,
         ORIG_STACK,
+        RAY_DL,
         SHADOW_SLOTS,
     ];
     /// Fields of the frames and slots above.
@@ -311,4 +356,30 @@ pub fn ram_lines(depth: u32) -> Vec<String> {
     }
     v.extend(ram::FIELDS.iter().map(Name::define));
     v
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ram;
+    use crate::tracer::MAX_RAY_DEPTH;
+
+    // The deepest recursion's stack and refraction frames end before the
+    // words placed after them.
+    const FRAMES: u32 = MAX_RAY_DEPTH - 1;
+    const _: () = assert!(ram::STACK.value + FRAMES * ram::STACK_FRAME <= ram::RAY_OL.value);
+    const _: () = assert!(ram::REFR.value + FRAMES * ram::REFR_FRAME <= ram::HIT_TL.value);
+    const _: () = assert!(ram::HIT_PL.value + 3 <= ram::UNORD.value);
+
+    /// The map runs in address order.
+    #[test]
+    fn the_map_runs_in_address_order() {
+        for w in ram::ALL.windows(2) {
+            assert!(
+                w[0].value <= w[1].value,
+                "{} after {}",
+                w[1].name,
+                w[0].name
+            );
+        }
+    }
 }

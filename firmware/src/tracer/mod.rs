@@ -31,6 +31,7 @@ pub mod kernel_names;
 pub mod layout;
 pub mod math;
 pub mod memory_map;
+pub mod positions;
 pub mod primitives;
 pub mod program;
 pub mod shading;
@@ -44,7 +45,7 @@ use crate::scene_image::{compile, CompileOptions, Report};
 pub use rtl::rc::Datapath;
 pub mod options;
 pub use options::{
-    AxisOrder, ChildOrder, Collapse, LeafPieces, NodeLayout, Normals, Numerics, Options,
+    AxisOrder, ChildOrder, Collapse, LeafPieces, NodeLayout, Normals, Numerics, Options, Positions,
     ShadowPackets, SubEdges, TestCuts, Traversal,
 };
 
@@ -337,6 +338,11 @@ fn build_one(
         layout: Some(crate::scene_image::NodeFormat::BitVectors),
         guard_bits: nm.guard_bits,
         target_extra_frac: opt.datapath.extra_bits(),
+        sphere_extra_frac: if opt.positions == Positions::Local {
+            primitives::sphere::E_MAX
+        } else {
+            0
+        },
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
@@ -362,6 +368,12 @@ fn build_one(
             )?
         }
     };
+    if lay.fit.sphere_local && lay.refract {
+        return Err(format!(
+            "{}: --positions local: not with transmitting objects (the refraction stack holds no origin remainders)",
+            scene.source
+        ));
+    }
     lay.fb[..256].copy_from_slice(&math::table_slots_for(
         nm.table_entries as usize,
         opt.datapath.extra_bits(),
@@ -406,6 +418,14 @@ fn checked(opt: &Options, nm: &Numerics) -> Result<(u32, u32), String> {
             "table size {}: must be 16, 32, 64 or 128 entries (each table has a 128-word slot of the RC's 512-word RAM)",
             nm.table_entries
         ));
+    }
+    if opt.positions == Positions::Local {
+        if opt.datapath != rtl::rc::Datapath::W16 {
+            return Err("--positions local: the 16-bit chip's (the 32-bit chip's formats carry 16 more fraction bits)".into());
+        }
+        if opt.traversal != Traversal::Packet {
+            return Err("--positions local: the packet traversal's (the paper's traversal keeps the paper's number handling)".into());
+        }
     }
     let tile = tile_shape(opt.ways)
         .ok_or_else(|| format!("--ways {}: must be 4, 8, 16, 32 or 64", opt.ways))?;

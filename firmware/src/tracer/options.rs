@@ -114,6 +114,9 @@ pub struct Options {
     pub child_order: ChildOrder,
     /// Streamed packet traversal: where banded polygons' sub-edges are.
     pub sub_edges: SubEdges,
+    /// Positions in the scene's one format or in local frames
+    /// ([`Positions`]).
+    pub positions: Positions,
 }
 
 spelled! {
@@ -153,6 +156,7 @@ impl Default for Options {
             test_cuts: TestCuts::default(),
             child_order: ChildOrder::default(),
             sub_edges: SubEdges::default(),
+            positions: Positions::Global,
         }
     }
 }
@@ -462,6 +466,24 @@ spelled! {
         Auto = "auto",
         Fine = "fine",
         Coarse = "coarse",
+    }
+}
+
+spelled! {
+    /// Where the 16-bit chip holds positions. Global: one fixed-point
+    /// format for the whole scene (coordinates, origins, `t`). Local: ray
+    /// origins carry a remainder (`RAY_OL`, 2^-14 LSB), and a sphere is
+    /// tested in a frame of its own, its centre the origin and its LSB
+    /// `2^-e` of the scene's, `e` fitted to its radius
+    /// ([`super::primitives::local`]); its hit point comes back to the
+    /// scene's format with the remainder (`HIT_PL`). The packet traversal
+    /// on the 16-bit chip, without refraction; shadow rays a packet per
+    /// light.
+    #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+    pub enum Positions ("positions") {
+        #[default]
+        Global = "global",
+        Local = "local",
     }
 }
 

@@ -112,18 +112,25 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
     }
     // Smooth triangles: the shading normal and the reflection's fallback.
     let smooth = lay.types.iter().any(|x| x.ty.primitive().smooth());
-    v.push((names::EYE.into(), shading::eye(nm.approx(), lay.refract)));
+    let local = lay.fit.sphere_local;
+    let eye = if local {
+        super::positions::eye(nm.approx(), lay.refract)
+    } else {
+        shading::eye(nm.approx(), lay.refract)
+    };
+    v.push((names::EYE.into(), eye));
     for (name, level0) in [(names::POST_EYE, true), (names::POST, false)] {
-        let mut post = shading::post(level0, lay.materials, smooth, lay.refract);
+        let mut post = shading::post(level0, lay.materials, smooth, lay.refract, local);
         if packet {
             shading::flag_hit(&mut post);
         }
         v.push((name.into(), post));
     }
-    v.push((
-        names::SHADOW.into(),
-        shading::light_setup(nm.approx(), lay.light_shifted),
-    ));
+    let mut shadow = shading::light_setup(nm.approx(), lay.light_shifted);
+    if local {
+        super::positions::shadow_origins(&mut shadow);
+    }
+    v.push((names::SHADOW.into(), shadow));
     v.push((
         names::PHONG.into(),
         shading::shade(&lay.shines, lay.phong_in_runs()),
@@ -140,10 +147,11 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
         shading::store_lane(names::STORE_COL, super::memory_map::ram::LANE_COL),
     ));
     for l in 0..opt.depth.saturating_sub(1) {
-        v.push((
-            names::reflect(l),
-            shading::reflect_setup(l, smooth, lay.refract),
-        ));
+        let mut reflect = shading::reflect_setup(l, smooth, lay.refract);
+        if local {
+            super::positions::origins(&mut reflect);
+        }
+        v.push((names::reflect(l), reflect));
         v.push((names::reflected(l), shading::reflect_pop(l)));
         if lay.refract {
             v.push((

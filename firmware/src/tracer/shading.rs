@@ -143,15 +143,7 @@ pub fn eye(nr: Approx, refract: bool) -> K {
          Out: r1..r3 = eye, r4..r6 = normalize(A + i B + j C) for pixel (px0 + col, py0 + row),\n\
          r7 = C_INF; a new level (PASS_T0, COL = 0, SH_D), OUT_OBJ = -1.",
     );
-    k.c(format!("ld r8, [r0 + #{}]", ram::LANE_COL))
-        .c("add r8, fb0, r8")
-        .note("i")
-        .c(format!("ld r9, [r0 + #{}]", ram::LANE_ROW))
-        .c("add r9, fb0, r9")
-        .note("j")
-        .c("mov r1, fb0")
-        .c("mov r2, fb0")
-        .c("mov r3, fb0");
+    eye_pixel(&mut k);
     for x in [10, 11, 12] {
         k.c("ldacc fb0, <<KD-Q13")
             .c("mac out, fb0, r8")
@@ -169,7 +161,21 @@ pub fn eye(nr: Approx, refract: bool) -> K {
     k
 }
 
-fn new_level_common(k: &mut K) {
+/// The eye kernels' start (stream: px0, py0, eye.xyz): r8 = i, r9 = j,
+/// the RC's pixel; r1..r3 = the eye.
+pub(super) fn eye_pixel(k: &mut K) {
+    k.c(format!("ld r8, [r0 + #{}]", ram::LANE_COL))
+        .c("add r8, fb0, r8")
+        .note("i")
+        .c(format!("ld r9, [r0 + #{}]", ram::LANE_ROW))
+        .c("add r9, fb0, r9")
+        .note("j")
+        .c("mov r1, fb0")
+        .c("mov r2, fb0")
+        .c("mov r3, fb0");
+}
+
+pub(super) fn new_level_common(k: &mut K) {
     k.c(format!("ld r7, [r0 + #{}]", ram::C_INF))
         .c(format!("st r7, [#{}]", ram::PASS_T0))
         .c("movb r8, #0");
@@ -188,7 +194,7 @@ fn new_level_common(k: &mut K) {
 /// [`smooth_triangle::shading_normal`]) and refraction (whether the hit is
 /// on an object's back, `SH_BACK`, for the index of refraction, and the
 /// object the rays it spawns leave).
-pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool) -> K {
+pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool, local: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
         "{}: after a closest-hit pass: the hit's shading state (stream: background.rgb,\n\
@@ -229,6 +235,9 @@ pub fn post(level0: bool, materials: usize, smooth: bool, refract: bool) -> K {
             .c(format!("st r11, [#{}]", ram::SH_P + i));
     }
     k.note("P = o + t d + EPS_LSB n");
+    if local {
+        super::positions::post(&mut k, 9);
+    }
     k.c(format!("ld r13, [r0 + #{}]", ram::HIT_MAT))
         .c(format!("st r13, [#{}]", ram::SH_MAT))
         .c("movb r14, #0")
@@ -734,8 +743,8 @@ mod tests {
         assert_eq!(eye(nr, false).fb_reads, 14);
         assert_eq!(light_setup(nr, false).fb_reads, 3);
         assert_eq!(light_setup(nr, true).fb_reads, 4);
-        assert_eq!(post(true, 5, false, false).fb_reads, 3 + 2 * 5);
-        assert_eq!(post(false, 5, true, true).fb_reads, 3 + 2 * 5);
+        assert_eq!(post(true, 5, false, false, false).fb_reads, 3 + 2 * 5);
+        assert_eq!(post(false, 5, true, true, true).fb_reads, 3 + 2 * 5);
         // Per material: the id, then per channel two words; a fractional
         // exponent two more.
         for runs in [false, true] {

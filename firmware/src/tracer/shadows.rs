@@ -64,9 +64,12 @@ pub fn merged(opt: &Options, lay: &FbImage) -> bool {
 }
 
 /// Whether merging can apply to this build: the packet traversal, a
-/// reflection level, 2 to [`MAX_LIGHTS`] lights.
+/// reflection level, 2 to [`MAX_LIGHTS`] lights, and positions in the
+/// scene's format (the stage holds no origin remainders,
+/// [`super::Positions::Local`]).
 pub fn applies(opt: &Options, lay: &FbImage) -> bool {
     lay.traversal == Traversal::Packet
+        && !lay.fit.sphere_local
         && opt.depth >= 2
         && (2..=MAX_LIGHTS).contains(&lay.lights.len())
 }

@@ -384,7 +384,7 @@ fn build_as(
     check_counts(mats.len(), scene.lights.len()).map_err(|m| err(0, m))?;
 
     let packet = opt.traversal == Traversal::Packet;
-    let (geo, fan, mut fit) = fit_scene(scene, s, frac, xb, fine_normals, packet && bands);
+    let (geo, fan, mut fit) = fit_scene(scene, s, frac, opt, fine_normals, packet && bands);
     let test_cuts = packet && opt.test_cuts.in_parts();
     fit.cyl_bound = test_cuts;
     // A streamed layout keeps the banded polygons' sub-edges in main
@@ -556,17 +556,20 @@ impl Finish {
 }
 
 /// The geometry every record is written from, and the kernels' scale
-/// shifts fitted to it (`xb`: the datapath's extra bits; `s`: LSBs per
-/// unit of the scene format `frac`). Also the polygons' largest fan
+/// shifts fitted to it (`opt`: the datapath, whose extra bits every
+/// format gets, and the positions; `s`: LSBs per unit of the scene format
+/// `frac`). Also the polygons' largest fan
 /// ([`polygon_fan`]; `bands`: banded records where they pay).
 fn fit_scene(
     scene: &Scene,
     s: f64,
     frac: u32,
-    xb: u32,
+    opt: &Options,
     fine_normals: bool,
     bands: bool,
 ) -> (Vec<Geometry>, usize, Fit) {
+    let xb = opt.datapath.extra_bits();
+    let local = opt.positions == super::Positions::Local;
     let fitter = Fitter { x: xb };
     let mut geo: Vec<Geometry> = Vec::with_capacity(scene.objects.len());
     let (fan, polygon_bands) = polygon_fan(scene, s, bands);
@@ -588,6 +591,7 @@ fn fit_scene(
     let mut fit = Fit {
         kt,
         fine_normals,
+        sphere_local: local,
         polygon_form: if polygon_bands {
             polygon::Form::Banded
         } else {

@@ -124,12 +124,42 @@ pub(super) fn camera(w: &mut W, scene: &Scene, opt: &Options) -> Result<(usize, 
     w.raw(0);
     w.raw(0);
     w.point(c.from);
+    if opt.positions == super::super::Positions::Local {
+        local_camera(w, c.from, [a, b, cc], kd);
+        return Ok((eye, kd));
+    }
     for k in 0..3 {
         w.push(a.axis(k) * w.one() / 2.0);
         w.push(b.axis(k) * (kd as f64).exp2());
         w.push(cc.axis(k) * (kd as f64).exp2());
     }
     Ok((eye, kd))
+}
+
+/// The rest of the camera stream for local positions
+/// ([`super::super::positions::eye`]): the eye's remainder (2^-14 LSB),
+/// then per axis the pixel steps' remainders `B_L`, `C_L` (2^-16 of
+/// their LSB), `A` in Q2.13 and its remainder `A_L` (2^-KD), `B`, `C`
+/// (2^-KD): the eye rays' directions to 2^-KD before normalising.
+fn local_camera(w: &mut W, from: Vec3, [a, b, cc]: [Vec3; 3], kd: u32) {
+    let s = w.s;
+    for x in from.to_array() {
+        w.push((x * s - w.sat(x * s) as f64) * 16384.0);
+    }
+    let k2 = (kd as f64).exp2();
+    for k in 0..3 {
+        let (ah, bh, ch) = (
+            w.sat(a.axis(k) * 8192.0) as f64,
+            w.sat(b.axis(k) * k2) as f64,
+            w.sat(cc.axis(k) * k2) as f64,
+        );
+        w.push((b.axis(k) * k2 - bh) * 65536.0);
+        w.push((cc.axis(k) * k2 - ch) * 65536.0);
+        w.push(ah);
+        w.push(a.axis(k) * k2 - ah * (kd as f64 - 13.0).exp2());
+        w.push(bh);
+        w.push(ch);
+    }
 }
 
 /// The light and shading streams: per light its position (with a scale

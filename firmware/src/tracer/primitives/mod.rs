@@ -620,6 +620,10 @@ pub struct Fit {
     pub ks_sphere: u32,
     pub ep_sphere: u32,
     pub sphere_fine: bool,
+    /// Local positions ([`super::Positions::Local`]): sphere records in
+    /// frames of their own ([`sphere::layout`]), `ks_sphere` fitted to
+    /// their radii there.
+    pub sphere_local: bool,
     /// Some opaque sphere is seen from inside (NFF's negative radius,
     /// `sg` = -1): the sphere kernel's first part cannot then reject a
     /// sphere whose centre is behind the ray.

@@ -51,9 +51,50 @@ pub const RADIUS: Field = Field::part("r", "the radius (fine: EP_SPHERE extra bi
 pub const SIGN: Field = Field::part("sg", "+1 seen from outside, -1 inside-visible");
 pub const OBJ: Field = Field::part("obj", "the object's id");
 pub const MAT: Field = Field::part("mat", "its material");
+/// Local positions ([`crate::tracer::Positions::Local`]): the record's
+/// frame, its LSB `2^-e` of the scene's ([`local_exponent`]).
+pub const SHIFTS: Field = Field::part("sh", "local: e + 2 and 14 - e, the frame's shifts");
+pub const SCALE: Field = Field::part("n", "local: 2^(14-e), a local length in 2^-14 LSB");
+pub const RADIUS_SG: Field = Field::part("rs", "local: sg r");
+pub const CENTRE_AGAIN: Field = Field::part(
+    "pc",
+    "local: the centre and its remainder again, per axis (the hit point)",
+);
+
+/// The largest exponent of a local frame: its LSB `2^-12` of the scene's
+/// (the remainders of 2^-14 LSB keep two bits below it).
+pub const E_MAX: u32 = 12;
+
+/// The exponent `e` of a sphere's local frame (its LSB `2^-e` of the
+/// scene's), for its radius `r` in LSB: the largest up to [`E_MAX`] with
+/// `(2 r + 3) 2^e < 2^14`, so that the vector from the centre to the
+/// ray's point at the rounded `b` (within `2 r` of the centre where the
+/// ray may hit, and up to 3 LSB along the ray from `b`'s rounding and the
+/// Q1.14 direction's length) fits with a guard bit.
+pub fn local_exponent(r: f64) -> u32 {
+    (0..=E_MAX)
+        .rev()
+        .find(|&e| (2.0 * r + 3.0) * (e as f64).exp2() < 16384.0)
+        .unwrap_or(0)
+}
 
 /// The record of `fit`'s spheres.
 pub fn layout(fit: &Fit) -> Layout {
+    if fit.sphere_local {
+        return Layout::new([
+            (CENTRE, 3),
+            (SHIFTS, 2),
+            (CENTRE_REM, 3),
+            (INV_R, 1),
+            (RADIUS, 1),
+            (SIGN, 1),
+            (SCALE, 1),
+            (OBJ, 1),
+            (MAT, 1),
+            (RADIUS_SG, 1),
+            (CENTRE_AGAIN, 6),
+        ]);
+    }
     let fine = fit.sphere_fine.then_some((CENTRE_REM, 3));
     Layout::new([(CENTRE, 3)].into_iter().chain(fine).chain([
         (INV_R, 1),
@@ -112,6 +153,10 @@ pub(crate) fn write(
     mat: usize,
 ) {
     let s = w.s;
+    if fit.sphere_local {
+        write_local(w, fit, center, radius, inside, id, mat);
+        return;
+    }
     let rq = (radius.abs() * s).round().max(1.0);
     let invr = ((14 + w.x + fit.ks_sphere) as f64).exp2()
         / if unrounded || fit.sphere_fine {
@@ -147,8 +192,61 @@ pub(crate) fn write(
     w.raw(mat as i64);
 }
 
+/// Write the local record of a sphere ([`layout`] with
+/// `fit.sphere_local`): its centre rounded and the remainders in 2^-14
+/// LSB, its radius and `invr` in its frame of `2^-e` LSB.
+fn write_local(
+    w: &mut W,
+    fit: &Fit,
+    center: Vec3,
+    radius: f64,
+    inside: bool,
+    id: usize,
+    mat: usize,
+) {
+    let s = w.s;
+    let r = radius.abs() * s;
+    let e = local_exponent(r);
+    let rl = r * (e as f64).exp2();
+    let sg = if inside { -1.0 } else { 1.0 };
+    let one = w.one();
+    let c = center.to_array().map(|x| x * s);
+    let hi = c.map(|x| w.sat(x) as f64);
+    w.field(CENTRE);
+    w.point(center);
+    w.field(SHIFTS);
+    w.raw(e as i64 + 2);
+    w.raw(14 - e as i64);
+    w.field(CENTRE_REM);
+    for i in 0..3 {
+        w.push((c[i] - hi[i]) * one);
+    }
+    w.field(INV_R);
+    w.push(((14 + w.x + fit.ks_sphere) as f64).exp2() / rl);
+    w.field(RADIUS);
+    w.push(rl);
+    w.field(SIGN);
+    w.push(sg * one);
+    w.field(SCALE);
+    w.push((14.0 - e as f64).exp2());
+    w.field(OBJ);
+    w.raw(id as i64);
+    w.field(MAT);
+    w.raw(mat as i64);
+    w.field(RADIUS_SG);
+    w.push(sg * rl);
+    w.field(CENTRE_AGAIN);
+    for i in 0..3 {
+        w.push(hi[i]);
+        w.push((c[i] - hi[i]) * one);
+    }
+}
+
 /// The sphere kernel for records of `fit` and the sides `sides`.
 pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
+    if fit.sphere_local && sides == Sides::Front {
+        return kernel_local(g, fit);
+    }
     let (fine, perp, two) = (fit.sphere_fine, g.fine_normals, sides == Sides::Both);
     let nr = g.approx;
     let mut k = K::new();
@@ -160,13 +258,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         if two { ", HIT_BACK_OBJ (the far side)" } else { "" }
     ));
     k.comment("oc = c - o");
-    k.c("sub r8, fb0, r1")
-        .c("sub r9, fb0, r2")
-        .c("sub r10, fb0, r3");
-    k.c("mul out, r8, r4")
-        .c("mac out, r9, r5")
-        .c("mac r11, r10, r6, >>Q14")
-        .note("b = oc.d");
+    oc_and_b(&mut k, "b = oc.d");
     if fine && !perp {
         // b's remainder: the accumulator minus round(b) 2^14, below 2^13
         // in magnitude, so its low half is exact (the wrap is intended).
@@ -202,18 +294,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         k.c("mov r12, fb0").note("r");
     }
     let r = if g.published { "r12" } else { "fb0" };
-    for x in [8, 9, 10] {
-        k.c(format!("mul r{x}, r{x}, r13, >>KS_SPHERE+EP_SPHERE"));
-    }
-    k.note("p/r");
-    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
-        .c("ldacc r14, <<Q14")
-        .c("msu out, r8, r8")
-        .c("msu out, r9, r9")
-        .c("msu r15, r10, r10, >>Q14")
-        .note("s = 1 - |p/r|^2")
-        .c("cmp.gt r15, #0")
-        .note("F: the line meets the sphere");
+    meets(&mut k, "KS_SPHERE+EP_SPHERE");
     if !two && g.test_cuts && !g.published && !fit.sphere_inside {
         // Seen from outside (sg = +1), t = b - h with h >= 0: a sphere
         // whose centre is not ahead has no root ahead, exactly.
@@ -232,6 +313,150 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     root(&mut k, g, two, r, er);
     normal_and_commit(&mut k, two);
     k
+}
+
+/// The sphere kernel of local records ([`layout`] with `fit.sphere_local`,
+/// one side): `b = round((c - o).d)` in the scene's LSB as in [`kernel`],
+/// then `p = (c - o) - b d` formed exactly in the accumulator from the
+/// rounded centre and origin and both remainders (`cl`, `RAY_OL`, 2^-14
+/// LSB) and the direction's (`RAY_DL`, 2^-27) and taken into the sphere's frame, `2^e` times finer: the
+/// accumulator's words shifted by the record's `e + 2` (saturating) and
+/// `14 - e`. In the frame: `p` made perpendicular to `d` (its part along
+/// `d`, `pd`, kept), `s = 1 - |p/r|^2`, `t = b + (pd - sg r sqrt(s)) 2^-e`
+/// rounded to the scene's LSB (for the nearest-hit comparisons), the
+/// normal as in [`kernel`], and the hit point `c + sg r n` back in the
+/// scene's format with its remainder: `HIT_PH`, `HIT_PL`, tagged by
+/// `HIT_TL = t` (its remainder `HIT_TLL`: nearest hits are told apart to
+/// 2^-14 LSB where both are local, overlapping spheres).
+fn kernel_local(g: &Gen, fit: &Fit) -> K {
+    let nr = g.approx;
+    let mut k = K::new();
+    k.doc(&format!(
+        "{}: the sphere test of one local record (the stream), for every awake ray.\n\
+         In: r1..r7 the rays, RAY_OL. Out where F (a nearer hit): r7 = t, HIT_N, HIT_OBJ, HIT_MAT,\n\
+         HIT_TL = t, HIT_PH and HIT_PL the hit point. b = round((c - o).d), p = ((c - o) - b d) 2^e,\n\
+         s = 1 - |p/r|^2, t = b + (pd - sg r sqrt(s)) 2^-e, n = -(sg p/r + sqrt(s) d), P = c + sg r n 2^-e",
+        kernel_name(Sides::Front),
+    ));
+    k.comment("oc = c - o (the rounded centre and origin)");
+    oc_and_b(&mut k, "b = round(oc.d)");
+    k.c("mov r14, fb0")
+        .note("e + 2")
+        .c("mov r15, fb0")
+        .note("14 - e");
+    k.comment("p = oc + cl - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
+    for (i, (x, d)) in [(8, 4), (9, 5), (10, 6)].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("ld r12, [r0 + #{}]", ram::RAY_OL + i))
+            .c(format!("ld r13, [r0 + #{}]", ram::RAY_DL + i))
+            .c("mul r13, r11, r13, >>Q13")
+            .note("b dl")
+            .c(format!("ldacc r{x}, <<Q14"))
+            .c("mac out, fb0, #1")
+            .note("+ cl")
+            .c("msu out, r12, #1")
+            .note("- ol")
+            .c("msu out, r13, #1")
+            .c(format!("msu out, r11, r{d}"))
+            .note("- b d")
+            .c("acch r12")
+            .c("accl r13")
+            .c("asl r12, r12, r14")
+            .c("srl r13, r13, r15")
+            .c(format!("or r{x}, r12, r13"))
+            .note("p 2^e (saturated far from the sphere)");
+    }
+    perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
+    k.note("r12 = pd, what p had along d");
+    k.c("mov r13, fb0").note("invr, in the frame");
+    meets(&mut k, "KS_SPHERE");
+    if g.test_cuts && !fit.sphere_inside {
+        k.c("(f) cmp.gt r11, #0").note("and its centre lies ahead");
+    }
+    k.cut(CUTS[0].0);
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
+    }
+    k.note("p/r in TMP0..2");
+    sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
+    k.c("mul r9, fb0, r8, >>Q14")
+        .note("h = r sqrt(s), in the frame")
+        .c("mov r10, fb0")
+        .note("sg")
+        .c("mul r9, r9, r10, >>Q14")
+        .c("sub r9, r12, r9")
+        .note("pd - sg h")
+        .c("mov r14, fb0")
+        .note("2^(14-e)")
+        .c("ldacc r11, <<Q14")
+        .c("mac r9, r14, r9, >>Q14")
+        .note("t = b + (pd - sg h) 2^-e")
+        .c("accl r12")
+        .c("sll r13, r9, #Q14")
+        .c("sub r12, r12, r13")
+        .note("its remainder, 2^-14 LSB")
+        .c("movb r15, #0")
+        .c("(f) movb r15, #1");
+    k.comment("t < tbest to 2^-14 LSB (a tbest not local has no remainder)");
+    k.c(format!("ld r13, [r0 + #{}]", ram::HIT_TL))
+        .c("cmp.eq r13, r7")
+        .c(format!("ld r13, [r0 + #{}]", ram::HIT_TLL))
+        .c("(!f) movb r13, #0")
+        .c("cmp.eq r9, r7")
+        .c("(f) cmp.lt r12, r13")
+        .c("(!f) cmp.lt r9, r7")
+        .c("(f) cmp.gt r9, #0")
+        .c("(f) cmp.ne r15, #0")
+        .note("F: a hit ahead, nearer than tbest")
+        .c(format!("(f) st r9, [#{}]", ram::HIT_TL))
+        .c(format!("(f) st r12, [#{}]", ram::HIT_TLL));
+    normal_and_commit(&mut k, false);
+    k.comment("the hit point c + sg r n 2^-e, to 2^-14 LSB");
+    k.c("mov r15, fb0").note("sg r");
+    for (i, n) in [11, 12, 13].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("mul r8, r{n}, r15, >>Q14"))
+            .c("ldacc fb0, <<Q14")
+            .c("mac out, fb0, #1")
+            .c("mac r9, r8, r14, >>Q14")
+            .note("P")
+            .c("accl r8")
+            .c("sll r10, r9, #Q14")
+            .c("sub r8, r8, r10")
+            .note("its remainder")
+            .c(format!("(f) st r9, [#{}]", ram::HIT_PH + i))
+            .c(format!("(f) st r8, [#{}]", ram::HIT_PL + i));
+    }
+    k
+}
+
+/// `oc = c - o` (r8..r10, the centre from the stream) and `b = oc.d`
+/// (r11; `note` says which).
+fn oc_and_b(k: &mut K, note: &str) {
+    k.c("sub r8, fb0, r1")
+        .c("sub r9, fb0, r2")
+        .c("sub r10, fb0, r3");
+    k.c("mul out, r8, r4")
+        .c("mac out, r9, r5")
+        .c("mac r11, r10, r6, >>Q14")
+        .note(note);
+}
+
+/// `p/r` (r8..r10: `p` times `invr` in r13, shifted by `shift`) and
+/// `s = 1 - |p/r|^2` (r15); F where the line meets the sphere.
+fn meets(k: &mut K, shift: &str) {
+    for x in [8, 9, 10] {
+        k.c(format!("mul r{x}, r{x}, r13, >>{shift}"));
+    }
+    k.note("p/r");
+    k.c(format!("ld r14, [r0 + #{}]", ram::C_ONE))
+        .c("ldacc r14, <<Q14")
+        .c("msu out, r8, r8")
+        .c("msu out, r9, r9")
+        .c("msu r15, r10, r10, >>Q14")
+        .note("s = 1 - |p/r|^2")
+        .c("cmp.gt r15, #0")
+        .note("F: the line meets the sphere");
 }
 
 /// The root: `h = r sqrt(s)` (`r` the register or stream that holds r,
@@ -353,7 +578,15 @@ impl super::ChipPrimitive for Sphere {
     fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
         let spheres = || scene.objects.iter().filter_map(|o| o.shape.as_sphere());
         let radii = spheres().map(|sp| sp.radius.abs() * s);
-        (fit.ks_sphere, fit.ep_sphere, fit.sphere_fine) = self::fit(radii, f);
+        if fit.sphere_local {
+            // Radii in their frames; no fine record (the remainders are
+            // the local record's).
+            let local = radii.map(|r| r * (local_exponent(r) as f64).exp2());
+            (fit.ks_sphere, fit.ep_sphere, _) = self::fit(local, f);
+            fit.sphere_fine = false;
+        } else {
+            (fit.ks_sphere, fit.ep_sphere, fit.sphere_fine) = self::fit(radii, f);
+        }
         fit.sphere_inside = spheres().any(|sp| sp.inside);
     }
 

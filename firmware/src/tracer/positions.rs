@@ -1,0 +1,142 @@
+//! Local positions ([`super::Positions::Local`]): the shading's part.
+//! Every ray's origin carries a remainder (`RAY_OL`, 2^-14 LSB) beside
+//! the rounded origin in r1..r3: zero at the eye (on the format's grid
+//! where the scene has curved objects, [`super::build`]), the remainder of
+//! the hit point it leaves (`SH_PL`) for shadow and reflected rays. A
+//! kernel that tests an object in a frame of its own (the sphere's,
+//! [`super::primitives::sphere`]) leaves its hit point to 2^-14 LSB
+//! (`HIT_PH`, `HIT_PL`) tagged with its `t` (`HIT_TL`); where the pass's
+//! nearest hit is such a one (`tbest = HIT_TL`), [`post`] takes that point
+//! for the hit being shaded instead of `o + t d`, which the scene's format
+//! rounds to an LSB.
+
+use super::emit::K;
+use super::math::Approx;
+use super::memory_map::ram;
+
+/// `k_eye` for local positions: the tile's eye rays with their
+/// directions to about 2^-27 (stream: px0, py0, eye.xyz, its remainder,
+/// then per axis `B_L, C_L, A, A_L, B, C`, [`crate::tracer::layout`]'s
+/// camera). `v = A + i B + j C` is summed exactly in the accumulator
+/// (2^-KD) and split into `v_H` (Q2.13) and its remainder `v_R`
+/// (2^-28); `Y = 1/|v|` (Q1.14) from the RSQ table and Newton steps on
+/// `v_H`; the direction `v Y` (length within a few 2^-14 of 1, its
+/// direction that of `v`) as `D_H` (Q1.14, r4..r6) and `D_L` (2^-27,
+/// `RAY_DL`). The origin's remainder is the eye's (`RAY_OL`).
+pub fn eye(nr: Approx, refract: bool) -> K {
+    let mut k = K::new();
+    k.doc(
+        "k_eye: the tile's eye rays, directions to 2^-27 (stream: px0, py0, eye.xyz, eye_l.xyz,\n\
+         (B_L, C_L, A, A_L, B, C) per axis).\n\
+         Out: r1..r3 = eye, RAY_OL its remainder, r4..r6 + RAY_DL = (A + i B + j C) / |.|\n\
+         for pixel (px0 + col, py0 + row), r7 = C_INF; a new level (PASS_T0, COL = 0, SH_D), OUT_OBJ = -1.",
+    );
+    super::shading::eye_pixel(&mut k);
+    for i in 0..3 {
+        k.c(format!("st fb0, [#{}]", ram::RAY_OL + i));
+    }
+    k.note("the eye's remainder");
+    for (a, v) in [10, 11, 12].into_iter().enumerate() {
+        let a = a as u32;
+        k.c("mul r13, fb0, r8, >>16")
+            .note("i B_L")
+            .c("mul r14, fb0, r9, >>16")
+            .note("j C_L")
+            .c("ldacc fb0, <<KD-Q13")
+            .c("mac out, fb0, #1")
+            .note("+ A_L")
+            .c("mac out, r13, #1")
+            .c("mac out, r14, #1")
+            .c("mac out, fb0, r8")
+            .c(format!("mac r{v}, fb0, r9, >>KD-Q13"))
+            .note("v_H, Q2.13")
+            .c("accl r13")
+            .c(format!("sll r14, r{v}, #KD-Q13"))
+            .c("sub r13, r13, r14")
+            .c("sll r13, r13, #28-KD")
+            .c(format!("st r13, [#{}]", ram::TMP0 + a))
+            .note("v_R, 2^-28");
+    }
+    k.comment("Y = 1/|v_H| (Q1.14)");
+    k.c("mul out, r10, r10")
+        .c("mac out, r11, r11")
+        .c("mac r13, r12, r12, >>Q15")
+        .note("X = |v_H|^2, Q.11")
+        .c("srl r14, r13, #RSQ_SHIFT")
+        .c(format!("ld r14, [r14 + #{}]", ram::RSQ))
+        .c(format!("ld r4, [r0 + #{}]", ram::C_ONE));
+    for _ in 0..nr.newton_steps {
+        k.c("mul r15, r14, r14, >>Q14")
+            .c("mul r15, r15, r13, >>Q11")
+            .c("sub r15, r15, r4")
+            .c("ldacc r14, <<Q15")
+            .c("msu r14, r14, r15, >>Q15");
+    }
+    k.comment("D = v Y: D_H (Q1.14) and D_L (2^-27)");
+    k.c("movb r7, #1");
+    for (a, (v, d)) in [(10, 4), (11, 5), (12, 6)].into_iter().enumerate() {
+        let a = a as u32;
+        k.c(format!("ld r15, [r0 + #{}]", ram::TMP0 + a))
+            .c("mul r15, r15, r14, >>Q15")
+            .c(format!("mul out, r{v}, r14"))
+            .c(format!("mac r{d}, r15, r7, >>Q13"))
+            .c("accl r15")
+            .c(format!("sll r13, r{d}, #Q13"))
+            .c("sub r15, r15, r13")
+            .c(format!("st r15, [#{}]", ram::RAY_DL + a));
+    }
+    super::shading::new_level_common(&mut k);
+    k.c("movb r8, #-1")
+        .c(format!("st r8, [#{}]", ram::OUT_OBJ))
+        .c(format!("st r8, [#{}]", ram::HIT_TL));
+    if refract {
+        k.c(format!("st r8, [#{}]", ram::ORIG_OBJ))
+            .c(format!("st r8, [#{}]", ram::HIT_BACK_OBJ))
+            .note("no back hit yet in this pass");
+    }
+    k
+}
+
+/// Appended to the kernels that set up reflected rays: their origins'
+/// remainders (the shaded hit point's, `SH_PL`), their directions'
+/// (none: Q1.14) and no local hit yet (`HIT_TL = -1`). Clobbers r8.
+pub fn origins(k: &mut K) {
+    k.comment("local positions: the origins' remainders, no local hit yet");
+    shadow_origins(k);
+    k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::HIT_TL));
+}
+
+/// The origins' and directions' remainders alone (shadow rays: their
+/// pass's hits are not shaded). Clobbers r8.
+pub fn shadow_origins(k: &mut K) {
+    for i in 0..3 {
+        k.c(format!("ld r8, [r0 + #{}]", ram::SH_PL + i))
+            .c(format!("st r8, [#{}]", ram::RAY_OL + i));
+    }
+    k.c("movb r8, #0");
+    for i in 0..3 {
+        k.c(format!("st r8, [#{}]", ram::RAY_DL + i));
+    }
+}
+
+/// In [`super::shading::post`], after `SH_P = o + t d`: `SH_PL = 0`, and
+/// where the pass's nearest hit is a local one (F: a hit, `r7 =
+/// HIT_TL`) its point and remainder. `hit`: the register that is nonzero
+/// where the pass hit. Clobbers r8, r10, r11.
+pub fn post(k: &mut K, hit: u8) {
+    k.comment("a local hit (tbest = HIT_TL): its point to 2^-14 LSB");
+    k.c("movb r10, #0");
+    for i in 0..3 {
+        k.c(format!("st r10, [#{}]", ram::SH_PL + i));
+    }
+    k.c(format!("ld r8, [r0 + #{}]", ram::HIT_TL))
+        .c(format!("cmp.ne r{hit}, #0"))
+        .c("(f) cmp.eq r8, r7")
+        .note("F: the nearest hit is local");
+    for i in 0..3 {
+        k.c(format!("ld r10, [r0 + #{}]", ram::HIT_PH + i))
+            .c(format!("(f) st r10, [#{}]", ram::SH_P + i))
+            .c(format!("ld r11, [r0 + #{}]", ram::HIT_PL + i))
+            .c(format!("(f) st r11, [#{}]", ram::SH_PL + i));
+    }
+}
