@@ -1162,3 +1162,42 @@ fn the_profile_checks_the_cost_model_against_the_frame() {
     let j = json(&[rings.to_str().unwrap(), "--traversal", "paper"]);
     assert!(j["profile"].get("cost_model").is_none());
 }
+
+/// Local positions (`--positions local`) on the 16-bit chip: SPD shells,
+/// whose smallest spheres are 0.22 LSB of its format and which the
+/// scene's one format refuses, renders against the reference; on SPD
+/// balls (its spheres 6 to 500 LSB in radius, a mirror each) the eye rays'
+/// directions and the spheres' hit points to a fraction of an LSB beat
+/// the scene's format in PSNR and hit agreement.
+#[test]
+fn local_positions_render_what_one_format_cannot() {
+    use firmware::tracer::{Datapath, Positions};
+    let o = |positions| Options {
+        datapath: Datapath::W16,
+        depth: 2,
+        positions,
+        ..opts(32, 32)
+    };
+    let spd = |name| {
+        let size = firmware::scene::spd::default_size(name).unwrap();
+        firmware::scene::spd::scene(name, size).unwrap()
+    };
+    let shells = spd("shells");
+    let Err(e) = render(&shells, &o(Positions::Global), &Default::default()) else {
+        panic!("shells in the scene's one format: rendered");
+    };
+    assert!(e.to_string().contains("below the 2 LSB minimum"), "{e}");
+    let (_, rep) = render(&shells, &o(Positions::Local), &Default::default()).unwrap();
+    let psnr = rep.json["psnr_db"].as_f64().unwrap();
+    eprintln!("shells 32x32 local: {psnr:.2} dB, hits {}", rep.json["hit_agreement"]);
+    assert!(psnr >= 40.0, "shells local: {psnr:.2} dB");
+    let balls = spd("balls");
+    let figures = |p| {
+        let (_, rep) = render(&balls, &o(p), &Default::default()).unwrap();
+        let j = &rep.json;
+        (j["psnr_db"].as_f64().unwrap(), j["hit_agreement"].as_f64().unwrap())
+    };
+    let (g, l) = (figures(Positions::Global), figures(Positions::Local));
+    eprintln!("balls 32x32: global {g:?}, local {l:?}");
+    assert!(l.0 >= g.0 + 5.0 && l.1 >= 0.998 && l.1 >= g.1, "balls: global {g:?}, local {l:?}");
+}
