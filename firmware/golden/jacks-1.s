@@ -39,7 +39,7 @@ INSIDE_TOL = 2          ; tolerance of the planar inside tests, Q.14
 ; ---- main memory (byte addresses) ----
 CTXBASE = 0x20000       ; the kernels (loaded into context memory)
 FBIMG = 0x40000         ; the FB image, loaded by the host
-FBWORDS = 489           ; its words
+FBWORDS = 501           ; its words
 TILELIST = 0x60000      ; the tile list, written by the host:
 TL_COUNT = 0            ;   the number of tiles
 TL_FIRST = 4            ;   the first tile's entry:
@@ -56,15 +56,15 @@ AXIS_Z = 8
 FB_EYE = 258            ; eye stream: px0, py0, eye.xyz, (A, B, C) per axis
 EYE_PX = 0              ;   the tile's corner, written per tile
 EYE_PY = 1
-FB_POST = 272           ; post-pass stream: background, (material, Ks) per material
-FB_LIGHT0 = 277         ; light streams: the position (a scale shift first where far)
-FB_SHADE0 = 280         ; shading streams: per material its Phong terms for the light
-ROOTBOX = 289           ; the root cell widened by P_TOL: per axis min, max
-FB_SPHERE = 295         ; the sphere records
+FB_POST = 284           ; post-pass stream: background, (material, Ks) per material
+FB_LIGHT0 = 289         ; light streams: the position (a scale shift first where far)
+FB_SHADE0 = 292         ; shading streams: per material its Phong terms for the light
+ROOTBOX = 301           ; the root cell widened by P_TOL: per axis min, max
+FB_SPHERE = 307         ; the sphere records
 SPHERE_WORDS = 8        ;   words of one
-FB_CYLINDER = 343       ; the cylinder records
+FB_CYLINDER = 355       ; the cylinder records
 CYLINDER_WORDS = 36     ;   words of one
-ROOT = 451              ; the BSP root node
+ROOT = 463              ; the BSP root node
 MAILBOX = 1048576       ; the mailboxes (main memory)
 NOBJ = 9                ; objects in the scene
 
@@ -1088,9 +1088,10 @@ k_done_with_hit:
         (f) sleep
 k_done_with_hit_end:
 
-; k_eye: the tile's eye rays (stream: px0, py0, eye.xyz, (A, B, C) per axis).
-; Out: r1..r3 = eye, r4..r6 = normalize(A + i B + j C) for pixel (px0 + col, py0 + row),
-; r7 = C_INF; a new level (PASS_T0, COL = 0, SH_D), OUT_OBJ = -1.
+; k_eye: the tile's eye rays, directions to 2^-27 (stream: px0, py0, eye.xyz, eye_l.xyz,
+; (B_L, C_L, A, A_L, B, C) per axis).
+; Out: r1..r3 = eye, RAY_OL its remainder, r4..r6 + RAY_DL = (A + i B + j C) / |.|
+; for pixel (px0 + col, py0 + row), r7 = C_INF; a new level (PASS_T0, COL = 0, SH_D), OUT_OBJ = -1.
 k_eye:
         ld r8, [r0 + #LANE_COL]
         add r8, fb0, r8                 ; i
@@ -1099,51 +1100,93 @@ k_eye:
         mov r1, fb0
         mov r2, fb0
         mov r3, fb0
+        mov r13, fb0
+        mov r13, fb0
+        mov r13, fb0                    ; the eye's remainder
+        mul r13, fb0, r8, >>16          ; i B_L
+        mul r14, fb0, r9, >>16          ; j C_L
         ldacc fb0, <<KD-Q13
+        mac out, fb0, #1                ; + A_L
+        mac out, r13, #1
+        mac out, r14, #1
         mac out, fb0, r8
-        mac r10, fb0, r9, >>KD-Q13
+        mac r10, fb0, r9, >>KD-Q13      ; v_H, Q2.13
+        accl r13
+        sll r14, r10, #KD-Q13
+        sub r13, r13, r14
+        sll r13, r13, #28-KD
+        st r13, [#TMP0]                 ; v_R, 2^-28
+        mul r13, fb0, r8, >>16          ; i B_L
+        mul r14, fb0, r9, >>16          ; j C_L
         ldacc fb0, <<KD-Q13
+        mac out, fb0, #1                ; + A_L
+        mac out, r13, #1
+        mac out, r14, #1
         mac out, fb0, r8
-        mac r11, fb0, r9, >>KD-Q13
+        mac r11, fb0, r9, >>KD-Q13      ; v_H, Q2.13
+        accl r13
+        sll r14, r11, #KD-Q13
+        sub r13, r13, r14
+        sll r13, r13, #28-KD
+        st r13, [#TMP0+1]               ; v_R, 2^-28
+        mul r13, fb0, r8, >>16          ; i B_L
+        mul r14, fb0, r9, >>16          ; j C_L
         ldacc fb0, <<KD-Q13
+        mac out, fb0, #1                ; + A_L
+        mac out, r13, #1
+        mac out, r14, #1
         mac out, fb0, r8
-        mac r12, fb0, r9, >>KD-Q13
-        ; normalize
-        sra r10, r10, #1
-        sra r11, r11, #1
-        sra r12, r12, #1
-        abs r13, r10
-        abs r14, r11
-        max r13, r13, r14
-        abs r14, r12
-        max r13, r13, r14
-        clz r13, r13
-        sub r13, r13, #2                ; shift to the top of the word
-        sll r10, r10, r13
-        sll r11, r11, r13
-        sll r12, r12, r13
+        mac r12, fb0, r9, >>KD-Q13      ; v_H, Q2.13
+        accl r13
+        sll r14, r12, #KD-Q13
+        sub r13, r13, r14
+        sll r13, r13, #28-KD
+        st r13, [#TMP0+2]               ; v_R, 2^-28
+        ; Y = 1/|v_H| (Q1.14)
         mul out, r10, r10
         mac out, r11, r11
-        mac r14, r12, r12, >>Q15        ; X = |v|^2, Q.11
-        srl r15, r14, #RSQ_SHIFT
-        ld r15, [r15 + #RSQ]            ; y = 1/sqrt(X) from the table
-        ld r9, [r0 + #C_ONE]
-        mul r8, r15, r15, >>Q14         ; Newton: y += y (1 - X y^2) / 2
-        mul r8, r8, r14, >>Q11
-        sub r8, r8, r9
-        ldacc r15, <<Q15
-        msu r15, r15, r8, >>Q15
-        mul r8, r15, r15, >>Q14         ; Newton: y += y (1 - X y^2) / 2
-        mul r8, r8, r14, >>Q11
-        sub r8, r8, r9
-        ldacc r15, <<Q15
-        msu r15, r15, r8, >>Q15
-        mul r10, r10, r15, >>Q13
-        mul r11, r11, r15, >>Q13
-        mul r12, r12, r15, >>Q13
-        mov r4, r10
-        mov r5, r11
-        mov r6, r12
+        mac r13, r12, r12, >>Q15        ; X = |v_H|^2, Q.11
+        srl r14, r13, #RSQ_SHIFT
+        ld r14, [r14 + #RSQ]
+        ld r4, [r0 + #C_ONE]
+        mul r15, r14, r14, >>Q14
+        mul r15, r15, r13, >>Q11
+        sub r15, r15, r4
+        ldacc r14, <<Q15
+        msu r14, r14, r15, >>Q15
+        mul r15, r14, r14, >>Q14
+        mul r15, r15, r13, >>Q11
+        sub r15, r15, r4
+        ldacc r14, <<Q15
+        msu r14, r14, r15, >>Q15
+        mul r15, r14, r14, >>Q14
+        mul r15, r15, r13, >>Q11
+        sub r15, r15, r4
+        ldacc r14, <<Q15
+        msu r14, r14, r15, >>Q15
+        ; D = v Y: D_H (Q1.14) and D_L (2^-27)
+        movb r7, #1
+        ld r15, [r0 + #TMP0]
+        mul r15, r15, r14, >>Q15
+        mul out, r10, r14
+        mac r4, r15, r7, >>Q13
+        accl r15
+        sll r13, r4, #Q13
+        sub r15, r15, r13
+        ld r15, [r0 + #TMP0+1]
+        mul r15, r15, r14, >>Q15
+        mul out, r11, r14
+        mac r5, r15, r7, >>Q13
+        accl r15
+        sll r13, r5, #Q13
+        sub r15, r15, r13
+        ld r15, [r0 + #TMP0+2]
+        mul r15, r15, r14, >>Q15
+        mul out, r12, r14
+        mac r6, r15, r7, >>Q13
+        accl r15
+        sll r13, r6, #Q13
+        sub r15, r15, r13
         ld r7, [r0 + #C_INF]
         st r7, [#PASS_T0]
         movb r8, #0

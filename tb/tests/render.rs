@@ -1189,15 +1189,24 @@ fn local_positions_render_what_one_format_cannot() {
     assert!(e.to_string().contains("below the 2 LSB minimum"), "{e}");
     let (_, rep) = render(&shells, &o(Positions::Local), &Default::default()).unwrap();
     let psnr = rep.json["psnr_db"].as_f64().unwrap();
-    eprintln!("shells 32x32 local: {psnr:.2} dB, hits {}", rep.json["hit_agreement"]);
+    eprintln!(
+        "shells 32x32 local: {psnr:.2} dB, hits {}",
+        rep.json["hit_agreement"]
+    );
     assert!(psnr >= 40.0, "shells local: {psnr:.2} dB");
     let balls = spd("balls");
     let figures = |p| {
         let (_, rep) = render(&balls, &o(p), &Default::default()).unwrap();
         let j = &rep.json;
-        (j["psnr_db"].as_f64().unwrap(), j["hit_agreement"].as_f64().unwrap())
+        (
+            j["psnr_db"].as_f64().unwrap(),
+            j["hit_agreement"].as_f64().unwrap(),
+        )
     };
     let (g, l) = (figures(Positions::Global), figures(Positions::Local));
     eprintln!("balls 32x32: global {g:?}, local {l:?}");
-    assert!(l.0 >= g.0 + 5.0 && l.1 >= 0.998 && l.1 >= g.1, "balls: global {g:?}, local {l:?}");
+    assert!(
+        l.0 >= g.0 + 5.0 && l.1 >= 0.998 && l.1 >= g.1,
+        "balls: global {g:?}, local {l:?}"
+    );
 }

@@ -14,6 +14,16 @@ use super::emit::K;
 use super::math::Approx;
 use super::memory_map::ram;
 
+/// Whether the eye rays' kernel is [`eye`] (and the camera stream its):
+/// local positions, or the 16-bit chip with fine normals (its eye rays'
+/// Q1.14 directions then rounded once from the exact `v Y` instead of
+/// normalised from the rounded `v`; the paper's traversal with coarse
+/// normals keeps the paper's kernel and its cycles).
+pub fn precise_eye(opt: &super::Options, fine_normals: bool) -> bool {
+    opt.positions == super::Positions::Local
+        || (opt.datapath == rtl::rc::Datapath::W16 && fine_normals)
+}
+
 /// `k_eye` for local positions: the tile's eye rays with their
 /// directions to about 2^-27 (stream: px0, py0, eye.xyz, its remainder,
 /// then per axis `B_L, C_L, A, A_L, B, C`, [`crate::tracer::layout`]'s
@@ -23,7 +33,7 @@ use super::memory_map::ram;
 /// `v_H`; the direction `v Y` (length within a few 2^-14 of 1, its
 /// direction that of `v`) as `D_H` (Q1.14, r4..r6) and `D_L` (2^-27,
 /// `RAY_DL`). The origin's remainder is the eye's (`RAY_OL`).
-pub fn eye(nr: Approx, refract: bool) -> K {
+pub fn eye(nr: Approx, refract: bool, local: bool) -> K {
     let mut k = K::new();
     k.doc(
         "k_eye: the tile's eye rays, directions to 2^-27 (stream: px0, py0, eye.xyz, eye_l.xyz,\n\
@@ -33,7 +43,11 @@ pub fn eye(nr: Approx, refract: bool) -> K {
     );
     super::shading::eye_pixel(&mut k);
     for i in 0..3 {
-        k.c(format!("st fb0, [#{}]", ram::RAY_OL + i));
+        if local {
+            k.c(format!("st fb0, [#{}]", ram::RAY_OL + i));
+        } else {
+            k.c("mov r13, fb0");
+        }
     }
     k.note("the eye's remainder");
     for (a, v) in [10, 11, 12].into_iter().enumerate() {
@@ -65,7 +79,10 @@ pub fn eye(nr: Approx, refract: bool) -> K {
         .c("srl r14, r13, #RSQ_SHIFT")
         .c(format!("ld r14, [r14 + #{}]", ram::RSQ))
         .c(format!("ld r4, [r0 + #{}]", ram::C_ONE));
-    for _ in 0..nr.newton_steps {
+    // Three steps whatever the table: the direction's length is within a
+    // few 2^-14 of one from the smallest table on (the direction is `v`'s
+    // whatever `Y`).
+    for _ in 0..nr.newton_steps.max(3) {
         k.c("mul r15, r14, r14, >>Q14")
             .c("mul r15, r15, r13, >>Q11")
             .c("sub r15, r15, r4")
@@ -82,13 +99,16 @@ pub fn eye(nr: Approx, refract: bool) -> K {
             .c(format!("mac r{d}, r15, r7, >>Q13"))
             .c("accl r15")
             .c(format!("sll r13, r{d}, #Q13"))
-            .c("sub r15, r15, r13")
-            .c(format!("st r15, [#{}]", ram::RAY_DL + a));
+            .c("sub r15, r15, r13");
+        if local {
+            k.c(format!("st r15, [#{}]", ram::RAY_DL + a));
+        }
     }
     super::shading::new_level_common(&mut k);
-    k.c("movb r8, #-1")
-        .c(format!("st r8, [#{}]", ram::OUT_OBJ))
-        .c(format!("st r8, [#{}]", ram::HIT_TL));
+    k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::OUT_OBJ));
+    if local {
+        k.c(format!("st r8, [#{}]", ram::HIT_TL));
+    }
     if refract {
         k.c(format!("st r8, [#{}]", ram::ORIG_OBJ))
             .c(format!("st r8, [#{}]", ram::HIT_BACK_OBJ))

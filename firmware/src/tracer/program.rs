@@ -113,8 +113,8 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
     // Smooth triangles: the shading normal and the reflection's fallback.
     let smooth = lay.types.iter().any(|x| x.ty.primitive().smooth());
     let local = lay.fit.sphere_local;
-    let eye = if local {
-        super::positions::eye(nm.approx(), lay.refract)
+    let eye = if super::positions::precise_eye(opt, lay.fine_normals) {
+        super::positions::eye(nm.approx(), lay.refract, local)
     } else {
         shading::eye(nm.approx(), lay.refract)
     };

@@ -392,12 +392,9 @@ fn build_as(
     if fit.polygon_form.banded() {
         fit.polygon_form = form;
     }
-    let mut w = W::new(s, frac, xb);
-    // Init stream.
-    w.fb.extend(table_slots_for(128, xb));
-    w.push(w.one());
-    w.push(w.max());
-    let (eye, kd) = camera(&mut w, scene, opt).map_err(|m| err(scene.lines.camera, m))?;
+    let mut w = init_stream(s, frac, xb);
+    let eye_kd = camera(&mut w, scene, opt, fine_normals);
+    let (eye, kd) = eye_kd.map_err(|m| err(scene.lines.camera, m))?;
 
     let refract = ChipType::ALL
         .iter()
@@ -476,6 +473,16 @@ fn build_as(
         mailbox_slots,
         &err,
     )
+}
+
+/// The FB image's writer with the init stream written: the tables'
+/// slots, one and the largest word.
+fn init_stream(s: f64, frac: u32, xb: u32) -> W {
+    let mut w = W::new(s, frac, xb);
+    w.fb.extend(table_slots_for(128, xb));
+    w.push(w.one());
+    w.push(w.max());
+    w
 }
 
 /// What every node format's [`FbImage`] shares (the part laid out before

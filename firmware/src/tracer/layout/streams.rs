@@ -78,7 +78,12 @@ pub fn light_shift_w(position: Vec3, m: f64, frac: u32, x: u32) -> Option<u32> {
 
 /// The eye stream (`D(i, j) = A + i B + j C`): its FB address and the
 /// scale shift `KD` of B and C.
-pub(super) fn camera(w: &mut W, scene: &Scene, opt: &Options) -> Result<(usize, u32), String> {
+pub(super) fn camera(
+    w: &mut W,
+    scene: &Scene,
+    opt: &Options,
+    fine_normals: bool,
+) -> Result<(usize, u32), String> {
     let xb = w.x;
     let c = &scene.camera;
     let (wd, hd) = (opt.width.max(1), opt.height.max(1));
@@ -124,7 +129,7 @@ pub(super) fn camera(w: &mut W, scene: &Scene, opt: &Options) -> Result<(usize, 
     w.raw(0);
     w.raw(0);
     w.point(c.from);
-    if opt.positions == super::super::Positions::Local {
+    if super::super::positions::precise_eye(opt, fine_normals) {
         local_camera(w, c.from, [a, b, cc], kd);
         return Ok((eye, kd));
     }
