@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use firmware::bsp::BspParams;
-use firmware::tracer::{Numerics, Options};
+use firmware::tracer::{Numerics, Options, Positions};
 use serde_json::json;
 
 use crate::cmd_scene::{load_scene, png_bytes};
@@ -164,8 +164,11 @@ pub struct RenderArgs {
     /// of 2^-14 LSB; each sphere tested in a frame of its own, its LSB
     /// fitted to its radius, its hit point brought back with the
     /// remainder). Local: the packet traversal on the 16-bit chip,
-    /// without refraction, shadow rays a packet per light
-    #[arg(long = ro::POSITIONS.long, value_name = "global|local", default_value = "global")]
+    /// without refraction, shadow rays a packet per light. Auto: local on
+    /// the 16-bit chip where global ones cannot hold the scene or render
+    /// a probe of the frame (1/16 of the tiles) under --datapath auto's
+    /// bar and local ones do better; else global
+    #[arg(long = ro::POSITIONS.long, value_name = "auto|global|local", default_value = "auto")]
     pub positions: firmware::tracer::Positions,
     /// With --json: when that file already holds a complete render made
     /// with these same arguments from the same scene, timing file,
@@ -455,8 +458,22 @@ fn build(
             _ => choice = crate::cli::DatapathChoice::Fixed(d),
         }
     }
-    let (datapath, mut datapath_reason, built) = choose_datapath(scene, opt, nm, choice, timing)?;
+    if let (Some((_, text)), Positions::Auto) = (program, opt.positions) {
+        // The file's header says whether it was emitted for local positions.
+        let local = text
+            .lines()
+            .nth(1)
+            .is_some_and(|l| l.contains("local positions"));
+        opt.positions = if local {
+            Positions::Local
+        } else {
+            Positions::Global
+        };
+    }
+    let (datapath, positions, mut datapath_reason, built) =
+        choose_datapath(scene, opt, nm, choice, timing)?;
     opt.datapath = datapath;
+    opt.positions = positions;
     let mut built = match built {
         Some(fw) => fw,
         None => crate::render::choose_firmware(scene, opt, nm, timing)?,
@@ -675,14 +692,72 @@ fn print_figures(opt: &Options, chip: &crate::render::ChipRender, j: &serde_json
     );
 }
 
-/// The chip `--datapath` asks for, why (printed and in the JSON), and the
-/// firmware when the choice built it.
+/// The probe's figures of the firmware chosen for `o` (its own probe, or
+/// one run for them): the firmware, PSNR (99 where identical) and hit
+/// agreement against the f64 reference on the probe's pixels.
+fn probe_figures(
+    scene: &firmware::scene::Scene,
+    o: &Options,
+    nm: &firmware::tracer::Numerics,
+    timing: &rtl::Timing,
+) -> Result<(firmware::tracer::Firmware, f64, f64)> {
+    let (fw, p) = crate::render::choose_firmware_probed(scene, o, nm, timing)?;
+    let p = match p {
+        Some(p) => p,
+        None => crate::render::probe(&fw, o, timing)?,
+    };
+    let (r8, rh) = match &p.reference {
+        Some(r) => r.clone(),
+        None => reference::render_pixels(scene, o.width, o.height, o.depth, &p.pixels),
+    };
+    let psnr = metrics::psnr(&p.rgb8, &r8);
+    Ok((
+        fw,
+        if psnr.is_finite() { psnr } else { 99.0 },
+        metrics::hit_agreement(&p.hits, &rh),
+    ))
+}
+
+/// A probe's firmware, PSNR and hit agreement ([`probe_figures`]).
+type Probed = (firmware::tracer::Firmware, f64, f64);
+
+/// The 16-bit chip's probe with positions `p` (`measured` of the options
+/// `on` gives), and with `auto` local ones instead where `p`'s fail or
+/// fall under the bar and local ones pass it or do better in both.
+fn measure_16(
+    measured: &dyn Fn(&Options) -> Result<Probed>,
+    on: &dyn Fn(rtl::rc::Datapath, Positions) -> Options,
+    p: Positions,
+    auto: bool,
+) -> Result<(Probed, Positions)> {
+    use crate::cli::{AUTO_MIN_HITS, AUTO_MIN_PSNR};
+    let passes = |p: f64, h: f64| p >= AUTO_MIN_PSNR && h >= AUTO_MIN_HITS;
+    let w16 = rtl::rc::Datapath::W16;
+    let m16 = measured(&on(w16, p)).map(|m| (m, p));
+    if !auto || matches!(&m16, Ok(((_, p, h), _)) if passes(*p, *h)) {
+        return m16;
+    }
+    match (measured(&on(w16, Positions::Local)), &m16) {
+        (Ok(l), Ok(((_, p, h), _))) if passes(l.1, l.2) || (l.1 > *p && l.2 >= *h) => {
+            Ok((l, Positions::Local))
+        }
+        (Ok(l), Err(_)) => Ok((l, Positions::Local)),
+        _ => m16,
+    }
+}
+
+/// The chip for `--datapath` and the positions for `--positions`, the
+/// firmware built where a probe chose them, and why.
 ///
-/// `auto`: the paper's 16-bit chip, unless it cannot hold the scene, or its
-/// render of the probe (1/16 of the frame's tiles, [`crate::render::probe`])
-/// falls under the project's bar ([`crate::cli::AUTO_MIN_PSNR`] dB and
-/// [`crate::cli::AUTO_MIN_HITS`] hit agreement against the f64 reference on
-/// the same pixels) while the 32-bit chip's does better.
+/// Datapath `auto`: the paper's 16-bit chip, unless it cannot hold the
+/// scene, or its render of the probe (1/16 of the frame's tiles,
+/// [`crate::render::probe`]) falls under the project's bar
+/// ([`crate::cli::AUTO_MIN_PSNR`] dB and [`crate::cli::AUTO_MIN_HITS`] hit
+/// agreement against the f64 reference on the same pixels) while the
+/// 32-bit chip's does better. Positions `auto` on the 16-bit chip: global,
+/// unless the scene's format cannot hold the scene or the probe with them
+/// falls under the bar, and local positions hold it or do better
+/// ([`Positions`]); on the 32-bit chip, global.
 fn choose_datapath(
     scene: &firmware::scene::Scene,
     opt: &Options,
@@ -691,41 +766,61 @@ fn choose_datapath(
     timing: &rtl::Timing,
 ) -> Result<(
     rtl::rc::Datapath,
+    Positions,
     String,
     Option<firmware::tracer::Firmware>,
 )> {
     use crate::cli::{AUTO_MIN_HITS, AUTO_MIN_PSNR};
     use rtl::rc::Datapath;
+    let auto_positions = opt.positions == Positions::Auto;
+    let fixed = |p: Positions| {
+        if p == Positions::Auto {
+            Positions::Global
+        } else {
+            p
+        }
+    };
     if let crate::cli::DatapathChoice::Fixed(d) = choice {
-        return Ok((d, format!("--datapath {}", d.bits()), None));
+        if !(auto_positions && d == Datapath::W16) {
+            return Ok((
+                d,
+                fixed(opt.positions),
+                format!("--datapath {}", d.bits()),
+                None,
+            ));
+        }
     }
-    let on = |d: Datapath| Options {
+    let on = |d: Datapath, p: Positions| Options {
         datapath: d,
+        positions: p,
         ..*opt
     };
-    let measured = |d: Datapath| -> Result<(firmware::tracer::Firmware, f64, f64)> {
-        let (fw, p) = crate::render::choose_firmware_probed(scene, &on(d), nm, timing)?;
-        let p = match p {
-            Some(p) => p,
-            None => crate::render::probe(&fw, &on(d), timing)?,
-        };
-        let (r8, rh) = match &p.reference {
-            Some(r) => r.clone(),
-            None => reference::render_pixels(scene, opt.width, opt.height, opt.depth, &p.pixels),
-        };
-        let psnr = metrics::psnr(&p.rgb8, &r8);
-        Ok((
-            fw,
-            if psnr.is_finite() { psnr } else { 99.0 },
-            metrics::hit_agreement(&p.hits, &rh),
-        ))
+    let measured = |o: &Options| probe_figures(scene, o, nm, timing);
+    let passes = |p: f64, h: f64| p >= AUTO_MIN_PSNR && h >= AUTO_MIN_HITS;
+    let m16 = measure_16(&measured, &on, fixed(opt.positions), auto_positions);
+    let local_note = |p: Positions| {
+        if p == Positions::Local && auto_positions {
+            ", local positions: global ones cannot hold the scene or fall under the bar"
+        } else {
+            ""
+        }
     };
-    let (fw16, p16, h16) = match measured(Datapath::W16) {
+    if let crate::cli::DatapathChoice::Fixed(_) = choice {
+        let (_, p) = m16.as_ref().map_err(|e| anyhow::anyhow!("{e:#}"))?;
+        let p = *p;
+        let ((fw, ..), _) = m16?;
+        let why = match local_note(p) {
+            "" => String::new(),
+            n => format!(" ({})", n.trim_start_matches(", ")),
+        };
+        return Ok((Datapath::W16, p, format!("--datapath 16{why}"), Some(fw)));
+    }
+    let ((fw16, p16, h16), pos16) = match m16 {
         Ok(m) => m,
         Err(e16) => {
             // A scene the 16-bit format cannot hold may still fit the
             // 32-bit chip's (16 more fraction bits).
-            let (fw32, ..) = match measured(Datapath::W32) {
+            let (fw32, ..) = match measured(&on(Datapath::W32, Positions::Global)) {
                 Ok(m) => m,
                 Err(e32) => anyhow::bail!(
                     "neither chip can render the scene (--datapath auto): the 16-bit chip: \
@@ -734,26 +829,29 @@ fn choose_datapath(
             };
             return Ok((
                 Datapath::W32,
+                Positions::Global,
                 "auto: the 16-bit chip cannot hold the scene (`--datapath 16` says why); the 32-bit chip can".into(),
                 Some(fw32),
             ));
         }
     };
     let m16 = format!(
-        "the 16-bit chip ({}) renders the probe (1/16 of the tiles) at {p16:.1} dB, {:.2}% hit agreement",
+        "the 16-bit chip ({}{}) renders the probe (1/16 of the tiles) at {p16:.1} dB, {:.2}% hit agreement",
         fw16.format(),
+        local_note(pos16),
         100.0 * h16
     );
-    if p16 >= AUTO_MIN_PSNR && h16 >= AUTO_MIN_HITS {
-        return Ok((Datapath::W16, format!("auto: {m16}"), Some(fw16)));
+    if passes(p16, h16) {
+        return Ok((Datapath::W16, pos16, format!("auto: {m16}"), Some(fw16)));
     }
     let bar = format!(
         "under the {AUTO_MIN_PSNR} dB / {}% bar",
         100.0 * AUTO_MIN_HITS
     );
-    match measured(Datapath::W32) {
+    match measured(&on(Datapath::W32, Positions::Global)) {
         Ok((fw32, p32, h32)) if p32 > p16 => Ok((
             Datapath::W32,
+            Positions::Global,
             format!(
                 "auto: {m16}, {bar}; the 32-bit chip ({}) at {p32:.1} dB, {:.2}%; --datapath 16 forces the paper's chip",
                 fw32.format(),
@@ -763,11 +861,13 @@ fn choose_datapath(
         )),
         Ok(_) => Ok((
             Datapath::W16,
+            pos16,
             format!("auto: {m16}, {bar}, and the 32-bit chip does no better"),
             Some(fw16),
         )),
         Err(e) => Ok((
             Datapath::W16,
+            pos16,
             format!("auto: {m16}, {bar}, and the 32-bit chip cannot render it ({e:#})"),
             Some(fw16),
         )),

@@ -191,20 +191,40 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
     assert_eq!(j["datapath_bits"], 32, "{why}");
     assert!(why.contains("under the 30 dB / 99% bar"), "{why}");
     assert!(j["psnr_db"].as_f64().unwrap() >= 30.0, "{j}");
+    // SPD shells: spheres of 0.2 LSB in the scene's format, which the
+    // 16-bit chip holds only with local positions.
     let shells = shared("shells-1.nff");
-    let (b, why) = bits(&[&shells]);
+    let (b, why) = bits(&[&shells, "--positions", "global"]);
     assert_eq!(b, 32, "{why}");
     assert!(why.contains("16-bit chip cannot hold"), "{why}");
+    let (b, why) = bits(&[&shells]);
+    assert_eq!(b, 16, "{why}");
+    assert!(
+        why.contains("local positions: global ones cannot hold the scene"),
+        "{why}"
+    );
     let (b, _) = bits(&["--datapath", "32"]);
     assert_eq!(b, 32);
     let (ok, _, err) = morphosys(
         dir.path(),
-        &["render", &shells, "--size", "8x8", "--datapath", "16"],
+        &[
+            "render",
+            &shells,
+            "--size",
+            "8x8",
+            "--datapath",
+            "16",
+            "--positions",
+            "global",
+        ],
     );
     assert!(
         !ok && err.contains("shells-1.nff:11: cannot represent the scene in 16-bit"),
         "{err}"
     );
+    let (b, why) = bits(&[&shells, "--datapath", "16"]);
+    assert_eq!(b, 16, "{why}");
+    assert!(why.starts_with("--datapath 16 (local positions"), "{why}");
     let (ok, _, err) = morphosys(dir.path(), &["render", "--datapath", "24"]);
     assert!(
         !ok && err.contains("--datapath") && err.lines().count() == 1,

@@ -478,12 +478,16 @@ spelled! {
     /// ([`super::primitives::local`]); its hit point comes back to the
     /// scene's format with the remainder (`HIT_PL`). The packet traversal
     /// on the 16-bit chip, without refraction; shadow rays a packet per
-    /// light.
+    /// light. Auto: `render` takes local ones on the 16-bit chip where
+    /// its probe with global ones falls under the bar of `--datapath
+    /// auto` (or the scene's format cannot hold the scene) and local ones
+    /// do better; the tracer itself builds auto as global.
     #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
     pub enum Positions ("positions") {
         #[default]
         Global = "global",
         Local = "local",
+        Auto = "auto",
     }
 }
 

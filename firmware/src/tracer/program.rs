@@ -284,7 +284,7 @@ fn title(scene: &Scene, lay: &FbImage, opt: &Options, tw: u32, th: u32, merged: 
         scene.source
     ));
     s.push_str(&format!(
-        "; {}x{}, {} ways ({}x{} tiles), depth {}, {} datapath, scene format Q{}.{}, {} normals\n",
+        "; {}x{}, {} ways ({}x{} tiles), depth {}, {} datapath, scene format Q{}.{}, {} normals{}\n",
         opt.width,
         opt.height,
         opt.ways,
@@ -294,7 +294,12 @@ fn title(scene: &Scene, lay: &FbImage, opt: &Options, tw: u32, th: u32, merged: 
         opt.datapath,
         opt.datapath.bits() - 1 - lay.frac,
         lay.frac,
-        if lay.fine_normals { "fine" } else { "coarse" }
+        if lay.fine_normals { "fine" } else { "coarse" },
+        if lay.fit.sphere_local {
+            ", local positions"
+        } else {
+            ""
+        }
     ));
     s.push_str(&format!(
         "; {} traversal, BSP {} split to depth {}, at most {} objects per leaf{}\n",

@@ -9,12 +9,25 @@ use super::*;
 
 pub(super) fn headline(r: &mut Runner) -> Result<String> {
     let mut rows = Vec::new();
+    // The chip auto chose per traversal (`local`: local positions).
+    let chip = |j: &Value| {
+        let local = if j["positions"] == "local" {
+            " local"
+        } else {
+            ""
+        };
+        format!("{}{local}", u(j, "datapath_bits"))
+    };
     for s in SMALL {
         let (p, k) = both_traversals(r, s)?;
         rows.push(vec![
             format!("`{}`", short(s)),
             thousands(u(&k, "objects")),
-            u(&k, "datapath_bits").to_string(),
+            if chip(&p) == chip(&k) {
+                chip(&k)
+            } else {
+                format!("{} (paper's: {})", chip(&k), chip(&p))
+            },
             fps(&p),
             psnr(&p),
             hits(&p),
