@@ -10,7 +10,7 @@
 //! size is a regression, not noise).
 
 use firmware::scene::{native, Scene};
-use firmware::tracer::Options;
+use firmware::tracer::{Datapath, Options, Positions};
 use tb::render::render;
 
 const HEAD: &str = r#"
@@ -39,9 +39,21 @@ enum Outcome {
 }
 
 fn run(name: &str, s: &Scene) -> Outcome {
+    run_on(name, s, Options::default().datapath, Positions::Global)
+}
+
+/// [`run`] on the 16-bit chip with local positions.
+fn run_local(name: &str, s: &Scene) -> Outcome {
+    run_on(name, s, Datapath::W16, Positions::Local)
+}
+
+/// [`run`] on `datapath` with `positions`.
+fn run_on(name: &str, s: &Scene, datapath: Datapath, positions: Positions) -> Outcome {
     let opt = Options {
         width: 32,
         height: 32,
+        datapath,
+        positions,
         ..Options::default()
     };
     match render(s, &opt, &Default::default()) {
@@ -120,7 +132,8 @@ fn grazing_rays_at_sphere_silhouettes() {
     // 1,024 whose shadow ray grazes the silhouette falls the other side
     // (the floor's hit point is rounded to the LSB); 68.38 dB with local
     // positions, which test the sphere in a frame of its own.
-    close(&run("grazing rays", &s), 50.0, 0.999);
+    close(&run("grazing rays", &s), 47.0, 0.999);
+    close(&run_local("grazing rays, local", &s), 65.0, 0.999);
 }
 
 #[test]
@@ -238,4 +251,63 @@ fn distances_that_overflow_16_bits() {
     );
     // The compiler picks a format for the bounds (Q12.3) and renders.
     close(&run("distances beyond 16 bits", &s), 47.0, 0.999);
+}
+
+/// Spheres of 0.2 to 0.6 units 20 units from the origin, in a scene that
+/// a sphere 1,900 units away stretches to a format of LSB 0.25: under 2
+/// LSB to a few LSB. The scene's one format refuses them; local positions
+/// hold each sphere in a frame of its own.
+#[test]
+fn sub_lsb_spheres_far_from_the_origin_in_local_frames() {
+    let s = scene(
+        "far-tiny.toml",
+        &(camera("[20.0, 17.0, 1.5]", "[20.0, 20.0, 0.3]")
+            + &light("[23.0, 15.0, 6.0]")
+            + &sphere("[1900.0, 1900.0, -50.0]", 20.0)
+            + &sphere("[20.0, 20.0, 0.6]", 0.6)
+            + &sphere("[20.9, 19.6, 0.2]", 0.2)
+            + &sphere("[19.3, 19.8, 0.3]", 0.3)),
+    );
+    match run("sub-LSB spheres, global", &s) {
+        Outcome::Refused(m) => assert!(m.contains("LSB"), "the refusal names the limit: {m}"),
+        Outcome::Rendered { .. } => {
+            panic!("a sphere under 2 LSB was rendered in the scene's format")
+        }
+    }
+    // Measured: 38.58 dB, every hit the reference's (local, 16-bit);
+    // the 32-bit chip's format holds them (16 more fraction bits).
+    close(&run_local("sub-LSB spheres, local", &s), 35.0, 0.999);
+    let wide = run_on(
+        "sub-LSB spheres, 32-bit",
+        &s,
+        Datapath::W32,
+        Positions::Global,
+    );
+    close(&wide, 60.0, 0.999);
+}
+
+/// Spheres from 8 units down to 1/512 of a unit in radius (4,096 sizes)
+/// in one scene: global positions refuse the smallest; local ones render
+/// them.
+#[test]
+fn a_scene_spanning_4096_sphere_sizes() {
+    let mut body = camera("[0.0, -30.0, 8.0]", "[0.0, 0.0, 4.0]") + &light("[10.0, -20.0, 30.0]");
+    body += &sphere("[0.0, 8.0, 8.0]", 8.0);
+    let mut r = 1.0;
+    for k in 0..10 {
+        let x = -9.0 + 2.0 * k as f64;
+        body += &sphere(&format!("[{x}, -9.0, 2.0]"), r);
+        r /= 2.0;
+    }
+    let s = scene("sizes.toml", &body);
+    match run("4096 sizes, global", &s) {
+        Outcome::Refused(m) => assert!(m.contains("LSB"), "the refusal names the limit: {m}"),
+        Outcome::Rendered { .. } => {
+            panic!("a sphere under 2 LSB was rendered in the scene's format")
+        }
+    }
+    // Measured: 67.95 dB, every hit the reference's (local, 16-bit).
+    close(&run_local("4096 sizes, local", &s), 64.0, 0.999);
+    let wide = run_on("4096 sizes, 32-bit", &s, Datapath::W32, Positions::Global);
+    close(&wide, 60.0, 0.999);
 }
