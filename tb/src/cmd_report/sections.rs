@@ -7,17 +7,18 @@ use anyhow::{anyhow, bail, Result};
 
 use super::*;
 
+/// The chip a render ran on: its bits, and `local` with local positions.
+fn chip(j: &Value) -> String {
+    let local = if j["positions"] == "local" {
+        " local"
+    } else {
+        ""
+    };
+    format!("{}{local}", u(j, "datapath_bits"))
+}
+
 pub(super) fn headline(r: &mut Runner) -> Result<String> {
     let mut rows = Vec::new();
-    // The chip auto chose per traversal (`local`: local positions).
-    let chip = |j: &Value| {
-        let local = if j["positions"] == "local" {
-            " local"
-        } else {
-            ""
-        };
-        format!("{}{local}", u(j, "datapath_bits"))
-    };
     for s in SMALL {
         let (p, k) = both_traversals(r, s)?;
         rows.push(vec![
@@ -299,6 +300,37 @@ pub(super) fn whitted(r: &mut Runner) -> Result<String> {
     )
 }
 
+pub(super) fn positions(r: &mut Runner) -> Result<String> {
+    let mut rows = Vec::new();
+    for fam in ["balls", "jacks", "lattice", "rings", "shells", "tree"] {
+        let s = r.spd(fam, None)?;
+        let mut row = vec![fam.to_string()];
+        for args in [
+            ["--datapath", "16", "--positions", "global"],
+            ["--datapath", "16", "--positions", "local"],
+            ["--datapath", "32", "--positions", "global"],
+        ] {
+            row.push(match r.render(&s, &args) {
+                Ok(j) => format!("{} dB, {}, {}", psnr(&j), hits(&j), fps(&j)),
+                Err(_) => "refused".into(),
+            });
+        }
+        rows.push(row);
+    }
+    body(
+        "One row: `morphosys spd balls --out balls.nff`, then \
+         `morphosys render balls.nff --datapath 16 --positions local --json out.json`.\n\n"
+            .to_string(),
+        &[
+            "scene",
+            "16-bit, global: PSNR, hits, frames/s",
+            "16-bit, local",
+            "32-bit",
+        ],
+        &rows,
+    )
+}
+
 pub(super) fn spd(r: &mut Runner) -> Result<String> {
     let mut rows = Vec::new();
     for fam in FAMILIES {
@@ -311,7 +343,7 @@ pub(super) fn spd(r: &mut Runner) -> Result<String> {
                 .map_err(|e| anyhow!(e))?
                 .to_string(),
             thousands(u(&j, "objects")),
-            u(&j, "datapath_bits").to_string(),
+            chip(&j),
             thousands(u(&j, "cycles")),
             fps(&j),
             psnr(&j),
