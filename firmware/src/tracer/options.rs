@@ -475,8 +475,9 @@ spelled! {
     /// origins carry a remainder (`RAY_OL`, 2^-14 LSB), and a sphere is
     /// tested in a frame of its own, its centre the origin and its LSB
     /// `2^-e` of the scene's, `e` fitted to its radius
-    /// ([`super::primitives::local`]); its hit point comes back to the
-    /// scene's format with the remainder (`HIT_PL`). The packet traversal
+    /// ([`super::primitives::sphere::local_exponent`]); its hit point
+    /// comes back to the scene's format with the remainder (`HIT_PL`),
+    /// and eye rays' directions carry one (`RAY_DL`). The packet traversal
     /// on the 16-bit chip, without refraction; shadow rays a packet per
     /// light. Auto: `render` takes local ones on the 16-bit chip where
     /// its probe with global ones falls under the bar of `--datapath
