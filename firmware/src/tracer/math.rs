@@ -291,6 +291,17 @@ pub fn perpendicular_to(k: &mut K, p: &[u8], d: &[u8], t: u8) {
     }
 }
 
+/// `rem` = what the accumulator holds below `hi`, the rounded result a
+/// multiplier operation just wrote with `>> shift`: the accumulator's
+/// lower word less `hi << shift` (exact while the remainder is below
+/// 2^15 in magnitude; the wrap of the shifted word is intended). `t` a
+/// temporary.
+pub fn remainder(k: &mut K, rem: u8, hi: u8, t: u8, shift: &str) {
+    k.c(format!("accl r{rem}"))
+        .c(format!("sll r{t}, r{hi}, #{shift}"))
+        .c(format!("sub r{rem}, r{rem}, r{t}"));
+}
+
 /// Reciprocal square root table of `n` entries (a power of two up to 128):
 /// entry k = 1/sqrt(X) for X = (k + 0.5) 2^(15 - log2 n) in Q.11, Q1.14
 /// (saturated at the bottom, where it is never used).

@@ -11,7 +11,7 @@
 //! rounds to an LSB.
 
 use super::emit::K;
-use super::math::Approx;
+use super::math::{remainder, Approx};
 use super::memory_map::ram;
 
 /// Whether the eye rays' kernel is [`eye`] (and the camera stream its):
@@ -63,11 +63,9 @@ pub fn eye(nr: Approx, refract: bool, local: bool) -> K {
             .c("mac out, r14, #1")
             .c("mac out, fb0, r8")
             .c(format!("mac r{v}, fb0, r9, >>KD-Q13"))
-            .note("v_H, Q2.13")
-            .c("accl r13")
-            .c(format!("sll r14, r{v}, #KD-Q13"))
-            .c("sub r13, r13, r14")
-            .c("sll r13, r13, #28-KD")
+            .note("v_H, Q2.13");
+        remainder(&mut k, 13, v, 14, "KD-Q13");
+        k.c("sll r13, r13, #28-KD")
             .c(format!("st r13, [#{}]", ram::TMP0 + a))
             .note("v_R, 2^-28");
     }
@@ -96,10 +94,8 @@ pub fn eye(nr: Approx, refract: bool, local: bool) -> K {
         k.c(format!("ld r15, [r0 + #{}]", ram::TMP0 + a))
             .c("mul r15, r15, r14, >>Q15")
             .c(format!("mul out, r{v}, r14"))
-            .c(format!("mac r{d}, r15, r7, >>Q13"))
-            .c("accl r15")
-            .c(format!("sll r13, r{d}, #Q13"))
-            .c("sub r15, r15, r13");
+            .c(format!("mac r{d}, r15, r7, >>Q13"));
+        remainder(&mut k, 15, d, 13, "Q13");
         if local {
             k.c(format!("st r15, [#{}]", ram::RAY_DL + a));
         }

@@ -367,13 +367,7 @@ pub fn broadcast_caps(t: &mut Code, lbl: &str, rec: Reg) {
 /// (r8..r10); F where the line meets the sphere (`|w| <= 1/4`).
 fn bounding_sphere(k: &mut K) {
     k.comment("bounding sphere about M: b = (M - o).d, p = (M - o) - b d");
-    k.c("sub r8, fb0, r1")
-        .c("sub r9, fb0, r2")
-        .c("sub r10, fb0, r3");
-    k.c("mul out, r8, r4")
-        .c("mac out, r9, r5")
-        .c("mac r11, r10, r6, >>Q14")
-        .note("b");
+    super::sphere::oc_and_b(k, "b");
     for (x, d) in [(8, 4), (9, 5), (10, 6)] {
         k.c(format!("ldacc r{x}, <<Q14"))
             .c(format!("msu r{x}, r11, r{d}, >>Q14-EP_CONE"));

@@ -35,7 +35,7 @@
 //! with a fine record within 2 LSB and 0.1.
 
 use super::super::emit::{define, Code, K};
-use super::super::math::{perpendicular_to, sqrt_q14};
+use super::super::math::{perpendicular_to, remainder, sqrt_q14};
 use super::super::memory_map::ram;
 use super::record::{Field, Fitter, Layout, W};
 use super::{
@@ -169,9 +169,8 @@ pub(crate) fn write(
     w.point(center);
     if fit.sphere_fine {
         w.field(CENTRE_REM);
-        for x in center.to_array() {
-            let hi = w.sat(x * s) as f64;
-            w.push((x * s - hi) * w.one());
+        for (_, rem) in split(w, center) {
+            w.push(rem);
         }
     }
     // invr before r: the packet traversal's kernel needs only invr before
@@ -210,16 +209,15 @@ fn write_local(
     let rl = r * (e as f64).exp2();
     let sg = if inside { -1.0 } else { 1.0 };
     let one = w.one();
-    let c = center.to_array().map(|x| x * s);
-    let hi = c.map(|x| w.sat(x) as f64);
+    let parts = split(w, center);
     w.field(CENTRE);
     w.point(center);
     w.field(SHIFTS);
     w.raw(e as i64 + 2);
     w.raw(14 - e as i64);
     w.field(CENTRE_REM);
-    for i in 0..3 {
-        w.push((c[i] - hi[i]) * one);
+    for (_, rem) in parts {
+        w.push(rem);
     }
     w.field(INV_R);
     w.push(((14 + w.x + fit.ks_sphere) as f64).exp2() / rl);
@@ -236,10 +234,19 @@ fn write_local(
     w.field(RADIUS_SG);
     w.push(sg * rl);
     w.field(CENTRE_AGAIN);
-    for i in 0..3 {
-        w.push(hi[i]);
-        w.push((c[i] - hi[i]) * one);
+    for (hi, rem) in parts {
+        w.push(hi);
+        w.push(rem);
     }
+}
+
+/// A point's coordinates as the records hold them: rounded to the LSB,
+/// and what the rounding left, in 2^-14 LSB (2^-30 on the 32-bit chip).
+fn split(w: &W, p: Vec3) -> [(f64, f64); 3] {
+    p.to_array().map(|x| {
+        let hi = w.sat(x * w.s) as f64;
+        (hi, (x * w.s - hi) * w.one())
+    })
 }
 
 /// The sphere kernel for records of `fit` and the sides `sides`.
@@ -390,11 +397,9 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
         .note("2^(14-e)")
         .c("ldacc r11, <<Q14")
         .c("mac r9, r14, r9, >>Q14")
-        .note("t = b + (pd - sg h) 2^-e")
-        .c("accl r12")
-        .c("sll r13, r9, #Q14")
-        .c("sub r12, r12, r13")
-        .note("its remainder, 2^-14 LSB")
+        .note("t = b + (pd - sg h) 2^-e");
+    remainder(&mut k, 12, 9, 13, "Q14");
+    k.note("its remainder, 2^-14 LSB")
         .c("movb r15, #0")
         .c("(f) movb r15, #1");
     k.comment("t < tbest to 2^-14 LSB (a tbest not local has no remainder)");
@@ -419,11 +424,9 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
             .c("ldacc fb0, <<Q14")
             .c("mac out, fb0, #1")
             .c("mac r9, r8, r14, >>Q14")
-            .note("P")
-            .c("accl r8")
-            .c("sll r10, r9, #Q14")
-            .c("sub r8, r8, r10")
-            .note("its remainder")
+            .note("P");
+        remainder(&mut k, 8, 9, 10, "Q14");
+        k.note("its remainder")
             .c(format!("(f) st r9, [#{}]", ram::HIT_PH + i))
             .c(format!("(f) st r8, [#{}]", ram::HIT_PL + i));
     }
@@ -432,7 +435,7 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
 
 /// `oc = c - o` (r8..r10, the centre from the stream) and `b = oc.d`
 /// (r11; `note` says which).
-fn oc_and_b(k: &mut K, note: &str) {
+pub(super) fn oc_and_b(k: &mut K, note: &str) {
     k.c("sub r8, fb0, r1")
         .c("sub r9, fb0, r2")
         .c("sub r10, fb0, r3");
