@@ -1319,41 +1319,7 @@ fn local_sphere_hit_points_vs_float_sphere() {
             ti.ty.broadcast(t, "test", fit, ti.caps)
         });
         assert_eq!(fw.frac, 10, "the test's format");
-        let rc = &sim.top.array.rc;
-        let (mut worst, mut hits, mut disagree) = (0.0f64, 0, 0);
-        for (i, r) in rs.iter().enumerate() {
-            let o = Vec3::new(
-                (r.o.x / lsb * 16384.0).round() / 16384.0 * lsb,
-                (r.o.y / lsb * 16384.0).round() / 16384.0 * lsb,
-                (r.o.z / lsb * 16384.0).round() / 16384.0 * lsb,
-            );
-            // The line the chip traces: its Q1.14 direction as the RCs hold it.
-            let d = Vec3::new(
-                rc.regs.read(4)[i] as f64,
-                rc.regs.read(5)[i] as f64,
-                rc.regs.read(6)[i] as f64,
-            )
-            .normalized();
-            let f = intersect(&shape, &Ray { o, d }, 0.0, f64::INFINITY, false);
-            let t = rc.regs.read(7)[i] as f64;
-            match (f, t < 32767.0) {
-                (Some(f), true) => {
-                    assert_eq!(rc.ram.read(i, ram::HIT_TL.at()) as f64, t, "tagged");
-                    let p = Vec3::new(0.0, 0.0, 0.0);
-                    let mut p = p.to_array();
-                    for (k, x) in p.iter_mut().enumerate() {
-                        *x = rc.ram.read(i, ram::HIT_PH.at() + k) as f64
-                            + rc.ram.read(i, ram::HIT_PL.at() + k) as f64 / 16384.0;
-                    }
-                    let want = o + d * f.t;
-                    let e = (Vec3::new(p[0], p[1], p[2]) - want * (1.0 / lsb)).length();
-                    worst = worst.max(e);
-                    hits += 1;
-                }
-                (None, false) => {}
-                _ => disagree += 1,
-            }
-        }
+        let (worst, hits, disagree) = local_hits(&sim, &rs, &shape, lsb);
         eprintln!("local sphere r = {radius} LSB: {hits} hits, {disagree} disagreements, worst hit point {worst:.4} LSB");
         assert!(hits >= 40, "r = {radius}: {hits} hits");
         assert!(disagree <= 2, "r = {radius}: {disagree} disagreements");
@@ -1364,4 +1330,115 @@ fn local_sphere_hit_points_vs_float_sphere() {
             "r = {radius}: hit point off by {worst} LSB"
         );
     }
+}
+
+/// Local positions: the triangle tested in a frame of its own
+/// (`triangle_local`), triangles from 0.3 to 3,000 LSB across, tilted
+/// at random and seen from their front from up to 3,000 LSB away: the hit
+/// point the kernel leaves (`HIT_PH` + `HIT_PL` 2^-14) against the f64
+/// triangle's on the line the chip traces (the origin to 2^-14 LSB, the
+/// Q1.14 direction the RCs hold), in LSB of the scene's format; hits and
+/// misses agree but within a few 2^-14 of an edge.
+#[test]
+fn local_triangle_hit_points_vs_float_triangle() {
+    LOCAL.with(|l| l.set(true));
+    let lsb = 2f64.powi(-10);
+    for size in [0.3f64, 1.5, 6.0, 100.0, 3000.0] {
+        let mut g = Lcg(size.to_bits() ^ 0x7a);
+        let c = Vec3::new(
+            0.3 + g.next() * lsb,
+            -0.2 + g.next() * lsb,
+            0.1 + g.next() * lsb,
+        );
+        let mut vert = || {
+            c + Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0))
+                * (0.5 * size * lsb)
+        };
+        let v = [vert(), vert(), vert()];
+        let n = (v[1] - v[0]).cross(v[2] - v[0]).normalized();
+        let shape = Shape::Triangle(Triangle { v, normals: None });
+        let rs: [Ray; 64] = std::array::from_fn(|_| {
+            // A point of the plane about the triangle, inside or out.
+            let (a, b) = (g.range(-0.2, 1.1), g.range(-0.2, 1.1));
+            let target = v[0] + (v[1] - v[0]) * a + (v[2] - v[0]) * (b * (1.0 - a.clamp(0.0, 1.0)));
+            let mut dir;
+            loop {
+                dir = Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0))
+                    .normalized();
+                if dir.dot(n) > 0.15 {
+                    break;
+                }
+            }
+            // From 1,500 to 3,000 LSB away, nearer for the smallest (the
+            // Q1.14 direction's rounding moves a far ray off its target by
+            // a sizeable part of them).
+            let far = g.range(1500.0, 3000.0) * (size / 100.0).clamp(0.03, 1.0);
+            let o = target + dir * (far * lsb);
+            Ray {
+                o,
+                d: (target - o).normalized(),
+            }
+        });
+        let (sim, fw) = run_with::<i16>(shape.clone(), &rs, false, |t, ti, fit| {
+            ti.ty.broadcast(t, "test", fit, ti.caps)
+        });
+        assert_eq!(fw.frac, 10, "the test's format");
+        let (worst, hits, disagree) = local_hits(&sim, &rs, &shape, lsb);
+        eprintln!("local triangle {size} LSB: {hits} hits, {disagree} disagreements, worst hit point {worst:.4} LSB");
+        assert!(hits >= 20, "{size} LSB: {hits} hits");
+        assert!(disagree <= 2, "{size} LSB: {disagree} disagreements");
+        // Within 0.1% of the triangle's size (the Q1.14 normal and edge
+        // duals of the frame) and a few 2^-14 LSB.
+        assert!(
+            worst <= 0.002 + 0.001 * size,
+            "{size} LSB: hit point off by {worst} LSB"
+        );
+    }
+}
+
+/// A local kernel's hits on `rs` against the f64 `shape` on the line the
+/// chip traces (the origin to 2^-14 LSB, the Q1.14 direction the RCs
+/// hold): the worst hit point (`HIT_PH` + `HIT_PL` 2^-14) in LSB of the
+/// scene's format (`lsb`), the hits, and the rays where chip and f64
+/// disagree on hitting.
+fn local_hits(
+    sim: &Sim<Chip<i16>>,
+    rs: &[Ray; 64],
+    shape: &Shape,
+    lsb: f64,
+) -> (f64, usize, usize) {
+    let rc = &sim.top.array.rc;
+    let (mut worst, mut hits, mut disagree) = (0.0f64, 0, 0);
+    for (i, r) in rs.iter().enumerate() {
+        let o = Vec3::new(
+            (r.o.x / lsb * 16384.0).round() / 16384.0 * lsb,
+            (r.o.y / lsb * 16384.0).round() / 16384.0 * lsb,
+            (r.o.z / lsb * 16384.0).round() / 16384.0 * lsb,
+        );
+        let d = Vec3::new(
+            rc.regs.read(4)[i] as f64,
+            rc.regs.read(5)[i] as f64,
+            rc.regs.read(6)[i] as f64,
+        )
+        .normalized();
+        let f = intersect(shape, &Ray { o, d }, 0.0, f64::INFINITY, false);
+        let t = rc.regs.read(7)[i] as f64;
+        match (f, t < 32767.0) {
+            (Some(f), true) => {
+                assert_eq!(rc.ram.read(i, ram::HIT_TL.at()) as f64, t, "tagged");
+                let mut p = [0.0; 3];
+                for (k, x) in p.iter_mut().enumerate() {
+                    *x = rc.ram.read(i, ram::HIT_PH.at() + k) as f64
+                        + rc.ram.read(i, ram::HIT_PL.at() + k) as f64 / 16384.0;
+                }
+                let want = o + d * f.t;
+                let e = (Vec3::new(p[0], p[1], p[2]) - want * (1.0 / lsb)).length();
+                worst = worst.max(e);
+                hits += 1;
+            }
+            (None, false) => {}
+            _ => disagree += 1,
+        }
+    }
+    (worst, hits, disagree)
 }

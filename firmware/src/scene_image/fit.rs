@@ -2,7 +2,7 @@
 //! the largest of them, the smallest feature, and the shape as the chip
 //! sees it once rounded.
 
-use crate::scene::{Scene, SceneError, Shape};
+use crate::scene::{Scene, SceneError, Shape, Vec3};
 
 use super::{CompileOptions, QFormat};
 
@@ -11,6 +11,41 @@ use super::{CompileOptions, QFormat};
 /// per cap), boxes 12, rectangles 2, polygons n - 2.
 pub fn tessellated_triangles(s: &Shape) -> usize {
     s.surface().tessellated_triangles()
+}
+
+/// The largest exponent of a local frame (`CompileOptions::local_frames`):
+/// its LSB `2^-12` of the scene's (the records' remainders of 2^-14 LSB
+/// keep two bits below it).
+pub const LOCAL_E_MAX: u32 = 12;
+
+/// The shapes the chip tests in a frame of their own with local
+/// positions (spheres and flat triangles): the frame's centre (the
+/// sphere's, the triangle's centroid) and its extent, the farthest point
+/// of the shape from it (scene units).
+pub fn local_frame(s: &Shape) -> Option<(Vec3, f64)> {
+    if let Some(sp) = s.as_sphere() {
+        return Some((sp.center, sp.radius.abs()));
+    }
+    let t = s.as_triangle().filter(|t| t.normals.is_none())?;
+    let c = (t.v[0] + t.v[1] + t.v[2]) * (1.0 / 3.0);
+    let r = t.v.iter().map(|v| (*v - c).length()).fold(0.0, f64::max);
+    Some((c, r))
+}
+
+/// The exponent `e` of a local frame (its LSB `2^-e` of the scene's) for
+/// a shape of extent `r` LSB about its centre: the largest up to
+/// [`LOCAL_E_MAX`] with `(2 r + 3) 2^e < 2^14`, so that the vector from
+/// the centre to a ray's point nearest it (within `r` where the ray may
+/// hit, and up to 3 LSB along the ray from the rounding of that point's
+/// distance and of the Q1.14 direction's length) and the distance from
+/// there to the hit (within `2 r`) fit with a guard bit; 0 without the
+/// guard bit (`2 r + 3 < 2^15`); none beyond (a shape over a quarter of
+/// the format's range).
+pub fn local_exponent(r: f64) -> Option<u32> {
+    (0..=LOCAL_E_MAX)
+        .rev()
+        .find(|&e| (2.0 * r + 3.0) * (e as f64).exp2() < 16384.0)
+        .or((2.0 * r + 3.0 < 32768.0).then_some(0))
 }
 
 /// The smallest length that defines a shape.
@@ -117,12 +152,33 @@ pub(super) fn smallest(
         what: "",
     };
     // The smallest feature against the least a record holds (in LSB of
-    // the chip's precision): spheres in frames of their own
-    // (`sphere_extra_frac`) hold features that much finer.
-    let finer = |s: &Shape| match s {
-        Shape::Sphere(_) => opt.sphere_extra_frac,
-        _ => 0,
+    // the chip's precision): shapes in frames of their own
+    // (`local_frames`) hold features `2^e` times finer.
+    let frame = |s: &Shape| {
+        local_frame(s)
+            .filter(|_| opt.local_frames)
+            .map(|(_, r)| local_exponent(r / lsb))
     };
+    if let Some(o) = scene
+        .objects
+        .iter()
+        .find(|o| frame(&o.shape).is_some_and(|e| e.is_none()))
+    {
+        let r = local_frame(&o.shape).map_or(0.0, |(_, r)| r);
+        return Err(SceneError {
+            file: scene.source.clone(),
+            line: o.line,
+            col: 0,
+            message: format!(
+                "cannot test this {} in a frame of its own (local positions): it reaches {r} = {:.0} LSB of {} from its centre, \
+                 over a quarter of the format's range",
+                o.shape.prim_type().name(),
+                r / lsb,
+                q.name()
+            ),
+        });
+    }
+    let finer = |s: &Shape| frame(s).flatten().unwrap_or(0);
     let least = |s: &Shape| {
         opt.min_feature_lsb * lsb * (-((opt.target_extra_frac + finer(s)) as f64)).exp2()
     };
@@ -143,9 +199,11 @@ pub(super) fn smallest(
     }
     if let Some((o, ratio)) = worst.filter(|(_, r)| *r < 1.0) {
         let f = ratio * least(&o.shape);
-        let held = match finer(&o.shape) {
-            0 => String::new(),
-            e => format!(" (its frame holds 2^-{e} LSB)"),
+        let held = match (opt.target_extra_frac, finer(&o.shape)) {
+            (0, 0) => String::new(),
+            (0, e) => format!(" (its frame holds 2^-{e} LSB)"),
+            (x, 0) => format!(" (the chip's records hold 2^-{x} LSB)"),
+            (x, e) => format!(" (its frame in the chip's records holds 2^-{} LSB)", x + e),
         };
         return Err(SceneError {
             file: scene.source.clone(),

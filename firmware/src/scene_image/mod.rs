@@ -33,7 +33,10 @@ use bitvec::prelude::*;
 use crate::bsp::{Bsp, BspParams};
 use crate::scene::{Aabb, Polygon, PrimType, Scene, SceneError, Vec3};
 
-pub use fit::{dequantized, fitted_frac, smallest_feature, tessellated_triangles};
+pub use fit::{
+    dequantized, fitted_frac, local_exponent, local_frame, smallest_feature, tessellated_triangles,
+    LOCAL_E_MAX,
+};
 pub use report::{Report, TriangleOnly};
 use sections::Writer;
 
@@ -107,11 +110,11 @@ pub struct CompileOptions {
     /// again with 16 more): the smallest-feature and degeneracy checks then
     /// apply at the chip's precision, not at the 16-bit image's.
     pub target_extra_frac: u32,
-    /// Fraction bits the chip's sphere records carry beyond the scene's
-    /// format (local positions: a sphere's frame, up to
-    /// `tracer::primitives::sphere::E_MAX`): spheres' features are checked
-    /// at that precision.
-    pub sphere_extra_frac: u32,
+    /// Local positions: the chip tests spheres and flat triangles in
+    /// frames of their own ([`fit::local_frame`], `2^e` times finer than
+    /// the format, [`fit::local_exponent`]): their features are checked at
+    /// their frame's precision, and one too large for a frame is refused.
+    pub local_frames: bool,
 }
 
 impl Default for CompileOptions {
@@ -123,7 +126,7 @@ impl Default for CompileOptions {
             guard_bits: 1,
             min_feature_lsb: 2.0,
             target_extra_frac: 0,
-            sphere_extra_frac: 0,
+            local_frames: false,
         }
     }
 }

@@ -200,12 +200,12 @@ pub(super) fn objects(
             // A record that quantizing made degenerate cannot be traced.
             let dq = dequantized(&o.shape, w.q);
             // (Rounding may tilt a rectangle's edges or a polygon's vertices
-            // off the plane by a fraction of an LSB: harmless. Spheres in
-            // frames of their own keep their radius there.)
+            // off the plane by a fraction of an LSB: harmless. Shapes in
+            // frames of their own keep their shape there.)
             if let Some(why) = dq
                 .degeneracy()
                 .filter(|_| opt.target_extra_frac == 0)
-                .filter(|_| opt.sphere_extra_frac == 0 || o.shape.as_sphere().is_none())
+                .filter(|_| !opt.local_frames || super::fit::local_frame(&o.shape).is_none())
                 .filter(|m| !m.contains("perpendicular") && !m.contains("not in the plane"))
             {
                 return Err(SceneError {

@@ -337,12 +337,13 @@ fn build_one(
         chip_costs,
         layout: Some(crate::scene_image::NodeFormat::BitVectors),
         guard_bits: nm.guard_bits,
-        target_extra_frac: opt.datapath.extra_bits(),
-        sphere_extra_frac: if opt.positions == Positions::Local {
-            primitives::sphere::E_MAX
-        } else {
-            0
-        },
+        // The chip's records are finer than the compiler's format where
+        // lights set its span (`layout::fit_frac`): features are checked
+        // at the records' precision.
+        target_extra_frac: opt.datapath.extra_bits()
+            + crate::scene_image::fitted_frac(scene, nm.guard_bits)
+                .map_or(0, |c| layout::fit_frac(scene, c, nm.guard_bits) - c),
+        local_frames: opt.positions == Positions::Local,
         ..CompileOptions::default()
     };
     let image = compile(scene, &copt).map_err(|e| e.to_string())?;
@@ -368,12 +369,6 @@ fn build_one(
             )?
         }
     };
-    if lay.fit.sphere_local && lay.refract {
-        return Err(format!(
-            "{}: --positions local: not with transmitting objects (the refraction stack holds no origin remainders)",
-            scene.source
-        ));
-    }
     lay.fb[..256].copy_from_slice(&math::table_slots_for(
         nm.table_entries as usize,
         opt.datapath.extra_bits(),

@@ -472,14 +472,14 @@ spelled! {
 spelled! {
     /// Where the 16-bit chip holds positions. Global: one fixed-point
     /// format for the whole scene (coordinates, origins, `t`). Local: ray
-    /// origins carry a remainder (`RAY_OL`, 2^-14 LSB), and a sphere is
-    /// tested in a frame of its own, its centre the origin and its LSB
-    /// `2^-e` of the scene's, `e` fitted to its radius
-    /// ([`super::primitives::sphere::local_exponent`]); its hit point
-    /// comes back to the scene's format with the remainder (`HIT_PL`),
-    /// and eye rays' directions carry one (`RAY_DL`). The packet traversal
-    /// on the 16-bit chip, without refraction; shadow rays a packet per
-    /// light. Auto: `render` takes local ones on the 16-bit chip where
+    /// origins carry a remainder (`RAY_OL`, 2^-14 LSB), and a sphere or
+    /// flat triangle seen from one side is tested in a frame of its own,
+    /// its centre the origin and its LSB `2^-e` of the scene's, `e`
+    /// fitted to its extent ([`crate::scene_image::local_exponent`]); its
+    /// hit point comes back to the scene's format with the remainder
+    /// (`HIT_PL`), and eye rays' directions carry one (`RAY_DL`).
+    /// Refracted rays start at the rounded hit point. The packet traversal
+    /// on the 16-bit chip; shadow rays a packet per light. Auto: `render` takes local ones on the 16-bit chip where
     /// its probe with global ones falls under the bar of `--datapath
     /// auto` (or the scene's format cannot hold the scene) and local ones
     /// do better; the tracer itself builds auto as global.

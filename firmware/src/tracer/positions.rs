@@ -122,6 +122,20 @@ pub fn origins(k: &mut K) {
     k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::HIT_TL));
 }
 
+/// Appended to the kernels that set up refracted rays: they start at the
+/// hit point as the refraction stack keeps it, rounded to the scene's
+/// LSB (no remainder), with Q1.14 directions, and no local hit yet.
+/// Clobbers r8.
+pub fn refracted_origins(k: &mut K) {
+    k.comment("local positions: the rounded origin's remainder (none), no local hit yet");
+    k.c("movb r8, #0");
+    for i in 0..3 {
+        k.c(format!("st r8, [#{}]", ram::RAY_OL + i))
+            .c(format!("st r8, [#{}]", ram::RAY_DL + i));
+    }
+    k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::HIT_TL));
+}
+
 /// The origins' and directions' remainders alone (shadow rays: their
 /// pass's hits are not shaded). Clobbers r8.
 pub fn shadow_origins(k: &mut K) {
@@ -155,4 +169,73 @@ pub fn post(k: &mut K, hit: u8) {
             .c(format!("ld r11, [r0 + #{}]", ram::HIT_PL + i))
             .c(format!("(f) st r11, [#{}]", ram::SH_PL + i));
     }
+}
+
+/// In a local kernel, after `oc = c - o` (r8..r10, the rounded centre
+/// and origin) and `b = round(oc.d)` (r11), with the frame's shifts in
+/// r14 (`e + 2`) and r15 (`14 - e`): `p = oc + cl - ol - b (d + dl)` in
+/// 2^-14 LSB (the stream's `cl` per axis, `RAY_OL`, `RAY_DL`) taken into
+/// the frame, `2^e` times finer than the scene's LSB: r8..r10 (saturated
+/// far from the frame's centre). Clobbers r12, r13.
+pub fn offset_in_frame(k: &mut K) {
+    for (i, (x, d)) in [(8, 4), (9, 5), (10, 6)].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("ld r12, [r0 + #{}]", ram::RAY_OL + i))
+            .c(format!("ld r13, [r0 + #{}]", ram::RAY_DL + i))
+            .c("mul r13, r11, r13, >>Q13")
+            .note("b dl")
+            .c(format!("ldacc r{x}, <<Q14"))
+            .c("mac out, fb0, #1")
+            .note("+ cl")
+            .c("msu out, r12, #1")
+            .note("- ol")
+            .c("msu out, r13, #1")
+            .c(format!("msu out, r11, r{d}"))
+            .note("- b d")
+            .c("acch r12")
+            .c("accl r13")
+            .c("asl r12, r12, r14")
+            .c("srl r13, r13, r15")
+            .c(format!("or r{x}, r12, r13"))
+            .note("p 2^e (saturated far from the frame)");
+    }
+}
+
+/// In a local kernel: F kept where `t` (register `t`, the scene's LSB)
+/// with its remainder (`rem`, 2^-14 LSB) lies ahead and is nearer than
+/// `tbest` (r7), told apart to 2^-14 LSB where `tbest` is a local hit's
+/// (`HIT_TL`; one that is not has no remainder); there `HIT_TL` and
+/// `HIT_TLL` take them. Clobbers `f` (F on entry) and `tmp`.
+pub fn nearer(k: &mut K, t: u8, rem: u8, f: u8, tmp: u8) {
+    k.c(format!("movb r{f}, #0"))
+        .c(format!("(f) movb r{f}, #1"));
+    k.comment("t < tbest to 2^-14 LSB (a tbest not local has no remainder)");
+    k.c(format!("ld r{tmp}, [r0 + #{}]", ram::HIT_TL))
+        .c(format!("cmp.eq r{tmp}, r7"))
+        .c(format!("ld r{tmp}, [r0 + #{}]", ram::HIT_TLL))
+        .c(format!("(!f) movb r{tmp}, #0"))
+        .c(format!("cmp.eq r{t}, r7"))
+        .c(format!("(f) cmp.lt r{rem}, r{tmp}"))
+        .c(format!("(!f) cmp.lt r{t}, r7"))
+        .c(format!("(f) cmp.gt r{t}, #0"))
+        .c(format!("(f) cmp.ne r{f}, #0"))
+        .note("F: a hit ahead, nearer than tbest")
+        .c(format!("(f) st r{t}, [#{}]", ram::HIT_TL))
+        .c(format!("(f) st r{rem}, [#{}]", ram::HIT_TLL));
+}
+
+/// In a local kernel, after [`nearer`]: axis `i` of the hit point `c +
+/// v 2^-e` (`op` "mac") or `c - v 2^-e` ("msu") to 2^-14 LSB, `v` in the
+/// frame (register `v`), `2^(14-e)` in `scale`, the stream's centre and
+/// its remainder (`c_i`, `cl_i`): where F, `HIT_PH` and `HIT_PL`.
+/// Clobbers `hi`, `lo`, `tmp`.
+pub fn hit_point_axis(k: &mut K, i: u32, op: &str, v: u8, scale: u8, [hi, lo, tmp]: [u8; 3]) {
+    k.c("ldacc fb0, <<Q14")
+        .c("mac out, fb0, #1")
+        .c(format!("{op} r{hi}, r{v}, r{scale}, >>Q14"))
+        .note("P");
+    remainder(k, lo, hi, tmp, "Q14");
+    k.note("its remainder")
+        .c(format!("(f) st r{hi}, [#{}]", ram::HIT_PH + i))
+        .c(format!("(f) st r{lo}, [#{}]", ram::HIT_PL + i));
 }

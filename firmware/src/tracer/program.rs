@@ -112,7 +112,7 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
     }
     // Smooth triangles: the shading normal and the reflection's fallback.
     let smooth = lay.types.iter().any(|x| x.ty.primitive().smooth());
-    let local = lay.fit.sphere_local;
+    let local = lay.fit.local;
     let eye = if super::positions::precise_eye(opt, lay.fine_normals) {
         super::positions::eye(nm.approx(), lay.refract, local)
     } else {
@@ -158,7 +158,11 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
                 names::refract_prepare(l),
                 shading::refract_prepare(l, lay.transmit_materials, nm.approx()),
             ));
-            v.push((names::refract(l), shading::refract_setup(l)));
+            let mut refract = shading::refract_setup(l);
+            if local {
+                super::positions::refracted_origins(&mut refract);
+            }
+            v.push((names::refract(l), refract));
             v.push((names::refracted(l), shading::refract_pop(l)));
         }
     }
@@ -295,7 +299,7 @@ fn title(scene: &Scene, lay: &FbImage, opt: &Options, tw: u32, th: u32, merged: 
         opt.datapath.bits() - 1 - lay.frac,
         lay.frac,
         if lay.fine_normals { "fine" } else { "coarse" },
-        if lay.fit.sphere_local {
+        if lay.fit.local {
             ", local positions"
         } else {
             ""

@@ -69,7 +69,7 @@ pub fn merged(opt: &Options, lay: &FbImage) -> bool {
 /// [`super::Positions::Local`]).
 pub fn applies(opt: &Options, lay: &FbImage) -> bool {
     lay.traversal == Traversal::Packet
-        && !lay.fit.sphere_local
+        && !lay.fit.local
         && opt.depth >= 2
         && (2..=MAX_LIGHTS).contains(&lay.lights.len())
 }

@@ -130,7 +130,7 @@ fn chip_json(
         "clock": clock.from,
         "fps_at_300mhz": chip.fps_at(300_000_000),
         ro::NORMALS.key(): if chip.firmware.layout.fine_normals { "fine" } else { "coarse" },
-        ro::POSITIONS.key(): if chip.firmware.layout.fit.sphere_local { "local" } else { "global" },
+        ro::POSITIONS.key(): if chip.firmware.layout.fit.local { "local" } else { "global" },
         "eye_rays": census[crate::render::RAY_EYE],
         "shadow_rays": census[crate::render::RAY_SHADOW],
         "reflect_rays": census[crate::render::RAY_REFLECT],

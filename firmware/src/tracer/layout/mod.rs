@@ -598,7 +598,7 @@ fn fit_scene(
     let mut fit = Fit {
         kt,
         fine_normals,
-        sphere_local: local,
+        local: local,
         polygon_form: if polygon_bands {
             polygon::Form::Banded
         } else {
@@ -608,6 +608,13 @@ fn fit_scene(
     };
     for p in PRIMITIVES {
         p.fit(scene, &geo, s, &fitter, &mut fit);
+    }
+    if local {
+        let tris = scene.objects.iter().zip(&geo).filter_map(|(o, g)| {
+            let t = o.shape.as_triangle().filter(|t| t.normals.is_none())?;
+            Some((t.v, *g.planars().first()?))
+        });
+        fit.kt_local = super::primitives::triangle_local::fit_kt(tris, s, &fitter);
     }
     (geo, fan, fit)
 }

@@ -373,6 +373,13 @@ pub const TRIANGLE: PlanarPrimitive = PlanarPrimitive(Inside::Triangle);
 pub const DISC: PlanarPrimitive = PlanarPrimitive(Inside::Disc);
 
 impl PlanarPrimitive {
+    /// Whether its records are the local triangle's
+    /// ([`super::triangle_local`]): a flat triangle, one side, local
+    /// positions.
+    fn local(&self, sides: Sides, fit: &Fit) -> bool {
+        self.0 == Inside::Triangle && sides == Sides::Front && fit.local
+    }
+
     /// Its object test's kernel label.
     fn label(&self, sides: Sides) -> &'static str {
         match self.0 {
@@ -396,11 +403,17 @@ impl super::ChipPrimitive for PlanarPrimitive {
         }
     }
 
-    fn layout(&self, _sides: Sides, _fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+    fn layout(&self, sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        if self.local(sides, fit) {
+            return super::triangle_local::layout();
+        }
         Layout::new(FIELDS)
     }
 
-    fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
+    fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
+        if self.local(sides, fit) {
+            return vec![(self.label(sides), super::triangle_local::kernel(g))];
+        }
         vec![(self.label(sides), self.object_kernel(g, sides))]
     }
 
@@ -424,11 +437,19 @@ impl super::ChipPrimitive for PlanarPrimitive {
             Inside::Disc => "discs",
         };
         let name = self.0.kt_name();
-        vec![define(
+        let mut v = vec![define(
             name,
             fit.kt[self.0.kt_index()],
             &format!("{what}: edge duals scaled by 2^{name}"),
-        )]
+        )];
+        if self.local(Sides::Front, fit) {
+            v.push(define(
+                "KT_LOCAL",
+                fit.kt_local,
+                "triangles in frames of their own: edge duals per LSB of the frame scaled by 2^(14+KT_LOCAL)",
+            ));
+        }
+        v
     }
 
     fn has_inside_test(&self) -> bool {
@@ -455,9 +476,10 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     /// Rectangles are priced as triangles (the cost model's kernels).
-    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
         match self.0 {
             Inside::Disc => TestCost::of(&self.object_kernel(g, Sides::Front)),
+            Inside::Triangle if fit.local => TestCost::of(&super::triangle_local::kernel(g)),
             _ => TestCost::of(&kernel(g, Inside::Triangle, Sides::Front)),
         }
     }
@@ -469,6 +491,13 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
+        if self.local(o.sides, o.fit) {
+            let (Some(t), [p]) = (o.shape.as_triangle(), o.geometry.planars()) else {
+                return Err(RecordError::mismatch("triangle"));
+            };
+            super::triangle_local::write(w, o.fit.kt_local, &t.v, p, o.id, o.mat);
+            return Ok(());
+        }
         for p in o.geometry.planars() {
             write(w, &o.fit.kt, p, o.id, o.mat);
         }

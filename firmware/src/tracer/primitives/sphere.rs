@@ -37,6 +37,7 @@
 use super::super::emit::{define, Code, K};
 use super::super::math::{perpendicular_to, remainder, sqrt_q14};
 use super::super::memory_map::ram;
+use super::super::positions;
 use super::record::{Field, Fitter, Layout, W};
 use super::{
     self_margin, CutTest, ErrorBound, Fit, Gen, Geometry, Object, RecordError, Sides, TestCost,
@@ -61,26 +62,21 @@ pub const CENTRE_AGAIN: Field = Field::part(
     "local: the centre and its remainder again, per axis (the hit point)",
 );
 
-/// The largest exponent of a local frame: its LSB `2^-12` of the scene's
-/// (the remainders of 2^-14 LSB keep two bits below it).
-pub const E_MAX: u32 = 12;
-
 /// The exponent `e` of a sphere's local frame (its LSB `2^-e` of the
-/// scene's), for its radius `r` in LSB: the largest up to [`E_MAX`] with
-/// `(2 r + 3) 2^e < 2^14`, so that the vector from the centre to the
-/// ray's point at the rounded `b` (within `2 r` of the centre where the
-/// ray may hit, and up to 3 LSB along the ray from `b`'s rounding and the
-/// Q1.14 direction's length) fits with a guard bit.
+/// scene's) for its radius `r` in LSB
+/// ([`crate::scene_image::local_exponent`]: the vector from the centre
+/// to the ray's point at the rounded `b` fits with a guard bit; the scene
+/// compiler refuses a sphere too large for a frame).
 pub fn local_exponent(r: f64) -> u32 {
-    (0..=E_MAX)
-        .rev()
-        .find(|&e| (2.0 * r + 3.0) * (e as f64).exp2() < 16384.0)
-        .unwrap_or(0)
+    crate::scene_image::local_exponent(r).unwrap_or(0)
 }
 
-/// The record of `fit`'s spheres.
-pub fn layout(fit: &Fit) -> Layout {
-    if fit.sphere_local {
+/// The record of `fit`'s spheres seen from `sides`.
+pub fn layout(fit: &Fit, sides: Sides) -> Layout {
+    if fit.local && sides == Sides::Both {
+        return layout(&glass(fit), sides);
+    }
+    if fit.local {
         return Layout::new([
             (CENTRE, 3),
             (SHIFTS, 2),
@@ -111,8 +107,22 @@ pub fn layout(fit: &Fit) -> Layout {
 pub const FINE_BELOW_LSB: f64 = 64.0;
 
 /// Words of a record.
-pub fn words(fit: &Fit) -> usize {
-    layout(fit).words()
+pub fn words(fit: &Fit, sides: Sides) -> usize {
+    layout(fit, sides).words()
+}
+
+/// With local positions, transmitting spheres keep the scene's format
+/// (two-sided kernels have no local form): their records and kernel as
+/// without, their shifts `KS_GLASS`, `EP_GLASS` (the `fit` of every
+/// sphere's radius in the scene's LSB).
+fn glass(fit: &Fit) -> Fit {
+    Fit {
+        local: false,
+        ks_sphere: fit.ks_glass,
+        ep_sphere: fit.ep_glass,
+        sphere_fine: fit.glass_fine,
+        ..*fit
+    }
 }
 
 /// The opaque kernel's cut ([`K::cut`]) and what F holds there.
@@ -153,7 +163,7 @@ pub(crate) fn write(
     mat: usize,
 ) {
     let s = w.s;
-    if fit.sphere_local {
+    if fit.local {
         write_local(w, fit, center, radius, inside, id, mat);
         return;
     }
@@ -192,7 +202,7 @@ pub(crate) fn write(
 }
 
 /// Write the local record of a sphere ([`layout`] with
-/// `fit.sphere_local`): its centre rounded and the remainders in 2^-14
+/// `fit.local`): its centre rounded and the remainders in 2^-14
 /// LSB, its radius and `invr` in its frame of `2^-e` LSB.
 fn write_local(
     w: &mut W,
@@ -209,16 +219,7 @@ fn write_local(
     let rl = r * (e as f64).exp2();
     let sg = if inside { -1.0 } else { 1.0 };
     let one = w.one();
-    let parts = split(w, center);
-    w.field(CENTRE);
-    w.point(center);
-    w.field(SHIFTS);
-    w.raw(e as i64 + 2);
-    w.raw(14 - e as i64);
-    w.field(CENTRE_REM);
-    for (_, rem) in parts {
-        w.push(rem);
-    }
+    let parts = write_frame(w, [CENTRE, SHIFTS, CENTRE_REM], center, e);
     w.field(INV_R);
     w.push(((14 + w.x + fit.ks_sphere) as f64).exp2() / rl);
     w.field(RADIUS);
@@ -233,7 +234,31 @@ fn write_local(
     w.raw(mat as i64);
     w.field(RADIUS_SG);
     w.push(sg * rl);
-    w.field(CENTRE_AGAIN);
+    write_centre_again(w, CENTRE_AGAIN, parts);
+}
+
+/// The head of a local record: the frame's centre `c` rounded to the
+/// scene's LSB, the frame's shifts `e + 2` and `14 - e`, the centre's
+/// remainders (2^-14 LSB), as the fields `[centre, shifts, remainder]`;
+/// the centre's parts, for [`write_centre_again`].
+pub(super) fn write_frame(w: &mut W, fields: [Field; 3], c: Vec3, e: u32) -> [(f64, f64); 3] {
+    let parts = split(w, c);
+    w.field(fields[0]);
+    w.point(c);
+    w.field(fields[1]);
+    w.raw(e as i64 + 2);
+    w.raw(14 - e as i64);
+    w.field(fields[2]);
+    for (_, rem) in parts {
+        w.push(rem);
+    }
+    parts
+}
+
+/// The tail of a local record: the centre and its remainder per axis
+/// (field `field`), for the hit point ([`positions::hit_point_axis`]).
+pub(super) fn write_centre_again(w: &mut W, field: Field, parts: [(f64, f64); 3]) {
+    w.field(field);
     for (hi, rem) in parts {
         w.push(hi);
         w.push(rem);
@@ -251,9 +276,16 @@ fn split(w: &W, p: Vec3) -> [(f64, f64); 3] {
 
 /// The sphere kernel for records of `fit` and the sides `sides`.
 pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
-    if fit.sphere_local && sides == Sides::Front {
-        return kernel_local(g, fit);
+    match (fit.local, sides) {
+        (true, Sides::Front) => kernel_local(g, fit),
+        (true, Sides::Both) => kernel_global(g, &glass(fit), sides, ["KS_GLASS", "EP_GLASS"]),
+        (false, _) => kernel_global(g, fit, sides, ["KS_SPHERE", "EP_SPHERE"]),
     }
+}
+
+/// The sphere kernel of records in the scene's format, its shifts named
+/// `ks` and `ep`.
+fn kernel_global(g: &Gen, fit: &Fit, sides: Sides, [ks, ep]: [&str; 2]) -> K {
     let (fine, perp, two) = (fit.sphere_fine, g.fine_normals, sides == Sides::Both);
     let nr = g.approx;
     let mut k = K::new();
@@ -274,7 +306,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
             .c("sub r12, r12, r14")
             .note("b's remainder below an LSB");
     }
-    k.comment("p = oc - b d, with EP_SPHERE more fraction bits");
+    k.comment(&format!("p = oc - b d, with {ep} more fraction bits"));
     for (x, d) in [(8, 4), (9, 5), (10, 6)] {
         if fine && !perp {
             k.c(format!("mul r13, r12, r{d}, >>Q14"))
@@ -287,12 +319,16 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
                 k.c("mac out, fb0, #1").note("+ the centre's remainder");
             }
         }
-        k.c(format!("msu r{x}, r11, r{d}, >>Q14-EP_SPHERE"));
+        k.c(format!("msu r{x}, r11, r{d}, >>Q14-{ep}"));
     }
     if perp {
         perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
     }
-    let er = if fine { "+EP_SPHERE" } else { "" };
+    let er = if fine {
+        format!("+{ep}")
+    } else {
+        String::new()
+    };
     // The paper's traversal keeps r in a register (its published
     // contexts); the packet traversal's multiplies by r from the stream
     // after the cut.
@@ -301,7 +337,7 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
         k.c("mov r12, fb0").note("r");
     }
     let r = if g.published { "r12" } else { "fb0" };
-    meets(&mut k, "KS_SPHERE+EP_SPHERE");
+    meets(&mut k, &format!("{ks}+{ep}"));
     if !two && g.test_cuts && !g.published && !fit.sphere_inside {
         // Seen from outside (sg = +1), t = b - h with h >= 0: a sphere
         // whose centre is not ahead has no root ahead, exactly.
@@ -317,12 +353,12 @@ pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     }
     k.note("p/r in TMP0..2");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
-    root(&mut k, g, two, r, er);
+    root(&mut k, g, two, r, &er);
     normal_and_commit(&mut k, two);
     k
 }
 
-/// The sphere kernel of local records ([`layout`] with `fit.sphere_local`,
+/// The sphere kernel of local records ([`layout`] with `fit.local`,
 /// one side): `b = round((c - o).d)` in the scene's LSB as in [`kernel`],
 /// then `p = (c - o) - b d` formed exactly in the accumulator from the
 /// rounded centre and origin and both remainders (`cl`, `RAY_OL`, 2^-14
@@ -352,27 +388,7 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
         .c("mov r15, fb0")
         .note("14 - e");
     k.comment("p = oc + cl - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
-    for (i, (x, d)) in [(8, 4), (9, 5), (10, 6)].into_iter().enumerate() {
-        let i = i as u32;
-        k.c(format!("ld r12, [r0 + #{}]", ram::RAY_OL + i))
-            .c(format!("ld r13, [r0 + #{}]", ram::RAY_DL + i))
-            .c("mul r13, r11, r13, >>Q13")
-            .note("b dl")
-            .c(format!("ldacc r{x}, <<Q14"))
-            .c("mac out, fb0, #1")
-            .note("+ cl")
-            .c("msu out, r12, #1")
-            .note("- ol")
-            .c("msu out, r13, #1")
-            .c(format!("msu out, r11, r{d}"))
-            .note("- b d")
-            .c("acch r12")
-            .c("accl r13")
-            .c("asl r12, r12, r14")
-            .c("srl r13, r13, r15")
-            .c(format!("or r{x}, r12, r13"))
-            .note("p 2^e (saturated far from the sphere)");
-    }
+    positions::offset_in_frame(&mut k);
     perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
     k.note("r12 = pd, what p had along d");
     k.c("mov r13, fb0").note("invr, in the frame");
@@ -399,36 +415,15 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
         .c("mac r9, r14, r9, >>Q14")
         .note("t = b + (pd - sg h) 2^-e");
     remainder(&mut k, 12, 9, 13, "Q14");
-    k.note("its remainder, 2^-14 LSB")
-        .c("movb r15, #0")
-        .c("(f) movb r15, #1");
-    k.comment("t < tbest to 2^-14 LSB (a tbest not local has no remainder)");
-    k.c(format!("ld r13, [r0 + #{}]", ram::HIT_TL))
-        .c("cmp.eq r13, r7")
-        .c(format!("ld r13, [r0 + #{}]", ram::HIT_TLL))
-        .c("(!f) movb r13, #0")
-        .c("cmp.eq r9, r7")
-        .c("(f) cmp.lt r12, r13")
-        .c("(!f) cmp.lt r9, r7")
-        .c("(f) cmp.gt r9, #0")
-        .c("(f) cmp.ne r15, #0")
-        .note("F: a hit ahead, nearer than tbest")
-        .c(format!("(f) st r9, [#{}]", ram::HIT_TL))
-        .c(format!("(f) st r12, [#{}]", ram::HIT_TLL));
+    k.note("its remainder, 2^-14 LSB");
+    positions::nearer(&mut k, 9, 12, 15, 13);
     normal_and_commit(&mut k, false);
     k.comment("the hit point c + sg r n 2^-e, to 2^-14 LSB");
     k.c("mov r15, fb0").note("sg r");
     for (i, n) in [11, 12, 13].into_iter().enumerate() {
         let i = i as u32;
-        k.c(format!("mul r8, r{n}, r15, >>Q14"))
-            .c("ldacc fb0, <<Q14")
-            .c("mac out, fb0, #1")
-            .c("mac r9, r8, r14, >>Q14")
-            .note("P");
-        remainder(&mut k, 8, 9, 10, "Q14");
-        k.note("its remainder")
-            .c(format!("(f) st r9, [#{}]", ram::HIT_PH + i))
-            .c(format!("(f) st r8, [#{}]", ram::HIT_PL + i));
+        k.c(format!("mul r8, r{n}, r15, >>Q14"));
+        positions::hit_point_axis(&mut k, i, "mac", 8, 14, [9, 8, 10]);
     }
     k
 }
@@ -542,8 +537,8 @@ impl super::ChipPrimitive for Sphere {
         ["sphere", "glass_sphere"]
     }
 
-    fn layout(&self, _sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
-        layout(fit)
+    fn layout(&self, sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        layout(fit, sides)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
@@ -564,7 +559,7 @@ impl super::ChipPrimitive for Sphere {
     }
 
     fn fit_header(&self, fit: &Fit) -> Vec<String> {
-        vec![
+        let mut v = vec![
             define(
                 "KS_SPHERE",
                 fit.ks_sphere,
@@ -575,15 +570,30 @@ impl super::ChipPrimitive for Sphere {
                 fit.ep_sphere,
                 "spheres: extra fraction bits of the perpendicular vector",
             ),
-        ]
+        ];
+        if fit.local {
+            v.push(define(
+                "KS_GLASS",
+                fit.ks_glass,
+                "transmitting spheres (the scene's format): invr = 2^(Q14+KS_GLASS) / r",
+            ));
+            v.push(define(
+                "EP_GLASS",
+                fit.ep_glass,
+                "transmitting spheres: extra fraction bits of the perpendicular vector",
+            ));
+        }
+        v
     }
 
     fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
         let spheres = || scene.objects.iter().filter_map(|o| o.shape.as_sphere());
         let radii = spheres().map(|sp| sp.radius.abs() * s);
-        if fit.sphere_local {
+        if fit.local {
             // Radii in their frames; no fine record (the remainders are
-            // the local record's).
+            // the local record's). Transmitting spheres: the scene's
+            // format, fitted to every sphere.
+            (fit.ks_glass, fit.ep_glass, fit.glass_fine) = self::fit(radii.clone(), f);
             let local = radii.map(|r| r * (local_exponent(r) as f64).exp2());
             (fit.ks_sphere, fit.ep_sphere, _) = self::fit(local, f);
             fit.sphere_fine = false;
@@ -606,9 +616,10 @@ impl super::ChipPrimitive for Sphere {
         let Some(sp) = o.shape.as_sphere() else {
             return Err(RecordError::mismatch("sphere"));
         };
+        let glassy = o.fit.local && o.sides == Sides::Both;
         write(
             w,
-            o.fit,
+            &if glassy { glass(o.fit) } else { *o.fit },
             o.unrounded,
             sp.center,
             sp.radius,
