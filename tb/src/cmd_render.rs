@@ -161,9 +161,9 @@ pub struct RenderArgs {
     pub normals: firmware::tracer::Normals,
     /// Where the 16-bit chip holds positions: global (one fixed-point
     /// format for the whole scene) or local (ray origins with a remainder
-    /// of 2^-14 LSB; each sphere and flat triangle tested in a frame of its
-    /// own, its LSB fitted to its size, its hit point brought back with
-    /// the remainder). Local: the packet traversal on the 16-bit chip,
+    /// of 2^-14 LSB; each sphere, flat triangle, open cylinder and cone
+    /// tested in a frame of its own, its LSB fitted to its size, its hit
+    /// point brought back with the remainder). Local: the packet traversal on the 16-bit chip,
     /// shadow rays a packet per light. Auto: local on
     /// the 16-bit chip where global ones cannot hold the scene or render
     /// a probe of the frame (1/16 of the tiles) under --datapath auto's
@@ -513,7 +513,7 @@ fn print_report(
         opt.datapath.bits(),
         j["format"].as_str().unwrap_or("?"),
         if j["positions"] == "local" {
-            ", local positions (spheres and triangles in frames of their own; origins and eye-ray directions with remainders)"
+            ", local positions (spheres, triangles, cylinders and cones in frames of their own; origins and eye-ray directions with remainders)"
         } else {
             ""
         }

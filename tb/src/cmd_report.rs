@@ -199,7 +199,7 @@ const SECTIONS: &[Section] = &[
         title: "Local positions",
         about: "The 16-bit chip with the scene's one number format (`--positions global`) \
                 and with local positions (`local`: ray origins and eye-ray directions with \
-                remainders, each sphere and flat triangle tested in a frame of its own; `docs/tracer.md`, \
+                remainders, each sphere, flat triangle, open cylinder and cone tested in a frame of its own; `docs/tracer.md`, \
                 \"Local positions\"), beside the 32-bit chip, on the SPD scenes with \
                 spheres at their default size, 256x256, depth 2, frames/s at each chip's \
                 clock. `refused`: the format cannot hold the scene (`render` says why).",

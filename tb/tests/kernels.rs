@@ -1407,8 +1407,21 @@ fn local_hits(
     shape: &Shape,
     lsb: f64,
 ) -> (f64, usize, usize) {
+    let (worst, _, hits, disagree) = local_hits_off(sim, rs, shape, lsb, |_| 0.0);
+    (worst, hits, disagree)
+}
+
+/// [`local_hits`], and the worst distance of a hit point from the
+/// surface (`off`, of a point in scene units, in LSB).
+fn local_hits_off(
+    sim: &Sim<Chip<i16>>,
+    rs: &[Ray; 64],
+    shape: &Shape,
+    lsb: f64,
+    off: impl Fn(Vec3) -> f64,
+) -> (f64, f64, usize, usize) {
     let rc = &sim.top.array.rc;
-    let (mut worst, mut hits, mut disagree) = (0.0f64, 0, 0);
+    let (mut worst, mut worst_off, mut hits, mut disagree) = (0.0f64, 0.0f64, 0, 0);
     for (i, r) in rs.iter().enumerate() {
         let o = Vec3::new(
             (r.o.x / lsb * 16384.0).round() / 16384.0 * lsb,
@@ -1434,11 +1447,173 @@ fn local_hits(
                 let want = o + d * f.t;
                 let e = (Vec3::new(p[0], p[1], p[2]) - want * (1.0 / lsb)).length();
                 worst = worst.max(e);
+                worst_off = worst_off.max(off(Vec3::new(p[0], p[1], p[2]) * lsb));
                 hits += 1;
             }
             (None, false) => {}
             _ => disagree += 1,
         }
     }
-    (worst, hits, disagree)
+    (worst, worst_off, hits, disagree)
+}
+
+/// Local positions: the open cylinder tested in a frame of its own
+/// (`cylinder_local`), radii from 0.3 to 1,000 LSB, lengths 1 to 20
+/// radii, axes at random, hit from up to 3,000 LSB away (not within 25
+/// degrees of the axis, nor at the silhouettes): hits and misses agree
+/// but at the rims; the hit points lie within 0.002 LSB plus two LSB of
+/// the cylinder's frame (2^-13 of its extent about its midpoint, or finer)
+/// of the f64 cylinder's surface, and within 0.002 LSB plus eight of them
+/// of its hit on the line the chip traces (the division of `s` errs along
+/// the surface).
+#[test]
+fn local_cylinder_hit_points_vs_float_cylinder() {
+    LOCAL.with(|l| l.set(true));
+    let lsb = 2f64.powi(-10);
+    for radius in [0.3f64, 2.0, 10.0, 100.0, 1000.0] {
+        let mut g = Lcg(radius.to_bits() ^ 0x3c);
+        let c = Vec3::new(
+            0.3 + g.next() * lsb,
+            -0.2 + g.next() * lsb,
+            0.1 + g.next() * lsb,
+        );
+        let axis =
+            Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+        let len = radius * g.range(1.0, 20.0).min(7000.0 / radius);
+        let (base, apex) = (c - axis * (0.5 * len * lsb), c + axis * (0.5 * len * lsb));
+        let shape = Shape::Cone(Cone {
+            base,
+            base_radius: radius * lsb,
+            apex,
+            apex_radius: radius * lsb,
+            inside: false,
+            caps: false,
+        });
+        let rs = rays_across_axis(&mut g, (c, axis, len), 0.5 * radius, radius, lsb);
+        let (sim, fw) = run_with::<i16>(shape.clone(), &rs, false, |t, ti, fit| {
+            ti.ty.broadcast(t, "test", fit, ti.caps)
+        });
+        assert_eq!(fw.frac, 10, "the test's format");
+        let off = |p: Vec3| {
+            let q = p - c;
+            ((q - axis * q.dot(axis)).length() / lsb - radius).abs()
+        };
+        let (worst, worst_off, hits, disagree) = local_hits_off(&sim, &rs, &shape, lsb, off);
+        eprintln!("local cylinder r = {radius} LSB: {hits} hits, {disagree} disagreements, worst hit point {worst:.4} LSB, {worst_off:.4} LSB off the surface");
+        assert!(hits >= 20, "r = {radius}: {hits} hits");
+        assert!(disagree <= 2, "r = {radius}: {disagree} disagreements");
+        // The frame's LSB, 2^-13 of the cylinder's extent about its
+        // midpoint or finer.
+        let ext = ((0.5 * len).powi(2) + radius * radius).sqrt();
+        let unit = (-(firmware::scene_image::local_exponent(ext).unwrap() as f64)).exp2();
+        assert!(
+            worst_off <= 0.002 + 2.0 * unit,
+            "r = {radius}: hit point {worst_off} LSB off the surface (the frame's LSB {unit})"
+        );
+        assert!(
+            worst <= 0.002 + 8.0 * unit,
+            "r = {radius}: hit point off by {worst} LSB (the frame's LSB {unit})"
+        );
+    }
+}
+
+/// Local positions: the open cone tested in a frame of its own
+/// (`cone_local`), radii from 0.3 to 1,000 LSB (the apex's 0.2 to 0.9
+/// of the base's), lengths 1 to 20 base radii, axes at random, hit from
+/// up to 3,000 LSB away (not within 25 degrees of the axis, nor at the
+/// silhouettes): hits and misses agree but at the rims; the hit points
+/// lie within 0.002 LSB plus twelve LSB of the cone's frame (2^-13 of its
+/// extent about its midpoint, or finer) of the f64 cone's surface, and
+/// within 0.002 LSB plus 24 of them (the scene format's cone kernel's
+/// bound on `t`, in LSB of its format) of its hit on the line the chip
+/// traces. (Measured: 3 to 8 LSB of the frame off the surface, 4 to 11
+/// along it.)
+#[test]
+fn local_cone_hit_points_vs_float_cone() {
+    LOCAL.with(|l| l.set(true));
+    let lsb = 2f64.powi(-10);
+    for radius in [0.3f64, 2.0, 10.0, 100.0, 1000.0] {
+        let mut g = Lcg(radius.to_bits() ^ 0xc0);
+        let c = Vec3::new(
+            0.3 + g.next() * lsb,
+            -0.2 + g.next() * lsb,
+            0.1 + g.next() * lsb,
+        );
+        let axis =
+            Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+        let len = radius * g.range(1.0, 20.0).min(7000.0 / radius);
+        let top = radius * g.range(0.2, 0.9);
+        let (base, apex) = (c - axis * (0.5 * len * lsb), c + axis * (0.5 * len * lsb));
+        let shape = Shape::Cone(Cone {
+            base,
+            base_radius: radius * lsb,
+            apex,
+            apex_radius: top * lsb,
+            inside: false,
+            caps: false,
+        });
+        let rs = rays_across_axis(&mut g, (c, axis, len), 0.5 * top, radius, lsb);
+        let (sim, fw) = run_with::<i16>(shape.clone(), &rs, false, |t, ti, fit| {
+            ti.ty.broadcast(t, "test", fit, ti.caps)
+        });
+        assert_eq!(fw.frac, 10, "the test's format");
+        // The distance from the cone's surface (across it: the radial
+        // miss times the half-angle's cosine).
+        let slope = (top - radius) / len;
+        let off = |p: Vec3| {
+            let q = p - base;
+            let z = q.dot(axis);
+            let rho = (q - axis * z).length() / lsb;
+            (rho - (radius + slope * z / lsb)).abs() / (1.0 + slope * slope).sqrt()
+        };
+        let (worst, worst_off, hits, disagree) = local_hits_off(&sim, &rs, &shape, lsb, off);
+        eprintln!("local cone r = {radius} LSB: {hits} hits, {disagree} disagreements, worst hit point {worst:.4} LSB, {worst_off:.4} LSB off the surface");
+        let ext = ((0.5 * len).powi(2) + radius * radius).sqrt();
+        let unit = (-(firmware::scene_image::local_exponent(ext).unwrap() as f64)).exp2();
+        assert!(hits >= 20, "r = {radius}: {hits} hits");
+        assert!(disagree <= 2, "r = {radius}: {disagree} disagreements");
+        assert!(
+            worst_off <= 0.002 + 12.0 * unit,
+            "r = {radius}: hit point {worst_off} LSB off the surface (the frame's LSB {unit})"
+        );
+        assert!(
+            worst <= 0.002 + 24.0 * unit,
+            "r = {radius}: hit point off by {worst} LSB (the frame's LSB {unit})"
+        );
+    }
+}
+
+/// 64 rays at a shape about the axis `axis` through `c` of length `len`
+/// (LSB): each at a point within `spread` LSB of the axis (in each
+/// coordinate), along it up to 0.1 of its length beyond either end (away
+/// from the silhouettes, as the sphere's test), not within 25 degrees of
+/// the axis (a ray along it meets the wall at a grazing angle, where the
+/// hit point along the ray is ill-conditioned), from 1,500 to 3,000 LSB
+/// away (scaled down for a `radius` under 30 LSB).
+fn rays_across_axis(
+    g: &mut Lcg,
+    (c, axis, len): (Vec3, Vec3, f64),
+    spread: f64,
+    radius: f64,
+    lsb: f64,
+) -> [Ray; 64] {
+    std::array::from_fn(|_| {
+        let along = g.range(-0.6, 0.6) * len;
+        let off = Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0));
+        let target = c + axis * (along * lsb) + off * (spread * lsb);
+        let mut dir;
+        loop {
+            dir =
+                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+            if dir.dot(axis).abs() < 0.9 {
+                break;
+            }
+        }
+        let far = g.range(1500.0, 3000.0) * (radius / 30.0).clamp(0.03, 1.0);
+        let o = target + dir * (far * lsb);
+        Ray {
+            o,
+            d: (target - o).normalized(),
+        }
+    })
 }

@@ -18,13 +18,24 @@ pub fn tessellated_triangles(s: &Shape) -> usize {
 /// keep two bits below it).
 pub const LOCAL_E_MAX: u32 = 12;
 
-/// The shapes the chip tests in a frame of their own with local
-/// positions (spheres and flat triangles): the frame's centre (the
-/// sphere's, the triangle's centroid) and its extent, the farthest point
-/// of the shape from it (scene units).
-pub fn local_frame(s: &Shape) -> Option<(Vec3, f64)> {
+/// The shapes of `scene` the chip tests in a frame of their own with
+/// local positions (spheres, flat triangles, and cylinders and cones
+/// where none of the scene's of that type has caps): the frame's centre
+/// (the sphere's, the triangle's centroid, the axis' midpoint) and its
+/// extent, the farthest point of the shape from it (scene units).
+pub fn local_frame(scene: &Scene, s: &Shape) -> Option<(Vec3, f64)> {
     if let Some(sp) = s.as_sphere() {
         return Some((sp.center, sp.radius.abs()));
+    }
+    if let Some(c) = s.as_cone() {
+        let ty = s.prim_type();
+        let capped = scene
+            .objects
+            .iter()
+            .any(|o| o.shape.prim_type() == ty && o.shape.capped());
+        let h = (c.apex - c.base).length() * 0.5;
+        let r = c.base_radius.abs().max(c.apex_radius.abs());
+        return (!capped).then(|| ((c.base + c.apex) * 0.5, (h * h + r * r).sqrt()));
     }
     let t = s.as_triangle().filter(|t| t.normals.is_none())?;
     let c = (t.v[0] + t.v[1] + t.v[2]) * (1.0 / 3.0);
@@ -155,7 +166,7 @@ pub(super) fn smallest(
     // the chip's precision): shapes in frames of their own
     // (`local_frames`) hold features `2^e` times finer.
     let frame = |s: &Shape| {
-        local_frame(s)
+        local_frame(scene, s)
             .filter(|_| opt.local_frames)
             .map(|(_, r)| local_exponent(r / lsb))
     };
@@ -164,7 +175,7 @@ pub(super) fn smallest(
         .iter()
         .find(|o| frame(&o.shape).is_some_and(|e| e.is_none()))
     {
-        let r = local_frame(&o.shape).map_or(0.0, |(_, r)| r);
+        let r = local_frame(scene, &o.shape).map_or(0.0, |(_, r)| r);
         return Err(SceneError {
             file: scene.source.clone(),
             line: o.line,

@@ -205,7 +205,7 @@ pub(super) fn objects(
             if let Some(why) = dq
                 .degeneracy()
                 .filter(|_| opt.target_extra_frac == 0)
-                .filter(|_| !opt.local_frames || super::fit::local_frame(&o.shape).is_none())
+                .filter(|_| !opt.local_frames || super::fit::local_frame(scene, &o.shape).is_none())
                 .filter(|m| !m.contains("perpendicular") && !m.contains("not in the plane"))
             {
                 return Err(SceneError {

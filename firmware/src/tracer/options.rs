@@ -472,8 +472,8 @@ spelled! {
 spelled! {
     /// Where the 16-bit chip holds positions. Global: one fixed-point
     /// format for the whole scene (coordinates, origins, `t`). Local: ray
-    /// origins carry a remainder (`RAY_OL`, 2^-14 LSB), and a sphere or
-    /// flat triangle seen from one side is tested in a frame of its own,
+    /// origins carry a remainder (`RAY_OL`, 2^-14 LSB), and a sphere, flat
+    /// triangle, open cylinder or cone seen from one side is tested in a frame of its own,
     /// its centre the origin and its LSB `2^-e` of the scene's, `e`
     /// fitted to its extent ([`crate::scene_image::local_exponent`]); its
     /// hit point comes back to the scene's format with the remainder

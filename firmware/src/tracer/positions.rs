@@ -227,13 +227,24 @@ pub fn nearer(k: &mut K, t: u8, rem: u8, f: u8, tmp: u8) {
 /// In a local kernel, after [`nearer`]: axis `i` of the hit point `c +
 /// v 2^-e` (`op` "mac") or `c - v 2^-e` ("msu") to 2^-14 LSB, `v` in the
 /// frame (register `v`), `2^(14-e)` in `scale`, the stream's centre and
-/// its remainder (`c_i`, `cl_i`): where F, `HIT_PH` and `HIT_PL`.
-/// Clobbers `hi`, `lo`, `tmp`.
-pub fn hit_point_axis(k: &mut K, i: u32, op: &str, v: u8, scale: u8, [hi, lo, tmp]: [u8; 3]) {
-    k.c("ldacc fb0, <<Q14")
-        .c("mac out, fb0, #1")
-        .c(format!("{op} r{hi}, r{v}, r{scale}, >>Q14"))
-        .note("P");
+/// its remainder (`c_i`, `cl_i`), and (`fine`) what `v`'s rounding left
+/// in 2^-14 LSB (a register, added as `op` "mac" adds `v`): where F,
+/// `HIT_PH` and `HIT_PL`. Clobbers `hi`, `lo`, `tmp`.
+#[allow(clippy::too_many_arguments)]
+pub fn hit_point_axis(
+    k: &mut K,
+    i: u32,
+    op: &str,
+    v: u8,
+    fine: Option<u8>,
+    scale: u8,
+    [hi, lo, tmp]: [u8; 3],
+) {
+    k.c("ldacc fb0, <<Q14").c("mac out, fb0, #1");
+    if let Some(f) = fine {
+        k.c(format!("mac out, r{f}, #1"));
+    }
+    k.c(format!("{op} r{hi}, r{v}, r{scale}, >>Q14")).note("P");
     remainder(k, lo, hi, tmp, "Q14");
     k.note("its remainder")
         .c(format!("(f) st r{hi}, [#{}]", ram::HIT_PH + i))

@@ -598,7 +598,7 @@ fn fit_scene(
     let mut fit = Fit {
         kt,
         fine_normals,
-        local: local,
+        local,
         polygon_form: if polygon_bands {
             polygon::Form::Banded
         } else {

@@ -54,7 +54,7 @@ use super::{
     commit_obj_mat, perpendicular, self_margin, Body, CutTest, ErrorBound, Fit, Gen, Geometry,
     Object, RecordError, Sides, TestCost,
 };
-use crate::scene::{Scene, Shape, Vec3};
+use crate::scene::{PrimType, Scene, Shape, Surface, Vec3};
 
 /// Words of the body.
 pub const BODY_WORDS: usize = 40;
@@ -71,7 +71,11 @@ pub const GCONE_CAP1: Field = Field::named("GCONE_CAP1", "glass cone record: ape
 
 /// The record of `s`: caps flag, body (twice for a glass cone), caps;
 /// without `caps` (records that carry none) the body alone.
-pub fn layout(s: Sides, caps: bool) -> Layout {
+pub fn layout(fit: &Fit, s: Sides, caps: bool) -> Layout {
+    if fit.cone_local && s == Sides::Front {
+        debug_assert!(!caps, "local cones' records carry no caps");
+        return super::cone_local::layout();
+    }
     let glass = s == Sides::Both;
     let mut l = Vec::new();
     if caps {
@@ -102,8 +106,11 @@ fn body_name(b: Body) -> &'static str {
 
 /// The kernels of a cone's test, in load order: the body run(s), the caps'
 /// disc.
-pub fn kernels(g: &Gen, s: Sides) -> Vec<(&'static str, K)> {
+pub fn kernels(g: &Gen, fit: &Fit, s: Sides) -> Vec<(&'static str, K)> {
     let cap = planar::kernel_name(Inside::Disc, s);
+    if fit.cone_local && s == Sides::Front {
+        return vec![(body_name(Body::Opaque), super::cone_local::kernel(g))];
+    }
     match s {
         Sides::Front => vec![
             (body_name(Body::Opaque), kernel(g, Body::Opaque)),
@@ -140,6 +147,19 @@ impl ConeFit {
     /// The cone from `base` (radius `rb`) to `apex` (radius `ra`) in the
     /// scene format of scale `scale` (LSBs per unit).
     pub fn of(base: Vec3, rb: f64, apex: Vec3, ra: f64, scale: f64) -> ConeFit {
+        ConeFit::with_margin(base, rb, apex, ra, scale, 2.0)
+    }
+
+    /// [`ConeFit::of`] with the bounding radius `margin` LSB more than
+    /// the cone's extent about its exact middle (`of`: 2).
+    pub fn with_margin(
+        base: Vec3,
+        rb: f64,
+        apex: Vec3,
+        ra: f64,
+        scale: f64,
+        margin: f64,
+    ) -> ConeFit {
         let axis = apex - base;
         let h = axis.length();
         let a = axis * (1.0 / h);
@@ -154,9 +174,10 @@ impl ConeFit {
             (m.z * scale).round(),
         );
         // The cone lies within sqrt((h/2)^2 + max(rb, ra)^2) of its exact
-        // middle; 2 LSB more cover the rounding of M.
+        // middle; the margin covers the rounding of M and of the ray's
+        // point nearest it.
         let bound = ((h / 2.0).powi(2) + rb.max(ra).powi(2)).sqrt() * scale;
-        let r = (bound + 2.0).ceil();
+        let r = (bound + margin).ceil();
         let big_s = 2.0 * r;
         ConeFit {
             m_q,
@@ -372,9 +393,16 @@ fn bounding_sphere(k: &mut K) {
         k.c(format!("ldacc r{x}, <<Q14"))
             .c(format!("msu r{x}, r11, r{d}, >>Q14-EP_CONE"));
     }
+    meets_bound(k, "KS_CONE+EP_CONE");
+}
+
+/// `w = p / S` (r8..r10: `p` times the stream's `invS`, shifted by
+/// `shift`); F where the line meets the bounding sphere (`|w| <= 1/2`).
+/// Clobbers r12, r15.
+pub(super) fn meets_bound(k: &mut K, shift: &str) {
     k.c("mov r12, fb0").note("invS");
     for x in [8, 9, 10] {
-        k.c(format!("mul r{x}, r{x}, r12, >>KS_CONE+EP_CONE"));
+        k.c(format!("mul r{x}, r{x}, r12, >>{shift}"));
     }
     k.note("w = p / S");
     k.c("movb r15, #1")
@@ -389,7 +417,7 @@ fn bounding_sphere(k: &mut K) {
 
 /// The cone's frame: `c q_perp`, `G` (zoomed into [1/8, 1/4) by `2^e`) and `c d_perp`,
 /// `s dz` into `CONE_TMP`, `TMP1`, `TMP2`.
-fn frame(k: &mut K) {
+pub(super) fn frame(k: &mut K) {
     let ct = ram::CONE_TMP;
     k.comment(
         "frame: w.ce1 = -c qx, w.ce2 = -c qy, w.a = -qz; d.ce1 = c dx, d.ce2 = c dy, d.a = dz",
@@ -443,7 +471,7 @@ fn frame(k: &mut K) {
 /// The quadratic `A tau^2 + 2 B tau + C` (zoomed), times `sg`, its discriminant and
 /// `sqrt(4D)` (r8); with `cut`, the kernel's cut of that name before the
 /// square root.
-fn quadratic(k: &mut K, nr: Approx, cut: Option<&str>) {
+pub(super) fn quadratic(k: &mut K, nr: Approx, cut: Option<&str>) {
     k.comment("A, -2B, 4C (zoomed: 2^e B, 2^2e C), times sg; 4D = 4B^2 - 4A C");
     k.c("mul out, r8, r8")
         .c("mac out, r9, r9")
@@ -476,6 +504,25 @@ fn quadratic(k: &mut K, nr: Approx, cut: Option<&str>) {
 /// The visible root `tau`, then `t = b + S tau` (r11, `TMP4`) where it is ahead and
 /// nearer than `tbest`.
 fn root(k: &mut K, g: &Gen, body: Body) {
+    root_tau(k, g);
+    k.c(format!("ld r11, [r0 + #{}]", ram::TMP0))
+        .c("ldacc r11, <<Q13")
+        .c("mac r11, fb0, r13, >>Q13")
+        .note("t = b + S tau");
+    if body != Body::Opaque {
+        self_margin(k, 12, g.datapath);
+        k.c("(f) cmp.gt r11, r12");
+    } else {
+        k.c("(f) cmp.gt r11, #0");
+    }
+    k.c("(f) cmp.lt r11, r7")
+        .c(format!("st r11, [#{}]", ram::TMP4));
+}
+
+/// The visible root: `tau` (r13, Q.14 of S) and `2^e tau` (r10), F kept
+/// where `|tau| < 1/2` (a hit within the bounding sphere). Clobbers r8,
+/// r9, r11, r12, r14, r15.
+pub(super) fn root_tau(k: &mut K, g: &Gen) {
     let ct = ram::CONE_TMP;
     let nr = g.approx;
     k.comment("tau' = 2^e tau = X / 2Y: B > 0: -(2B + sqrt 4D) / 2A, else 4C / 2(sqrt 4D - 2B)");
@@ -514,23 +561,11 @@ fn root(k: &mut K, g: &Gen, body: Body) {
         .c("abs r12, r13")
         .c("sra r12, r12, #Q13")
         .c("(f) cmp.eq r12, #0")
-        .note("|tau| < 1/2: within the bounding sphere")
-        .c(format!("ld r11, [r0 + #{}]", ram::TMP0))
-        .c("ldacc r11, <<Q13")
-        .c("mac r11, fb0, r13, >>Q13")
-        .note("t = b + S tau");
-    if body != Body::Opaque {
-        self_margin(k, 12, g.datapath);
-        k.c("(f) cmp.gt r11, r12");
-    } else {
-        k.c("(f) cmp.gt r11, #0");
-    }
-    k.c("(f) cmp.lt r11, r7")
-        .c(format!("st r11, [#{}]", ram::TMP4));
+        .note("|tau| < 1/2: within the bounding sphere");
 }
 
 /// The hit's height within the cone: F kept where `|q_z + tau d_z| <= hh`.
-fn height(k: &mut K) {
+pub(super) fn height(k: &mut K) {
     k.comment("height of the hit: |qz + tau dz| <= hh");
     k.c(format!("ld r12, [r0 + #{}]", ram::TMP1))
         .c(format!("ld r14, [r0 + #{}]", ram::TMP2))
@@ -541,7 +576,7 @@ fn height(k: &mut K) {
 }
 
 /// The gradient at the hit, normalised, in the scene's axes: `HIT_N`, `tbest`.
-fn normal(k: &mut K, nr: Approx) {
+pub(super) fn normal(k: &mut K, nr: Approx) {
     let ct = ram::CONE_TMP;
     k.comment("normal: sg (c (c q_perp + tau c d_perp), -s (G + tau s dz)), zoomed, halved");
     for (x, qa, da) in [(8, 3, 0), (9, 4, 1)] {
@@ -584,12 +619,12 @@ impl super::ChipPrimitive for Cone {
         ["cone", "glass_cone"]
     }
 
-    fn layout(&self, sides: Sides, _fit: &Fit, _fan: usize, caps: bool) -> Layout {
-        layout(sides, caps)
+    fn layout(&self, sides: Sides, fit: &Fit, _fan: usize, caps: bool) -> Layout {
+        layout(fit, sides, caps)
     }
 
-    fn kernels(&self, sides: Sides, g: &Gen, _fit: &Fit) -> Vec<(&'static str, K)> {
-        kernels(g, sides)
+    fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
+        kernels(g, fit, sides)
     }
 
     fn broadcast(&self, sides: Sides, t: &mut Code, at: &str, _fit: &Fit, caps: bool) {
@@ -616,10 +651,18 @@ impl super::ChipPrimitive for Cone {
     }
 
     fn fit_header(&self, fit: &Fit) -> Vec<String> {
-        vec![
+        let mut v = vec![
             define("KS_CONE", fit.ks_cone, "cones: invS = 2^(Q14+KS_CONE) / S"),
             define("EP_CONE", fit.ep_cone, "cones: extra fraction bits of p"),
-        ]
+        ];
+        if fit.cone_local {
+            v.push(define(
+                "KS_CONEL",
+                fit.ks_conel,
+                "cones in frames of their own: invS = 2^(Q14+KS_CONEL) / S, S in the frame",
+            ));
+        }
+        v
     }
 
     fn geometry(&self, shape: &Shape, s: f64) -> Geometry {
@@ -632,15 +675,32 @@ impl super::ChipPrimitive for Cone {
         Geometry::Cone(Box::new((f, caps)))
     }
 
-    fn fit(&self, _scene: &Scene, geo: &[Geometry], _s: f64, f: &Fitter, fit: &mut Fit) {
+    fn fit(&self, scene: &Scene, geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
         let fits = geo.iter().filter_map(|g| match g {
             Geometry::Cone(fc) => Some(fc.0),
             _ => None,
         });
         (fit.ks_cone, fit.ep_cone) = self::fit(fits, f);
+        // Local positions: opaque cones in frames of their own where no
+        // cone has caps (their records then carry none).
+        let cones = || {
+            scene
+                .objects
+                .iter()
+                .filter_map(|o| o.shape.as_cone())
+                .filter(|c| c.prim_type() == PrimType::Cone)
+        };
+        fit.cone_local = fit.local && !cones().any(|c| c.caps);
+        if fit.cone_local {
+            let local = cones().map(|c| (c.base, c.base_radius, c.apex, c.apex_radius));
+            fit.ks_conel = super::cone_local::fit_ks(local, s, f);
+        }
     }
 
-    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
+        if fit.cone_local {
+            return TestCost::of(&super::cone_local::kernel(g));
+        }
         TestCost {
             each: planar::kernel(g, Inside::Disc, Sides::Front).len(),
             ..TestCost::of(&kernel(g, Body::Opaque))
@@ -656,6 +716,18 @@ impl super::ChipPrimitive for Cone {
         let (Some(c), Geometry::Cone(fc)) = (o.shape.as_cone(), o.geometry) else {
             return Err(RecordError::mismatch("cone"));
         };
+        if o.fit.cone_local && o.sides == Sides::Front {
+            return super::cone_local::write(
+                w,
+                o.fit.ks_conel,
+                (c.base, c.base_radius),
+                (c.apex, c.apex_radius),
+                c.inside,
+                o.id,
+                o.mat,
+            )
+            .map_err(RecordError::Object);
+        }
         write(
             w,
             o.fit,

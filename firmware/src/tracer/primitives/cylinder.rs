@@ -83,6 +83,10 @@ pub const GCYL_CAP1: Field = Field::named("GCYL_CAP1", "glass cylinder record: a
 /// The record of `s`: caps flag, body (twice for a glass cylinder), caps;
 /// without `caps` (records that carry none) the body alone.
 pub fn layout(fit: &Fit, s: Sides, caps: bool) -> Layout {
+    if fit.cyl_local && s == Sides::Front {
+        debug_assert!(!caps, "local cylinders' records carry no caps");
+        return super::cylinder_local::layout();
+    }
     let body = body_words(fit.fine_normals);
     let glass = s == Sides::Both;
     let mut l = Vec::new();
@@ -116,6 +120,9 @@ fn body_name(b: Body) -> &'static str {
 /// caps' disc.
 pub fn kernels(g: &Gen, fit: &Fit, s: Sides) -> Vec<(&'static str, K)> {
     let cap = planar::kernel_name(Inside::Disc, s);
+    if fit.cyl_local && s == Sides::Front {
+        return vec![(body_name(Body::Opaque), super::cylinder_local::kernel(g))];
+    }
     match s {
         Sides::Front => vec![
             (body_name(Body::Opaque), kernel(g, fit, Body::Opaque)),
@@ -583,10 +590,18 @@ impl super::ChipPrimitive for Cylinder {
     }
 
     fn fit_header(&self, fit: &Fit) -> Vec<String> {
-        vec![
+        let mut v = vec![
             define("KS_CYL", fit.ks_cyl, "cylinders: invr = 2^(Q14+KS_CYL) / r"),
             define("EP_CYL", fit.ep_cyl, "cylinders: extra fraction bits of p"),
-        ]
+        ];
+        if fit.cyl_local {
+            v.push(define(
+                "KS_CYLL",
+                fit.ks_cyll,
+                "cylinders in frames of their own: invr = 2^(Q14+KS_CYLL) / r, r in the frame",
+            ));
+        }
+        v
     }
 
     fn geometry(&self, shape: &Shape, _s: f64) -> Geometry {
@@ -604,9 +619,20 @@ impl super::ChipPrimitive for Cylinder {
         let base_radii = cones().map(|c| c.base_radius.abs() * s);
         (fit.ks_cyl, fit.ep_cyl) = self::fit(radii, base_radii, f);
         fit.cyl_inside = cylinders().any(|c| c.inside);
+        // Local positions: opaque cylinders in frames of their own where
+        // no cylinder has caps (their records then carry none,
+        // `layout::records_carry_caps`).
+        fit.cyl_local = fit.local && !cylinders().any(|c| c.caps);
+        if fit.cyl_local {
+            let local = cylinders().map(|c| (c.base, c.apex, c.base_radius));
+            fit.ks_cyll = super::cylinder_local::fit_ks(local, s, f);
+        }
     }
 
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
+        if fit.cyl_local {
+            return TestCost::of(&super::cylinder_local::kernel(g));
+        }
         TestCost {
             each: planar::kernel(g, Inside::Disc, Sides::Front).len(),
             ..TestCost::of(&kernel(g, fit, Body::Opaque))
@@ -627,6 +653,19 @@ impl super::ChipPrimitive for Cylinder {
         let (Some(c), Geometry::Planars(discs)) = (o.shape.as_cone(), o.geometry) else {
             return Err(RecordError::mismatch("cylinder"));
         };
+        if o.fit.cyl_local && o.sides == Sides::Front {
+            super::cylinder_local::write(
+                w,
+                o.fit.ks_cyll,
+                c.base,
+                c.apex,
+                c.base_radius,
+                c.inside,
+                o.id,
+                o.mat,
+            );
+            return Ok(());
+        }
         write(
             w,
             o.fit,

@@ -18,6 +18,16 @@ pub struct Fit {
     /// spheres' radii there, `kt_local` to the triangles' edge duals.
     pub local: bool,
     pub kt_local: u32,
+    /// Local positions, no cylinder with caps: opaque cylinders in frames
+    /// of their own ([`super::cylinder_local`]), `KS_CYLL` fitted to
+    /// their radii there.
+    pub cyl_local: bool,
+    pub ks_cyll: u32,
+    /// Local positions, no cone with caps: opaque cones in frames of
+    /// their own ([`super::cone_local`]), `KS_CONEL` fitted to their
+    /// bounding spheres there.
+    pub cone_local: bool,
+    pub ks_conel: u32,
     /// Local positions: the transmitting spheres' shifts and record
     /// variant (their records in the scene's format, [`super::sphere`]).
     pub ks_glass: u32,

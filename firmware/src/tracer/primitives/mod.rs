@@ -27,7 +27,9 @@
 
 pub mod aabox;
 pub mod cone;
+pub mod cone_local;
 pub mod cylinder;
+pub mod cylinder_local;
 mod fit;
 pub use fit::Fit;
 pub mod planar;

@@ -423,7 +423,7 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
     for (i, n) in [11, 12, 13].into_iter().enumerate() {
         let i = i as u32;
         k.c(format!("mul r8, r{n}, r15, >>Q14"));
-        positions::hit_point_axis(&mut k, i, "mac", 8, 14, [9, 8, 10]);
+        positions::hit_point_axis(&mut k, i, "mac", 8, None, 14, [9, 8, 10]);
     }
     k
 }

@@ -110,13 +110,13 @@ fn every_kernel_reads_exactly_its_record() {
                     for ((name, k), f) in k.iter().zip(&fields) {
                         assert_eq!(Some(k.fb_reads), l.words_of(*f), "{name} reads {f}");
                     }
-                    let l = cone::layout(s, true);
+                    let l = cone::layout(&fit, s, true);
                     let fields = if glass {
                         vec![cone::CONE_BODY, cone::GCONE_INNER, cone::GCONE_CAP0]
                     } else {
                         vec![cone::CONE_BODY, cone::CONE_CAP0]
                     };
-                    let k = cone::kernels(&g, s);
+                    let k = cone::kernels(&g, &fit, s);
                     assert_eq!(k.len(), fields.len());
                     for ((name, k), f) in k.iter().zip(&fields) {
                         assert_eq!(Some(k.fb_reads), l.words_of(*f), "{name} reads {f}");
@@ -185,7 +185,7 @@ fn every_writer_follows_its_layout() {
                     let mut w = writer();
                     let on = caps.then_some((true, &discs));
                     cone::write(&mut w, &fit, s, &cf, false, on, 7, 1).unwrap();
-                    holds_to(&w, 0, &cone::layout(s, caps), "cone");
+                    holds_to(&w, 0, &cone::layout(&fit, s, caps), "cone");
                 }
             }
         }
@@ -274,4 +274,56 @@ fn holds_to_prefix(w: &W, named: &Layout, form: polygon::Form) {
             "{form:?}: {f} written at another offset than its layout's"
         );
     }
+}
+
+/// Local positions: the kernels that test an object in a frame of its
+/// own read exactly the words their writers write, at their layouts'
+/// offsets (the sphere, the flat triangle, the open cylinder and cone).
+#[test]
+fn every_local_kernel_reads_exactly_its_record() {
+    use crate::scene::Vec3;
+    let v = Vec3::new;
+    let g = Gen {
+        datapath: Datapath::W16,
+        approx: Approx::default(),
+        fine_normals: true,
+        test_cuts: true,
+        published: false,
+    };
+    let fit = Fit {
+        local: true,
+        cyl_local: true,
+        cone_local: true,
+        fine_normals: true,
+        ks_cyll: 6,
+        ks_conel: 6,
+        ..Fit::default()
+    };
+    let s = Sides::Front;
+    let l = sphere::layout(&fit, s);
+    assert_eq!(sphere::kernel(&g, &fit, s).fb_reads, l.words());
+    let mut w = writer();
+    sphere::write(&mut w, &fit, false, v(1.0, 2.0, 3.0), 0.5, false, 7, 1);
+    holds_to(&w, 0, &l, "local sphere");
+    let tri = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
+    assert_eq!(
+        triangle_local::kernel(&g).fb_reads,
+        triangle_local::layout().words()
+    );
+    let mut w = writer();
+    triangle_local::write(&mut w, 4, &tri, &planar::flat_triangle(tri), 7, 1);
+    holds_to(&w, 0, &triangle_local::layout(), "local triangle");
+    let (base, apex) = (v(0.0, 0.0, 0.0), v(0.0, 0.3, 2.0));
+    let l = cylinder::layout(&fit, s, false);
+    let k = cylinder::kernels(&g, &fit, s);
+    assert_eq!((k.len(), k[0].1.fb_reads), (1, l.words()));
+    let mut w = writer();
+    cylinder_local::write(&mut w, 6, base, apex, 0.5, false, 7, 1);
+    holds_to(&w, 0, &l, "local cylinder");
+    let l = cone::layout(&fit, s, false);
+    let k = cone::kernels(&g, &fit, s);
+    assert_eq!((k.len(), k[0].1.fb_reads), (1, l.words()));
+    let mut w = writer();
+    cone_local::write(&mut w, 12, (base, 0.5), (apex, 0.25), false, 7, 1).unwrap();
+    holds_to(&w, 0, &l, "local cone");
 }

@@ -10,8 +10,8 @@
 //! per LSB of the frame, negated, scaled by `2^(14+KT_LOCAL)`; `uc`, `wc`
 //! the centroid's barycentric coordinates (Q1.14).
 //!
-//! **Method**: `b = round((c - o).d)` in the scene's LSB and `p = (c - o)
-//! - b d` in the frame, exactly as the local sphere forms it
+//! **Method**: `b = round((c - o).d)` in the scene's LSB and `p = (c - o) -
+//! b d` in the frame, exactly as the local sphere forms it
 //! ([`positions::offset_in_frame`]): `|p| <= R` where the ray can hit.
 //! Then the plane through `c`: `den = -n.d > 0` (the front face), `num =
 //! -n.p`, `s = num / den` (F only where `|s| < 2^15`: a hit lies within
@@ -212,7 +212,7 @@ pub fn kernel(g: &super::Gen) -> K {
     k.comment("the hit point c - g 2^-e, to 2^-14 LSB");
     k.c(format!("ld r14, [r0 + #{}]", ram::TMP3));
     for (i, v) in [8, 9, 10].into_iter().enumerate() {
-        positions::hit_point_axis(&mut k, i as u32, "msu", v, 14, [11, 12, 13]);
+        positions::hit_point_axis(&mut k, i as u32, "msu", v, None, 14, [11, 12, 13]);
     }
     k
 }
