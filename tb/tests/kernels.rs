@@ -72,6 +72,20 @@ fn with_driver(fw: &Firmware, body: impl FnOnce(&mut Code)) -> asm::Image {
     asm::assemble(&src, "kernel-test.s").unwrap()
 }
 
+/// A chip of datapath `W` with `img` and `fw`'s FB image loaded, run to
+/// the driver's `wait` (the scene and contexts loaded, `k_init` run).
+fn at_wait<W: Word>(img: &asm::Image, fw: &Firmware) -> Sim<Chip<W>> {
+    let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
+    img.load(&mut chip).unwrap();
+    chip.load(tracer::mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
+    let mut sim = Sim::new(chip);
+    let wait = img.symbol("wait").unwrap() as u32;
+    while sim.top.risc.pc != wait {
+        sim.step().unwrap();
+    }
+    sim
+}
+
 /// Run the test of `shape` (in a one-object scene) for 64 rays on the chip
 /// of datapath `W`: the generated firmware's own kernels, broadcast by its
 /// own code for the type ([`ChipType::broadcast`]). `transmit`: the
@@ -150,14 +164,7 @@ fn run_with<W: Word>(
         t.li(R7, format!("FB_{}", ty.name().to_uppercase()));
         broadcast(t, &lay.types[0], &lay.fit);
     });
-    let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
-    img.load(&mut chip).unwrap();
-    chip.load(tracer::mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
-    let mut sim = Sim::new(chip);
-    let wait = img.symbol("wait").unwrap() as u32;
-    while sim.top.risc.pc != wait {
-        sim.step().unwrap();
-    }
+    let mut sim = at_wait::<W>(&img, &fw);
     let lsb = (-(fw.frac as f64)).exp2();
     let max = ((W::BITS - 1) as f64).exp2() - 1.0;
     let one = ((W::BITS - 2) as f64).exp2();
@@ -1198,14 +1205,7 @@ fn snell_on<W: Word>(ior: f64, seed: u64) -> (usize, f64) {
             .li(R2, "FB_TRANSMIT")
             .sbcb(R1, R2, klen(&k));
     });
-    let mut chip = Chip::<W>::build(Timing::default(), rtl::memory::DEFAULT_SIZE);
-    img.load(&mut chip).unwrap();
-    chip.load(tracer::mem::FB_IMAGE, &fw.fb_bytes()).unwrap();
-    let mut sim = Sim::new(chip);
-    let wait = img.symbol("wait").unwrap() as u32;
-    while sim.top.risc.pc != wait {
-        sim.step().unwrap();
-    }
+    let mut sim = at_wait::<W>(&img, &fw);
     let one = ((W::BITS - 2) as f64).exp2();
     let max = ((W::BITS - 1) as f64).exp2() - 1.0;
     let u = |x: f64| W::wrap((x * one).round().clamp(-max - 1.0, max) as i64);
@@ -1616,4 +1616,110 @@ fn rays_across_axis(
             d: (target - o).normalized(),
         }
     })
+}
+
+/// Local positions: the shadow rays' directions (`k_shadow_rays`,
+/// `positions::shadow_direction`) from hit points with remainders
+/// (`SH_P` plus `SH_PL` 2^-14) 100 to 16,000 LSB from a light, against the f64
+/// direction from that exact point to the light as the record holds it:
+/// the direction the chip traces (`D_H` 2^-14 + `RAY_DL` 2^-27) within
+/// 2^-26 of it (measured: 2^-27.5), where its Q1.14 part alone is off by
+/// up to 2^-14.5.
+#[test]
+fn local_shadow_directions_vs_f64() {
+    let mut scene = Scene::load(&PathBufExt::default_scene()).unwrap();
+    scene.lights.truncate(1);
+    let opt = Options {
+        datapath: Datapath::W16,
+        positions: tracer::Positions::Local,
+        ..Options::default()
+    };
+    let fw = tracer::build(&scene, &opt).unwrap();
+    assert!(!fw.layout.light_shifted, "the test's light is not shifted");
+    let img = with_driver(&fw, |t| {
+        t.m(
+            "BCAST_FB",
+            format!("{}, FB_LIGHT0", tracer::kernel_names::SHADOW),
+        );
+    });
+    let mut sim = at_wait::<i16>(&img, &fw);
+    let lsb = (-(fw.frac as f64)).exp2();
+    let light = scene.lights[0].position * (1.0 / lsb);
+    let lq = Vec3::new(light.x.round(), light.y.round(), light.z.round());
+    let mut g = Lcg(0x5d);
+    let mut points = Vec::new();
+    for lane in 0..64 {
+        // A point in the format's range (the lanes' rays at random).
+        let (dir, p) = loop {
+            let dir =
+                Vec3::new(g.range(-1.0, 1.0), g.range(-1.0, 1.0), g.range(-1.0, 1.0)).normalized();
+            let far = (g.range(100f64.ln(), 16000f64.ln())).exp();
+            let p = lq - dir * far;
+            if p.to_array().iter().all(|x| x.abs() < 32000.0) {
+                break (dir, p);
+            }
+        };
+        let (ph, pl) = (
+            Vec3::new(p.x.round(), p.y.round(), p.z.round()),
+            Vec3::new(g.range(-0.5, 0.5), g.range(-0.5, 0.5), g.range(-0.5, 0.5)),
+        );
+        let ram_ = &mut sim.top.array.rc.ram;
+        for i in 0..3 {
+            ram_.write(lane, ram::SH_P.at() + i, ph.axis(i) as i16);
+            ram_.write(
+                lane,
+                ram::SH_PL.at() + i,
+                (pl.axis(i) * 16384.0).round() as i16,
+            );
+            ram_.write(
+                lane,
+                ram::SH_N.at() + i,
+                (dir.axis(i) * 16384.0).round() as i16,
+            );
+            ram_.write(
+                lane,
+                ram::SH_D.at() + i,
+                (-dir.axis(i) * 16384.0).round() as i16,
+            );
+        }
+        ram_.write(lane, ram::ACT.at(), 1);
+        points.push(
+            ph + Vec3::new(
+                (pl.x * 16384.0).round() / 16384.0,
+                (pl.y * 16384.0).round() / 16384.0,
+                (pl.z * 16384.0).round() / 16384.0,
+            ),
+        );
+    }
+    let go = img.symbol("GO").unwrap() as u32;
+    sim.top.mem.write(go, 4, 1);
+    rtl::chip::run_to_halt(&mut sim, 1_000_000).unwrap();
+    let rc = &sim.top.array.rc;
+    let (mut worst, mut worst_h) = (0.0f64, 0.0f64);
+    for (lane, p) in points.into_iter().enumerate() {
+        let want = (lq - p).normalized();
+        let dh = Vec3::new(
+            rc.regs.read(4)[lane] as f64,
+            rc.regs.read(5)[lane] as f64,
+            rc.regs.read(6)[lane] as f64,
+        ) * (1.0 / 16384.0);
+        let dl = Vec3::new(
+            rc.ram.read(lane, ram::RAY_DL.at()) as f64,
+            rc.ram.read(lane, ram::RAY_DL.at() + 1) as f64,
+            rc.ram.read(lane, ram::RAY_DL.at() + 2) as f64,
+        ) * (-27f64).exp2();
+        let d = dh + dl;
+        // The direction's error across it (its length is the Q1.14
+        // direction's, within a few 2^-14 of one).
+        let across = |d: Vec3| (d.normalized() - want).length();
+        worst = worst.max(across(d));
+        worst_h = worst_h.max(across(dh));
+    }
+    eprintln!(
+        "shadow directions: within {:.2e} (2^{:.1}) of the f64 direction; D_H alone {:.2e}",
+        worst,
+        worst.log2(),
+        worst_h
+    );
+    assert!(worst < (-26f64).exp2(), "direction off by {worst}");
 }

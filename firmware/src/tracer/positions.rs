@@ -10,7 +10,7 @@
 //! for the hit being shaded instead of `o + t d`, which the scene's format
 //! rounds to an LSB.
 
-use super::emit::K;
+use super::emit::{Name, K};
 use super::math::{remainder, Approx};
 use super::memory_map::ram;
 
@@ -69,37 +69,7 @@ pub fn eye(nr: Approx, refract: bool, local: bool) -> K {
             .c(format!("st r13, [#{}]", ram::TMP0 + a))
             .note("v_R, 2^-28");
     }
-    k.comment("Y = 1/|v_H| (Q1.14)");
-    k.c("mul out, r10, r10")
-        .c("mac out, r11, r11")
-        .c("mac r13, r12, r12, >>Q15")
-        .note("X = |v_H|^2, Q.11")
-        .c("srl r14, r13, #RSQ_SHIFT")
-        .c(format!("ld r14, [r14 + #{}]", ram::RSQ))
-        .c(format!("ld r4, [r0 + #{}]", ram::C_ONE));
-    // Three steps whatever the table: the direction's length is within a
-    // few 2^-14 of one from the smallest table on (the direction is `v`'s
-    // whatever `Y`).
-    for _ in 0..nr.newton_steps.max(3) {
-        k.c("mul r15, r14, r14, >>Q14")
-            .c("mul r15, r15, r13, >>Q11")
-            .c("sub r15, r15, r4")
-            .c("ldacc r14, <<Q15")
-            .c("msu r14, r14, r15, >>Q15");
-    }
-    k.comment("D = v Y: D_H (Q1.14) and D_L (2^-27)");
-    k.c("movb r7, #1");
-    for (a, (v, d)) in [(10, 4), (11, 5), (12, 6)].into_iter().enumerate() {
-        let a = a as u32;
-        k.c(format!("ld r15, [r0 + #{}]", ram::TMP0 + a))
-            .c("mul r15, r15, r14, >>Q15")
-            .c(format!("mul out, r{v}, r14"))
-            .c(format!("mac r{d}, r15, r7, >>Q13"));
-        remainder(&mut k, 15, d, 13, "Q13");
-        if local {
-            k.c(format!("st r15, [#{}]", ram::RAY_DL + a));
-        }
-    }
+    unit_with_remainder(&mut k, nr, [10, 11, 12], ram::TMP0, [7, 13], local);
     super::shading::new_level_common(&mut k);
     k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::OUT_OBJ));
     if local {
@@ -118,7 +88,7 @@ pub fn eye(nr: Approx, refract: bool, local: bool) -> K {
 /// (none: Q1.14) and no local hit yet (`HIT_TL = -1`). Clobbers r8.
 pub fn origins(k: &mut K) {
     k.comment("local positions: the origins' remainders, no local hit yet");
-    shadow_origins(k);
+    shadow_origins(k, true);
     k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::HIT_TL));
 }
 
@@ -136,16 +106,114 @@ pub fn refracted_origins(k: &mut K) {
     k.c("movb r8, #-1").c(format!("st r8, [#{}]", ram::HIT_TL));
 }
 
-/// The origins' and directions' remainders alone (shadow rays: their
-/// pass's hits are not shaded). Clobbers r8.
-pub fn shadow_origins(k: &mut K) {
+/// The origins' remainders (the shaded hit point's), and with `dl` the
+/// directions' (none: Q1.14; shadow rays towards a light not shifted
+/// have theirs from [`shadow_direction`]). Shadow rays need no more:
+/// their pass's hits are not shaded. Clobbers r8.
+pub fn shadow_origins(k: &mut K, dl: bool) {
     for i in 0..3 {
         k.c(format!("ld r8, [r0 + #{}]", ram::SH_PL + i))
             .c(format!("st r8, [#{}]", ram::RAY_OL + i));
     }
-    k.c("movb r8, #0");
-    for i in 0..3 {
-        k.c(format!("st r8, [#{}]", ram::RAY_DL + i));
+    if dl {
+        k.c("movb r8, #0");
+        for i in 0..3 {
+            k.c(format!("st r8, [#{}]", ram::RAY_DL + i));
+        }
+    }
+}
+
+/// In `k_shadow_rays` (local positions, a light not shifted), after
+/// `tbest` (r7): the direction from the hit point with its remainder
+/// (`SH_P` + `SH_PL` 2^-14) to the light, to 2^-27, as the eye rays'
+/// ([`eye`]): `A = (L - P) 2^14 - PL` exact in the accumulator (`L - P`
+/// in `TMP0..2`), taken `2^e` times finer (`e = clz(max |L - P|) - 2`,
+/// -1..=13, its largest component in [2^13, 2^14): Q2.13) as `v_H` and
+/// the bits below (`v_R`, 2^-15 of its LSB, as the eye's 2^-28), `Y =
+/// 1/|v_H|` from the RSQ table and three Newton steps, and `D = v Y`:
+/// `D_H` in r4..r6 (Q1.14), `D_L` in `RAY_DL` (2^-27). Clobbers r8..r15,
+/// `TMP3..5`.
+pub fn shadow_direction(k: &mut K, nr: Approx) {
+    k.comment("local positions: D = (L - P - PL) / |.| to 2^-27 (P with its remainder)");
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP0 + i as u32));
+    }
+    k.c("abs r12, r8")
+        .c("abs r13, r9")
+        .c("max r12, r12, r13")
+        .c("abs r13, r10")
+        .c("max r12, r12, r13")
+        .c("clz r12, r12")
+        .c("sub r12, r12, #2")
+        .c("min r12, r12, #13")
+        .note("e")
+        .c("add r13, r12, #2")
+        .note("e + 2")
+        .c("movb r14, #14")
+        .c("sub r14, r14, r12")
+        .note("14 - e");
+    for (i, x) in [8, 9, 10].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("ld r15, [r0 + #{}]", ram::SH_PL + i))
+            .c(format!("ldacc r{x}, <<Q14"))
+            .c("msu out, r15, #1")
+            .note("A = (L - P) 2^14 - PL")
+            .c("acch r11")
+            .c("accl r12")
+            .c("asl r11, r11, r13")
+            .c("srl r15, r12, r14")
+            .c(format!("or r{x}, r11, r15"))
+            .note("v_H = A 2^e >> 14, floored")
+            .c("sll r12, r12, r13")
+            .c("srl r12, r12, #1")
+            .c(format!("st r12, [#{}]", ram::TMP3 + i))
+            .note("v_R, the bits below, 2^-15 of v_H's LSB");
+    }
+    unit_with_remainder(k, nr, [8, 9, 10], ram::TMP3, [13, 11], true);
+}
+
+/// The unit direction of `v = v_H + v_R 2^-15` (`v_H` in registers `v`,
+/// Q2.13 with its largest component in [2^13, 2^14); `v_R` in RAM from
+/// `v_r`, 2^-28): `Y = 1/|v_H|` (r14, Q1.14) from the RSQ table and at
+/// least three Newton steps (the direction's length within a few 2^-14
+/// of one from the smallest table on; its direction is `v`'s whatever
+/// `Y`), then `D = v Y` as `D_H` in r4..r6 (Q1.14) and, with `dl`, its
+/// remainder in `RAY_DL` (2^-27). `one` is set to 1, `tmp` clobbered, as
+/// are r13..r15.
+fn unit_with_remainder(
+    k: &mut K,
+    nr: Approx,
+    v: [u8; 3],
+    v_r: Name,
+    [one, tmp]: [u8; 2],
+    dl: bool,
+) {
+    k.comment("Y = 1/|v_H| (Q1.14)");
+    k.c(format!("mul out, r{}, r{}", v[0], v[0]))
+        .c(format!("mac out, r{}, r{}", v[1], v[1]))
+        .c(format!("mac r13, r{}, r{}, >>Q15", v[2], v[2]))
+        .note("X = |v_H|^2, Q.11")
+        .c("srl r14, r13, #RSQ_SHIFT")
+        .c(format!("ld r14, [r14 + #{}]", ram::RSQ))
+        .c(format!("ld r4, [r0 + #{}]", ram::C_ONE));
+    for _ in 0..nr.newton_steps.max(3) {
+        k.c("mul r15, r14, r14, >>Q14")
+            .c("mul r15, r15, r13, >>Q11")
+            .c("sub r15, r15, r4")
+            .c("ldacc r14, <<Q15")
+            .c("msu r14, r14, r15, >>Q15");
+    }
+    k.comment("D = v Y: D_H (Q1.14) and D_L (2^-27)");
+    k.c(format!("movb r{one}, #1"));
+    for (a, (x, d)) in v.into_iter().zip([4u8, 5, 6]).enumerate() {
+        k.c(format!("ld r15, [r0 + #{}]", v_r + a as u32))
+            .c("mul r15, r15, r14, >>Q15")
+            .c(format!("mul out, r{x}, r14"))
+            .c(format!("mac r{d}, r15, r{one}, >>Q13"));
+        remainder(k, 15, d, tmp, "Q13");
+        if dl {
+            k.c(format!("st r15, [#{}]", ram::RAY_DL + a as u32));
+        }
     }
 }
 
@@ -169,6 +237,46 @@ pub fn post(k: &mut K, hit: u8) {
             .c(format!("ld r11, [r0 + #{}]", ram::HIT_PL + i))
             .c(format!("(f) st r11, [#{}]", ram::SH_PL + i));
     }
+}
+
+/// The margin of a local record's bound on the ray's line ([`near`]),
+/// LSB of the scene's format: the roundings of the centre and the origin
+/// (up to 1 LSB per axis), of `b d` and `oc - b d` (0.5 per axis), what
+/// the direction's remainder moves `b d` (up to 1 per axis), and the
+/// distance along the ray that `b`'s rounding and the Q1.14 direction's
+/// length leave in `oc - b d` (3, as [`crate::scene_image::local_exponent`]
+/// allows for).
+pub const NEAR_MARGIN: f64 = 8.0;
+
+/// The bound a local record holds for [`near`]: a shape's extent `r`
+/// (LSB) about its frame's centre and [`NEAR_MARGIN`], in whole LSB.
+pub fn near_bound(r: f64) -> f64 {
+    (r + NEAR_MARGIN).ceil()
+}
+
+/// In a local kernel, after `oc = c - o` (r8..r10) and `b = round(oc.d)`
+/// (r11), before the frame: F where the ray's line passes within the
+/// stream's bound `R` ([`near_bound`]) of the frame's centre, by `oc - b
+/// d` in the scene's LSB (`|oc - b d|^2 <= R^2`, exact in the
+/// accumulator; saturated far from the centre): a test of a few
+/// contexts that rejects rays the frame's test would (the kernels' first
+/// cut). Clobbers r12..r15.
+pub fn near(k: &mut K) {
+    k.comment("near: the line within R of the centre, in the scene's LSB");
+    for (x, d, y) in [(8, 4, 12), (9, 5, 13), (10, 6, 14)] {
+        k.c(format!("ldacc r{x}, <<Q14"))
+            .c(format!("msu r{y}, r11, r{d}, >>Q14"));
+    }
+    k.note("oc - b d")
+        .c("mov r15, fb0")
+        .note("R")
+        .c("mul out, r15, r15")
+        .c("msu out, r12, r12")
+        .c("msu out, r13, r13")
+        .c("msu out, r14, r14")
+        .c("acch r15")
+        .c("cmp.ge r15, #0")
+        .note("F: |oc - b d| <= R");
 }
 
 /// In a local kernel, after `oc = c - o` (r8..r10, the rounded centre

@@ -126,9 +126,9 @@ fn kernels(lay: &FbImage, opt: &Options, nm: &Numerics, g: &Gen, merged: bool) -
         }
         v.push((name.into(), post));
     }
-    let mut shadow = shading::light_setup(nm.approx(), lay.light_shifted);
+    let mut shadow = shading::light_setup(nm.approx(), lay.light_shifted, local);
     if local {
-        super::positions::shadow_origins(&mut shadow);
+        super::positions::shadow_origins(&mut shadow, lay.light_shifted);
     }
     v.push((names::SHADOW.into(), shadow));
     v.push((

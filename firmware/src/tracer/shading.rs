@@ -292,7 +292,11 @@ pub fn flag_hit(k: &mut K) {
 /// light divided by `2^k` ([`super::layout::light_shift`]); the direction
 /// is that of `light / 2^k - P / 2^k`, and where `k > 0` (a light outside
 /// every object's reach) the segment is not cut at the light.
-pub fn light_setup(nr: Approx, shifted: bool) -> K {
+/// `local` (local positions, lights not shifted): the direction to
+/// 2^-27 from the hit point with its remainder
+/// ([`super::positions::shadow_direction`]).
+pub fn light_setup(nr: Approx, shifted: bool, local: bool) -> K {
+    let precise = local && !shifted;
     let mut k = K::new();
     k.doc(&format!(
         "k_shadow_rays: the shadow rays towards one light (stream: {}the light's position).\n\
@@ -316,6 +320,11 @@ pub fn light_setup(nr: Approx, shifted: bool) -> K {
             .c("sub r9, fb0, r2")
             .c("sub r10, fb0, r3")
             .note("L - P");
+        if precise {
+            for (i, x) in [8, 9, 10].into_iter().enumerate() {
+                k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
+            }
+        }
     }
     normalize(&mut k, &[8, 9, 10], [11, 12, 13, 14, 15], true, nr);
     k.c("mov r4, r8").c("mov r5, r9").c("mov r6, r10");
@@ -328,6 +337,9 @@ pub fn light_setup(nr: Approx, shifted: bool) -> K {
     k.c("sub r7, r11, #2")
         .note("tbest = |L - P| - 2")
         .c(format!("st r7, [#{}]", ram::PASS_T0));
+    if precise {
+        super::positions::shadow_direction(&mut k, nr);
+    }
     k.comment("nl = N.L");
     k.c(format!("ld r12, [r0 + #{}]", ram::SH_N))
         .c("mul out, r12, r4")
@@ -741,8 +753,10 @@ mod tests {
         let nr = Approx::default();
         assert_eq!(init().fb_reads, 258);
         assert_eq!(eye(nr, false).fb_reads, 14);
-        assert_eq!(light_setup(nr, false).fb_reads, 3);
-        assert_eq!(light_setup(nr, true).fb_reads, 4);
+        for local in [false, true] {
+            assert_eq!(light_setup(nr, false, local).fb_reads, 3);
+            assert_eq!(light_setup(nr, true, local).fb_reads, 4);
+        }
         assert_eq!(post(true, 5, false, false, false).fb_reads, 3 + 2 * 5);
         assert_eq!(post(false, 5, true, true, true).fb_reads, 3 + 2 * 5);
         // Per material: the id, then per channel two words; a fractional

@@ -631,7 +631,7 @@ impl super::ChipPrimitive for Cone {
         broadcast(t, at, sides, caps)
     }
 
-    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, sides: Sides, _fit: &Fit) -> Option<CutTest> {
         (sides == Sides::Front).then(|| CutTest {
             kernel: body_name(Body::Opaque),
             field: CONE_BODY.name,

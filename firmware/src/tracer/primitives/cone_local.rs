@@ -2,7 +2,7 @@
 //! [`super::Fit::cone_local`]: seen from one side, records without caps;
 //! the scene format's kernel, [`super::cone`], in the frame).
 //!
-//! **Record** (46 words): `M.xyz, sh, ml.xyz, invS, (ce1, ce2, a) twice,
+//! **Record** (47 words): `M.xyz, Rn, sh, ml.xyz, invS, (ce1, ce2, a) twice,
 //! s, g, sg, R, nsc, hh, -sg c, -sg s, (e1, e2, a) x, (e1, e2, a) y,
 //! (e1, e2, a) z, obj, mat`. `M` is the axis'
 //! midpoint rounded to the scene's LSB and `ml` its remainder (2^-14
@@ -14,10 +14,12 @@
 //! `S = 2 R`, `invS = 2^(14+KS_CONEL) / S`; the rest the scene format's
 //! record ([`super::cone::ConeFit`]) in the frame.
 //!
-//! **Method**: `b = round((M - o).d)` in the scene's LSB and `p = (M - o) -
-//! b d` in the frame, exactly ([`positions::offset_in_frame`]); `w = p
-//! / S` and the scene format's kernel from there (the bounding sphere's
-//! cut `sphere`, the quadratic, its root `tau`, the height, the normal);
+//! **Method**: `b = round((M - o).d)` in the scene's LSB, the cut
+//! `sphere` where the line passes outside `Rn` ([`positions::near`]),
+//! `p = (M - o) - b d` in the frame, exactly
+//! ([`positions::offset_in_frame`]); `w = p / S` and the scene format's
+//! kernel from there (the bounding sphere, the quadratic, its root `tau`,
+//! the height, the normal);
 //! `s = S tau` in the frame, `t = b + s 2^-e` with its remainder,
 //! compared as the local sphere's ([`positions::nearer`]); the hit point
 //! `o + t d` to 2^-14 LSB (the origin, the direction and `t` with their
@@ -61,6 +63,7 @@ pub fn layout() -> Layout {
     Layout::new([
         (cone::CONE_BODY, 0),
         (MID, 3),
+        (sphere::NEAR, 1),
         (SHIFTS, 2),
         (MID_REM, 3),
         (INV_S, 1),
@@ -129,7 +132,8 @@ pub(crate) fn write(
     }
     let one = w.one();
     let sg = if inside { -1.0 } else { 1.0 };
-    sphere::write_frame(w, [MID, SHIFTS, MID_REM], m, e);
+    let ext = extent(base, rb, apex, ra) * w.s;
+    sphere::write_frame(w, [MID, SHIFTS, MID_REM], (m, ext), e);
     w.field(INV_S);
     w.push(inv_s);
     w.field(FRAME);
@@ -178,6 +182,8 @@ pub fn kernel(g: &Gen) -> K {
     );
     k.comment("oc = M - o (the rounded midpoint and origin)");
     sphere::oc_and_b(&mut k, "b = round(oc.d)");
+    positions::near(&mut k);
+    k.cut(CUTS[0].0);
     k.c("mov r14, fb0")
         .note("e + 2")
         .c("mov r15, fb0")
@@ -185,7 +191,6 @@ pub fn kernel(g: &Gen) -> K {
     k.comment("p = oc + ml - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
     positions::offset_in_frame(&mut k);
     cone::meets_bound(&mut k, "KS_CONEL");
-    k.cut(CUTS[0].0);
     k.c(format!("st r11, [#{}]", ram::TMP0)).note("b");
     cone::frame(&mut k);
     cone::quadratic(&mut k, nr, Some(CUTS[1].0));

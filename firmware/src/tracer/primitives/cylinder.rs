@@ -570,7 +570,7 @@ impl super::ChipPrimitive for Cylinder {
         broadcast(t, at, fit, sides, caps)
     }
 
-    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, sides: Sides, _fit: &Fit) -> Option<CutTest> {
         (sides == Sides::Front).then(|| CutTest {
             kernel: body_name(Body::Opaque),
             field: CYL_BODY.name,

@@ -2,21 +2,21 @@
 //! [`super::Fit::cyl_local`]: seen from one side, records without caps;
 //! `scene/shape/cone.rs` with equal radii).
 //!
-//! **Record** (43 words): `M.xyz, sh, ml.xyz, rb, e1.xyz, e2.xyz, invr, r,
+//! **Record** (43 words): `M.xyz, Rn, sh, ml.xyz, e1.xyz, e2.xyz, invr, r,
 //! sg, nsc, a.xyz, hh, sg, (e1, e2) x, (e1, e2) y, (e1, e2) z, obj, mat,
 //! sg r, e, (-a, M, ml) per axis`. `M` is the axis' midpoint rounded to the scene's
 //! LSB and `ml` its remainder (2^-14 LSB); the frame's LSB is `2^-e` of
 //! the scene's, `e` fitted to the cylinder's extent `R = sqrt((H/2)^2 +
 //! r^2)` about `M` ([`crate::scene_image::local_exponent`]); `sh` is `e +
-//! 2, 14 - e`, `nsc` is `2^(14-e)`; `rb` bounds `|p|^2 / 2^16` where the
-//! ray may hit; `e1, e2, a` an orthonormal frame, `a` along the axis;
+//! 2, 14 - e`, `nsc` is `2^(14-e)`; `Rn` the bound of the first cut
+//! ([`positions::near`]); `e1, e2, a` an orthonormal frame, `a` along the axis;
 //! `r` the radius and `invr = 2^(14+KS_CYLL) / r` in the frame; `hh` half
 //! the height in the frame, plus 2.
 //!
-//! **Method**: `b = round((M - o).d)` in the scene's LSB and `p = (M - o) -
-//! b d` in the frame, exactly ([`positions::offset_in_frame`]); the
-//! cut `near` where `|p|` exceeds `R` (the line passes outside the
-//! cylinder's bounding sphere). Across the axis the method of the scene
+//! **Method**: `b = round((M - o).d)` in the scene's LSB, the cut `near`
+//! where the line passes outside `Rn` ([`positions::near`]), and `p =
+//! (M - o) - b d` in the frame, exactly ([`positions::offset_in_frame`]).
+//! Across the axis the method of the scene
 //! format's kernel: `d2 = (d.e1, d.e2)` normalised (`|d2|` kept), `p2 =
 //! (p.e1, p.e2)`, `b2 = p2.d2n`, `q2 = p2 - b2 d2n` made perpendicular to
 //! `d2n`, `s2 = 1 - |q2 / r|^2`, `tau = b2 - sg r sqrt(s2)` and `s = tau /
@@ -44,10 +44,6 @@ use crate::scene::Vec3;
 pub const MID: Field = Field::part("M.xyz", "the axis' midpoint, rounded");
 pub const SHIFTS: Field = Field::part("sh", "e + 2 and 14 - e, the frame's shifts");
 pub const MID_REM: Field = Field::part("ml.xyz", "the midpoint's remainder, 2^-14 LSB");
-pub const BOUND: Field = Field::part(
-    "rb",
-    "((R + 2) 2^e)^2 / 2^16, rounded up: |p|^2 where the ray may hit",
-);
 pub const ACROSS: Field = Field::part("e1.xyz, e2.xyz", "the unit vectors across the axis");
 pub const INV_R: Field = Field::part("invr", "2^(14+KS_CYLL) / r, r in the frame");
 pub const RADIUS: Field = Field::part("r", "the radius in the frame");
@@ -72,9 +68,9 @@ pub fn layout() -> Layout {
     Layout::new([
         (super::cylinder::CYL_BODY, 0),
         (MID, 3),
+        (sphere::NEAR, 1),
         (SHIFTS, 2),
         (MID_REM, 3),
-        (BOUND, 1),
         (ACROSS, 6),
         (INV_R, 1),
         (RADIUS, 1),
@@ -132,9 +128,7 @@ pub(crate) fn write(
     let e2 = a.cross(e1);
     let ext = ((axis.length() * 0.5).powi(2) + radius * radius).sqrt() * w.s;
     let sg = if inside { -w.one() } else { w.one() };
-    let parts = sphere::write_frame(w, [MID, SHIFTS, MID_REM], m, e);
-    w.field(BOUND);
-    w.raw((((ext + 2.0) * (e as f64).exp2()).powi(2) / 65536.0).ceil() as i64 + 1);
+    let parts = sphere::write_frame(w, [MID, SHIFTS, MID_REM], (m, ext), e);
     w.field(ACROSS);
     w.unit(e1);
     w.unit(e2);
@@ -187,19 +181,14 @@ pub fn kernel(g: &super::Gen) -> K {
     );
     k.comment("oc = M - o (the rounded midpoint and origin)");
     sphere::oc_and_b(&mut k, "b = round(oc.d)");
+    positions::near(&mut k);
+    k.cut(CUTS[0].0);
     k.c("mov r14, fb0")
         .note("e + 2")
         .c("mov r15, fb0")
         .note("14 - e");
     k.comment("p = oc + ml - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
     positions::offset_in_frame(&mut k);
-    k.c("mul out, r8, r8")
-        .c("mac out, r9, r9")
-        .c("mac out, r10, r10")
-        .c("acch r12")
-        .c("cmp.ge fb0, r12")
-        .note("F: |p| within the bounding sphere");
-    k.cut(CUTS[0].0);
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
         k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
     }

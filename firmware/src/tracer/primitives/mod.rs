@@ -82,7 +82,7 @@ pub trait ChipPrimitive: Sync {
 
     /// The test the packet traversal runs in parts, where it has one: its
     /// first kernel's cuts ([`K::cut`]).
-    fn cut_test(&self, _sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, _sides: Sides, _fit: &Fit) -> Option<CutTest> {
         None
     }
 

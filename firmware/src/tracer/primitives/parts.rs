@@ -26,8 +26,8 @@ pub struct CutTest {
 impl ChipType {
     /// The test that runs in parts, for the types that have one
     /// ([`super::ChipPrimitive::cut_test`]).
-    pub fn cut_test(self) -> Option<CutTest> {
-        self.primitive().cut_test(self.sides())
+    pub fn cut_test(self, fit: &Fit) -> Option<CutTest> {
+        self.primitive().cut_test(self.sides(), fit)
     }
 
     /// What a cut test's object runs after its first kernel whatever F,

@@ -421,11 +421,15 @@ impl super::ChipPrimitive for PlanarPrimitive {
         super::one(t, self.label(sides));
     }
 
-    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, sides: Sides, fit: &Fit) -> Option<CutTest> {
         Some(CutTest {
             kernel: self.label(sides),
             field: "0",
-            cuts: &CUTS,
+            cuts: if self.local(sides, fit) {
+                &super::triangle_local::CUTS
+            } else {
+                &CUTS
+            },
             then: None,
         })
     }

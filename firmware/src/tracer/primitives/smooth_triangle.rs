@@ -223,7 +223,7 @@ impl super::ChipPrimitive for SmoothTriangle {
         super::one(t, kernel_name(sides));
     }
 
-    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, sides: Sides, _fit: &Fit) -> Option<CutTest> {
         Some(CutTest {
             kernel: kernel_name(sides),
             field: "0",

@@ -55,6 +55,12 @@ pub const MAT: Field = Field::part("mat", "its material");
 /// Local positions ([`crate::tracer::Positions::Local`]): the record's
 /// frame, its LSB `2^-e` of the scene's ([`local_exponent`]).
 pub const SHIFTS: Field = Field::part("sh", "local: e + 2 and 14 - e, the frame's shifts");
+/// A local record's bound on the ray's line about its centre
+/// ([`positions::near`]).
+pub const NEAR: Field = Field::part(
+    "R",
+    "local: the shape's extent about the centre plus the roundings, LSB",
+);
 pub const SCALE: Field = Field::part("n", "local: 2^(14-e), a local length in 2^-14 LSB");
 pub const RADIUS_SG: Field = Field::part("rs", "local: sg r");
 pub const CENTRE_AGAIN: Field = Field::part(
@@ -79,6 +85,7 @@ pub fn layout(fit: &Fit, sides: Sides) -> Layout {
     if fit.local {
         return Layout::new([
             (CENTRE, 3),
+            (NEAR, 1),
             (SHIFTS, 2),
             (CENTRE_REM, 3),
             (INV_R, 1),
@@ -130,6 +137,16 @@ pub const CUTS: [(&str, &str); 1] = [(
     "line",
     "the ray's line meets the sphere and, where none is seen from inside, its centre lies ahead",
 )];
+
+/// The local kernel's cuts: [`positions::near`], then [`CUTS`].
+pub const LOCAL_CUTS: [(&str, &str); 2] = [NEAR_CUT, CUTS[0]];
+
+/// The first cut of the local kernels ([`positions::near`]) and what F
+/// holds there.
+pub const NEAR_CUT: (&str, &str) = (
+    "near",
+    "the ray's line passes within the shape's extent (and the roundings) of its frame's centre",
+);
 
 pub fn kernel_name(s: Sides) -> &'static str {
     match s {
@@ -219,7 +236,7 @@ fn write_local(
     let rl = r * (e as f64).exp2();
     let sg = if inside { -1.0 } else { 1.0 };
     let one = w.one();
-    let parts = write_frame(w, [CENTRE, SHIFTS, CENTRE_REM], center, e);
+    let parts = write_frame(w, [CENTRE, SHIFTS, CENTRE_REM], (center, r), e);
     w.field(INV_R);
     w.push(((14 + w.x + fit.ks_sphere) as f64).exp2() / rl);
     w.field(RADIUS);
@@ -238,13 +255,21 @@ fn write_local(
 }
 
 /// The head of a local record: the frame's centre `c` rounded to the
-/// scene's LSB, the frame's shifts `e + 2` and `14 - e`, the centre's
-/// remainders (2^-14 LSB), as the fields `[centre, shifts, remainder]`;
-/// the centre's parts, for [`write_centre_again`].
-pub(super) fn write_frame(w: &mut W, fields: [Field; 3], c: Vec3, e: u32) -> [(f64, f64); 3] {
+/// scene's LSB, the bound of [`positions::near`] for a shape of extent
+/// `r` LSB about it ([`NEAR`]), the frame's shifts `e + 2` and `14 - e`,
+/// the centre's remainders (2^-14 LSB), as the fields `[centre, shifts,
+/// remainder]`; the centre's parts, for [`write_centre_again`].
+pub(super) fn write_frame(
+    w: &mut W,
+    fields: [Field; 3],
+    (c, r): (Vec3, f64),
+    e: u32,
+) -> [(f64, f64); 3] {
     let parts = split(w, c);
     w.field(fields[0]);
     w.point(c);
+    w.field(NEAR);
+    w.push(positions::near_bound(r));
     w.field(fields[1]);
     w.raw(e as i64 + 2);
     w.raw(14 - e as i64);
@@ -383,6 +408,8 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
     ));
     k.comment("oc = c - o (the rounded centre and origin)");
     oc_and_b(&mut k, "b = round(oc.d)");
+    positions::near(&mut k);
+    k.cut(NEAR_CUT.0);
     k.c("mov r14, fb0")
         .note("e + 2")
         .c("mov r15, fb0")
@@ -396,7 +423,7 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
     if g.test_cuts && !fit.sphere_inside {
         k.c("(f) cmp.gt r11, #0").note("and its centre lies ahead");
     }
-    k.cut(CUTS[0].0);
+    k.cut(LOCAL_CUTS[1].0);
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
         k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
     }
@@ -549,11 +576,11 @@ impl super::ChipPrimitive for Sphere {
         super::one(t, kernel_name(sides));
     }
 
-    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, sides: Sides, fit: &Fit) -> Option<CutTest> {
         (sides == Sides::Front).then(|| CutTest {
             kernel: kernel_name(sides),
             field: "0",
-            cuts: &CUTS,
+            cuts: if fit.local { &LOCAL_CUTS } else { &CUTS },
             then: None,
         })
     }

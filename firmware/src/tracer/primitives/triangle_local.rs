@@ -1,7 +1,7 @@
 //! The flat triangle in a frame of its own (local positions,
 //! [`super::Fit::local`]; `scene/shape/triangle.rs`).
 //!
-//! **Record** (33 words): `c.xyz, sh, cl.xyz, n.xyz, nsc, uc, au.xyz,
+//! **Record** (34 words): `c.xyz, Rn, sh, cl.xyz, n.xyz, nsc, uc, au.xyz,
 //! wc, aw.xyz, n.xyz, obj, mat, (c, cl) per axis`. `c` is the centroid
 //! rounded to the scene's LSB and `cl` its remainder (2^-14 LSB); the
 //! frame's LSB is `2^-e` of the scene's, `e` fitted to the triangle's
@@ -10,8 +10,9 @@
 //! per LSB of the frame, negated, scaled by `2^(14+KT_LOCAL)`; `uc`, `wc`
 //! the centroid's barycentric coordinates (Q1.14).
 //!
-//! **Method**: `b = round((c - o).d)` in the scene's LSB and `p = (c - o) -
-//! b d` in the frame, exactly as the local sphere forms it
+//! **Method**: `b = round((c - o).d)` in the scene's LSB, the cut `near`
+//! where the line passes outside `Rn` ([`positions::near`]), and `p =
+//! (c - o) - b d` in the frame, exactly as the local sphere forms it
 //! ([`positions::offset_in_frame`]): `|p| <= R` where the ray can hit.
 //! Then the plane through `c`: `den = -n.d > 0` (the front face), `num =
 //! -n.p`, `s = num / den` (F only where `|s| < 2^15`: a hit lies within
@@ -61,6 +62,7 @@ pub const CENTRE_AGAIN: Field = Field::part(
 pub fn layout() -> Layout {
     Layout::new([
         (CENTRE, 3),
+        (sphere::NEAR, 1),
         (SHIFTS, 2),
         (CENTRE_REM, 3),
         (NORMAL, 3),
@@ -76,10 +78,10 @@ pub fn layout() -> Layout {
     ])
 }
 
-/// A triangle's frame: its centroid, its exponent `e` and its edge duals'
-/// largest component per LSB of the frame (for `KT_LOCAL`), `s` LSB per
-/// scene unit.
-fn frame(v: &[Vec3; 3], p: &Planar, s: f64) -> (Vec3, u32, f64) {
+/// A triangle's frame: its centroid and extent about it (LSB), its
+/// exponent `e` and its edge duals' largest component per LSB of the
+/// frame (for `KT_LOCAL`), `s` LSB per scene unit.
+fn frame(v: &[Vec3; 3], p: &Planar, s: f64) -> ((Vec3, f64), u32, f64) {
     let c = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
     let r = v.iter().map(|x| (*x - c).length()).fold(0.0, f64::max) * s;
     let e = crate::scene_image::local_exponent(r).unwrap_or(0);
@@ -90,7 +92,7 @@ fn frame(v: &[Vec3; 3], p: &Planar, s: f64) -> (Vec3, u32, f64) {
             .chain(p.ew.to_array())
             .map(|x| x.abs() / per)
             .fold(0.0, f64::max);
-    (c, e, dual)
+    ((c, r), e, dual)
 }
 
 /// `KT_LOCAL` for the scene's flat triangles `tris` (vertices, record
@@ -105,11 +107,11 @@ pub fn fit_kt(tris: impl Iterator<Item = ([Vec3; 3], Planar)>, s: f64, f: &Fitte
 
 /// Write the local record of the flat triangle `v` (record geometry `p`).
 pub(crate) fn write(w: &mut W, kt: u32, v: &[Vec3; 3], p: &Planar, id: usize, mat: usize) {
-    let (c, e, _) = frame(v, p, w.s);
+    let ((c, r), e, _) = frame(v, p, w.s);
     let per = w.s * (e as f64).exp2();
     let one = w.one();
     let sc = (14.0 + kt as f64).exp2() / per;
-    let parts = sphere::write_frame(w, [CENTRE, SHIFTS, CENTRE_REM], c, e);
+    let parts = sphere::write_frame(w, [CENTRE, SHIFTS, CENTRE_REM], (c, r), e);
     w.field(NORMAL);
     w.unit(p.n);
     w.field(SCALE);
@@ -131,7 +133,10 @@ pub(crate) fn write(w: &mut W, kt: u32, v: &[Vec3; 3], p: &Planar, id: usize, ma
     sphere::write_centre_again(w, CENTRE_AGAIN, parts);
 }
 
-/// The kernel (one side; cuts [`planar::CUTS`]).
+/// The kernel's cuts: [`positions::near`], then [`planar::CUTS`].
+pub const CUTS: [(&str, &str); 3] = [sphere::NEAR_CUT, planar::CUTS[0], planar::CUTS[1]];
+
+/// The kernel (one side; cuts [`CUTS`]).
 pub fn kernel(g: &super::Gen) -> K {
     let mut k = K::new();
     k.doc(
@@ -142,6 +147,8 @@ pub fn kernel(g: &super::Gen) -> K {
     );
     k.comment("oc = c - o (the rounded centroid and origin)");
     sphere::oc_and_b(&mut k, "b = round(oc.d)");
+    positions::near(&mut k);
+    k.cut(CUTS[0].0);
     k.c("mov r14, fb0")
         .note("e + 2")
         .c("mov r15, fb0")

@@ -613,7 +613,7 @@ impl super::ChipPrimitive for Polygon {
         broadcast(t, at, sides, fit.polygon_form)
     }
 
-    fn cut_test(&self, sides: Sides) -> Option<CutTest> {
+    fn cut_test(&self, sides: Sides, _fit: &Fit) -> Option<CutTest> {
         Some(CutTest {
             kernel: head_name(sides),
             field: POLY_HEAD.name,

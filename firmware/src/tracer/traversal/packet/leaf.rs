@@ -335,7 +335,7 @@ fn type_loop(
         t.addi(R9, R9, -1).bnez(R9, format!("{n}_obj"));
         t.label(format!("{n}_end"));
     };
-    let Some(cut) = ty.cut_test().filter(|_| lay.test_cuts) else {
+    let Some(cut) = ty.cut_test(&lay.fit).filter(|_| lay.test_cuts) else {
         one_run_each(t, &|t, _| ty.broadcast(t, n, &lay.fit, caps));
         return;
     };
