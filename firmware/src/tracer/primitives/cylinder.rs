@@ -84,7 +84,9 @@ pub const GCYL_CAP1: Field = Field::named("GCYL_CAP1", "glass cylinder record: a
 /// without `caps` (records that carry none) the body alone.
 pub fn layout(fit: &Fit, s: Sides, caps: bool) -> Layout {
     if fit.cyl_local && s == Sides::Front {
-        debug_assert!(!caps, "local cylinders' records carry no caps");
+        // No caps whatever `caps` says: no cylinder of the scene has them
+        // (the paper traversal's layout, built to size a local scene's
+        // stream, asks with caps).
         return super::cylinder_local::layout();
     }
     let body = body_words(fit.fine_normals);
