@@ -90,7 +90,7 @@ pub fn extent(base: Vec3, rb: f64, apex: Vec3, ra: f64) -> f64 {
 /// A cone's frame, `s` LSB per scene unit: its midpoint, its exponent
 /// and its fit in the frame.
 fn frame(base: Vec3, rb: f64, apex: Vec3, ra: f64, s: f64) -> (Vec3, u32, ConeFit) {
-    let e = crate::scene_image::local_exponent(extent(base, rb, apex, ra) * s).unwrap_or(0);
+    let e = sphere::local_exponent(extent(base, rb, apex, ra) * s);
     // The margin: 3 LSB of the scene's format, as the frame's exponent
     // allows for (the rounding of the ray's point nearest M and of its
     // direction's length).
@@ -180,16 +180,7 @@ pub fn kernel(g: &Gen) -> K {
          w = p / S; the scene format's cone test on w: tau; s = S tau, t = b + s 2^-e,\n\
          P = o + t d (with the remainders of o, t and d)",
     );
-    k.comment("oc = M - o (the rounded midpoint and origin)");
-    sphere::oc_and_b(&mut k, "b = round(oc.d)");
-    positions::near(&mut k);
-    k.cut(CUTS[0].0);
-    k.c("mov r14, fb0")
-        .note("e + 2")
-        .c("mov r15, fb0")
-        .note("14 - e");
-    k.comment("p = oc + ml - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
-    positions::offset_in_frame(&mut k);
+    sphere::enter_frame(&mut k, ["M", "midpoint", "ml"], CUTS[0].0);
     cone::meets_bound(&mut k, "KS_CONEL");
     k.c(format!("st r11, [#{}]", ram::TMP0)).note("b");
     cone::frame(&mut k);

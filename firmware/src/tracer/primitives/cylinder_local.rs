@@ -95,7 +95,7 @@ fn frame(base: Vec3, apex: Vec3, r: f64, s: f64) -> (Vec3, u32, f64) {
     let m = (base + apex) * 0.5;
     let h2 = (apex - base).length() * 0.5;
     let ext = (h2 * h2 + r * r).sqrt() * s;
-    let e = crate::scene_image::local_exponent(ext).unwrap_or(0);
+    let e = sphere::local_exponent(ext);
     (m, e, r.abs() * s * (e as f64).exp2())
 }
 
@@ -179,16 +179,7 @@ pub fn kernel(g: &super::Gen) -> K {
          across the axis d2n = d2 / |d2|, q2 = p2 - (p2.d2n) d2n, s2 = 1 - |q2/r|^2, tau = p2.d2n - sg r sqrt(s2),\n\
          s = tau / |d2|, t = b + s 2^-e, g = p - s d, |g.a| <= hh, P = M + (-(g.a) a + sg r n) 2^-e",
     );
-    k.comment("oc = M - o (the rounded midpoint and origin)");
-    sphere::oc_and_b(&mut k, "b = round(oc.d)");
-    positions::near(&mut k);
-    k.cut(CUTS[0].0);
-    k.c("mov r14, fb0")
-        .note("e + 2")
-        .c("mov r15, fb0")
-        .note("14 - e");
-    k.comment("p = oc + ml - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
-    positions::offset_in_frame(&mut k);
+    sphere::enter_frame(&mut k, ["M", "midpoint", "ml"], CUTS[0].0);
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
         k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
     }

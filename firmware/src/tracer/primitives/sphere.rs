@@ -406,16 +406,7 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
          s = 1 - |p/r|^2, t = b + (pd - sg r sqrt(s)) 2^-e, n = -(sg p/r + sqrt(s) d), P = c + sg r n 2^-e",
         kernel_name(Sides::Front),
     ));
-    k.comment("oc = c - o (the rounded centre and origin)");
-    oc_and_b(&mut k, "b = round(oc.d)");
-    positions::near(&mut k);
-    k.cut(NEAR_CUT.0);
-    k.c("mov r14, fb0")
-        .note("e + 2")
-        .c("mov r15, fb0")
-        .note("14 - e");
-    k.comment("p = oc + cl - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
-    positions::offset_in_frame(&mut k);
+    enter_frame(&mut k, ["c", "centre", "cl"], NEAR_CUT.0);
     perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
     k.note("r12 = pd, what p had along d");
     k.c("mov r13, fb0").note("invr, in the frame");
@@ -465,6 +456,28 @@ pub(super) fn oc_and_b(k: &mut K, note: &str) {
         .c("mac out, r9, r5")
         .c("mac r11, r10, r6, >>Q14")
         .note(note);
+}
+
+/// The start of every local kernel, its record's head from
+/// [`write_frame`]: `oc` (r8..r10) and `b = round(oc.d)` (r11) from the
+/// rounded centre (`c`, the `what` in the comments) and origin, the cut
+/// `cut` where the line passes outside the record's bound
+/// ([`positions::near`]), the frame's shifts (r14 `e + 2`, r15 `14 - e`)
+/// and `p` in the frame (r8..r10, [`positions::offset_in_frame`], the
+/// centre's remainder named `rem`). Clobbers r12..r15.
+pub(super) fn enter_frame(k: &mut K, [c, what, rem]: [&str; 3], cut: &str) {
+    k.comment(&format!("oc = {c} - o (the rounded {what} and origin)"));
+    oc_and_b(k, "b = round(oc.d)");
+    positions::near(k);
+    k.cut(cut);
+    k.c("mov r14, fb0")
+        .note("e + 2")
+        .c("mov r15, fb0")
+        .note("14 - e");
+    k.comment(&format!(
+        "p = oc + {rem} - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)"
+    ));
+    positions::offset_in_frame(k);
 }
 
 /// `p/r` (r8..r10: `p` times `invr` in r13, shifted by `shift`) and

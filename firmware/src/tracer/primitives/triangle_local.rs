@@ -84,7 +84,7 @@ pub fn layout() -> Layout {
 fn frame(v: &[Vec3; 3], p: &Planar, s: f64) -> ((Vec3, f64), u32, f64) {
     let c = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
     let r = v.iter().map(|x| (*x - c).length()).fold(0.0, f64::max) * s;
-    let e = crate::scene_image::local_exponent(r).unwrap_or(0);
+    let e = sphere::local_exponent(r);
     let per = s * (e as f64).exp2();
     let dual =
         p.eu.to_array()
@@ -145,16 +145,7 @@ pub fn kernel(g: &super::Gen) -> K {
          HIT_TL = t, HIT_PH and HIT_PL the hit point. b = round((c - o).d), p = ((c - o) - b d) 2^e,\n\
          s = n.p / n.d, g = p - s d, u = uc + g.au, w = wc + g.aw, t = b + s 2^-e, P = c - g 2^-e",
     );
-    k.comment("oc = c - o (the rounded centroid and origin)");
-    sphere::oc_and_b(&mut k, "b = round(oc.d)");
-    positions::near(&mut k);
-    k.cut(CUTS[0].0);
-    k.c("mov r14, fb0")
-        .note("e + 2")
-        .c("mov r15, fb0")
-        .note("14 - e");
-    k.comment("p = oc + cl - ol - b (d + dl) in 2^-14 LSB, then in the frame: >> (14 - e)");
-    positions::offset_in_frame(&mut k);
+    sphere::enter_frame(&mut k, ["c", "centroid", "cl"], CUTS[0].0);
     k.comment("den = -n.d, num = -n.p, s = num / den");
     k.c("mov r12, fb0").c("mov r13, fb0").c("mov r14, fb0");
     k.c("mul out, r12, r4")
