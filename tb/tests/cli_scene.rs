@@ -145,9 +145,11 @@ fn compile_reports_and_bad_scenes_fail_with_file_line() {
 }
 
 /// `render --datapath auto` (the default) keeps the paper's 16-bit chip for
-/// the default scene, moves a scene the 16-bit format cannot hold
-/// (shells-1) to the 32-bit chip, says so in the JSON, and `--datapath 16`
-/// on shells-1 is refused with the scene's own error.
+/// the default scene and, with local positions, for SPD balls-2 (whose
+/// global positions fall under the bar: with them the 32-bit chip), moves
+/// a scene the 16-bit format cannot hold (shells-1) to the 32-bit chip,
+/// says so in the JSON, and `--datapath 16` on shells-1 is refused with
+/// the scene's own error.
 #[test]
 fn render_datapath_auto_picks_the_chip_and_says_why() {
     let dir = tempfile::tempdir().unwrap();
@@ -172,7 +174,8 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
         "{why}"
     );
     // SPD balls size 2 at 24x24: the 16-bit chip's probe (the middle tile)
-    // measures 28.6 dB against the reference, under the 30 dB bar.
+    // with global positions measures 28.6 dB against the reference, under
+    // the 30 dB bar; with local ones 64.9 dB.
     let (ok, _, err) = morphosys(
         dir.path(),
         &["spd", "balls", "--size", "2", "--out", "b2.nff"],
@@ -182,6 +185,28 @@ fn render_datapath_auto_picks_the_chip_and_says_why() {
         dir.path(),
         &[
             "render", "b2.nff", "--size", "24x24", "--out", "x.png", "--json", "x.json",
+        ],
+    );
+    assert!(ok, "{err}");
+    let j: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path().join("x.json")).unwrap()).unwrap();
+    let why = j["datapath_choice"].as_str().unwrap();
+    assert_eq!(j["datapath_bits"], 16, "{why}");
+    assert!(why.contains("local positions"), "{why}");
+    assert!(j["psnr_db"].as_f64().unwrap() >= 40.0, "{j}");
+    let (ok, _, err) = morphosys(
+        dir.path(),
+        &[
+            "render",
+            "b2.nff",
+            "--size",
+            "24x24",
+            "--positions",
+            "global",
+            "--out",
+            "x.png",
+            "--json",
+            "x.json",
         ],
     );
     assert!(ok, "{err}");

@@ -247,14 +247,23 @@ pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
 /// Scenes without curved objects (spheres, cylinders, cones) are not
 /// moved: a plane's normal does not turn with the ray, and the move would
 /// only round every vertex afresh (and may change the median tree's
-/// shape).
+/// shape). Nor are scenes with local positions whose curved objects are
+/// all tested in frames of their own: their eye rays start at the eye
+/// with its remainder ([`positions::eye`]), and the move would round the
+/// lights and the planes afresh.
 fn build_as(
     scene: &Scene,
     opt: &Options,
     nm: &Numerics,
     force_stream: bool,
 ) -> Result<Firmware, String> {
-    let curved = scene.objects.iter().any(|o| o.shape.surface().curved());
+    let local = opt.positions == Positions::Local;
+    let curved = scene.objects.iter().any(|o| {
+        o.shape.surface().curved()
+            && !(local
+                && scene.materials[o.material].t <= 0.0
+                && crate::scene_image::local_frame(scene, &o.shape).is_some())
+    });
     if !nm.normals.fine_on(opt.datapath) || !curved {
         return build_any_bsp(scene, opt, nm, force_stream);
     }

@@ -358,3 +358,79 @@ pub fn hit_point_axis(
         .c(format!("(f) st r{hi}, [#{}]", ram::HIT_PH + i))
         .c(format!("(f) st r{lo}, [#{}]", ram::HIT_PL + i));
 }
+
+/// After a plane's division ([`super::math::divide`]: `q = num 2^14 /
+/// den` in `q`, the normalised divisor's reciprocal `rc` and its shift
+/// `sh` left by it): the part of `t` the quotient leaves, in 2^-11 LSB
+/// (within 16 LSB of `q`), into `out`. `num` with its remainder `num_l`
+/// (2^-14 LSB) and `den` (Q1.14) with its remainder (2^-28), whose
+/// product with `q` is in `q_den_l` (`q den_l 2^-14`), are the exact
+/// numerator and denominator, which may differ from those `q` was divided
+/// from by a few LSB: the residual `num 2^14 + num_l - q den - q den_l
+/// 2^-14` is exact in the accumulator and divided by the same reciprocal,
+/// so `q` + it is `t` to a few 2^-14 LSB whatever the division's error.
+/// Clobbers `a`, `b` (`num_l` may be `b`).
+pub fn quotient_rest(
+    k: &mut K,
+    [num, num_l, den, q_den_l, q, rc, sh]: [u8; 7],
+    out: u8,
+    [a, b]: [u8; 2],
+) {
+    k.comment("t's rest below q: (num 2^14 + num_l - q den) / den, 2^-11 LSB");
+    k.c(format!("ldacc r{num}, <<Q14"))
+        .c(format!("mac out, r{num_l}, #1"))
+        .c(format!("msu out, r{q}, r{den}"))
+        .c(format!("msu out, r{q_den_l}, #1"))
+        .c(format!("acc r{a}, >>4"))
+        .note("the residual / 16")
+        .c(format!("mul out, r{a}, r{rc}"))
+        .c(format!("acch r{out}"))
+        .c(format!("accl r{b}"))
+        .c(format!("add r{a}, r{sh}, #2"))
+        .c(format!("sll r{out}, r{out}, r{a}"))
+        .c(format!("rsb r{a}, r{sh}, #Q14"))
+        .c(format!("srl r{b}, r{b}, r{a}"))
+        .c(format!("or r{out}, r{out}, r{b}"))
+        .note("(residual rc 2^sh) >> 14");
+}
+
+/// `t = q + rest 2^-11` (the LSB quotient `q`, its [`quotient_rest`]
+/// `rest`) rounded to the scene's LSB into `t` and its remainder (2^-14
+/// LSB) into `rem`. Clobbers `tmp`.
+pub fn fine_t(k: &mut K, q: u8, rest: u8, [t, rem, tmp]: [u8; 3]) {
+    k.c(format!("ldacc r{q}, <<Q14"))
+        .c(format!("mac out, r{rest}, #8"))
+        .c(format!("acc r{t}, >>Q14"))
+        .note("t");
+    remainder(k, rem, t, tmp, "Q14");
+    k.note("its remainder, 2^-14 LSB");
+}
+
+/// In a kernel that has `t` (register `t`, the scene's LSB) with its
+/// remainder (`rem`, 2^-14 LSB), after [`nearer`]: the hit point `o + t
+/// d` to 2^-14 LSB, from the origin with its remainder (`RAY_OL`) and the
+/// direction with its (`RAY_DL`): where F, `HIT_PH` and `HIT_PL`.
+/// Clobbers the four `tmp`.
+pub fn ray_point(k: &mut K, t: u8, rem: u8, [a, b, hi, lo]: [u8; 4]) {
+    k.comment("the hit point o + t d, to 2^-14 LSB");
+    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("ld r{a}, [r0 + #{}]", ram::RAY_OL + i))
+            .c(format!("ld r{b}, [r0 + #{}]", ram::RAY_DL + i))
+            .c(format!("mul r{b}, r{t}, r{b}, >>Q13"))
+            .note("t dl")
+            .c(format!("mul r{lo}, r{rem}, r{d}, >>Q14"))
+            .note("t's remainder d")
+            .c(format!("ldacc r{o}, <<Q14"))
+            .c(format!("mac out, r{a}, #1"))
+            .note("+ ol")
+            .c(format!("mac out, r{b}, #1"))
+            .c(format!("mac out, r{lo}, #1"))
+            .c(format!("mac r{hi}, r{t}, r{d}, >>Q14"))
+            .note("P");
+        remainder(k, lo, hi, a, "Q14");
+        k.note("its remainder")
+            .c(format!("(f) st r{hi}, [#{}]", ram::HIT_PH + i))
+            .c(format!("(f) st r{lo}, [#{}]", ram::HIT_PL + i));
+    }
+}

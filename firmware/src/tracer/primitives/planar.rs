@@ -22,16 +22,27 @@
 //! object (`ORIG_OBJ`) does not hit it again (a distance margin would also
 //! drop the hits of rays starting near an edge on the next face).
 //!
+//! **Local positions** (an opaque rectangle or disc; flat triangles have
+//! a frame of their own, [`super::triangle_local`]): the record
+//! [`FINE_FIELDS`] (21 words, the plane's offset below the LSB after the
+//! vertex), [`plane_hit_fine`] (the numerator exact from the origin's
+//! remainder and that offset, F before `tbest + 1`) and, past the inside
+//! cut, [`fine_commit`]: `t` and the hit point `o + t d` to 2^-14 LSB,
+//! compared and tagged as the local kernels' hits
+//! ([`crate::tracer::positions`]).
+//!
 //! **Registers**: r1..r7 the ray (r7 the new `tbest` where F); r8..r15
-//! temporaries; RAM `TMP3` (two-sided: the back flag).
+//! temporaries; RAM `TMP3` (two-sided: the back flag); local positions
+//! `TMP1`, `TMP2`, `TMP4..TMP8`.
 //!
 //! **Error** against the f64 shapes: their `error_bound` (below), which
 //! `tb/tests/kernels.rs` holds both chips to; the largest `t` errors at
 //! grazing incidence, where the rounding of the direction is amplified.
 
 use super::super::emit::{define, Code, K};
-use super::super::math::divide;
+use super::super::math::{self, divide};
 use super::super::memory_map::ram;
+use super::super::positions;
 use super::record::{total, Field, Layout, W};
 use super::{
     commit_streamed_normal, commit_streamed_normal_two, CutTest, ErrorBound, Fit, Gen, Geometry,
@@ -42,6 +53,12 @@ use crate::scene::{Shape, Vec3};
 /// The record's fields, in stream order.
 pub const NORMAL: Field = Field::part("n.xyz", "the plane's unit normal (Q1.14)");
 pub const VERTEX: Field = Field::part("v0.xyz", "a vertex, for the plane's offset");
+/// Local positions, one side ([`plane_hit_fine`]): the plane's offset
+/// below the LSB.
+pub const PLANE_REM: Field = Field::part(
+    "v0n",
+    "local: -n.(v0 - v0 rounded), the plane's offset below the LSB, 2^-14 LSB",
+);
 pub const VERTEX_AGAIN: Field =
     Field::part("v0.xyz'", "the vertex again, for the hit's coordinates");
 pub const EDGE_U: Field = Field::part("eu.xyz", "the first edge dual, scaled by 2^KT");
@@ -62,6 +79,20 @@ pub const FIELDS: [(Field, usize); 8] = [
 
 /// Record words.
 pub const WORDS: usize = total(&FIELDS);
+
+/// The record of [`plane_hit_fine`]'s kernels: [`FIELDS`] with the
+/// plane's offset below the LSB ([`PLANE_REM`]) after the vertex.
+pub const FINE_FIELDS: [(Field, usize); 9] = [
+    FIELDS[0],
+    FIELDS[1],
+    (PLANE_REM, 1),
+    FIELDS[2],
+    FIELDS[3],
+    FIELDS[4],
+    FIELDS[5],
+    FIELDS[6],
+    FIELDS[7],
+];
 
 /// Tolerance of the barycentric / rectangle / disc inside tests, Q.14.
 pub const INSIDE_TOL: i32 = 2;
@@ -186,12 +217,30 @@ impl Planar {
 /// Write the record of planar `p` (object `id`, material `mat`); `kt`:
 /// the scale shifts of [`super::Fit::kt`].
 pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize) {
+    write_as(w, kt, p, (id, mat), false)
+}
+
+/// [`write`], with `fine` the record of [`plane_hit_fine`]'s kernels
+/// ([`FINE_FIELDS`]): `-n.(v0 - v0 rounded)` with the normal as the
+/// record holds it, so that the chip's plane passes through `v0` itself.
+fn write_as(w: &mut W, kt: &[u32; 3], p: &Planar, (id, mat): (usize, usize), fine: bool) {
     let k = kt[p.kind.kt_index()];
     let sc = ((14 + w.x) as f64 - w.frac as f64 + k as f64).exp2();
     w.field(NORMAL);
     w.unit(p.n);
     w.field(VERTEX);
     w.point(p.v0);
+    if fine {
+        let one = w.one();
+        let off: f64 = (0..3)
+            .map(|i| {
+                let x = p.v0.axis(i) * w.s;
+                (p.n.axis(i) * one).round() / one * (x - w.sat(x) as f64)
+            })
+            .sum();
+        w.field(PLANE_REM);
+        w.push(-off * 16384.0);
+    }
     w.field(VERTEX_AGAIN);
     w.point(p.v0);
     w.field(EDGE_U);
@@ -225,6 +274,19 @@ pub const CUTS: [(&str, &str); 2] = [
 /// `tbest`. With `cut`, the kernel has a cut ([`K::cut`]) of that name
 /// once F is known, before the division.
 pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
+    plane_hit_as(k, g, sides, cut, false)
+}
+
+/// [`plane_hit`] for local positions (one side): F where the plane is hit
+/// in front before `tbest + 1` (a local `tbest` carries a remainder,
+/// [`positions::nearer`] tells them apart), and the part of `t` below
+/// the quotient `q` (r9) in `TMP1` ([`positions::quotient_rest`]), for
+/// [`fine_commit`].
+pub fn plane_hit_fine(k: &mut K, g: &Gen, cut: Option<&str>) {
+    plane_hit_as(k, g, Sides::Front, cut, true)
+}
+
+fn plane_hit_as(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>, fine: bool) {
     k.comment("den = -n.d, num = -n.(v0 - o)");
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
@@ -233,10 +295,36 @@ pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
     k.c("sub r12, fb0, r1")
         .c("sub r13, fb0, r2")
         .c("sub r14, fb0, r3");
-    k.c("mul out, r8, r12")
-        .c("mac out, r9, r13")
-        .c("mac r15, r10, r14, >>Q14");
-    k.c("neg r11, r11").c("neg r15, r15");
+    if fine {
+        // num = n.(ol - (v0 - o)) exact in the accumulator (the origin's
+        // remainder, the plane's offset below the LSB from the record),
+        // rounded, and its remainder kept for the quotient's rest.
+        for (i, n) in [8, 9, 10].into_iter().enumerate() {
+            k.c(format!("ld r15, [r0 + #{}]", ram::RAY_OL + i as u32));
+            k.c(match i {
+                0 => "mul out, r8, r15".to_string(),
+                1 => "mac out, r9, r15".to_string(),
+                _ => format!("mac r15, r{n}, r15, >>Q14"),
+            });
+        }
+        k.note("n.ol, 2^-14 LSB")
+            .c("ldacc r15")
+            .c("mac out, fb0, #1")
+            .note("- n.(v0's part below the LSB)")
+            .c("msu out, r8, r12")
+            .c("msu out, r9, r13")
+            .c("msu r15, r10, r14, >>Q14")
+            .note("num");
+        math::remainder(k, 12, 15, 13, "Q14");
+        k.note("its remainder, 2^-14 LSB")
+            .c(format!("st r12, [#{}]", ram::TMP2))
+            .c("neg r11, r11");
+    } else {
+        k.c("mul out, r8, r12")
+            .c("mac out, r9, r13")
+            .c("mac r15, r10, r14, >>Q14");
+        k.c("neg r11, r11").c("neg r15, r15");
+    }
     if sides == Sides::Both {
         k.c("movb r12, #0")
             .c("cmp.lt r11, #0")
@@ -247,17 +335,74 @@ pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
             .c(format!("st r12, [#{}]", ram::TMP3))
             .note("1: a back hit");
     }
-    k.c("cmp.gt r11, #0")
-        .c("(f) cmp.gt r15, #0")
-        .c("ldacc r15, <<Q14")
-        .c("msu out, r7, r11")
-        .c("acch r8")
-        .c("(f) cmp.lt r8, #0")
+    k.c("cmp.gt r11, #0").c("(f) cmp.gt r15, #0");
+    if fine {
+        k.c("ldacc r15, <<Q14")
+            .c("adds r13, r7, #1")
+            .note("tbest + 1")
+            .c("mac out, r12, #1")
+            .c("msu out, r13, r11")
+            .c("acch r12");
+    } else {
+        k.c("ldacc r15, <<Q14").c("msu out, r7, r11").c("acch r8");
+    }
+    k.c(format!("(f) cmp.lt r{}, #0", if fine { 12 } else { 8 }))
         .note("F: num 2^14 < tbest den, t fits");
     if let Some(c) = cut {
         k.cut(c);
     }
+    if fine {
+        for (x, at) in [(8, ram::TMP6), (9, ram::TMP7), (10, ram::TMP8)] {
+            k.c(format!("st r{x}, [#{at}]"));
+        }
+        k.note("n, for fine_commit");
+    }
     divide(k, 15, 11, 9, [8, 10, 12, 13, 14], g.approx);
+    if fine {
+        for (x, at) in [(15, ram::TMP1), (12, ram::TMP4), (8, ram::TMP5)] {
+            k.c(format!("st r{x}, [#{at}]"));
+        }
+        k.note("num, the reciprocal and its shift, for fine_commit");
+    }
+}
+
+/// After [`plane_hit_fine`] and the inside test (the quotient `q` in r9):
+/// `t` (r15) with its remainder (r12) from `q` and the rest the division
+/// left ([`positions::quotient_rest`]: the numerator with its remainder,
+/// the denominator `-n.(d + dl)` exact from the normal kept in
+/// `TMP6..TMP8` and the direction's remainder), F kept where it is nearer
+/// than `tbest` to 2^-14 LSB ([`positions::nearer`]), the commit, and the
+/// hit point `o + t d` to 2^-14 LSB ([`positions::ray_point`]).
+pub fn fine_commit(k: &mut K) {
+    k.comment("den = -n.(d + dl) to 2^-28 (Q1.14 and its remainder)");
+    for (i, (x, d)) in [(8, 12), (10, 13), (11, 14)].into_iter().enumerate() {
+        k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP6 + i as u32))
+            .c(format!("ld r{d}, [r0 + #{}]", ram::RAY_DL + i as u32));
+    }
+    k.c("mul out, r8, r12")
+        .c("mac out, r10, r13")
+        .c("mac r15, r11, r14, >>Q13")
+        .note("n.dl, 2^-28");
+    k.c("neg r15, r15")
+        .c("ldacc r15")
+        .c("msu out, r8, r4")
+        .c("msu out, r10, r5")
+        .c("msu r11, r11, r6, >>Q14")
+        .note("den");
+    math::remainder(k, 14, 11, 13, "Q14");
+    k.note("its remainder, 2^-28")
+        .c("mul r13, r9, r14, >>Q14")
+        .note("q den_l 2^-14")
+        .c(format!("ld r14, [r0 + #{}]", ram::TMP2))
+        .note("num's remainder");
+    for (x, at) in [(15, ram::TMP1), (12, ram::TMP4), (8, ram::TMP5)] {
+        k.c(format!("ld r{x}, [r0 + #{at}]"));
+    }
+    positions::quotient_rest(k, [15, 14, 11, 13, 9, 12, 8], 13, [10, 14]);
+    positions::fine_t(k, 9, 13, [15, 12, 14]);
+    positions::nearer(k, 15, 12, 11, 13);
+    commit_streamed_normal(k, 15);
+    positions::ray_point(k, 15, 12, [8, 10, 11, 13]);
 }
 
 /// After [`plane_hit`]: the hit point relative to `v0` (the stream's
@@ -320,12 +465,13 @@ pub fn disc_object_name(s: Sides) -> &'static str {
 /// triangle.
 pub fn kernel(g: &Gen, inside: Inside, sides: Sides) -> K {
     let cuts = inside != Inside::Disc;
-    planar_kernel(g, inside, sides, kernel_name(inside, sides), cuts)
+    planar_kernel(g, inside, sides, kernel_name(inside, sides), cuts, false)
 }
 
 /// The kernel of a planar test named `name`, with the cuts of [`CUTS`]
-/// or without.
-fn planar_kernel(g: &Gen, inside: Inside, sides: Sides, name: &str, cuts: bool) -> K {
+/// or without; `fine` (local positions, one side): `t` and the hit point
+/// to 2^-14 LSB ([`plane_hit_fine`], [`fine_commit`]).
+fn planar_kernel(g: &Gen, inside: Inside, sides: Sides, name: &str, cuts: bool, fine: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
         "{}: the {} test of one record (the stream){}.\n\
@@ -344,17 +490,24 @@ fn planar_kernel(g: &Gen, inside: Inside, sides: Sides, name: &str, cuts: bool) 
         },
         if sides == Sides::Both {
             ", HIT_BACK_OBJ"
+        } else if fine {
+            ", HIT_TL = t, HIT_TLL its remainder, HIT_PH and HIT_PL the hit point"
         } else {
             ""
         },
     ));
     let cut = cuts.then_some(CUTS[0].0);
-    plane_hit(&mut k, g, sides, cut);
+    if fine {
+        plane_hit_fine(&mut k, g, cut);
+    } else {
+        plane_hit(&mut k, g, sides, cut);
+    }
     inside_test(&mut k, inside);
     if cut.is_some() {
         k.cut(CUTS[1].0);
     }
     match sides {
+        _ if fine => fine_commit(&mut k),
         Sides::Front => commit_streamed_normal(&mut k, 9),
         Sides::Both => commit_streamed_normal_two(&mut k, 9),
     }
@@ -388,9 +541,16 @@ impl PlanarPrimitive {
         }
     }
 
+    /// Whether its scene-format records are tested with `t` and the hit
+    /// point to 2^-14 LSB ([`plane_hit_fine`]): local positions, one side.
+    fn fine(&self, sides: Sides, fit: &Fit) -> bool {
+        sides == Sides::Front && fit.local
+    }
+
     /// Its object test's kernel (with cuts).
-    fn object_kernel(&self, g: &Gen, sides: Sides) -> K {
-        planar_kernel(g, self.0, sides, self.label(sides), true)
+    fn object_kernel(&self, g: &Gen, sides: Sides, fit: &Fit) -> K {
+        let fine = self.fine(sides, fit);
+        planar_kernel(g, self.0, sides, self.label(sides), true, fine)
     }
 }
 
@@ -407,6 +567,9 @@ impl super::ChipPrimitive for PlanarPrimitive {
         if self.local(sides, fit) {
             return super::triangle_local::layout();
         }
+        if self.fine(sides, fit) {
+            return Layout::new(FINE_FIELDS);
+        }
         Layout::new(FIELDS)
     }
 
@@ -414,7 +577,7 @@ impl super::ChipPrimitive for PlanarPrimitive {
         if self.local(sides, fit) {
             return vec![(self.label(sides), super::triangle_local::kernel(g))];
         }
-        vec![(self.label(sides), self.object_kernel(g, sides))]
+        vec![(self.label(sides), self.object_kernel(g, sides, fit))]
     }
 
     fn broadcast(&self, sides: Sides, t: &mut Code, _at: &str, _fit: &Fit, _caps: bool) {
@@ -482,8 +645,9 @@ impl super::ChipPrimitive for PlanarPrimitive {
     /// Rectangles are priced as triangles (the cost model's kernels).
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
         match self.0 {
-            Inside::Disc => TestCost::of(&self.object_kernel(g, Sides::Front)),
+            Inside::Disc => TestCost::of(&self.object_kernel(g, Sides::Front, fit)),
             Inside::Triangle if fit.local => TestCost::of(&super::triangle_local::kernel(g)),
+            _ if fit.local => TestCost::of(&self.object_kernel(g, Sides::Front, fit)),
             _ => TestCost::of(&kernel(g, Inside::Triangle, Sides::Front)),
         }
     }
@@ -502,8 +666,9 @@ impl super::ChipPrimitive for PlanarPrimitive {
             super::triangle_local::write(w, o.fit.kt_local, &t.v, p, o.id, o.mat);
             return Ok(());
         }
+        let fine = self.fine(o.sides, o.fit);
         for p in o.geometry.planars() {
-            write(w, &o.fit.kt, p, o.id, o.mat);
+            write_as(w, &o.fit.kt, p, (o.id, o.mat), fine);
         }
         Ok(())
     }
