@@ -309,14 +309,30 @@ pub fn offset_in_frame(k: &mut K) {
     }
 }
 
+/// The nearest hit a local kernel keeps, 2^-14 LSB ([`nearer`]): 1/32
+/// LSB. A ray leaving a surface meets it again only where its origin's
+/// error puts it behind (the entry root of a ray leaving a curved
+/// surface lies behind its origin, a plane's back is not tested), and a
+/// shadow ray from a floor a few LSB beside the point where a sphere
+/// touches it meets the sphere under half an LSB away.
+pub const NEAREST: i32 = 512;
+
 /// In a local kernel: F kept where `t` (register `t`, the scene's LSB)
-/// with its remainder (`rem`, 2^-14 LSB) lies ahead and is nearer than
-/// `tbest` (r7), told apart to 2^-14 LSB where `tbest` is a local hit's
-/// (`HIT_TL`; one that is not has no remainder); there `HIT_TL` and
-/// `HIT_TLL` take them. Clobbers `f` (F on entry) and `tmp`.
+/// with its remainder (`rem`, 2^-14 LSB) lies more than [`NEAREST`]
+/// ahead and is nearer than `tbest` (r7), told apart to 2^-14 LSB where
+/// `tbest` is a local hit's (`HIT_TL`; one that is not has no
+/// remainder); there `HIT_TL` and `HIT_TLL` take them. Clobbers `f` (F
+/// on entry) and `tmp`.
 pub fn nearer(k: &mut K, t: u8, rem: u8, f: u8, tmp: u8) {
     k.c(format!("movb r{f}, #0"))
         .c(format!("(f) movb r{f}, #1"));
+    k.comment("t more than NEAREST ahead: min(max(t, -1), 1) 2^14 + rem");
+    k.c(format!("min r{tmp}, r{t}, #1"))
+        .c(format!("max r{tmp}, r{tmp}, #-1"))
+        .c(format!("sll r{tmp}, r{tmp}, #14"))
+        .c(format!("add r{tmp}, r{tmp}, r{rem}"))
+        .c(format!("cmp.le r{tmp}, #{NEAREST}"))
+        .c(format!("(f) movb r{f}, #0"));
     k.comment("t < tbest to 2^-14 LSB (a tbest not local has no remainder)");
     k.c(format!("ld r{tmp}, [r0 + #{}]", ram::HIT_TL))
         .c(format!("cmp.eq r{tmp}, r7"))
@@ -325,7 +341,6 @@ pub fn nearer(k: &mut K, t: u8, rem: u8, f: u8, tmp: u8) {
         .c(format!("cmp.eq r{t}, r7"))
         .c(format!("(f) cmp.lt r{rem}, r{tmp}"))
         .c(format!("(!f) cmp.lt r{t}, r7"))
-        .c(format!("(f) cmp.gt r{t}, #0"))
         .c(format!("(f) cmp.ne r{f}, #0"))
         .note("F: a hit ahead, nearer than tbest")
         .c(format!("(f) st r{t}, [#{}]", ram::HIT_TL))
