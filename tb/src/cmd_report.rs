@@ -24,7 +24,10 @@ use anyhow::{anyhow, bail, Context, Result};
 use serde_json::Value;
 
 mod sections;
+mod span;
 use sections::*;
+pub use span::scene as span_scene;
+use span::span;
 
 /// `morphosys report` arguments.
 #[derive(clap::Args, Debug)]
@@ -205,6 +208,18 @@ const SECTIONS: &[Section] = &[
                 clock. `refused`: the format cannot hold the scene (`render` says why).",
         checked: false,
         write: positions,
+    },
+    Section {
+        id: "span",
+        title: "Where one format per scene fails: the span against the smallest object",
+        about: "Five spheres of radius 0.5 down to 0.04 on a floor whose half width is \
+                2^6 to 2^14 times the smallest radius (`scenes/span/`), 128x128, \
+                depth 2: the 16-bit chip with the scene's one format (`--positions \
+                global`, refused where the smallest sphere is under 2 LSB of it) and with \
+                local positions, beside the 32-bit chip. PSNR and hit agreement against \
+                the f64 reference.",
+        checked: false,
+        write: span,
     },
     Section {
         id: "spd",
