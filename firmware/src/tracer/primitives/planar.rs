@@ -220,6 +220,22 @@ pub(crate) fn write(w: &mut W, kt: &[u32; 3], p: &Planar, id: usize, mat: usize)
     write_as(w, kt, p, (id, mat), false)
 }
 
+/// The word [`PLANE_REM`] of a plane of normal `n` through `v0`, after
+/// `v0` rounded: `-n.(v0 - v0 rounded)` in 2^-14 LSB with the normal as
+/// the record holds it (Q1.14), so that the chip's plane passes through
+/// `v0` itself.
+pub(super) fn plane_rem(w: &mut W, n: Vec3, v0: Vec3) {
+    let one = w.one();
+    let off: f64 = (0..3)
+        .map(|i| {
+            let x = v0.axis(i) * w.s;
+            (n.axis(i) * one).round() / one * (x - w.sat(x) as f64)
+        })
+        .sum();
+    w.field(PLANE_REM);
+    w.push(-off * 16384.0);
+}
+
 /// [`write`], with `fine` the record of [`plane_hit_fine`]'s kernels
 /// ([`FINE_FIELDS`]): `-n.(v0 - v0 rounded)` with the normal as the
 /// record holds it, so that the chip's plane passes through `v0` itself.
@@ -231,15 +247,7 @@ fn write_as(w: &mut W, kt: &[u32; 3], p: &Planar, (id, mat): (usize, usize), fin
     w.field(VERTEX);
     w.point(p.v0);
     if fine {
-        let one = w.one();
-        let off: f64 = (0..3)
-            .map(|i| {
-                let x = p.v0.axis(i) * w.s;
-                (p.n.axis(i) * one).round() / one * (x - w.sat(x) as f64)
-            })
-            .sum();
-        w.field(PLANE_REM);
-        w.push(-off * 16384.0);
+        plane_rem(w, p.n, p.v0);
     }
     w.field(VERTEX_AGAIN);
     w.point(p.v0);
@@ -274,7 +282,7 @@ pub const CUTS: [(&str, &str); 2] = [
 /// `tbest`. With `cut`, the kernel has a cut ([`K::cut`]) of that name
 /// once F is known, before the division.
 pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
-    plane_hit_as(k, g, sides, cut, false)
+    plane_hit_as(k, g, sides, cut, false, false)
 }
 
 /// [`plane_hit`] for local positions (one side): F where the plane is hit
@@ -283,10 +291,17 @@ pub fn plane_hit(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
 /// the quotient `q` (r9) in `TMP1` ([`positions::quotient_rest`]), for
 /// [`fine_commit`].
 pub fn plane_hit_fine(k: &mut K, g: &Gen, cut: Option<&str>) {
-    plane_hit_as(k, g, Sides::Front, cut, true)
+    plane_hit_as(k, g, Sides::Front, cut, true, false)
 }
 
-fn plane_hit_as(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>, fine: bool) {
+/// [`plane_hit`] of a record that carries [`PLANE_REM`] after the vertex
+/// (a polygon's of a scene with local positions) without using it (the
+/// two-sided test): the word is read past.
+pub fn plane_hit_past_rem(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>) {
+    plane_hit_as(k, g, sides, cut, false, true)
+}
+
+fn plane_hit_as(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>, fine: bool, past_rem: bool) {
     k.comment("den = -n.d, num = -n.(v0 - o)");
     k.c("mov r8, fb0").c("mov r9, fb0").c("mov r10, fb0");
     k.c("mul out, r8, r4")
@@ -295,6 +310,10 @@ fn plane_hit_as(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>, fine: bool)
     k.c("sub r12, fb0, r1")
         .c("sub r13, fb0, r2")
         .c("sub r14, fb0, r3");
+    if past_rem {
+        k.c("mov r15, fb0")
+            .note("the plane's offset below the LSB, not used");
+    }
     if fine {
         // num = n.(ol - (v0 - o)) exact in the accumulator (the origin's
         // remainder, the plane's offset below the LSB from the record),
@@ -366,7 +385,8 @@ fn plane_hit_as(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>, fine: bool)
     }
 }
 
-/// After [`plane_hit_fine`] and the inside test (the quotient `q` in r9):
+/// After [`plane_hit_fine`] and the inside test (the quotient `q` in r9;
+/// the polygon's: the crossing test):
 /// `t` (r15) with its remainder (r12) from `q` and the rest the division
 /// left ([`positions::quotient_rest`]: the numerator with its remainder,
 /// the denominator `-n.(d + dl)` exact from the normal kept in

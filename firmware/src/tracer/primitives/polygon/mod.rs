@@ -78,7 +78,7 @@ pub use broadcast::{broadcast, broadcast_edges};
 
 use super::super::emit::{Code, Name, Reg, K};
 use super::super::memory_map::ram;
-use super::planar::plane_hit;
+use super::planar::{self, plane_hit, plane_hit_fine, plane_hit_past_rem};
 use super::record::{Field, Layout, W};
 use super::{
     commit_streamed_normal, commit_streamed_normal_two, CutTest, ErrorBound, Fit, Gen, Object,
@@ -186,20 +186,32 @@ pub fn keeps_apart(banded_words: usize) -> bool {
     banded_words > APART_FROM
 }
 
+/// Words of the head; `fine` (local positions, one side): with the
+/// plane's offset below the LSB ([`planar::PLANE_REM`]).
+fn head_words(fine: bool) -> usize {
+    HEAD_WORDS + fine as usize
+}
+
 /// The record with room for `fan` edges (sub-edges where banded; none
 /// where they are apart).
 pub fn layout(fan: usize, form: Form) -> Layout {
+    layout_as(fan, form, false)
+}
+
+/// [`layout`], the head `fine` ([`head_words`]).
+fn layout_as(fan: usize, form: Form, fine: bool) -> Layout {
     let table = [(POLY_BOUNDS, BANDS + 1), (POLY_TAIL, 1)];
+    let head = (POLY_HEAD, head_words(fine));
     match form {
         Form::Plain => Layout::new([
             (POLY_EDGES, 1),
-            (POLY_HEAD, HEAD_WORDS),
+            head,
             (POLY_FAN, fan * EDGE_WORDS),
             (TAIL, TAIL_WORDS),
         ]),
         Form::Banded => Layout::new([
             (POLY_NB, 1),
-            (POLY_HEAD, HEAD_WORDS),
+            head,
             table[0],
             (POLY_STARTS, BANDS + 1),
             table[1],
@@ -208,7 +220,7 @@ pub fn layout(fan: usize, form: Form) -> Layout {
         ]),
         Form::Apart => Layout::new([
             (POLY_NB, 1),
-            (POLY_HEAD, HEAD_WORDS),
+            head,
             table[0],
             (POLY_STARTS_APART, BANDS + 1),
             table[1],
@@ -225,7 +237,11 @@ pub fn words(fan: usize, form: Form) -> usize {
 
 /// The header lines of the record's fields and of an edge's words.
 pub fn header(form: Form) -> Vec<String> {
-    let mut v = Layout::header(&[layout(0, form)]);
+    header_as(form, false)
+}
+
+fn header_as(form: Form, fine: bool) -> Vec<String> {
+    let mut v = Layout::header(&[layout_as(0, form, fine)]);
     v.push(if form.banded() {
         POLY_BAND_EDGE_WORDS.define()
     } else {
@@ -256,7 +272,15 @@ const ABOVE: &str = "k_polygon_above";
 /// The kernels of a polygon's test, in load order: the head, the edge
 /// (banded records: the sub-edge and the two probes), the tail.
 pub fn kernels(g: &Gen, s: Sides, form: Form) -> Vec<(&'static str, K)> {
-    let mut v = vec![(head_name(s), head(g, s))];
+    kernels_as(g, s, form, false)
+}
+
+/// [`kernels`] of records whose head is `fine` ([`head_words`]: local
+/// positions): one side, the head's plane test [`plane_hit_fine`] and the
+/// tail's commit [`planar::fine_commit`], `t` and the hit point to 2^-14
+/// LSB; two sides, the scene format's test, past the word it does not use.
+fn kernels_as(g: &Gen, s: Sides, form: Form, fine: bool) -> Vec<(&'static str, K)> {
+    let mut v = vec![(head_name(s), head(g, s, fine))];
     if form.banded() {
         v.push((BAND_EDGE, band_edge()));
         v.push((BELOW, probe(false)));
@@ -264,7 +288,7 @@ pub fn kernels(g: &Gen, s: Sides, form: Form) -> Vec<(&'static str, K)> {
     } else {
         v.push((EDGE, edge()));
     }
-    v.push((tail_name(s), tail(s)));
+    v.push((tail_name(s), tail(s, fine && s == Sides::Front)));
     v
 }
 
@@ -347,11 +371,23 @@ pub fn band_edges(edges: &[[i64; 5]]) -> usize {
 /// Write the record of polygon `v` into a record of `size` words (in
 /// `form`; the sub-edges of `Form::Apart` into `w.fans`). Err: the
 /// sub-edges apart are past what `POLY_FANS_AT` reaches.
+#[cfg(test)]
 pub(crate) fn write(
     w: &mut W,
     v: &[Vec3],
     size: usize,
     form: Form,
+    id: usize,
+    mat: usize,
+) -> Result<(), String> {
+    write_as(w, v, (size, form, false), id, mat)
+}
+
+/// [`write`], the head `fine` ([`head_words`]).
+fn write_as(
+    w: &mut W,
+    v: &[Vec3],
+    (size, form, fine): (usize, Form, bool),
     id: usize,
     mat: usize,
 ) -> Result<(), String> {
@@ -367,6 +403,9 @@ pub(crate) fn write(
     w.field(POLY_HEAD);
     w.unit(n);
     w.point(v[0]);
+    if fine {
+        planar::plane_rem(w, n, v[0]);
+    }
     w.point(v[0]);
     let axis = |a: usize| {
         Vec3::new(
@@ -395,7 +434,7 @@ pub(crate) fn write(
             POLY_STARTS
         });
         row(w, &at, BANDS + 1);
-        let fan = 1 + HEAD_WORDS + TABLE_WORDS;
+        let fan = 1 + head_words(fine) + TABLE_WORDS;
         if form == Form::Apart {
             // The tail after the sub-edges' place; the sub-edges on a
             // unit of their own in main memory.
@@ -443,7 +482,7 @@ pub(crate) fn write(
     Ok(())
 }
 
-fn head(g: &Gen, sides: Sides) -> K {
+fn head(g: &Gen, sides: Sides, fine: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
         "{}: the polygon's plane (the head of its record){}; then -px, -py.\n\
@@ -455,7 +494,11 @@ fn head(g: &Gen, sides: Sides) -> K {
             ""
         }
     ));
-    plane_hit(&mut k, g, sides, None);
+    match (fine, sides) {
+        (true, Sides::Front) => plane_hit_fine(&mut k, g, None),
+        (true, Sides::Both) => plane_hit_past_rem(&mut k, g, sides, None),
+        (false, _) => plane_hit(&mut k, g, sides, None),
+    }
     for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
         let x = 10 + i;
         k.c(format!("ldacc r{o}, <<Q14"))
@@ -570,7 +613,7 @@ fn probe(above: bool) -> K {
     k
 }
 
-fn tail(sides: Sides) -> K {
+fn tail(sides: Sides, fine: bool) -> K {
     let mut k = K::new();
     k.doc(&format!(
         "{}: commit where valid and the parity is odd (stream: n.xyz, obj, mat).\n\
@@ -586,6 +629,7 @@ fn tail(sides: Sides) -> K {
         .c("cmp.ne r13, #0")
         .c("(f) cmp.ne r8, #0");
     match sides {
+        _ if fine => planar::fine_commit(&mut k),
         Sides::Front => commit_streamed_normal(&mut k, 9),
         Sides::Both => commit_streamed_normal_two(&mut k, 9),
     }
@@ -602,11 +646,11 @@ impl super::ChipPrimitive for Polygon {
     }
 
     fn layout(&self, _sides: Sides, fit: &Fit, fan: usize, _caps: bool) -> Layout {
-        layout(fan, fit.polygon_form)
+        layout_as(fan, fit.polygon_form, fit.local)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
-        kernels(g, sides, fit.polygon_form)
+        kernels_as(g, sides, fit.polygon_form, fit.local)
     }
 
     fn broadcast(&self, sides: Sides, t: &mut Code, at: &str, fit: &Fit, _caps: bool) {
@@ -627,12 +671,12 @@ impl super::ChipPrimitive for Polygon {
     }
 
     fn record_header(&self, fit: &Fit, _sides: &[Sides], _caps: bool) -> Vec<String> {
-        header(fit.polygon_form)
+        header_as(fit.polygon_form, fit.local)
     }
 
     /// The head whole, the tail, an edge per edge (plain records).
-    fn test_cost(&self, g: &Gen, _fit: &Fit) -> TestCost {
-        let k: Vec<usize> = kernels(g, Sides::Front, Form::Plain)
+    fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
+        let k: Vec<usize> = kernels_as(g, Sides::Front, Form::Plain, fit.local)
             .iter()
             .map(|(_, k)| k.len())
             .collect();
@@ -668,6 +712,7 @@ impl super::ChipPrimitive for Polygon {
         let Some(p) = o.shape.as_polygon() else {
             return Err(RecordError::mismatch("polygon"));
         };
-        write(w, &p.v, o.size, o.fit.polygon_form, o.id, o.mat).map_err(RecordError::Scene)
+        let f = (o.size, o.fit.polygon_form, o.fit.local);
+        write_as(w, &p.v, f, o.id, o.mat).map_err(RecordError::Scene)
     }
 }
