@@ -1833,3 +1833,73 @@ fn local_shadow_directions_vs_f64() {
     );
     assert!(worst < (-26f64).exp2(), "direction off by {worst}");
 }
+
+/// Local positions: the transmitting sphere's two-sided kernel in its
+/// frame (`sphere::local_roots_two`), rays from outside and from inside,
+/// against the f64 two-sided sphere as the scene format's glass kernel is
+/// held (its `error_bound`); then shadow rays from the hit points it
+/// leaves (`HIT_PH` + `HIT_PL`) towards a light on their side of the
+/// surface: the sphere does not shadow itself (the far root of a ray
+/// leaving it is its own origin, which `SELF_LSB` drops).
+#[test]
+fn local_glass_sphere_kernel_vs_float_two_sided_sphere() {
+    LOCAL.with(|l| l.set(true));
+    let b: ErrorBound = primitives::of_shape(&shape_sphere()).error_bound();
+    let (t, mean, n) = b.on(Datapath::W16);
+    measure_sides::<i16>("local glass sphere", shape_sphere(), true, t, mean, n);
+    let lsb = 2f64.powi(-10);
+    let c = Vec3::new(0.0, 0.0, 1.0);
+    let shape = Shape::Sphere(Sphere {
+        center: c,
+        radius: 1.0,
+        inside: false,
+    });
+    let eye = Vec3::new(0.0, -6.0, 2.0);
+    let light = Vec3::new(3.0, -5.0, 6.0);
+    let mut g = Lcg(3);
+    let rs: [Ray; 64] = std::array::from_fn(|_| {
+        let target = c + Vec3::new(g.range(-0.7, 0.7), g.range(-0.7, 0.7), g.range(-0.7, 0.7));
+        Ray {
+            o: eye,
+            d: (target - eye).normalized(),
+        }
+    });
+    let (sim, fw) = run_with::<i16>(shape.clone(), &rs, true, |t, ti, fit| {
+        ti.ty.broadcast(t, "test", fit, ti.caps)
+    });
+    assert_eq!(fw.frac, 10, "the test's format");
+    let rc = &sim.top.array.rc;
+    let word = |i: usize, at: usize| rc.ram.read(i, at).to_i64() as f64;
+    let mut lit = Vec::new();
+    let mut worst = 0.0f64;
+    let shadow: [Ray; 64] = std::array::from_fn(|i| {
+        let p = Vec3::new(
+            word(i, ram::HIT_PH.at()) + word(i, ram::HIT_PL.at()) / 16384.0,
+            word(i, ram::HIT_PH.at() + 1) + word(i, ram::HIT_PL.at() + 1) / 16384.0,
+            word(i, ram::HIT_PH.at() + 2) + word(i, ram::HIT_PL.at() + 2) / 16384.0,
+        ) * lsb;
+        // On the sphere to its normal's length (Q1.14 components and the
+        // square root's approximation): within 0.06% of the radius, 1,024
+        // LSB (measured 0.32 LSB).
+        let off = ((p - c).length() - 1.0).abs() / lsb;
+        assert!(off < 0.6, "ray {i}: hit point {off} LSB off the sphere");
+        worst = worst.max(off);
+        if (p - c).normalized().dot((light - p).normalized()) > 0.1 {
+            lit.push(i);
+        }
+        Ray {
+            o: p,
+            d: (light - p).normalized(),
+        }
+    });
+    eprintln!("local glass sphere: hit points within {worst:.3} LSB of the sphere");
+    assert!(lit.len() >= 32, "{} rays see the light", lit.len());
+    let (sim, _) = run_with::<i16>(shape.clone(), &shadow, true, |t, ti, fit| {
+        ti.ty.broadcast(t, "test", fit, ti.caps)
+    });
+    let rc = &sim.top.array.rc;
+    for i in lit {
+        let t = rc.regs.read(7)[i].to_i64();
+        assert_eq!(t, 32767, "shadow ray {i} meets its own sphere at {t} LSB");
+    }
+}

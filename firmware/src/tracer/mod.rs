@@ -248,9 +248,11 @@ pub fn resolve_bsp(opt: &Options, objects: usize) -> Vec<BspParams> {
 /// moved: a plane's normal does not turn with the ray, and the move would
 /// only round every vertex afresh (and may change the median tree's
 /// shape). Nor are scenes with local positions whose curved objects are
-/// all tested in frames of their own: their eye rays start at the eye
-/// with its remainder ([`positions::eye`]), and the move would round the
-/// lights and the planes afresh.
+/// all opaque and tested in frames of their own: their eye rays start at
+/// the eye with its remainder ([`positions::eye`]), and the move would
+/// round the lights and the planes afresh (with transmitting ones, whose
+/// refracted rays start at the rounded hit point, the move measures
+/// better: SPD mount-2 at 128x128, depth 5, 38.88 against 37.54 dB).
 fn build_as(
     scene: &Scene,
     opt: &Options,

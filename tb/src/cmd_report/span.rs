@@ -68,7 +68,7 @@ pub fn scene(k: i32) -> String {
 
 pub(super) fn span(r: &mut Runner) -> Result<String> {
     let dir = std::path::Path::new("scenes/span");
-    std::fs::create_dir_all(&dir)?;
+    std::fs::create_dir_all(dir)?;
     let mut rows = Vec::new();
     let mut psnr_series: Vec<Series> = CHIPS
         .iter()

@@ -28,11 +28,6 @@ pub struct Fit {
     /// bounding spheres there.
     pub cone_local: bool,
     pub ks_conel: u32,
-    /// Local positions: the transmitting spheres' shifts and record
-    /// variant (their records in the scene's format, [`super::sphere`]).
-    pub ks_glass: u32,
-    pub ep_glass: u32,
-    pub glass_fine: bool,
     /// Some opaque sphere is seen from inside (NFF's negative radius,
     /// `sg` = -1): the sphere kernel's first part cannot then reject a
     /// sphere whose centre is behind the ray.

@@ -25,7 +25,8 @@
 //! **Two-sided** (a transmitting sphere, [`Sides::Both`]): where the near
 //! root is not ahead of the ray by more than `SELF_LSB` the far root, the
 //! normal turned to the ray; a far-side hit records the object in
-//! `HIT_BACK_OBJ`.
+//! `HIT_BACK_OBJ`. With local positions the same in the sphere's frame
+//! ([`kernel_local`]).
 //!
 //! **Registers**: r1..r7 the ray (kept but r7, which becomes the new
 //! `tbest` where F); r8..r15 temporaries; RAM `TMP0..TMP3`.
@@ -78,10 +79,7 @@ pub fn local_exponent(r: f64) -> u32 {
 }
 
 /// The record of `fit`'s spheres seen from `sides`.
-pub fn layout(fit: &Fit, sides: Sides) -> Layout {
-    if fit.local && sides == Sides::Both {
-        return layout(&glass(fit), sides);
-    }
+pub fn layout(fit: &Fit, _sides: Sides) -> Layout {
     if fit.local {
         return Layout::new([
             (CENTRE, 3),
@@ -116,20 +114,6 @@ pub const FINE_BELOW_LSB: f64 = 64.0;
 /// Words of a record.
 pub fn words(fit: &Fit, sides: Sides) -> usize {
     layout(fit, sides).words()
-}
-
-/// With local positions, transmitting spheres keep the scene's format
-/// (two-sided kernels have no local form): their records and kernel as
-/// without, their shifts `KS_GLASS`, `EP_GLASS` (the `fit` of every
-/// sphere's radius in the scene's LSB).
-fn glass(fit: &Fit) -> Fit {
-    Fit {
-        local: false,
-        ks_sphere: fit.ks_glass,
-        ep_sphere: fit.ep_glass,
-        sphere_fine: fit.glass_fine,
-        ..*fit
-    }
 }
 
 /// The opaque kernel's cut ([`K::cut`]) and what F holds there.
@@ -302,8 +286,8 @@ fn split(w: &W, p: Vec3) -> [(f64, f64); 3] {
 /// The sphere kernel for records of `fit` and the sides `sides`.
 pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     match (fit.local, sides) {
-        (true, Sides::Front) => kernel_local(g, fit),
-        (true, Sides::Both) => kernel_global(g, &glass(fit), sides, ["KS_GLASS", "EP_GLASS"]),
+        (true, Sides::Front) => kernel_local(g, fit, false),
+        (true, Sides::Both) => kernel_local(g, fit, true),
         (false, _) => kernel_global(g, fit, sides, ["KS_SPHERE", "EP_SPHERE"]),
     }
 }
@@ -395,23 +379,29 @@ fn kernel_global(g: &Gen, fit: &Fit, sides: Sides, [ks, ep]: [&str; 2]) -> K {
 /// normal as in [`kernel`], and the hit point `c + sg r n` back in the
 /// scene's format with its remainder: `HIT_PH`, `HIT_PL`, tagged by
 /// `HIT_TL = t` (its remainder `HIT_TLL`: nearest hits are told apart to
-/// 2^-14 LSB where both are local, overlapping spheres).
-fn kernel_local(g: &Gen, fit: &Fit) -> K {
+/// 2^-14 LSB where both are local, overlapping spheres). Two-sided
+/// (`two`, a transmitting sphere): where the near root is not more than
+/// `SELF_LSB` ahead, the far root `b + (pd + sg h) 2^-e`, the sign turned
+/// to the ray and the hit a far-side one (`HIT_BACK_OBJ`), its point
+/// `c - sg r n 2^-e` with the turned normal.
+fn kernel_local(g: &Gen, fit: &Fit, two: bool) -> K {
     let nr = g.approx;
     let mut k = K::new();
     k.doc(&format!(
-        "{}: the sphere test of one local record (the stream), for every awake ray.\n\
+        "{}: the sphere test of one local record (the stream), for every awake ray{}.\n\
          In: r1..r7 the rays, RAY_OL. Out where F (a nearer hit): r7 = t, HIT_N, HIT_OBJ, HIT_MAT,\n\
-         HIT_TL = t, HIT_PH and HIT_PL the hit point. b = round((c - o).d), p = ((c - o) - b d) 2^e,\n\
+         HIT_TL = t, HIT_PH and HIT_PL the hit point{}. b = round((c - o).d), p = ((c - o) - b d) 2^e,\n\
          s = 1 - |p/r|^2, t = b + (pd - sg r sqrt(s)) 2^-e, n = -(sg p/r + sqrt(s) d), P = c + sg r n 2^-e",
-        kernel_name(Sides::Front),
+        kernel_name(if two { Sides::Both } else { Sides::Front }),
+        if two { ", seen from either side" } else { "" },
+        if two { ", HIT_BACK_OBJ (the far side)" } else { "" },
     ));
     enter_frame(&mut k, ["c", "centre", "cl"], NEAR_CUT.0);
     perpendicular_to(&mut k, &[8, 9, 10], &[4, 5, 6], 12);
     k.note("r12 = pd, what p had along d");
     k.c("mov r13, fb0").note("invr, in the frame");
     meets(&mut k, "KS_SPHERE");
-    if g.test_cuts && !fit.sphere_inside {
+    if g.test_cuts && !fit.sphere_inside && !two {
         k.c("(f) cmp.gt r11, #0").note("and its centre lies ahead");
     }
     k.cut(LOCAL_CUTS[1].0);
@@ -420,6 +410,10 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
     }
     k.note("p/r in TMP0..2");
     sqrt_q14(&mut k, 15, 8, [9, 10, 13, 14], nr);
+    if two {
+        local_roots_two(&mut k, g);
+        return k;
+    }
     k.c("mul r9, fb0, r8, >>Q14")
         .note("h = r sqrt(s), in the frame")
         .c("mov r10, fb0")
@@ -444,6 +438,64 @@ fn kernel_local(g: &Gen, fit: &Fit) -> K {
         positions::hit_point_axis(&mut k, i, "mac", 8, None, 14, [9, 8, 10]);
     }
     k
+}
+
+/// The two-sided end of [`kernel_local`], after `sqrt(s)` (r8), with
+/// `b` (r11), `pd` (r12), `p/r` in `TMP0..2` and F where the line meets
+/// the sphere: the near root, or the far one where the near root is not
+/// more than `SELF_LSB` ahead (`TMP3` = 1, the sign turned), `t` with its
+/// remainder, [`positions::nearer`], the normal turned to the ray and the
+/// commit with `HIT_BACK_OBJ`, and the hit point `c + sg' r n 2^-e` with
+/// the turned sign `sg'`.
+fn local_roots_two(k: &mut K, g: &Gen) {
+    k.c("movb r13, #0")
+        .c("(f) movb r13, #1")
+        .c(format!("st r13, [#{}]", ram::TMP4))
+        .note("meets");
+    k.c("mul r9, fb0, r8, >>Q14")
+        .note("h = r sqrt(s), in the frame")
+        .c("mov r10, fb0")
+        .note("sg")
+        .c("mul r9, r9, r10, >>Q14")
+        .c("mov r14, fb0")
+        .note("2^(14-e)")
+        .c("sub r13, r12, r9")
+        .c("ldacc r11, <<Q14")
+        .c("mac r15, r14, r13, >>Q14")
+        .note("t1 = b + (pd - sg h) 2^-e");
+    self_margin(k, 13, g.datapath);
+    k.c("cmp.le r15, r13")
+        .note("the near root not ahead: the far side")
+        .c("(f) add r12, r12, r9")
+        .c("(!f) sub r12, r12, r9")
+        .c("(f) neg r10, r10")
+        .c("movb r15, #0")
+        .c("(f) movb r15, #1")
+        .c(format!("st r15, [#{}]", ram::TMP3))
+        .c("ldacc r11, <<Q14")
+        .c("mac r9, r14, r12, >>Q14")
+        .note("t = b + (pd -+ sg h) 2^-e");
+    remainder(k, 12, 9, 15, "Q14");
+    k.note("its remainder, 2^-14 LSB")
+        .c(format!("ld r15, [r0 + #{}]", ram::TMP4))
+        .c("cmp.ne r15, #0")
+        .c("(f) cmp.gt r9, r13")
+        .note("F: the line meets the sphere, the root more than SELF_LSB ahead");
+    positions::nearer(k, 9, 12, 15, 13);
+    normal_and_commit(k, true);
+    k.comment("the hit point c + sg' r n 2^-e, to 2^-14 LSB (sg' turned on the far side)");
+    k.c(format!("ld r13, [r0 + #{}]", ram::HIT_N + 2))
+        .note("n.z again (the commit took r13; where F it is the hit's)")
+        .c("mov r15, fb0")
+        .note("sg r")
+        .c("xor r15, r15, r9")
+        .c("sub r15, r15, r9")
+        .note("negated on the far side (r9 = -back)");
+    for (i, n) in [11, 12, 13].into_iter().enumerate() {
+        let i = i as u32;
+        k.c(format!("mul r8, r{n}, r15, >>Q14"));
+        positions::hit_point_axis(k, i, "mac", 8, None, 14, [9, 8, 10]);
+    }
 }
 
 /// `oc = c - o` (r8..r10, the centre from the stream) and `b = oc.d`
@@ -599,7 +651,7 @@ impl super::ChipPrimitive for Sphere {
     }
 
     fn fit_header(&self, fit: &Fit) -> Vec<String> {
-        let mut v = vec![
+        vec![
             define(
                 "KS_SPHERE",
                 fit.ks_sphere,
@@ -610,30 +662,15 @@ impl super::ChipPrimitive for Sphere {
                 fit.ep_sphere,
                 "spheres: extra fraction bits of the perpendicular vector",
             ),
-        ];
-        if fit.local {
-            v.push(define(
-                "KS_GLASS",
-                fit.ks_glass,
-                "transmitting spheres (the scene's format): invr = 2^(Q14+KS_GLASS) / r",
-            ));
-            v.push(define(
-                "EP_GLASS",
-                fit.ep_glass,
-                "transmitting spheres: extra fraction bits of the perpendicular vector",
-            ));
-        }
-        v
+        ]
     }
 
     fn fit(&self, scene: &Scene, _geo: &[Geometry], s: f64, f: &Fitter, fit: &mut Fit) {
         let spheres = || scene.objects.iter().filter_map(|o| o.shape.as_sphere());
         let radii = spheres().map(|sp| sp.radius.abs() * s);
         if fit.local {
-            // Radii in their frames; no fine record (the remainders are
-            // the local record's). Transmitting spheres: the scene's
-            // format, fitted to every sphere.
-            (fit.ks_glass, fit.ep_glass, fit.glass_fine) = self::fit(radii.clone(), f);
+            // Radii in their frames, transmitting spheres' too; no fine
+            // record (the remainders are the local record's).
             let local = radii.map(|r| r * (local_exponent(r) as f64).exp2());
             (fit.ks_sphere, fit.ep_sphere, _) = self::fit(local, f);
             fit.sphere_fine = false;
@@ -656,10 +693,9 @@ impl super::ChipPrimitive for Sphere {
         let Some(sp) = o.shape.as_sphere() else {
             return Err(RecordError::mismatch("sphere"));
         };
-        let glassy = o.fit.local && o.sides == Sides::Both;
         write(
             w,
-            &if glassy { glass(o.fit) } else { *o.fit },
+            o.fit,
             o.unrounded,
             sp.center,
             sp.radius,
