@@ -78,8 +78,9 @@ pub fn local_exponent(r: f64) -> u32 {
     crate::scene_image::local_exponent(r).unwrap_or(0)
 }
 
-/// The record of `fit`'s spheres seen from `sides`.
-pub fn layout(fit: &Fit, _sides: Sides) -> Layout {
+/// The record of `fit`'s spheres (seen from either side: a transmitting
+/// sphere's is the opaque one's).
+pub fn layout(fit: &Fit) -> Layout {
     if fit.local {
         return Layout::new([
             (CENTRE, 3),
@@ -112,8 +113,8 @@ pub fn layout(fit: &Fit, _sides: Sides) -> Layout {
 pub const FINE_BELOW_LSB: f64 = 64.0;
 
 /// Words of a record.
-pub fn words(fit: &Fit, sides: Sides) -> usize {
-    layout(fit, sides).words()
+pub fn words(fit: &Fit) -> usize {
+    layout(fit).words()
 }
 
 /// The opaque kernel's cut ([`K::cut`]) and what F holds there.
@@ -286,8 +287,7 @@ fn split(w: &W, p: Vec3) -> [(f64, f64); 3] {
 /// The sphere kernel for records of `fit` and the sides `sides`.
 pub fn kernel(g: &Gen, fit: &Fit, sides: Sides) -> K {
     match (fit.local, sides) {
-        (true, Sides::Front) => kernel_local(g, fit, false),
-        (true, Sides::Both) => kernel_local(g, fit, true),
+        (true, _) => kernel_local(g, fit, sides == Sides::Both),
         (false, _) => kernel_global(g, fit, sides, ["KS_SPHERE", "EP_SPHERE"]),
     }
 }
@@ -432,12 +432,20 @@ fn kernel_local(g: &Gen, fit: &Fit, two: bool) -> K {
     normal_and_commit(&mut k, false);
     k.comment("the hit point c + sg r n 2^-e, to 2^-14 LSB");
     k.c("mov r15, fb0").note("sg r");
-    for (i, n) in [11, 12, 13].into_iter().enumerate() {
-        let i = i as u32;
-        k.c(format!("mul r8, r{n}, r15, >>Q14"));
-        positions::hit_point_axis(&mut k, i, "mac", 8, None, 14, [9, 8, 10]);
-    }
+    hit_point_from_normal(&mut k);
     k
+}
+
+/// The end of the local kernels: the hit point `c + v n 2^-e` to 2^-14
+/// LSB from the normal (r11..r13) and `v` in the frame (r15: `sg r`,
+/// turned on a far-side hit), the frame's `2^(14-e)` in r14, the
+/// stream's centre and its remainder per axis: where F, `HIT_PH` and
+/// `HIT_PL`. Clobbers r8..r10.
+fn hit_point_from_normal(k: &mut K) {
+    for (i, n) in [11, 12, 13].into_iter().enumerate() {
+        k.c(format!("mul r8, r{n}, r15, >>Q14"));
+        positions::hit_point_axis(k, i as u32, "mac", 8, None, 14, [9, 8, 10]);
+    }
 }
 
 /// The two-sided end of [`kernel_local`], after `sqrt(s)` (r8), with
@@ -491,11 +499,7 @@ fn local_roots_two(k: &mut K, g: &Gen) {
         .c("xor r15, r15, r9")
         .c("sub r15, r15, r9")
         .note("negated on the far side (r9 = -back)");
-    for (i, n) in [11, 12, 13].into_iter().enumerate() {
-        let i = i as u32;
-        k.c(format!("mul r8, r{n}, r15, >>Q14"));
-        positions::hit_point_axis(k, i, "mac", 8, None, 14, [9, 8, 10]);
-    }
+    hit_point_from_normal(k);
 }
 
 /// `oc = c - o` (r8..r10, the centre from the stream) and `b = oc.d`
@@ -629,8 +633,8 @@ impl super::ChipPrimitive for Sphere {
         ["sphere", "glass_sphere"]
     }
 
-    fn layout(&self, sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
-        layout(fit, sides)
+    fn layout(&self, _sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
+        layout(fit)
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {

@@ -43,7 +43,7 @@ fn every_kernel_reads_exactly_its_record() {
                     ..Fit::default()
                 };
                 for s in [Sides::Front, Sides::Both] {
-                    assert_eq!(sphere::kernel(&g, &fit, s).fb_reads, sphere::words(&fit, s));
+                    assert_eq!(sphere::kernel(&g, &fit, s).fb_reads, sphere::words(&fit));
                     assert_eq!(aabox::kernel(&g, s).fb_reads, aabox::words(s));
                     for i in [
                         planar::Inside::Triangle,
@@ -166,7 +166,7 @@ fn every_writer_follows_its_layout() {
             };
             let mut w = writer();
             sphere::write(&mut w, &fit, false, v(1.0, 2.0, 3.0), 0.5, false, 7, 1);
-            holds_to(&w, 0, &sphere::layout(&fit, Sides::Front), "sphere");
+            holds_to(&w, 0, &sphere::layout(&fit), "sphere");
             for s in [Sides::Front, Sides::Both] {
                 let mut w = writer();
                 aabox::write(&mut w, s, v(0.0, 0.0, 0.0), v(1.0, 2.0, 3.0), 7, 1);
@@ -243,7 +243,7 @@ fn every_writer_follows_its_layout() {
     let fan = edges.len();
     let size = polygon::words(fan, polygon::Form::Plain);
     let mut w = writer();
-    polygon::write(&mut w, &star, size, polygon::Form::Plain, 7, 1).unwrap();
+    polygon::write_as(&mut w, &star, (size, polygon::Form::Plain, false), 7, 1).unwrap();
     holds_to(
         &w,
         0,
@@ -253,7 +253,7 @@ fn every_writer_follows_its_layout() {
     for form in [polygon::Form::Banded, polygon::Form::Apart] {
         let mut w = writer();
         let size = polygon::words(0, form) + 4096;
-        polygon::write(&mut w, &star, size, form, 7, 1).unwrap();
+        polygon::write_as(&mut w, &star, (size, form, false), 7, 1).unwrap();
         // Up to the sub-edges, whose room is the scene's most.
         let l = polygon::layout(0, form);
         let named: Vec<_> = l.0.iter().filter(|f| f.0.named).copied().collect();
@@ -300,7 +300,7 @@ fn every_local_kernel_reads_exactly_its_record() {
         ..Fit::default()
     };
     let s = Sides::Front;
-    let l = sphere::layout(&fit, s);
+    let l = sphere::layout(&fit);
     assert_eq!(sphere::kernel(&g, &fit, s).fb_reads, l.words());
     let mut w = writer();
     sphere::write(&mut w, &fit, false, v(1.0, 2.0, 3.0), 0.5, false, 7, 1);

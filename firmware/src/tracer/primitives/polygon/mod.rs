@@ -370,21 +370,9 @@ pub fn band_edges(edges: &[[i64; 5]]) -> usize {
 
 /// Write the record of polygon `v` into a record of `size` words (in
 /// `form`; the sub-edges of `Form::Apart` into `w.fans`). Err: the
-/// sub-edges apart are past what `POLY_FANS_AT` reaches.
-#[cfg(test)]
-pub(crate) fn write(
-    w: &mut W,
-    v: &[Vec3],
-    size: usize,
-    form: Form,
-    id: usize,
-    mat: usize,
-) -> Result<(), String> {
-    write_as(w, v, (size, form, false), id, mat)
-}
-
-/// [`write`], the head `fine` ([`head_words`]).
-fn write_as(
+/// sub-edges apart are past what `POLY_FANS_AT` reaches. `fine`: the head
+/// with the plane's offset below the LSB ([`head_words`]).
+pub(crate) fn write_as(
     w: &mut W,
     v: &[Vec3],
     (size, form, fine): (usize, Form, bool),
