@@ -428,24 +428,30 @@ pub fn fine_t(k: &mut K, q: u8, rest: u8, [t, rem, tmp]: [u8; 3]) {
 /// Clobbers the four `tmp`.
 pub fn ray_point(k: &mut K, t: u8, rem: u8, [a, b, hi, lo]: [u8; 4]) {
     k.comment("the hit point o + t d, to 2^-14 LSB");
-    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
-        let i = i as u32;
-        k.c(format!("ld r{a}, [r0 + #{}]", ram::RAY_OL + i))
-            .c(format!("ld r{b}, [r0 + #{}]", ram::RAY_DL + i))
-            .c(format!("mul r{b}, r{t}, r{b}, >>Q13"))
-            .note("t dl")
-            .c(format!("mul r{lo}, r{rem}, r{d}, >>Q14"))
-            .note("t's remainder d")
-            .c(format!("ldacc r{o}, <<Q14"))
-            .c(format!("mac out, r{a}, #1"))
-            .note("+ ol")
-            .c(format!("mac out, r{b}, #1"))
-            .c(format!("mac out, r{lo}, #1"))
-            .c(format!("mac r{hi}, r{t}, r{d}, >>Q14"))
-            .note("P");
-        remainder(k, lo, hi, a, "Q14");
-        k.note("its remainder")
-            .c(format!("(f) st r{hi}, [#{}]", ram::HIT_PH + i))
+    for i in 0..3 {
+        ray_point_axis(k, i, t, rem, [a, b, hi, lo]);
+        k.c(format!("(f) st r{hi}, [#{}]", ram::HIT_PH + i))
             .c(format!("(f) st r{lo}, [#{}]", ram::HIT_PL + i));
     }
+}
+
+/// Axis `i` of [`ray_point`]'s point into `hi` (the scene's LSB) and `lo`
+/// (its remainder, 2^-14 LSB). Clobbers `a`, `b`.
+pub fn ray_point_axis(k: &mut K, i: u32, t: u8, rem: u8, [a, b, hi, lo]: [u8; 4]) {
+    let (o, d) = (1 + i, 4 + i);
+    k.c(format!("ld r{a}, [r0 + #{}]", ram::RAY_OL + i))
+        .c(format!("ld r{b}, [r0 + #{}]", ram::RAY_DL + i))
+        .c(format!("mul r{b}, r{t}, r{b}, >>Q13"))
+        .note("t dl")
+        .c(format!("mul r{lo}, r{rem}, r{d}, >>Q14"))
+        .note("t's remainder d")
+        .c(format!("ldacc r{o}, <<Q14"))
+        .c(format!("mac out, r{a}, #1"))
+        .note("+ ol")
+        .c(format!("mac out, r{b}, #1"))
+        .c(format!("mac out, r{lo}, #1"))
+        .c(format!("mac r{hi}, r{t}, r{d}, >>Q14"))
+        .note("P");
+    remainder(k, lo, hi, a, "Q14");
+    k.note("its remainder");
 }

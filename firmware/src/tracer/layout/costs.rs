@@ -93,7 +93,7 @@ pub fn chip_costs(
     // (Scenes a chip-cost tree serves are mostly streamed: where banded
     // records would be over `polygon::APART_FROM` words, a record moves
     // without its sub-edges, as `build_packet` lays them out.)
-    let (fan, polygon_bands) = super::polygon_fan(scene, s, true);
+    let (fan, polygon_bands) = super::polygon_fan(scene, s, true, None);
     let polygon_form = match polygon_bands {
         false => polygon::Form::Plain,
         true if polygon::keeps_apart(polygon::words(fan, polygon::Form::Banded)) => {

@@ -579,7 +579,11 @@ fn fit_scene(
     let local = opt.positions == super::Positions::Local;
     let fitter = Fitter { x: xb };
     let mut geo: Vec<Geometry> = Vec::with_capacity(scene.objects.len());
-    let (fan, polygon_bands) = polygon_fan(scene, s, bands);
+    let poly_k = local.then(|| {
+        let polys = scene.objects.iter().filter_map(|o| o.shape.as_polygon());
+        polygon::fine_k(polys.map(|p| &p.v[..]), s)
+    });
+    let (fan, polygon_bands) = polygon_fan(scene, s, bands, poly_k);
     for o in &scene.objects {
         geo.push(
             ChipType::of_object(&o.shape, false)
@@ -599,6 +603,7 @@ fn fit_scene(
         kt,
         fine_normals,
         local,
+        poly_k: poly_k.unwrap_or(0),
         polygon_form: if polygon_bands {
             polygon::Form::Banded
         } else {
@@ -610,11 +615,34 @@ fn fit_scene(
         p.fit(scene, &geo, s, &fitter, &mut fit);
     }
     if local {
-        let tris = scene.objects.iter().zip(&geo).filter_map(|(o, g)| {
-            let t = o.shape.as_triangle().filter(|t| t.normals.is_none())?;
-            Some((t.v, *g.planars().first()?))
+        use super::primitives::triangle_local as tl;
+        let framed = |o: &crate::scene::Object, g: &Geometry| {
+            let p = *g.planars().first()?;
+            let c = match o.shape.as_triangle() {
+                Some(t) if t.normals.is_none() => tl::centre(&p, Some(&t.v)),
+                Some(_) => return None,
+                None if o.shape.as_rectangle().is_some() || o.shape.as_disc().is_some() => {
+                    tl::centre(&p, None)
+                }
+                None => return None,
+            };
+            Some((c, p))
+        };
+        // Rectangles and discs in frames where every one fits a frame and
+        // most are small enough for a frame finer than the fine planar
+        // kernel's edges ([`tl::frames_pay`]).
+        let extents: Vec<f64> = scene
+            .objects
+            .iter()
+            .zip(&geo)
+            .filter(|(o, _)| o.shape.as_triangle().is_none())
+            .filter_map(|(o, g)| framed(o, g).map(|((_, r), _)| r))
+            .collect();
+        fit.planar_frames = tl::frames_pay(&extents, s);
+        let shapes = scene.objects.iter().zip(&geo).filter_map(|(o, g)| {
+            framed(o, g).filter(|_| o.shape.as_triangle().is_some() || fit.planar_frames)
         });
-        fit.kt_local = super::primitives::triangle_local::fit_kt(tris, s, &fitter);
+        fit.kt_local = tl::fit_kt(shapes, s, &fitter);
     }
     (geo, fan, fit)
 }
@@ -623,12 +651,12 @@ fn fit_scene(
 /// (at `s` LSB per unit), or where the records are banded (`bands`: the
 /// packet traversal's, a polygon of [`polygon::BANDED_FROM`] edges or
 /// more) the most sub-edges; and whether they are banded.
-pub(crate) fn polygon_fan(scene: &Scene, s: f64, bands: bool) -> (usize, bool) {
+pub(crate) fn polygon_fan(scene: &Scene, s: f64, bands: bool, fine: Option<u32>) -> (usize, bool) {
     let edges: Vec<Vec<[i64; 5]>> = scene
         .objects
         .iter()
         .filter_map(|o| o.shape.as_polygon())
-        .map(|p| polygon::edges(&p.v, s).1)
+        .map(|p| polygon::edges_as(&p.v, s, fine).1)
         .collect();
     let banded = bands && edges.iter().any(|e| e.len() >= polygon::BANDED_FROM);
     let fan = edges

@@ -18,6 +18,14 @@ pub struct Fit {
     /// spheres' radii there, `kt_local` to the triangles' edge duals.
     pub local: bool,
     pub kt_local: u32,
+    /// Local positions, every rectangle and disc small enough for a frame
+    /// ([`super::triangle_local::fits`]): opaque rectangles and discs in
+    /// frames of their own as the triangles, `kt_local` fitted to their
+    /// duals too.
+    pub planar_frames: bool,
+    /// Local positions: the polygons' crossing test in `2^-poly_k` LSB
+    /// ([`super::polygon::fine_k`]).
+    pub poly_k: u32,
     /// Local positions, no cylinder with caps: opaque cylinders in frames
     /// of their own ([`super::cylinder_local`]), `KS_CYLL` fitted to
     /// their radii there.

@@ -394,6 +394,18 @@ fn plane_hit_as(k: &mut K, g: &Gen, sides: Sides, cut: Option<&str>, fine: bool,
 /// than `tbest` to 2^-14 LSB ([`positions::nearer`]), the commit, and the
 /// hit point `o + t d` to 2^-14 LSB ([`positions::ray_point`]).
 pub fn fine_commit(k: &mut K) {
+    fine_t(k);
+    positions::nearer(k, 15, 12, 11, 13);
+    commit_streamed_normal(k, 15);
+    positions::ray_point(k, 15, 12, [8, 10, 11, 13]);
+}
+
+/// After [`plane_hit_fine`] (the quotient `q` in r9): `t` (r15) with its
+/// remainder (r12, 2^-14 LSB) from `q` and the rest the division left
+/// ([`positions::quotient_rest`]: the numerator with its remainder, the
+/// denominator `-n.(d + dl)` exact from the normal kept in `TMP6..TMP8`
+/// and the direction's remainder). Clobbers r8..r15; F kept.
+pub fn fine_t(k: &mut K) {
     k.comment("den = -n.(d + dl) to 2^-28 (Q1.14 and its remainder)");
     for (i, (x, d)) in [(8, 12), (10, 13), (11, 14)].into_iter().enumerate() {
         k.c(format!("ld r{x}, [r0 + #{}]", ram::TMP6 + i as u32))
@@ -420,9 +432,6 @@ pub fn fine_commit(k: &mut K) {
     }
     positions::quotient_rest(k, [15, 14, 11, 13, 9, 12, 8], 13, [10, 14]);
     positions::fine_t(k, 9, 13, [15, 12, 14]);
-    positions::nearer(k, 15, 12, 11, 13);
-    commit_streamed_normal(k, 15);
-    positions::ray_point(k, 15, 12, [8, 10, 11, 13]);
 }
 
 /// After [`plane_hit`]: the hit point relative to `v0` (the stream's
@@ -546,11 +555,20 @@ pub const TRIANGLE: PlanarPrimitive = PlanarPrimitive(Inside::Triangle);
 pub const DISC: PlanarPrimitive = PlanarPrimitive(Inside::Disc);
 
 impl PlanarPrimitive {
-    /// Whether its records are the local triangle's
-    /// ([`super::triangle_local`]): a flat triangle, one side, local
-    /// positions.
-    fn local(&self, sides: Sides, fit: &Fit) -> bool {
-        self.0 == Inside::Triangle && sides == Sides::Front && fit.local
+    /// Whether its records are in frames of their own
+    /// ([`super::triangle_local`]): a flat triangle of a scene with local
+    /// positions, a rectangle or disc of one whose rectangles and discs
+    /// all fit a frame ([`Fit::planar_frames`]); either side.
+    fn local(&self, fit: &Fit) -> bool {
+        match self.0 {
+            Inside::Triangle => fit.local,
+            _ => fit.planar_frames,
+        }
+    }
+
+    /// Its kernel in frames of their own.
+    fn local_kernel(&self, g: &Gen, sides: Sides) -> K {
+        super::triangle_local::kernel(g, self.0, self.label(sides), sides == Sides::Both)
     }
 
     /// Its object test's kernel label.
@@ -562,9 +580,10 @@ impl PlanarPrimitive {
     }
 
     /// Whether its scene-format records are tested with `t` and the hit
-    /// point to 2^-14 LSB ([`plane_hit_fine`]): local positions, one side.
+    /// point to 2^-14 LSB ([`plane_hit_fine`]): local positions, one side,
+    /// not in frames.
     fn fine(&self, sides: Sides, fit: &Fit) -> bool {
-        sides == Sides::Front && fit.local
+        sides == Sides::Front && fit.local && !self.local(fit)
     }
 
     /// Its object test's kernel (with cuts).
@@ -584,8 +603,8 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     fn layout(&self, sides: Sides, fit: &Fit, _fan: usize, _caps: bool) -> Layout {
-        if self.local(sides, fit) {
-            return super::triangle_local::layout();
+        if self.local(fit) {
+            return super::triangle_local::layout(sides == Sides::Both);
         }
         if self.fine(sides, fit) {
             return Layout::new(FINE_FIELDS);
@@ -594,8 +613,8 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     fn kernels(&self, sides: Sides, g: &Gen, fit: &Fit) -> Vec<(&'static str, K)> {
-        if self.local(sides, fit) {
-            return vec![(self.label(sides), super::triangle_local::kernel(g))];
+        if self.local(fit) {
+            return vec![(self.label(sides), self.local_kernel(g, sides))];
         }
         vec![(self.label(sides), self.object_kernel(g, sides, fit))]
     }
@@ -608,7 +627,7 @@ impl super::ChipPrimitive for PlanarPrimitive {
         Some(CutTest {
             kernel: self.label(sides),
             field: "0",
-            cuts: if self.local(sides, fit) {
+            cuts: if self.local(fit) {
                 &super::triangle_local::CUTS
             } else {
                 &CUTS
@@ -629,11 +648,11 @@ impl super::ChipPrimitive for PlanarPrimitive {
             fit.kt[self.0.kt_index()],
             &format!("{what}: edge duals scaled by 2^{name}"),
         )];
-        if self.local(Sides::Front, fit) {
+        if self.local(fit) {
             v.push(define(
                 "KT_LOCAL",
                 fit.kt_local,
-                "triangles in frames of their own: edge duals per LSB of the frame scaled by 2^(14+KT_LOCAL)",
+                "planar shapes in frames of their own: edge duals per LSB of the frame scaled by 2^(14+KT_LOCAL)",
             ));
         }
         v
@@ -665,8 +684,8 @@ impl super::ChipPrimitive for PlanarPrimitive {
     /// Rectangles are priced as triangles (the cost model's kernels).
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
         match self.0 {
+            _ if self.local(fit) => TestCost::of(&self.local_kernel(g, Sides::Front)),
             Inside::Disc => TestCost::of(&self.object_kernel(g, Sides::Front, fit)),
-            Inside::Triangle if fit.local => TestCost::of(&super::triangle_local::kernel(g)),
             _ if fit.local => TestCost::of(&self.object_kernel(g, Sides::Front, fit)),
             _ => TestCost::of(&kernel(g, Inside::Triangle, Sides::Front)),
         }
@@ -679,11 +698,13 @@ impl super::ChipPrimitive for PlanarPrimitive {
     }
 
     fn write(&self, w: &mut W, o: &Object) -> Result<(), RecordError> {
-        if self.local(o.sides, o.fit) {
-            let (Some(t), [p]) = (o.shape.as_triangle(), o.geometry.planars()) else {
-                return Err(RecordError::mismatch("triangle"));
+        if self.local(o.fit) {
+            let [p] = o.geometry.planars() else {
+                return Err(RecordError::mismatch("planar"));
             };
-            super::triangle_local::write(w, o.fit.kt_local, &t.v, p, o.id, o.mat);
+            let c = super::triangle_local::centre(p, o.shape.as_triangle().map(|t| &t.v));
+            let two = o.sides == Sides::Both;
+            super::triangle_local::write(w, (o.fit.kt_local, two), c, p, (o.id, o.mat));
             return Ok(());
         }
         let fine = self.fine(o.sides, o.fit);

@@ -243,7 +243,7 @@ fn every_writer_follows_its_layout() {
     let fan = edges.len();
     let size = polygon::words(fan, polygon::Form::Plain);
     let mut w = writer();
-    polygon::write_as(&mut w, &star, (size, polygon::Form::Plain, false), 7, 1).unwrap();
+    polygon::write_as(&mut w, &star, (size, polygon::Form::Plain, None), 7, 1).unwrap();
     holds_to(
         &w,
         0,
@@ -253,7 +253,7 @@ fn every_writer_follows_its_layout() {
     for form in [polygon::Form::Banded, polygon::Form::Apart] {
         let mut w = writer();
         let size = polygon::words(0, form) + 4096;
-        polygon::write_as(&mut w, &star, (size, form, false), 7, 1).unwrap();
+        polygon::write_as(&mut w, &star, (size, form, None), 7, 1).unwrap();
         // Up to the sub-edges, whose room is the scene's most.
         let l = polygon::layout(0, form);
         let named: Vec<_> = l.0.iter().filter(|f| f.0.named).copied().collect();
@@ -306,13 +306,21 @@ fn every_local_kernel_reads_exactly_its_record() {
     sphere::write(&mut w, &fit, false, v(1.0, 2.0, 3.0), 0.5, false, 7, 1);
     holds_to(&w, 0, &l, "local sphere");
     let tri = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
-    assert_eq!(
-        triangle_local::kernel(&g).fb_reads,
-        triangle_local::layout().words()
-    );
-    let mut w = writer();
-    triangle_local::write(&mut w, 4, &tri, &planar::flat_triangle(tri), 7, 1);
-    holds_to(&w, 0, &triangle_local::layout(), "local triangle");
+    let n = v(0.0, 0.0, 1.0);
+    let shapes = [
+        (planar::flat_triangle(tri), Some(&tri)),
+        (planar::Planar::rectangle(tri[0], tri[1], tri[2], n), None),
+        (planar::Planar::disc(tri[0], tri[1], tri[2], 0.5, n), None),
+    ];
+    for ((p, vs), two) in shapes.into_iter().flat_map(|x| [(x, false), (x, true)]) {
+        let l = triangle_local::layout(two);
+        let k = triangle_local::kernel(&g, p.kind, "k", two);
+        assert_eq!(k.fb_reads, l.words(), "{:?}, two sides {two}", p.kind);
+        let mut w = writer();
+        let c = triangle_local::centre(&p, vs);
+        triangle_local::write(&mut w, (4, two), c, &p, (7, 1));
+        holds_to(&w, 0, &l, "local planar shape");
+    }
     let (base, apex) = (v(0.0, 0.0, 0.0), v(0.0, 0.3, 2.0));
     let l = cylinder::layout(&fit, s, false);
     let k = cylinder::kernels(&g, &fit, s);

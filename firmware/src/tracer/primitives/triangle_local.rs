@@ -30,7 +30,7 @@ use super::super::emit::K;
 use super::super::math::{divide, remainder};
 use super::super::memory_map::ram;
 use super::super::positions;
-use super::planar::{self, Planar};
+use super::planar::{self, Inside, Planar};
 use super::record::{Field, Fitter, Layout, W};
 use super::sphere;
 use crate::scene::Vec3;
@@ -50,6 +50,10 @@ pub const DUAL_W: Field = Field::part(
     "-ew per LSB of the frame, scaled by 2^(14+KT_LOCAL)",
 );
 pub const W_CENTRE: Field = Field::part("wc", "w at the centroid (Q1.14)");
+pub const OBJ_FIRST: Field = Field::part(
+    "obj'",
+    "seen from either side: the object's id, before the normal (ORIG_OBJ)",
+);
 pub const NORMAL_AGAIN: Field = Field::part("n.xyz'", "the normal again, for the hit");
 pub const OBJ: Field = Field::part("obj", "the object's id");
 pub const MAT: Field = Field::part("mat", "its material");
@@ -58,9 +62,20 @@ pub const CENTRE_AGAIN: Field = Field::part(
     "the centroid and its remainder again, per axis (the hit point)",
 );
 
-/// The record.
-pub fn layout() -> Layout {
-    Layout::new([
+/// The record; `two` (seen from either side): with the object's id
+/// again before the normal ([`OBJ_FIRST`]).
+pub fn layout(two: bool) -> Layout {
+    if two {
+        let mut f = one_side();
+        f.insert(10, (OBJ_FIRST, 1));
+        return Layout::new(f);
+    }
+    Layout::new(one_side())
+}
+
+/// The one-sided record's fields.
+fn one_side() -> Vec<(Field, usize)> {
+    Vec::from([
         (CENTRE, 3),
         (sphere::NEAR, 1),
         (SHIFTS, 2),
@@ -78,12 +93,30 @@ pub fn layout() -> Layout {
     ])
 }
 
-/// A triangle's frame: its centroid and extent about it (LSB), its
+/// A planar shape's centre and extent about it (scene units): a
+/// triangle's centroid (its vertices `v`), a rectangle's or a disc's
+/// centre (from its record geometry `p`).
+pub fn centre(p: &Planar, v: Option<&[Vec3; 3]>) -> (Vec3, f64) {
+    match (p.kind, v) {
+        (planar::Inside::Triangle, Some(v)) => {
+            let c = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
+            (c, v.iter().map(|x| (*x - c).length()).fold(0.0, f64::max))
+        }
+        (planar::Inside::Disc, _) => (p.v0, 1.0 / p.eu.length().max(1e-300)),
+        _ => {
+            // A rectangle: its edges from the duals (`eu = e1 / |e1|^2`).
+            let edge = |d: Vec3| d * (1.0 / d.dot(d).max(1e-300));
+            let half = (edge(p.eu) + edge(p.ew)) * 0.5;
+            (p.v0 + half, half.length())
+        }
+    }
+}
+
+/// A planar shape's frame: its centre and extent about it (LSB), its
 /// exponent `e` and its edge duals' largest component per LSB of the
 /// frame (for `KT_LOCAL`), `s` LSB per scene unit.
-fn frame(v: &[Vec3; 3], p: &Planar, s: f64) -> ((Vec3, f64), u32, f64) {
-    let c = (v[0] + v[1] + v[2]) * (1.0 / 3.0);
-    let r = v.iter().map(|x| (*x - c).length()).fold(0.0, f64::max) * s;
+fn frame(c: (Vec3, f64), p: &Planar, s: f64) -> ((Vec3, f64), u32, f64) {
+    let (c, r) = (c.0, c.1 * s);
     let e = sphere::local_exponent(r);
     let per = s * (e as f64).exp2();
     let dual =
@@ -95,19 +128,52 @@ fn frame(v: &[Vec3; 3], p: &Planar, s: f64) -> ((Vec3, f64), u32, f64) {
     ((c, r), e, dual)
 }
 
-/// `KT_LOCAL` for the scene's flat triangles `tris` (vertices, record
-/// geometry), `s` LSB per scene unit: the largest shift that keeps every
-/// scaled dual in the word.
-pub fn fit_kt(tris: impl Iterator<Item = ([Vec3; 3], Planar)>, s: f64, f: &Fitter) -> u32 {
-    let m = tris
-        .map(|(v, p)| frame(&v, &p, s).2 * 16384.0)
+/// Whether a planar shape of extent `r` (scene units, [`centre`]) fits a
+/// frame at `s` LSB per unit.
+pub fn fits(r: f64, s: f64) -> bool {
+    crate::scene_image::local_exponent(r * s).is_some()
+}
+
+/// Whether a scene's rectangles and discs of extents `r` (scene units,
+/// [`centre`]; `s` LSB per unit) are tested in frames: every one fits a
+/// frame and most have one of [`FRAME_E_PAYS`] or finer. A frame's `t`
+/// and hit point are as fine as its LSB (a shape over a few thousand LSB
+/// gets a frame no finer than the scene's, where the fine planar kernel
+/// has `t` to 2^-11 LSB); its edges are its Q1.14 coordinates'.
+pub fn frames_pay(r: &[f64], s: f64) -> bool {
+    let e = |r: f64| crate::scene_image::local_exponent(r * s);
+    let fine = r
+        .iter()
+        .filter(|&&r| e(r).is_some_and(|e| e >= FRAME_E_PAYS))
+        .count();
+    !r.is_empty() && r.iter().all(|&r| fits(r, s)) && 2 * fine > r.len()
+}
+
+/// The frame exponent from which a rectangle's or disc's frame pays
+/// ([`frames_pay`]): 2^-3 LSB.
+pub const FRAME_E_PAYS: u32 = 3;
+
+/// `KT_LOCAL` for the scene's planar shapes in frames (their
+/// [`centre`]s and record geometry), `s` LSB per scene unit: the largest
+/// shift that keeps every scaled dual in the word.
+pub fn fit_kt(shapes: impl Iterator<Item = ((Vec3, f64), Planar)>, s: f64, f: &Fitter) -> u32 {
+    let m = shapes
+        .map(|(c, p)| frame(c, &p, s).2 * 16384.0)
         .fold(0.0, f64::max);
     f.shift(m, 20)
 }
 
-/// Write the local record of the flat triangle `v` (record geometry `p`).
-pub(crate) fn write(w: &mut W, kt: u32, v: &[Vec3; 3], p: &Planar, id: usize, mat: usize) {
-    let ((c, r), e, _) = frame(v, p, w.s);
+/// Write the local record of the planar shape of centre and extent `c`
+/// ([`centre`]), record geometry `p`; `two`: seen from either side
+/// ([`layout`]).
+pub(crate) fn write(
+    w: &mut W,
+    (kt, two): (u32, bool),
+    c: (Vec3, f64),
+    p: &Planar,
+    (id, mat): (usize, usize),
+) {
+    let ((c, r), e, _) = frame(c, p, w.s);
     let per = w.s * (e as f64).exp2();
     let one = w.one();
     let sc = (14.0 + kt as f64).exp2() / per;
@@ -124,6 +190,10 @@ pub(crate) fn write(w: &mut W, kt: u32, v: &[Vec3; 3], p: &Planar, id: usize, ma
     w.push((c - p.v0).dot(p.ew) * one);
     w.field(DUAL_W);
     w.scaled(p.ew, -sc);
+    if two {
+        w.field(OBJ_FIRST);
+        w.raw(id as i64);
+    }
     w.field(NORMAL_AGAIN);
     w.unit(p.n);
     w.field(OBJ);
@@ -136,16 +206,56 @@ pub(crate) fn write(w: &mut W, kt: u32, v: &[Vec3; 3], p: &Planar, id: usize, ma
 /// The kernel's cuts: [`positions::near`], then [`planar::CUTS`].
 pub const CUTS: [(&str, &str); 3] = [sphere::NEAR_CUT, planar::CUTS[0], planar::CUTS[1]];
 
-/// The kernel (one side; cuts [`CUTS`]).
-pub fn kernel(g: &super::Gen) -> K {
+/// The kernel of a triangle, rectangle or disc (`inside`) in its frame,
+/// named `name` (cuts [`CUTS`]); `two`: seen from either side (a
+/// transmitting one: the back turns `den`, `num` and the normal, the hit
+/// is a back hit, `HIT_BACK_OBJ`, and a ray leaving the object, its
+/// `ORIG_OBJ`, does not hit it again; the record [`layout`] of two sides).
+pub fn kernel(g: &super::Gen, inside: Inside, name: &str, two: bool) -> K {
     let mut k = K::new();
-    k.doc(
-        "k_triangle: the triangle test of one local record (the stream), for every awake ray.\n\
+    k.doc(&format!(
+        "{name}: the {} test of one local record (the stream), for every awake ray{}.\n\
          In: r1..r7 the rays, RAY_OL, RAY_DL. Out where F (a nearer hit): r7 = t, HIT_N, HIT_OBJ, HIT_MAT,\n\
-         HIT_TL = t, HIT_PH and HIT_PL the hit point. b = round((c - o).d), p = ((c - o) - b d) 2^e,\n\
+         HIT_TL = t, HIT_PH and HIT_PL the hit point{}. b = round((c - o).d), p = ((c - o) - b d) 2^e,\n\
          s = n.p / n.d, g = p - s d, u = uc + g.au, w = wc + g.aw, t = b + s 2^-e, P = c - g 2^-e",
-    );
-    sphere::enter_frame(&mut k, ["c", "centroid", "cl"], CUTS[0].0);
+        match inside {
+            Inside::Triangle => "triangle",
+            Inside::Rectangle => "rectangle",
+            Inside::Disc => "disc",
+        },
+        if two { ", seen from either side" } else { "" },
+        if two { ", HIT_BACK_OBJ" } else { "" },
+    ));
+    sphere::enter_frame(&mut k, ["c", "centre", "cl"], CUTS[0].0);
+    plane_in_frame(&mut k, g, two);
+    inside_in_frame(&mut k, inside);
+    k.cut(planar::CUTS[1].0);
+    if two {
+        k.c("mov r13, fb0")
+            .note("obj")
+            .c(format!("ld r11, [r0 + #{}]", ram::ORIG_OBJ))
+            .c("(f) cmp.ne r13, r11")
+            .note("not the object the ray leaves");
+    }
+    positions::nearer(&mut k, 15, 12, 11, 13);
+    if two {
+        commit_two(&mut k);
+    } else {
+        super::commit_streamed_normal(&mut k, 15);
+    }
+    k.comment("the hit point c - g 2^-e, to 2^-14 LSB");
+    k.c(format!("ld r14, [r0 + #{}]", ram::TMP3));
+    for (i, v) in [8, 9, 10].into_iter().enumerate() {
+        positions::hit_point_axis(&mut k, i as u32, "msu", v, None, 14, [11, 12, 13]);
+    }
+    k
+}
+
+/// In the frame (`p` in r8..r10, `b` in r11): the plane through the
+/// centre (`two`: on either side, `TMP4` = 1 on the back), F where it is
+/// hit in front within `2^15` of `b`, `s`, `g` (r8..r10), `t` (r15)
+/// with its remainder (r12), `2^(14-e)` in `TMP3`.
+fn plane_in_frame(k: &mut K, g: &super::Gen, two: bool) {
     k.comment("den = -n.d, num = -n.p, s = num / den");
     k.c("mov r12, fb0").c("mov r13, fb0").c("mov r14, fb0");
     k.c("mul out, r12, r4")
@@ -158,6 +268,16 @@ pub fn kernel(g: &super::Gen) -> K {
         .note("den")
         .c("neg r12, r12")
         .note("num");
+    if two {
+        k.c("movb r13, #0")
+            .c("cmp.lt r15, #0")
+            .note("the back: den and num change sign")
+            .c("(f) movb r13, #1")
+            .c("(f) neg r15, r15")
+            .c("(f) neg r12, r12")
+            .c(format!("st r13, [#{}]", ram::TMP4))
+            .note("1: a back hit");
+    }
     for (i, x) in [8, 9, 10].into_iter().enumerate() {
         k.c(format!("st r{x}, [#{}]", ram::TMP0 + i as u32));
     }
@@ -171,7 +291,7 @@ pub fn kernel(g: &super::Gen) -> K {
         .c("(f) cmp.lt r12, r14")
         .note("F: the front face, |s| < 2^15");
     k.cut(planar::CUTS[0].0);
-    divide(&mut k, 12, 15, 12, [8, 9, 10, 13, 14], g.approx);
+    divide(k, 12, 15, 12, [8, 9, 10, 13, 14], g.approx);
     k.c(format!("ld r13, [r0 + #{}]", ram::TMP3))
         .c("xor r12, r12, r13")
         .c("sub r12, r12, r13")
@@ -187,9 +307,14 @@ pub fn kernel(g: &super::Gen) -> K {
         .c("ldacc r11, <<Q14")
         .c("mac r15, r14, r12, >>Q14")
         .note("t = b + s 2^-e");
-    remainder(&mut k, 12, 15, 13, "Q14");
+    remainder(k, 12, 15, 13, "Q14");
     k.note("its remainder, 2^-14 LSB")
         .c(format!("st r14, [#{}]", ram::TMP3));
+}
+
+/// `u = uc + g.au`, `w = wc + g.aw` (Q1.14, r13, r14) and F kept where
+/// they are inside (with [`planar::INSIDE_TOL`]).
+fn inside_in_frame(k: &mut K, inside: Inside) {
     k.comment("u = uc + g.au, w = wc + g.aw (Q1.14)");
     for x in [13, 14] {
         k.c("ldacc fb0, <<KT_LOCAL")
@@ -198,19 +323,51 @@ pub fn kernel(g: &super::Gen) -> K {
             .c(format!("mac r{x}, fb0, r10, >>KT_LOCAL"));
     }
     k.c(format!("ld r11, [r0 + #{}]", ram::C_ONE))
-        .c("add r11, r11, #INSIDE_TOL")
-        .c("(f) cmp.ge r13, #-INSIDE_TOL")
-        .c("(f) cmp.ge r14, #-INSIDE_TOL")
-        .c("adds r13, r13, r14")
-        .c("(f) cmp.le r13, r11")
-        .note("F: inside the triangle");
-    k.cut(planar::CUTS[1].0);
-    positions::nearer(&mut k, 15, 12, 11, 13);
-    super::commit_streamed_normal(&mut k, 15);
-    k.comment("the hit point c - g 2^-e, to 2^-14 LSB");
-    k.c(format!("ld r14, [r0 + #{}]", ram::TMP3));
-    for (i, v) in [8, 9, 10].into_iter().enumerate() {
-        positions::hit_point_axis(&mut k, i as u32, "msu", v, None, 14, [11, 12, 13]);
+        .c("add r11, r11, #INSIDE_TOL");
+    match inside {
+        Inside::Triangle => {
+            k.c("(f) cmp.ge r13, #-INSIDE_TOL")
+                .c("(f) cmp.ge r14, #-INSIDE_TOL")
+                .c("adds r13, r13, r14")
+                .c("(f) cmp.le r13, r11")
+                .note("F: inside the triangle");
+        }
+        Inside::Rectangle => {
+            k.c("(f) cmp.ge r13, #-INSIDE_TOL")
+                .c("(f) cmp.ge r14, #-INSIDE_TOL")
+                .c("(f) cmp.le r13, r11")
+                .c("(f) cmp.le r14, r11")
+                .note("F: inside the rectangle");
+        }
+        Inside::Disc => {
+            k.c("mul out, r13, r13")
+                .c("mac r13, r14, r14, >>Q14")
+                .c("(f) cmp.le r13, r11")
+                .note("F: inside the disc");
+        }
     }
-    k
+}
+
+/// The commit of a two-sided kernel where F (`t` in r15): the streamed
+/// normal turned where the back was hit (`TMP4`), the object, and
+/// `HIT_BACK_OBJ` (the object on the back, else -1). Keeps r8..r10.
+fn commit_two(k: &mut K) {
+    k.c(format!("ld r11, [r0 + #{}]", ram::TMP4))
+        .c("movb r13, #1")
+        .c("sub r13, r13, r11")
+        .c("sub r13, r13, r11")
+        .note("1 - 2 back")
+        .c("(f) mov r7, r15");
+    for i in 0..3 {
+        k.c("mul r14, fb0, r13")
+            .c(format!("(f) st r14, [#{}]", ram::HIT_N + i));
+    }
+    k.c("mov r14, fb0")
+        .c(format!("(f) st r14, [#{}]", ram::HIT_OBJ))
+        .c("neg r11, r11")
+        .c("add r13, r14, #1")
+        .c("and r13, r13, r11")
+        .c("sub r13, r13, #1")
+        .c(format!("(f) st r13, [#{}]", ram::HIT_BACK_OBJ))
+        .c(format!("(f) st fb0, [#{}]", ram::HIT_MAT));
 }

@@ -63,6 +63,17 @@
 //! **Two-sided** (a transmitting polygon): the head's plane test on both
 //! sides and the planar kernels' two-sided commit in the tail.
 //!
+//! **Local positions** (`Fit::local`, [`kernels`]): the head carries the
+//! plane's offset below the LSB after the vertex and `U`, `V` again at
+//! its end (22 words); the edges are relative to the rounded `v0` in
+//! `2^-POLY_K` LSB ([`fine_k`], cut under [`FINE_EDGE_MAX`]) with the rows
+//! first (`yi, yj, xi, s ey, s ex`; sub-edges `ya - 1, yb - 1, xi, yi, s
+//! ey, s ex`). The one-sided head finds `t` and the hit point to 2^-14
+//! LSB and leaves `-px`, `-py` in that unit (rounded up) with the parts
+//! below (r9, r15); the crossing test is exact with them; the tail
+//! commits `t` and the point the head left. The two-sided head is the
+//! scene format's, its point in the edges' unit without a remainder.
+//!
 //! **Registers**: r1..r7 the ray (r7 the new `tbest` where F); r8 the
 //! parity and r9 `t` across the runs; r10, r11 `-px`, `-py` across the
 //! runs; r12..r15 temporaries; RAM `TMP0` (valid), `TMP3` (two-sided:
@@ -73,17 +84,15 @@
 //! gear-like polygon.
 
 mod broadcast;
+mod kernels;
 
 pub use broadcast::{broadcast, broadcast_edges};
+use kernels::{band_edge, edge, head, probe, tail};
 
 use super::super::emit::{Code, Name, Reg, K};
-use super::super::memory_map::ram;
-use super::planar::{self, plane_hit, plane_hit_fine, plane_hit_past_rem};
+use super::planar;
 use super::record::{Field, Layout, W};
-use super::{
-    commit_streamed_normal, commit_streamed_normal_two, CutTest, ErrorBound, Fit, Gen, Object,
-    RecordError, Sides, TestCost,
-};
+use super::{CutTest, ErrorBound, Fit, Gen, Object, RecordError, Sides, TestCost};
 use crate::scene::{Shape, Vec3};
 
 /// The record's fields. A plain record: the edge count, the head, the
@@ -186,10 +195,11 @@ pub fn keeps_apart(banded_words: usize) -> bool {
     banded_words > APART_FROM
 }
 
-/// Words of the head; `fine` (local positions, one side): with the
-/// plane's offset below the LSB ([`planar::PLANE_REM`]).
+/// Words of the head; `fine` (local positions): with the plane's offset
+/// below the LSB ([`planar::PLANE_REM`]) after the vertex and the axes
+/// `U`, `V` again after them (the hit point's remainder projected).
 fn head_words(fine: bool) -> usize {
-    HEAD_WORDS + fine as usize
+    HEAD_WORDS + 7 * fine as usize
 }
 
 /// The record with room for `fan` edges (sub-edges where banded; none
@@ -276,19 +286,21 @@ pub fn kernels(g: &Gen, s: Sides, form: Form) -> Vec<(&'static str, K)> {
 }
 
 /// [`kernels`] of records whose head is `fine` ([`head_words`]: local
-/// positions): one side, the head's plane test [`plane_hit_fine`] and the
-/// tail's commit [`planar::fine_commit`], `t` and the hit point to 2^-14
-/// LSB; two sides, the scene format's test, past the word it does not use.
+/// positions): one side, the head's plane test [`plane_hit_fine`], `t`
+/// and the hit point to 2^-14 LSB before the crossing test, which takes
+/// the point's remainder ([`head_fine`], [`edge`]); two sides, the scene
+/// format's test past the words it does not use, its point without a
+/// remainder.
 fn kernels_as(g: &Gen, s: Sides, form: Form, fine: bool) -> Vec<(&'static str, K)> {
     let mut v = vec![(head_name(s), head(g, s, fine))];
     if form.banded() {
-        v.push((BAND_EDGE, band_edge()));
+        v.push((BAND_EDGE, band_edge(fine)));
         v.push((BELOW, probe(false)));
         v.push((ABOVE, probe(true)));
     } else {
-        v.push((EDGE, edge()));
+        v.push((EDGE, edge(fine)));
     }
-    v.push((tail_name(s), tail(s, fine && s == Sides::Front)));
+    v.push((tail_name(s), tail(s, fine)));
     v
 }
 
@@ -303,6 +315,15 @@ pub fn normal(v: &[Vec3]) -> Vec3 {
 /// `vi -> vj` (vertices quantized to the scene format `s`, relative to
 /// `v0`), `[xi, yi, yj, s ey, s ex]` with `s = sign(ey)`.
 pub fn edges(v: &[Vec3], s: f64) -> ((usize, usize), Vec<[i64; 5]>) {
+    edges_as(v, s, None)
+}
+
+/// [`edges`]; `fine` (the crossing test with the point's remainder,
+/// [`edge`]) with its scale `k`: the vertices relative to `v0` rounded to
+/// the LSB in `2^-k` LSB, and an edge with `|ex| + |ey|` of
+/// [`FINE_EDGE_MAX`] or more cut into parts under it at rounded points
+/// between its ends.
+pub fn edges_as(v: &[Vec3], s: f64, fine: Option<u32>) -> ((usize, usize), Vec<[i64; 5]>) {
     let n = normal(v);
     // The normal's dominant axis is dropped (ties as the reference breaks
     // them).
@@ -314,23 +335,73 @@ pub fn edges(v: &[Vec3], s: f64) -> ((usize, usize), Vec<[i64; 5]>) {
         2
     };
     let (ua, va) = ((drop + 1) % 3, (drop + 2) % 3);
-    let q = |x: f64| (x * s).round() as i64;
-    let p2 = |p: Vec3| {
-        (
-            q(p.axis(ua)) - q(v[0].axis(ua)),
-            q(p.axis(va)) - q(v[0].axis(va)),
-        )
-    };
+    let sk = (fine.unwrap_or(0) as f64).exp2();
+    let q = |p: Vec3, a: usize| ((p.axis(a) * s - (v[0].axis(a) * s).round()) * sk).round() as i64;
+    let p2 = |p: Vec3| (q(p, ua), q(p, va));
     let mut edges = Vec::new();
     for k in 0..v.len() {
         let ((xi, yi), (xj, yj)) = (p2(v[k]), p2(v[(k + 1) % v.len()]));
-        let (ex, ey) = (xj - xi, yj - yi);
-        if ey != 0 {
-            let sg = ey.signum();
-            edges.push([xi, yi, yj, sg * ey, sg * ex]);
+        let long = (xj - xi).abs() + (yj - yi).abs();
+        let parts = if fine.is_some() {
+            long / FINE_EDGE_MAX + 1
+        } else {
+            1
+        };
+        let at = |m: i64| {
+            let f = m as f64 / parts as f64;
+            let r = |a: i64, b: i64| a + ((b - a) as f64 * f).round() as i64;
+            (r(xi, xj), r(yi, yj))
+        };
+        for m in 0..parts {
+            let ((xi, yi), (xj, yj)) = (at(m), at(m + 1));
+            let (ex, ey) = (xj - xi, yj - yi);
+            if ey != 0 {
+                let sg = ey.signum();
+                edges.push([xi, yi, yj, sg * ey, sg * ex]);
+            }
         }
     }
     ((ua, va), edges)
+}
+
+/// The longest edge (`|ex| + |ey|`, units) of a fine record: the crossing
+/// test's integer part saturates in the word only where the point lies
+/// farther from the edge's line than its fraction can reach ([`edge`]).
+pub const FINE_EDGE_MAX: i64 = 32000;
+
+/// The scale `k` of the fine records' crossing test (local positions):
+/// the vertices relative to the first in `2^-k` LSB, up to
+/// [`FINE_K_MAX`], for every polygon of `polygons` (`s` LSB per unit) one
+/// that keeps its vertices within 16,000 units of the first.
+pub fn fine_k<'a>(polygons: impl Iterator<Item = &'a [Vec3]>, s: f64) -> u32 {
+    polygons
+        .map(|v| {
+            let span = v
+                .iter()
+                .flat_map(|p| (0..3).map(move |a| (p.axis(a) - v[0].axis(a)).abs()))
+                .fold(0.0, f64::max)
+                * s
+                + 1.0;
+            (0..=FINE_K_MAX)
+                .rev()
+                .find(|&k| span * (k as f64).exp2() <= 16000.0)
+                .unwrap_or(0)
+        })
+        .min()
+        .unwrap_or(0)
+}
+
+/// The finest scale of [`fine_k`]: 2^-8 LSB.
+pub const FINE_K_MAX: u32 = 8;
+
+/// An edge's words in the record: `xi, yi, yj, s ey, s ex`; `fine`, the
+/// rows first ([`edge`]): `yi, yj, xi, s ey, s ex`.
+fn edge_words(e: &[i64; 5], fine: bool) -> [i64; 5] {
+    if fine {
+        [e[1], e[2], e[0], e[3], e[4]]
+    } else {
+        *e
+    }
 }
 
 /// A polygon's bands (from its [`edges`]): the bounds `Y_0 < .. < Y_nb`
@@ -375,13 +446,14 @@ pub fn band_edges(edges: &[[i64; 5]]) -> usize {
 pub(crate) fn write_as(
     w: &mut W,
     v: &[Vec3],
-    (size, form, fine): (usize, Form, bool),
+    (size, form, scale): (usize, Form, Option<u32>),
     id: usize,
     mat: usize,
 ) -> Result<(), String> {
     let start = w.fb.len();
+    let fine = scale.is_some();
     let n = normal(v);
-    let ((ua, va), edges) = edges(v, w.s);
+    let ((ua, va), edges) = edges_as(v, w.s, scale);
     let banded = form.banded().then(|| bands(&edges));
     w.field(if form.banded() { POLY_NB } else { POLY_EDGES });
     w.raw(match &banded {
@@ -402,8 +474,10 @@ pub(crate) fn write_as(
             (a == 2) as u8 as f64,
         )
     };
-    w.unit(axis(ua));
-    w.unit(axis(va));
+    for _ in 0..1 + fine as usize {
+        w.unit(axis(ua));
+        w.unit(axis(va));
+    }
     if let Some((bounds, sub)) = &banded {
         let row = |w: &mut W, xs: &[i64], n: usize| {
             for k in 0..n {
@@ -439,7 +513,7 @@ pub(crate) fn write_as(
             w.field(POLY_FANS_AT);
             w.raw(units as i64);
             w.fan_most = w.fan_most.max(*at.last().unwrap() as usize);
-            for x in sub.iter().flatten().flat_map(sub_edge_words) {
+            for x in sub.iter().flatten().flat_map(|e| sub_edge_words(e, fine)) {
                 let v = w.sat(x as f64);
                 w.fans.push(v);
             }
@@ -448,15 +522,15 @@ pub(crate) fn write_as(
             w.field(POLY_TAIL);
             w.raw(fan as i64 + at.last().unwrap());
             w.field(POLY_BAND_FAN);
-            for x in sub.iter().flatten().flat_map(sub_edge_words) {
+            for x in sub.iter().flatten().flat_map(|e| sub_edge_words(e, fine)) {
                 w.raw(x);
             }
         }
     } else {
         w.field(POLY_FAN);
         for e in &edges {
-            for x in e {
-                w.raw(*x);
+            for x in edge_words(e, fine) {
+                w.raw(x);
             }
         }
     }
@@ -470,158 +544,15 @@ pub(crate) fn write_as(
     Ok(())
 }
 
-fn head(g: &Gen, sides: Sides, fine: bool) -> K {
-    let mut k = K::new();
-    k.doc(&format!(
-        "{}: the polygon's plane (the head of its record){}; then -px, -py.\n\
-         In: r1..r3 o, r4..r6 d, r7 tbest. Out: r9 = t, TMP0 = valid, r10, r11 = -px, -py, r8 = 0 (parity).",
-        head_name(sides),
-        if sides == Sides::Both {
-            ", seen from either side"
-        } else {
-            ""
-        }
-    ));
-    match (fine, sides) {
-        (true, Sides::Front) => plane_hit_fine(&mut k, g, None),
-        (true, Sides::Both) => plane_hit_past_rem(&mut k, g, sides, None),
-        (false, _) => plane_hit(&mut k, g, sides, None),
-    }
-    for (i, (o, d)) in [(1, 4), (2, 5), (3, 6)].into_iter().enumerate() {
-        let x = 10 + i;
-        k.c(format!("ldacc r{o}, <<Q14"))
-            .c(format!("mac r{x}, r9, r{d}, >>Q14"))
-            .c(format!("subs r{x}, fb0, r{x}"));
-    }
-    k.note("v0 - P");
-    k.c("movb r15, #0")
-        .c("(f) movb r15, #1")
-        .c(format!("st r15, [#{}]", ram::TMP0))
-        .note("valid");
-    k.comment("v0 - P on the plane of U, V: -px in r10, -py in r11");
-    k.c("mul out, fb0, r10")
-        .c("mac out, fb0, r11")
-        .c("mac r13, fb0, r12, >>Q14");
-    k.c("mul out, fb0, r10")
-        .c("mac out, fb0, r11")
-        .c("mac r11, fb0, r12, >>Q14")
-        .c("mov r10, r13")
-        .c("movb r8, #0")
-        .note("parity");
-    k
-}
-
-fn edge() -> K {
-    let mut k = K::new();
-    k.doc(
-        "k_polygon_edge: one edge of the crossing test (stream: xi, yi, yj, s ey, s ex).\n\
-         In: r10, r11 = -px, -py, r8 parity. Out: r8 flipped where the edge crosses the\n\
-         point's row to its right: (yi > py) != (yj > py) and s ((xi - px) ey - ex (yi - py)) > 0.",
-    );
-    k.c("adds r12, fb0, r10")
-        .note("xi - px")
-        .c("adds r13, fb0, r11")
-        .note("yi - py")
-        .c("adds r14, fb0, r11")
-        .note("yj - py")
-        .c("movb r15, #0")
-        .c("cmp.gt r13, #0")
-        .c("(f) movb r15, #1")
-        .c("cmp.gt r14, #0")
-        .c("(f) xor r15, r15, #1")
-        .note("straddles the row")
-        .c("mov r14, fb0")
-        .c("mul out, r12, r14")
-        .c("msu r13, fb0, r13")
-        .c("cmp.ne r15, #0")
-        .c("(f) cmp.gt r13, #0")
-        .c("(f) xor r8, r8, #1")
-        .note("crosses to the right: flip");
-    k
-}
-
 /// A sub-edge's record words: `ya`, `yb` one LSB lower, so that `ya - py
 /// > 0` is the sign bit of `(ya - 1) - py` clear, and the straddle test
-/// one `xor` of two sign bits ([`band_edge`]).
-fn sub_edge_words(e: &[i64; 6]) -> [i64; 6] {
-    [e[0], e[1] - 1, e[2] - 1, e[3], e[4], e[5]]
-}
-
-fn band_edge() -> K {
-    let mut k = K::new();
-    k.doc(
-        "k_polygon_band_edge: one sub-edge of a banded record's crossing test (stream: xi, ya - 1,\n\
-         yb - 1, yi, s ey, s ex). In: r10, r11 = -px, -py, r8 parity. Out: r8 flipped where the\n\
-         point's row lies in [ya, yb) and the edge's line crosses it to the right: s ((xi - px) ey -\n\
-         ex (yi - py)) > 0. (ya - 1) - py >= 0 where ya - py > 0 (saturating adds keep the sign), so\n\
-         the row is straddled where the sign bits of (ya - 1) - py and (yb - 1) - py differ.",
-    );
-    k.c("adds r12, fb0, r10")
-        .note("xi - px")
-        .c("adds r13, fb0, r11")
-        .note("ya - 1 - py")
-        .c("adds r14, fb0, r11")
-        .note("yb - 1 - py")
-        .c("xor r15, r13, r14")
-        .note("negative: straddles the row within the band")
-        .c("adds r13, fb0, r11")
-        .note("yi - py")
-        .c("mov r14, fb0")
-        .c("mul out, r12, r14")
-        .c("msu r13, fb0, r13")
-        .c("cmp.lt r15, #0")
-        .c("(f) cmp.gt r13, #0")
-        .c("(f) xor r8, r8, #1")
-        .note("crosses to the right: flip");
-    k
-}
-
-/// A band probe (stream: a band bound Y): F where the plane hit is valid
-/// and the point's row is below Y (`above`: at or above it).
-fn probe(above: bool) -> K {
-    let mut k = K::new();
-    let (name, what) = if above {
-        (ABOVE, "py >= Y")
+/// one `xor` of two sign bits ([`band_edge`]); `fine`, the rows first.
+fn sub_edge_words(e: &[i64; 6], fine: bool) -> [i64; 6] {
+    if fine {
+        [e[1] - 1, e[2] - 1, e[0], e[3], e[4], e[5]]
     } else {
-        (BELOW, "py < Y")
-    };
-    k.doc(&format!(
-        "{name}: a band probe (stream: a band bound Y). In: TMP0 = valid, r11 = -py.\n\
-         Out: F where valid and {what} (F is free between the head and the tail)."
-    ));
-    k.c(format!("ld r12, [r0 + #{}]", ram::TMP0))
-        .c("cmp.ne r12, #0")
-        .c("adds r13, fb0, r11")
-        .note("Y - py")
-        .c(if above {
-            "(f) cmp.le r13, #0"
-        } else {
-            "(f) cmp.gt r13, #0"
-        });
-    k
-}
-
-fn tail(sides: Sides, fine: bool) -> K {
-    let mut k = K::new();
-    k.doc(&format!(
-        "{}: commit where valid and the parity is odd (stream: n.xyz, obj, mat).\n\
-         Out where F: r7 = t, HIT_N, HIT_OBJ, HIT_MAT{}.",
-        tail_name(sides),
-        if sides == Sides::Both {
-            ", HIT_BACK_OBJ"
-        } else {
-            ""
-        }
-    ));
-    k.c(format!("ld r13, [r0 + #{}]", ram::TMP0))
-        .c("cmp.ne r13, #0")
-        .c("(f) cmp.ne r8, #0");
-    match sides {
-        _ if fine => planar::fine_commit(&mut k),
-        Sides::Front => commit_streamed_normal(&mut k, 9),
-        Sides::Both => commit_streamed_normal_two(&mut k, 9),
+        [e[0], e[1] - 1, e[2] - 1, e[3], e[4], e[5]]
     }
-    k
 }
 
 /// The polygon ([`super::ChipPrimitive`]): 4 or more coplanar vertices,
@@ -662,6 +593,24 @@ impl super::ChipPrimitive for Polygon {
         header_as(fit.polygon_form, fit.local)
     }
 
+    fn fit_header(&self, fit: &Fit) -> Vec<String> {
+        if !fit.local {
+            return Vec::new();
+        }
+        vec![
+            super::define(
+                "POLY_K",
+                fit.poly_k,
+                "polygons: the crossing test in 2^-POLY_K LSB (local positions)",
+            ),
+            super::define(
+                "POLY_KSH",
+                14 - fit.poly_k,
+                "polygons: 14 - POLY_K, the bits of the point's part below that unit",
+            ),
+        ]
+    }
+
     /// The head whole, the tail, an edge per edge (plain records).
     fn test_cost(&self, g: &Gen, fit: &Fit) -> TestCost {
         let k: Vec<usize> = kernels_as(g, Sides::Front, Form::Plain, fit.local)
@@ -700,7 +649,8 @@ impl super::ChipPrimitive for Polygon {
         let Some(p) = o.shape.as_polygon() else {
             return Err(RecordError::mismatch("polygon"));
         };
-        let f = (o.size, o.fit.polygon_form, o.fit.local);
+        let scale = o.fit.local.then_some(o.fit.poly_k);
+        let f = (o.size, o.fit.polygon_form, scale);
         write_as(w, &p.v, f, o.id, o.mat).map_err(RecordError::Scene)
     }
 }
