@@ -109,6 +109,13 @@ pub enum DatapathChoice {
 pub(crate) const AUTO_MIN_PSNR: f64 = 30.0;
 pub(crate) const AUTO_MIN_HITS: f64 = 0.99;
 
+/// The bar of `--positions auto` on the 16-bit chip: where its probe with
+/// global positions falls under this PSNR or hit agreement and local
+/// positions do better, it takes local ones (they cost cycles, so a
+/// scene global positions render this well keeps them).
+pub(crate) const POSITIONS_MIN_PSNR: f64 = 40.0;
+pub(crate) const POSITIONS_MIN_HITS: f64 = 0.999;
+
 pub(crate) fn parse_datapath_choice(s: &str) -> Result<DatapathChoice, String> {
     if s.trim() == "auto" {
         return Ok(DatapathChoice::Auto);

@@ -723,15 +723,17 @@ type Probed = (firmware::tracer::Firmware, f64, f64);
 
 /// The 16-bit chip's probe with positions `p` (`measured` of the options
 /// `on` gives), and with `auto` local ones instead where `p`'s fail or
-/// fall under the bar and local ones pass it or do better in both.
+/// fall under the positions' bar ([`crate::cli::POSITIONS_MIN_PSNR`],
+/// [`crate::cli::POSITIONS_MIN_HITS`]) and local ones pass it or do better
+/// in both.
 fn measure_16(
     measured: &dyn Fn(&Options) -> Result<Probed>,
     on: &dyn Fn(rtl::rc::Datapath, Positions) -> Options,
     p: Positions,
     auto: bool,
 ) -> Result<(Probed, Positions)> {
-    use crate::cli::{AUTO_MIN_HITS, AUTO_MIN_PSNR};
-    let passes = |p: f64, h: f64| p >= AUTO_MIN_PSNR && h >= AUTO_MIN_HITS;
+    use crate::cli::{POSITIONS_MIN_HITS, POSITIONS_MIN_PSNR};
+    let passes = |p: f64, h: f64| p >= POSITIONS_MIN_PSNR && h >= POSITIONS_MIN_HITS;
     let w16 = rtl::rc::Datapath::W16;
     let m16 = measured(&on(w16, p)).map(|m| (m, p));
     if !auto || matches!(&m16, Ok(((_, p, h), _)) if passes(*p, *h)) {
@@ -756,8 +758,8 @@ fn measure_16(
 /// agreement against the f64 reference on the same pixels) while the
 /// 32-bit chip's does better. Positions `auto` on the 16-bit chip: global,
 /// unless the scene's format cannot hold the scene or the probe with them
-/// falls under the bar, and local positions hold it or do better
-/// ([`Positions`]); on the 32-bit chip, global.
+/// falls under the positions' bar (40 dB, 99.9%), and local positions hold
+/// it or do better ([`Positions`]); on the 32-bit chip, global.
 fn choose_datapath(
     scene: &firmware::scene::Scene,
     opt: &Options,
@@ -800,7 +802,7 @@ fn choose_datapath(
     let m16 = measure_16(&measured, &on, fixed(opt.positions), auto_positions);
     let local_note = |p: Positions| {
         if p == Positions::Local && auto_positions {
-            ", local positions: global ones cannot hold the scene or fall under the bar"
+            ", local positions: global ones cannot hold the scene or fall under 40 dB or 99.9% hit agreement"
         } else {
             ""
         }
