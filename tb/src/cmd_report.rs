@@ -386,8 +386,13 @@ pub fn command(a: ReportArgs) -> Result<()> {
         .iter()
         .filter(|s| a.only.is_empty() || a.only.iter().any(|o| o == s.id))
         .collect();
-    // Check the documents before hours of work, not after. An existing
+    // Check the documents before hours of work, not after: two paths of
+    // one file would have the second write replace the first. An existing
     // document keeps what lies outside its sections.
+    crate::output::Files::new()
+        .output(&a.out, "--out")
+        .output(&a.readme, "--readme")
+        .check()?;
     let old = if a.out.exists() || !a.only.is_empty() {
         let text = read_text(&a.out)?;
         if !a.only.is_empty() {

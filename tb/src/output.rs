@@ -320,6 +320,9 @@ pub struct Files {
     /// files): neither an input nor another output, but made by the
     /// writer itself (folders included), so not checked for writability.
     beside: Vec<(PathBuf, String)>,
+    /// Waveform outputs: their GTKWave save file names them by their
+    /// absolute path, one line each.
+    waveforms: Vec<(PathBuf, String)>,
 }
 
 impl Files {
@@ -345,6 +348,7 @@ impl Files {
     pub fn waveform(&mut self, path: &Path, what: &str) -> &mut Files {
         self.output(path, what);
         if !is_stream(path) && path != Path::new("-") {
+            self.waveforms.push((path.to_path_buf(), what.into()));
             for (p, kind) in rtl::chip::waveform_side_files(path) {
                 self.beside.push((p, format!("{what}'s {kind}")));
             }
@@ -357,6 +361,30 @@ impl Files {
     /// standard output are not). Marks standard output as taken when an
     /// output is `-`.
     pub fn check(&self) -> Result<()> {
+        for (p, what) in &self.waveforms {
+            let abs = std::path::absolute(p).unwrap_or_else(|_| p.clone());
+            if let Some(c) = abs.to_string_lossy().chars().find(|c| c.is_control()) {
+                let shown: String = p
+                    .to_string_lossy()
+                    .chars()
+                    .map(|c| match c.is_control() {
+                        true => format!("U+{:04X}", c as u32),
+                        false => c.to_string(),
+                    })
+                    .collect();
+                anyhow::bail!(
+                    "{what} {shown}: its path {}holds the control character U+{:04X}, which the \
+                     GTKWave save file written beside it (one line per path) cannot name: give \
+                     a path without it",
+                    if p.to_string_lossy().contains(c) {
+                        ""
+                    } else {
+                        "(a folder above it) "
+                    },
+                    c as u32
+                );
+            }
+        }
         for (i, (p, what)) in self.outputs.iter().enumerate() {
             check_writable(p, what)?;
             let me = id(p);

@@ -439,3 +439,190 @@ fn a_tree_too_large_for_node_indices_is_refused_before_memory_runs_out() {
     );
     assert!(!d.path().join("x.png").exists());
 }
+
+/// A scene's file name is written into the generated program's header
+/// comment: its line breaks are written out, not lines of the program
+/// (a name holding `\n.entry 0\nhalt` ran that program instead).
+#[test]
+fn a_scene_name_cannot_add_lines_to_the_program() {
+    let d = tempfile::tempdir().unwrap();
+    let tetra = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff");
+    let evil = "t\n.entry 0\nhalt ;.nff";
+    std::fs::copy(&tetra, d.path().join(evil)).unwrap();
+    std::fs::copy(&tetra, d.path().join("plain.nff")).unwrap();
+    let run = |scene: &str, asm: &str| {
+        let args = [
+            "render",
+            scene,
+            "--size",
+            "16x16",
+            "--datapath",
+            "16",
+            "--out",
+            "o.png",
+            "--emit-asm",
+            asm,
+        ];
+        let (ok, out, err) = morphosys(d.path(), &args);
+        assert!(ok, "{err}");
+        let cycles = out
+            .lines()
+            .find(|l| l.starts_with("cycles"))
+            .unwrap()
+            .to_string();
+        (cycles, std::fs::read_to_string(d.path().join(asm)).unwrap())
+    };
+    let (evil_cycles, evil_asm) = run(evil, "evil.s");
+    let (plain_cycles, plain_asm) = run("plain.nff", "plain.s");
+    assert_eq!(evil_cycles, plain_cycles);
+    assert!(
+        evil_asm
+            .lines()
+            .next()
+            .unwrap()
+            .ends_with("tU+000A.entry 0U+000Ahalt ;.nff"),
+        "{}",
+        evil_asm.lines().next().unwrap()
+    );
+    assert!(!evil_asm
+        .lines()
+        .any(|l| l == ".entry 0" || l.starts_with("halt ;")));
+    assert_eq!(evil_asm.lines().count(), plain_asm.lines().count());
+}
+
+/// `report --readme` naming the document `--out` writes is refused before
+/// any render (the second write, built from the old text, replaced the
+/// first).
+#[test]
+fn report_refuses_the_readme_and_the_document_as_one_file() {
+    let d = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    std::fs::create_dir_all(d.path().join("scenes")).unwrap();
+    std::fs::copy(
+        root.join("scenes/default.toml"),
+        d.path().join("scenes/default.toml"),
+    )
+    .unwrap();
+    let doc = "# r\n<!-- report: headline -->\nold\n<!-- /report: headline -->\n";
+    std::fs::write(d.path().join("r.md"), doc).unwrap();
+    fails_with(
+        d.path(),
+        &[
+            "report", "--only", "headline", "--out", "r.md", "--readme", "./r.md",
+        ],
+        &["--readme", "r.md", "same file"],
+    );
+    assert_eq!(std::fs::read_to_string(d.path().join("r.md")).unwrap(), doc);
+}
+
+/// A line break in a waveform's path (or a folder above it) would add
+/// lines to the GTKWave save file written beside it, where `^>1 sh x` runs
+/// a program: refused before the run, for `run`, `render` and `tb rc`,
+/// and nothing is written.
+#[test]
+fn a_waveform_path_cannot_add_lines_to_the_save_file() {
+    let d = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    std::fs::copy(
+        root.join("firmware/conformance/dct.s"),
+        d.path().join("dct.s"),
+    )
+    .unwrap();
+    let evil = "w\n^>1 sh payload.sh\n[*]x.vcd";
+    let runs: [&[&str]; 3] = [
+        &["run", "dct.s", "--vcd", evil, "--trace-cycles", "200"],
+        &[
+            "render",
+            "../scenes/spd/tetra-1.nff",
+            "--size",
+            "8x8",
+            "--out",
+            "o.png",
+            "--vcd",
+            evil,
+        ],
+        &["tb", "rc", "--vcd", evil],
+    ];
+    for args in runs {
+        let args: Vec<String> = args
+            .iter()
+            .map(|a| a.replace("../scenes", &root.join("scenes").display().to_string()))
+            .collect();
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        fails_with(d.path(), &args, &["--vcd", "U+000A", "save file"]);
+    }
+    // A folder above it: the save file holds the absolute path.
+    let above = d.path().join("a\nb");
+    std::fs::create_dir(&above).unwrap();
+    std::fs::copy(root.join("firmware/conformance/dct.s"), above.join("dct.s")).unwrap();
+    fails_with(
+        &above,
+        &["run", "dct.s", "--vcd", "w.vcd", "--trace-cycles", "200"],
+        &["--vcd w.vcd", "a folder above it", "U+000A"],
+    );
+    assert!(!above.join("w.vcd").exists());
+    let left: Vec<_> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.contains(".vcd") || n.contains(".gtkw"))
+        .collect();
+    assert!(left.is_empty(), "{left:?}");
+}
+
+/// `tb cosim` hands its build folder to Verilator, which runs `make -C
+/// <folder>` through the shell: a folder whose path holds `$(...)` (as
+/// `--build-dir`, or a folder above it) is refused before Verilator runs,
+/// and nothing is run.
+#[test]
+fn the_cosim_build_folder_cannot_run_shell_code() {
+    let d = tempfile::tempdir().unwrap();
+    let args = |dir: &str| {
+        [
+            "-q",
+            "tb",
+            "cosim",
+            "--datapath",
+            "16",
+            "--random",
+            "10",
+            "--array",
+            "0",
+            "--build-dir",
+            dir,
+        ]
+        .map(String::from)
+    };
+    let a = args("vb$(touch${IFS}PWN_VB)");
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    fails_with(d.path(), &a, &["--build-dir", "holds `$`", "make"]);
+    let above = d.path().join("p$(touch${IFS}PWN_ABOVE)");
+    std::fs::create_dir(&above).unwrap();
+    let a = args("vb");
+    let a: Vec<&str> = a.iter().map(String::as_str).collect();
+    fails_with(&above, &a, &["--build-dir", "holds `$`"]);
+    assert!(!d.path().join("PWN_VB").exists() && !above.join("PWN_ABOVE").exists());
+    assert!(!d.path().join("vb$(touch${IFS}PWN_VB)").exists() && !above.join("vb").exists());
+}
+
+/// `tb cosim --random/--array` counts are range-checked before anything is
+/// allocated (2^64 - 1 panicked on the stream's capacity; 10^9 asked for
+/// 16 GB).
+#[test]
+fn cosim_counts_are_range_checked() {
+    let d = tempfile::tempdir().unwrap();
+    for (flag, n) in [
+        ("--random", "18446744073709551615"),
+        ("--random", "1000000000"),
+        ("--array", "200000000"),
+        ("--random", "many"),
+    ] {
+        let (ok, _, err) = morphosys(d.path(), &["tb", "cosim", flag, n]);
+        assert!(!ok, "{flag} {n}");
+        assert!(
+            err.contains(flag) && !err.contains("panicked"),
+            "{flag} {n}: {err}"
+        );
+    }
+    let (ok, _, err) = morphosys(d.path(), &["tb", "cosim", "--random", "30000000"]);
+    assert!(!ok && err.contains("at most 20000000"), "{err}");
+}

@@ -364,7 +364,7 @@ pub fn command(
         std::fs::create_dir_all(d).with_context(|| format!("--vcd {}", path.display()))?;
     }
     let mut files = crate::output::Files::new();
-    files.output(&path, "--vcd");
+    files.waveform(&path, "--vcd");
     if let Some(j) = &json {
         files.output(j, "--json");
     }

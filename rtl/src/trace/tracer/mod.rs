@@ -479,6 +479,18 @@ impl Tracer {
     /// per translate filter.
     pub(super) fn side_files(&self) -> io::Result<SideFiles> {
         let vcd_abs = std::path::absolute(&self.cfg.path)?;
+        // The save file names the waveform and its filters one per line:
+        // a line break in the path would add lines (GTKWave runs a
+        // process filter a `^>` line names).
+        if let Some(c) = vcd_abs.to_string_lossy().chars().find(|c| c.is_control()) {
+            return Err(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                format!(
+                    "the waveform's path holds the control character U+{:04X}, which its GTKWave save file cannot name",
+                    c as u32
+                ),
+            ));
+        }
         let gtkw = save_file_path(&vcd_abs);
         let mut filters: Vec<(&'static str, PathBuf)> = Vec::new();
         let mut decoders: Vec<(LabelKind, u32, PathBuf)> = Vec::new();

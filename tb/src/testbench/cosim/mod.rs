@@ -99,6 +99,8 @@ pub fn build(top: Top, dp: Datapath, src: &Path, dir: &Path) -> anyhow::Result<P
             src.display()
         )
     })?;
+    make_safe(&std::path::absolute(dir)?, "the build folder (--build-dir)")?;
+    make_safe(&src, "the Verilog sources' folder (MORPHOSYS_VERILOG)")?;
     let obj = dir.join(format!("{}_w{}", top.module(), dp.bits()));
     std::fs::create_dir_all(&obj).with_context(|| format!("cannot make {}", obj.display()))?;
     let obj = obj.canonicalize()?;
@@ -146,6 +148,33 @@ pub fn build(top: Top, dp: Datapath, src: &Path, dir: &Path) -> anyhow::Result<P
         );
     }
     Ok(obj.join("obj").join(program))
+}
+
+/// Refuse a path Verilator would hand to make and make to the shell
+/// (`make -C <Mdir>`, the sources in its makefile) unless it holds only
+/// letters, digits and `/._-+,=@%:~`: a `$(...)`, a quote or a space
+/// there would run or break a command.
+fn make_safe(p: &Path, what: &str) -> anyhow::Result<()> {
+    let text = p.to_string_lossy();
+    let ok = |c: char| c.is_ascii_alphanumeric() || "/._-+,=@%:~".contains(c);
+    if let Some(c) = text.chars().find(|&c| !ok(c)) {
+        let shown: String = text
+            .chars()
+            .map(|c| match c.is_control() {
+                true => format!("U+{:04X}", c as u32),
+                false => c.to_string(),
+            })
+            .collect();
+        let c = match c.is_control() || c == ' ' {
+            true => format!("U+{:04X}", c as u32),
+            false => format!("`{c}`"),
+        };
+        bail!(
+            "{what} {shown} holds {c}: Verilator hands the path to make and make to the shell, \
+             so it may hold only letters, digits and /._-+,=@%:~ (give another folder)"
+        );
+    }
+    Ok(())
 }
 
 /// What a co-simulation compared.
@@ -434,16 +463,21 @@ pub struct CosimArgs {
     /// The RC's datapath width: 16, 32, or both (the default).
     #[arg(long, value_name = "16|32|both", default_value = "both", value_parser = parse_widths)]
     pub datapath: Widths,
-    /// Random context cycles after the RC testbench's stream, per width.
-    #[arg(long, value_name = "N", default_value_t = 1_000_000)]
+    /// Random context cycles after the RC testbench's stream, per width
+    /// (up to 20,000,000: the stream is made whole before it runs, about
+    /// 32 bytes a cycle).
+    #[arg(long, value_name = "N", default_value_t = 1_000_000,
+          value_parser = |s: &str| parse_count(s, MAX_RANDOM))]
     pub random: usize,
     /// Seed of the random stream.
     #[arg(long, value_name = "SEED", default_value_t = SEED, value_parser = parse_seed)]
     pub seed: u64,
     /// Random cycles of the 8x8 array (the Verilog array with its
     /// interconnect against the Rust array, all three broadcast modes),
-    /// per width; 0 leaves the array out.
-    #[arg(long, value_name = "N", default_value_t = 100_000)]
+    /// per width; 0 leaves the array out (up to 5,000,000: about 110 bytes
+    /// a cycle).
+    #[arg(long, value_name = "N", default_value_t = 100_000,
+          value_parser = |s: &str| parse_count(s, MAX_ARRAY))]
     pub array: usize,
     /// Also measure the Verilated array's speed against the Rust array's
     /// on the same stream (array cycles per second, one thread each).
@@ -465,6 +499,26 @@ fn parse_widths(s: &str) -> Result<Widths, String> {
             .map(|d| Widths(vec![d]))
             .map_err(|e| e.replace("a datapath width:", "a datapath width: both,")),
     }
+}
+
+/// The most random RC and array cycles `tb cosim` takes (their streams
+/// are made whole before they run).
+pub const MAX_RANDOM: usize = 20_000_000;
+pub const MAX_ARRAY: usize = 5_000_000;
+
+/// A cycle count from 0 to `max`.
+fn parse_count(s: &str, max: usize) -> Result<usize, String> {
+    let n: u128 = s
+        .trim()
+        .replace('_', "")
+        .parse()
+        .map_err(|_| format!("`{s}` is not a count of cycles (0 to {max})"))?;
+    if n > max as u128 {
+        return Err(format!(
+            "{n} cycles: at most {max} (the stream is made whole before it runs; split a longer run over seeds with --seed)"
+        ));
+    }
+    Ok(n as usize)
 }
 
 fn parse_seed(s: &str) -> Result<u64, String> {
