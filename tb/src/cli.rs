@@ -212,6 +212,13 @@ pub(crate) fn check_size(w: u64, h: u64) -> Result<(u32, u32), String> {
         return Err(format!("{w}x{h}: each side must be 1..={MAX_SIDE}"));
     }
     let px = w as f64 * h as f64;
+    let long = if w > MAX_SIDE { "width" } else { "height" };
+    if px <= (MAX_SIDE * MAX_SIDE) as f64 {
+        // Few pixels, one side too long: the cost is not what refuses it.
+        return Err(format!(
+            "{w}x{h}: the {long} is over {MAX_SIDE}; each side must be 1..={MAX_SIDE}"
+        ));
+    }
     let mb = px * 40.0 / 1e6;
     let secs = px * 140.0 / 15e6;
     let mem = if mb >= 1000.0 {

@@ -134,8 +134,10 @@ const SECTIONS: &[Section] = &[
         title: "The 16-bit and the 32-bit chip",
         about: "The same firmware on the paper's 16-bit datapath and on the 32-bit one the \
                 paper announces for the next chip (`docs/isa.md`, section 1a): 16 more \
-                fraction bits, the same context word, TinyRISC and timing, in the same \
-                cycles. What the 16 more bits cost in silicon comes from the RC in Verilog \
+                fraction bits, the same context word, TinyRISC and timing: the same \
+                program, whose cycles differ where the rays it traces do (a hit, a \
+                shadow or a reflection the finer format decides otherwise). What the 16 \
+                more bits cost in silicon comes from the RC in Verilog \
                 synthesized by Yosys (`morphosys cost`, `docs/silicon.md`): the 32-bit RC's \
                 longest path sets an estimated clock (300 MHz for the 16-bit RC, scaled by \
                 path depth), and its array of 64 RCs with their RAM has more transistors; \
@@ -368,6 +370,10 @@ pub fn command(a: ReportArgs) -> Result<()> {
                     ""
                 }
             );
+            // What it renders, as its section's paragraph says.
+            for l in wrap(s.about, 69).lines() {
+                println!("{:11}{l}", "");
+            }
         }
         return Ok(());
     }

@@ -236,6 +236,12 @@ fn command_on<W: Word>(a: &RunArgs, datapath: Datapath, timing: Timing) -> anyho
         }
         Err(e) => return Err(anyhow!("{e}")),
     };
+    if a.vcd.is_some() && a.window.trace_from >= cycles {
+        eprintln!(
+            "morphosys: warning: --trace-from {} is past the program's halt at cycle {cycles}: the waveform holds no cycles",
+            a.window.trace_from
+        );
+    }
     crate::report!(
         "halted after {cycles} cycles ({:.3} us at {} MHz), {}-bit datapath",
         cycles as f64 * 1e6 / timing.clock_hz as f64,

@@ -12,8 +12,8 @@ use clap::{CommandFactory, Parser, Subcommand};
     name = "morphosys",
     version,
     about = "Cycle-level model of the MorphoSys reconfigurable SIMD processor and its BSP ray tracer",
-    after_help = "Environment: RAYON_NUM_THREADS=N sets the host threads (default: every core; \
-the outputs are the same on any number); MORPHOSYS_SIMD=portable|avx2|avx512 forces the \
+    after_help = "Environment: RAYON_NUM_THREADS=N sets the host threads (default: every core, \
+at most 8 per core; the outputs are the same on any number); MORPHOSYS_SIMD=portable|avx2|avx512 forces the \
 instruction set of the simulator's per-cycle path (default: the widest the CPU has; the \
 same bits on every path).",
     propagate_version = true
@@ -164,6 +164,15 @@ fn main() -> ExitCode {
         eprintln!("morphosys: error: {}", printable(&e));
         return ExitCode::from(2);
     }
+    // The host threads, checked alike.
+    match host_threads() {
+        Ok(Some(note)) if !cli.quiet => eprintln!("morphosys: {}", printable(&note)),
+        Ok(_) => {}
+        Err(e) => {
+            eprintln!("morphosys: error: {}", printable(&e));
+            return ExitCode::from(2);
+        }
+    }
     match run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         // A reader that went away (`morphosys spd balls | head`) ends the
@@ -192,6 +201,40 @@ fn main() -> ExitCode {
         },
     }
 }
+
+/// `RAYON_NUM_THREADS`, checked as `MORPHOSYS_SIMD` is: a count of host
+/// threads (0: every core), at most [`THREADS_PER_CORE`] per core (more
+/// only slow the work: 1,000 threads ran a small render 60 times slower
+/// than 2, with the same results). The global pool is started with it;
+/// `Some` says where the count was capped.
+fn host_threads() -> Result<Option<String>, String> {
+    let Some(v) = std::env::var_os("RAYON_NUM_THREADS") else {
+        return Ok(None);
+    };
+    let s = v.to_string_lossy();
+    let n: usize = s.trim().parse().map_err(|_| {
+        format!("RAYON_NUM_THREADS={s}: not a number of host threads (0 or unset: every core)")
+    })?;
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    let cap = THREADS_PER_CORE * cores;
+    let (threads, note) = match n > cap {
+        true => (
+            cap,
+            Some(format!(
+                "RAYON_NUM_THREADS={n}: {cap} host threads ({THREADS_PER_CORE} per core of {cores}; more only slow the work)"
+            )),
+        ),
+        false => (n, None),
+    };
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build_global()
+        .map_err(|e| format!("cannot start {threads} host threads: {e}"))?;
+    Ok(note)
+}
+
+/// The most host threads per core `RAYON_NUM_THREADS` gets.
+const THREADS_PER_CORE: usize = 8;
 
 /// An error's text as the terminal should get it: a control character
 /// from the input (an escape sequence, a NUL in a scene's token or a file

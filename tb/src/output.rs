@@ -429,6 +429,25 @@ impl Files {
                     );
                 }
             }
+            // The writer makes the folders it lacks: one that is a file
+            // (or the side file a folder) fails it only after the work.
+            let mut at = p.parent();
+            while let Some(dir) = at.filter(|d| !d.as_os_str().is_empty()) {
+                if dir.exists() && !dir.is_dir() {
+                    anyhow::bail!(
+                        "{what} would be {}, but {} is not a folder: move it or give the waveform another folder",
+                        p.display(),
+                        dir.display()
+                    );
+                }
+                at = dir.parent();
+            }
+            if p.is_dir() {
+                anyhow::bail!(
+                    "{what} would be {}, which is a folder: move it or give the waveform another folder",
+                    p.display()
+                );
+            }
         }
         Ok(())
     }

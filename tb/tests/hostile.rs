@@ -626,3 +626,161 @@ fn cosim_counts_are_range_checked() {
     let (ok, _, err) = morphosys(d.path(), &["tb", "cosim", "--random", "30000000"]);
     assert!(!ok && err.contains("at most 20000000"), "{err}");
 }
+
+/// `RAYON_NUM_THREADS` is checked as `MORPHOSYS_SIMD` is: nonsense is
+/// refused, and a count far over the cores is capped and said (1,000
+/// threads ran 60 times slower than 2, with the same image).
+#[test]
+fn host_thread_counts_are_checked_and_capped() {
+    let d = tempfile::tempdir().unwrap();
+    let run = |threads: &str| {
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_morphosys"))
+            .current_dir(d.path())
+            .env("RAYON_NUM_THREADS", threads)
+            .args(["spd", "tetra", "--out", "t.nff"])
+            .output()
+            .unwrap();
+        (
+            out.status.code(),
+            String::from_utf8_lossy(&out.stderr).into_owned(),
+        )
+    };
+    for bad in ["abc", "-1", "2.5", ""] {
+        let (code, err) = run(bad);
+        assert_eq!(code, Some(2), "{bad:?}: {err}");
+        assert!(
+            err.contains("RAYON_NUM_THREADS") && err.contains("not a number"),
+            "{err}"
+        );
+    }
+    let (code, err) = run("100000");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(
+        err.contains("RAYON_NUM_THREADS=100000") && err.contains("per core"),
+        "{err}"
+    );
+    let (code, err) = run("2");
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("RAYON_NUM_THREADS"), "{err}");
+}
+
+/// An image with one side over the limit and few pixels is refused for
+/// that side, not for a cost of "about 0 MB ... about 0 seconds".
+#[test]
+fn a_long_thin_size_is_refused_for_its_side() {
+    let d = tempfile::tempdir().unwrap();
+    fails_with(
+        d.path(),
+        &["render", "--size", "1x10000"],
+        &["--size", "1x10000", "the height is over 4096"],
+    );
+    let (ok, _, err) = morphosys(d.path(), &["render", "--size", "10000x10000"]);
+    assert!(!ok && err.contains("GB of memory"), "{err}");
+}
+
+/// A trace window that starts after the program halts says its waveform
+/// is empty (it was written without a word).
+#[test]
+fn a_trace_window_past_the_halt_is_said() {
+    let d = tempfile::tempdir().unwrap();
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    std::fs::copy(
+        root.join("firmware/conformance/dct.s"),
+        d.path().join("dct.s"),
+    )
+    .unwrap();
+    let (ok, _, err) = morphosys(
+        d.path(),
+        &[
+            "-q",
+            "run",
+            "dct.s",
+            "--vcd",
+            "z.vcd",
+            "--trace-from",
+            "99999999",
+        ],
+    );
+    assert!(ok, "{err}");
+    assert!(
+        err.contains("warning: --trace-from 99999999 is past the program's halt"),
+        "{err}"
+    );
+    let (ok, _, err) = morphosys(d.path(), &["-q", "run", "dct.s", "--vcd", "y.vcd"]);
+    assert!(ok && !err.contains("warning"), "{err}");
+}
+
+/// `report --list` says what each section renders (it printed titles
+/// only).
+#[test]
+fn report_list_says_what_each_section_renders() {
+    let d = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(d.path(), &["report", "--list"]);
+    assert!(ok, "{err}");
+    let lines: Vec<&str> = out.lines().collect();
+    let heads: Vec<usize> = (0..lines.len())
+        .filter(|&i| !lines[i].starts_with(' '))
+        .collect();
+    assert!(heads.len() >= 10, "{out}");
+    for (k, &i) in heads.iter().enumerate() {
+        let end = heads.get(k + 1).copied().unwrap_or(lines.len());
+        let about = lines[i + 1..end].join(" ");
+        assert!(
+            about.split_whitespace().count() >= 8,
+            "{}: {about:?}",
+            lines[i]
+        );
+    }
+    assert!(
+        out.contains("whitted") && out.contains("ray depth 2"),
+        "{out}"
+    );
+}
+
+/// A file where a waveform's side folder goes (`.surfer`) is found before
+/// the render, with the path named (the render failed at its end, "Not a
+/// directory", and wrote nothing).
+#[test]
+fn an_obstructed_side_folder_is_found_before_the_work() {
+    let d = tempfile::tempdir().unwrap();
+    let tetra = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff");
+    std::fs::write(d.path().join(".surfer"), "x").unwrap();
+    let t = tetra.display().to_string();
+    fails_with(
+        d.path(),
+        &[
+            "-q", "render", &t, "--size", "8x8", "--vcd", "w.vcd", "--out", "w.png",
+        ],
+        &[".surfer", "is not a folder"],
+    );
+    assert!(!d.path().join("w.png").exists() && !d.path().join("w.vcd").exists());
+}
+
+/// A program over TinyRISC's code space (SPD gears-1 at ray depth 8) is
+/// said as such, not as an internal error with a caret under an empty
+/// line.
+#[test]
+fn a_program_over_the_code_space_says_so() {
+    let d = tempfile::tempdir().unwrap();
+    let gears = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/gears-1.nff");
+    let g = gears.display().to_string();
+    let args = [
+        "render",
+        &g,
+        "--depth",
+        "8",
+        "--datapath",
+        "16",
+        "--size",
+        "8x8",
+        "--out",
+        "o.png",
+    ];
+    fails_with(
+        d.path(),
+        &args,
+        &["ray depth 8", "bytes of TinyRISC code", "lower --depth"],
+    );
+    let (_, _, err) = morphosys(d.path(), &args);
+    assert!(!err.contains("internal"), "{err}");
+}

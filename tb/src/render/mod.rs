@@ -313,11 +313,32 @@ fn place_tile(
     }
 }
 
+/// Assemble the tracer's generated program (for ray depth `depth`): a
+/// program over TinyRISC's code space is said as such (each level of
+/// recursion adds its code), any other failure is an internal error.
+pub(crate) fn assemble_generated(fw: &Firmware, depth: u32) -> Result<asm::Image> {
+    asm::assemble(&fw.source, "tracer.s").map_err(|e| {
+        let text = e.to_string();
+        let bytes = text
+            .split("sections overlap: ")
+            .nth(1)
+            .filter(|t| t.contains("(.text) run into"))
+            .and_then(|t| t.split(' ').next())
+            .and_then(|n| n.parse::<u64>().ok());
+        match bytes {
+            Some(n) => anyhow!(
+                "the program generated for ray depth {depth} is {n} bytes of TinyRISC code, over the \
+                 65,536 below its data: lower --depth (each level of recursion adds its shading code)"
+            ),
+            None => anyhow!("internal: the generated firmware does not assemble:\n{e}"),
+        }
+    })
+}
+
 fn render_firmware(fw: Firmware, opt: &Options, host: &RenderSettings) -> Result<ChipRender> {
     let t0 = std::time::Instant::now();
     let progress = host.progress;
-    let img = asm::assemble(&fw.source, "tracer.s")
-        .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
+    let img = assemble_generated(&fw, opt.depth)?;
     let (w, h) = (opt.width, opt.height);
     let (tw, th) = (fw.tile_w, fw.tile_h);
     let mut tiles = Vec::new();

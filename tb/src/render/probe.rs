@@ -1,8 +1,7 @@
 //! The probe: a render of 1/16 of the frame's tiles (every fourth tile row and column), by
 //! which the autotuners ([`crate::autotune`]) and `--datapath auto` compare firmwares.
 
-use anyhow::{anyhow, Result};
-use firmware::asm;
+use anyhow::Result;
 use firmware::tracer::{Firmware, Options};
 use rtl::rc::Datapath;
 use rtl::Timing;
@@ -104,8 +103,7 @@ fn probe_at(fw: &Firmware, opt: &Options, timing: &Timing, phase: u32) -> Result
             tiles.push((tx * tw, ty * th));
         }
     }
-    let img = asm::assemble(&fw.source, "tracer.s")
-        .map_err(|e| anyhow!("internal: the generated firmware does not assemble:\n{e}"))?;
+    let img = super::assemble_generated(fw, opt.depth)?;
     let items = work_items(tiles.len(), rayon::current_num_threads(), false);
     let frame = Frame {
         img: &img,
