@@ -214,6 +214,11 @@ fn default_out(scene: &Path) -> PathBuf {
 }
 
 pub fn command(a: RenderArgs) -> Result<()> {
+    for knob in a.paper_ignores() {
+        eprintln!(
+            "morphosys: warning: {knob}: a knob of the packet traversal, which --traversal paper ignores"
+        );
+    }
     let scene = load_scene(a.scene.as_deref())?;
     let (timing, clock_given) = crate::timing::load_or_default_file(a.timing.as_deref())?;
     let firmware_text = match &a.firmware {
@@ -364,6 +369,47 @@ impl RenderArgs {
         }
         files.check()?;
         Ok(out_path)
+    }
+
+    /// The packet traversal's knobs this command line sets otherwise than
+    /// their defaults while it asks for the paper's traversal, which
+    /// ignores them (as `--OPTION VALUE`).
+    fn paper_ignores(&self) -> Vec<String> {
+        if self.traversal != firmware::tracer::Traversal::Paper {
+            return Vec::new();
+        }
+        let d = Options::default();
+        [
+            (
+                "collapse",
+                self.collapse.to_string(),
+                d.collapse.to_string(),
+            ),
+            (
+                "leaf-pieces",
+                self.leaf_pieces.to_string(),
+                d.pieces.to_string(),
+            ),
+            (
+                "shadow-packets",
+                self.shadow_packets.to_string(),
+                d.shadows.to_string(),
+            ),
+            (
+                "test-cuts",
+                self.test_cuts.to_string(),
+                d.test_cuts.to_string(),
+            ),
+            (
+                "child-order",
+                self.child_order.to_string(),
+                d.child_order.to_string(),
+            ),
+        ]
+        .into_iter()
+        .filter(|(_, given, default)| given != default)
+        .map(|(name, given, _)| format!("--{name} {given}"))
+        .collect()
     }
 
     /// The tracer's options and the RC arithmetic's knobs this command
@@ -642,7 +688,7 @@ fn print_figures(opt: &Options, chip: &crate::render::ChipRender, j: &serde_json
             if chip.leaf_cache.is_some() {
                 let p = chip.firmware.pieces;
                 format!(
-                    "leaves moved by DMA in pieces into FB banks 1 and 0: {}{}",
+                    "leaves moved by DMA in pieces of whole records (at least one each) into FB banks 1 and 0: {}{}",
                     match p.second_or_rest() {
                         s if s < p.rest => format!(
                             "the first of up to {} words, the second {}, the others {}",

@@ -313,9 +313,11 @@ pub struct CostArgs {
     /// Also write the figures as JSON here (`-` for standard output).
     #[arg(long, value_name = "PATH")]
     pub json: Option<PathBuf>,
-    /// Synthesize the Verilog RC with Yosys now (about half a minute) and
-    /// write the results where `morphosys cost` reads them from
-    /// (rtl/verilog/synth/cost.json in the source tree), or to --out.
+    /// Synthesize the Verilog RC with Yosys now (several minutes: every
+    /// unit at both widths) and write the results to
+    /// rtl/verilog/synth/cost.json in the source tree, or to --out. The
+    /// figures `cost`, `sweep` and `report` use are those compiled into the
+    /// binary from that file: rebuild (`cargo build`) to use new ones.
     #[arg(long)]
     pub synthesize: bool,
     /// With --synthesize: write the results here instead.
@@ -359,6 +361,17 @@ pub fn to_json(s: &Synthesis) -> serde_json::Value {
 
 /// `morphosys cost`.
 pub fn command(a: CostArgs) -> anyhow::Result<()> {
+    // The outputs checked before the synthesis's minutes (a missing
+    // folder, two paths of one file); `--json -` takes standard output and
+    // the table goes to standard error.
+    let mut files = crate::output::Files::new();
+    if let Some(j) = &a.json {
+        files.output(j, "--json");
+    }
+    if let Some(o) = &a.out {
+        files.output(o, "--out");
+    }
+    files.check()?;
     let fresh;
     let s: &Synthesis = if a.synthesize {
         let dir = crate::testbench::cosim::verilog_dir();
@@ -371,7 +384,7 @@ pub fn command(a: CostArgs) -> anyhow::Result<()> {
         let path = a.out.clone().unwrap_or_else(committed_path);
         crate::output::write(&path, (serde_json::to_string_pretty(&s)? + "\n").as_bytes())?;
         crate::note!(
-            "wrote {} in {:.0} s",
+            "wrote {} in {:.0} s (the table below is its figures; the binary's own, used by sweep and report, change when it is rebuilt)",
             path.display(),
             t.elapsed().as_secs_f64()
         );
@@ -380,7 +393,7 @@ pub fn command(a: CostArgs) -> anyhow::Result<()> {
     } else {
         Synthesis::committed()
     };
-    print!("{}", table(s));
+    crate::report!("{}", table(s).trim_end());
     if let Some(j) = &a.json {
         crate::output::write(
             j,

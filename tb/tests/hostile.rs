@@ -784,3 +784,106 @@ fn a_program_over_the_code_space_says_so() {
     let (_, _, err) = morphosys(d.path(), &args);
     assert!(!err.contains("internal"), "{err}");
 }
+
+/// `cost --json -` gives standard output to the JSON alone (the table goes
+/// to standard error), and `--synthesize`'s outputs are checked before
+/// the synthesis: one file twice, a missing folder.
+#[test]
+fn cost_outputs_are_checked_and_kept_apart() {
+    let d = tempfile::tempdir().unwrap();
+    let (ok, out, err) = morphosys(d.path(), &["cost", "--json", "-"]);
+    assert!(ok, "{err}");
+    let v: serde_json::Value =
+        serde_json::from_str(&out).expect("standard output is the JSON alone");
+    assert!(v["widths"].is_array());
+    assert!(err.contains("What the RC costs in silicon"), "{err}");
+    fails_with(
+        d.path(),
+        &[
+            "cost",
+            "--synthesize",
+            "--out",
+            "x.json",
+            "--json",
+            "x.json",
+        ],
+        &["same file"],
+    );
+    fails_with(
+        d.path(),
+        &["cost", "--synthesize", "--out", "no/such/x.json"],
+        &["--out", "does not exist"],
+    );
+}
+
+/// `--leaf-pieces 1,1` says the pieces hold whole records (at least one
+/// each), not pieces "of up to 1 words".
+#[test]
+fn leaf_pieces_smaller_than_a_record_are_said_as_done() {
+    let d = tempfile::tempdir().unwrap();
+    let balls = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/balls-4.nff");
+    let b = balls.display().to_string();
+    let (ok, out, err) = morphosys(
+        d.path(),
+        &[
+            "-q",
+            "render",
+            &b,
+            "--size",
+            "8x8",
+            "--leaf-pieces",
+            "1,1",
+            "--out",
+            "o.png",
+        ],
+    );
+    assert!(ok, "{err}");
+    let line = out
+        .lines()
+        .find(|l| l.starts_with("scene streamed"))
+        .expect(&out);
+    assert!(
+        line.contains("pieces of whole records (at least one each)"),
+        "{line}"
+    );
+}
+
+/// The packet traversal's knobs given with `--traversal paper` are said to
+/// be ignored (they were ignored silently); their defaults are not.
+#[test]
+fn packet_knobs_under_the_paper_traversal_are_said() {
+    let d = tempfile::tempdir().unwrap();
+    let tetra = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/spd/tetra-1.nff");
+    let t = tetra.display().to_string();
+    let base = [
+        "-q",
+        "render",
+        &t,
+        "--size",
+        "8x8",
+        "--traversal",
+        "paper",
+        "--out",
+        "o.png",
+    ];
+    let with = |extra: &[&str]| {
+        let mut a: Vec<&str> = base.to_vec();
+        a.extend_from_slice(extra);
+        let (ok, _, err) = morphosys(d.path(), &a);
+        assert!(ok, "{err}");
+        err
+    };
+    let err = with(&[
+        "--child-order",
+        "majority",
+        "--leaf-pieces",
+        "64,256",
+        "--collapse",
+        "2",
+    ]);
+    for k in ["--child-order majority", "--leaf-pieces", "--collapse 2"] {
+        assert!(err.contains(&format!("warning: {k}")), "{k}: {err}");
+    }
+    assert!(!with(&["--child-order", "auto"]).contains("warning"));
+    assert!(!with(&[]).contains("warning"));
+}
