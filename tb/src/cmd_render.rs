@@ -559,7 +559,7 @@ fn print_report(
         opt.datapath.bits(),
         j["format"].as_str().unwrap_or("?"),
         if j["positions"] == "local" {
-            ", local positions (spheres, triangles, cylinders and cones in frames of their own; origins and eye-ray directions with remainders)"
+            ", local positions (spheres, triangles, cylinders, cones, and rectangles and discs where most are small, in frames of their own; polygons' crossing test on the hit point to 2^-14 LSB; origins and eye-ray directions with remainders)"
         } else {
             ""
         }
