@@ -364,14 +364,7 @@ impl Files {
         for (p, what) in &self.waveforms {
             let abs = std::path::absolute(p).unwrap_or_else(|_| p.clone());
             if let Some(c) = abs.to_string_lossy().chars().find(|c| c.is_control()) {
-                let shown: String = p
-                    .to_string_lossy()
-                    .chars()
-                    .map(|c| match c.is_control() {
-                        true => format!("U+{:04X}", c as u32),
-                        false => c.to_string(),
-                    })
-                    .collect();
+                let shown = escaped(&p.to_string_lossy());
                 anyhow::bail!(
                     "{what} {shown}: its path {}holds the control character U+{:04X}, which the \
                      GTKWave save file written beside it (one line per path) cannot name: give \
@@ -451,6 +444,17 @@ impl Files {
         }
         Ok(())
     }
+}
+
+/// `text` on one line: its control characters (line breaks included)
+/// written as `U+000A`.
+pub(crate) fn escaped(text: &str) -> String {
+    text.chars()
+        .map(|c| match c.is_control() {
+            true => format!("U+{:04X}", c as u32),
+            false => c.to_string(),
+        })
+        .collect()
 }
 
 /// Check before the work that `path` can be written: a regular file's

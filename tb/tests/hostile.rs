@@ -605,8 +605,8 @@ fn the_cosim_build_folder_cannot_run_shell_code() {
 }
 
 /// `tb cosim --random/--array` counts are range-checked before anything is
-/// allocated (2^64 - 1 panicked on the stream's capacity; 10^9 asked for
-/// 16 GB).
+/// allocated (issue 62 reported 2^64 - 1 panicking on the stream's
+/// capacity and 10^9 asking for 16 GB).
 #[test]
 fn cosim_counts_are_range_checked() {
     let d = tempfile::tempdir().unwrap();
@@ -628,8 +628,8 @@ fn cosim_counts_are_range_checked() {
 }
 
 /// `RAYON_NUM_THREADS` is checked as `MORPHOSYS_SIMD` is: nonsense is
-/// refused, and a count far over the cores is capped and said (1,000
-/// threads ran 60 times slower than 2, with the same image).
+/// refused, and a count far over the cores is capped and said (issue 62
+/// reported 1,000 threads 60 times slower than 2, with the same image).
 #[test]
 fn host_thread_counts_are_checked_and_capped() {
     let d = tempfile::tempdir().unwrap();

@@ -158,13 +158,7 @@ fn make_safe(p: &Path, what: &str) -> anyhow::Result<()> {
     let text = p.to_string_lossy();
     let ok = |c: char| c.is_ascii_alphanumeric() || "/._-+,=@%:~".contains(c);
     if let Some(c) = text.chars().find(|&c| !ok(c)) {
-        let shown: String = text
-            .chars()
-            .map(|c| match c.is_control() {
-                true => format!("U+{:04X}", c as u32),
-                false => c.to_string(),
-            })
-            .collect();
+        let shown = crate::output::escaped(&text);
         let c = match c.is_control() || c == ' ' {
             true => format!("U+{:04X}", c as u32),
             false => format!("`{c}`"),

@@ -163,18 +163,8 @@ pub(super) fn edge(fine: bool) -> K {
             .c("(f) cmp.gt r14, #0")
             .note("F: straddles the row")
             .c("adds r12, fb0, r10")
-            .note("xi - px")
-            .c("mov r14, fb0")
-            .c("mul out, r12, r14")
-            .c("mov r12, fb0")
-            .c("msu r13, r12, r13")
-            .note("A")
-            .c("ldacc r13, <<POLY_KSH")
-            .c("mac out, r9, r14")
-            .c("msu r13, r12, r15")
-            .c("(f) cmp.gt r13, #0")
-            .c("(f) xor r8, r8, #1")
-            .note("crosses to the right: flip");
+            .note("xi - px");
+        fine_crossing(&mut k);
         return k;
     }
     k.doc(
@@ -223,18 +213,8 @@ pub(super) fn band_edge(fine: bool) -> K {
             .c("adds r12, fb0, r10")
             .note("xi - px")
             .c("adds r13, fb0, r11")
-            .note("yi - py")
-            .c("mov r14, fb0")
-            .c("mul out, r12, r14")
-            .c("mov r12, fb0")
-            .c("msu r13, r12, r13")
-            .note("A")
-            .c("ldacc r13, <<POLY_KSH")
-            .c("mac out, r9, r14")
-            .c("msu r13, r12, r15")
-            .c("(f) cmp.gt r13, #0")
-            .c("(f) xor r8, r8, #1")
-            .note("crosses to the right: flip");
+            .note("yi - py");
+        fine_crossing(&mut k);
         return k;
     }
     k.doc(
@@ -328,4 +308,22 @@ pub(super) fn tail(sides: Sides, fine: bool) -> K {
         Sides::Both => commit_streamed_normal_two(&mut k, 9),
     }
     k
+}
+
+/// The fine edge kernels' crossing (after the straddle test in F, `xi -
+/// px` in r12 and `yi - py` in r13; stream: `s ey, s ex`): `2^POLY_KSH A +
+/// bx ey - ex by` exact in the accumulator, the parity flipped where it
+/// is positive.
+fn fine_crossing(k: &mut K) {
+    k.c("mov r14, fb0")
+        .c("mul out, r12, r14")
+        .c("mov r12, fb0")
+        .c("msu r13, r12, r13")
+        .note("A")
+        .c("ldacc r13, <<POLY_KSH")
+        .c("mac out, r9, r14")
+        .c("msu r13, r12, r15")
+        .c("(f) cmp.gt r13, #0")
+        .c("(f) xor r8, r8, #1")
+        .note("crosses to the right: flip");
 }
